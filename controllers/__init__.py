@@ -1,0 +1,1 @@
+"""Steering controllers for wmr-mj (steering state and reference in, armature voltage out)."""

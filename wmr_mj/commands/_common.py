@@ -1,0 +1,52 @@
+"""Argument helpers shared by the subcommands."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from typing import Any
+
+
+def positive_float(text: str) -> float:
+    """argparse type: a finite number > 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number; a finite number > 0 is accepted") from None
+    if not math.isfinite(value) or value <= 0:
+        raise argparse.ArgumentTypeError(f"{text!r} is not accepted; a finite number > 0 is required")
+    return value
+
+
+def positive_int(text: str) -> int:
+    """argparse type: an integer >= 1."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not an integer; an integer >= 1 is accepted") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text!r} is not accepted; an integer >= 1 is required")
+    return value
+
+
+def parse_assignments(items: list[str] | None) -> dict[str, float]:
+    """``NAME=VALUE`` pairs (``--param l3=0.15``) into a dict; bad syntax raises ParameterError."""
+    from ..errors import ParameterError
+
+    out: dict[str, float] = {}
+    for item in items or []:
+        name, sep, value = item.partition("=")
+        if not sep or not name:
+            raise ParameterError(f"--param {item!r} is not NAME=VALUE (e.g. --param mu=0.02)")
+        try:
+            out[name.strip()] = float(value)
+        except ValueError:
+            raise ParameterError(f"--param {item!r}: {value!r} is not a number") from None
+    return out
+
+
+def print_json(obj: Any) -> None:
+    json.dump(obj, sys.stdout, indent=2, sort_keys=True, allow_nan=False, default=float)
+    sys.stdout.write("\n")

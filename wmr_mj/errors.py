@@ -1,0 +1,62 @@
+"""Exception hierarchy of wmr-mj.
+
+Every error a user can cause by bad input derives from :class:`WmrMjError`; the
+CLI prints its message as one line and exits with status 2. Messages name the
+culprit and what is accepted.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+__all__ = [
+    "WmrMjError",
+    "ParameterError",
+    "UnknownNameError",
+    "ModelFileError",
+    "InfeasiblePathError",
+    "LogError",
+    "SchedulerError",
+]
+
+
+class WmrMjError(Exception):
+    """Base class of every user-facing wmr-mj error."""
+
+
+class ParameterError(WmrMjError, ValueError):
+    """A parameter value is out of its accepted range (non-positive, non-finite...)."""
+
+
+class UnknownNameError(WmrMjError, KeyError):
+    """A name (parameter, model source, controller, channel...) is not known.
+
+    The message lists the valid names.
+    """
+
+    def __init__(self, kind: str, name: str, valid: Iterable[str]):
+        self.kind = kind
+        self.name = name
+        self.valid = sorted(valid)
+        super().__init__(
+            f"unknown {kind} {name!r}; valid {kind}s: {', '.join(self.valid)}"
+        )
+
+    def __str__(self) -> str:  # KeyError would quote the message
+        return self.args[0]
+
+
+class ModelFileError(WmrMjError):
+    """A model file is missing or MuJoCo cannot compile it."""
+
+
+class InfeasiblePathError(WmrMjError, ValueError):
+    """A reference path violates the steering range, rate or acceleration limit."""
+
+
+class LogError(WmrMjError):
+    """An MCAP log is missing, not MCAP, corrupt, or of an unknown schema version."""
+
+
+class SchedulerError(WmrMjError):
+    """A Dask scheduler cannot be reached or used."""
