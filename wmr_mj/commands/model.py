@@ -1,0 +1,46 @@
+"""``wmr-mj model``: write or check models/c80.xml and models/scene.xml, or print a parameter table."""
+
+from __future__ import annotations
+
+import argparse
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("model", help="write/check the MJCF files generated from the C80 parameter set")
+    p.add_argument("action", choices=("write", "check", "params"),
+                   help="write: regenerate models/*.xml; check: exit 1 if they differ from the parameter set; "
+                        "params: print the parameter set with sources and the derived coefficients")
+    p.add_argument("--param", action="append", metavar="NAME=VALUE", help="override a parameter (repeatable)")
+    p.add_argument("--json", action="store_true", help="with 'params': print one JSON object")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..params import C80, PARAMETER_SOURCES, with_params
+    from ..plant import MODELS_DIR, robot_xml, scene_file_xml, write_model_files
+    from ._common import parse_assignments, print_json
+
+    params = with_params(C80, **parse_assignments(args.param))
+    if args.action == "write":
+        for path in write_model_files(params):
+            print(f"wrote {path}")
+        return 0
+    if args.action == "check":
+        stale = [name for name, text in (("c80.xml", robot_xml(params)), ("scene.xml", scene_file_xml(params)))
+                 if not (MODELS_DIR / name).is_file() or (MODELS_DIR / name).read_text() != text]
+        if stale:
+            print(f"out of date: {', '.join(stale)} (run: wmr-mj model write)")
+            return 1
+        print("models/c80.xml and models/scene.xml match the parameter set")
+        return 0
+    paper, nonholonomic = params.coefficients("paper"), params.coefficients("nonholonomic")
+    if args.json:
+        print_json({"parameters": params.as_dict(), "paper": paper.as_dict(), "nonholonomic": nonholonomic.as_dict(),
+                    "kinetic_energy": params.kinetic_energy_coefficients()})
+        return 0
+    for name, value in params.as_dict().items():
+        print(f"{name:22s} {value:12.6g}  {PARAMETER_SOURCES[name]}")
+    print()
+    for key in ("P", "C_V", "F", "K", "gyro"):
+        print(f"{key:5s} paper {getattr(paper, key):10.5g}   nonholonomic {getattr(nonholonomic, key):10.5g}")
+    return 0
