@@ -21,8 +21,15 @@ from .errors import WmrMjError
 COMMANDS = ("identify", "robustness", "run", "replay", "sweep", "validate", "figures", "model")
 
 
+class _OneLineParser(argparse.ArgumentParser):
+    """Argument errors as one line (no usage dump), exit status 2."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _OneLineParser(
         prog="wmr-mj",
         description="MuJoCo validation testbed for computed-torque steering control of the C80 cart.",
     )

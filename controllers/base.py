@@ -1,0 +1,56 @@
+"""The steering-controller interface.
+
+A controller maps the steering state and the reference to an armature voltage,
+vectorised over a leading batch axis so that one call controls many
+simulations::
+
+    u = controller.voltage(alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot)   # arrays (B,) -> (B,)
+
+``voltage_scalar`` is the same law on Python floats, for the single-run loop
+where NumPy's per-call overhead would dominate (a test keeps the two equal).
+The motor's voltage limit is applied outside the law by :func:`saturate`.
+"""
+
+from __future__ import annotations
+
+import abc
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+__all__ = ["SteeringController", "saturate"]
+
+
+class SteeringController(abc.ABC):
+    """Steering state and reference in (rad, rad/s, rad/s^2), armature voltage out (V)."""
+
+    name: str = "controller"
+
+    @abc.abstractmethod
+    def voltage(
+        self,
+        alpha: ArrayLike,
+        alpha_dot: ArrayLike,
+        alpha0: ArrayLike,
+        alpha0_dot: ArrayLike,
+        alpha0_ddot: ArrayLike,
+    ) -> np.ndarray:
+        """Unsaturated armature voltage for each simulation of the batch, V."""
+
+    def voltage_scalar(
+        self, alpha: float, alpha_dot: float, alpha0: float, alpha0_dot: float, alpha0_ddot: float
+    ) -> float:
+        """The same law on floats (override for speed)."""
+        return float(self.voltage(np.array([alpha]), np.array([alpha_dot]), np.array([alpha0]),
+                                  np.array([alpha0_dot]), np.array([alpha0_ddot]))[0])
+
+    def describe(self) -> dict:
+        """JSON-able description for logs and reports."""
+        return {"controller": self.name}
+
+
+def saturate(u: ArrayLike, limit: float) -> tuple[np.ndarray, np.ndarray]:
+    """(clip(u, -limit, limit), mask of saturated entries)."""
+    u = np.asarray(u, dtype=float)
+    clipped = np.clip(u, -limit, limit)
+    return clipped, clipped != u

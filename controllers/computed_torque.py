@@ -1,0 +1,216 @@
+"""Computed-torque steering control (3.2)-(3.3) and a PD baseline.
+
+The law of the paper, with the model-based part taken from a reduced model
+``model`` (:class:`wmr_mj.reduced.SteeringModel`, the estimate P^, K^, G^)::
+
+    u = P^ (alpha0'' + K_D E' + K_P E) + K^(alpha) + G^(alpha', alpha)        (3.2)-(3.3)
+    E = alpha0 - alpha,   G^ = C_V^ alpha' + F^ s + gyro^ V_A alpha'/cos^2 alpha
+
+with s the Coulomb sign. The paper writes s = sgn(alpha') (2.5); the joint
+holds still under any torque within +-F (a dead band the analysis does not
+see), so the sign is a design choice exposed here: ``friction_sign`` =
+'measured' (sgn alpha', the paper), 'reference' (sgn alpha0') or 'none', each
+optionally smoothed as tanh(x / friction_width).
+
+Gains: K_P, K_D directly, or ``gains_from_omega_r`` (3.6): K_P = omega_r^2/4,
+K_D = omega_r (critical damping).
+
+Usage::
+
+    from wmr_mj import C80
+    from controllers import ComputedTorque, model_from_source
+    ctrl = ComputedTorque(model_from_source("paper", params=C80), kp=6.0, kd=9.0)
+    u = ctrl.voltage(alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot)
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from wmr_mj.errors import ParameterError, UnknownNameError
+from wmr_mj.params import C80, C80Parameters
+from wmr_mj.reduced import MODEL_NAMES, SteeringModel, smooth_sign, steering_model
+
+from .base import SteeringController
+
+__all__ = [
+    "ComputedTorque",
+    "PDController",
+    "gains_from_omega_r",
+    "model_from_source",
+    "MODEL_SOURCES",
+    "FRICTION_SIGNS",
+    "CONTROLLER_NAMES",
+    "make_controller",
+]
+
+MODEL_SOURCES = (*MODEL_NAMES, "identified", "explicit")
+FRICTION_SIGNS = ("measured", "reference", "none")
+CONTROLLER_NAMES = ("computed-torque", "pd")
+_COEFFICIENT_KEYS = ("P", "C_V", "F", "K", "gyro")
+
+
+def _check_gain(name: str, value: float) -> float:
+    value = float(value)
+    if not math.isfinite(value) or value <= 0:
+        raise ParameterError(f"gain {name} = {value!r} is not accepted; gains must be finite and > 0")
+    return value
+
+
+def gains_from_omega_r(omega_r: float) -> tuple[float, float]:
+    """(K_P, K_D) = (omega_r^2 / 4, omega_r), critical damping (3.6)."""
+    omega_r = _check_gain("omega_r", omega_r)
+    return omega_r**2 / 4.0, omega_r
+
+
+def _read_identified(identified: str | Path | Mapping) -> Mapping:
+    if isinstance(identified, Mapping):
+        return identified
+    path = Path(identified)
+    if not path.is_file():
+        raise ParameterError(f"identified-model file {str(path)!r} does not exist; write one with: wmr-mj identify --out PATH")
+    try:
+        return json.loads(path.read_text())
+    except (json.JSONDecodeError, UnicodeDecodeError):
+        raise ParameterError(f"identified-model file {str(path)!r} is not JSON from wmr-mj identify") from None
+
+
+def model_from_source(
+    source: str,
+    *,
+    params: C80Parameters = C80,
+    identified: str | Path | Mapping | None = None,
+    coefficients: Mapping[str, float] | None = None,
+) -> SteeringModel:
+    """The controller's model (the estimate) from a named source.
+
+    'paper', 'paper-lagrange', 'nonholonomic': evaluated on ``params`` (the
+    estimate's parameter set). 'identified': the ``identified`` mapping or JSON
+    file written by ``wmr-mj identify`` (keys P, C_V, F, K, gyro). 'explicit':
+    ``coefficients`` given as numbers (missing ones are 0, P required).
+    """
+    if source not in MODEL_SOURCES:
+        raise UnknownNameError("model source", source, MODEL_SOURCES)
+    if source in MODEL_NAMES:
+        return steering_model(source, params)
+    if source == "identified":
+        if identified is None:
+            raise ParameterError("model source 'identified' needs an identification (wmr-mj identify --out PATH)")
+        data = _read_identified(identified)
+        values = data.get("identified", data)
+    else:
+        if coefficients is None:
+            raise ParameterError("model source 'explicit' needs coefficients P, C_V, F, K, gyro")
+        values = coefficients
+    unknown = set(values) - set(_COEFFICIENT_KEYS) - {"V_A"}
+    if source == "explicit" and unknown:
+        raise UnknownNameError("coefficient", sorted(unknown)[0], _COEFFICIENT_KEYS)
+    if "P" not in values:
+        raise ParameterError(f"model source {source!r}: coefficient P is required")
+    try:
+        coeffs = {k: float(values.get(k, 0.0)) for k in _COEFFICIENT_KEYS}
+    except (TypeError, ValueError):
+        raise ParameterError(f"model source {source!r}: coefficients must be numbers") from None
+    return SteeringModel(**coeffs, V_A=float(values.get("V_A", params.V_A)), name=source)
+
+
+class ComputedTorque(SteeringController):
+    """u = P^ (alpha0'' + K_D E' + K_P E) + K^(alpha) + G^(alpha'), (3.2)-(3.3)."""
+
+    name = "computed-torque"
+
+    def __init__(
+        self,
+        model: SteeringModel,
+        *,
+        kp: float = 6.0,
+        kd: float = 9.0,
+        friction_sign: str = "measured",
+        friction_width: float = 0.0,
+    ):
+        if friction_sign not in FRICTION_SIGNS:
+            raise UnknownNameError("friction sign", friction_sign, FRICTION_SIGNS)
+        if not math.isfinite(friction_width) or friction_width < 0:
+            raise ParameterError(f"friction_width = {friction_width!r} must be finite and >= 0 (rad/s)")
+        self.model = model
+        self.kp = _check_gain("K_P", kp)
+        self.kd = _check_gain("K_D", kd)
+        self.friction_sign = friction_sign
+        self.friction_width = float(friction_width)
+        m = model
+        self._P, self._C_V, self._F, self._K = m.P, m.C_V, m.F, m.K
+        self._gyro_V = m.gyro * m.V_A
+        if friction_sign == "none":
+            self._F = 0.0
+
+    def _sign_source(self, alpha_dot, alpha0_dot):
+        return alpha0_dot if self.friction_sign == "reference" else alpha_dot
+
+    def voltage(self, alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot) -> np.ndarray:
+        alpha = np.asarray(alpha, dtype=float)
+        alpha_dot = np.asarray(alpha_dot, dtype=float)
+        servo = (np.asarray(alpha0_ddot, dtype=float) + self.kd * (np.asarray(alpha0_dot, dtype=float) - alpha_dot)
+                 + self.kp * (np.asarray(alpha0, dtype=float) - alpha))
+        cos = np.cos(alpha)
+        s = smooth_sign(self._sign_source(alpha_dot, np.asarray(alpha0_dot, dtype=float)), self.friction_width)
+        return (self._P * servo + self._K * np.sin(alpha) / cos**3 + self._C_V * alpha_dot + self._F * s
+                + self._gyro_V * alpha_dot / cos**2)
+
+    def voltage_scalar(self, alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot) -> float:
+        servo = alpha0_ddot + self.kd * (alpha0_dot - alpha_dot) + self.kp * (alpha0 - alpha)
+        c = math.cos(alpha)
+        x = alpha0_dot if self.friction_sign == "reference" else alpha_dot
+        if self.friction_width > 0.0:
+            s = math.tanh(x / self.friction_width)
+        else:
+            s = (x > 0.0) - (x < 0.0)
+        return (self._P * servo + self._K * math.sin(alpha) / (c * c * c) + self._C_V * alpha_dot + self._F * s
+                + self._gyro_V * alpha_dot / (c * c))
+
+    def describe(self) -> dict:
+        return {"controller": self.name, "model": self.model.name, "kp": self.kp, "kd": self.kd,
+                "friction_sign": self.friction_sign, "friction_width": self.friction_width,
+                "estimate": self.model.coefficients.as_dict()}
+
+
+class PDController(SteeringController):
+    """PD baseline without the model-based part: u = P^ (K_D E' + K_P E).
+
+    P^ scales the servo into volts so that the gains mean the same as in the
+    computed-torque law.
+    """
+
+    name = "pd"
+
+    def __init__(self, model: SteeringModel, *, kp: float = 6.0, kd: float = 9.0):
+        self.model = model
+        self.kp = _check_gain("K_P", kp)
+        self.kd = _check_gain("K_D", kd)
+        self._P = model.P
+
+    def voltage(self, alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot) -> np.ndarray:
+        return self._P * (self.kd * (np.asarray(alpha0_dot, dtype=float) - np.asarray(alpha_dot, dtype=float))
+                          + self.kp * (np.asarray(alpha0, dtype=float) - np.asarray(alpha, dtype=float)))
+
+    def voltage_scalar(self, alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot) -> float:
+        return self._P * (self.kd * (alpha0_dot - alpha_dot) + self.kp * (alpha0 - alpha))
+
+    def describe(self) -> dict:
+        return {"controller": self.name, "model": self.model.name, "kp": self.kp, "kd": self.kd,
+                "estimate": {"P": self._P}}
+
+
+def make_controller(name: str, model: SteeringModel, *, kp: float = 6.0, kd: float = 9.0,
+                    friction_sign: str = "measured", friction_width: float = 0.0) -> SteeringController:
+    """A controller by name ('computed-torque' or 'pd')."""
+    if name == "computed-torque":
+        return ComputedTorque(model, kp=kp, kd=kd, friction_sign=friction_sign, friction_width=friction_width)
+    if name == "pd":
+        return PDController(model, kp=kp, kd=kd)
+    raise UnknownNameError("controller", name, CONTROLLER_NAMES)
