@@ -10,7 +10,7 @@ with s the Coulomb sign. The paper writes s = sgn(alpha') (2.5); the joint
 holds still under any torque within +-F (a dead band the analysis does not
 see), so the sign is a design choice exposed here: ``friction_sign`` =
 'measured' (sgn alpha', the paper), 'reference' (sgn alpha0') or 'none', each
-optionally smoothed as tanh(x / friction_width).
+optionally smoothed as x / sqrt(x^2 + friction_width^2).
 
 Gains: K_P, K_D directly, or ``gains_from_omega_r`` (3.6): K_P = omega_r^2/4,
 K_D = omega_r (critical damping).
@@ -157,17 +157,18 @@ class ComputedTorque(SteeringController):
         alpha_dot = np.asarray(alpha_dot, dtype=float)
         servo = (np.asarray(alpha0_ddot, dtype=float) + self.kd * (np.asarray(alpha0_dot, dtype=float) - alpha_dot)
                  + self.kp * (np.asarray(alpha0, dtype=float) - alpha))
-        cos = np.cos(alpha)
+        c = np.cos(alpha)
         s = smooth_sign(self._sign_source(alpha_dot, np.asarray(alpha0_dot, dtype=float)), self.friction_width)
-        return (self._P * servo + self._K * np.sin(alpha) / cos**3 + self._C_V * alpha_dot + self._F * s
-                + self._gyro_V * alpha_dot / cos**2)
+        # the same operations, in the same order, as voltage_scalar: bit-identical results
+        return (self._P * servo + self._K * np.sin(alpha) / (c * c * c) + self._C_V * alpha_dot + self._F * s
+                + self._gyro_V * alpha_dot / (c * c))
 
     def voltage_scalar(self, alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot) -> float:
         servo = alpha0_ddot + self.kd * (alpha0_dot - alpha_dot) + self.kp * (alpha0 - alpha)
         c = math.cos(alpha)
         x = alpha0_dot if self.friction_sign == "reference" else alpha_dot
         if self.friction_width > 0.0:
-            s = math.tanh(x / self.friction_width)
+            s = x / math.sqrt(x * x + self.friction_width * self.friction_width)
         else:
             s = (x > 0.0) - (x < 0.0)
         return (self._P * servo + self._K * math.sin(alpha) / (c * c * c) + self._C_V * alpha_dot + self._F * s

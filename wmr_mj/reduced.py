@@ -39,11 +39,15 @@ MODEL_NAMES = ("paper", "paper-lagrange", "nonholonomic")
 
 
 def smooth_sign(x: ArrayLike, width: float) -> np.ndarray:
-    """tanh(x / width); the exact sign when width == 0."""
+    """x / sqrt(x^2 + width^2); the exact sign when width == 0.
+
+    Algebraic rather than tanh so that NumPy and ``math`` give the same bits
+    (only IEEE-exact operations), which keeps batched and serial runs identical.
+    """
     x = np.asarray(x, dtype=float)
     if width <= 0.0:
         return np.sign(x)
-    return np.tanh(x / width)
+    return x / np.sqrt(x * x + width * width)
 
 
 @dataclass(frozen=True)

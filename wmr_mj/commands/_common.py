@@ -48,5 +48,8 @@ def parse_assignments(items: list[str] | None) -> dict[str, float]:
 
 
 def print_json(obj: Any) -> None:
-    json.dump(obj, sys.stdout, indent=2, sort_keys=True, allow_nan=False, default=float)
+    """One JSON object on stdout; non-finite numbers become null."""
+    from ..io import _clean
+
+    json.dump(_clean(obj), sys.stdout, indent=2, sort_keys=True, allow_nan=False, default=float)
     sys.stdout.write("\n")

@@ -1,0 +1,145 @@
+"""``wmr-mj run``: one headless closed-loop run on the MuJoCo plant, reported against the region."""
+
+from __future__ import annotations
+
+import argparse
+import math
+
+from ._common import parse_assignments, positive_float, positive_int
+
+
+def add_run_options(p: argparse.ArgumentParser) -> None:
+    """Options shared by ``run`` and ``sweep`` (the closed-loop configuration)."""
+    from controllers.computed_torque import CONTROLLER_NAMES, FRICTION_SIGNS, MODEL_SOURCES
+
+    from ..simulate import PATH_NAMES
+
+    p.add_argument("--controller", default="computed-torque", help=f"one of {', '.join(CONTROLLER_NAMES)}")
+    p.add_argument("--model", default="paper", help=f"model source of the estimate: one of {', '.join(MODEL_SOURCES)}")
+    p.add_argument("--identified", metavar="PATH",
+                   help="JSON from `wmr-mj identify --out` for --model identified (default: identify the nominal plant now)")
+    p.add_argument("--coef", action="append", metavar="NAME=VALUE", help="coefficient for --model explicit (P, C_V, F, K, gyro)")
+    p.add_argument("--duration", type=positive_float, default=35.0, help="simulated time, s (default 35)")
+    p.add_argument("--control-period", type=positive_float, default=None,
+                   help="controller period, s, a multiple of the 1 ms physics step (default: every step)")
+    p.add_argument("--kp", type=positive_float, default=None, help="K_P, 1/s^2 (default 6)")
+    p.add_argument("--kd", type=positive_float, default=None, help="K_D, 1/s (default 9)")
+    p.add_argument("--omega-r", type=positive_float, default=None, help="gains by (3.6): K_P = omega_r^2/4, K_D = omega_r")
+    p.add_argument("--friction-sign", default="measured", help=f"Coulomb compensation sign: one of {', '.join(FRICTION_SIGNS)}")
+    p.add_argument("--friction-width", type=float, default=0.0,
+                   help="smoothing of that sign, rad/s: x/sqrt(x^2+w^2) (default 0: exact sign)")
+    p.add_argument("--path", default="paper-circle", help=f"reference path of point C: one of {', '.join(PATH_NAMES)}")
+    p.add_argument("--param", action="append", metavar="NAME=VALUE", help="override a plant parameter (repeatable)")
+    p.add_argument("--m1-inertia", default="payload", choices=("payload", "scale"),
+                   help="m1 changes as a compact payload at the CoM (default) or scales the chassis inertia")
+    p.add_argument("--box", default="derived", help="parameter box of the analysis: derived (from the parameter set "
+                                                     "over --m1-range) or paper (5.1)")
+    p.add_argument("--m1-range", nargs=2, type=positive_float, metavar=("LO", "HI"), default=(550.0, 750.0),
+                   help="m1 range of the analysis box, kg (default 550 750)")
+
+
+def config_from_args(args: argparse.Namespace, **extra):
+    """A RunConfig from the shared options (raises WmrMjError on bad input)."""
+    from controllers import gains_from_omega_r
+
+    from ..errors import ParameterError
+    from ..simulate import RunConfig
+
+    if args.omega_r is not None and (args.kp is not None or args.kd is not None):
+        raise ParameterError("give either --omega-r or --kp/--kd, not both")
+    if args.omega_r is not None:
+        kp, kd = gains_from_omega_r(args.omega_r)
+    else:
+        kp = 6.0 if args.kp is None else args.kp
+        kd = 9.0 if args.kd is None else args.kd
+    if not math.isfinite(args.friction_width) or args.friction_width < 0:
+        raise ParameterError(f"--friction-width {args.friction_width} must be finite and >= 0 (rad/s)")
+    identified = args.identified
+    if args.model == "identified" and identified is None:
+        from ..identify import identify_plant
+        from ..params import C80
+
+        identified = identify_plant(C80, duration=30.0, seed=0).as_dict()
+    coefficients = parse_assignments(args.coef) if args.coef else None
+    return RunConfig(controller=args.controller, model=args.model, duration=args.duration,
+                     control_period=args.control_period, kp=kp, kd=kd, friction_sign=args.friction_sign,
+                     friction_width=args.friction_width, path=args.path,
+                     plant_overrides=parse_assignments(args.param), m1_inertia=args.m1_inertia,
+                     identified=identified, coefficients=coefficients, box=args.box,
+                     m1_range=tuple(args.m1_range), **extra)
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("run", help="simulate the circle headless with a controller and report the errors")
+    add_run_options(p)
+    p.add_argument("--m1", type=positive_float, default=650.0, help="plant chassis mass, kg (default 650)")
+    p.add_argument("--out", metavar="PATH", help="MCAP log path (default logs/run-<time>-<model>-m<m1>.mcap)")
+    p.add_argument("--no-log", action="store_true", help="do not write an MCAP log")
+    p.add_argument("--log-every", type=positive_int, default=1, help="log signals every k-th control step (default 1)")
+    p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
+                   help="progress bar (default: only on a terminal)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=run)
+
+
+def default_log_path(config) -> str:
+    import time
+
+    stamp = time.strftime("%Y%m%d-%H%M%S")
+    return f"logs/run-{stamp}-{config.model}-m{config.m1:g}.mcap"
+
+
+def format_report(s: dict) -> str:
+    """Human-readable run report."""
+    def ratio(x):
+        return "n/a" if x is None else f"{x:.3f}"
+
+    lines = [
+        f"controller {s['controller']} ({s['model']} model), plant m1 = {s['m1']:g} kg, K_P = {s['kp']:g}, "
+        f"K_D = {s['kd']:g}, {s['duration']:g} s, {s['steps']} steps in {s['wall_s']:.2f} s "
+        f"({s['realtime_factor']:.0f}x real time)",
+        f"{'':22s} {'whole run':>12s} {'after ' + format(s['settle_s'], '.1f') + ' s':>12s} {'bound':>12s} {'ratio':>8s}",
+        f"{'sup|E|   [rad]':22s} {s['sup_E']:12.5g} {s['sup_E_settled']:12.5g} {s['E_max']:12.5g} {ratio(s['E_ratio']):>8s}",
+        f"{'sup|E|dot [rad/s]':22s} {s['sup_Edot']:12.5g} {s['sup_Edot_settled']:12.5g} {s['Edot_max']:12.5g} {ratio(s['Edot_ratio']):>8s}",
+        f"analysis (4.23): {s['condition']:.4f} < 1: {'yes' if s['stable'] else 'no'}; errors "
+        f"{'INSIDE' if s['inside'] else 'OUTSIDE'} the analytic region",
+        f"voltage saturated {100 * s['saturated_fraction']:.1f}% of the time",
+    ]
+    if s["left_steering_range"]:
+        lines.append(f"the steering reached its stop (+-range) at t = {s['left_steering_range_at_s']:.3f} s")
+    if s.get("status") != "completed":
+        lines.append(f"run {s['status']}: report covers the simulated part only")
+    return "\n".join(lines)
+
+
+def run(args: argparse.Namespace) -> int:
+    import functools
+    import sys
+
+    from ..simulate import run_closed_loop
+    from ._common import print_json
+
+    config = config_from_args(args, m1=args.m1)
+    factory = None
+    path = None
+    if not args.no_log:
+        from ..mcaplog import RunLogger
+
+        path = args.out or default_log_path(config)
+        factory = functools.partial(RunLogger, path, log_every=args.log_every)
+    from ..mcaplog import terminate_as_interrupt
+
+    with terminate_as_interrupt():
+        result = run_closed_loop(config, logger_factory=factory, progress=args.progress)
+    summary = dict(result.summary)
+    summary["log"] = path
+    if args.json:
+        print_json(summary)
+    else:
+        print(format_report(summary))
+        if path:
+            print(f"log: {path}")
+    if result.status == "interrupted":
+        print("wmr-mj: interrupted; the log holds what was simulated", file=sys.stderr)
+        return 130
+    return 0
