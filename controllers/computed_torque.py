@@ -170,7 +170,7 @@ class ComputedTorque(SteeringController):
         if self.friction_width > 0.0:
             s = x / math.sqrt(x * x + self.friction_width * self.friction_width)
         else:
-            s = (x > 0.0) - (x < 0.0)
+            s = 1.0 if x > 0.0 else (-1.0 if x < 0.0 else 0.0)
         return (self._P * servo + self._K * math.sin(alpha) / (c * c * c) + self._C_V * alpha_dot + self._F * s
                 + self._gyro_V * alpha_dot / (c * c))
 

@@ -144,3 +144,13 @@ def test_cli_bad_parameter_exits_2_with_one_line(argv, needle):
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and needle in lines[0], proc.stderr
     assert "Traceback" not in proc.stderr
+
+
+def test_wheels_roll_without_side_slip_at_paper_speed():
+    """On the 1 m circle at 0.2 m/s the contact points slide sideways by < 1% of V_A."""
+    from wmr_mj.plant import measure_side_slip
+
+    slip = measure_side_slip(C80, duration=15.0, settle=8.0)
+    assert abs(slip["alpha"] - slip["alpha_target"]) < 0.02  # it was on the circle
+    assert slip["max_slip_fraction"] < 0.01
+    assert slip["max_slip_m_s"] > 0.0  # soft contacts do slip a little: the measurement is live

@@ -242,6 +242,7 @@ def report(config: RunConfig, *, analysis, params: C80Parameters, settle_s: floa
 
     Shared by the serial runner and the batched sweep so both report alike.
     """
+    sup_E, sup_Edot = float(sup_E), float(sup_Edot)
     stable = bool(analysis.stable)
     E_max = float(analysis.E_max) if stable else math.inf
     Ed_max = float(analysis.Edot_max) if stable else math.inf

@@ -275,8 +275,19 @@ def _csv_text(rows: list[dict[str, Any]], extra: Sequence[str]) -> str:
     w = csv.DictWriter(buf, fieldnames=cols, extrasaction="ignore", lineterminator="\n")
     w.writeheader()
     for r in sorted(rows, key=lambda r: r["run"]):
-        w.writerow({k: ("" if r.get(k) is None else (repr(r[k]) if isinstance(r.get(k), float) else r[k])) for k in cols})
+        w.writerow({k: _cell(r.get(k)) for k in cols})
     return buf.getvalue()
+
+
+def _cell(value: Any) -> Any:
+    """CSV text of a value: floats round-trip exactly (repr), None is empty."""
+    if value is None:
+        return ""
+    if isinstance(value, (bool, np.bool_)):
+        return str(bool(value))
+    if isinstance(value, (float, np.floating)):
+        return repr(float(value))
+    return value
 
 
 def read_results(path: str | os.PathLike) -> list[dict[str, Any]]:

@@ -53,3 +53,19 @@ def print_json(obj: Any) -> None:
 
     json.dump(_clean(obj), sys.stdout, indent=2, sort_keys=True, allow_nan=False, default=float)
     sys.stdout.write("\n")
+
+
+def parse_range(item: str) -> tuple[str, tuple[float, float]]:
+    """``NAME=LO:HI`` (``--range mu=0.015:0.02``) into (name, (lo, hi)); bad syntax raises ParameterError."""
+    from ..errors import ParameterError
+
+    name, sep, span = item.partition("=")
+    lo_s, sep2, hi_s = span.partition(":")
+    name = name.strip()
+    if not sep or not sep2 or not name or not lo_s.strip() or not hi_s.strip():
+        raise ParameterError(f"--range {item!r} is not NAME=LO:HI (e.g. --range mu=0.015:0.02)")
+    try:
+        lo, hi = float(lo_s), float(hi_s)
+    except ValueError:
+        raise ParameterError(f"--range {item!r}: LO and HI must be numbers") from None
+    return name, (lo, hi)

@@ -7,9 +7,10 @@ import argparse
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("model", help="write/check the MJCF files generated from the C80 parameter set")
-    p.add_argument("action", choices=("write", "check", "params"),
+    p.add_argument("action", choices=("write", "check", "params", "slip"),
                    help="write: regenerate models/*.xml; check: exit 1 if they differ from the parameter set; "
-                        "params: print the parameter set with sources and the derived coefficients")
+                        "params: print the parameter set with sources and the derived coefficients; "
+                        "slip: measure the wheels' side slip on the 1 m circle")
     p.add_argument("--param", action="append", metavar="NAME=VALUE", help="override a parameter (repeatable)")
     p.add_argument("--json", action="store_true", help="with 'params': print one JSON object")
     p.set_defaults(func=run)
@@ -32,6 +33,17 @@ def run(args: argparse.Namespace) -> int:
             print(f"out of date: {', '.join(stale)} (run: wmr-mj model write)")
             return 1
         print("models/c80.xml and models/scene.xml match the parameter set")
+        return 0
+    if args.action == "slip":
+        from ..plant import measure_side_slip
+
+        slip = measure_side_slip(params)
+        if args.json:
+            print_json(slip)
+        else:
+            print(f"side slip on the 1 m circle at V_A = {params.V_A:g} m/s: max {1e3 * slip['max_slip_m_s']:.3f} mm/s "
+                  f"({100 * slip['max_slip_fraction']:.2f}% of V_A, slip angle {1e3 * slip['max_slip_angle_rad']:.2f} mrad), "
+                  f"rms {1e3 * slip['rms_slip_m_s']:.3f} mm/s")
         return 0
     paper, nonholonomic = params.coefficients("paper"), params.coefficients("nonholonomic")
     if args.json:

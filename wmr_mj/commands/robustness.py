@@ -9,7 +9,7 @@ from __future__ import annotations
 import argparse
 import math
 
-from ._common import positive_float
+from ._common import parse_range, positive_float
 
 
 def _nonneg_float(text: str) -> float:
@@ -94,21 +94,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-def _parse_range(item: str) -> tuple[str, tuple[float, float]]:
-    from ..errors import ParameterError
-
-    name, sep, span = item.partition("=")
-    lo_s, sep2, hi_s = span.partition(":")
-    name = name.strip()
-    if not sep or not sep2 or not name or not lo_s.strip() or not hi_s.strip():
-        raise ParameterError(f"--range {item!r} is not NAME=LO:HI (e.g. --range mu=0.015:0.02)")
-    try:
-        lo, hi = float(lo_s), float(hi_s)
-    except ValueError:
-        raise ParameterError(f"--range {item!r}: LO and HI must be numbers") from None
-    return name, (lo, hi)
-
-
 def _parse_estimate(items: list[str]) -> dict[str, float]:
     from ..errors import ParameterError
 
@@ -156,7 +141,7 @@ def run(args: argparse.Namespace) -> int:
 
         ranges: dict[str, tuple[float, float]] = {}
         for item in args.range or []:
-            name, span = _parse_range(item)
+            name, span = parse_range(item)
             if name in ranges:
                 raise ParameterError(f"--range {name} given twice; give each parameter once")
             ranges[name] = span

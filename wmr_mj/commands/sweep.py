@@ -1,0 +1,146 @@
+"""``wmr-mj sweep``: N closed-loop runs with m1 (and other parameters) drawn over their ranges."""
+
+from __future__ import annotations
+
+import argparse
+
+from ._common import positive_int
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    from .run import add_run_options
+
+    p = sub.add_parser("sweep", help="m1 Monte-Carlo on mujoco.batch: per-run errors against the region, table and plot")
+    add_run_options(p)
+    p.add_argument("--n", type=int, default=200, help="number of runs (default 200)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the draw (default 0)")
+    p.add_argument("--sampling", default="lhs", help="uniform, lhs (Latin hypercube, default) or grid")
+    p.add_argument("--range", action="append", metavar="NAME=LO:HI",
+                   help="draw another plant parameter over a range too (repeatable); the box includes it")
+    p.add_argument("--out", metavar="DIR", help="output folder (default logs/sweep-<time>); rerun to resume")
+    p.add_argument("--chunk", type=positive_int, default=128, help="simulations per batch (default 128)")
+    p.add_argument("--nthread", type=int, default=0, help="threads of the batch (default 0: all cores)")
+    p.add_argument("--scheduler", metavar="ADDRESS", help="run the chunks on a Dask cluster (e.g. tcp://127.0.0.1:8786)")
+    p.add_argument("--log", action="store_true", help="also write an MCAP log per run (re-run one by one; bit-identical)")
+    p.add_argument("--json", action="store_true", help="print one summary JSON object")
+    p.set_defaults(func=run)
+
+
+def summarize_sweep(results: list[dict], wall_s: float) -> dict:
+    """The sweep's summary: counts inside/outside and worst ratios."""
+    import math
+
+    def worst(key):
+        vals = [r[key] for r in results if r.get(key) is not None]
+        return max(vals) if vals else None
+
+    steps = sum(int(r["steps"]) for r in results if r.get("steps") is not None)
+    inside = sum(1 for r in results if r["inside"])
+    first = results[0]
+    return {
+        "n": len(results),
+        "inside": inside,
+        "outside": len(results) - inside,
+        "worst_E_ratio": worst("E_ratio"),
+        "worst_Edot_ratio": worst("Edot_ratio"),
+        "worst_sup_E": worst("sup_E"),
+        "worst_sup_Edot": worst("sup_Edot"),
+        "E_max": first["E_max"],
+        "Edot_max": first["Edot_max"],
+        "hit_steering_stop": sum(1 for r in results if r["left_steering_range"]),
+        "steps": steps,
+        "wall_s": wall_s,
+        "steps_per_s": steps / wall_s if wall_s > 0 and math.isfinite(wall_s) else None,
+    }
+
+
+def run(args: argparse.Namespace) -> int:
+    import functools
+    import sys
+    import time
+    from pathlib import Path
+
+    from ..errors import ParameterError
+    from ..io import write_json_atomic
+    from ..sweep import SweepSpec, run_sweep
+    from ._common import parse_range, print_json
+    from .run import config_from_args
+
+    if args.n < 1:
+        raise ParameterError(f"--n {args.n} is not accepted; the number of runs must be >= 1")
+    ranges = dict(parse_range(item) for item in (args.range or []))
+    if "m1" in ranges:
+        raise ParameterError("draw m1 with --m1-range LO HI, not --range m1=...")
+    base = config_from_args(args)
+    spec = SweepSpec(n=args.n, seed=args.seed, sampling=args.sampling, m1_range=tuple(args.m1_range),
+                     ranges=ranges, base=base)
+    out = Path(args.out or f"logs/sweep-{time.strftime('%Y%m%d-%H%M%S')}")
+    tty = sys.stderr.isatty()
+
+    def progress(done, total):
+        if tty:
+            sys.stderr.write(f"\r{done}/{total} runs")
+            sys.stderr.flush()
+
+    t0 = time.perf_counter()
+    results = run_sweep(spec, out_dir=out, chunk=args.chunk, nthread=args.nthread, scheduler=args.scheduler,
+                        progress=progress)
+    wall = time.perf_counter() - t0
+    if tty:
+        sys.stderr.write("\n")
+    summary = summarize_sweep(results, wall)
+    summary.update({"folder": str(out), "model": base.model, "controller": base.controller, "seed": args.seed,
+                    "sampling": args.sampling, "ranges": {"m1": list(args.m1_range), **{k: list(v) for k, v in ranges.items()}}})
+    plot_path = out / "region.png"
+    _plot(results, summary, plot_path)
+    summary["plot"] = str(plot_path)
+    if args.log:
+        from ..mcaplog import RunLogger
+        from ..simulate import run_closed_loop
+
+        logs_dir = out / "mcap"
+        for r in results:
+            cfg = base.replace(m1=r["m1"], plant_overrides={**base.plant_overrides, **{k: r[k] for k in ranges}})
+            run_closed_loop(cfg, logger_factory=functools.partial(RunLogger, logs_dir / f"run-{r['run']:05d}.mcap"),
+                            progress=False)
+        summary["mcap_dir"] = str(logs_dir)
+    write_json_atomic(out / "summary.json", summary)
+    if args.json:
+        print_json(summary)
+        return 0
+    print(f"{summary['n']} runs ({base.model} model, m1 over {args.m1_range[0]:g}-{args.m1_range[1]:g} kg, "
+          f"{args.sampling}, seed {args.seed}): {summary['inside']} inside, {summary['outside']} outside the region")
+    fmt = lambda x: "n/a" if x is None else f"{x:.3f}"  # noqa: E731
+    print(f"worst sup|E|/E_max = {fmt(summary['worst_E_ratio'])}, worst sup|E'|/Edot_max = {fmt(summary['worst_Edot_ratio'])}; "
+          f"{summary['hit_steering_stop']} runs hit the steering stop")
+    print(f"{summary['steps']} steps in {wall:.1f} s ({summary['steps_per_s']:.3g} steps/s)")
+    print(f"table: {out / 'runs.csv'}\nplot:  {plot_path}")
+    return 0
+
+
+def _plot(results: list[dict], summary: dict, path) -> None:
+    """Fig.-7-style plot: the analytic region and every run's (sup|E|, sup|E'|)."""
+    try:
+        from ..plots import plot_sweep
+    except ImportError:
+        plot_sweep = None
+    if plot_sweep is not None:
+        plot_sweep(results, path)
+        return
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(5, 4))
+    E_max, Ed_max = summary["E_max"], summary["Edot_max"]
+    if E_max is not None and Ed_max is not None:
+        ax.add_patch(plt.Rectangle((0, 0), E_max, Ed_max, alpha=0.15, color="C0", label="analytic bounds"))
+    sc = ax.scatter([r["sup_E"] for r in results], [r["sup_Edot"] for r in results], c=[r["m1"] for r in results], s=12)
+    fig.colorbar(sc, ax=ax, label="m1 [kg]")
+    ax.set_xlabel("sup |E| [rad]")
+    ax.set_ylabel("sup |E'| [rad/s]")
+    ax.legend(loc="upper right")
+    fig.tight_layout()
+    fig.savefig(path, dpi=150)
+    plt.close(fig)
