@@ -154,3 +154,9 @@ def test_wheels_roll_without_side_slip_at_paper_speed():
     assert abs(slip["alpha"] - slip["alpha_target"]) < 0.02  # it was on the circle
     assert slip["max_slip_fraction"] < 0.01
     assert slip["max_slip_m_s"] > 0.0  # soft contacts do slip a little: the measurement is live
+
+
+def test_model_card_is_a_fresh_rendering():
+    from wmr_mj.modelcard import render_model_card
+
+    assert (MODELS_DIR / "README.md").read_text() == render_model_card(C80), "run: wmr-mj model card"

@@ -7,10 +7,10 @@ import argparse
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("model", help="write/check the MJCF files generated from the C80 parameter set")
-    p.add_argument("action", choices=("write", "check", "params", "slip"),
+    p.add_argument("action", choices=("write", "check", "params", "slip", "card"),
                    help="write: regenerate models/*.xml; check: exit 1 if they differ from the parameter set; "
                         "params: print the parameter set with sources and the derived coefficients; "
-                        "slip: measure the wheels' side slip on the 1 m circle")
+                        "slip: measure the wheels' side slip on the 1 m circle; card: write models/README.md")
     p.add_argument("--param", action="append", metavar="NAME=VALUE", help="override a parameter (repeatable)")
     p.add_argument("--json", action="store_true", help="with 'params': print one JSON object")
     p.set_defaults(func=run)
@@ -33,6 +33,13 @@ def run(args: argparse.Namespace) -> int:
             print(f"out of date: {', '.join(stale)} (run: wmr-mj model write)")
             return 1
         print("models/c80.xml and models/scene.xml match the parameter set")
+        return 0
+    if args.action == "card":
+        from ..io import write_text_atomic
+        from ..modelcard import render_model_card
+
+        path = write_text_atomic(MODELS_DIR / "README.md", render_model_card(params))
+        print(f"wrote {path}")
         return 0
     if args.action == "slip":
         from ..plant import measure_side_slip
