@@ -1,0 +1,492 @@
+"""MCAP run logs: writer (wmr_mj.mcaplog) and reader (wmr_mj.logs).
+
+A small cart model with the C80's body and joint names is compiled from a string,
+stepped with some ctrl, and logged with the runner's block contract.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pytest
+
+from wmr_mj.errors import LogError
+from wmr_mj.logs import load_log
+from wmr_mj.mcaplog import RunLogger, foxglove_schema, terminate_as_interrupt
+
+TEST_MJCF = """
+<mujoco model="c80_test">
+  <option timestep="0.001" integrator="implicitfast"/>
+  <worldbody>
+    <light pos="0 0 4" dir="0 0 -1"/>
+    <geom name="floor" type="plane" size="0 0 0.1" rgba=".8 .8 .8 1"/>
+    <body name="chassis" pos="0 0 0.2">
+      <freejoint name="chassis_free"/>
+      <geom type="box" size="0.6 0.3 0.05" pos="0.3 0 0.1" rgba="0.2 0.4 0.8 1" mass="50"/>
+      <geom type="sphere" size="0.05" pos="0.8 0 0.2" rgba="1 1 0 1" mass="0.1"/>
+      <geom type="ellipsoid" size="0.1 0.05 0.03" pos="0 0 0.2" rgba="0 1 0 1" mass="0.1"/>
+      <body name="drive_unit">
+        <geom type="box" size="0.04 0.3 0.03" rgba=".3 .3 .3 1" mass="5"/>
+        <body name="rear_left_wheel" pos="0 0.35 -0.05">
+          <joint name="rear_left_spin" type="hinge" axis="0 1 0" damping="0.01"/>
+          <geom type="cylinder" size="0.15 0.04" euler="90 0 0" rgba=".1 .1 .1 1" mass="2"/>
+        </body>
+        <body name="rear_right_wheel" pos="0 -0.35 -0.05">
+          <joint name="rear_right_spin" type="hinge" axis="0 1 0" damping="0.01"/>
+          <geom type="cylinder" size="0.15 0.04" euler="90 0 0" rgba=".1 .1 .1 1" mass="2"/>
+        </body>
+      </body>
+      <body name="steering_unit" pos="0.612 0 0">
+        <joint name="steer" type="hinge" axis="0 0 1" range="-0.9 0.9" damping="0.5"/>
+        <geom type="capsule" size="0.03 0.2" euler="90 0 0" rgba=".6 .2 .2 1" mass="3"/>
+        <body name="front_left_wheel" pos="0 0.25 -0.1">
+          <joint name="front_left_spin" type="hinge" axis="0 1 0"/>
+          <geom type="cylinder" size="0.1 0.03" euler="90 0 0" rgba=".1 .1 .1 1" mass="1"/>
+        </body>
+        <body name="front_right_wheel" pos="0 -0.25 -0.1">
+          <joint name="front_right_spin" type="hinge" axis="0 1 0"/>
+          <geom type="cylinder" size="0.1 0.03" euler="90 0 0" rgba=".1 .1 .1 1" mass="1"/>
+        </body>
+      </body>
+    </body>
+  </worldbody>
+  <actuator>
+    <motor name="steer_motor" joint="steer" gear="1" ctrlrange="-20 20"/>
+    <motor name="drive_left" joint="rear_left_spin" gear="1"/>
+    <motor name="drive_right" joint="rear_right_spin" gear="1"/>
+  </actuator>
+</mujoco>
+"""
+
+ROW_KEYS = (
+    "t", "alpha", "alpha_dot", "alpha0", "alpha0_dot", "alpha0_ddot", "E", "E_dot", "voltage_cmd",
+    "voltage", "current", "steer_torque", "A_pos", "C_pos", "heading", "qpos", "qvel", "ctrl",
+)  # fmt: skip
+CONFIG = {"seed": 7, "controller": "test", "settle_s": 0.5, "E_max": 0.5, "Edot_max": 2.0, "gains": {"kp": 6.0}}
+
+
+def synthetic_run(path, seconds=1.0, *, block_rows=1000, log_every=1, substeps=1, nan_at=None,
+                  tamper_at=None, summary=None, **kw):  # fmt: skip
+    """Simulate TEST_MJCF under a simple steering law and log it; returns the rows logged."""
+    m = mujoco.MjModel.from_xml_string(TEST_MJCF)
+    d = mujoco.MjData(m)
+    spec = mujoco.mjtState.mjSTATE_INTEGRATION
+    s0 = np.empty(mujoco.mj_stateSize(m, spec))
+    mujoco.mj_getState(m, d, s0, spec)
+    jid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, "steer")
+    qa, va = m.jnt_qposadr[jid], m.jnt_dofadr[jid]
+    cb = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "steering_unit")
+    ab = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "drive_unit")
+    n = int(round(seconds / (m.opt.timestep * substeps)))
+    ref = np.column_stack([np.linspace(0, 2, 50), 0.2 * np.sin(np.linspace(0, 3, 50))])
+    log = RunLogger(path, mjcf_xml=TEST_MJCF, config=CONFIG, parameters={"m1": 650.0, "voltage_limit": 20.0},
+                    initial_state=s0, timestep=m.opt.timestep, control_substeps=substeps, reference_path=ref,
+                    log_every=log_every, **kw)  # fmt: skip
+    rows = {k: [] for k in ROW_KEYS}
+    out = {k: [] for k in ROW_KEYS}
+    for k in range(n):
+        t = d.time
+        a0, a0d = 0.3 * np.sin(2 * t), 0.6 * np.cos(2 * t)
+        u = 40 * (a0 - d.qpos[qa]) - 2 * d.qvel[va]
+        ctrl = np.array([np.clip(u, -20, 20), 1.0, 1.0])
+        row = {
+            "t": t, "alpha": d.qpos[qa], "alpha_dot": d.qvel[va], "alpha0": a0, "alpha0_dot": a0d,
+            "alpha0_ddot": -1.2 * np.sin(2 * t), "E": a0 - d.qpos[qa], "E_dot": a0d - d.qvel[va],
+            "voltage_cmd": u, "voltage": np.clip(u, -20, 20), "current": 0.1 * u, "steer_torque": ctrl[0],
+            "A_pos": d.xpos[ab][:2].copy(), "C_pos": d.xpos[cb][:2].copy(),
+            "heading": 2 * np.arctan2(d.qpos[6], d.qpos[3]), "qpos": d.qpos.copy(), "qvel": d.qvel.copy(), "ctrl": ctrl,
+        }  # fmt: skip
+        if nan_at is not None and k == nan_at:
+            row["E"] = np.nan
+            row["voltage"] = np.inf
+            row["qpos"][0] = np.nan  # a NaN pose: /tf leaves the row out, /sim/state keeps it
+        if tamper_at is not None and k == tamper_at:
+            row["qpos"][2] += 1e-12
+        for key in ROW_KEYS:
+            rows[key].append(row[key])
+        d.ctrl[:] = ctrl
+        for _ in range(substeps):
+            mujoco.mj_step(m, d)
+        if len(rows["t"]) == block_rows or k == n - 1:
+            blk = {key: np.array(v) for key, v in rows.items()}
+            for key in ROW_KEYS:
+                out[key].append(blk[key])
+            log.write_block(blk)
+            rows = {key: [] for key in ROW_KEYS}
+    log.close(summary if summary is not None else {"sup_abs_E": 0.1, "nan": float("nan")})
+    return {k: np.concatenate(v) for k, v in out.items()}
+
+
+@pytest.fixture(scope="module")
+def logged(tmp_path_factory):
+    path = tmp_path_factory.mktemp("log") / "run.mcap"
+    rows = synthetic_run(path, 1.2, block_rows=500, nan_at=700)
+    return path, rows
+
+
+def test_round_trip_arrays(logged):
+    path, rows = logged
+    log = load_log(path)
+    assert not log.truncated and log.status == "completed"
+    assert log.rows == len(rows["t"]) == 1200
+    for k in ROW_KEYS:
+        got = log.state[k] if k in ("qpos", "qvel", "ctrl") else log.signals[k]
+        assert got.shape == rows[k].shape, k
+        assert np.array_equal(got, rows[k], equal_nan=True), k
+    steer = log.channel("/steering")
+    assert set(steer) == {"log_time", "t", "alpha", "alpha_dot", "alpha0", "alpha0_dot", "alpha0_ddot", "e", "e_dot"}
+    assert np.array_equal(steer["log_time"], np.rint(rows["t"] * 1e9).astype(np.uint64))
+
+
+def test_metadata_and_attachments(logged):
+    path, _ = logged
+    log = load_log(path)
+    assert log.info["schema_version"] == "1"
+    assert log.config == CONFIG
+    assert log.seed == 7
+    assert log.timestep == 0.001 and log.control_substeps == 1 and log.log_every == 1
+    assert set(log.versions) >= {"python", "mujoco", "numpy", "mcap", "wmr_mj"}
+    assert log.mjcf_xml == TEST_MJCF
+    assert log.parameters == {"m1": 650.0, "voltage_limit": 20.0}
+    m = mujoco.MjModel.from_xml_string(TEST_MJCF)
+    d = mujoco.MjData(m)
+    s0 = np.empty(mujoco.mj_stateSize(m, mujoco.mjtState.mjSTATE_INTEGRATION))
+    mujoco.mj_getState(m, d, s0, mujoco.mjtState.mjSTATE_INTEGRATION)
+    assert np.array_equal(log.initial_state, s0)
+    assert log.reference_path.shape == (50, 2)
+    assert log.summary["status"] == "completed" and log.summary["sup_abs_E"] == 0.1
+    assert log.summary["nan"] is None  # NaN in the summary becomes null
+    assert {"c80.xml", "parameters.json", "initial_state.npy"} <= set(log.attachments)
+
+
+def test_official_mcap_reader_and_schemas(logged):
+    from mcap.reader import make_reader
+    from mcap.stream_reader import StreamReader
+
+    path, rows = logged
+    with open(path, "rb") as f:
+        reader = make_reader(f)
+        summ = reader.get_summary()
+        topics = {c.topic: c for c in summ.channels.values()}
+        assert set(topics) == {"/steering", "/motor", "/pose", "/sim/state", "/tf", "/scene"}
+        schemas = {topics[t].topic: summ.schemas[topics[t].schema_id] for t in topics}
+        assert schemas["/tf"].name == "foxglove.FrameTransforms" and schemas["/tf"].encoding == "jsonschema"
+        assert schemas["/scene"].name == "foxglove.SceneUpdate" and schemas["/scene"].encoding == "jsonschema"
+        assert json.loads(schemas["/tf"].data) == foxglove_schema("foxglove.FrameTransforms")
+        assert schemas["/steering"].encoding == "ros2msg" and topics["/steering"].message_encoding == "cdr"
+        counts = {}
+        for _, ch, _ in reader.iter_messages(log_time_order=True):
+            counts[ch.topic] = counts.get(ch.topic, 0) + 1
+        assert counts["/sim/state"] == counts["/steering"] == 1200
+        assert counts["/tf"] == 1199  # the NaN pose row is left out
+        assert counts["/scene"] == 1
+        assert summ.statistics.message_count == sum(counts.values())
+        assert {m.name for m in reader.iter_metadata()} == {"wmr_mj", "versions", "config", "summary"}
+        assert {a.name for a in reader.iter_attachments()} >= {"c80.xml", "parameters.json", "initial_state.npy"}
+    with open(path, "rb") as f:  # CRCs of chunks, attachments, summary and data section
+        assert sum(1 for _ in StreamReader(f, validate_crcs=True).records) > 10
+    # the compression is zstd
+    with open(path, "rb") as f:
+        assert {ci.compression for ci in make_reader(f).get_summary().chunk_indexes} == {"zstd"}
+
+
+def test_foxglove_messages_validate(logged):
+    jsonschema = pytest.importorskip("jsonschema")
+    path, _ = logged
+    log = load_log(path)
+    scene = log.messages("/scene")
+    assert len(scene) == 1
+    jsonschema.validate(scene[0][1], foxglove_schema("foxglove.SceneUpdate"))
+    ids = {e["id"] for e in scene[0][1]["entities"]}
+    assert {"body:chassis", "body:steering_unit", "body:front_left_wheel", "reference_path"} <= ids
+    validator = jsonschema.validators.validator_for(foxglove_schema("foxglove.FrameTransforms"))(
+        foxglove_schema("foxglove.FrameTransforms")
+    )
+    raw = log.raw_messages("/tf")
+    for _, payload in raw[::4] + raw[-3:]:
+        msg = json.loads(payload, parse_constant=lambda c: pytest.fail(f"non-JSON constant {c}"))
+        validator.validate(msg)
+    frames = {(x["parent_frame_id"], x["child_frame_id"]) for x in json.loads(raw[0][1])["transforms"]}
+    assert {("world", "chassis"), ("chassis", "steering_unit"), ("steering_unit", "front_left_wheel"),
+            ("chassis", "drive_unit"), ("drive_unit", "rear_right_wheel")} <= frames  # fmt: skip
+
+
+def _compose(transforms):
+    from wmr_mj.mcaplog import _qmul, _qrot
+
+    world = {"world": (np.zeros(3), np.array([1.0, 0, 0, 0]))}
+    for tr in transforms:
+        p, q = world[tr["parent_frame_id"]]
+        tl = np.array([tr["translation"][k] for k in "xyz"])
+        r = np.array([tr["rotation"][k] for k in "wxyz"])
+        world[tr["child_frame_id"]] = (p + _qrot(q, tl), _qmul(q, r))
+    return world
+
+
+def test_tf_matches_mujoco_kinematics(logged):
+    path, rows = logged
+    log = load_log(path)
+    m = mujoco.MjModel.from_xml_string(TEST_MJCF)
+    d = mujoco.MjData(m)
+    msgs = dict(log.messages("/tf"))
+    for k in (0, 333, 1199):
+        d.qpos[:] = rows["qpos"][k]
+        mujoco.mj_kinematics(m, d)
+        world = _compose(msgs[int(round(rows["t"][k] * 1e9))]["transforms"])
+        for b in range(1, m.nbody):
+            p, q = world[mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b)]
+            assert np.allclose(p, d.xpos[b], atol=2e-6)
+            assert abs(abs(np.dot(q, d.xquat[b])) - 1) < 1e-7
+
+
+def test_nan_survives_and_json_stays_valid(logged):
+    path, rows = logged
+    log = load_log(path)
+    assert np.isnan(log.signals["E"][700]) and np.isposinf(log.signals["voltage"][700])
+    assert np.isnan(log.state["qpos"][700, 0])
+    t700 = int(round(rows["t"][700] * 1e9))
+    assert t700 not in dict(log.raw_messages("/tf"))
+    for name in ("config", "summary", "wmr_mj"):
+        for v in log.metadata[name].values():
+            if name != "wmr_mj":
+                json.loads(v, parse_constant=lambda c: pytest.fail(f"non-JSON constant {c} in {name}"))
+
+
+def test_log_every_and_substeps(tmp_path):
+    path = tmp_path / "every.mcap"
+    rows = synthetic_run(path, 0.3, block_rows=64, log_every=3, substeps=2)
+    log = load_log(path)
+    assert log.rows == 150 and log.log_every == 3 and log.control_substeps == 2
+    assert np.array_equal(log.signals["t"], rows["t"][::3])
+    assert np.array_equal(log.signals["A_pos"], rows["A_pos"][::3])
+    assert np.array_equal(log.state["qpos"], rows["qpos"])
+    assert len(log.raw_messages("/tf")) == 50
+
+
+@pytest.mark.parametrize("compression", ["lz4", "none"])
+def test_other_compressions(tmp_path, compression):
+    path = tmp_path / f"{compression}.mcap"
+    rows = synthetic_run(path, 0.2, compression=compression)
+    log = load_log(path)
+    assert np.array_equal(log.state["qvel"], rows["qvel"])
+    assert log.info["compression"] == ("lz4" if compression == "lz4" else "none")
+
+
+def test_each_block_is_on_disk(tmp_path):
+    """After write_block returns, the file read as it is holds every row (complete chunks)."""
+    m = mujoco.MjModel.from_xml_string(TEST_MJCF)
+    d = mujoco.MjData(m)
+    s0 = np.empty(mujoco.mj_stateSize(m, mujoco.mjtState.mjSTATE_INTEGRATION))
+    mujoco.mj_getState(m, d, s0, mujoco.mjtState.mjSTATE_INTEGRATION)
+    path = tmp_path / "open.mcap"
+    log = RunLogger(path, mjcf_xml=TEST_MJCF, config={}, parameters={}, initial_state=s0, timestep=0.001, control_substeps=1)
+    for b in range(3):
+        log.write_block(_block(m, 1000, b))
+        partial = load_log(path)
+        assert partial.truncated and partial.summary is None
+        assert partial.rows == 1000 * (b + 1)
+    log.close({}, status="completed")
+    assert not load_log(path).truncated
+    with pytest.raises(RuntimeError):
+        log.write_block(_block(m, 10, 0))
+
+
+def _block(m, n, b):
+    t = (np.arange(n) + b * n) * 1e-3
+    blk = {k: np.sin(t + i) for i, k in enumerate(ROW_KEYS) if k not in ("A_pos", "C_pos", "qpos", "qvel", "ctrl")}
+    blk["t"] = t
+    blk["A_pos"] = np.column_stack([t, 0 * t])
+    blk["C_pos"] = np.column_stack([t + 0.6, 0 * t])
+    blk["qpos"] = np.tile(m.qpos0, (n, 1))
+    blk["qvel"] = np.zeros((n, m.nv))
+    blk["ctrl"] = np.zeros((n, m.nu))
+    return blk
+
+
+def test_context_manager_closes_on_error(tmp_path):
+    m = mujoco.MjModel.from_xml_string(TEST_MJCF)
+    s0 = np.empty(mujoco.mj_stateSize(m, mujoco.mjtState.mjSTATE_INTEGRATION))
+    mujoco.mj_getState(m, mujoco.MjData(m), s0, mujoco.mjtState.mjSTATE_INTEGRATION)
+    path = tmp_path / "err.mcap"
+    with pytest.raises(ZeroDivisionError):
+        with RunLogger(path, mjcf_xml=TEST_MJCF, config={}, parameters={}, initial_state=s0, timestep=0.001,
+                       control_substeps=1) as log:  # fmt: skip
+            log.write_block(_block(m, 200, 0))
+            1 / 0
+    log2 = load_log(path)
+    assert log2.status == "error" and not log2.truncated and log2.rows == 200
+    assert "ZeroDivisionError" in log2.summary["reason"]
+
+
+# --------------------------------------------------------------------------- bad input
+
+
+def _write_small(tmp_path, name="small.mcap", seconds=0.4, **kw):
+    path = tmp_path / name
+    synthetic_run(path, seconds, block_rows=100, flush_period_s=0.1, **kw)
+    return path
+
+
+def test_missing_and_not_mcap(tmp_path):
+    with pytest.raises(LogError, match="no such file"):
+        load_log(tmp_path / "missing.mcap")
+    bad = tmp_path / "notes.mcap"
+    bad.write_text("hello, this is not a log\n")
+    with pytest.raises(LogError, match="not an MCAP file"):
+        load_log(bad)
+    empty = tmp_path / "empty.mcap"
+    empty.write_bytes(b"")
+    with pytest.raises(LogError):
+        load_log(empty)
+    with pytest.raises(LogError, match="is a directory"):
+        load_log(tmp_path)
+
+
+def _chunk_spans(path):
+    from mcap.reader import make_reader
+
+    with open(path, "rb") as f:
+        return [(ci.chunk_start_offset, ci.chunk_length) for ci in make_reader(f).get_summary().chunk_indexes]
+
+
+def test_corrupted_chunk(tmp_path):
+    path = _write_small(tmp_path)
+    data = bytearray(path.read_bytes())
+    spans = _chunk_spans(path)
+    rng = np.random.default_rng(3)
+    for i, (start, length) in enumerate(spans[1::3]):
+        bad = bytearray(data)
+        at = start + length - 1 - int(rng.integers(0, max(1, length // 2)))
+        bad[at] ^= 0xFF
+        bad[at - 1] ^= 0x5A
+        p = tmp_path / f"corrupt{i}.mcap"
+        p.write_bytes(bytes(bad))
+        with pytest.raises(LogError, match="corrupt") as exc:
+            load_log(p)
+        assert "\n" not in str(exc.value) and str(p) in str(exc.value)
+
+
+def test_unknown_schema_version(tmp_path, monkeypatch):
+    import wmr_mj.mcaplog as mcaplog
+
+    monkeypatch.setattr(mcaplog, "SCHEMA_VERSION", "99")
+    path = _write_small(tmp_path, "v99.mcap", seconds=0.1)
+    with pytest.raises(LogError, match="schema version '99'"):
+        load_log(path)
+
+
+def test_random_cuts(tmp_path):
+    path = _write_small(tmp_path, seconds=0.6)
+    data = path.read_bytes()
+    full = load_log(path)
+    rng = np.random.default_rng(20240611)
+    offsets = sorted(set(rng.integers(0, len(data), 40).tolist()) | {0, 4, 8, 20, 200, len(data) - 1, len(data) - 8})
+    read = failed = 0
+    partial = set()
+    for off in offsets:
+        p = tmp_path / f"cut{off}.mcap"
+        p.write_bytes(data[:off])
+        try:
+            log = load_log(p)
+        except LogError as exc:
+            assert "\n" not in str(exc)
+            failed += 1
+            continue
+        read += 1
+        assert log.truncated
+        assert log.rows <= full.rows
+        partial.add(log.rows)
+        assert np.array_equal(log.state["qpos"], full.state["qpos"][: log.rows])
+        n = len(log.signals.get("t", []))
+        assert np.array_equal(log.signals.get("E", np.empty(0)), full.signals["E"][:n])
+    assert read > 10 and failed >= 3
+    assert len(partial) >= 4  # cuts at different places keep different numbers of flushed rows
+
+
+# --------------------------------------------------------------------------- kills
+
+_LOOP = textwrap.dedent(
+    """
+    import sys, time
+    import numpy as np, mujoco
+    sys.path.insert(0, {tests!r})
+    from test_mcaplog import TEST_MJCF, _block
+    from wmr_mj.mcaplog import RunLogger, terminate_as_interrupt
+    m = mujoco.MjModel.from_xml_string(TEST_MJCF)
+    s0 = np.empty(mujoco.mj_stateSize(m, mujoco.mjtState.mjSTATE_INTEGRATION))
+    mujoco.mj_getState(m, mujoco.MjData(m), s0, mujoco.mjtState.mjSTATE_INTEGRATION)
+    try:
+        with terminate_as_interrupt(), RunLogger({path!r}, mjcf_xml=TEST_MJCF, config={{"seed": 1}}, parameters={{}},
+                                                 initial_state=s0, timestep=0.001, control_substeps=1, model=m) as log:
+            b = 0
+            while True:
+                log.write_block(_block(m, 1000, b))
+                b += 1
+                print("block", b, flush=True)
+                time.sleep(0.05)
+    except KeyboardInterrupt:
+        sys.exit(130)
+    """
+)
+
+
+def _start_loop(tmp_path, name):
+    path = tmp_path / name
+    code = _LOOP.format(tests=str(Path(__file__).parent), path=str(path))
+    proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    blocks = 0
+    deadline = time.time() + 60
+    while blocks < 3 and time.time() < deadline:
+        line = proc.stdout.readline()
+        if not line:
+            break
+        blocks += line.startswith("block")
+    assert blocks >= 3, proc.stderr.read() if proc.poll() is not None else "no progress"
+    return proc, path
+
+
+def test_sigkill_leaves_readable_truncated_log(tmp_path):
+    proc, path = _start_loop(tmp_path, "killed.mcap")
+    proc.send_signal(signal.SIGKILL)
+    proc.wait(timeout=30)
+    log = load_log(path)
+    assert log.truncated and log.summary is None and log.status == "truncated"
+    assert log.rows >= 3000 and log.rows % 1000 == 0
+    assert np.array_equal(log.state["t"], np.arange(log.rows) * 1e-3)
+
+
+def test_sigterm_finishes_file_as_interrupted(tmp_path):
+    proc, path = _start_loop(tmp_path, "termed.mcap")
+    proc.send_signal(signal.SIGTERM)
+    assert proc.wait(timeout=30) == 130
+    log = load_log(path)
+    assert not log.truncated
+    assert log.status == "interrupted"
+    assert log.rows >= 3000 and log.summary["rows"] == log.rows
+
+
+def test_terminate_as_interrupt_restores_handler():
+    before = signal.getsignal(signal.SIGTERM)
+    with pytest.raises(KeyboardInterrupt):
+        with terminate_as_interrupt():
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(1)
+    assert signal.getsignal(signal.SIGTERM) == before
+
+
+def test_measure_logging_overhead_calls_run_both_ways(tmp_path):
+    from wmr_mj.mcaplog import measure_logging_overhead
+
+    seen = []
+    res = measure_logging_overhead(lambda p: (seen.append(p), time.sleep(0.001)), tmp_path / "x.mcap", repeats=2)
+    assert seen.count(None) == 2 and seen.count(tmp_path / "x.mcap") == 2
+    assert set(res) == {"unlogged_s", "logged_s", "ratio"} and res["ratio"] > 0
