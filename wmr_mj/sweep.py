@@ -362,10 +362,8 @@ def run_sweep(spec: SweepSpec, *, out_dir: str | os.PathLike | None = None, chun
     if scheduler is not None:
         client = _connect(scheduler)
         try:
-            from distributed import as_completed
-
             futures = [client.submit(_run_chunk, spec_json, c, 1, pure=False) for c in chunks]
-            for fut in as_completed(futures):
+            for fut in futures:  # in order; each finished chunk is saved before the next is awaited
                 record(fut.result())
         finally:
             client.close()
