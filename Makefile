@@ -22,6 +22,8 @@ test: $(STAMP)
 
 bench: $(STAMP)
 	$(PY) bench/bench_run.py
+	$(PY) bench/bench_logging.py --end-to-end
+	$(PY) bench/bench_sweep.py
 
 clean:
 	rm -rf $(VENV) build *.egg-info
