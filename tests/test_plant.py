@@ -160,3 +160,16 @@ def test_model_card_is_a_fresh_rendering():
     from wmr_mj.modelcard import render_model_card
 
     assert (MODELS_DIR / "README.md").read_text() == render_model_card(C80), "run: wmr-mj model card"
+
+
+@pytest.mark.parametrize("path", sorted(MODELS_DIR.glob("*.xml")), ids=lambda p: p.name)
+def test_every_model_file_steps_without_warnings(path):
+    """Each MJCF in models/ compiles and runs 10 s from its home keyframe with no MuJoCo warning."""
+    model = load_model_file(path)
+    data = mujoco.MjData(model)
+    if model.nkey:
+        mujoco.mj_resetDataKeyframe(model, data, model.key("home").id)
+    for _ in range(10_000):
+        mujoco.mj_step(model, data)
+    assert all(w.number == 0 for w in data.warning), [mujoco.mjtWarning(i).name for i, w in enumerate(data.warning) if w.number]
+    assert np.all(np.isfinite(data.qpos))
