@@ -31,19 +31,19 @@ def positive_int(text: str) -> int:
     return value
 
 
-def parse_assignments(items: list[str] | None) -> dict[str, float]:
+def parse_assignments(items: list[str] | None, *, option: str = "--param", example: str = "mu=0.02") -> dict[str, float]:
     """``NAME=VALUE`` pairs (``--param l3=0.15``) into a dict; bad syntax raises ParameterError."""
     from ..errors import ParameterError
 
     out: dict[str, float] = {}
     for item in items or []:
         name, sep, value = item.partition("=")
-        if not sep or not name:
-            raise ParameterError(f"--param {item!r} is not NAME=VALUE (e.g. --param mu=0.02)")
+        if not sep or not name.strip():
+            raise ParameterError(f"{option} {item!r} is not NAME=VALUE (e.g. {option} {example})")
         try:
             out[name.strip()] = float(value)
         except ValueError:
-            raise ParameterError(f"--param {item!r}: {value!r} is not a number") from None
+            raise ParameterError(f"{option} {item!r}: {value!r} is not a number") from None
     return out
 
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 import argparse
 import math
 
-from ._common import parse_range, positive_float
+from ._common import parse_assignments, parse_range, positive_float
 
 
 def _nonneg_float(text: str) -> float:
@@ -94,21 +94,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-def _parse_estimate(items: list[str]) -> dict[str, float]:
-    from ..errors import ParameterError
-
-    out: dict[str, float] = {}
-    for item in items:
-        name, sep, value = item.partition("=")
-        if not sep or not name.strip():
-            raise ParameterError(f"--estimate {item!r} is not NAME=VALUE (e.g. --estimate P=0.385)")
-        try:
-            out[name.strip()] = float(value)
-        except ValueError:
-            raise ParameterError(f"--estimate {item!r}: {value!r} is not a number") from None
-    return out
-
-
 def run(args: argparse.Namespace) -> int:
     from ..errors import ParameterError
     from ..robustness import (
@@ -156,7 +141,7 @@ def run(args: argparse.Namespace) -> int:
         box_label = f"derived from C80 ({model} model; {', '.join(spans)})"
 
     bounds = ReferenceBounds(alpha_ddot_max=args.alpha_ddot, alpha_dot_max=args.alpha_dot, sin_cos3_max=args.sin_cos3)
-    estimate = _parse_estimate(args.estimate) if args.estimate else None
+    estimate = parse_assignments(args.estimate, option="--estimate", example="P=0.385") if args.estimate else None
     result = analyse(box, kp=kp, kd=kd, bounds=bounds, reading=args.reading, gammas=args.gammas, estimate=estimate)
 
     if args.json:
