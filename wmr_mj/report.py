@@ -402,7 +402,7 @@ def run_validate(settings: ValidateSettings, out_dir: str | os.PathLike, *, log:
         def sweep_progress(done: int, total: int) -> None:
             if not resumed:
                 resumed.append(done)  # the first call reports the runs found in runs.csv
-            st.update(f"{done}/{total} runs")
+            st.update(f"{done:.0f}/{total} runs")
 
         run_sweep(spec, out_dir=sweep_dir, nthread=settings.nthread, progress=sweep_progress)
         rows = read_results(sweep_dir / "runs.csv")

@@ -451,7 +451,7 @@ def run_on_reduced_model(
     law = controller.voltage_scalar
 
     def rhs(t, x):
-        a, ad = x
+        a, ad = float(x[0]), float(x[1])
         a0, a0d, a0dd = (float(v) for v in reference.at(t))
         u = law(a, ad, a0, a0d, a0dd)
         s = float(smooth_sign(ad, friction_width))

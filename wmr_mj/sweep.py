@@ -264,12 +264,13 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
 
 # -- sweeps: chunks, resume, Dask ---------------------------------------------------------
 
-def _run_chunk(spec_json: str, indices: list[int], nthread: int) -> list[dict[str, Any]]:
+def _run_chunk(spec_json: str, indices: list[int], nthread: int,
+               progress: Callable[[int, int], None] | None = None) -> list[dict[str, Any]]:
     """Run the sweep's runs ``indices`` (a Dask task: arguments and result are plain data)."""
     spec = spec_from_json(spec_json)
     samples = draw_samples(spec)
     configs = _run_configs(spec, samples[indices])
-    reports = run_batch(configs, nthread=nthread)
+    reports = run_batch(configs, nthread=nthread, progress=progress)
     for i, r in zip(indices, reports):
         r["run"] = int(i)
         for name, value in zip(spec.names[1:], samples[i][1:]):
@@ -347,7 +348,11 @@ def _connect(scheduler: str):
 
 def run_sweep(spec: SweepSpec, *, out_dir: str | os.PathLike | None = None, chunk: int = 128, nthread: int = 0,
               scheduler: str | None = None, progress: Callable[[int, int], None] | None = None) -> list[dict[str, Any]]:
-    """All runs of ``spec``, in run order. With ``out_dir``: runs.csv (atomic, after every chunk) and resume."""
+    """All runs of ``spec``, in run order. With ``out_dir``: runs.csv (atomic, after every chunk) and resume.
+
+    progress(done, total) is called as runs finish and, locally, as a chunk steps (done
+    is then fractional).
+    """
     from .io import write_json_atomic, write_text_atomic
 
     if chunk < 1:
@@ -392,5 +397,10 @@ def run_sweep(spec: SweepSpec, *, out_dir: str | os.PathLike | None = None, chun
             client.close()
     else:
         for c in chunks:
-            record(_run_chunk(spec_json, c, nthread))
+            base_done = len(done)
+            step_progress = None
+            if progress is not None:
+                def step_progress(k: int, n: int, base_done=base_done, size=len(c)) -> None:
+                    progress(base_done + size * k / n, spec.n)  # fractional runs while a chunk steps
+            record(_run_chunk(spec_json, c, nthread, step_progress))
     return [done[i] for i in range(spec.n)]

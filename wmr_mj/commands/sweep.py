@@ -79,7 +79,7 @@ def run(args: argparse.Namespace) -> int:
 
     def progress(done, total):
         if tty:
-            sys.stderr.write(f"\r{done}/{total} runs")
+            sys.stderr.write(f"\r{done:.0f}/{total} runs")
             sys.stderr.flush()
 
     t0 = time.perf_counter()
