@@ -488,3 +488,15 @@ def test_multibody_steering_torque_varying_speed():
     J = p.steering_inertia
     nh = J * (a_dd + V_d * np.tan(a) / p.l1 + VA * a_d / (p.l1 * np.cos(a) ** 2))
     assert np.abs(tau - nh).max() < 1e-6 * np.abs(tau).max()
+
+
+def test_torque_form_h_v_f_match_voltage_form():
+    """(2.13): P = (R_a/k_i) H, K = (R_a/k_i) V, F_V = (R_a/k_i) F_tau, from the torque form (2.7)."""
+    from wmr_mj.params import C80
+
+    tf = C80.steering_model_torque_form()
+    c = C80.coefficients("paper")
+    r = C80.R_a / C80.k_i
+    assert c.P == pytest.approx(r * tf["H"], rel=1e-14)
+    assert c.K == pytest.approx(r * tf["V"], rel=1e-14)
+    assert c.F == pytest.approx(r * tf["F"], rel=1e-14)

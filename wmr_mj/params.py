@@ -273,6 +273,13 @@ class C80Parameters:
         ) / self.l1**2 + 0.5 * self.front_axle_mass + self.front_wheel_mass + self.I_y3 / self.r3**2
         return {"A": A, "B": B, "C": J / self.l1, "D": 0.5 * J}
 
+    def steering_model_torque_form(self) -> dict[str, float]:
+        """The paper's torque form (2.7)-(2.8) at the motor shaft: H, the V(alpha)
+        coefficient 2 B V_A^2 / i2 (N m), the friction torque F(alpha') / sgn (N m)."""
+        ke = self.kinetic_energy_coefficients()
+        return {"H": 2 * ke["D"] / self.i2, "V": 2 * ke["B"] * self.V_A**2 / self.i2,
+                "F": self.steering_friction_torque / self.i2}
+
     def coefficients(self, model: str = "paper") -> Coefficients:
         """Reduced-model coefficients in volts for ``model`` = 'paper' or 'nonholonomic'.
 
