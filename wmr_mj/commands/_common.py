@@ -20,15 +20,23 @@ def positive_float(text: str) -> float:
     return value
 
 
-def positive_int(text: str) -> int:
-    """argparse type: an integer >= 1."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not an integer; an integer >= 1 is accepted") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"{text!r} is not accepted; an integer >= 1 is required")
-    return value
+def int_at_least(minimum: int):
+    """argparse type factory: an integer >= minimum."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not an integer; an integer >= {minimum} is accepted") from None
+        if value < minimum:
+            raise argparse.ArgumentTypeError(f"{text!r} is not accepted; an integer >= {minimum} is required")
+        return value
+
+    parse.__name__ = f"integer >= {minimum}"
+    return parse
+
+
+positive_int = int_at_least(1)
 
 
 def parse_assignments(items: list[str] | None, *, option: str = "--param", example: str = "mu=0.02") -> dict[str, float]:

@@ -10,24 +10,10 @@ from __future__ import annotations
 
 import argparse
 
-from ._common import positive_float, positive_int
+from ._common import int_at_least, positive_float, positive_int
 
 
-def _nonneg_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not an integer; an integer >= 0 is accepted") from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"{text!r} is not accepted; an integer >= 0 is required")
-    return value
-
-
-def _int(text: str) -> int:
-    try:
-        return int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+_nonneg_int = int_at_least(0)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -38,7 +24,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                                         "the robustness analysis, write index.html",
                        description=__doc__.split("\n\n")[1] if __doc__ else None)
     p.add_argument("--n", type=positive_int, default=DEFAULT_N, help=f"runs per model source (default {DEFAULT_N})")
-    p.add_argument("--seed", type=_int, default=0, help="seed of the m1 samples and the identification (default 0)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the m1 samples and the identification (default 0)")
     p.add_argument("--sampling", choices=SAMPLINGS, default="lhs", help="sampling of m1 (default lhs)")
     p.add_argument("--duration", type=positive_float, default=DEFAULT_DURATION,
                    help=f"simulated time per run, s (default {DEFAULT_DURATION:g}; >= ~10 s reaches the circle)")
