@@ -325,25 +325,23 @@ class Path:
         starts = self.starts
         return np.clip(np.searchsorted(starts, s, side="right") - 1, 0, len(self.segments) - 1)
 
-    def curvature(self, s: ArrayLike) -> np.ndarray:
-        """kappa at arc length s (vectorised; 1/m)."""
+    def _piecewise(self, s: ArrayLike, method: str) -> np.ndarray:
+        """Segment.<method> evaluated on each segment's share of s (local arc length)."""
         s = np.asarray(s, dtype=float)
         idx, starts, out = self._locate(s), self.starts, np.empty_like(s)
         for i, seg in enumerate(self.segments):
             m = idx == i
             if np.any(m):
-                out[m] = seg.curvature(s[m] - starts[i])
+                out[m] = getattr(seg, method)(s[m] - starts[i])
         return out
+
+    def curvature(self, s: ArrayLike) -> np.ndarray:
+        """kappa at arc length s (vectorised; 1/m)."""
+        return self._piecewise(s, "curvature")
 
     def curvature_rate(self, s: ArrayLike) -> np.ndarray:
         """d kappa / ds at arc length s (vectorised; 1/m^2)."""
-        s = np.asarray(s, dtype=float)
-        idx, starts, out = self._locate(s), self.starts, np.empty_like(s)
-        for i, seg in enumerate(self.segments):
-            m = idx == i
-            if np.any(m):
-                out[m] = seg.curvature_rate(s[m] - starts[i])
-        return out
+        return self._piecewise(s, "curvature_rate")
 
 
 # --------------------------------------------------------------------------

@@ -127,13 +127,13 @@ def analysis_box(source: str, params: Any = None, *, m1_range: tuple[float, floa
     'identified' -> the non-holonomic model's.
     """
     from .params import C80
-    from .robustness import ParameterBox
+    from .simulate import RunConfig
+    from .simulate import analysis_box as box_of
 
     if source not in SOURCES:
         raise UnknownNameError("model source", source, SOURCES)
-    model = "paper" if source == "paper" else "nonholonomic"
-    return ParameterBox.from_parameters(C80 if params is None else params, m1_range=tuple(m1_range), model=model,
-                                        m1_inertia=m1_inertia)
+    return box_of(RunConfig(model=source, m1_range=tuple(m1_range), m1_inertia=m1_inertia),
+                  C80 if params is None else params)
 
 
 def check_assumptions(identified: Mapping[str, float], box, std_error: Mapping[str, float] | None = None

@@ -42,6 +42,7 @@ __all__ = [
     "run_closed_loop",
     "build_reference",
     "analysis_for",
+    "analysis_box",
     "plant_parameters",
     "estimate_parameters",
     "report",
@@ -152,6 +153,20 @@ def build_reference(path: str, params: C80Parameters, *, dt: float, duration: fl
     return reference, settle_s
 
 
+def analysis_box(config: RunConfig, params: C80Parameters = C80):
+    """The parameter box of the analysis: the paper's (5.1), or derived from ``params`` over
+    the config's m1 range (and box ranges) with the model the controller's source stands on
+    ('nonholonomic' for nonholonomic and identified, 'paper' otherwise)."""
+    from .robustness import ParameterBox
+
+    if config.box == "paper":
+        return ParameterBox.paper()
+    box_model = "nonholonomic" if config.model in ("nonholonomic", "identified") else "paper"
+    return ParameterBox.from_parameters(params, m1_range=tuple(config.m1_range), model=box_model,
+                                        m1_inertia=config.m1_inertia,
+                                        ranges={k: tuple(v) for k, v in config.box_ranges.items()} or None)
+
+
 def analysis_for(config: RunConfig, reference, params: C80Parameters = C80, *, estimate=None):
     """The robustness analysis (4.17)-(4.23) for the run's box, gains and reference bounds.
 
@@ -159,15 +174,9 @@ def analysis_for(config: RunConfig, reference, params: C80Parameters = C80, *, e
     errors are then truth-anywhere-in-the-box minus this estimate. None: the
     estimate is anywhere in the box too, as in the paper's (4.2).
     """
-    from .robustness import ParameterBox, ReferenceBounds, analyse
+    from .robustness import ReferenceBounds, analyse
 
-    if config.box == "paper":
-        box = ParameterBox.paper()
-    else:
-        box_model = "nonholonomic" if config.model in ("nonholonomic", "identified") else "paper"
-        box = ParameterBox.from_parameters(params, m1_range=tuple(config.m1_range), model=box_model,
-                                           m1_inertia=config.m1_inertia,
-                                           ranges={k: tuple(v) for k, v in config.box_ranges.items()} or None)
+    box = analysis_box(config, params)
     b = reference.bounds()
     bounds = ReferenceBounds(alpha_ddot_max=max(b["max_abs_alpha0_ddot"], 1e-12),
                              alpha_dot_max=max(b["max_abs_alpha0_dot"], 1e-12),
@@ -254,7 +263,7 @@ def report(config: RunConfig, *, analysis, params: C80Parameters, settle_s: floa
         "kp": config.kp,
         "kd": config.kd,
         "path": config.path,
-        "duration": control_steps * (steps // max(control_steps, 1)) * TIMESTEP,
+        "duration": steps * TIMESTEP,
         "steps": int(steps),
         "control_steps": int(control_steps),
         "wall_s": float(wall_s),
