@@ -41,7 +41,49 @@ __all__ = [
     "with_params",
     "parameter_names",
     "PARAMETER_SOURCES",
+    "PAPER_KP",
+    "PAPER_KD",
+    "M1_NOMINAL",
+    "M1_RANGE",
+    "UNCERTAINTY_NAMES",
+    "UNCERTAINTY_SOURCES",
+    "uncertainty_ranges",
 ]
+
+# The paper's design and uncertainty (5.1): written here once, imported everywhere else.
+PAPER_KP = 6.0  # K_P of (5.1), 1/s^2
+PAPER_KD = 9.0  # K_D of (5.1), 1/s
+M1_NOMINAL = 650.0  # kg, the centre of (5.1)'s 550-750 kg
+M1_RANGE = (550.0, 750.0)  # kg, (5.1)
+
+# Uncertainty boxes for model-mismatch experiments: parameter name -> (lo, hi) in its
+# SI unit. 'm1' is the paper's; 'full' adds what a real C80 also varies in.
+_UNCERTAINTY: dict[str, dict[str, tuple[float, float]]] = {
+    "m1": {"m1": M1_RANGE},
+    "full": {
+        "m1": M1_RANGE,
+        "mu": (0.0129, 0.0215),
+        "ground_friction": (0.6, 1.0),
+        "R_a": (1.0, 1.3),
+        "V_A": (0.15, 0.25),
+    },
+}
+UNCERTAINTY_NAMES = tuple(_UNCERTAINTY)
+#: Where each range of the 'full' box comes from.
+UNCERTAINTY_SOURCES: dict[str, str] = {
+    "m1": "(5.1): chassis mass 550-750 kg",
+    "mu": "chosen: steering Coulomb coefficient +-25% around 0.0172 (lubrication, wear and load spread of a king-pin bearing)",
+    "ground_friction": "chosen: tyre-floor friction 0.6 (dusty or damp concrete) to 1.0 (dry rubber on concrete)",
+    "R_a": "chosen: armature resistance 1.0-1.3 Ohm, copper at +0.39 %/K from 20 C to about 95 C winding temperature",
+    "V_A": "chosen: forward speed 0.15-0.25 m/s, +-25% around (5.1)'s 0.2 m/s (drive speed loop, wheel wear)",
+}
+
+
+def uncertainty_ranges(name: str) -> dict[str, tuple[float, float]]:
+    """The ranged parameters of uncertainty box ``name`` ('m1' or 'full'), name -> (lo, hi)."""
+    if name not in _UNCERTAINTY:
+        raise UnknownNameError("uncertainty box", name, UNCERTAINTY_NAMES)
+    return dict(_UNCERTAINTY[name])
 
 # One line per field: where its value comes from.
 PARAMETER_SOURCES: dict[str, str] = {
