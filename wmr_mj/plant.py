@@ -46,7 +46,7 @@ __all__ = [
     "BEAM_PITCH_RATIO",
 ]
 
-MODELS_DIR = Path(__file__).resolve().parent.parent / "models"
+from .resources import MODELS_DIR  # noqa: E402  (re-exported)
 TIMESTEP = 1e-3  # s, physics step (the paper's controller runs at every step)
 # Beams are slender rods: their inertia about their own axis is set to this
 # fraction of the transverse one (MuJoCo needs it > 0; it never matters here).
