@@ -1,12 +1,13 @@
-# wmr-mj: `make demo` runs the headline job headless; `make test` runs the suite.
+# wmr-mj: `make demo` runs the headline job headless; `make test` lints, then runs the suite
+# (tests/test_wheel.py included: it builds the wheel and runs it from a fresh virtualenv).
 PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test venv bench clean
+.PHONY: demo test lint venv bench clean
 
-$(STAMP): pyproject.toml
+$(STAMP): pyproject.toml setup.py
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
 	$(PY) -m pip install -q -e '.[test,dask,video]'
@@ -17,7 +18,10 @@ venv: $(STAMP)
 demo: $(STAMP)
 	$(VENV)/bin/wmr-mj validate
 
-test: $(STAMP)
+lint: $(STAMP)
+	$(VENV)/bin/ruff check .
+
+test: lint
 	$(PY) -m pytest
 
 bench: $(STAMP)
@@ -26,4 +30,4 @@ bench: $(STAMP)
 	$(PY) bench/bench_sweep.py
 
 clean:
-	rm -rf $(VENV) build *.egg-info
+	rm -rf $(VENV) build dist *.egg-info .ruff_cache

@@ -17,6 +17,8 @@ __all__ = [
     "InfeasiblePathError",
     "LogError",
     "SchedulerError",
+    "OutputPathError",
+    "NotEnoughMemoryError",
 ]
 
 
@@ -60,3 +62,12 @@ class LogError(WmrMjError):
 
 class SchedulerError(WmrMjError):
     """A Dask scheduler cannot be reached or used."""
+
+
+class OutputPathError(WmrMjError):
+    """An output file or folder cannot be created or written (missing permission, a file in
+    the way, a read-only file system)."""
+
+
+class NotEnoughMemoryError(WmrMjError):
+    """A job would need more memory than the machine has available; refused before it starts."""

@@ -27,7 +27,8 @@ def int_at_least(minimum: int):
         try:
             value = int(text)
         except ValueError:
-            raise argparse.ArgumentTypeError(f"{text!r} is not an integer; an integer >= {minimum} is accepted") from None
+            raise argparse.ArgumentTypeError(
+                f"{text!r} is not an integer; an integer >= {minimum} is accepted") from None
         if value < minimum:
             raise argparse.ArgumentTypeError(f"{text!r} is not accepted; an integer >= {minimum} is required")
         return value
@@ -39,7 +40,8 @@ def int_at_least(minimum: int):
 positive_int = int_at_least(1)
 
 
-def parse_assignments(items: list[str] | None, *, option: str = "--param", example: str = "mu=0.02") -> dict[str, float]:
+def parse_assignments(items: list[str] | None, *, option: str = "--param",
+                      example: str = "mu=0.02") -> dict[str, float]:
     """``NAME=VALUE`` pairs (``--param l3=0.15``) into a dict; bad syntax raises ParameterError."""
     from ..errors import ParameterError
 
@@ -57,9 +59,9 @@ def parse_assignments(items: list[str] | None, *, option: str = "--param", examp
 
 def print_json(obj: Any) -> None:
     """One JSON object on stdout; non-finite numbers become null."""
-    from ..io import _clean
+    from ..io import json_safe
 
-    json.dump(_clean(obj), sys.stdout, indent=2, sort_keys=True, allow_nan=False, default=float)
+    json.dump(json_safe(obj), sys.stdout, indent=2, sort_keys=True, allow_nan=False, default=float)
     sys.stdout.write("\n")
 
 

@@ -29,9 +29,10 @@ def default_folder(prefix: str) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..io import check_output_path
     from ..plots import paper_example, paper_figures, write_figures
 
-    out = args.out or default_folder("figures")
+    out = check_output_path(args.out or default_folder("figures"), kind="dir", option="--out")
     example = paper_example(duration=args.duration)
     paths = write_figures(paper_figures(example), out)
     for path in paths:

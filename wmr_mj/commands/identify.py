@@ -20,10 +20,12 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..identify import COEFFICIENT_NAMES, identify_plant
-    from ..io import write_json_atomic
+    from ..io import check_output_path, write_json_atomic
     from ..params import C80, with_params
     from ._common import print_json
 
+    if args.out:  # before the identification, which takes a while
+        check_output_path(args.out, kind="file", option="--out")
     params = with_params(C80, m1=args.m1, **parse_assignments(args.param))
     result = identify_plant(params, duration=args.duration, seed=args.seed)
     obj = result.as_dict()
@@ -36,13 +38,15 @@ def run(args: argparse.Namespace) -> int:
     se = result.diagnostics["std_error"]
     print(f"Steering identification of the MuJoCo plant: m1 = {params.m1:g} kg, {args.duration:g} s, seed {args.seed}, "
           f"{result.diagnostics['samples']} samples, residual {result.diagnostics['residual_rms_V']:.3g} V rms")
-    print(f"{'coef':5s} {'identified':>12s} {'+-':>8s} {'paper':>10s} {'diff':>8s} {'nonholon.':>10s} {'diff':>8s}  unit")
+    print(f"{'coef':5s} {'identified':>12s} {'+-':>8s} {'paper':>10s} {'diff':>8s} {'nonholon.':>10s} "
+          f"{'diff':>8s}  unit")
     rel = {name: result.relative_difference(name) for name in ("paper", "nonholonomic")}
     for k in COEFFICIENT_NAMES:
         cells = []
         for name in ("paper", "nonholonomic"):
             r = rel[name][k]
-            cells.append(f"{getattr(result.predicted[name], k):10.4g} {('   n/a' if r is None else f'{100 * r:+7.1f}%'):>8s}")
+            diff = "   n/a" if r is None else f"{100 * r:+7.1f}%"
+            cells.append(f"{getattr(result.predicted[name], k):10.4g} {diff:>8s}")
         print(f"{k:5s} {getattr(result.identified, k):12.5g} {se[k]:8.2g} {cells[0]} {cells[1]}  {units[k]}")
     print(result.verdict())
     if args.out:

@@ -12,7 +12,6 @@ import argparse
 
 from ._common import int_at_least, positive_float, positive_int
 
-
 _nonneg_int = int_at_least(0)
 
 
@@ -41,8 +40,15 @@ def run(args: argparse.Namespace) -> int:
     import sys
     import time
 
-    from ..report import (ValidateSettings, format_identification_table, format_verdict_table, json_summary,
-                          run_validate, write_pointer)
+    from ..io import check_output_path
+    from ..report import (
+        ValidateSettings,
+        format_identification_table,
+        format_verdict_table,
+        json_summary,
+        run_validate,
+        write_pointer,
+    )
     from ._common import print_json
     from .figures import default_folder
 
@@ -50,6 +56,7 @@ def run(args: argparse.Namespace) -> int:
     settings = ValidateSettings(n=args.n, seed=args.seed, sampling=args.sampling, duration=args.duration,
                                 identify_duration=args.identify_duration, nthread=args.nthread)
     out = args.out or default_folder("validate")
+    check_output_path(out, kind="dir", option="--out")
     summary = run_validate(settings, out)
     pointer = write_pointer(out)
     wall = time.perf_counter() - t0
