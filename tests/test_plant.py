@@ -11,7 +11,19 @@ import numpy as np
 import pytest
 
 from wmr_mj import C80, ModelFileError, ParameterError, UnknownNameError, with_params
-from wmr_mj.plant import MODELS_DIR, Plant, compile_model, load_model_file, robot_xml, scene_file_xml
+from wmr_mj.plant import (
+    MODELS_DIR,
+    STEERING_FRICTION_MODELS,
+    TYRE_CONTACT_MODELS,
+    Plant,
+    compile_model,
+    load_model_file,
+    robot_spec,
+    robot_xml,
+    scene_file_xml,
+    scene_spec,
+    scene_xml,
+)
 
 
 def _mass_and_inertia_about(model, data, body_names, point, axis):
@@ -38,38 +50,144 @@ def test_compiled_model_equals_parameter_set(params):
     mujoco.mj_forward(model, data)
     z = np.array([0.0, 0.0, 1.0])
     # masses
-    assert model.body("chassis").mass[0] == params.m1
+    # every number enters the MJCF with 6 significant digits: relative error <= 5e-6
+    rel = 5e-6
+    assert model.body("chassis").mass[0] == pytest.approx(params.m1, rel=rel)
     rear = ["drive_unit", "rear_left_wheel", "rear_right_wheel"]
     front = ["steering_unit", "front_left_wheel", "front_right_wheel"]
-    assert sum(model.body(n).mass[0] for n in rear) == pytest.approx(params.m2, rel=1e-12)
-    assert sum(model.body(n).mass[0] for n in front) == pytest.approx(params.m3, rel=1e-12)
+    assert sum(model.body(n).mass[0] for n in rear) == pytest.approx(params.m2, rel=rel)
+    assert sum(model.body(n).mass[0] for n in front) == pytest.approx(params.m3, rel=rel)
     # chassis inertia and CoM
-    assert np.allclose(model.body("chassis").inertia, params.chassis_inertia, rtol=1e-12)
+    assert np.allclose(model.body("chassis").inertia, params.chassis_inertia, rtol=rel)
     assert np.allclose(data.xipos[model.body("chassis").id][:2], [params.l3, 0.0])
     # steering unit yaw inertia about the pivot, computed from the compiled bodies
     pivot = data.xanchor[model.joint("steer").id]
     _, J_yaw = _mass_and_inertia_about(model, data, front, pivot, z)
-    assert J_yaw == pytest.approx(params.steering_yaw_inertia, rel=1e-9)
+    assert J_yaw == pytest.approx(params.steering_yaw_inertia, rel=rel)
     # wheel spin inertia and radii
-    assert model.body("front_left_wheel").inertia[1] == pytest.approx(params.I_y3)
-    assert model.body("rear_left_wheel").inertia[1] == pytest.approx(params.I_y2)
-    assert model.geom("front_left_contact").size[0] == params.r3
-    assert model.geom("rear_left_contact").size[0] == params.r2
+    assert model.body("front_left_wheel").inertia[1] == pytest.approx(params.I_y3, rel=rel)
+    assert model.body("rear_left_wheel").inertia[1] == pytest.approx(params.I_y2, rel=rel)
+    assert model.geom("front_left_contact").size[0] == pytest.approx(params.r3, rel=rel)
+    assert model.geom("rear_left_contact").size[0] == pytest.approx(params.r2, rel=rel)
     # geometry: wheelbase and tracks
     A = data.site_xpos[model.site("A").id]
     C = data.site_xpos[model.site("C").id]
-    assert np.linalg.norm((C - A)[:2]) == pytest.approx(params.l1, abs=1e-12)
+    assert np.linalg.norm((C - A)[:2]) == pytest.approx(params.l1, rel=rel)
     for side, half in (("rear_left", params.l2), ("front_left", params.l4)):
         y = data.xpos[model.body(f"{side}_wheel").id][1]
-        assert y == pytest.approx(half, abs=1e-12)
+        assert y == pytest.approx(half, rel=rel)
     # motor, gear, friction, limits
     act = model.actuator("steering_motor").id
-    assert model.actuator_gear[act][0] == params.i2
+    assert model.actuator_gear[act][0] == pytest.approx(params.i2, rel=rel)
+    assert model.actuator_dyntype[act] == mujoco.mjtDyn.mjDYN_DCMOTOR
     assert np.allclose(model.actuator_ctrlrange[act], [-params.voltage_limit, params.voltage_limit])
     j = model.joint("steer").id
-    assert model.dof_frictionloss[model.jnt_dofadr[j]] == pytest.approx(params.l3 * params.l4 / params.l1 * params.mu * params.Q)
-    assert np.allclose(model.jnt_range[j], [-params.steering_range, params.steering_range])
+    assert model.dof_frictionloss[model.jnt_dofadr[j]] == pytest.approx(
+        params.l3 * params.l4 / params.l1 * params.mu * params.Q, rel=rel)
+    assert np.allclose(model.jnt_range[j], [-params.steering_range, params.steering_range], rtol=rel)
     assert model.opt.timestep == 1e-3
+
+
+def _model_arrays(model: mujoco.MjModel) -> dict[str, object]:
+    """Every array and scalar of an MjModel and its options, by name."""
+    out = {}
+    for owner, prefix in ((model, ""), (model.opt, "opt.")):
+        for name in dir(owner):
+            if name.startswith("_"):
+                continue
+            try:
+                value = getattr(owner, name)
+            except Exception:  # noqa: BLE001  (some properties need a context)
+                continue
+            if isinstance(value, (np.ndarray, int, float)):
+                out[prefix + name] = value
+    return out
+
+
+def _differing(a: mujoco.MjModel, b: mujoco.MjModel) -> list[str]:
+    fa, fb = _model_arrays(a), _model_arrays(b)
+    assert fa.keys() == fb.keys()
+    return [k for k in fa if not np.array_equal(fa[k], fb[k])]
+
+
+@pytest.mark.parametrize("steering_friction", STEERING_FRICTION_MODELS)
+@pytest.mark.parametrize("params", [C80, with_params(C80, m1=613.7, mu=0.0213, l1=0.6531)])
+def test_mjspec_xml_round_trips(params, steering_friction):
+    """The model compiled from the written XML is the one compiled from the MjSpec, field for field."""
+    from_spec = scene_spec(params, steering_friction=steering_friction).compile()
+    from_xml, xml = compile_model(params, steering_friction=steering_friction)
+    assert xml == scene_xml(params, steering_friction=steering_friction)
+    assert _differing(from_spec, from_xml) == []
+    assert _differing(robot_spec(params).compile(), mujoco.MjModel.from_xml_string(robot_xml(params))) == []
+    # the first of the mass changes is visible (the test can fail)
+    assert _differing(from_xml, compile_model(C80 if params is not C80 else with_params(C80, m1=651.0))[0])
+
+
+def test_scene_file_with_include_compiles_to_the_simulated_model(tmp_path):
+    """models/scene.xml (which includes c80.xml) == the one-string scene that runs simulate."""
+    (tmp_path / "c80.xml").write_text(robot_xml(C80))
+    (tmp_path / "scene.xml").write_text(scene_file_xml(C80))
+    assert _differing(load_model_file(tmp_path / "scene.xml"), compile_model(C80)[0]) == []
+
+
+def _significant_digits(text: str) -> dict[str, int]:
+    """Every number in the attribute values of an XML text -> its count of significant digits."""
+    import re
+
+    numbers = re.findall(r'(?<=[" ])-?\d+\.?\d*(?:e[-+]?\d+)?(?=[" ])', text)
+    return {n: len(n.lstrip("-").split("e")[0].replace(".", "").lstrip("0").rstrip("0") or "0") for n in numbers}
+
+
+def test_xml_numbers_have_at_most_7_significant_digits():
+    # the check sees the old f-string model's 17-digit numbers
+    assert max(_significant_digits('diaginertia="44.01041666666666 170.76 205.021"').values()) == 16
+    params = with_params(C80, m1=613.7, mu=0.0213, l1=0.6531)  # numbers with long expansions
+    for text in (robot_xml(params), scene_file_xml(params), scene_xml(params, steering_friction="soft")):
+        digits = _significant_digits(text)
+        assert len(digits) > 10  # distinct numbers
+        assert max(digits.values()) <= 7, {n: k for n, k in digits.items() if k > 7}
+
+
+def test_names_other_code_uses_are_in_the_model():
+    model, _ = compile_model(C80)
+    for kind, names in {
+        "body": ("chassis", "drive_unit", "steering_unit", "rear_left_wheel", "rear_right_wheel", "front_left_wheel",
+                 "front_right_wheel"),
+        "joint": ("chassis_free", "steer", "rear_left_spin", "rear_right_spin", "front_left_spin", "front_right_spin"),
+        "site": ("A", "C"),
+        "actuator": ("steering_motor", "drive"),
+        "tendon": ("differential",),
+        "sensor": ("steer_angle", "steer_rate", "steer_motor_torque", "steer_joint_torque", "A_pos", "C_pos",
+                   "chassis_quat", "A_vel"),
+        "key": ("home",),
+    }.items():
+        for name in names:
+            getattr(model, kind)(name)  # raises KeyError when missing
+    assert model.actuator_trntype[model.actuator("drive").id] == mujoco.mjtTrn.mjTRN_TENDON
+    assert model.actuator_dyntype[model.actuator("steering_motor").id] == mujoco.mjtDyn.mjDYN_DCMOTOR
+    xml = robot_xml(C80)
+    for cls in ("wheel", "steer", "visual", "collision"):
+        assert f'<default class="{cls}">' in xml
+    assert xml.index("<default>") < xml.index("<worldbody>")
+
+
+@pytest.mark.parametrize("name,option", [("steering_friction", "bogus"), ("tyre_contact", "rubber")])
+def test_unknown_friction_or_contact_model_is_an_unknown_name(name, option):
+    with pytest.raises(UnknownNameError, match="valid") as info:
+        Plant(C80, **{name: option})
+    valid = STEERING_FRICTION_MODELS if name == "steering_friction" else TYRE_CONTACT_MODELS
+    assert all(v in str(info.value) for v in valid)
+    with pytest.raises(UnknownNameError):
+        compile_model(C80, **{name: option})
+
+
+def test_friction_models_differ_only_in_the_steering_joints_solver_parameters():
+    stiff, _ = compile_model(C80, steering_friction="stiction")
+    soft, _ = compile_model(C80, steering_friction="soft")
+    assert sorted(_differing(stiff, soft)) == ["dof_solimp", "dof_solref"]
+    dof = stiff.jnt_dofadr[stiff.joint("steer").id]
+    changed = np.flatnonzero(np.any(stiff.dof_solref != soft.dof_solref, axis=1))
+    assert changed.tolist() == [dof]
 
 
 def test_dcmotor_torque_is_equation_2_9():
@@ -171,5 +289,6 @@ def test_every_model_file_steps_without_warnings(path):
         mujoco.mj_resetDataKeyframe(model, data, model.key("home").id)
     for _ in range(10_000):
         mujoco.mj_step(model, data)
-    assert all(w.number == 0 for w in data.warning), [mujoco.mjtWarning(i).name for i, w in enumerate(data.warning) if w.number]
+    raised = [mujoco.mjtWarning(i).name for i, w in enumerate(data.warning) if w.number]
+    assert not raised, raised
     assert np.all(np.isfinite(data.qpos))

@@ -112,11 +112,15 @@ def _multisine(rng: np.random.Generator, t: np.ndarray, freqs: np.ndarray, ampli
 
 
 def excite_plant(params: C80Parameters = C80, *, duration: float = 60.0, seed: int = 0,
-                 angle_amplitude: float = 0.75, dither_amplitude: float = 4.0) -> Excitation:
-    """Drive the MuJoCo plant at V_A and excite its steering; record every step."""
+                 angle_amplitude: float = 0.75, dither_amplitude: float = 4.0,
+                 steering_friction: str = "stiction", tyre_contact: str = "stiff") -> Excitation:
+    """Drive the MuJoCo plant at V_A and excite its steering; record every step.
+
+    steering_friction, tyre_contact: the plant's friction and contact laws (``wmr_mj.plant``).
+    """
     if not math.isfinite(duration) or duration <= 0:
         raise ParameterError(f"duration = {duration!r} s must be finite and > 0")
-    plant = Plant(params)
+    plant = Plant(params, steering_friction=steering_friction, tyre_contact=tyre_contact)
     m, d = plant.model, plant.data
     dt = m.opt.timestep
     n = int(round(duration / dt))
@@ -187,7 +191,7 @@ class IdentificationResult:
         g_id, g_nh = self.identified.gyro, self.predicted["nonholonomic"].gyro
         return (
             f"K (sin/cos^3 coefficient): the plant shows {K_id:.4g} V (+-{se.get('K', float('nan')):.2g}), "
-            f"{100 * K_id / K_paper:.1f}% of the paper's (2.7) prediction {K_paper:.4g} V; "
+            f"{100 * K_id / K_paper:.2g}% of the paper's (2.7) prediction {K_paper:.4g} V; "
             f"the non-holonomic model predicts 0. "
             f"gyro (V_A alpha'/cos^2 coefficient): the plant shows {g_id:.4g} V s/m, "
             f"{100 * g_id / g_nh:.1f}% of the non-holonomic prediction {g_nh:.4g}; the paper's model has none."
@@ -195,9 +199,14 @@ class IdentificationResult:
 
 
 def identify_plant(params: C80Parameters = C80, *, duration: float = 60.0, seed: int = 0,
-                   min_rate: float = 0.02) -> IdentificationResult:
-    """Excite the MuJoCo plant for ``duration`` s and fit the steering model."""
-    exc = excite_plant(params, duration=duration, seed=seed)
+                   min_rate: float = 0.02, steering_friction: str = "stiction",
+                   tyre_contact: str = "stiff") -> IdentificationResult:
+    """Excite the MuJoCo plant for ``duration`` s and fit the steering model.
+
+    steering_friction, tyre_contact: the plant's friction and contact laws (``wmr_mj.plant``).
+    """
+    exc = excite_plant(params, duration=duration, seed=seed, steering_friction=steering_friction,
+                       tyre_contact=tyre_contact)
     coeffs, diag = fit_steering_model(exc.alpha, exc.alpha_dot, exc.alpha_ddot, exc.voltage, exc.speed,
                                       min_rate=min_rate, max_angle=params.steering_range - 0.02)
     diag["mujoco_warnings"] = int(exc.warnings)

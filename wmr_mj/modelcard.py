@@ -8,9 +8,17 @@ from __future__ import annotations
 
 import mujoco
 
+from .friction import (
+    HOLD_RATE,
+    FrictionLaw,
+    contact_softness_of,
+    measure_contact_softness,
+    measure_friction_law,
+    wheel_penetration,
+)
 from .identify import identify_plant
 from .params import C80, PARAMETER_SOURCES, C80Parameters, with_params
-from .plant import measure_side_slip
+from .plant import STEERING_FRICTION_MODELS, STICTION_SOLIMP, STICTION_SOLREF, TYRE_CONTACT_SOLREF, measure_side_slip
 
 __all__ = ["render_model_card"]
 
@@ -28,6 +36,24 @@ def _g(x: float, digits: int = 4) -> str:
     return f"{x:.{digits}g}"
 
 
+def _rate(x: float) -> str:
+    """A steering rate with a unit that keeps it readable."""
+    x = abs(x)
+    if x < 1e-3:
+        return f"{1e6 * x:.3g} µrad/s"
+    if x < 1e-2:
+        return f"{1e3 * x:.3g} mrad/s"
+    return f"{x:.3g} rad/s"
+
+
+def _depth(x: float) -> str:
+    return f"{1e6 * x:.3g} µm" if x < 1e-4 else f"{1e3 * x:.3g} mm"
+
+
+def _nums(values) -> str:
+    return " ".join(f"{v:g}" for v in values)
+
+
 def render_model_card(params: C80Parameters = C80) -> str:
     p = params
     lo, hi = with_params(p, m1=550.0), with_params(p, m1=750.0)
@@ -36,6 +62,10 @@ def render_model_card(params: C80Parameters = C80) -> str:
     ke = p.kinetic_energy_coefficients()
     slip = measure_side_slip(p)
     ident = identify_plant(p, duration=60.0, seed=0)
+    laws = {name: measure_friction_law(p, steering_friction=name) for name in STEERING_FRICTION_MODELS}
+    stiction = laws["stiction"]
+    contacts = {"stiff": contact_softness_of("stiff", wheel_penetration(p), slip, ident),
+                "soft": measure_contact_softness(p, tyre_contact="soft")}
     se = ident.diagnostics["std_error"]
     out = []
     w = out.append
@@ -46,7 +76,9 @@ def render_model_card(params: C80Parameters = C80) -> str:
     w("")
     w("`c80.xml` is the robot (chassis, drive unit, steering unit, DC-motor steering joint); `scene.xml` includes it "
       "and adds the floor and light. Both are written by `wmr-mj model write` from one parameter set, "
-      "`wmr_mj.params.C80`; `wmr-mj model check` says whether the files match it.")
+      "`wmr_mj.params.C80`; `wmr-mj model check` says whether the files match it. The model is built with "
+      "`mujoco.MjSpec` (`wmr_mj.plant.robot_spec`, `scene_spec`) and written with its `to_xml`; every number enters "
+      "the spec rounded to 6 significant digits, so the files compile to the same model as the spec.")
     w("")
     w("## Parameter set")
     w("")
@@ -74,7 +106,7 @@ def render_model_card(params: C80Parameters = C80) -> str:
         a, b = getattr(paper_lo, k), getattr(paper_hi, k)
         interval = _PAPER_INTERVALS.get(k)
         w(f"| {k} | {_g(getattr(paper, k))} | ({_g(min(a, b))}, {_g(max(a, b))}) | "
-          f"{'(%g, %g)' % interval if interval else '-'} | {_g(getattr(nh, k))} | {units[k]} |")
+          f"{'({:g}, {:g})'.format(*interval) if interval else '-'} | {_g(getattr(nh, k))} | {units[k]} |")
     w("")
     w("K spans the paper's interval because m1 changes as a compact payload at the chassis centre of mass "
       "(`m1_inertia='payload'`, the reading of (2.3), where I_z1 does not depend on m1). Scaling the chassis inertia "
@@ -100,12 +132,27 @@ def render_model_card(params: C80Parameters = C80) -> str:
     w("- **Steering motor**: MuJoCo's native `dcmotor` actuator `steering_motor` in voltage mode: torque at the joint "
       "= i2 k (u − k i2 α')/R_a with k = sqrt(k_i k_b), i.e. (2.9)-(2.10) with α_m = i2 α and C_V = k_b i2 "
       "((2.11)'s k_b i2 α_m' double-counts i2; (2.13) is used). `ctrlrange` is the voltage limit. No rotor inertia "
-      "or inductance, as in the paper.")
-    w("- **Steering friction**: the Coulomb torque (l3 l4/l1) μ Q of (2.5) as the joint's `frictionloss`: the joint "
-      "holds still under any torque within ±that value, which (2.5)'s F sgn(α') does not describe at rest.")
+      "or inductance, as in the paper. `to_xml` writes it as a `general` actuator with dyntype, gaintype and "
+      "biastype `dcmotor`.")
+    w(f"- **Steering friction**: the Coulomb torque (l3 l4/l1) μ Q = {_g(p.steering_friction_torque)} N m of (2.5) "
+      "as the joint's `frictionloss`, a constraint MuJoCo solves softly. The `steer` class makes it stiff: "
+      f"`solreffriction=\"{_nums(STICTION_SOLREF)}\"` (a time constant of two 1 ms steps, the least MuJoCo "
+      f"uses at this step; smaller ones are clamped) and `solimpfriction=\"{_nums(STICTION_SOLIMP)}\"`. "
+      "Measured below: under constant voltages of 0.5 F and 0.9 F the joint creeps at "
+      f"{_rate(stiction.creep_rates[0.5])} and "
+      f"{_rate(stiction.creep_rates[0.9])}, it breaks away between "
+      f"{_g(stiction.breakaway_voltage - stiction.breakaway_resolution, 5)} and {_g(stiction.breakaway_voltage, 5)} V "
+      f"(F = {_g(stiction.friction_voltage, 5)} V), and at 1.3 F it slides at {_rate(stiction.slide_rates[1.3])}. "
+      "(2.5)'s F sgn(α') describes the sliding; at rest the friction "
+      "is a constraint torque that (2.5) does not describe. `steering_friction=\"soft\"` (`--steering-friction "
+      "soft`) keeps MuJoCo's default softness, under which the joint creeps at "
+      f"{_rate(laws['soft'].creep_rates[0.5])} at 0.5 F.")
     w("- **Wheels**: each touches the floor with one sphere (`*_contact`, radius r2 or r3, `condim` 3, friction "
       "`ground_friction`): one contact point, as the rolling-disc model assumes; the tyre cylinders are visual only. "
-      "Spin inertia ½ m r², diametral m(3r² + w²)/12.")
+      "Spin inertia ½ m r², diametral m(3r² + w²)/12. The spin joints have no friction, damping or armature, so no "
+      "soft friction constraint acts on them. The wheel spheres and the floor carry "
+      f"`solref=\"{_nums(TYRE_CONTACT_SOLREF)}\"` (see *Measured: tyre contacts*). The rolling-resistance arms "
+      "f2, f3 of (2.5) are listed above but not modelled in the MJCF.")
     w("- **Sensors**: `steer_angle`, `steer_rate`, `steer_motor_torque` (motor side; current = torque / k_i), "
       "`steer_joint_torque`, `A_pos`, `C_pos`, `chassis_quat` (heading), `A_vel`.")
     w("- **Keyframe `home`**: rolling straight ahead at V_A, wheels spinning at V_A/r, drive commanding i1 V_A/r2.")
@@ -115,8 +162,9 @@ def render_model_card(params: C80Parameters = C80) -> str:
     w(f"On the steady 1 m circle of C at V_A = {p.V_A:g} m/s (`wmr-mj model slip`, 30 s, after 10 s): the largest "
       f"side-slip speed of a wheel's contact point is {1e3 * slip['max_slip_m_s']:.3f} mm/s "
       f"({100 * slip['max_slip_fraction']:.2f}% of V_A, slip angle {1e3 * slip['max_slip_angle_rad']:.2f} mrad), "
-      f"rms {1e3 * slip['rms_slip_m_s']:.3f} mm/s. The soft contacts creep slightly; at the paper's speeds the wheels "
-      "roll without side slip to within that figure.")
+      f"rms {1e3 * slip['rms_slip_m_s']:.3f} mm/s, under side forces up to {100 * slip['max_side_force_ratio']:.2g}% "
+      "of a wheel's normal force. The contacts slip slightly (see *Measured: tyre contacts*); at the paper's speeds "
+      "the wheels roll without side slip to within that figure.")
     w("")
     w("## Measured: steering identification")
     w("")
@@ -126,8 +174,80 @@ def render_model_card(params: C80Parameters = C80) -> str:
     w("| coefficient | identified | ± (std. error) | paper model | non-holonomic model |")
     w("|---|---:|---:|---:|---:|")
     for k in ("P", "C_V", "F", "K", "gyro"):
-        w(f"| {k} | {_g(getattr(ident.identified, k))} | {_g(se[k], 2)} | {_g(getattr(paper, k))} | {_g(getattr(nh, k))} |")
+        w(f"| {k} | {_g(getattr(ident.identified, k))} | {_g(se[k], 2)} | {_g(getattr(paper, k))} "
+          f"| {_g(getattr(nh, k))} |")
     w("")
     w(ident.verdict())
     w("")
+    _friction_section(w, laws)
+    _contact_section(w, contacts)
     return "\n".join(out)
+
+
+def _friction_section(w, laws: dict[str, FrictionLaw]) -> None:
+    any_law = next(iter(laws.values()))
+    w("## Measured: steering friction law")
+    w("")
+    w(f"`wmr-mj model friction` (`wmr_mj.friction.measure_friction_law`): from the `home` keyframe with the cart "
+      f"driving at V_A, a constant steering voltage for {any_law.duration:g} s; the rate is read over the last second. "
+      f"F = (R_a/(k_i i2)) (l3 l4/l1) μ Q = {_g(any_law.friction_voltage, 5)} V is the friction voltage of (2.13) "
+      f"({_g(any_law.friction_torque, 5)} N m at the joint). Break-away is the least constant voltage whose rate "
+      f"exceeds {HOLD_RATE:g} rad/s, bracketed by a grid search on constant voltages from [0, 2F]; every voltage "
+      "tried below the bracket held within that rate. The sliding rate (2.13) predicts at u is (u − F)/C_V; the "
+      "non-holonomic model's gyroscopic term adds gyro V_A/cos²α to C_V, (u − F)/(C_V + gyro V_A) near α = 0.")
+    w("")
+    w("| friction model | break-away voltage | break-away torque | creep at 0.5 F | creep at 0.9 F | rate at 1.3 F "
+      "| (2.13) at 1.3 F | with gyro | holds below, slides above | MuJoCo warnings |")
+    w("|---|---|---:|---:|---:|---:|---:|---:|---|---:|")
+    for name, law in laws.items():
+        lo = law.breakaway_voltage - law.breakaway_resolution
+        w(f"| `{name}` | ({_g(lo, 5)}, {_g(law.breakaway_voltage, 5)}] V "
+          f"= {law.breakaway_voltage / law.friction_voltage:.4f} F | {_g(law.breakaway_torque, 4)} N m "
+          f"| {_rate(law.creep_rates[0.5])} | {_rate(law.creep_rates[0.9])} | {_rate(law.slide_rates[1.3])} "
+          f"| {_rate(law.predicted_slide_rates[1.3])} | {_rate(law.predicted_slide_rates_gyro[1.3])} "
+          f"| {'yes' if law.holds() else 'no'} | {law.mujoco_warnings} |")
+    w("")
+    soft = laws.get("soft")
+    if soft is not None:
+        w(f"With MuJoCo's default softness the joint does not hold: it creeps at {_rate(soft.creep_rates[0.5])} "
+          f"at 0.5 F and {_rate(soft.creep_rates[0.9])} at 0.9 F, and passes {HOLD_RATE:g} rad/s already at "
+          f"{_g(soft.breakaway_voltage / soft.friction_voltage, 2)} F. Both laws slide alike above F, at the rate "
+          "of the non-holonomic model with its gyroscopic term, below (2.13)'s (u − F)/C_V.")
+        w("")
+
+
+def _contact_section(w, contacts) -> None:
+    stiff, soft = contacts["stiff"], contacts["soft"]
+    w("## Measured: tyre contacts")
+    w("")
+    w("Contact friction in MuJoCo is soft like `frictionloss` (MuJoCo's modeling guide, *Friction*): a wheel under a "
+      "side force slips sideways at a speed that grows with the force, and the contact's normal direction is a "
+      "stiff spring. Where it matters to the steering: "
+      "the chassis must follow the steered axle for the gyroscopic torque to act (identification, 60 s, seed 0), and "
+      "the wheels should roll without side slip as the rolling-disc model assumes (side slip on the 1 m circle, as "
+      "above). `tyre_contact=\"soft\"` is MuJoCo's default `solref`.")
+    w("")
+    w("| tyre contact | solref | penetration rear / front | largest side-slip angle | cornering coefficient "
+      "| identified gyro | identified K | identified P |")
+    w("|---|---|---|---:|---|---:|---:|---:|")
+    for name, c, ref in (("stiff", stiff, _nums(TYRE_CONTACT_SOLREF)), ("soft", soft, "0.02 1")):
+        lo, hi = c.cornering_coefficient
+        w(f"| `{name}` | {ref} | {_depth(c.penetration_rear)} / {_depth(c.penetration_front)} "
+          f"| {1e3 * c.max_slip_angle:.3g} mrad | {lo:.3g}-{hi:.3g} /rad "
+          f"| {_g(c.gyro)} ± {_g(c.gyro_std_error, 2)} V s/m | {_g(c.K, 3)} V | {_g(c.P)} V s²/rad |")
+    w("")
+    w("The cornering coefficient is a wheel's side/normal force ratio per radian of its slip angle on the circle at "
+      f"V_A = {C80.V_A:g} m/s (the slip speed, not the slip angle, follows the force, so the figure belongs to this "
+      "speed); a tyre's is its cornering stiffness over its load, C_α/F_z. The non-holonomic model predicts "
+      f"gyro = P/l1 = {_g(C80.coefficients('nonholonomic').gyro)} V s/m.")
+    w("")
+    lo, hi = stiff.cornering_coefficient
+    w("The decision, on physical grounds: rubber tyres have C_α/F_z of the order of 10-20 per rad (a typical range; "
+      f"the C80's tyres are not documented). MuJoCo's default contacts act as {soft.cornering_coefficient[0]:.2g}-"
+      f"{soft.cornering_coefficient[1]:.2g} per rad, several times more compliant sideways than a tyre, and give a "
+      f"gyro {100 * (1 - soft.gyro / stiff.gyro):.2g}% lower than the stiff ones; the stiff contacts act as "
+      f"{lo:.2g}-{hi:.2g} per rad, a tyre's order, so the plant keeps them. Their normal direction is stiffer than a "
+      "rubber tyre's (penetration of µm); that changes only the small K the tilting chassis leaves, below "
+      f"{100 * max(abs(stiff.K), abs(soft.K)) / C80.coefficients('paper').K:.2g}% of the paper's K "
+      "with either contact.")
+    w("")

@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import sys
 import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -33,8 +32,10 @@ from controllers import SteeringController, make_controller, model_from_source
 from controllers.computed_torque import CONTROLLER_NAMES, FRICTION_SIGNS, MODEL_SOURCES
 
 from .errors import ParameterError, UnknownNameError
+from .memory import require_run_memory
 from .params import C80, C80Parameters, parameter_names, with_params
-from .plant import TIMESTEP, Plant
+from .plant import STEERING_FRICTION_MODELS, TIMESTEP, TYRE_CONTACT_MODELS, Plant
+from .progress import progress_bar
 
 __all__ = [
     "RunConfig",
@@ -79,6 +80,8 @@ class RunConfig:
     m1_range: tuple[float, float] = (550.0, 750.0)
     box_ranges: Mapping[str, tuple[float, float]] = field(default_factory=dict)  # other ranged parameters
     seed: int = 0  # recorded; a single run draws nothing at random
+    steering_friction: str = "stiction"  # plant's steering friction law: one of STEERING_FRICTION_MODELS
+    tyre_contact: str = "stiff"  # plant's tyre-floor contact law: one of TYRE_CONTACT_MODELS
 
     def __post_init__(self) -> None:
         if self.controller not in CONTROLLER_NAMES:
@@ -91,6 +94,10 @@ class RunConfig:
             raise UnknownNameError("path", self.path, PATH_NAMES)
         if self.box not in ("derived", "paper"):
             raise UnknownNameError("box", self.box, ("derived", "paper"))
+        if self.steering_friction not in STEERING_FRICTION_MODELS:
+            raise UnknownNameError("steering friction model", self.steering_friction, STEERING_FRICTION_MODELS)
+        if self.tyre_contact not in TYRE_CONTACT_MODELS:
+            raise UnknownNameError("tyre contact model", self.tyre_contact, TYRE_CONTACT_MODELS)
         for name in ("m1", "duration", "kp", "kd"):
             value = getattr(self, name)
             if not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
@@ -221,29 +228,6 @@ def _substeps(config: RunConfig, timestep: float) -> int:
     return n
 
 
-class _Progress:
-    """A one-line progress bar on a terminal; silent when stderr is not one."""
-
-    def __init__(self, total: int, enabled: bool | None = None):
-        self.total = max(total, 1)
-        self.enabled = sys.stderr.isatty() if enabled is None else enabled
-        self.next = 0
-
-    def update(self, done: int) -> None:
-        if not self.enabled or done < self.next:
-            return
-        frac = done / self.total
-        bar = "#" * int(30 * frac)
-        sys.stderr.write(f"\r[{bar:<30s}] {100 * frac:5.1f}%")
-        sys.stderr.flush()
-        self.next = done + self.total // 100
-
-    def close(self) -> None:
-        if self.enabled:
-            sys.stderr.write("\r" + " " * 40 + "\r")
-            sys.stderr.flush()
-
-
 def report(config: RunConfig, *, analysis, params: C80Parameters, settle_s: float, sup_E: float, sup_Edot: float,
            sup_E_settled: float, sup_Edot_settled: float, saturated_fraction: float, left_range_at: float | None,
            final_alpha: float, control_steps: int, steps: int, wall_s: float, status: str) -> dict[str, Any]:
@@ -301,19 +285,21 @@ def run_closed_loop(
     """Run ``config`` on the MuJoCo plant; optionally stream rows to an MCAP logger.
 
     logger_factory(mjcf_xml=..., config=..., parameters=..., initial_state=..., timestep=...,
-    control_substeps=..., reference_path=...) returns a ``wmr_mj.mcaplog.RunLogger``; it
+    control_substeps=..., reference_path=..., bounds={"E_max", "Edot_max"}, model=the compiled
+    plant) returns a ``wmr_mj.mcaplog.RunLogger``; it
     receives a block of rows every simulated second and is closed with the summary,
     also when the run is interrupted (KeyboardInterrupt or SIGTERM).
     """
     params = plant_parameters(config, base)
     estimate = estimate_parameters(base)
     controller = _controller(config, estimate)
-    plant = Plant(params)
+    plant = Plant(params, steering_friction=config.steering_friction, tyre_contact=config.tyre_contact)
     m, d = plant.model, plant.data
     dt = m.opt.timestep
     substeps = _substeps(config, dt)
     period = substeps * dt
     n = int(round(config.duration / period))
+    require_run_memory(duration_s=n * period, control_period_s=period)  # before the arrays
     reference, settle_s = build_reference(config.path, estimate, dt=period, duration=n * period)
     analysis = analysis_for(config, reference, estimate, estimate=_estimate_of(controller))
     a0_all, a0d_all, a0dd_all = reference.alpha0, reference.alpha0_dot, reference.alpha0_ddot
@@ -323,16 +309,17 @@ def run_closed_loop(
     full = logger_factory is not None
     block_len = max(1, int(round(1.0 / period)))  # one simulated second per block
     rows = {k: np.empty(n) for k in ROW_FIELDS}
-    if full:
-        ext = {"A_pos": np.empty((block_len, 2)), "C_pos": np.empty((block_len, 2)),
-               "qpos": np.empty((block_len, m.nq)), "qvel": np.empty((block_len, m.nv)),
-               "ctrl": np.empty((block_len, m.nu))}
+    if full:  # per logged row: qpos, qvel, ctrl in one mj_getState call, and the site positions
+        log_spec = int(mujoco.mjtState.mjSTATE_QPOS | mujoco.mjtState.mjSTATE_QVEL | mujoco.mjtState.mjSTATE_CTRL)
+        log_state = np.empty((block_len, mujoco.mj_stateSize(m, log_spec)))
+        log_sites = np.empty((block_len, m.nsite, 3))
     logger = None
     if full:
         state = np.empty(mujoco.mj_stateSize(m, mujoco.mjtState.mjSTATE_INTEGRATION))
         mujoco.mj_getState(m, d, state, mujoco.mjtState.mjSTATE_INTEGRATION)
         logger = logger_factory(mjcf_xml=plant.xml, config=config.as_dict(), parameters=params.as_dict(),
                                 initial_state=state, timestep=dt, control_substeps=substeps,
+                                bounds={"E_max": analysis.E_max, "Edot_max": analysis.Edot_max}, model=m,
                                 reference_path=np.asarray(reference.C_xy)[::max(1, len(reference.C_xy) // 2000)])
 
     qpos, qvel, ctrl = d.qpos, d.qvel, d.ctrl
@@ -347,7 +334,7 @@ def run_closed_loop(
     r_E, r_Ed, r_uc, r_u, r_i, r_tau, r_h = rows["E"], rows["E_dot"], rows["voltage_cmd"], rows["voltage"], rows["current"], rows["steer_torque"], rows["heading"]
     saturated = 0
     left_range_at = None
-    bar = _Progress(n, progress)
+    bar = progress_bar(n, desc="run", unit="step", unit_scale=True, enabled=progress)
     status = "completed"
     k = 0
     block_start = 0
@@ -360,10 +347,11 @@ def run_closed_loop(
         sl = slice(block_start, upto)
         block = {key: rows[key][sl] for key in ROW_FIELDS}
         cnt = upto - block_start
-        for key, buf in ext.items():
-            block[key] = buf[:cnt].copy()
+        st, nq, nv = log_state[:cnt], m.nq, m.nv
+        block.update(qpos=st[:, :nq].copy(), qvel=st[:, nq:nq + nv].copy(), ctrl=st[:, nq + nv:].copy(),
+                     A_pos=log_sites[:cnt, site_A, :2].copy(), C_pos=log_sites[:cnt, site_C, :2].copy())
+        block_start = upto  # first: an interrupt raised as the block is written must not send it twice
         logger.write_block(block)
-        block_start = upto
 
     try:
         while k < n:
@@ -380,9 +368,7 @@ def run_closed_loop(
             ctrl[act] = u
             if full:
                 j = k - block_start
-                ext["qpos"][j] = qpos
-                ext["qvel"][j] = qvel
-                ext["ctrl"][j] = ctrl
+                mujoco.mj_getState(m, d, log_state[j], log_spec)
             for _ in range(substeps):
                 mujoco.mj_step(m, d)
             # after mj_step, forces and kinematics belong to the state the step started from
@@ -401,15 +387,14 @@ def run_closed_loop(
             q = xquat[chassis]
             r_h[k] = math.atan2(2.0 * (q[0] * q[3] + q[1] * q[2]), 1.0 - 2.0 * (q[2] * q[2] + q[3] * q[3]))
             if full:
-                ext["A_pos"][j] = site_xpos[site_A][:2]
-                ext["C_pos"][j] = site_xpos[site_C][:2]
+                log_sites[j] = site_xpos
             if left_range_at is None and abs(a) >= range_limit:
                 left_range_at = k * period
             k += 1
             if full and k - block_start == block_len:
                 flush(k)
             if k & 1023 == 0:
-                bar.update(k)
+                bar.update(1024)
     except KeyboardInterrupt:
         status = "interrupted"
     finally:

@@ -12,24 +12,35 @@ def add_run_options(p: argparse.ArgumentParser) -> None:
     """Options shared by ``run`` and ``sweep`` (the closed-loop configuration)."""
     from controllers.computed_torque import CONTROLLER_NAMES, FRICTION_SIGNS, MODEL_SOURCES
 
+    from ..plant import STEERING_FRICTION_MODELS, TYRE_CONTACT_MODELS
     from ..simulate import PATH_NAMES
 
     p.add_argument("--controller", default="computed-torque", help=f"one of {', '.join(CONTROLLER_NAMES)}")
     p.add_argument("--model", default="paper", help=f"model source of the estimate: one of {', '.join(MODEL_SOURCES)}")
     p.add_argument("--identified", metavar="PATH",
-                   help="JSON from `wmr-mj identify --out` for --model identified (default: identify the nominal plant now)")
-    p.add_argument("--coef", action="append", metavar="NAME=VALUE", help="coefficient for --model explicit (P, C_V, F, K, gyro)")
+                   help="JSON from `wmr-mj identify --out` for --model identified "
+                        "(default: identify the nominal plant now)")
+    p.add_argument("--coef", action="append", metavar="NAME=VALUE",
+                   help="coefficient for --model explicit (P, C_V, F, K, gyro)")
     p.add_argument("--duration", type=positive_float, default=35.0, help="simulated time, s (default 35)")
     p.add_argument("--control-period", type=positive_float, default=None,
                    help="controller period, s, a multiple of the 1 ms physics step (default: every step)")
     p.add_argument("--kp", type=positive_float, default=None, help="K_P, 1/s^2 (default 6)")
     p.add_argument("--kd", type=positive_float, default=None, help="K_D, 1/s (default 9)")
-    p.add_argument("--omega-r", type=positive_float, default=None, help="gains by (3.6): K_P = omega_r^2/4, K_D = omega_r")
-    p.add_argument("--friction-sign", default="measured", help=f"Coulomb compensation sign: one of {', '.join(FRICTION_SIGNS)}")
+    p.add_argument("--omega-r", type=positive_float, default=None,
+                   help="gains by (3.6): K_P = omega_r^2/4, K_D = omega_r")
+    p.add_argument("--friction-sign", default="measured",
+                   help=f"Coulomb compensation sign: one of {', '.join(FRICTION_SIGNS)}")
     p.add_argument("--friction-width", type=float, default=0.0,
                    help="smoothing of that sign, rad/s: x/sqrt(x^2+w^2) (default 0: exact sign)")
     p.add_argument("--path", default="paper-circle", help=f"reference path of point C: one of {', '.join(PATH_NAMES)}")
     p.add_argument("--param", action="append", metavar="NAME=VALUE", help="override a plant parameter (repeatable)")
+    p.add_argument("--steering-friction", default="stiction",
+                   help=f"plant's steering friction law: one of {', '.join(STEERING_FRICTION_MODELS)} (default "
+                        "stiction: holds below break-away; soft: MuJoCo's default frictionloss, creeps at mrad/s)")
+    p.add_argument("--tyre-contact", default="stiff",
+                   help=f"plant's tyre-floor contacts: one of {', '.join(TYRE_CONTACT_MODELS)} (default stiff; "
+                        "soft: MuJoCo's default solref, see models/README.md)")
     p.add_argument("--m1-inertia", default="payload", choices=("payload", "scale"),
                    help="m1 changes as a compact payload at the CoM (default) or scales the chassis inertia")
     p.add_argument("--box", default="derived", help="parameter box of the analysis: derived (from the parameter set "
@@ -66,7 +77,8 @@ def config_from_args(args: argparse.Namespace, **extra):
                      friction_width=args.friction_width, path=args.path,
                      plant_overrides=parse_assignments(args.param), m1_inertia=args.m1_inertia,
                      identified=identified, coefficients=coefficients, box=args.box,
-                     m1_range=tuple(args.m1_range), **extra)
+                     m1_range=tuple(args.m1_range), steering_friction=args.steering_friction,
+                     tyre_contact=args.tyre_contact, **extra)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -83,6 +95,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def default_log_path(config) -> str:
+    """logs/run-<time>-<model>-m<m1>.mcap for a RunConfig or the run command's arguments."""
     import time
 
     stamp = time.strftime("%Y%m%d-%H%M%S")
@@ -94,13 +107,16 @@ def format_report(s: dict) -> str:
     def ratio(x):
         return "n/a" if x is None else f"{x:.3f}"
 
+    after = f"after {s['settle_s']:.1f} s"
     lines = [
         f"controller {s['controller']} ({s['model']} model), plant m1 = {s['m1']:g} kg, K_P = {s['kp']:g}, "
         f"K_D = {s['kd']:g}, {s['duration']:g} s, {s['steps']} steps in {s['wall_s']:.2f} s "
         f"({s['realtime_factor']:.0f}x real time)",
-        f"{'':22s} {'whole run':>12s} {'after ' + format(s['settle_s'], '.1f') + ' s':>12s} {'bound':>12s} {'ratio':>8s}",
-        f"{'sup|E|   [rad]':22s} {s['sup_E']:12.5g} {s['sup_E_settled']:12.5g} {s['E_max']:12.5g} {ratio(s['E_ratio']):>8s}",
-        f"{'sup|E|dot [rad/s]':22s} {s['sup_Edot']:12.5g} {s['sup_Edot_settled']:12.5g} {s['Edot_max']:12.5g} {ratio(s['Edot_ratio']):>8s}",
+        f"{'':22s} {'whole run':>12s} {after:>12s} {'bound':>12s} {'ratio':>8s}",
+        f"{'sup|E|   [rad]':22s} {s['sup_E']:12.5g} {s['sup_E_settled']:12.5g} {s['E_max']:12.5g} "
+        f"{ratio(s['E_ratio']):>8s}",
+        f"{'sup|E|dot [rad/s]':22s} {s['sup_Edot']:12.5g} {s['sup_Edot_settled']:12.5g} {s['Edot_max']:12.5g} "
+        f"{ratio(s['Edot_ratio']):>8s}",
         f"analysis (4.23): {s['condition']:.4f} < 1: {'yes' if s['stable'] else 'no'}; errors "
         f"{'INSIDE' if s['inside'] else 'OUTSIDE'} the analytic region",
         f"voltage saturated {100 * s['saturated_fraction']:.1f}% of the time",
@@ -116,16 +132,23 @@ def run(args: argparse.Namespace) -> int:
     import functools
     import sys
 
+    from ..io import check_output_path
+    from ..memory import require_run_memory
+    from ..plant import TIMESTEP
     from ..simulate import run_closed_loop
     from ._common import print_json
 
-    config = config_from_args(args, m1=args.m1)
-    factory = None
+    # refuse what cannot work before anything runs (an identification for --model identified)
+    require_run_memory(duration_s=args.duration, control_period_s=args.control_period or TIMESTEP)
     path = None
     if not args.no_log:
+        path = args.out or default_log_path(args)
+        check_output_path(path, kind="file", option="--out")
+    config = config_from_args(args, m1=args.m1)
+    factory = None
+    if path is not None:
         from ..mcaplog import RunLogger
 
-        path = args.out or default_log_path(config)
         factory = functools.partial(RunLogger, path, log_every=args.log_every)
     from ..mcaplog import terminate_as_interrupt
 
