@@ -206,6 +206,42 @@ def test_unstable_gives_nulls(capsys):
     assert json.loads(capsys.readouterr().out)["E_max"] is None
 
 
+# ----------------------------------------------------------------- extreme gains (no overflow, no traceback)
+@pytest.mark.parametrize("kp,kd", [(1e308, 1e308), (1e308, 1.0), (1.0, 1e308), (1e-300, 1e300)])
+def test_extreme_gains_give_finite_gammas(kp, kd):
+    g1, g2 = exact_gammas(kp, kd)
+    assert math.isfinite(g1) and math.isfinite(g2) and g1 > 0 and g2 > 0
+    if kd * kd > 4 * kp or math.isinf(kd * kd):  # strongly over-damped: 1/K_P and ~2/K_D
+        assert g1 == pytest.approx(1.0 / kp)
+        assert g2 == pytest.approx(2.0 / kd, rel=1e-6)
+
+
+def test_gammas_accepted_over_stated_range():
+    rng = np.random.default_rng(0)
+    for _ in range(2000):
+        kp = 10.0 ** rng.uniform(-100, 100)
+        kd = math.sqrt(kp * 10.0 ** rng.uniform(-100, 100))
+        if not (1e-100 <= kd <= 1e100):
+            continue
+        g1, g2 = exact_gammas(kp, kd)
+        assert math.isfinite(g1) and math.isfinite(g2) and g1 > 0 and g2 > 0
+    # critical damping still matches (4.16) at the extremes
+    for kp in (1e-200, 1e200):
+        assert exact_gammas(kp, 2 * math.sqrt(kp)) == pytest.approx(paper_gammas(kp, 2 * math.sqrt(kp)), rel=1e-12)
+
+
+def test_cli_extreme_gains(capsys):
+    assert main(["robustness", "--kp", "1e308", "--kd", "1e308", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["stable"] is True and out["gamma1"] == pytest.approx(1e-308)
+    assert main(["robustness", "--kp", "1e300", "--kd", "1e-300"]) == 2  # gamma1 ~ 1e450
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err and "gamma1" in err and "accepted" in err
+    assert main(["robustness", "--kp", "5e-324", "--kd", "5e-324"]) == 2  # subnormal
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err and "smallest normal float" in err
+
+
 # ----------------------------------------------------------------- region vs LP
 REGION_CASES = [
     dict(),

@@ -65,6 +65,10 @@ Closed region (4.21)-(4.23): with (4.17) ||E|| <= gamma1 ||eta||, ||E'|| <= gamm
     condition = gamma1 delta2 + gamma2 delta3 < 1                                       (4.23)
     E_max     = gamma1 delta1 / (1 - condition),   Edot_max = gamma2 delta1 / (1 - condition)
 
+This is the paper's analysis ("the paper's claim"). :mod:`wmr_mj.certificate` redoes it
+for the controller actually run on the plant actually simulated (friction at rest by
+compensation mode, the gyroscopic term, K~ over the reachable angle, the supply).
+
 Usage::
 
     from wmr_mj.robustness import ParameterBox, analyse
@@ -82,6 +86,7 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import math
+import sys
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, Literal
@@ -124,6 +129,9 @@ def _check_gains(kp: float, kd: float) -> tuple[float, float]:
             raise ParameterError(f"gain {name} must be a number, got {value!r}") from None
         if not math.isfinite(v) or v <= 0.0:
             raise ParameterError(f"gain {name} = {value!r} is not accepted: a finite number > 0 is required")
+        if v < sys.float_info.min:  # subnormal: K_D/2 and the logs of the closed forms lose it
+            raise ParameterError(f"gain {name} = {value!r} is not accepted: a number >= "
+                                 f"{sys.float_info.min:.4g} (the smallest normal float) is required")
         out.append(v)
     return out[0], out[1]
 
@@ -139,6 +147,15 @@ def gains_from_omega_r(omega_r: float) -> tuple[float, float]:
     return _check_gains(0.25 * w * w, w)
 
 
+def _stiffness_ratio(kp: float, kd: float) -> float:
+    """r = K_P / a^2 = 4 K_P / K_D^2 (a = K_D/2); < 1 over-damped, > 1 under-damped.
+
+    Divided in two steps so that extreme but finite gains (1e308) do not overflow a^2.
+    """
+    a = 0.5 * kd
+    return (kp / a) / a
+
+
 def damping_regime(kp: float, kd: float) -> str:
     """'over-damped', 'critically damped' or 'under-damped' (K_D^2 vs 4 K_P).
 
@@ -146,24 +163,28 @@ def damping_regime(kp: float, kd: float) -> str:
     counts as critical); the gammas are continuous there anyway.
     """
     kp, kd = _check_gains(kp, kd)
-    d = kd * kd - 4.0 * kp
-    if abs(d) <= 1e-12 * 4.0 * kp:
+    r = _stiffness_ratio(kp, kd)
+    if abs(1.0 - r) <= 1e-12:
         return "critically damped"
-    return "over-damped" if d > 0.0 else "under-damped"
+    return "over-damped" if r < 1.0 else "under-damped"
 
 
-def _peak_time_scaled(y: float) -> float:
-    """a t* as a function of y = d / a^2 = 1 - K_P/a^2 (y <= 1), smooth through y = 0.
+def _peak_time_scaled(y: float, one_minus_y: float, log_r: float) -> float:
+    """a t* as a function of y = d / a^2 = 1 - r (r = K_P/a^2), smooth through y = 0.
 
     atanh(sqrt y)/sqrt y for y > 0, atan(sqrt(-y))/sqrt(-y) for y < 0: both are the
-    series 1 + y/3 + y^2/5 + ..., used near y = 0.
+    series 1 + y/3 + y^2/5 + ..., used near y = 0. ``one_minus_y`` (= r) and log r are
+    passed separately: 1 - y loses r when r < 1e-16, and r may underflow.
     """
     if abs(y) < 1e-6:
         return 1.0 + y / 3.0 + y * y / 5.0
     if y > 0.0:
         x = math.sqrt(y)
-        # atanh(x) = 0.5 log1p(2x/(1-x)), with 1 - x = (1 - y)/(1 + x) (no cancellation near x = 1)
-        return 0.5 * math.log1p(2.0 * x * (1.0 + x) / (1.0 - y)) / x
+        if one_minus_y > 1e-12:
+            # atanh(x) = 0.5 log1p(2x/(1-x)), with 1 - x = (1 - y)/(1 + x) (no cancellation near x = 1)
+            return 0.5 * math.log1p(2.0 * x * (1.0 + x) / one_minus_y) / x
+        # strongly over-damped: atanh(x) = log1p(x) - log(r)/2, in logs (r may underflow)
+        return (math.log1p(x) - 0.5 * log_r) / x
     x = math.sqrt(-y)
     return math.atan(x) / x
 
@@ -172,26 +193,55 @@ def exact_gammas(kp: float, kd: float) -> tuple[float, float]:
     """(gamma1, gamma2) = (int |h|, int |g|) exactly, for any K_P, K_D > 0 (4.14).
 
     Closed forms in the module docstring; no quadrature. Smooth through critical
-    damping (no sqrt(d) cancellation).
+    damping (no sqrt(d) cancellation). Extreme but finite gains (up to 1e308) are
+    evaluated without overflow (in logs where a^2, K_P/a^2 or exp(-a t*) would leave
+    the floating-point range); gains whose gammas themselves leave it raise
+    ParameterError.
     """
     kp, kd = _check_gains(kp, kd)
     a = 0.5 * kd
-    # y = d / a^2 = 1 - 4 K_P / K_D^2
-    y = 1.0 - kp / (a * a)
-    h_peak = math.exp(-_peak_time_scaled(y)) / math.sqrt(kp)
+    aa = a * a
+    ordinary = 1e-300 < aa < 1e300 and 1e-300 < kp < 1e300
+    # y = d / a^2 = 1 - 4 K_P / K_D^2; r = 1 - y, formed without a^2 when a^2 is extreme
+    r = kp / aa if ordinary else _stiffness_ratio(kp, kd)
+    y = 1.0 - r
+    one_minus_y = 1.0 - y if ordinary else r
+    log_r = math.log(kp) - 2.0 * math.log(a)
+    at_peak = None
+    if ordinary or y > -1e-6:
+        at_peak = _peak_time_scaled(y, one_minus_y, log_r)
     if y >= 0.0:
-        return 1.0 / kp, 2.0 * h_peak
-    v = a * math.sqrt(-y)  # damped frequency
-    z = a * math.pi / v  # q = exp(-z): decay per half-period
-    gamma1 = 1.0 / (kp * math.tanh(0.5 * z))
-    gamma2 = 2.0 * h_peak / -math.expm1(-z)
+        # h_peak = exp(-a t*) / sqrt(K_P); in logs when exp(-a t*) would underflow
+        h_peak = math.exp(-at_peak) / math.sqrt(kp) if at_peak < 700.0 else math.exp(-at_peak - 0.5 * math.log(kp))
+        gamma1, gamma2 = 1.0 / kp, 2.0 * h_peak
+    else:
+        root_kp = math.sqrt(kp)
+        if r < 1e300:
+            v = a * math.sqrt(-y)  # damped frequency
+        else:  # a^2 << K_P: v = sqrt(K_P) sqrt(1 - a^2/K_P), no overflow
+            v = root_kp * math.sqrt(1.0 - (a / root_kp) ** 2)
+        if at_peak is None:  # a^2 or K_P extreme: atan(v/a)/(v/a) without overflow
+            at_peak = math.atan2(v, a) * (a / v)
+        h_peak = math.exp(-at_peak) / root_kp
+        z = a * math.pi / v  # q = exp(-z): decay per half-period
+        with_z = kp * math.tanh(0.5 * z)
+        gamma1 = 1.0 / with_z if with_z > 0.0 else math.inf
+        decay = -math.expm1(-z)
+        gamma2 = 2.0 * h_peak / decay if decay > 0.0 else math.inf
+    for name, value in (("gamma1", gamma1), ("gamma2", gamma2)):
+        if not (math.isfinite(value) and value > 0.0):
+            raise ParameterError(
+                f"gains K_P = {kp:g}, K_D = {kd:g}: the operator gain {name} = {value:g} is outside the "
+                "floating-point range; gains with K_P, K_D and K_D^2/K_P between 1e-100 and 1e100 are always accepted"
+            )
     return gamma1, gamma2
 
 
 def paper_gammas(kp: float, kd: float) -> tuple[float, float]:
     """The paper's printed (4.16): (1/K_P, 4/(e K_D)); exact only for K_D = 2 sqrt(K_P)."""
     kp, kd = _check_gains(kp, kd)
-    return 1.0 / kp, 4.0 / (math.e * kd)
+    e_kd = math.e * kd
+    return 1.0 / kp, (4.0 / e_kd if math.isfinite(e_kd) else (4.0 / math.e) / kd)
 
 
 def impulse_responses(t: Any, kp: float, kd: float) -> tuple[Any, Any]:

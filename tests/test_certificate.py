@@ -1,0 +1,391 @@
+"""Tests of the certificate (wmr_mj.certificate) against closed forms, a brute-force friction
+enumeration, direct substitution of the fixed point, and one MuJoCo run at the dead band."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from wmr_mj import C80, with_params
+from wmr_mj.certificate import (
+    GYRO_BAND,
+    PLANT_K_BAND,
+    VERDICTS,
+    Assumption,
+    certificate_for,
+    certify,
+    fixed_point,
+    friction_term,
+    judge,
+    loop_crossover,
+)
+from wmr_mj.cli import main
+from wmr_mj.errors import ParameterError, UnknownNameError
+from wmr_mj.robustness import ParameterBox, analyse, exact_gammas
+from wmr_mj.simulate import RunConfig, build_reference
+
+
+def _S(a: float) -> float:
+    return math.sin(a) / math.cos(a) ** 3
+
+
+# A plant box with nothing uncertain but the Coulomb level (the closed-form cases).
+EXACT = dict(P=0.385, C_V=4.77, gyro=0.629, V_A=0.2)
+REF = dict(alpha0_max=0.659, alpha0_dot_max=0.23, alpha0_ddot_max=0.155)
+LIMITS = dict(steering_range=0.9, voltage_limit=24.0, control_period=0.001)
+
+
+def _certify(*, F=(1.313, 1.724), F_hat=1.518, K=(0.0, 0.0), K_hat=0.0, gyro=None, gyro_hat=None, kp=100.0,
+             kd=20.0, sign="measured", **kw):
+    box = ParameterBox(P=(EXACT["P"],) * 2, C_V=(EXACT["C_V"],) * 2, F=F, K=K)
+    g = EXACT["gyro"]
+    args = dict(box=box, gyro=gyro or (g, g), V_A=(EXACT["V_A"],) * 2, P_hat=EXACT["P"], C_V_hat=EXACT["C_V"],
+                F_hat=F_hat, K_hat=K_hat, gyro_hat=g if gyro_hat is None else gyro_hat, V_A_hat=EXACT["V_A"],
+                kp=kp, kd=kd, friction_sign=sign, **REF, **LIMITS)
+    args.update(kw)
+    return certify(**args)
+
+
+@pytest.fixture(scope="module")
+def circle():
+    return build_reference("paper-circle", C80, dt=1e-3, duration=35.0)[0]
+
+
+# ----------------------------------------------------------------- friction term by mode
+@pytest.mark.parametrize("F_hat", [0.0, 1.0, 1.518, 2.5])
+def test_friction_term_closed_forms(F_hat):
+    F = (1.313, 1.724)
+    assert friction_term("none", F=F, F_hat=F_hat) == 1.724
+    assert friction_term("measured", F=F, F_hat=F_hat) == max(1.724, F_hat)
+    assert friction_term("reference", F=F, F_hat=F_hat) == pytest.approx(1.724 + F_hat)
+    with pytest.raises(UnknownNameError, match="measured, none, reference"):
+        friction_term("paper", F=F, F_hat=F_hat)
+
+
+def _brute_friction(mode: str, F_range, F_hat: float) -> float:
+    """sup |f - F^ s| by enumeration: sliding (f = F sgn a'), stuck (|tau + F^ s| <= F, f = tau + F^ s)
+    with s = 0 (exact sign at rest) or locked to the creep direction sgn(tau + F^ s) ('measured'),
+    s anything in [-1, 1] ('reference'), s = 0 ('none')."""
+    worst = 0.0
+    s_all = np.linspace(-1.0, 1.0, 41)
+    for F in np.linspace(*F_range, 5):
+        for direction in (-1.0, 1.0):  # sliding
+            if mode == "measured":
+                ss = direction * np.linspace(0.0, 1.0, 21)  # smoothed or exact, same sign as a'
+            elif mode == "reference":
+                ss = s_all
+            else:
+                ss = [0.0]
+            worst = max(worst, max(abs(F * direction - F_hat * s) for s in ss))
+        for tau in np.linspace(-F - F_hat - 0.1, F + F_hat + 0.1, 801):  # stuck
+            if mode == "measured":
+                cand = [0.0] + [s for s in s_all if s != 0 and (tau + F_hat * s) * s > 0]
+            elif mode == "reference":
+                cand = s_all
+            else:
+                cand = [0.0]
+            for s in cand:
+                if abs(tau + F_hat * s) <= F:
+                    worst = max(worst, abs(tau))  # f - F^ s = tau
+    return worst
+
+
+@pytest.mark.parametrize("mode", ["measured", "reference", "none"])
+@pytest.mark.parametrize("F_hat", [1.0, 1.518, 2.5])
+def test_friction_term_matches_enumeration(mode, F_hat):
+    F = (1.313, 1.724)
+    F_hat_eff = 0.0 if mode == "none" else F_hat
+    brute = _brute_friction(mode, F, F_hat_eff)
+    phi = friction_term(mode, F=F, F_hat=F_hat_eff)
+    assert brute <= phi + 1e-12
+    assert brute == pytest.approx(phi, rel=0.01)  # the bound is reached
+
+
+@pytest.mark.parametrize("sign,phi", [("none", 1.724), ("measured", 1.724), ("reference", 1.724 + 1.518)])
+def test_delta1_is_friction_over_P_when_nothing_else_is_uncertain(sign, phi):
+    c = _certify(sign=sign, F_hat=0.0 if sign == "none" else 1.518)
+    assert c.delta1 == pytest.approx(phi / 0.385, rel=1e-12)
+    assert c.friction_term == pytest.approx(phi / 0.385, rel=1e-12)
+    assert c.delta2 == 0.0 and c.delta3 == 0.0 and c.condition == 0.0
+    # critical damping: gamma1 = 1/K_P, so E_max is exactly phi/(P^ K_P); 'none'/'measured' = the dead band
+    assert c.E_max == pytest.approx(phi / (0.385 * 100.0), rel=1e-12)
+    if sign != "reference":
+        assert c.E_max == pytest.approx(c.dead_band, rel=1e-12)
+    assert c.Edot_max == pytest.approx(4.0 / (math.e * 20.0) * phi / 0.385, rel=1e-12)
+
+
+# ----------------------------------------------------------------- fixed point
+def test_paper_example_moves_to_0166():
+    """(5.1): K~ sin/cos^3 over the reachable angle instead of over alpha0 (0.105 -> 0.166 rad)."""
+    r = analyse(ParameterBox.paper())
+    assert r.condition == pytest.approx(0.26204, abs=1e-5) and r.E_max == pytest.approx(0.10499, abs=1e-5)
+    from scipy.optimize import brentq
+
+    a0 = brentq(lambda a: _S(a) - 1.24, 0.3, 1.2)
+
+    def phi(x):
+        d1 = (0.03 * 0.4 + 0.03 + 0.08 * 0.23 + 0.09 * _S(a0 + x)) / 0.37
+        return r.gamma1 * d1 / (1.0 - r.condition)
+
+    assert phi(0.0) == pytest.approx(r.E_max, rel=1e-9)
+    x, iterations, reason = fixed_point(phi, a0)
+    assert reason == "" and iterations > 3
+    assert x == pytest.approx(phi(x), rel=1e-12)  # direct substitution
+    assert x == pytest.approx(0.1663, abs=5e-4)
+
+
+def test_fixed_point_refusals():
+    # leaves (-pi/2, pi/2)
+    x, _, reason = fixed_point(lambda x: 1.0 + 2.0 * x, 0.5)
+    assert math.isinf(x) and "pi/2" in reason
+    # (4.23) fails on the way
+    x, _, reason = fixed_point(lambda x: 0.1 + x if x < 0.3 else math.inf, 0.0)
+    assert math.isinf(x) and "(4.23)" in reason
+    # tangent: phi(x) = x at x = 0.25 and phi >= x beyond (x + (x - 1/4)^2 ... touches)
+    x, _, reason = fixed_point(lambda x: x + (x - 0.25) ** 2, 0.0, max_iterations=200000)
+    assert math.isinf(x)
+
+
+def test_design_fixed_point_by_substitution(circle):
+    """certificate_for's E_max solves E = Phi(E), recomputed here from the closed forms."""
+    cfg = RunConfig(model="nonholonomic", kp=100.0, kd=20.0, friction_width=0.01)
+    c = certificate_for(cfg, circle)
+    assert c.certified, c.unmet
+    b = circle.bounds()
+    P, F_max = C80.coefficients("nonholonomic").P, c.inputs["box"]["F"][1]
+    G_hat = C80.coefficients("nonholonomic").gyro * C80.V_A
+    G_lo, G_hi = GYRO_BAND[0] * G_hat, GYRO_BAND[1] * G_hat  # P fixed over m1
+    dG = max(G_hat - G_lo, G_hi - G_hat)
+    a_max = b["max_abs_alpha0"] + c.E_max
+    c2 = math.cos(a_max) ** 2
+    d1 = (F_max + PLANT_K_BAND * _S(a_max) + dG * b["max_abs_alpha0_dot"] / c2) / P
+    d3 = dG / c2 / P
+    g1, g2 = exact_gammas(100.0, 20.0)
+    cond = g2 * d3
+    assert c.delta1 == pytest.approx(d1, rel=1e-12)
+    assert c.condition == pytest.approx(cond, rel=1e-12)
+    assert c.E_max == pytest.approx(g1 * d1 / (1 - cond), rel=1e-11)
+    assert c.Edot_max == pytest.approx(g2 * d1 / (1 - cond), rel=1e-11)
+    assert c.alpha_max == pytest.approx(b["max_abs_alpha0"] + c.E_max)
+
+
+@pytest.mark.parametrize("omega_r", [20.0, 40.0])
+def test_high_gain_approaches_dead_band_from_above(circle, omega_r):
+    kp, kd = omega_r**2 / 4, omega_r
+    c = certificate_for(RunConfig(model="nonholonomic", kp=kp, kd=kd, friction_sign="none"), circle)
+    F_max = c.inputs["box"]["F"][1]
+    dead = F_max / (C80.coefficients("nonholonomic").P * kp)
+    assert c.dead_band == pytest.approx(dead)
+    assert 1.0 < c.E_max / dead < 1.05
+
+
+# ----------------------------------------------------------------- gyro
+def test_gyro_term_zero_when_model_has_it():
+    c = _certify()  # plant gyro range == the estimate's
+    assert c.gyro_term == 0.0 and c.gyro_Edot_term == 0.0
+    # the paper's model (no gyro): the whole plant term is unmodelled, through max|a0'| and ||E'||
+    p = _certify(gyro_hat=0.0)
+    a_max = REF["alpha0_max"] + p.E_max
+    G = EXACT["gyro"] * EXACT["V_A"]
+    c2 = math.cos(a_max) ** 2
+    assert p.gyro_term == pytest.approx(G * REF["alpha0_dot_max"] / c2 / EXACT["P"], rel=1e-12)
+    assert p.gyro_Edot_term == pytest.approx(G / c2 / EXACT["P"], rel=1e-12)
+    assert p.delta3 == pytest.approx(G / c2 / EXACT["P"], rel=1e-12)
+    assert p.E_max > c.E_max
+
+
+def test_paper_design_is_not_certified(circle):
+    """The paper's design (paper model, 6/9, exact sign) on this plant: K^ = 5.33 V has no counterpart."""
+    c = certificate_for(RunConfig(), circle)
+    assert not c.valid and not c.certified
+    assert {"reachable angle", "inside the steering stops", "within the supply"} <= set(c.unmet)
+    assert "(4.23) small gain" not in c.unmet  # (4.23) itself holds
+    assert c.K_term == pytest.approx((5.3336 + PLANT_K_BAND) * 1.2372 / 0.385, rel=2e-3)
+    assert c.dead_band == pytest.approx(c.inputs["box"]["F"][1] / (0.385 * 6.0), rel=1e-3)  # 0.746 rad
+    assert c.verdict(0.001, 0.001) == "uncertified-outside"
+    d = c.as_dict()
+    json.dumps(d, allow_nan=False)
+    assert d["E_max"] is None and d["valid"] is False
+
+
+# ----------------------------------------------------------------- assumptions and verdicts
+def test_supply_and_stops_assumptions_by_hand():
+    c = _certify(sign="none", F_hat=0.0)
+    a_max = REF["alpha0_max"] + c.E_max
+    rate = REF["alpha0_dot_max"] + c.Edot_max
+    u = (EXACT["P"] * (REF["alpha0_ddot_max"] + 20.0 * c.Edot_max + 100.0 * c.E_max) + EXACT["C_V"] * rate
+         + EXACT["gyro"] * EXACT["V_A"] * rate / math.cos(a_max) ** 2)
+    assert c.voltage_max == pytest.approx(u, rel=1e-12)
+    assert c.certified
+    low = _certify(sign="none", F_hat=0.0, voltage_limit=u * 0.99)
+    assert low.unmet == ("within the supply",)
+    tight = _certify(sign="none", F_hat=0.0, steering_range=a_max * 0.999)
+    assert tight.unmet == ("inside the steering stops",)
+
+
+def test_control_period_assumption():
+    wc, pm = loop_crossover(100.0, 20.0)
+    assert abs(complex(100.0, 20.0 * wc)) == pytest.approx(wc * wc, rel=1e-12)  # |L(j wc)| = 1
+    assert pm == pytest.approx(math.atan(20.0 * wc / 100.0))
+    ok = _certify(control_period=0.001)
+    limit = 0.1 * pm / wc
+    assert ok.certified
+    slow = _certify(control_period=limit * 1.01)
+    assert slow.unmet == ("control period",)
+    assert _certify(control_period=limit * 0.99).certified
+
+
+def test_verdict_table():
+    good = _certify()
+    bad = _certify(stated=(Assumption("x", "x", False, 2.0, 1.0, kind="stated"),))
+    assert good.certified and not bad.certified and bad.unmet == ("x",)
+    E, Ed = good.E_max, good.Edot_max
+    table = {
+        (good, 0.5 * E, 0.5 * Ed): "certified-inside",
+        (good, 1.01 * E, 0.1 * Ed): "certified-outside",
+        (good, 0.1 * E, 1.01 * Ed): "certified-outside",
+        (bad, 0.5 * E, 0.5 * Ed): "uncertified-inside",
+        (bad, 2.0 * E, 0.5 * Ed): "uncertified-outside",
+    }
+    for (cert, x, y), verdict in table.items():
+        assert cert.verdict(x, y) == verdict
+        assert verdict in VERDICTS
+    # the region (4.21) is the polygon, not the rectangle E_max x Edot_max: with delta3 > 0 and
+    # ||E'|| = 0, ||E|| <= gamma1 delta1 < E_max = gamma1 delta1 / (1 - gamma2 delta3)
+    g = _certify(gyro=(0.3, 1.0))
+    assert g.delta2 == 0.0 and g.gamma2 * g.delta3 > 0.01
+    assert g.inside(g.E_max, g.Edot_max)  # the corner is in the region
+    assert g.vertices[1][0] == pytest.approx(g.gamma1 * g.delta1)
+    assert not g.inside(0.999 * g.E_max, 0.0)  # inside the rectangle, outside the region
+    assert g.inside(0.999 * g.gamma1 * g.delta1, 0.0)
+    j = judge(good, 0.5 * E, 0.25 * Ed)
+    for key in ("E_max", "Edot_max", "condition", "valid", "assumptions", "inside", "E_ratio", "Edot_ratio",
+                "verdict"):
+        assert key in j
+    assert j["E_ratio"] == pytest.approx(0.5) and j["Edot_ratio"] == pytest.approx(0.25)
+    assert all({"name", "met", "value", "limit"} <= set(a) for a in j["assumptions"])
+    json.dumps(j, allow_nan=False)
+    assert good.verdict(math.nan, 0.0) == "certified-outside"  # a diverged run is outside
+    assert judge(good, math.inf, 0.0)["E_ratio"] is None
+    with pytest.raises(ParameterError, match="sup_E"):
+        good.inside(-1.0, 0.0)
+
+
+def test_certify_validation():
+    with pytest.raises(UnknownNameError, match="friction sign"):
+        _certify(sign="exact")
+    with pytest.raises(ParameterError, match="P_hat"):
+        _certify(P_hat=0.0)
+    with pytest.raises(ParameterError, match="alpha0_max"):
+        _certify(alpha0_max=2.0)
+    with pytest.raises(ParameterError, match="PD"):
+        _certify(feedforward=False)
+
+
+def test_pd_has_no_feedforward():
+    c = _certify(sign="none", F_hat=0.0, feedforward=False, C_V_hat=0.0, gyro_hat=0.0)
+    assert c.P_term == pytest.approx(REF["alpha0_ddot_max"])  # |P - 0| a0''/P
+
+
+def test_identified_two_sigma_hull(circle, tmp_path):
+    ident = {"identified": {"P": 0.39, "C_V": 4.8, "F": 1.5, "K": -0.005, "gyro": 0.70},
+             "diagnostics": {"std_error": {"P": 0.01, "C_V": 0.02, "F": 0.2, "K": 0.03, "gyro": 0.2}}}
+    c = certificate_for(RunConfig(model="identified", identified=ident, kp=100.0, kd=20.0,
+                                  friction_width=0.01), circle)
+    box = c.inputs["box"]
+    assert box["P"] == pytest.approx([0.37, 0.41])  # hull of 0.385 (box) and 0.39 +- 0.02
+    assert box["C_V"] == pytest.approx([4.76, 4.84])
+    assert box["F"] == pytest.approx([1.1, 1.9])
+    assert box["K"] == pytest.approx([-0.065, 0.055])
+    assert c.inputs["gyro"][1] == pytest.approx(1.1)
+    assert c.inputs["estimate"]["gyro"] == 0.70
+    # the same from a file written by `wmr-mj identify --out`
+    path = tmp_path / "ident.json"
+    path.write_text(json.dumps(ident))
+    from_file = certificate_for(RunConfig(model="identified", identified=str(path), kp=100.0, kd=20.0,
+                                          friction_width=0.01), circle)
+    assert from_file.inputs["box"] == c.inputs["box"] and from_file.E_max == c.E_max
+
+
+# ----------------------------------------------------------------- CLI
+def test_cli_certificate(capsys):
+    assert main(["robustness", "--certificate", "--model", "nonholonomic", "--omega-r", "20",
+                 "--friction-width", "0.01", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    for key in ("E_max", "Edot_max", "condition", "valid", "assumptions", "paper_region"):
+        assert key in out
+    assert out["valid"] and out["certified"]
+    assert out["E_max"] == pytest.approx(0.0463, abs=5e-4)
+    assert all({"name", "met", "value", "limit"} <= set(a) for a in out["assumptions"])
+    assert main(["robustness", "--certificate"]) == 0  # the paper's design: a table with what fails
+    text = capsys.readouterr().out
+    assert "[NOT met] reachable angle" in text and "NOT CERTIFIED" in text and "the paper's claim" in text
+    assert main(["robustness", "--certificate", "--uncertainty", "full", "--model", "nonholonomic",
+                 "--omega-r", "20", "--json"]) == 0
+    full = json.loads(capsys.readouterr().out)
+    assert full["inputs"]["box"]["P"][1] == pytest.approx(0.5005, abs=1e-3)  # R_a 1.3 Ohm moves P
+    assert full["inputs"]["V_A"] == pytest.approx([0.15, 0.25])
+
+
+@pytest.mark.parametrize("argv,pattern", [
+    (["--kp", "6", "--certificate"], "before --certificate"),
+    (["--certificate", "--model", "bogus"], "unknown model source"),
+    (["--certificate", "--friction-sign", "exact"], "friction sign"),
+    (["--certificate", "--range", "bogus=1:2"], "unknown parameter"),
+])
+def test_cli_certificate_bad_input(capsys, argv, pattern):
+    assert main(["robustness", *argv]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err and pattern in err
+
+
+def test_cli_certificate_extreme_gains(capsys):
+    assert main(["robustness", "--certificate", "--kp", "1e308", "--kd", "1e308", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["E_max"] is None or math.isfinite(out["E_max"])
+
+
+def test_cli_without_certificate_unchanged(capsys):
+    assert main(["robustness"]) == 0
+    text = capsys.readouterr().out
+    assert "0.26204" in text and "+0.28%" in text and "Certificate" not in text
+
+
+# ----------------------------------------------------------------- MuJoCo: the dead band
+def test_mujoco_none_at_high_gain_reaches_dead_band():
+    """With no Coulomb compensation the PD must carry the whole friction while the joint slides:
+    sup|E| = F/(P^ K_P) (critical damping does not overshoot). At m1 = 750 kg, F = F_max of the box."""
+    from wmr_mj.simulate import run_closed_loop
+
+    cfg = RunConfig(model="nonholonomic", kp=100.0, kd=20.0, friction_sign="none", m1=750.0, duration=12.0)
+    result = run_closed_loop(cfg, progress=False)
+    reference = build_reference(cfg.path, C80, dt=1e-3, duration=cfg.duration)[0]
+    cert = certificate_for(cfg, reference)
+    sup_E = result.summary["sup_E"]
+    F_plant = with_params(C80, m1=750.0).coefficients("nonholonomic").F
+    assert cert.inputs["box"]["F"][1] == pytest.approx(F_plant, rel=1e-12)  # m1 = 750 kg is the box's F_max
+    assert cert.dead_band == pytest.approx(F_plant / (C80.coefficients("nonholonomic").P * 100.0), rel=1e-12)
+    assert sup_E == pytest.approx(cert.dead_band, rel=0.03)
+    assert sup_E < cert.E_max
+    assert cert.verdict(sup_E, result.summary["sup_Edot"]) == "certified-inside"
+
+
+def test_extreme_gains_certify_or_refuse_cleanly():
+    """Any finite gains: a certificate (JSON-clean) or a WmrMjError, never another exception."""
+    from wmr_mj.errors import WmrMjError
+
+    rng = np.random.default_rng(0)
+    made = 0
+    for _ in range(300):
+        kp, kd = 10.0 ** rng.uniform(-307, 308, size=2)
+        try:
+            c = _certify(kp=kp, kd=kd)
+        except WmrMjError:
+            continue
+        json.dumps(c.as_dict(), allow_nan=False)
+        assert c.verdict(0.01, 0.01) in VERDICTS
+        made += 1
+    assert made > 100
