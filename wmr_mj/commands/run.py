@@ -15,8 +15,14 @@ def add_run_options(p: argparse.ArgumentParser) -> None:
     from ..plant import STEERING_FRICTION_MODELS, TYRE_CONTACT_MODELS
     from ..simulate import PATH_NAMES
 
-    p.add_argument("--controller", default="computed-torque", help=f"one of {', '.join(CONTROLLER_NAMES)}")
-    p.add_argument("--model", default="paper", help=f"model source of the estimate: one of {', '.join(MODEL_SOURCES)}")
+    from ..designs import PRESET_NAMES
+
+    p.add_argument("--preset", default="paper",
+                   help=f"controller design: one of {', '.join(PRESET_NAMES)} (default paper: paper model, K_P = 6, "
+                        "K_D = 9, exact sign; certified: see wmr_mj/designs.py); explicit options override it")
+    p.add_argument("--controller", default=None, help=f"one of {', '.join(CONTROLLER_NAMES)} (default: the preset's)")
+    p.add_argument("--model", default=None,
+                   help=f"model source of the estimate: one of {', '.join(MODEL_SOURCES)} (default: the preset's)")
     p.add_argument("--identified", metavar="PATH",
                    help="JSON from `wmr-mj identify --out` for --model identified "
                         "(default: identify the nominal plant now)")
@@ -25,14 +31,14 @@ def add_run_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--duration", type=positive_float, default=35.0, help="simulated time, s (default 35)")
     p.add_argument("--control-period", type=positive_float, default=None,
                    help="controller period, s, a multiple of the 1 ms physics step (default: every step)")
-    p.add_argument("--kp", type=positive_float, default=None, help="K_P, 1/s^2 (default 6)")
-    p.add_argument("--kd", type=positive_float, default=None, help="K_D, 1/s (default 9)")
+    p.add_argument("--kp", type=positive_float, default=None, help="K_P, 1/s^2 (default: the preset's)")
+    p.add_argument("--kd", type=positive_float, default=None, help="K_D, 1/s (default: the preset's)")
     p.add_argument("--omega-r", type=positive_float, default=None,
                    help="gains by (3.6): K_P = omega_r^2/4, K_D = omega_r")
-    p.add_argument("--friction-sign", default="measured",
-                   help=f"Coulomb compensation sign: one of {', '.join(FRICTION_SIGNS)}")
-    p.add_argument("--friction-width", type=float, default=0.0,
-                   help="smoothing of that sign, rad/s: x/sqrt(x^2+w^2) (default 0: exact sign)")
+    p.add_argument("--friction-sign", default=None,
+                   help=f"Coulomb compensation sign: one of {', '.join(FRICTION_SIGNS)} (default: the preset's)")
+    p.add_argument("--friction-width", type=float, default=None,
+                   help="smoothing of that sign, rad/s: x/sqrt(x^2+w^2) (0: exact sign; default: the preset's)")
     p.add_argument("--path", default="paper-circle", help=f"reference path of point C: one of {', '.join(PATH_NAMES)}")
     p.add_argument("--param", action="append", metavar="NAME=VALUE", help="override a plant parameter (repeatable)")
     p.add_argument("--steering-friction", default="stiction",
@@ -53,28 +59,34 @@ def config_from_args(args: argparse.Namespace, **extra):
     """A RunConfig from the shared options (raises WmrMjError on bad input)."""
     from controllers import gains_from_omega_r
 
+    from ..designs import preset
     from ..errors import ParameterError
     from ..simulate import RunConfig
 
+    design = preset(args.preset)
     if args.omega_r is not None and (args.kp is not None or args.kd is not None):
         raise ParameterError("give either --omega-r or --kp/--kd, not both")
     if args.omega_r is not None:
         kp, kd = gains_from_omega_r(args.omega_r)
     else:
-        kp = 6.0 if args.kp is None else args.kp
-        kd = 9.0 if args.kd is None else args.kd
-    if not math.isfinite(args.friction_width) or args.friction_width < 0:
-        raise ParameterError(f"--friction-width {args.friction_width} must be finite and >= 0 (rad/s)")
+        kp = design.kp if args.kp is None else args.kp
+        kd = design.kd if args.kd is None else args.kd
+    controller = design.controller if args.controller is None else args.controller
+    model = design.model if args.model is None else args.model
+    friction_sign = design.friction_sign if args.friction_sign is None else args.friction_sign
+    friction_width = design.friction_width if args.friction_width is None else args.friction_width
+    if not math.isfinite(friction_width) or friction_width < 0:
+        raise ParameterError(f"--friction-width {friction_width} must be finite and >= 0 (rad/s)")
     identified = args.identified
-    if args.model == "identified" and identified is None:
+    if model == "identified" and identified is None:
         from ..identify import identify_plant
         from ..params import C80
 
         identified = identify_plant(C80, duration=30.0, seed=0).as_dict()
     coefficients = parse_assignments(args.coef) if args.coef else None
-    return RunConfig(controller=args.controller, model=args.model, duration=args.duration,
-                     control_period=args.control_period, kp=kp, kd=kd, friction_sign=args.friction_sign,
-                     friction_width=args.friction_width, path=args.path,
+    return RunConfig(controller=controller, model=model, duration=args.duration,
+                     control_period=args.control_period, kp=kp, kd=kd, friction_sign=friction_sign,
+                     friction_width=friction_width, path=args.path,
                      plant_overrides=parse_assignments(args.param), m1_inertia=args.m1_inertia,
                      identified=identified, coefficients=coefficients, box=args.box,
                      m1_range=tuple(args.m1_range), steering_friction=args.steering_friction,
