@@ -116,21 +116,28 @@ def default_log_path(config) -> str:
 
 def format_report(s: dict) -> str:
     """Human-readable run report."""
+    from ..verdicts import format_verdict
+
     def ratio(x):
         return "n/a" if x is None else f"{x:.3f}"
+
+    def num(x):
+        return "n/a" if x is None else f"{x:.5g}"
+
+    cert = s.get("certificate") or {}
 
     after = f"after {s['settle_s']:.1f} s"
     lines = [
         f"controller {s['controller']} ({s['model']} model), plant m1 = {s['m1']:g} kg, K_P = {s['kp']:g}, "
         f"K_D = {s['kd']:g}, {s['duration']:g} s, {s['steps']} steps in {s['wall_s']:.2f} s "
         f"({s['realtime_factor']:.0f}x real time)",
-        f"{'':22s} {'whole run':>12s} {after:>12s} {'bound':>12s} {'ratio':>8s}",
-        f"{'sup|E|   [rad]':22s} {s['sup_E']:12.5g} {s['sup_E_settled']:12.5g} {s['E_max']:12.5g} "
-        f"{ratio(s['E_ratio']):>8s}",
-        f"{'sup|E|dot [rad/s]':22s} {s['sup_Edot']:12.5g} {s['sup_Edot_settled']:12.5g} {s['Edot_max']:12.5g} "
+        *format_verdict(s),
+        f"{'':22s} {'whole run':>12s} {after:>12s} {'certificate':>12s} {'ratio':>8s} {'paper':>12s} {'ratio':>8s}",
+        f"{'sup|E|   [rad]':22s} {s['sup_E']:12.5g} {s['sup_E_settled']:12.5g} {num(cert.get('E_max')):>12s} "
+        f"{ratio(cert.get('E_ratio')):>8s} {s['E_max']:12.5g} {ratio(s['E_ratio']):>8s}",
+        f"{'sup|E|dot [rad/s]':22s} {s['sup_Edot']:12.5g} {s['sup_Edot_settled']:12.5g} "
+        f"{num(cert.get('Edot_max')):>12s} {ratio(cert.get('Edot_ratio')):>8s} {s['Edot_max']:12.5g} "
         f"{ratio(s['Edot_ratio']):>8s}",
-        f"analysis (4.23): {s['condition']:.4f} < 1: {'yes' if s['stable'] else 'no'}; errors "
-        f"{'INSIDE' if s['inside'] else 'OUTSIDE'} the analytic region",
         f"voltage saturated {100 * s['saturated_fraction']:.1f}% of the time",
     ]
     if s["left_steering_range"]:
