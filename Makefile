@@ -5,7 +5,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test lint venv bench clean
+.PHONY: demo test lint venv bench clean foxglove-reader
 
 $(STAMP): pyproject.toml setup.py
 	$(PYTHON) -m venv $(VENV)
@@ -21,13 +21,22 @@ demo: $(STAMP)
 lint: $(STAMP)
 	$(VENV)/bin/ruff check .
 
-test: lint
+# Foxglove's own MCAP reader (@mcap/core, pinned in tests/foxglove_reader/package-lock.json) for
+# tests/test_foxglove_reader.py; best effort: without node/npm that test skips and says why.
+FOXGLOVE_READER := tests/foxglove_reader/node_modules/.package-lock.json
+$(FOXGLOVE_READER): tests/foxglove_reader/package-lock.json
+	-command -v npm >/dev/null && npm ci --prefix tests/foxglove_reader --no-audit --no-fund --loglevel=error
+
+foxglove-reader: $(FOXGLOVE_READER)
+
+test: lint $(FOXGLOVE_READER)
 	$(PY) -m pytest
 
 bench: $(STAMP)
 	$(PY) bench/bench_run.py
 	$(PY) bench/bench_logging.py --end-to-end
 	$(PY) bench/bench_sweep.py
+	$(PY) bench/bench_video.py
 
 clean:
 	rm -rf $(VENV) build dist *.egg-info .ruff_cache

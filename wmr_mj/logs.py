@@ -1,101 +1,64 @@
-"""Read wmr-mj run logs (MCAP) into NumPy arrays.
+"""Read wmr-mj run logs (MCAP) into NumPy arrays, with mcap's own readers.
 
 ::
 
     from wmr_mj.logs import load_log
     log = load_log("logs/run.mcap")
-    s = log.signals                      # t, alpha, E, E_dot, voltage, A_pos (N,2), ...
-    st = log.state                       # t, qpos (N,nq), qvel (N,nv), ctrl (N,nu): every row
-    steer = log.channel("/steering")     # one channel's fields (+ "log_time" in ns)
+    s = log.signals                      # t, alpha, E, E_dot, voltage, A_pos (N, 2), ... every logged row
+    st = log.state                       # t, qpos (N, nq), qvel (N, nv), ctrl (N, nu): every control step
+    steer = log.channel("/steering")     # one channel's fields as arrays (+ "log_time" [ns] for per-row channels)
     log.config, log.summary, log.metadata, log.attachments, log.mjcf_xml, log.initial_state
     log.truncated                        # True when the run was killed before the footer
 
-Fixed-layout channels (CDR, flat float64 fields) are decoded in bulk: the
-payloads of each chunk are viewed with a structured dtype built from the
-ros2msg schema text stored in the file, then concatenated. JSON channels
-(``/tf``, ``/scene``) are parsed on demand by :meth:`RunLog.messages`.
+A finished file is read through its index (``mcap.reader.make_reader``): the summary, the
+metadata and attachments, and only the chunks of the channels asked for; every chunk's CRC is
+checked once. A file without its footer (a killed run, a copy cut short) is read from the start
+with ``mcap.stream_reader.StreamReader`` up to its last complete chunk and flagged ``truncated``.
+The messages are decoded from the ros2msg schema text stored in the file
+(:mod:`wmr_mj.logformat`): the packed channels (/signals, /sim/state) a few messages a second,
+the per-row channels in bulk with a structured dtype.
 
-Every problem a user can cause (missing file, not MCAP, a corrupt chunk, an
-unknown schema version) raises :class:`wmr_mj.errors.LogError` with one line
-naming the file. A file that ends early (abrupt kill, copy cut short) is read up
-to its last complete chunk and flagged ``truncated``.
+Every problem a user can cause (missing file, not MCAP, a corrupt chunk, an unknown schema
+version) raises :class:`wmr_mj.errors.LogError` with one line naming the file.
 """
 
 from __future__ import annotations
 
 import io
 import json
-import re
-import struct
-import zlib
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from .errors import LogError
+from . import logformat as lf
+from .errors import LogError, UnknownNameError
 
 __all__ = ["RunLog", "load_log", "SUPPORTED_SCHEMA_VERSIONS"]
 
-SUPPORTED_SCHEMA_VERSIONS = ("1",)
-MCAP_MAGIC = b"\x89MCAP0\r\n"
+SUPPORTED_SCHEMA_VERSIONS = lf.SUPPORTED_SCHEMA_VERSIONS
 ACCEPTED = "wmr-mj replay accepts MCAP run logs written by `wmr-mj run`"
 
-_PRIMS = {
-    "float64": "<f8", "float32": "<f4", "int8": "i1", "uint8": "u1", "int16": "<i2", "uint16": "<u2",
-    "int32": "<i4", "uint32": "<u4", "int64": "<i8", "uint64": "<u8", "bool": "u1", "byte": "u1", "char": "u1",
-}  # fmt: skip
 
-class _Truncated(Exception):
-    pass
-
-
-def _ros2msg_dtype(text: str) -> np.dtype | None:
-    """Structured dtype (4-byte CDR header + fields) of a flat ros2msg schema, or None
-    when the schema has nested types or variable-length fields (not fixed layout)."""
-    fields: list[tuple] = [("__cdr", "u1", (4,))]
-    offset = 0
-    for raw in text.splitlines():
-        line = raw.split("#", 1)[0].strip()
-        if not line:
-            continue
-        if line.startswith("==="):
-            break  # nested definitions follow: not a flat message
-        m = re.fullmatch(r"(\w+)(?:\[(\d+)\])?\s+(\w+)(\s*=.*)?", line)
-        if not m or m.group(1) not in _PRIMS:
-            return None
-        if m.group(4):  # constant
-            continue
-        code = _PRIMS[m.group(1)]
-        size = np.dtype(code).itemsize
-        pad = (-offset) % size  # CDR aligns each primitive to its size, relative to the payload
-        if pad:
-            fields.append((f"__pad{offset}", "u1", (pad,)))
-            offset += pad
-        count = int(m.group(2)) if m.group(2) else 1
-        fields.append((m.group(3), code, (count,)) if m.group(2) else (m.group(3), code))
-        offset += size * count
-    return np.dtype(fields)
-
-
-@dataclass
+@dataclass(frozen=True)
 class _Channel:
     id: int
     topic: str
     encoding: str
     schema_name: str
     schema_encoding: str
-    schema_data: bytes
+    schema_text: str
     metadata: dict[str, str]
-    log_times: list[np.ndarray] = field(default_factory=list)
-    payloads: list[np.ndarray] = field(default_factory=list)  # (n, L) uint8 blocks
-    loose: list[tuple[int, bytes]] = field(default_factory=list)  # variable-size messages
+
+
+class _Truncated(Exception):
+    pass
 
 
 class RunLog:
-    """A loaded run log; see the module docstring."""
+    """A loaded run log; see the module docstring. Made by :func:`load_log`."""
 
     def __init__(self, path: Path):
         self.path = path
@@ -104,9 +67,14 @@ class RunLog:
         self.attachment_types: dict[str, str] = {}
         self.truncated = False
         self.truncated_reason = ""
-        self._channels: dict[int, _Channel] = {}
-        self._by_topic: dict[str, _Channel] = {}
+        self._channels: dict[str, _Channel] = {}
+        self._messages: dict[str, list[tuple[int, bytes]]] = {}  # topic -> (log_time, payload), once read
+        self._counts: dict[str, int] = {}
+        self._indexed = False  # True: unread topics come from the file's index
         self._decoded: dict[str, dict[str, np.ndarray]] = {}
+
+    def _fail(self, what: str) -> LogError:
+        return LogError(f"{self.path}: {what}; {ACCEPTED}")
 
     # ---- metadata
     def _json_record(self, name: str) -> dict[str, Any] | None:
@@ -132,11 +100,12 @@ class RunLog:
 
     @cached_property
     def summary(self) -> dict[str, Any] | None:
-        """The summary written at close (with "status"), or None for a truncated log."""
+        """The summary written at close (with "status"), or None for a log cut before it."""
         return self._json_record("summary")
 
     @property
     def status(self) -> str:
+        """"completed", "interrupted", "error" (from the summary), or "truncated"."""
         if self.summary is not None and "status" in self.summary:
             return str(self.summary["status"])
         return "truncated" if self.truncated else "unknown"
@@ -152,28 +121,34 @@ class RunLog:
         except ValueError:
             return self.info.get("seed")
 
+    def _info_number(self, key: str, kind: type, default: str) -> Any:
+        try:
+            return kind(self.info.get(key, default))
+        except ValueError:
+            raise self._fail(f"the wmr_mj metadata record has {key} = {self.info.get(key)!r}") from None
+
     @property
     def timestep(self) -> float:
-        return float(self.info.get("timestep", "nan"))
+        return self._info_number("timestep", float, "nan")
 
     @property
     def control_substeps(self) -> int:
-        return int(self.info.get("control_substeps", "1"))
+        return self._info_number("control_substeps", int, "1")
 
     @property
     def log_every(self) -> int:
-        return int(self.info.get("log_every", "1"))
+        return self._info_number("log_every", int, "1")
 
-    def _attachment_named(self, suffix: str, kind: str) -> bytes:
-        for name, data in self.attachments.items():
-            if name.endswith(suffix):
-                return data
-        raise LogError(f"{self.path}: the log has no {kind} attachment ({suffix}); it was cut before it was written")
+    def _attachment_named(self, name: str, kind: str) -> bytes:
+        data = self.attachments.get(name)
+        if data is None:
+            raise LogError(f"{self.path}: the log has no {kind} attachment ({name}); it was cut before it was written")
+        return data
 
     @property
     def mjcf_xml(self) -> str:
         """The exact MJCF the run simulated."""
-        return self._attachment_named(".xml", "MJCF").decode("utf-8")
+        return self._attachment_named("c80.xml", "MJCF").decode("utf-8")
 
     @property
     def parameters(self) -> dict[str, Any]:
@@ -186,334 +161,291 @@ class RunLog:
 
     @property
     def reference_path(self) -> np.ndarray | None:
+        """Desired path of C, (M, 2) world xy, when the run had one."""
         data = self.attachments.get("reference_path.npy")
         return None if data is None else np.load(io.BytesIO(data), allow_pickle=False)
 
     # ---- channels
     @property
     def topics(self) -> list[str]:
-        return list(self._by_topic)
-
-    def message_count(self, topic: str) -> int:
-        ch = self._get(topic)
-        return sum(len(x) for x in ch.log_times) + len(ch.loose)
+        return list(self._channels)
 
     def _get(self, topic: str) -> _Channel:
-        ch = self._by_topic.get(topic)
+        ch = self._channels.get(topic)
         if ch is None:
-            from .errors import UnknownNameError
-
-            raise UnknownNameError("channel", topic, self._by_topic)
+            raise UnknownNameError("channel", topic, self._channels)
         return ch
 
+    def message_count(self, topic: str) -> int:
+        self._get(topic)
+        if topic in self._counts:
+            return self._counts[topic]
+        return len(self.raw_messages(topic))
+
+    def raw_messages(self, topic: str) -> list[tuple[int, bytes]]:
+        """(log_time ns, payload bytes) pairs of any channel, in log-time order."""
+        self._get(topic)
+        if topic not in self._messages:
+            self._read_indexed([topic])
+        return self._messages[topic]
+
+    def _read_indexed(self, topics: list[str], *, validate_crcs: bool = False) -> None:
+        """Messages of ``topics`` through the file's index (finished files)."""
+        from mcap.reader import make_reader
+
+        got: dict[str, list[tuple[int, bytes]]] = {t: [] for t in topics}
+        if self._indexed:
+            try:
+                with open(self.path, "rb") as f:
+                    for _, channel, message in make_reader(f, validate_crcs=validate_crcs).iter_messages(topics=topics):
+                        got[channel.topic].append((message.log_time, message.data))
+            except OSError as exc:
+                raise LogError(f"{self.path}: cannot be read ({exc.strerror or exc}); {ACCEPTED}") from None
+            except Exception as exc:  # the library's parse and CRC errors
+                raise self._fail(f"corrupt MCAP file ({type(exc).__name__}: {exc})") from None
+        self._messages.update(got)
+
     def channel(self, topic: str) -> dict[str, np.ndarray]:
-        """Fields of a fixed-layout channel as arrays (one row per message), plus "log_time" [ns]."""
+        """A numbers-only CDR channel as arrays: one row per message plus "log_time" [ns] for
+        per-row channels; the rows of all messages concatenated for packed channels (a field
+        with k values per row is (rows, k))."""
         if topic in self._decoded:
             return self._decoded[topic]
         ch = self._get(topic)
-        if ch.encoding != "cdr" or ch.schema_encoding != "ros2msg":
-            raise LogError(f"{self.path}: channel {topic} is {ch.encoding}, not a fixed-layout cdr channel; use messages()")
-        dt = _ros2msg_dtype(ch.schema_data.decode("utf-8", "replace"))
-        if dt is None:
-            raise LogError(f"{self.path}: channel {topic} has a schema that is not a flat ros2msg message")
-        blocks = list(ch.payloads)
-        times = list(ch.log_times)
-        if ch.loose:
-            times.append(np.array([t for t, _ in ch.loose], np.uint64))
-            sizes = {len(p) for _, p in ch.loose}
-            if sizes != {dt.itemsize}:
-                raise LogError(f"{self.path}: messages of {topic} do not match their schema ({sorted(sizes)} bytes, expected {dt.itemsize})")
-            blocks.append(np.frombuffer(b"".join(p for _, p in ch.loose), np.uint8).reshape(-1, dt.itemsize))
-        for blk in blocks:
-            if blk.shape[1] != dt.itemsize:
-                raise LogError(f"{self.path}: messages of {topic} are {blk.shape[1]} bytes, their schema needs {dt.itemsize}")
-        raw = np.concatenate(blocks) if len(blocks) > 1 else (blocks[0] if blocks else np.empty((0, dt.itemsize), np.uint8))
-        arr = np.frombuffer(np.ascontiguousarray(raw).data, dtype=dt) if raw.size else np.empty(0, dt)
-        out: dict[str, np.ndarray] = {"log_time": np.concatenate(times) if times else np.empty(0, np.uint64)}
-        for name in dt.names:
-            if not name.startswith("__"):
-                out[name] = np.ascontiguousarray(arr[name])
-        order = np.argsort(out["log_time"], kind="stable")
-        if order.size and np.any(order != np.arange(order.size)):
-            out = {k: v[order] for k, v in out.items()}
+        if ch.encoding != "cdr" or ch.schema_encoding != "ros2msg" or lf.parse_ros2msg(ch.schema_text) is None:
+            raise LogError(f"{self.path}: channel {topic} ({ch.schema_name}, {ch.encoding}) is not a numbers-only "
+                           "CDR channel; use messages() or raw_messages()")
+        msgs = self.raw_messages(topic)
+        dt = lf.row_dtype(ch.schema_text)
+        if dt is not None:
+            out = self._rows_in_bulk(topic, dt, msgs)
+        else:
+            out = self._packed(topic, ch, msgs)
         self._decoded[topic] = out
         return out
 
-    def messages(self, topic: str) -> list[tuple[int, Any]]:
-        """(log_time ns, decoded message) pairs of a JSON channel, in log-time order."""
-        ch = self._get(topic)
-        if ch.encoding != "json":
-            raise LogError(f"{self.path}: channel {topic} is {ch.encoding}; use channel() for fixed-layout channels")
-        out = []
-        for times, blk in zip(ch.log_times, ch.payloads):
-            for t, row in zip(times.tolist(), blk):
-                out.append((t, json.loads(row.tobytes())))
-        out += [(t, json.loads(p)) for t, p in ch.loose]
-        out.sort(key=lambda x: x[0])
+    def _rows_in_bulk(self, topic: str, dt: np.dtype, msgs: list[tuple[int, bytes]]) -> dict[str, np.ndarray]:
+        sizes = {len(p) for _, p in msgs}
+        if sizes - {dt.itemsize}:
+            raise self._fail(f"messages of {topic} are {sorted(sizes)} bytes; their schema needs {dt.itemsize}")
+        arr = np.frombuffer(b"".join(p for _, p in msgs), dt)
+        out = {"log_time": np.fromiter((t for t, _ in msgs), np.uint64, len(msgs))}
+        for name in dt.names:
+            if not name.startswith("__"):
+                out[name] = np.ascontiguousarray(arr[name])
         return out
 
-    def raw_messages(self, topic: str) -> list[tuple[int, bytes]]:
-        """(log_time ns, payload bytes) pairs of any channel."""
-        ch = self._get(topic)
-        out = [(t, row.tobytes()) for times, blk in zip(ch.log_times, ch.payloads) for t, row in zip(times.tolist(), blk)]
-        out += list(ch.loose)
-        out.sort(key=lambda x: x[0])
+    def _packed(self, topic: str, ch: _Channel, msgs: list[tuple[int, bytes]]) -> dict[str, np.ndarray]:
+        fields = lf.parse_ros2msg(ch.schema_text) or ()
+        seqs = [f.name for f in fields if f.length == -1]
+        parts: dict[str, list[np.ndarray]] = {name: [] for name in seqs}
+        for _, payload in msgs:
+            try:
+                msg = lf.decode_cdr(ch.schema_text, payload)
+            except ValueError as exc:
+                raise self._fail(f"a message of {topic} does not fit its schema ({exc})") from None
+            rows = int(msg.get("rows", len(msg[seqs[0]]) if seqs else 0))
+            for name in seqs:
+                a = msg[name]
+                if rows == 0 or a.size % rows:
+                    raise self._fail(f"field {name} of {topic} has {a.size} values for {rows} rows")
+                parts[name].append(a if a.size == rows else a.reshape(rows, -1))
+        out = {}
+        for name, blocks in parts.items():
+            out[name] = np.concatenate(blocks) if blocks else np.empty(0)
         return out
+
+    def messages(self, topic: str) -> list[tuple[int, Any]]:
+        """(log_time ns, decoded message) pairs of a JSON channel or a numbers-only CDR channel
+        (a dict per message). Other CDR channels (/tf): decode ``raw_messages`` with a ROS 2
+        decoder such as mcap-ros2-support."""
+        ch = self._get(topic)
+        msgs = self.raw_messages(topic)
+        if ch.encoding == "json":
+            return [(t, json.loads(p)) for t, p in msgs]
+        if ch.encoding == "cdr" and lf.parse_ros2msg(ch.schema_text) is not None:
+            return [(t, {k: (v.copy() if isinstance(v, np.ndarray) else v)
+                         for k, v in lf.decode_cdr(ch.schema_text, p).items()}) for t, p in msgs]
+        raise LogError(f"{self.path}: channel {topic} ({ch.schema_name}) has strings or nested types; decode "
+                       "raw_messages() with a ROS 2 decoder (e.g. mcap-ros2-support)")
 
     @cached_property
     def signals(self) -> dict[str, np.ndarray]:
-        """The runner's block keys (every log_every-th row): t, alpha, ..., A_pos (N,2), C_pos (N,2), heading."""
-        from .mcaplog import SIGNAL_TOPICS, channel_layouts
-
-        out: dict[str, np.ndarray] = {}
-        pairs: dict[str, list[tuple[int, np.ndarray]]] = {}
-        for topic in SIGNAL_TOPICS:
-            if topic not in self._by_topic:
-                continue
-            ch = self.channel(topic)
-            for f in channel_layouts()["channels"][topic]["fields"]:
-                if f["name"] not in ch or (f["block"] in out and "index" not in f):
-                    continue
-                if "index" in f:
-                    pairs.setdefault(f["block"], []).append((f["index"], ch[f["name"]]))
-                else:
-                    out[f["block"]] = ch[f["name"]]
-        for key, cols in pairs.items():
-            out[key] = np.column_stack([c for _, c in sorted(cols, key=lambda x: x[0])])
-        return out
+        """The runner's block keys at every logged row: t, alpha, ..., E, E_dot, ..., A_pos (N, 2), C_pos (N, 2),
+        heading."""
+        fields = lf.channel_layouts()["channels"][lf.SIGNALS_TOPIC]["fields"]
+        if lf.SIGNALS_TOPIC not in self._channels:  # a file cut before its first block
+            return {f["block"]: np.empty((0, f["columns"]) if "columns" in f else 0) for f in fields}
+        ch = self.channel(lf.SIGNALS_TOPIC)
+        return {f["block"]: ch[f["name"]] for f in fields if f["name"] in ch}
 
     @cached_property
     def state(self) -> dict[str, np.ndarray]:
-        """/sim/state: t, qpos (N,nq), qvel (N,nv), ctrl (N,nu) at every control step."""
-        if "/sim/state" not in self._by_topic:
-            return {}
-        ch = self.channel("/sim/state")
-        return {k: ch[k] for k in ("t", "qpos", "qvel", "ctrl") if k in ch}
+        """/sim/state: t, qpos (N, nq), qvel (N, nv), ctrl (N, nu) at every control step."""
+        widths = {"qpos": "nq", "qvel": "nv", "ctrl": "nu"}
+        if lf.STATE_TOPIC not in self._channels:  # a file cut before its first block
+            return {"t": np.empty(0), **{k: np.empty((0, self._info_number(w, int, "0"))) for k, w in widths.items()}}
+        ch = self.channel(lf.STATE_TOPIC)
+        out = {k: ch[k] for k in ("t", *widths) if k in ch}
+        for k, w in widths.items():  # a model with one coordinate, or no rows, still gets (N, n)
+            if k in out and out[k].ndim == 1:
+                out[k] = out[k].reshape(out["t"].size, self._info_number(w, int, "0"))
+        return out
 
     @property
     def rows(self) -> int:
         """Number of control steps logged (rows of /sim/state)."""
-        return self.message_count("/sim/state") if "/sim/state" in self._by_topic else 0
+        return int(self.state["t"].size)
 
     def __repr__(self) -> str:
         return f"RunLog({str(self.path)!r}, rows={self.rows}, status={self.status!r}, truncated={self.truncated})"
 
 
-# --------------------------------------------------------------------------- parsing
+# --------------------------------------------------------------------------- loading
 
 
-def _str(buf: memoryview, pos: int, end: int) -> tuple[str, int]:
-    if pos + 4 > end:
-        raise _Truncated
-    (n,) = struct.unpack_from("<I", buf, pos)
-    pos += 4
-    if pos + n > end:
-        raise _Truncated
-    return bytes(buf[pos : pos + n]).decode("utf-8"), pos + n
+def _channel_of(channel: Any, schemas: dict[int, Any]) -> _Channel:
+    schema = schemas.get(channel.schema_id)
+    return _Channel(
+        id=channel.id, topic=channel.topic, encoding=channel.message_encoding,
+        schema_name=schema.name if schema else "", schema_encoding=schema.encoding if schema else "",
+        schema_text=bytes(schema.data).decode("utf-8", "replace") if schema else "", metadata=dict(channel.metadata),
+    )  # fmt: skip
 
 
-def _map(buf: memoryview, pos: int, end: int) -> tuple[dict[str, str], int]:
-    if pos + 4 > end:
-        raise _Truncated
-    (n,) = struct.unpack_from("<I", buf, pos)
-    pos += 4
-    stop = pos + n
-    if stop > end:
-        raise _Truncated
-    out = {}
-    while pos < stop:
-        k, pos = _str(buf, pos, stop)
-        v, pos = _str(buf, pos, stop)
-        out[k] = v
-    return out, stop
+def _load_indexed(log: RunLog, f: Any) -> None:
+    """A finished file: summary, metadata, attachments and the packed channels through the index;
+    every chunk's CRC checked."""
+    from mcap.data_stream import ReadDataStream
+    from mcap.reader import make_reader
+    from mcap.records import Chunk
+    from mcap.stream_reader import get_chunk_data_stream
+
+    reader = make_reader(f)
+    summary = reader.get_summary()
+    if summary is None:
+        raise log._fail("MCAP file without a summary section (not written by wmr-mj)")
+    for ch in summary.channels.values():
+        log._channels.setdefault(ch.topic, _channel_of(ch, summary.schemas))
+    if summary.statistics is not None:
+        for cid, n in summary.statistics.channel_message_counts.items():
+            if cid in summary.channels:
+                log._counts[summary.channels[cid].topic] = int(n)
+    for rec in reader.iter_metadata():
+        log.metadata[rec.name] = dict(rec.metadata)
+    for rec in reader.iter_attachments():
+        log.attachments[rec.name] = bytes(rec.data)
+        log.attachment_types[rec.name] = rec.media_type
+    log._indexed = True
+    packed = {c.id for c in summary.channels.values() if c.topic in (lf.SIGNALS_TOPIC, lf.STATE_TOPIC)}
+    for ci in summary.chunk_indexes:  # chunks that the packed read below does not check
+        if not packed & set(ci.message_index_offsets):
+            f.seek(ci.chunk_start_offset + 9)  # past the record's opcode and length
+            get_chunk_data_stream(Chunk.read(ReadDataStream(f)), validate_crc=True)
 
 
-class _Parser:
-    def __init__(self, path: Path, log: RunLog):
-        self.path = path
-        self.log = log
-        self.schemas: dict[int, tuple[str, str, bytes]] = {}
+def _load_stream(log: RunLog, f: Any, size: int) -> None:
+    """A file without footer: every record from the start, up to the last complete chunk."""
+    from mcap.records import Attachment, Channel, Chunk, DataEnd, Footer, Message, Metadata, Schema
+    from mcap.stream_reader import StreamReader, breakup_chunk
 
-    def fail(self, what: str) -> LogError:
-        return LogError(f"{self.path}: {what}; {ACCEPTED}")
+    schemas: dict[int, Any] = {}
+    channels: dict[int, _Channel] = {}
+    messages: dict[str, list[tuple[int, bytes]]] = {}
+    records = StreamReader(f, emit_chunks=True).records
+    reason = "the writer stopped after a complete block"
+    data_end = False
 
-    # records valid at top level and inside chunks
-    def schema(self, buf: memoryview, p: int, end: int) -> None:
-        (sid,) = struct.unpack_from("<H", buf, p)
-        name, p = _str(buf, p + 2, end)
-        enc, p = _str(buf, p, end)
-        (n,) = struct.unpack_from("<I", buf, p)
-        self.schemas[sid] = (name, enc, bytes(buf[p + 4 : p + 4 + n]))
+    def take(rec: Any) -> None:
+        if isinstance(rec, Schema):
+            schemas[rec.id] = rec
+        elif isinstance(rec, Channel):
+            channels[rec.id] = _channel_of(rec, schemas)
+            log._channels.setdefault(rec.topic, channels[rec.id])
+            messages.setdefault(rec.topic, [])
+        elif isinstance(rec, Message):
+            ch = channels.get(rec.channel_id)
+            if ch is None:
+                raise log._fail(f"message on undeclared channel {rec.channel_id}")
+            messages[ch.topic].append((rec.log_time, rec.data))
 
-    def channel(self, buf: memoryview, p: int, end: int) -> None:
-        cid, sid = struct.unpack_from("<HH", buf, p)
-        topic, p = _str(buf, p + 4, end)
-        enc, p = _str(buf, p, end)
-        meta, p = _map(buf, p, end)
-        if cid in self.log._channels:
-            return
-        sname, senc, sdata = self.schemas.get(sid, ("", "", b""))
-        ch = _Channel(cid, topic, enc, sname, senc, sdata, meta)
-        self.log._channels[cid] = ch
-        self.log._by_topic.setdefault(topic, ch)
-
-    def message(self, buf: memoryview, p: int, end: int) -> None:
-        cid, _seq, log_time, _pub = struct.unpack_from("<HIQQ", buf, p)
-        ch = self.log._channels.get(cid)
-        if ch is None:
-            raise self.fail(f"message on undeclared channel {cid}")
-        ch.loose.append((log_time, bytes(buf[p + 22 : end])))
-
-    def chunk_records(self, data: bytes, where: int) -> None:
-        """Records of one decompressed chunk; fixed-size runs of one channel in bulk."""
-        n = len(data)
-        if n >= 9 and data[0] == 0x05:
-            (length,) = struct.unpack_from("<Q", data, 1)
-            size = 9 + length
-            if length >= 22 and n % size == 0:
-                dt = np.dtype(
-                    [("op", "u1"), ("len", "<u8"), ("channel", "<u2"), ("seq", "<u4"), ("log_time", "<u8"), ("pub", "<u8"), ("payload", "u1", (length - 22,))]
-                )
-                rec = np.frombuffer(data, dt)
-                cid = int(rec["channel"][0])
-                if np.all(rec["op"] == 5) and np.all(rec["len"] == length) and np.all(rec["channel"] == cid):
-                    ch = self.log._channels.get(cid)
-                    if ch is None:
-                        raise self.fail(f"chunk at byte {where} holds messages of undeclared channel {cid}")
-                    ch.log_times.append(rec["log_time"].copy())
-                    ch.payloads.append(rec["payload"])
-                    return
-        buf = memoryview(data)
-        p = 0
-        while p < n:
-            if p + 9 > n:
-                raise self.fail(f"chunk at byte {where} is corrupt (record header cut at {p})")
-            op, length = struct.unpack_from("<BQ", buf, p)
-            body, end = p + 9, p + 9 + length
-            if end > n:
-                raise self.fail(f"chunk at byte {where} is corrupt (record runs past the chunk)")
-            if op == 0x05:
-                self.message(buf, body, end)
-            elif op == 0x03:
-                self.schema(buf, body, end)
-            elif op == 0x04:
-                self.channel(buf, body, end)
-            p = end
-
-    def decompress(self, comp: str, data: bytes, size: int, crc: int, where: int) -> bytes:
-        try:
-            if comp == "":
-                out = bytes(data)
-            elif comp == "zstd":
-                import zstandard
-
-                out = zstandard.ZstdDecompressor().decompress(bytes(data), max_output_size=size)
-            elif comp == "lz4":
-                import lz4.frame
-
-                out = lz4.frame.decompress(bytes(data))
-            else:
-                raise self.fail(f"chunk at byte {where} uses unsupported compression {comp!r} (zstd, lz4 or none are read)")
-        except LogError:
-            raise
-        except Exception as exc:
-            raise self.fail(f"chunk at byte {where} is corrupt ({comp} decompression failed: {exc})") from None
-        if len(out) != size:
-            raise self.fail(f"chunk at byte {where} is corrupt (decompressed to {len(out)} bytes, expected {size})")
-        if crc and zlib.crc32(out) != crc:
-            raise self.fail(f"chunk at byte {where} is corrupt (CRC mismatch)")
-        return out
-
-    def parse(self, data: bytes) -> None:
-        log = self.log
-        if len(data) < 8 or data[:8] != MCAP_MAGIC:
-            if len(data) < 8 and MCAP_MAGIC.startswith(data):
-                raise self.fail("the file is empty or cut inside the MCAP magic")
-            raise self.fail("not an MCAP file (bad magic bytes)")
-        buf = memoryview(data)
-        total = len(data)
-        finished = total >= 16 and data[-8:] == MCAP_MAGIC
-        p = 8
-        data_end = False
+    try:
         while True:
-            if p == total:
-                break
-            if p + 9 > total:
-                raise _Truncated(f"record header cut at byte {p}")
-            op, length = struct.unpack_from("<BQ", buf, p)
-            body, end = p + 9, p + 9 + length
-            if end > total:
-                raise _Truncated(f"record at byte {p} runs past the end of the file")
+            start = f.tell()
             try:
-                if op == 0x06:  # chunk
-                    t0, t1, usize, ucrc = struct.unpack_from("<QQQI", buf, body)
-                    comp, q = _str(buf, body + 28, end)
-                    (clen,) = struct.unpack_from("<Q", buf, q)
-                    if q + 8 + clen != end:
-                        raise self.fail(f"chunk at byte {p} is corrupt (inconsistent lengths)")
-                    self.chunk_records(self.decompress(comp, buf[q + 8 : end], usize, ucrc, p), p)
-                elif op == 0x05:
-                    self.message(buf, body, end)
-                elif op == 0x03:
-                    self.schema(buf, body, end)
-                elif op == 0x04:
-                    self.channel(buf, body, end)
-                elif op == 0x0C:  # metadata
-                    name, q = _str(buf, body, end)
-                    meta, q = _map(buf, q, end)
-                    log.metadata[name] = meta
-                elif op == 0x09:  # attachment
-                    _lt, _ct = struct.unpack_from("<QQ", buf, body)
-                    name, q = _str(buf, body + 16, end)
-                    media, q = _str(buf, q, end)
-                    (dlen,) = struct.unpack_from("<Q", buf, q)
-                    payload = bytes(buf[q + 8 : q + 8 + dlen])
-                    (crc,) = struct.unpack_from("<I", buf, q + 8 + dlen)
-                    if crc and zlib.crc32(buf[body : q + 8 + dlen]) != crc:
-                        raise self.fail(f"attachment {name!r} at byte {p} is corrupt (CRC mismatch)")
-                    log.attachments[name] = payload
-                    log.attachment_types[name] = media
-                elif op == 0x0F:  # data end: the summary section follows
-                    data_end = True
-                    break
-                elif op == 0x01 and p != 8:
-                    raise self.fail(f"unexpected header record at byte {p}")
-                elif op == 0x00 or (op > 0x0F and op < 0x80):
-                    raise self.fail(f"invalid record opcode 0x{op:02x} at byte {p}")
-            except (struct.error, UnicodeDecodeError, _Truncated):
-                raise self.fail(f"record at byte {p} (opcode 0x{op:02x}) is corrupt") from None
-            p = end
-        if not data_end:
-            raise _Truncated("no data-end record")
-        if not finished:
-            raise _Truncated("no footer")
+                rec = next(records)
+            except StopIteration:
+                break
+            except Exception as exc:
+                if data_end:
+                    raise _Truncated("the file ends in its summary section, after all its data") from None
+                if start >= size:  # a killed writer: everything flushed is complete
+                    raise _Truncated("the writer stopped after a complete block") from None
+                if f.tell() >= size:  # the cut: a record runs past the end of the file
+                    raise _Truncated("the file ends inside a record") from None
+                raise log._fail(f"corrupt MCAP file ({type(exc).__name__}: {exc})") from None
+            if isinstance(rec, Chunk):
+                try:
+                    inner = breakup_chunk(rec, validate_crc=True)
+                except Exception as exc:
+                    if f.tell() >= size:
+                        raise _Truncated("the file ends inside a chunk") from None
+                    raise log._fail(f"corrupt MCAP file (a chunk: {type(exc).__name__}: {exc})") from None
+                for r in inner:
+                    take(r)
+            elif isinstance(rec, Metadata):
+                log.metadata[rec.name] = dict(rec.metadata)
+            elif isinstance(rec, Attachment):
+                log.attachments[rec.name] = bytes(rec.data)
+                log.attachment_types[rec.name] = rec.media_type
+            elif isinstance(rec, DataEnd):
+                data_end = True
+            elif isinstance(rec, Footer):  # read this way only when the closing magic is missing
+                reason = "the file ends after its footer, without the closing MCAP magic"
+                break
+            else:
+                take(rec)
+    except _Truncated as exc:
+        reason = str(exc)
+    for msgs in messages.values():
+        msgs.sort(key=lambda x: x[0])
+    log._messages.update(messages)
+    log.truncated = bool(reason)
+    log.truncated_reason = reason
 
 
 def load_log(path: str | Path) -> RunLog:
     """Load a run log; raises LogError on a missing, non-MCAP, corrupt or unsupported file."""
+    from mcap.writer import MCAP0_MAGIC
+
     path = Path(path)
+    log = RunLog(path)
     try:
-        data = path.read_bytes()
+        with open(path, "rb") as f:
+            size = f.seek(0, 2)
+            f.seek(0)
+            head = f.read(8)
+            if head != MCAP0_MAGIC:
+                what = "an empty file" if not head else "it does not start with the MCAP magic"
+                raise LogError(f"{path}: not an MCAP file ({what}); {ACCEPTED}")
+            f.seek(max(size - 8, 8))
+            finished = size >= 16 and f.read(8) == MCAP0_MAGIC  # a closed file ends with the magic too
+            f.seek(0)
+            try:
+                if finished:
+                    _load_indexed(log, f)
+                else:
+                    _load_stream(log, f, size)
+            except LogError:
+                raise
+            except Exception as exc:  # the library's parse and CRC errors: corruption, in one line
+                raise log._fail(f"corrupt MCAP file ({type(exc).__name__}: {exc})") from None
     except FileNotFoundError:
         raise LogError(f"{path}: no such file; {ACCEPTED}") from None
     except IsADirectoryError:
         raise LogError(f"{path}: is a directory; {ACCEPTED}") from None
     except OSError as exc:
-        raise LogError(f"{path}: cannot be read ({exc.strerror}); {ACCEPTED}") from None
-    log = RunLog(path)
-    parser = _Parser(path, log)
-    try:
-        parser.parse(data)
-    except _Truncated as exc:
-        log.truncated = True
-        log.truncated_reason = str(exc) or "the file ends early"
-    except LogError:
-        raise
-    except Exception as exc:  # any other parse failure is corruption, reported in one line
-        raise LogError(f"{path}: corrupt MCAP file ({type(exc).__name__}: {exc}); {ACCEPTED}") from None
-    if data[-8:] == MCAP_MAGIC and log.truncated and len(data) > 16:
-        # a finished file (footer magic present) that cannot be walked to its end is corrupt
-        raise LogError(f"{path}: corrupt MCAP file ({log.truncated_reason} although the file has a footer); {ACCEPTED}")
+        raise LogError(f"{path}: cannot be read ({exc.strerror or exc}); {ACCEPTED}") from None
     info = log.metadata.get("wmr_mj")
     if info is None:
         if log.truncated:
@@ -523,10 +455,11 @@ def load_log(path: str | Path) -> RunLog:
     if version not in SUPPORTED_SCHEMA_VERSIONS:
         raise LogError(
             f"{path}: unknown wmr-mj log schema version {version!r}; this wmr-mj reads schema version(s) "
-            f"{', '.join(SUPPORTED_SCHEMA_VERSIONS)}"
+            f"{', '.join(SUPPORTED_SCHEMA_VERSIONS)} (write the log again with `wmr-mj run`)"
         )
-    # decode every fixed-layout channel now, so that a bad payload is reported here
-    for topic, ch in log._by_topic.items():
-        if ch.encoding == "cdr" and ch.schema_encoding == "ros2msg":
-            log.channel(topic)
+    # the full-rate channels now (their chunks' CRCs checked), so that a bad file is reported here
+    packed = [t for t in (lf.SIGNALS_TOPIC, lf.STATE_TOPIC) if t in log._channels and t not in log._messages]
+    if packed:
+        log._read_indexed(packed, validate_crcs=True)
+    _ = log.signals, log.state
     return log

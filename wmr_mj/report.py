@@ -34,9 +34,6 @@ import html
 import io
 import math
 import os
-import platform
-import sys
-import threading
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass
@@ -46,6 +43,7 @@ from typing import Any
 import numpy as np
 
 from .errors import ParameterError, UnknownNameError
+from .io import software_versions
 
 __all__ = [
     "SOURCES",
@@ -259,89 +257,6 @@ def nominal_behaviour(rows: Mapping[str, np.ndarray], summary: Mapping[str, Any]
     }
 
 
-def software_versions() -> dict[str, str]:
-    import matplotlib
-    import mujoco
-    import scipy
-
-    from . import __version__
-
-    out = {"wmr_mj": __version__, "python": platform.python_version(), "platform": platform.platform(),
-           "mujoco": mujoco.__version__, "numpy": np.__version__, "scipy": scipy.__version__,
-           "matplotlib": matplotlib.__version__}
-    try:
-        import subprocess
-
-        root = Path(__file__).resolve().parent.parent
-        rev = subprocess.run(["git", "-C", str(root), "rev-parse", "--short", "HEAD"], capture_output=True,
-                             text=True, timeout=5)
-        if rev.returncode == 0 and rev.stdout.strip():
-            out["git_commit"] = rev.stdout.strip()
-    except (OSError, ValueError, Exception):  # no git: no commit recorded
-        pass
-    return out
-
-
-# --------------------------------------------------------------------------- progress on stderr
-class _Stages:
-    """One line per stage on stderr with its wall time; a live counter on a terminal."""
-
-    def __init__(self, stream=None, enabled: bool = True, tty: bool | None = None):
-        self.stream = stream if stream is not None else sys.stderr
-        self.enabled = enabled
-        self.tty = (hasattr(self.stream, "isatty") and self.stream.isatty()) if tty is None else tty
-        self._lock = threading.Lock()
-        self._label = ""
-        self._extra = ""
-        self._t0 = 0.0
-        self._stop: threading.Event | None = None
-        self._thread: threading.Thread | None = None
-        self.timings: dict[str, float] = {}
-
-    def _draw(self) -> None:
-        with self._lock:
-            if self._stop is None:
-                return
-            el = time.perf_counter() - self._t0
-            self.stream.write(f"\r\x1b[Kvalidate: {self._label} {self._extra} [{el:.0f} s]")
-            self.stream.flush()
-
-    def start(self, key: str, label: str) -> None:
-        self._key, self._label, self._extra = key, label, ""
-        self._t0 = time.perf_counter()
-        if self.enabled and self.tty:
-            self._stop = threading.Event()
-
-            def tick(stop=self._stop):
-                while not stop.wait(0.5):
-                    self._draw()
-
-            self._thread = threading.Thread(target=tick, daemon=True)
-            self._thread.start()
-            self._draw()
-
-    def update(self, text: str) -> None:
-        self._extra = text
-        if self.enabled and self.tty:
-            self._draw()
-
-    def done(self, result: str = "") -> float:
-        el = time.perf_counter() - self._t0
-        self.timings[self._key] = el
-        if self._stop is not None:
-            self._stop.set()
-            if self._thread is not None:
-                self._thread.join()
-            with self._lock:
-                self._stop = None
-                self.stream.write("\r\x1b[K")
-        if self.enabled:
-            tail = f": {result}" if result else ""
-            self.stream.write(f"validate: {self._label} ... {el:.1f} s{tail}\n")
-            self.stream.flush()
-        return el
-
-
 # --------------------------------------------------------------------------- the run
 def write_pointer(folder: str | os.PathLike) -> Path:
     """Write ``<parent>/validate-latest``: a text file holding the folder's absolute path."""
@@ -362,6 +277,7 @@ def run_validate(settings: ValidateSettings, out_dir: str | os.PathLike, *, log:
     from .identify import identify_plant
     from .io import write_json_atomic, write_text_atomic
     from .params import C80, with_params
+    from .progress import Stages
     from .simulate import RunConfig, run_closed_loop
     from .sweep import SweepSpec, read_results, run_sweep
 
@@ -369,7 +285,7 @@ def run_validate(settings: ValidateSettings, out_dir: str | os.PathLike, *, log:
     folder = Path(out_dir)
     folder.mkdir(parents=True, exist_ok=True)
     fig_dir = folder / "figures"
-    st = _Stages(stream, enabled=log, tty=tty)
+    st = Stages("validate", stream=stream, enabled=log, tty=tty)
     figures: dict[str, list[str]] = {}
 
     def rel(p: Path) -> str:
@@ -399,10 +315,10 @@ def run_validate(settings: ValidateSettings, out_dir: str | os.PathLike, *, log:
                                  f"{settings.m1_range[0]:g}-{settings.m1_range[1]:g} kg ({settings.sampling})")
         resumed: list[int] = []
 
-        def sweep_progress(done: int, total: int) -> None:
+        def sweep_progress(done: int, total: int, resumed: list[int] = resumed) -> None:
             if not resumed:
                 resumed.append(done)  # the first call reports the runs found in runs.csv
-            st.update(f"{done:.0f}/{total} runs")
+            st.update(done, total)
 
         run_sweep(spec, out_dir=sweep_dir, nthread=settings.nthread, progress=sweep_progress)
         rows = read_results(sweep_dir / "runs.csv")

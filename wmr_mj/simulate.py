@@ -31,6 +31,7 @@ import numpy as np
 from controllers import SteeringController, make_controller, model_from_source
 from controllers.computed_torque import CONTROLLER_NAMES, FRICTION_SIGNS, MODEL_SOURCES
 
+from .certificate import certificate_for
 from .errors import ParameterError, UnknownNameError
 from .memory import require_run_memory
 from .params import C80, C80Parameters, parameter_names, with_params
@@ -230,16 +231,21 @@ def _substeps(config: RunConfig, timestep: float) -> int:
 
 def report(config: RunConfig, *, analysis, params: C80Parameters, settle_s: float, sup_E: float, sup_Edot: float,
            sup_E_settled: float, sup_Edot_settled: float, saturated_fraction: float, left_range_at: float | None,
-           final_alpha: float, control_steps: int, steps: int, wall_s: float, status: str) -> dict[str, Any]:
+           final_alpha: float, control_steps: int, steps: int, wall_s: float, status: str,
+           certificate=None, drift: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """The run's report: sup errors (whole run and after the entry transient) against the region.
 
-    Shared by the serial runner and the batched sweep so both report alike.
+    Shared by the serial runner and the batched sweep so both report alike. E_max,
+    Edot_max, inside, E_ratio, Edot_ratio are the paper's claim (``analysis``); with a
+    ``certificate`` (:mod:`wmr_mj.certificate`) and the end-of-run ``drift``
+    (:func:`wmr_mj.verdicts.drift`) the separated verdict is added
+    (:func:`wmr_mj.verdicts.judge_run`: verdict, certificate, paper_region, drift).
     """
     sup_E, sup_Edot = float(sup_E), float(sup_Edot)
     stable = bool(analysis.stable)
     E_max = float(analysis.E_max) if stable else math.inf
     Ed_max = float(analysis.Edot_max) if stable else math.inf
-    return {
+    out = {
         "status": status,
         "controller": config.controller,
         "model": config.model,
@@ -269,10 +275,26 @@ def report(config: RunConfig, *, analysis, params: C80Parameters, settle_s: floa
         "left_steering_range_at_s": left_range_at,
         "final_alpha": float(final_alpha),
     }
+    if certificate is not None:
+        from .verdicts import judge_run
+
+        out.update(judge_run(certificate=certificate, analysis=analysis, sup_E=sup_E, sup_Edot=sup_Edot,
+                             drift=drift or {}))
+    return out
 
 
 def _sup(x: np.ndarray) -> float:
     return float(np.max(np.abs(x))) if x.size else 0.0
+
+
+def _drift_of(E: np.ndarray, final_alpha_dot: float, period: float) -> dict[str, Any]:
+    """End-of-run drift from the serial rows (the batch computes the same windows per block)."""
+    from .verdicts import drift, drift_window_steps
+
+    k = len(E)
+    w = drift_window_steps(k, period)
+    return drift(prev_window=_sup(E[max(0, k - 2 * w):k - w]), last_window=_sup(E[k - w:]),
+                 final_alpha_dot=final_alpha_dot)
 
 
 def run_closed_loop(
@@ -302,6 +324,7 @@ def run_closed_loop(
     require_run_memory(duration_s=n * period, control_period_s=period)  # before the arrays
     reference, settle_s = build_reference(config.path, estimate, dt=period, duration=n * period)
     analysis = analysis_for(config, reference, estimate, estimate=_estimate_of(controller))
+    certificate = certificate_for(config, reference, params=base)
     a0_all, a0d_all, a0dd_all = reference.alpha0, reference.alpha0_dot, reference.alpha0_ddot
     if len(a0_all) < n:
         raise ParameterError(f"reference shorter than the run: {len(a0_all)} < {n} samples")
@@ -313,6 +336,7 @@ def run_closed_loop(
         log_spec = int(mujoco.mjtState.mjSTATE_QPOS | mujoco.mjtState.mjSTATE_QVEL | mujoco.mjtState.mjSTATE_CTRL)
         log_state = np.empty((block_len, mujoco.mj_stateSize(m, log_spec)))
         log_sites = np.empty((block_len, m.nsite, 3))
+        state_rows, site_rows, get_state = list(log_state), list(log_sites), mujoco.mj_getState  # cheaper per step
     logger = None
     if full:
         state = np.empty(mujoco.mj_stateSize(m, mujoco.mjtState.mjSTATE_INTEGRATION))
@@ -368,7 +392,7 @@ def run_closed_loop(
             ctrl[act] = u
             if full:
                 j = k - block_start
-                mujoco.mj_getState(m, d, log_state[j], log_spec)
+                get_state(m, d, state_rows[j], log_spec)
             for _ in range(substeps):
                 mujoco.mj_step(m, d)
             # after mj_step, forces and kinematics belong to the state the step started from
@@ -387,7 +411,7 @@ def run_closed_loop(
             q = xquat[chassis]
             r_h[k] = math.atan2(2.0 * (q[0] * q[3] + q[1] * q[2]), 1.0 - 2.0 * (q[2] * q[2] + q[3] * q[3]))
             if full:
-                log_sites[j] = site_xpos
+                site_rows[j][...] = site_xpos
             if left_range_at is None and abs(a) >= range_limit:
                 left_range_at = k * period
             k += 1
@@ -408,7 +432,8 @@ def run_closed_loop(
                      sup_Edot=_sup(done["E_dot"]), sup_E_settled=_sup(done["E"][after]),
                      sup_Edot_settled=_sup(done["E_dot"][after]), saturated_fraction=saturated / k,
                      left_range_at=left_range_at, final_alpha=done["alpha"][-1], control_steps=k,
-                     steps=k * substeps, wall_s=wall, status=status)
+                     steps=k * substeps, wall_s=wall, status=status, certificate=certificate,
+                     drift=_drift_of(done["E"], done["alpha_dot"][-1], period))
     summary["mujoco_warnings"] = int(sum(w.number for w in d.warning))
     summary["analysis"] = analysis.as_dict()
     summary["controller_config"] = controller.describe()
