@@ -124,6 +124,7 @@ def summarize(log: RunLog, settle_s: float | None = None) -> dict[str, Any]:
             late = ok[t >= settle_s]
             out["inside_after_settle"] = bool(np.all(late)) if late.size else None
             out["samples_outside_after_settle"] = int(np.count_nonzero(~late))
+    out["verdict"] = summary.get("verdict")  # the runner's separated verdict (wmr_mj.verdicts)
     out["summary"] = log.summary
     out["versions"] = log.versions
     return out
@@ -306,7 +307,7 @@ def format_summary(rep: dict[str, Any]) -> str:
         def verdict(inside: Any, count: Any) -> str:
             return {True: "INSIDE", False: f"OUTSIDE ({count} samples)", None: "n/a"}[inside]
 
-        text = f"bounds     E_max = {_fmt(rep['E_max'], 'rad')}, Edot_max = {_fmt(rep['Edot_max'], 'rad/s')}: "
+        text = f"paper's claim E_max = {_fmt(rep['E_max'], 'rad')}, Edot_max = {_fmt(rep['Edot_max'], 'rad/s')}: "
         text += f"whole run {verdict(rep['inside'], rep.get('samples_outside'))}"
         if settle is not None:
             late = verdict(rep["inside_after_settle"], rep.get("samples_outside_after_settle"))
@@ -314,6 +315,10 @@ def format_summary(rep: dict[str, Any]) -> str:
         lines.append(text)
     else:
         lines.append("bounds     none in the log (no finite E_max / Edot_max in its summary or config)")
+    if rep.get("summary"):
+        from .verdicts import format_verdict
+
+        lines.extend("verdict    " + line for line in format_verdict(rep["summary"]))
     if rep["summary"]:
         extra = {k: v for k, v in rep["summary"].items() if k not in ("status", "rows", "last_t")}
         sc = [f"{k}={_fmt(v) if isinstance(v, float) else v}" for k, v in extra.items()

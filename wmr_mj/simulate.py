@@ -343,7 +343,7 @@ def run_closed_loop(
         mujoco.mj_getState(m, d, state, mujoco.mjtState.mjSTATE_INTEGRATION)
         logger = logger_factory(mjcf_xml=plant.xml, config=config.as_dict(), parameters=params.as_dict(),
                                 initial_state=state, timestep=dt, control_substeps=substeps,
-                                bounds={"E_max": analysis.E_max, "Edot_max": analysis.Edot_max}, model=m,
+                                bounds={"E_max": certificate.E_max, "Edot_max": certificate.Edot_max}, model=m,
                                 reference_path=np.asarray(reference.C_xy)[::max(1, len(reference.C_xy) // 2000)])
 
     qpos, qvel, ctrl = d.qpos, d.qvel, d.ctrl
