@@ -37,6 +37,7 @@ from .memory import require_run_memory
 from .params import C80, C80Parameters, parameter_names, with_params
 from .plant import STEERING_FRICTION_MODELS, TIMESTEP, TYRE_CONTACT_MODELS, Plant
 from .progress import progress_bar
+from .summary import RunSummary
 
 __all__ = [
     "RunConfig",
@@ -198,7 +199,7 @@ class RunResult:
 
     config: RunConfig
     rows: dict[str, np.ndarray]
-    summary: dict[str, Any]
+    summary: RunSummary
     status: str = "completed"
 
 
@@ -232,7 +233,7 @@ def _substeps(config: RunConfig, timestep: float) -> int:
 def report(config: RunConfig, *, analysis, params: C80Parameters, settle_s: float, sup_E: float, sup_Edot: float,
            sup_E_settled: float, sup_Edot_settled: float, saturated_fraction: float, left_range_at: float | None,
            final_alpha: float, control_steps: int, steps: int, wall_s: float, status: str,
-           certificate=None, drift: Mapping[str, Any] | None = None) -> dict[str, Any]:
+           certificate=None, drift: Mapping[str, Any] | None = None) -> RunSummary:
     """The run's report: sup errors (whole run and after the entry transient) against the region.
 
     Shared by the serial runner and the batched sweep so both report alike. E_max,
@@ -245,7 +246,7 @@ def report(config: RunConfig, *, analysis, params: C80Parameters, settle_s: floa
     stable = bool(analysis.stable)
     E_max = float(analysis.E_max) if stable else math.inf
     Ed_max = float(analysis.Edot_max) if stable else math.inf
-    out = {
+    out: RunSummary = {
         "status": status,
         "controller": config.controller,
         "model": config.model,
