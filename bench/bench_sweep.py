@@ -1,11 +1,25 @@
-"""Closed-loop sweep throughput against MuJoCo's open-loop rollout, same models, threads, steps.
+"""Closed-loop sweep throughput against MuJoCo's open-loop rollout: same models, threads and steps.
 
-    .venv/bin/python bench/bench_sweep.py [--nsim 128] [--seconds 10] [--nthread 2] [--repeats 3]
+    .venv/bin/python bench/bench_sweep.py [--sizes 16,32,64,128,256] [--seconds 10] [--nthread 2]
+                                          [--repeats 3] [--sweep-n 32] [--sweep-seconds 35] [--no-cpu]
 
-Prints physics steps per second (medians over repeats) of
-  rollout:    mujoco.rollout stepping the nsim models open loop (C, no Python per step)
-  closed:     wmr_mj.sweep.run_batch: mujoco.batch + the vectorised computed-torque law every 1 ms step
-and their ratio (target >= 0.90). Compilation and reference generation are outside both timings.
+For each batch size, side by side in one process and interleaved repeat by repeat, prints the
+physics steps per second (medians over repeats) of
+
+  rollout:  ``mujoco.rollout`` stepping the models open loop (C, no Python per step), each
+            driven by the voltages its own closed-loop run applied (from a serial run before
+            the timings), so that both loops do the same physics step for step (checked: the
+            open loop ends where the closed loop did, to the bit); rollout records every
+            step into output arrays allocated once;
+  closed:   ``wmr_mj.sweep.run_batch``: the vectorised law every 1 ms step on ``mujoco.batch``,
+            one group of simulations per thread (compilation and reference outside the timing);
+
+and their ratio (target >= 0.90); beside it the same ratio in CPU seconds of one thread's share
+(nsim/nthread runs on one thread each side), which other processes on the machine do not blur
+as they blur wall time. Then the whole sweep as ``wmr-mj sweep --n 32`` runs it
+(``run_sweep`` with its output folder: drawing, compilation, reference, statistics and the
+CSV included; the command's imports and plot excluded) against rollout of the same models
+(target >= 0.85). The machine may be shared: compare ratios, not absolute figures.
 """
 
 from __future__ import annotations
@@ -13,6 +27,7 @@ from __future__ import annotations
 import argparse
 import statistics
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -22,47 +37,126 @@ import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 from mujoco import rollout  # noqa: E402
 
-from wmr_mj.plant import compile_model  # noqa: E402
-from wmr_mj.simulate import RunConfig, plant_parameters  # noqa: E402
-from wmr_mj.sweep import run_batch  # noqa: E402
+from wmr_mj.simulate import RunConfig, plant_parameters, run_closed_loop  # noqa: E402
+from wmr_mj.sweep import SweepSpec, batch_model, run_batch, run_sweep  # noqa: E402
+
+
+def applied_voltages(configs: list[RunConfig]) -> np.ndarray:
+    """(nsim, nstep) steering voltage each config's closed loop applies (serial runs)."""
+    return np.stack([run_closed_loop(c, progress=False).rows["voltage"] for c in configs])
+
+
+class OpenLoop:
+    """Rollout of the models of ``configs``, open loop, on ``nthread`` threads."""
+
+    def __init__(self, configs: list[RunConfig], voltage: np.ndarray, nthread: int):
+        self.models = [batch_model(plant_parameters(c)) for c in configs]
+        m = self.models[0]
+        self.nstep = voltage.shape[1]
+        spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+        self.initial = np.empty((len(configs), mujoco.mj_stateSize(m, spec)))
+        for i, model in enumerate(self.models):
+            d = mujoco.MjData(model)
+            mujoco.mj_resetDataKeyframe(model, d, model.key("home").id)
+            mujoco.mj_getState(model, d, self.initial[i], spec)
+        self.control = np.tile(m.key("home").ctrl, (len(configs), self.nstep, 1))
+        self.control[:, :, m.actuator("steering_motor").id] = voltage
+        self.datas = [mujoco.MjData(m) for _ in range(max(nthread, 1))]
+        self.nthread = nthread
+        # rollout records every step; its outputs are allocated (and their pages touched) once,
+        # outside the timings, so that they time the stepping and not the page faults
+        self.state = np.zeros((len(configs), self.nstep, mujoco.mj_stateSize(m, spec)))
+        self.sensordata = np.zeros((len(configs), self.nstep, m.nsensordata))
+
+    def steps_per_s(self, pool: rollout.Rollout, *, clock=time.perf_counter) -> float:
+        t = clock()
+        state, _ = pool.rollout(self.models, self.datas, self.initial, self.control, state=self.state,
+                                sensordata=self.sensordata)
+        rate = len(self.models) * self.nstep / (clock() - t)
+        m = self.models[0]
+        self.final_alpha = state[:, -1, 1 + m.jnt_qposadr[m.joint("steer").id]]  # state: time, qpos, ...
+        return rate
+
+    def same_as(self, reports: list[dict]) -> bool:
+        """Whether the open loop ended where the closed loop did, to the bit (the same physics)."""
+        return bool(np.array_equal(self.final_alpha, [r["final_alpha_after_step"] for r in reports]))
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--nsim", type=int, default=128)
-    ap.add_argument("--seconds", type=float, default=12.0, help="simulated time per run (>= 10 for the circle)")
+    ap.add_argument("--sizes", default="16,32,64,128,256", help="batch sizes, comma-separated")
+    ap.add_argument("--seconds", type=float, default=10.0,
+                    help="simulated time per run in the batch comparison (>= 10 for the circle)")
     ap.add_argument("--nthread", type=int, default=2)
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--model", default="nonholonomic")
+    ap.add_argument("--sweep-n", type=int, default=32, help="runs of the whole-sweep comparison (0: skip it)")
+    ap.add_argument("--sweep-seconds", type=float, default=35.0, help="simulated time per run of the whole sweep")
+    ap.add_argument("--no-cpu", action="store_true", help="skip the one-thread CPU-time ratios")
     args = ap.parse_args()
+    sizes = [int(x) for x in args.sizes.split(",") if x.strip()]
 
-    m1 = np.linspace(550.0, 750.0, args.nsim)
-    configs = [RunConfig(model=args.model, duration=args.seconds, m1=float(m)) for m in m1]
-    models = [compile_model(plant_parameters(c))[0] for c in configs]
-    nstep = int(round(args.seconds / models[0].opt.timestep))
-    nstate = mujoco.mj_stateSize(models[0], mujoco.mjtState.mjSTATE_FULLPHYSICS)
-    initial = np.empty((args.nsim, nstate))
-    for i, m in enumerate(models):
-        d = mujoco.MjData(m)
-        mujoco.mj_resetDataKeyframe(m, d, m.key("home").id)
-        mujoco.mj_getState(m, d, initial[i], mujoco.mjtState.mjSTATE_FULLPHYSICS)
-    control = np.tile(models[0].key("home").ctrl, (args.nsim, nstep, 1))
-    control[:, :, 0] = 3.0  # a steering voltage, so the steering moves as in the closed loop
-    datas = [mujoco.MjData(models[0]) for _ in range(args.nthread)]
+    cases = {}
+    for nsim in sizes:
+        configs = [RunConfig(model=args.model, duration=args.seconds, m1=float(m))
+                   for m in np.linspace(550.0, 750.0, nsim)]
+        voltages = applied_voltages(configs)
+        per_thread = max(1, nsim // max(args.nthread, 1))  # one thread's share, for the CPU-time ratio
+        cases[nsim] = (configs, OpenLoop(configs, voltages, args.nthread),
+                       OpenLoop(configs[:per_thread], voltages[:per_thread], 0))
+    open_loop: dict[int, list[float]] = {n: [] for n in sizes}
+    closed: dict[int, list[float]] = {n: [] for n in sizes}
+    same: dict[int, bool] = {}
+    cpu: dict[int, list[float]] = {n: [] for n in sizes}
+    sweep_open: list[float] = []
+    sweep_closed: list[float] = []
+    spec = (SweepSpec(n=args.sweep_n, seed=0, base=RunConfig(model=args.model, duration=args.sweep_seconds))
+            if args.sweep_n else None)
+    with (rollout.Rollout(nthread=args.nthread) as pool, rollout.Rollout(nthread=0) as caller,
+          tempfile.TemporaryDirectory() as tmp):
+        sweep_ol = None
+        if spec is not None:
+            from wmr_mj.sweep import _run_configs, draw_samples
 
-    open_loop, closed_loop = [], []
-    with rollout.Rollout(nthread=args.nthread) as r:
-        for _ in range(args.repeats):
-            t = time.perf_counter()
-            r.rollout(models, datas, initial, control)
-            open_loop.append(args.nsim * nstep / (time.perf_counter() - t))
-            reports = run_batch(configs, nthread=args.nthread)
-            closed_loop.append(reports[0]["batch_steps_per_s"])
-    ro, cl = statistics.median(open_loop), statistics.median(closed_loop)
-    print(f"models: {args.nsim} (m1 550-750 kg), {nstep} steps each, {args.nthread} threads, {args.repeats} repeats")
-    print(f"rollout (open loop)      : {ro:12.0f} steps/s  (median; runs: {', '.join(f'{x:.0f}' for x in open_loop)})")
-    print(f"closed loop (run_batch)  : {cl:12.0f} steps/s  (median; runs: {', '.join(f'{x:.0f}' for x in closed_loop)})")
-    print(f"ratio closed/open        : {cl / ro:.3f}   (target >= 0.90)")
+            sweep_configs = _run_configs(spec, draw_samples(spec))
+            sweep_ol = OpenLoop(sweep_configs, applied_voltages(sweep_configs), args.nthread)
+        for rep in range(args.repeats):
+            for nsim in sizes:
+                configs, ol, one = cases[nsim]
+                open_loop[nsim].append(ol.steps_per_s(pool))
+                reports = run_batch(configs, nthread=args.nthread)
+                closed[nsim].append(reports[0]["batch_steps_per_s"])
+                same[nsim] = ol.same_as(reports)
+                if not args.no_cpu:  # CPU seconds of one thread's share: what a shared machine cannot blur
+                    rollout_rate = one.steps_per_s(caller, clock=time.thread_time)
+                    closed_cpu = run_batch(configs[:len(one.models)], nthread=1)[0]["batch_cpu_s"]
+                    cpu[nsim].append(len(one.models) * one.nstep / closed_cpu / rollout_rate)
+            if sweep_ol is not None:
+                sweep_open.append(sweep_ol.steps_per_s(pool))
+                t = time.perf_counter()
+                results = run_sweep(spec, out_dir=Path(tmp) / f"sweep-{rep}", chunk=128, nthread=args.nthread)
+                sweep_closed.append(sum(r["steps"] for r in results) / (time.perf_counter() - t))
+
+    print(f"{args.model} model, m1 550-750 kg, {args.seconds:g} s per run, {args.nthread} threads, "
+          f"{args.repeats} repeats (medians; ratio = median closed / median rollout, "
+          "paired = median of the repeat-by-repeat ratios)")
+    print(f"{'nsim':>6s} {'rollout steps/s':>16s} {'closed steps/s':>16s} {'ratio':>7s} {'paired':>7s} "
+          f"{'cpu':>6s}  same physics")
+    for nsim in sizes:
+        ro, cl = statistics.median(open_loop[nsim]), statistics.median(closed[nsim])
+        paired = statistics.median(c / o for c, o in zip(closed[nsim], open_loop[nsim]))
+        cpu_ratio = f"{statistics.median(cpu[nsim]):6.3f}" if cpu[nsim] else f"{'-':>6s}"
+        print(f"{nsim:6d} {ro:16.0f} {cl:16.0f} {cl / ro:7.3f} {paired:7.3f} {cpu_ratio}  "
+              f"{'yes' if same[nsim] else 'NO'}")
+    print("target: ratio >= 0.90 for every size. cpu: the same ratio in CPU seconds of one thread's share "
+          "(nsim/nthread runs, one thread each side), which load from other processes does not blur. "
+          "same physics: the open loop ends where the closed loop did, to the bit")
+    if sweep_open:
+        ro, cl = statistics.median(sweep_open), statistics.median(sweep_closed)
+        paired = statistics.median(c / o for c, o in zip(sweep_closed, sweep_open))
+        print(f"whole sweep --n {args.sweep_n} ({args.sweep_seconds:g} s per run; run_sweep with drawing, compilation, "
+              f"reference, statistics, CSV): rollout {ro:.0f}, sweep {cl:.0f} steps/s, ratio {cl / ro:.3f}, "
+              f"paired {paired:.3f} (target >= 0.85)")
 
 
 if __name__ == "__main__":

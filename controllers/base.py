@@ -7,18 +7,32 @@ simulations::
     u = controller.voltage(alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot)   # arrays (B,) -> (B,)
 
 ``voltage_scalar`` is the same law on Python floats, for the single-run loop
-where NumPy's per-call overhead would dominate (a test keeps the two equal).
+where NumPy's per-call overhead would dominate, and ``batch_law(n)`` the same
+law for the batched loop of ``wmr_mj.sweep``: a callable that writes into
+buffers it owns, so that a control step allocates nothing (tests keep all three
+bit-identical)::
+
+    law = controller.batch_law(n)
+    u = law(alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot, E, E_dot, u_out)
+
 The motor's voltage limit is applied outside the law by :func:`saturate`.
 """
 
 from __future__ import annotations
 
 import abc
+from collections.abc import Callable
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-__all__ = ["SteeringController", "saturate"]
+__all__ = ["SteeringController", "BatchLaw", "saturate"]
+
+#: law(alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot, E, E_dot, u) -> u: alpha, alpha_dot (n,) arrays
+#: (rad, rad/s; strided views are fine); the reference as floats; E = alpha0 - alpha and
+#: E_dot = alpha0_dot - alpha_dot are written into the (n,) arrays E, E_dot; the unsaturated
+#: voltage (V) into u, which is returned.
+BatchLaw = Callable[[np.ndarray, np.ndarray, float, float, float, np.ndarray, np.ndarray, np.ndarray], np.ndarray]
 
 
 class SteeringController(abc.ABC):
@@ -43,6 +57,21 @@ class SteeringController(abc.ABC):
         """The same law on floats (override for speed)."""
         return float(self.voltage(np.array([alpha]), np.array([alpha_dot]), np.array([alpha0]),
                                   np.array([alpha0_dot]), np.array([alpha0_ddot]))[0])
+
+    def batch_law(self, n: int) -> BatchLaw:
+        """The law for a batch of ``n`` simulations, writing into the caller's buffers.
+
+        This default calls :meth:`voltage` (which allocates); controllers override it
+        with a law that allocates nothing per call.
+        """
+
+        def law(alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot, E, E_dot, u):
+            np.subtract(alpha0, alpha, out=E)
+            np.subtract(alpha0_dot, alpha_dot, out=E_dot)
+            u[...] = self.voltage(alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot)
+            return u
+
+        return law
 
     def describe(self) -> dict:
         """JSON-able description for logs and reports."""

@@ -31,7 +31,6 @@ from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
-from numpy.typing import ArrayLike
 
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import C80, C80Parameters
@@ -74,7 +73,8 @@ def _read_identified(identified: str | Path | Mapping) -> Mapping:
         return identified
     path = Path(identified)
     if not path.is_file():
-        raise ParameterError(f"identified-model file {str(path)!r} does not exist; write one with: wmr-mj identify --out PATH")
+        raise ParameterError(f"identified-model file {str(path)!r} does not exist; "
+                             "write one with: wmr-mj identify --out PATH")
     try:
         return json.loads(path.read_text())
     except (json.JSONDecodeError, UnicodeDecodeError):
@@ -152,27 +152,108 @@ class ComputedTorque(SteeringController):
     def _sign_source(self, alpha_dot, alpha0_dot):
         return alpha0_dot if self.friction_sign == "reference" else alpha_dot
 
+    # The three forms of the law below (arrays, floats, a batch writing into buffers) do the
+    # same IEEE operations in the same order, so they give the same bits; a term whose
+    # coefficient is exactly 0 (K^ of the non-holonomic model, gyro^ of the paper's, F^ with
+    # friction_sign='none') is left out of all three rather than added as 0.
+
     def voltage(self, alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot) -> np.ndarray:
         alpha = np.asarray(alpha, dtype=float)
         alpha_dot = np.asarray(alpha_dot, dtype=float)
         servo = (np.asarray(alpha0_ddot, dtype=float) + self.kd * (np.asarray(alpha0_dot, dtype=float) - alpha_dot)
                  + self.kp * (np.asarray(alpha0, dtype=float) - alpha))
         c = np.cos(alpha)
-        s = smooth_sign(self._sign_source(alpha_dot, np.asarray(alpha0_dot, dtype=float)), self.friction_width)
-        # the same operations, in the same order, as voltage_scalar: bit-identical results
-        return (self._P * servo + self._K * np.sin(alpha) / (c * c * c) + self._C_V * alpha_dot + self._F * s
-                + self._gyro_V * alpha_dot / (c * c))
+        u = self._P * servo
+        if self._K:
+            u = u + self._K * np.sin(alpha) / (c * c * c)
+        if self._C_V:
+            u = u + self._C_V * alpha_dot
+        if self._F:
+            u = u + self._F * smooth_sign(self._sign_source(alpha_dot, np.asarray(alpha0_dot, dtype=float)),
+                                          self.friction_width)
+        if self._gyro_V:
+            u = u + self._gyro_V * alpha_dot / (c * c)
+        return u
 
     def voltage_scalar(self, alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot) -> float:
         servo = alpha0_ddot + self.kd * (alpha0_dot - alpha_dot) + self.kp * (alpha0 - alpha)
         c = math.cos(alpha)
-        x = alpha0_dot if self.friction_sign == "reference" else alpha_dot
-        if self.friction_width > 0.0:
-            s = x / math.sqrt(x * x + self.friction_width * self.friction_width)
-        else:
-            s = 1.0 if x > 0.0 else (-1.0 if x < 0.0 else 0.0)
-        return (self._P * servo + self._K * math.sin(alpha) / (c * c * c) + self._C_V * alpha_dot + self._F * s
-                + self._gyro_V * alpha_dot / (c * c))
+        u = self._P * servo
+        if self._K:
+            u = u + self._K * math.sin(alpha) / (c * c * c)
+        if self._C_V:
+            u = u + self._C_V * alpha_dot
+        if self._F:
+            x = alpha0_dot if self.friction_sign == "reference" else alpha_dot
+            if self.friction_width > 0.0:
+                s = x / math.sqrt(x * x + self.friction_width * self.friction_width)
+            else:
+                s = 1.0 if x > 0.0 else (-1.0 if x < 0.0 else 0.0)
+            u = u + self._F * s
+        if self._gyro_V:
+            u = u + self._gyro_V * alpha_dot / (c * c)
+        return u
+
+    def batch_law(self, n: int):
+        """(3.2)-(3.3) for n simulations with NumPy ``out=`` buffers: no allocation per call.
+
+        About 20 small ufunc calls per control step; in a batch their per-call cost, not the
+        arithmetic, is what the law adds to the physics (see bench/bench_sweep.py).
+        """
+        P, K, C_V, F, gyro_V = self._P, self._K, self._C_V, self._F, self._gyro_V
+        width, reference_sign = self.friction_width, self.friction_sign == "reference"
+        width2 = width * width
+        # gains as arrays: an array-array ufunc call costs less than one with a Python float
+        kd, kp, Pv = np.full(n, self.kd), np.full(n, self.kp), np.full(n, P)
+        Kv, C_Vv, Fv, gyro_Vv = np.full(n, K), np.full(n, C_V), np.full(n, F), np.full(n, gyro_V)
+        c, t, t2 = np.empty(n), np.empty(n), np.empty(n)
+        sub, add, mul, div, cos = np.subtract, np.add, np.multiply, np.divide, np.cos
+
+        def law(alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot, E, E_dot, u):
+            sub(alpha0, alpha, out=E)
+            sub(alpha0_dot, alpha_dot, out=E_dot)
+            mul(kd, E_dot, out=u)
+            add(u, alpha0_ddot, out=u)  # alpha0'' + K_D E' (addition commutes exactly)
+            mul(kp, E, out=t)
+            add(u, t, out=u)  # the servo of (3.2)
+            mul(Pv, u, out=u)
+            if K:
+                cos(alpha, out=c)
+                np.sin(alpha, out=t)
+                mul(Kv, t, out=t)
+                mul(c, c, out=t2)
+                mul(t2, c, out=t2)
+                div(t, t2, out=t)
+                add(u, t, out=u)
+            if C_V:
+                mul(C_Vv, alpha_dot, out=t)
+                add(u, t, out=u)
+            if F:
+                if reference_sign:  # one sign for the whole batch
+                    x = float(alpha0_dot)
+                    s = (x / math.sqrt(x * x + width2) if width > 0.0
+                         else (1.0 if x > 0.0 else (-1.0 if x < 0.0 else 0.0)))
+                    add(u, F * s, out=u)
+                else:
+                    if width > 0.0:
+                        mul(alpha_dot, alpha_dot, out=t2)
+                        add(t2, width2, out=t2)
+                        np.sqrt(t2, out=t2)
+                        div(alpha_dot, t2, out=t)
+                    else:
+                        np.sign(alpha_dot, out=t)
+                    mul(Fv, t, out=t)
+                    add(u, t, out=u)
+            if gyro_V:
+                if not K:
+                    cos(alpha, out=c)
+                mul(gyro_Vv, alpha_dot, out=t)
+                mul(c, c, out=t2)
+                div(t, t2, out=t)
+                add(u, t, out=u)
+            return u
+
+        return law
 
     def describe(self) -> dict:
         return {"controller": self.name, "model": self.model.name, "kp": self.kp, "kd": self.kd,
@@ -201,6 +282,21 @@ class PDController(SteeringController):
 
     def voltage_scalar(self, alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot) -> float:
         return self._P * (self.kd * (alpha0_dot - alpha_dot) + self.kp * (alpha0 - alpha))
+
+    def batch_law(self, n: int):
+        """The PD law for n simulations with NumPy ``out=`` buffers: no allocation per call."""
+        kd, kp, Pv, t = np.full(n, self.kd), np.full(n, self.kp), np.full(n, self._P), np.empty(n)
+
+        def law(alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot, E, E_dot, u):
+            np.subtract(alpha0, alpha, out=E)
+            np.subtract(alpha0_dot, alpha_dot, out=E_dot)
+            np.multiply(kd, E_dot, out=u)
+            np.multiply(kp, E, out=t)
+            np.add(u, t, out=u)
+            np.multiply(Pv, u, out=u)
+            return u
+
+        return law
 
     def describe(self) -> dict:
         return {"controller": self.name, "model": self.model.name, "kp": self.kp, "kd": self.kd,

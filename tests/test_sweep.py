@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import subprocess
 import sys
 
@@ -11,7 +12,17 @@ import pytest
 
 from wmr_mj import ParameterError, SchedulerError, UnknownNameError
 from wmr_mj.simulate import RunConfig, run_closed_loop
-from wmr_mj.sweep import SweepSpec, draw_samples, read_results, run_batch, run_sweep
+from wmr_mj.sweep import (
+    SweepSpec,
+    batch_model,
+    connect,
+    draw_samples,
+    latin_hypercube,
+    read_results,
+    run_batch,
+    run_configs,
+    run_sweep,
+)
 
 BASE = RunConfig(model="nonholonomic", duration=10.0)
 KEYS = ("sup_E", "sup_Edot", "sup_E_settled", "sup_Edot_settled", "E_max", "Edot_max", "saturated_fraction",
@@ -31,9 +42,106 @@ def test_batch_is_bit_identical_to_runs_one_by_one():
     assert len({b["sup_E"] for b in batch}) == len(batch)
 
 
+LAW_INPUTS = (np.array([0.0, 0.31, -0.62, 0.05, 0.8, -0.1, 0.2, 0.0]),  # alpha, rad
+              np.array([0.0, 0.4, -0.03, 0.0, -1.5, 2e-3, -2e-3, 0.1]))  # alpha', rad/s (exact zeros included)
+
+
+@pytest.mark.parametrize("options", [dict(model="paper"), dict(model="nonholonomic"), dict(model="paper-lagrange"),
+                                     dict(model="paper", friction_sign="reference"),
+                                     dict(model="nonholonomic", friction_sign="none"),
+                                     dict(model="paper", friction_width=0.01),
+                                     dict(model="nonholonomic", friction_sign="reference", friction_width=0.01),
+                                     dict(controller="pd", model="paper")])
+def test_batch_law_is_bit_identical_to_the_scalar_and_array_laws(options):
+    from wmr_mj.simulate import _controller, estimate_parameters
+
+    controller = _controller(RunConfig(**options), estimate_parameters())
+    alpha, alpha_dot = LAW_INPUTS
+    law = controller.batch_law(len(alpha))
+    E, E_dot, u = np.empty(len(alpha)), np.empty(len(alpha)), np.empty(len(alpha))
+    state = np.zeros((len(alpha), 3))  # the law reads strided views of state rows in the batch
+    state[:, 0], state[:, 2] = alpha, alpha_dot
+    for ref in ((0.3, 0.1, -0.2), (-0.5, 0.0, 0.4), (0.0, -0.2, 0.0)):
+        out = law(state[:, 0], state[:, 2], *ref, E, E_dot, u)
+        scalar = [controller.voltage_scalar(a, ad, *ref) for a, ad in zip(alpha, alpha_dot)]
+        assert out is u and u.tolist() == scalar
+        assert controller.voltage(alpha, alpha_dot, *ref).tolist() == scalar
+        assert E.tolist() == [ref[0] - a for a in alpha] and E_dot.tolist() == [ref[1] - ad for ad in alpha_dot]
+
+
+def test_batch_model_is_the_serial_model_but_for_the_sky():
+    import mujoco
+
+    from wmr_mj.plant import compile_model
+    from wmr_mj.simulate import plant_parameters
+
+    cfg = BASE.replace(m1=612.3456789, plant_overrides={"mu": 0.0191234567, "V_A": 0.23})
+    serial, _ = compile_model(plant_parameters(cfg), steering_friction=cfg.steering_friction)
+    batch = batch_model(plant_parameters(cfg), steering_friction=cfg.steering_friction)
+    assert batch.ntex == serial.ntex - 1
+    skip = ("tex", "name", "mat_texid", "paths")
+    compared = 0
+    for name in dir(serial):
+        value = getattr(serial, name)
+        if name.startswith("_") or name.startswith(skip) or not isinstance(value, np.ndarray):
+            continue
+        assert np.array_equal(value, getattr(batch, name), equal_nan=True), name
+        compared += 1
+    for name in dir(serial.opt):
+        if not name.startswith("_") and not callable(getattr(serial.opt, name)):
+            assert np.array_equal(getattr(serial.opt, name), getattr(batch.opt, name)), name
+    assert compared > 100 and isinstance(serial, mujoco.MjModel)
+
+
+def test_a_nan_voltage_applies_nothing_as_in_the_serial_run(monkeypatch):
+    from controllers import ComputedTorque
+    from wmr_mj import simulate, sweep
+
+    class NanWhileTurning(ComputedTorque):
+        """The law of the paper, but NaN while the reference turns fast (a diverged law)."""
+
+        def voltage_scalar(self, alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot):
+            return math.nan if alpha0_dot > 0.002 else super().voltage_scalar(alpha, alpha_dot, alpha0, alpha0_dot,
+                                                                              alpha0_ddot)
+
+        def batch_law(self, n):
+            law = super().batch_law(n)
+
+            def nan_law(alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot, E, E_dot, u):
+                law(alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot, E, E_dot, u)
+                if alpha0_dot > 0.002:
+                    u[:] = math.nan
+                return u
+
+            return nan_law
+
+    def controller(config, params):
+        c = original(config, params)
+        return NanWhileTurning(c.model, kp=c.kp, kd=c.kd)
+
+    original = simulate._controller
+    monkeypatch.setattr(simulate, "_controller", controller)
+    monkeypatch.setattr(sweep, "_controller", controller)
+    configs = [BASE.replace(path="lane-change", duration=4.0, m1=m) for m in (560.0, 720.0)]
+    for cfg, b in zip(configs, run_batch(configs, nthread=1)):
+        s = run_closed_loop(cfg, progress=False).summary
+        assert s["saturated_fraction"] > 0  # the NaN steps happened (counted as saturated)
+        for key in KEYS:
+            assert s[key] == b[key], key
+
+
+def test_latin_hypercube_is_scipys():
+    from scipy.stats import qmc
+
+    for n, d, seed in ((1, 1, 0), (7, 3, 5), (50, 5, 1)):
+        expected = qmc.LatinHypercube(d=d, rng=np.random.default_rng(seed)).random(n)
+        assert np.array_equal(latin_hypercube(n, d, np.random.default_rng(seed).spawn(1)[0]), expected)
+
+
 def test_paper_model_batch_matches_serial_including_steering_stop():
     configs = [RunConfig(model="paper", duration=10.0, m1=m) for m in (560.0, 740.0)]
-    for cfg, b in zip(configs, run_batch(configs, nthread=1)):
+    # two runs on two threads: one group whose batch steps on both threads (sweep.batch_groups)
+    for cfg, b in zip(configs, run_batch(configs, nthread=2)):
         s = run_closed_loop(cfg, progress=False).summary
         assert b["left_steering_range"] and b["left_steering_range_at_s"] == s["left_steering_range_at_s"]
         assert b["sup_Edot"] == s["sup_Edot"]
@@ -79,10 +187,20 @@ def test_dask_gives_the_same_numbers_as_local(tmp_path):
     distributed = pytest.importorskip("distributed")
     spec = SweepSpec(n=4, seed=2, sampling="uniform", base=BASE)
     local = run_sweep(spec, chunk=2, nthread=1)
+    configs = [BASE.replace(duration=3.0, path="lane-change", m1=m, plant_overrides={"mu": mu})
+               for m, mu in ((560.0, 0.012), (700.0, 0.02), (640.0, 0.03))]
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
         remote = run_sweep(spec, out_dir=tmp_path, chunk=2, scheduler=cluster.scheduler_address)
+        client = connect(cluster.scheduler_address)
+        try:
+            remote_configs = run_configs(configs, chunk=2, client=client)  # what falsify sends, chunk by chunk
+        finally:
+            client.close()
     for a, b in zip(local, remote):
         for key in KEYS + ("m1", "run"):
+            assert a[key] == b[key]
+    for a, b in zip(run_configs(configs, chunk=2, nthread=1), remote_configs):
+        for key in KEYS + ("m1",):
             assert a[key] == b[key]
 
 
@@ -95,7 +213,8 @@ def test_unreachable_scheduler_is_a_clear_error():
                                            ({"m1_range": (600.0, 600.0)}, ParameterError),
                                            ({"ranges": {"wheelbase": (1.0, 2.0)}}, UnknownNameError),
                                            ({"sampling": "sobol"}, UnknownNameError),
-                                           ({"n": 10, "sampling": "grid", "ranges": {"mu": (0.01, 0.02)}}, ParameterError)])
+                                           ({"n": 10, "sampling": "grid", "ranges": {"mu": (0.01, 0.02)}},
+                                            ParameterError)])
 def test_bad_spec_raises(kwargs, error):
     with pytest.raises(error):
         SweepSpec(base=BASE, **kwargs)
@@ -103,7 +222,8 @@ def test_bad_spec_raises(kwargs, error):
 
 def test_cli_sweep_json_and_files(tmp_path):
     proc = subprocess.run([sys.executable, "-m", "wmr_mj.cli", "sweep", "--n", "3", "--model", "nonholonomic",
-                           "--duration", "10", "--out", str(tmp_path), "--json"], capture_output=True, text=True, check=True)
+                           "--duration", "10", "--out", str(tmp_path), "--json"],
+                          capture_output=True, text=True, check=True)
     obj = json.loads(proc.stdout)
     for key in ("n", "inside", "outside", "worst_E_ratio", "worst_Edot_ratio", "steps_per_s"):
         assert key in obj
@@ -114,11 +234,26 @@ def test_cli_sweep_json_and_files(tmp_path):
     assert (tmp_path / "region.png").stat().st_size > 1000
 
 
+def test_uncertainty_box_and_ranges_from_the_command_line():
+    import argparse
+
+    from wmr_mj.commands._common import box_ranges_from_args
+    from wmr_mj.params import uncertainty_ranges
+
+    full = uncertainty_ranges("full")
+    assert box_ranges_from_args(argparse.Namespace(uncertainty=None, range=None)) == {}
+    args = argparse.Namespace(uncertainty="full", range=["mu=0.015:0.02", "l4=0.2:0.3"])
+    got = box_ranges_from_args(args)
+    assert got == {**{k: v for k, v in full.items() if k != "m1"}, "mu": (0.015, 0.02), "l4": (0.2, 0.3)}
+
+
 @pytest.mark.parametrize("argv", [["--n", "0"], ["--m1-range", "750", "550"], ["--range", "nope=1:2"],
+                                  ["--uncertainty", "nope"],
                                   ["--range", "mu=0.03:0.01"], ["--sampling", "sobol"],
                                   ["--scheduler", "tcp://127.0.0.1:9"], ["--range", "mu=abc"]])
 def test_cli_sweep_bad_input_exits_2(argv, tmp_path):
-    proc = subprocess.run([sys.executable, "-m", "wmr_mj.cli", "sweep", "--duration", "10", "--out", str(tmp_path), *argv],
+    proc = subprocess.run([sys.executable, "-m", "wmr_mj.cli", "sweep", "--duration", "10", "--out", str(tmp_path),
+                           *argv],
                           capture_output=True, text=True, timeout=120)
     assert proc.returncode == 2, proc.stderr
     assert len(proc.stderr.strip().splitlines()) == 1, proc.stderr

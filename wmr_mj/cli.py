@@ -18,7 +18,7 @@ from collections.abc import Sequence
 
 from .errors import WmrMjError
 
-COMMANDS = ("identify", "robustness", "run", "replay", "sweep", "validate", "figures", "model")
+COMMANDS = ("identify", "robustness", "run", "replay", "sweep", "falsify", "validate", "figures", "model")
 
 
 class _OneLineParser(argparse.ArgumentParser):

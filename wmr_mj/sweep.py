@@ -2,10 +2,19 @@
 
 The plant's m1 (and any other named parameter) is drawn over its range; each
 simulation runs on its own compiled model (mass and inertia consistent, as
-``wmr_mj.params.with_params``), the controller acts on all simulations in one
-vectorised call per control step, and each run is reported exactly as a single
+``wmr_mj.params.with_params``), and each run is reported exactly as a single
 ``wmr_mj.simulate.run_closed_loop`` would report it (a test keeps them
 bit-identical).
+
+How a batch runs at the speed of open-loop ``mujoco.rollout`` (bench/bench_sweep.py):
+
+- the simulations are split into one group per thread; each group is a
+  ``mujoco.batch.Batch`` stepped on its own thread, with its own vectorised law
+  (``controller.batch_law``: NumPy ``out=`` buffers, nothing allocated per step).
+  The GIL is held only while a law runs, so one group's law overlaps the other
+  groups' physics, and no thread waits for another at the end of a step;
+- statistics are folded in blocks of 1000 steps, not step by step;
+- models are compiled without the scene's sky texture (95% of compiling it).
 
 Usage::
 
@@ -16,7 +25,8 @@ Usage::
 
 ``run_sweep(spec, out_dir=...)`` writes ``runs.csv`` after every chunk and
 resumes from it; ``scheduler="tcp://host:8786"`` runs the chunks on a Dask
-cluster with the same results.
+cluster with the same results. ``run_configs`` runs any list of configs that
+differ in plant parameters only (what ``wmr_mj.falsify`` evaluates).
 """
 
 from __future__ import annotations
@@ -27,6 +37,7 @@ import io
 import json
 import math
 import os
+import threading
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -49,16 +60,24 @@ from .simulate import (
     estimate_parameters,
     plant_parameters,
     report,
+    run_closed_loop,
 )
 
 __all__ = [
     "SweepSpec",
     "draw_samples",
+    "latin_hypercube",
+    "batch_model",
+    "thread_count",
+    "batch_groups",
     "run_batch",
     "run_sweep",
     "SAMPLINGS",
     "RESULT_COLUMNS",
     "read_results",
+    "run_configs",
+    "config_from_dict",
+    "connect",
 ]
 
 SAMPLINGS = ("uniform", "lhs", "grid")
@@ -123,6 +142,21 @@ class SweepSpec:
         return hashlib.sha256(json.dumps(obj, sort_keys=True, default=str).encode()).hexdigest()[:16]
 
 
+def latin_hypercube(n: int, d: int, rng: np.random.Generator) -> np.ndarray:
+    """(n, d) points in [0, 1)^d, one in each of the n strata of every axis (scrambled LHS).
+
+    The algorithm of ``scipy.stats.qmc.LatinHypercube(d, rng=parent).random(n)`` (scipy 1.17)
+    with ``rng = parent.spawn(1)[0]``, the child generator scipy draws from: the same
+    numbers (a test compares the two). Written out here because importing scipy.stats
+    costs 0.6-0.8 s, a seventh of a 32-run sweep.
+    """
+    jitter = rng.uniform(size=(n, d))
+    strata = np.tile(np.arange(1, n + 1), (d, 1))
+    for axis in range(d):
+        rng.shuffle(strata[axis, :])
+    return (strata.T - jitter) / n
+
+
 def draw_samples(spec: SweepSpec) -> np.ndarray:
     """(n, d) parameter values: m1 first, then ``spec.ranges`` in order. Seeded."""
     bounds = spec.bounds
@@ -131,9 +165,7 @@ def draw_samples(spec: SweepSpec) -> np.ndarray:
     if spec.sampling == "uniform":
         unit = rng.random((spec.n, d))
     elif spec.sampling == "lhs":
-        from scipy.stats import qmc
-
-        unit = qmc.LatinHypercube(d=d, rng=rng).random(spec.n)
+        unit = latin_hypercube(spec.n, d, rng.spawn(1)[0])  # scipy's qmc draws from a spawned child
     else:
         k = round(spec.n ** (1.0 / d))
         axes = [np.linspace(0.0, 1.0, k)] if k > 1 else [np.array([0.5])]
@@ -151,15 +183,179 @@ def _run_configs(spec: SweepSpec, samples: np.ndarray) -> list[RunConfig]:
     return out
 
 
+_PLANT_OPTIONS = ("steering_friction", "tyre_contact")  # RunConfig fields that choose the plant's laws
+
+
+def _plant_options(config: RunConfig) -> dict[str, Any]:
+    """The plant-law keywords the config carries (compile_model and Plant take them)."""
+    return {name: getattr(config, name) for name in _PLANT_OPTIONS if hasattr(config, name)}
+
+
+def batch_model(params: C80Parameters, **plant_options: Any) -> mujoco.MjModel:
+    """The plant of ``compile_model(params, ...)`` without its sky texture, for the batch.
+
+    Generating the 512x3072 sky gradient is 95% of compiling the scene (11.6 of 12 ms
+    measured); a texture touches no physics, and a test checks that every other model
+    field equals the serial run's. Falls back to compile_model where the plant has no spec.
+    """
+    from . import plant
+
+    if not hasattr(plant, "scene_spec"):
+        return compile_model(params, **plant_options)[0]
+    spec = plant.scene_spec(params, **plant_options)
+    for texture in list(spec.textures):
+        if texture.type == mujoco.mjtTexture.mjTEXTURE_SKYBOX:
+            spec.delete(texture)
+    return spec.compile()
+
+
+def thread_count(nthread: int, nsim: int) -> int:
+    """Threads for nsim simulations: nthread, or every core this process may use when 0."""
+    if nthread < 0:
+        raise ParameterError(f"nthread = {nthread} is not accepted; give 0 (all cores) or a count >= 1")
+    if nthread == 0:
+        nthread = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    return max(1, min(nthread, nsim))
+
+
+def batch_groups(nsim: int, threads: int) -> list[tuple[np.ndarray, int]]:
+    """(simulation indices, batch threads) of each group: one Python thread per group.
+
+    min(threads, floor(sqrt(nsim))) groups: each law call costs about 5 us whatever the
+    group's size, under the GIL, so many small groups would queue for it; the threads
+    left over step inside the groups' batches.
+    """
+    ngroups = max(1, min(threads, math.isqrt(nsim)))
+    per_group = np.array_split(np.arange(threads), ngroups)
+    return [(idx, len(t)) for idx, t in zip(np.array_split(np.arange(nsim), ngroups), per_group)]
+
+
+@dataclass
+class _BatchStats:
+    """Per-simulation statistics of a batch, written by the group loops at their indices."""
+
+    nsim: int
+    sup_E: np.ndarray = field(init=False)
+    sup_Ed: np.ndarray = field(init=False)
+    sup_E_s: np.ndarray = field(init=False)
+    sup_Ed_s: np.ndarray = field(init=False)
+    saturated: np.ndarray = field(init=False)
+    left_at: np.ndarray = field(init=False)
+    final_alpha: np.ndarray = field(init=False)
+    final_alpha_after_step: np.ndarray = field(init=False)
+    warnings: np.ndarray = field(init=False)
+    law_nan: np.ndarray = field(init=False)  # the law gave NaN: re-run serially
+    cpu_s: list[float] = field(default_factory=list)  # CPU time of each group's thread
+
+    def __post_init__(self) -> None:
+        n = self.nsim
+        self.law_nan = np.zeros(n, dtype=bool)
+        self.sup_E, self.sup_Ed, self.sup_E_s, self.sup_Ed_s = (np.zeros(n) for _ in range(4))
+        self.saturated, self.warnings = np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64)
+        self.left_at, self.final_alpha, self.final_alpha_after_step = (np.full(n, np.nan) for _ in range(3))
+
+
+@dataclass(frozen=True, kw_only=True)
+class _Loop:
+    """What every group's control loop shares: reference, timing, limits, indices."""
+
+    alpha0: np.ndarray
+    alpha0_dot: np.ndarray
+    alpha0_ddot: np.ndarray
+    n: int  # control steps
+    substeps: int
+    period: float
+    settle_k: int
+    block: int
+    qpos_adr: int
+    dof_adr: int
+    actuator: int
+    keyframe: int
+    voltage_limit: np.ndarray  # (nsim,)
+    range_limit: np.ndarray  # (nsim,)
+
+
+def _run_group(loop: _Loop, models: Sequence[mujoco.MjModel], idx: np.ndarray, threads: int, law,
+               stats: _BatchStats, stop: threading.Event, progress: Callable[[int, int], None] | None) -> None:
+    """The closed loop of simulations ``idx`` on one thread, from the home keyframe to the end.
+
+    Groups share nothing but the GIL, held only while the law runs: while one thread
+    computes its law, the others step (mujoco.batch releases the GIL), and no thread
+    waits for another at the end of a step. The loop body is what a control step costs
+    beyond the physics (bench/bench_sweep.py): a copy, the law, two clips, the step call.
+    """
+    from mujoco.batch import Batch
+
+    g = len(idx)
+    batch = Batch(models[0], nsim=g, nthread=threads)
+    batch.set_models(list(models))
+    batch.reset(keyframe=loop.keyframe)
+    alpha_now = batch.bind("qpos")[:, loop.qpos_adr]  # views of the state rows: no copy
+    alpha_dot_now = batch.bind("qvel")[:, loop.dof_adr]
+    ctrl_now = batch.bind("ctrl")[:, loop.actuator]
+    block = loop.block
+    bufs = a_buf, E_buf, Ed_buf, u_buf = tuple(np.empty((block, g)) for _ in range(4))
+    rows = [list(buf) for buf in bufs]  # row views made once, not at every step
+    clipped = np.empty(g)
+    lo, hi = -loop.voltage_limit[idx], loop.voltage_limit[idx]
+    range_limit = loop.range_limit[idx]
+    step, nstep = batch.step, loop.substeps
+    maximum, minimum = np.maximum, np.minimum
+    for k0 in range(0, loop.n, block):
+        count = min(block, loop.n - k0)
+        reference = (loop.alpha0[k0:k0 + count].tolist(), loop.alpha0_dot[k0:k0 + count].tolist(),
+                     loop.alpha0_ddot[k0:k0 + count].tolist())
+        for alpha, E, E_dot, u, a0, a0d, a0dd in zip(*rows, *reference):
+            alpha[:] = alpha_now  # recorded: the state row changes with the step
+            law(alpha, alpha_dot_now, a0, a0d, a0dd, E, E_dot, u)
+            # the voltage limit; a NaN passes through to MuJoCo, which then warns (BADCTRL), and
+            # the simulation is re-run serially (run_batch), where NaN applies nothing
+            maximum(u, lo, out=clipped)
+            minimum(clipped, hi, out=ctrl_now)
+            step(nstep=nstep)
+        _block_stats(loop, stats, idx, k0, count, a_buf, E_buf, Ed_buf, u_buf, lo, hi, range_limit)
+        if progress is not None:
+            progress(k0 + count, loop.n)
+        if stop.is_set():
+            return
+    stats.final_alpha[idx] = a_buf[count - 1]
+    stats.final_alpha_after_step[idx] = alpha_now
+    stats.warnings[idx] = batch.warning[:, :, 1].sum(axis=1)  # (nsim, mjNWARNING, (lastinfo, number))
+
+
+def _block_stats(loop: _Loop, stats: _BatchStats, idx: np.ndarray, k0: int, rows: int, a_buf, E_buf, Ed_buf,
+                 u_buf, lo, hi, range_limit) -> None:
+    """Fold control steps k0 .. k0+rows-1 into the statistics (max and count are exact in bulk)."""
+    E = np.abs(E_buf[:rows])
+    Ed = np.abs(Ed_buf[:rows])
+    stats.sup_E[idx] = np.maximum(stats.sup_E[idx], E.max(axis=0))
+    stats.sup_Ed[idx] = np.maximum(stats.sup_Ed[idx], Ed.max(axis=0))
+    first_settled = max(loop.settle_k - k0, 0)
+    if first_settled < rows:
+        stats.sup_E_s[idx] = np.maximum(stats.sup_E_s[idx], E[first_settled:].max(axis=0))
+        stats.sup_Ed_s[idx] = np.maximum(stats.sup_Ed_s[idx], Ed[first_settled:].max(axis=0))
+    u = u_buf[:rows]
+    # saturated as in the serial loop: the applied voltage differs from the law's (NaN included)
+    stats.saturated[idx] += (~((u >= lo) & (u <= hi))).sum(axis=0)
+    stats.law_nan[idx] |= np.isnan(u).any(axis=0)
+    hit = np.abs(a_buf[:rows]) >= range_limit
+    first = np.where(hit.any(axis=0), hit.argmax(axis=0), -1)
+    new = np.isnan(stats.left_at[idx]) & (first >= 0)
+    stats.left_at[idx[new]] = (k0 + first[new]) * loop.period
+
+
 def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parameters = C80,
               progress: Callable[[int, int], None] | None = None) -> list[dict[str, Any]]:
     """Run closed-loop configs that differ only in their plant parameters, all at once.
 
-    One ``mujoco.batch.Batch`` with one compiled model per simulation; one
-    vectorised controller call per control step. Returns per-run reports.
+    The simulations are split into groups (:func:`batch_groups`: one per thread of
+    ``nthread``, 0: every core, up to sqrt(nsim) groups). Each group is a
+    ``mujoco.batch.Batch`` on its own Python thread with one compiled model per simulation
+    and its own vectorised law (``controller.batch_law``), so the law of one group runs
+    while the others step. Returns per-run reports, each bit-identical to
+    ``run_closed_loop`` of the same config. ``batch_cpu_s`` is the CPU time of the group
+    threads (a figure for benchmarks on a shared machine; batch-internal threads excluded).
     """
-    from mujoco.batch import Batch
-
     if not configs:
         return []
     first = configs[0]
@@ -170,7 +366,8 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
     estimate = estimate_parameters(base)
     controller = _controller(first, estimate)
     plants = [plant_parameters(c, base) for c in configs]
-    models = [compile_model(p)[0] for p in plants]
+    options = _plant_options(first)
+    models = [batch_model(p, **options) for p in plants]
     model = models[0]
     nsim = len(configs)
     dt = model.opt.timestep
@@ -179,86 +376,68 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
     n = int(round(first.duration / period))
     reference, settle_s = build_reference(first.path, estimate, dt=period, duration=n * period)
     analysis = analysis_for(first, reference, estimate, estimate=_estimate_of(controller))
-    a0_all, a0d_all, a0dd_all = reference.alpha0, reference.alpha0_dot, reference.alpha0_ddot
+    loop = _Loop(alpha0=np.asarray(reference.alpha0), alpha0_dot=np.asarray(reference.alpha0_dot),
+                 alpha0_ddot=np.asarray(reference.alpha0_ddot), n=n, substeps=substeps, period=period,
+                 settle_k=int(math.ceil(settle_s / period - 1e-9)), block=min(n, 1000),
+                 qpos_adr=int(model.jnt_qposadr[model.joint("steer").id]),
+                 dof_adr=int(model.jnt_dofadr[model.joint("steer").id]),
+                 actuator=model.actuator("steering_motor").id, keyframe=model.key("home").id,
+                 voltage_limit=np.array([p.voltage_limit for p in plants]),
+                 range_limit=np.array([p.steering_range for p in plants]) - 1e-3)
+    stats = _BatchStats(nsim)
+    groups = batch_groups(nsim, thread_count(nthread, nsim))
+    stop = threading.Event()
+    errors: list[BaseException] = []
 
-    batch = Batch(model, nsim=nsim, nthread=nthread)
-    batch.set_models(models)
-    batch.reset(keyframe=model.key("home").id)
-    qpos, qvel, ctrl = batch.bind("qpos"), batch.bind("qvel"), batch.bind("ctrl")
-    qa = model.jnt_qposadr[model.joint("steer").id]
-    dv = model.jnt_dofadr[model.joint("steer").id]
-    act = model.actuator("steering_motor").id
-    limits = np.array([p.voltage_limit for p in plants])
-    range_limits = np.array([p.steering_range for p in plants]) - 1e-3
-    sup_E = np.zeros(nsim)
-    sup_Ed = np.zeros(nsim)
-    sup_E_s = np.zeros(nsim)
-    sup_Ed_s = np.zeros(nsim)
-    saturated = np.zeros(nsim, dtype=np.int64)
-    left_at = np.full(nsim, np.nan)
-    settle_k = int(math.ceil(settle_s / period - 1e-9))
-    law = controller.voltage
-    # per-step work is only the law and the voltage limit; the statistics of a block of
-    # steps are computed in bulk (the same numbers as step by step: max and count are exact)
-    block = min(n, 1000)
-    a_buf, ad_buf = np.empty((block, nsim)), np.empty((block, nsim))
-    ucmd_buf, u_buf = np.empty((block, nsim)), np.empty((block, nsim))
-    lo, hi = -limits, limits
-
-    def block_stats(k0: int, rows: int) -> None:
-        ks = np.arange(k0, k0 + rows)
-        E = np.abs(a0_all[ks, None] - a_buf[:rows])
-        Ed = np.abs(a0d_all[ks, None] - ad_buf[:rows])
-        np.maximum(sup_E, E.max(axis=0), out=sup_E)
-        np.maximum(sup_Ed, Ed.max(axis=0), out=sup_Ed)
-        after = ks >= settle_k
-        if after.any():
-            np.maximum(sup_E_s, E[after].max(axis=0), out=sup_E_s)
-            np.maximum(sup_Ed_s, Ed[after].max(axis=0), out=sup_Ed_s)
-        saturated[:] += (u_buf[:rows] != ucmd_buf[:rows]).sum(axis=0)
-        hit = np.abs(a_buf[:rows]) >= range_limits
-        first = np.where(hit.any(axis=0), hit.argmax(axis=0), -1)
-        new = np.isnan(left_at) & (first >= 0)
-        left_at[new] = (k0 + first[new]) * period
+    def work(idx: np.ndarray, threads: int, report_progress) -> None:
+        try:
+            cpu0 = time.thread_time()
+            _run_group(loop, [models[i] for i in idx], idx, threads, controller.batch_law(len(idx)), stats, stop,
+                       report_progress)
+            stats.cpu_s.append(time.thread_time() - cpu0)
+        except BaseException as exc:  # noqa: BLE001  (re-raised on the calling thread)
+            errors.append(exc)
+            stop.set()
 
     wall0 = time.perf_counter()
-    j = 0
-    k0 = 0
-    for k in range(n):
-        alpha = a_buf[j]
-        alpha_dot = ad_buf[j]
-        alpha[:] = qpos[:, qa]
-        alpha_dot[:] = qvel[:, dv]
-        u_cmd = law(alpha, alpha_dot, a0_all[k], a0d_all[k], a0dd_all[k])
-        ucmd_buf[j] = u_cmd
-        u = np.clip(u_cmd, lo, hi, out=u_buf[j])
-        np.nan_to_num(u, copy=False, nan=0.0)  # a diverged law applies nothing, as in the serial loop
-        ctrl[:, act] = u
-        batch.step(nstep=substeps)
-        j += 1
-        if j == block:
-            block_stats(k0, j)
-            k0, j = k + 1, 0
-            if progress is not None:
-                progress(k + 1, n)
-    if j:
-        block_stats(k0, j)
-    alpha = a_buf[j - 1] if j else a_buf[block - 1]
+    workers = [threading.Thread(target=work, args=(idx, threads, None), daemon=True) for idx, threads in groups[1:]]
+    for w in workers:
+        w.start()
+    try:
+        work(*groups[0], progress)  # the calling thread runs the first group and reports progress
+    finally:
+        for w in workers:
+            while w.is_alive():
+                try:
+                    w.join()
+                except KeyboardInterrupt:  # stop the groups at their next block, then re-raise
+                    stop.set()
+                    raise
+    if errors:
+        raise errors[0]
     wall = time.perf_counter() - wall0
-    final_alpha = qpos[:, qa].copy()  # state after the last step; the serial run reports the last control row
     reports = []
     for i, (c, p) in enumerate(zip(configs, plants)):
-        r = report(c, analysis=analysis, params=p, settle_s=settle_s, sup_E=sup_E[i], sup_Edot=sup_Ed[i],
-                   sup_E_settled=sup_E_s[i], sup_Edot_settled=sup_Ed_s[i], saturated_fraction=saturated[i] / n,
-                   left_range_at=None if np.isnan(left_at[i]) else float(left_at[i]), final_alpha=alpha[i],
-                   control_steps=n, steps=n * substeps, wall_s=wall / nsim, status="completed")
-        r["final_alpha_after_step"] = float(final_alpha[i])
-        r["mujoco_warnings"] = 0
-        reports.append(r)
-    # batch-level figures for benchmarks
-    for r in reports:
+        r = report(c, analysis=analysis, params=p, settle_s=settle_s, sup_E=stats.sup_E[i], sup_Edot=stats.sup_Ed[i],
+                   sup_E_settled=stats.sup_E_s[i], sup_Edot_settled=stats.sup_Ed_s[i],
+                   saturated_fraction=stats.saturated[i] / n,
+                   left_range_at=None if np.isnan(stats.left_at[i]) else float(stats.left_at[i]),
+                   final_alpha=stats.final_alpha[i], control_steps=n, steps=n * substeps, wall_s=wall / nsim,
+                   status="completed")
+        if stats.law_nan[i]:
+            # NaN from the law: the serial loop applies 0 V, MuJoCo would zero every control of
+            # the step (BADCTRL); the serial run is the truth
+            serial = run_closed_loop(c, progress=False, base=base).summary
+            r = {key: serial[key] for key in r}
+            r["mujoco_warnings"] = serial["mujoco_warnings"]
+        else:
+            r["mujoco_warnings"] = int(stats.warnings[i])
+        r["final_alpha_after_step"] = float(stats.final_alpha_after_step[i])  # the serial run reports the last row
+        # batch-level figures for benchmarks
         r["batch_wall_s"] = wall
         r["batch_steps_per_s"] = nsim * n * substeps / wall if wall > 0 else None
+        r["batch_cpu_s"] = sum(stats.cpu_s)  # robust to a shared machine, unlike the wall time
+        reports.append(r)
     return reports
 
 
@@ -286,11 +465,47 @@ def spec_to_json(spec: SweepSpec) -> str:
 
 def spec_from_json(text: str) -> SweepSpec:
     obj = json.loads(text)
-    base = dict(obj["base"])
-    base["m1_range"] = tuple(base["m1_range"])
-    base["box_ranges"] = {k: tuple(v) for k, v in base.get("box_ranges", {}).items()}
     return SweepSpec(n=obj["n"], seed=obj["seed"], sampling=obj["sampling"], m1_range=tuple(obj["m1_range"]),
-                     ranges={k: tuple(v) for k, v in obj["ranges"].items()}, base=RunConfig(**base))
+                     ranges={k: tuple(v) for k, v in obj["ranges"].items()}, base=config_from_dict(obj["base"]))
+
+
+def config_from_dict(obj: Mapping[str, Any]) -> RunConfig:
+    """The RunConfig of ``RunConfig.as_dict()`` (after a JSON round trip: lists back to tuples)."""
+    d = dict(obj)
+    d["m1_range"] = tuple(d["m1_range"])
+    d["box_ranges"] = {k: tuple(v) for k, v in d.get("box_ranges", {}).items()}
+    return RunConfig(**d)
+
+
+def _run_config_chunk(config_dicts: list[dict[str, Any]], nthread: int) -> list[dict[str, Any]]:
+    """Reports of configs given as ``as_dict()`` (a Dask task: arguments and result are plain data)."""
+    return run_batch([config_from_dict(d) for d in config_dicts], nthread=nthread)
+
+
+def run_configs(configs: Sequence[RunConfig], *, chunk: int = 128, nthread: int = 0, client: Any = None,
+                progress: Callable[[int, int], None] | None = None) -> list[dict[str, Any]]:
+    """Reports of ``configs`` (differing only in plant parameters), in order.
+
+    Locally: batches of at most ``chunk`` simulations (``run_batch``). With a Dask
+    ``client`` (see :func:`connect`): one task per chunk, the same numbers.
+    progress(done, total) is called as chunks finish.
+    """
+    if chunk < 1:
+        raise ParameterError(f"chunk = {chunk} must be >= 1")
+    parts = [list(configs[i:i + chunk]) for i in range(0, len(configs), chunk)]
+    reports: list[dict[str, Any]] = []
+    if client is not None:
+        futures = [client.submit(_run_config_chunk, [c.as_dict() for c in part], 1, pure=False) for part in parts]
+        for fut in futures:
+            reports.extend(fut.result())
+            if progress is not None:
+                progress(len(reports), len(configs))
+        return reports
+    for part in parts:
+        reports.extend(run_batch(part, nthread=nthread))
+        if progress is not None:
+            progress(len(reports), len(configs))
+    return reports
 
 
 def _csv_text(rows: list[dict[str, Any]], extra: Sequence[str]) -> str:
@@ -334,6 +549,11 @@ def read_results(path: str | os.PathLike) -> list[dict[str, Any]]:
     return out
 
 
+def connect(scheduler: str):
+    """A ``distributed.Client`` of the Dask scheduler at ``scheduler`` (SchedulerError if unreachable)."""
+    return _connect(scheduler)
+
+
 def _connect(scheduler: str):
     try:
         from distributed import Client
@@ -344,6 +564,14 @@ def _connect(scheduler: str):
     except (OSError, TimeoutError, ValueError) as exc:
         raise SchedulerError(f"cannot reach the Dask scheduler at {scheduler!r} ({type(exc).__name__}); "
                              "give the address of a running scheduler, e.g. tcp://127.0.0.1:8786") from None
+
+
+def _chunk_progress(progress: Callable[[float, int], None] | None, done: int, size: int,
+                    total: int) -> Callable[[int, int], None] | None:
+    """A chunk's step progress as fractional runs of the sweep."""
+    if progress is None:
+        return None
+    return lambda k, n: progress(done + size * k / n, total)
 
 
 def run_sweep(spec: SweepSpec, *, out_dir: str | os.PathLike | None = None, chunk: int = 128, nthread: int = 0,
@@ -397,10 +625,5 @@ def run_sweep(spec: SweepSpec, *, out_dir: str | os.PathLike | None = None, chun
             client.close()
     else:
         for c in chunks:
-            base_done = len(done)
-            step_progress = None
-            if progress is not None:
-                def step_progress(k: int, n: int, base_done=base_done, size=len(c)) -> None:
-                    progress(base_done + size * k / n, spec.n)  # fractional runs while a chunk steps
-            record(_run_chunk(spec_json, c, nthread, step_progress))
+            record(_run_chunk(spec_json, c, nthread, _chunk_progress(progress, len(done), len(c), spec.n)))
     return [done[i] for i in range(spec.n)]

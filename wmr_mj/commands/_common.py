@@ -79,3 +79,19 @@ def parse_range(item: str) -> tuple[str, tuple[float, float]]:
     except ValueError:
         raise ParameterError(f"--range {item!r}: LO and HI must be numbers") from None
     return name, (lo, hi)
+
+
+def box_ranges_from_args(args: argparse.Namespace) -> dict[str, tuple[float, float]]:
+    """The ranged plant parameters besides m1 (whose range is --m1-range): those of the
+    --uncertainty box (``wmr_mj.params.uncertainty_ranges``; 'm1' when not given), then each
+    --range NAME=LO:HI, which adds a parameter or replaces its range."""
+    from ..errors import ParameterError
+    from ..params import uncertainty_ranges
+
+    ranges = {k: v for k, v in uncertainty_ranges(getattr(args, "uncertainty", None) or "m1").items() if k != "m1"}
+    for item in getattr(args, "range", None) or []:
+        name, span = parse_range(item)
+        if name == "m1":
+            raise ParameterError("give m1's range with --m1-range LO HI, not --range m1=...")
+        ranges[name] = span
+    return ranges

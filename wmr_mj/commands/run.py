@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import math
 
-from ._common import parse_assignments, positive_float, positive_int
+from ._common import box_ranges_from_args, parse_assignments, positive_float, positive_int
 
 
 def add_run_options(p: argparse.ArgumentParser) -> None:
@@ -53,6 +53,13 @@ def add_run_options(p: argparse.ArgumentParser) -> None:
                                                      "over --m1-range) or paper (5.1)")
     p.add_argument("--m1-range", nargs=2, type=positive_float, metavar=("LO", "HI"), default=(550.0, 750.0),
                    help="m1 range of the analysis box, kg (default 550 750)")
+    from ..params import UNCERTAINTY_NAMES
+
+    p.add_argument("--uncertainty", default=None,
+                   help=f"uncertainty box: one of {', '.join(UNCERTAINTY_NAMES)} (m1: the paper's 550-750 kg, "
+                        "the default of run and sweep; full: also steering and tyre friction, R_a and V_A, the "
+                        "default of falsify; sources in wmr_mj/params.py). A run draws nothing: the box is what "
+                        "its analysis covers; m1's range is --m1-range")
 
 
 def config_from_args(args: argparse.Namespace, **extra):
@@ -90,7 +97,7 @@ def config_from_args(args: argparse.Namespace, **extra):
                      plant_overrides=parse_assignments(args.param), m1_inertia=args.m1_inertia,
                      identified=identified, coefficients=coefficients, box=args.box,
                      m1_range=tuple(args.m1_range), steering_friction=args.steering_friction,
-                     tyre_contact=args.tyre_contact, **extra)
+                     tyre_contact=args.tyre_contact, box_ranges=box_ranges_from_args(args), **extra)
 
 
 def register(sub: argparse._SubParsersAction) -> None:

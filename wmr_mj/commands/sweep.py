@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 from ._common import positive_int
 
@@ -10,7 +11,8 @@ from ._common import positive_int
 def register(sub: argparse._SubParsersAction) -> None:
     from .run import add_run_options
 
-    p = sub.add_parser("sweep", help="m1 Monte-Carlo on mujoco.batch: per-run errors against the region, table and plot")
+    p = sub.add_parser("sweep",
+                       help="m1 Monte-Carlo on mujoco.batch: per-run errors against the region, table and plot")
     add_run_options(p)
     p.add_argument("--n", type=int, default=200, help="number of runs (default 200)")
     p.add_argument("--seed", type=int, default=0, help="seed of the draw (default 0)")
@@ -21,7 +23,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--chunk", type=positive_int, default=128, help="simulations per batch (default 128)")
     p.add_argument("--nthread", type=int, default=0, help="threads of the batch (default 0: all cores)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="run the chunks on a Dask cluster (e.g. tcp://127.0.0.1:8786)")
-    p.add_argument("--log", action="store_true", help="also write an MCAP log per run (re-run one by one; bit-identical)")
+    p.add_argument("--log", action="store_true",
+                   help="also write an MCAP log per run (re-run one by one; bit-identical)")
     p.add_argument("--json", action="store_true", help="print one summary JSON object")
     p.set_defaults(func=run)
 
@@ -56,43 +59,32 @@ def summarize_sweep(results: list[dict], wall_s: float) -> dict:
 
 def run(args: argparse.Namespace) -> int:
     import functools
-    import sys
     import time
-    from pathlib import Path
 
     from ..errors import ParameterError
-    from ..io import write_json_atomic
+    from ..io import check_output_path, write_json_atomic
+    from ..progress import counter_callback, progress_bar
     from ..sweep import SweepSpec, run_sweep
-    from ._common import parse_range, print_json
+    from ._common import box_ranges_from_args, print_json
     from .run import config_from_args
 
     if args.n < 1:
         raise ParameterError(f"--n {args.n} is not accepted; the number of runs must be >= 1")
-    ranges = dict(parse_range(item) for item in (args.range or []))
-    if "m1" in ranges:
-        raise ParameterError("draw m1 with --m1-range LO HI, not --range m1=...")
+    ranges = box_ranges_from_args(args)  # --uncertainty (default m1), then --range
+    out = check_output_path(args.out or f"logs/sweep-{time.strftime('%Y%m%d-%H%M%S')}", kind="dir", option="--out")
     base = config_from_args(args)
     spec = SweepSpec(n=args.n, seed=args.seed, sampling=args.sampling, m1_range=tuple(args.m1_range),
                      ranges=ranges, base=base)
-    out = Path(args.out or f"logs/sweep-{time.strftime('%Y%m%d-%H%M%S')}")
-    tty = sys.stderr.isatty()
-
-    def progress(done, total):
-        if tty:
-            sys.stderr.write(f"\r{done:.0f}/{total} runs")
-            sys.stderr.flush()
-
     t0 = time.perf_counter()
-    results = run_sweep(spec, out_dir=out, chunk=args.chunk, nthread=args.nthread, scheduler=args.scheduler,
-                        progress=progress)
+    with progress_bar(spec.n, desc="sweep", unit="runs", fractional=True) as bar:
+        results = run_sweep(spec, out_dir=out, chunk=args.chunk, nthread=args.nthread, scheduler=args.scheduler,
+                            progress=counter_callback(bar))
     wall = time.perf_counter() - t0
-    if tty:
-        sys.stderr.write("\n")
     summary = summarize_sweep(results, wall)
     summary.update({"folder": str(out), "model": base.model, "controller": base.controller, "seed": args.seed,
-                    "sampling": args.sampling, "ranges": {"m1": list(args.m1_range), **{k: list(v) for k, v in ranges.items()}}})
-    plot_path = out / "region.png"
-    _plot(results, summary, plot_path)
+                    "sampling": args.sampling,
+                    "ranges": {"m1": list(args.m1_range), **{k: list(v) for k, v in ranges.items()}}})
+    plot_path = _plot(results, summary, out / "region")
     summary["plot"] = str(plot_path)
     if args.log:
         from ..mcaplog import RunLogger
@@ -111,36 +103,32 @@ def run(args: argparse.Namespace) -> int:
     print(f"{summary['n']} runs ({base.model} model, m1 over {args.m1_range[0]:g}-{args.m1_range[1]:g} kg, "
           f"{args.sampling}, seed {args.seed}): {summary['inside']} inside, {summary['outside']} outside the region")
     fmt = lambda x: "n/a" if x is None else f"{x:.3f}"  # noqa: E731
-    print(f"worst sup|E|/E_max = {fmt(summary['worst_E_ratio'])}, worst sup|E'|/Edot_max = {fmt(summary['worst_Edot_ratio'])}; "
+    print(f"worst sup|E|/E_max = {fmt(summary['worst_E_ratio'])}, "
+          f"worst sup|E'|/Edot_max = {fmt(summary['worst_Edot_ratio'])}; "
           f"{summary['hit_steering_stop']} runs hit the steering stop")
     print(f"{summary['steps']} steps in {wall:.1f} s ({summary['steps_per_s']:.3g} steps/s)")
     print(f"table: {out / 'runs.csv'}\nplot:  {plot_path}")
     return 0
 
 
-def _plot(results: list[dict], summary: dict, path) -> None:
-    """Fig.-7-style plot: the analytic region and every run's (sup|E|, sup|E'|)."""
-    try:
-        from ..plots import plot_sweep
-    except ImportError:
-        plot_sweep = None
-    if plot_sweep is not None:
-        plot_sweep(results, path)
-        return
-    import matplotlib
+def _plot(results: list[dict], summary: dict, stem: Path) -> Path:
+    """Fig.-7-style plot ``<stem>.png``: the bounds a run is judged by (sup|E| <= E_max and
+    sup|E'| <= E'_max, the sweep's inside/outside) and every run's (sup|E|, sup|E'|)."""
+    import math
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.patches import Rectangle
 
-    fig, ax = plt.subplots(figsize=(5, 4))
+    from ..plots import new_figure, save_figure
+
+    fig, ax = new_figure(5.0, 4.0)
     E_max, Ed_max = summary["E_max"], summary["Edot_max"]
-    if E_max is not None and Ed_max is not None:
-        ax.add_patch(plt.Rectangle((0, 0), E_max, Ed_max, alpha=0.15, color="C0", label="analytic bounds"))
-    sc = ax.scatter([r["sup_E"] for r in results], [r["sup_Edot"] for r in results], c=[r["m1"] for r in results], s=12)
+    if E_max is not None and Ed_max is not None and math.isfinite(E_max) and math.isfinite(Ed_max):
+        ax.add_patch(Rectangle((0, 0), E_max, Ed_max, alpha=0.15, color="C0", label="analytic bounds"))
+    sc = ax.scatter([r["sup_E"] for r in results], [r["sup_Edot"] for r in results], c=[r["m1"] for r in results],
+                    s=12, label="runs")
     fig.colorbar(sc, ax=ax, label="m1 [kg]")
     ax.set_xlabel("sup |E| [rad]")
     ax.set_ylabel("sup |E'| [rad/s]")
-    ax.legend(loc="upper right")
-    fig.tight_layout()
-    fig.savefig(path, dpi=150)
-    plt.close(fig)
+    ax.legend(loc="best")  # the runs sit anywhere; keep the legend off them
+    (path,) = save_figure(fig, stem, formats=("png",))
+    return path

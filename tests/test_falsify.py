@@ -1,0 +1,146 @@
+"""Worst-case search: the optimiser on synthetic objectives with known answers, seeding,
+the exact budget, the reported worst run against a serial re-run, and the command."""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from wmr_mj.errors import ParameterError, UnknownNameError
+from wmr_mj.falsify import (
+    FalsifySpec,
+    falsify,
+    objective_source,
+    objective_value,
+    population_size,
+    random_worst,
+    search_worst,
+    worst_config,
+)
+from wmr_mj.simulate import RunConfig, run_closed_loop
+
+BOX = np.array([[550.0, 750.0], [0.01, 0.03], [0.6, 1.0]])
+CORNER = np.array([550.0, 0.03, 0.6])  # the synthetic worst case: low, high, low
+
+
+def bowl(points: np.ndarray) -> np.ndarray:
+    """Largest (0) at CORNER, falling off with the distance in box units: a known argmax."""
+    unit = (points - BOX[:, 0]) / (BOX[:, 1] - BOX[:, 0])
+    target = (CORNER - BOX[:, 0]) / (BOX[:, 1] - BOX[:, 0])
+    return -np.sum((unit - target) ** 2, axis=1)
+
+
+def test_search_finds_the_known_worst_corner_and_beats_chance():
+    calls = []
+
+    def evaluate(points):
+        calls.append(len(points))
+        return bowl(points)
+
+    trace = search_worst(evaluate, BOX, budget=400, seed=3)
+    best = trace.points[trace.best]
+    assert np.all(np.abs(best - CORNER) <= 0.03 * (BOX[:, 1] - BOX[:, 0])), best
+    # one call per generation, each with the whole population
+    population = population_size(400, 3)
+    assert calls == [population] * (400 // population)
+    assert len(trace.values) == sum(calls) <= 400
+    chance = random_worst(bowl, BOX, n=len(trace.values), seed=3)
+    assert trace.values.max() > chance.values.max()
+
+
+def test_the_same_seed_gives_the_same_search():
+    a = search_worst(bowl, BOX, budget=60, seed=7)
+    b = search_worst(bowl, BOX, budget=60, seed=7)
+    c = search_worst(bowl, BOX, budget=60, seed=8)
+    assert np.array_equal(a.points, b.points) and np.array_equal(a.values, b.values)
+    assert not np.array_equal(a.points, c.points)
+
+
+def test_undefined_values_are_never_the_worst():
+    def half_undefined(points):
+        v = bowl(points)
+        v[points[:, 0] < 650.0] = np.nan  # the corner itself is undefined
+        return v
+
+    trace = search_worst(half_undefined, BOX, budget=40, seed=0)
+    assert trace.points[trace.best][0] >= 650.0 and not math.isnan(trace.values[trace.best])
+
+
+@pytest.mark.parametrize("budget,population", [(4, None), (10, 20), (10, 4)])
+def test_budget_below_a_population_is_refused(budget, population):
+    with pytest.raises(ParameterError, match="budget|population"):
+        search_worst(bowl, BOX, budget=budget, population=population)
+
+
+def test_objective_is_read_from_the_summary():
+    s = {"sup_E": 0.02, "E_ratio": 0.5}
+    assert objective_value(s, "sup-E") == 0.02
+    assert objective_value(s, "certificate") == 0.5 and "no certificate" in objective_source(s, "certificate")
+    s2 = {**s, "certificate": {"E_ratio": 0.25}, "paper_region": {"E_max": 0.08}}
+    assert objective_value(s2, "certificate") == 0.25 and objective_source(s2, "certificate") == "certificate.E_ratio"
+    assert objective_value(s2, "paper") == 0.02 / 0.08
+    assert objective_value({**s, "paper_region": {"E_max": math.inf}}, "paper") is None
+    with pytest.raises(UnknownNameError):
+        objective_value(s, "sup-F")
+
+
+def test_the_reported_worst_run_reproduces_exactly():
+    base = RunConfig(model="nonholonomic", path="lane-change", duration=3.0)
+    spec = FalsifySpec(base=base, box={"m1": (550.0, 750.0), "mu": (0.01, 0.03)}, objective="sup-E", budget=10,
+                       seed=1)
+    result = falsify(spec, nthread=2)
+    assert len(result.search) == len(result.random) == 10
+    worst = result.worst
+    assert worst.objective == max(e.objective for e in result.search) == worst.sup_E
+    serial = run_closed_loop(worst_config(result), progress=False).summary
+    assert serial["sup_E"] == worst.sup_E and serial["sup_Edot"] == worst.sup_Edot  # to the bit
+    # the parameters as printed (repr) give the same run
+    again = run_closed_loop(base.replace(m1=float(repr(worst.params["m1"])),
+                                         plant_overrides={"mu": float(repr(worst.params["mu"]))}), progress=False)
+    assert again.summary["sup_E"] == worst.sup_E
+    out = result.as_dict(log="x.mcap")
+    assert set(out["worst"]["params"]) == {"m1", "mu"} and out["evaluations"] == 10 and out["budget"] == 10
+    assert out["random"]["worst_objective"] == result.random_worst.objective
+
+
+def test_spec_refuses_bad_boxes():
+    with pytest.raises(UnknownNameError):
+        FalsifySpec(box={"wheelbase": (1.0, 2.0)})
+    with pytest.raises(ParameterError):
+        FalsifySpec(box={"m1": (750.0, 550.0)})
+    with pytest.raises(ParameterError, match="budget"):
+        FalsifySpec(box={"m1": (550.0, 750.0)}, budget=3)
+
+
+def test_cli_falsify_json_files_and_replayable_log(tmp_path):
+    from wmr_mj.logs import load_log
+
+    proc = subprocess.run([sys.executable, "-m", "wmr_mj.cli", "falsify", "--model", "nonholonomic", "--path",
+                           "lane-change", "--duration", "3", "--uncertainty", "m1", "--range", "mu=0.01:0.03",
+                           "--budget", "10", "--nthread", "2", "--out", str(tmp_path), "--json"],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    obj = json.loads(proc.stdout)
+    for key in ("objective", "budget", "evaluations", "seed", "worst", "random", "log"):
+        assert key in obj
+    assert set(obj["worst"]) >= {"params", "objective", "sup_E", "sup_Edot", "verdict"}
+    assert set(obj["random"]) >= {"worst_objective", "worst_params"}
+    assert obj["reproduced"] and obj["evaluations"] == 10
+    log = load_log(obj["log"])
+    assert log.summary["sup_E"] == obj["worst"]["sup_E"]
+    assert all((tmp_path / f"history.{ext}").stat().st_size > 1000 for ext in ("png", "svg"))
+
+
+@pytest.mark.parametrize("argv", [["--uncertainty", "nope"], ["--budget", "3"], ["--against", "moon"],
+                                  ["--range", "nope=1:2"]])
+def test_cli_falsify_bad_input_exits_2(argv, tmp_path):
+    proc = subprocess.run([sys.executable, "-m", "wmr_mj.cli", "falsify", "--duration", "3", "--path", "lane-change",
+                           "--out", str(tmp_path), *argv], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2, proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1, proc.stderr
+    assert "Traceback" not in proc.stderr
