@@ -120,7 +120,7 @@ def test_spec_refuses_bad_boxes():
 def test_cli_falsify_json_files_and_replayable_log(tmp_path):
     from wmr_mj.logs import load_log
 
-    proc = subprocess.run([sys.executable, "-m", "wmr_mj.cli", "falsify", "--model", "nonholonomic", "--path",
+    proc = subprocess.run([sys.executable, "-m", "wmr_mj.cli", "falsify", "--preset", "certified", "--path",
                            "lane-change", "--duration", "3", "--uncertainty", "m1", "--range", "mu=0.01:0.03",
                            "--budget", "10", "--nthread", "2", "--out", str(tmp_path), "--json"],
                           capture_output=True, text=True, timeout=120)

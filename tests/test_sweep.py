@@ -26,7 +26,8 @@ from wmr_mj.sweep import (
 
 BASE = RunConfig(model="nonholonomic", duration=10.0)
 KEYS = ("sup_E", "sup_Edot", "sup_E_settled", "sup_Edot_settled", "E_max", "Edot_max", "saturated_fraction",
-        "final_alpha", "inside", "left_steering_range", "left_steering_range_at_s")
+        "final_alpha", "inside", "left_steering_range", "left_steering_range_at_s",
+        "verdict", "certificate", "paper_region", "drift")
 
 
 def test_batch_is_bit_identical_to_runs_one_by_one():
@@ -274,3 +275,21 @@ def test_cli_sweep_log_writes_replayable_mcap_per_run(tmp_path):
         log = load_log(path)
         assert log.summary["sup_E"] == row["sup_E"]  # the logged re-run is the swept run, bit for bit
         assert float(np.max(np.abs(log.signals["E"]))) == row["sup_E"]
+
+
+def test_certified_design_sweep_over_m1_is_certified_inside_for_every_run(tmp_path):
+    """Issue 8: a sweep of the certified design over m1 550-750 kg has no run outside certified-inside."""
+    from wmr_mj.designs import CERTIFIED
+    from wmr_mj.params import M1_RANGE
+    from wmr_mj.verdicts import count_verdicts
+
+    base = RunConfig(**CERTIFIED.config_changes(), duration=35.0)
+    spec = SweepSpec(n=8, seed=0, sampling="lhs", m1_range=M1_RANGE, base=base)
+    rows = run_sweep(spec, out_dir=tmp_path)
+    counts = count_verdicts(r["verdict"] for r in rows)
+    assert counts["certified-inside"] == 8, counts
+    assert max(r["cert_E_ratio"] for r in rows) < 1.0
+    assert min(r["m1"] for r in rows) < 575.0 and max(r["m1"] for r in rows) > 725.0  # the range is covered
+    saved = read_results(tmp_path / "runs.csv")  # the verdict columns survive the CSV
+    assert [r["verdict"] for r in saved] == [r["verdict"] for r in rows]
+    assert [r["cert_E_ratio"] for r in saved] == [r["cert_E_ratio"] for r in rows]

@@ -305,8 +305,9 @@ class FalsifyResult:
             if e.objective is not None and e.objective > value:
                 best, value = e, e.objective
         if best is None:
-            raise ParameterError("the objective is undefined for every run (e.g. the region does not exist: "
-                                 "its condition (4.23) fails); search --objective sup-E instead")
+            raise ParameterError("the objective is undefined for every run: the design has no certificate over "
+                                 "this box (an assumption fails: see wmr-mj robustness --certificate) or the "
+                                 "region does not exist; search --objective sup-E or --against paper instead")
         return best
 
     @property

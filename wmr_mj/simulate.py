@@ -289,7 +289,10 @@ def _sup(x: np.ndarray) -> float:
 
 
 def _drift_of(E: np.ndarray, final_alpha_dot: float, period: float) -> dict[str, Any]:
-    """End-of-run drift from the serial rows (the batch computes the same windows per block)."""
+    """End-of-run drift from the serial rows (the batch computes the same windows per block).
+
+    final_alpha_dot: alpha' of the last control step, as alpha0' - E' (the batch keeps E', not alpha').
+    """
     from .verdicts import drift, drift_window_steps
 
     k = len(E)
@@ -434,7 +437,7 @@ def run_closed_loop(
                      sup_Edot_settled=_sup(done["E_dot"][after]), saturated_fraction=saturated / k,
                      left_range_at=left_range_at, final_alpha=done["alpha"][-1], control_steps=k,
                      steps=k * substeps, wall_s=wall, status=status, certificate=certificate,
-                     drift=_drift_of(done["E"], done["alpha_dot"][-1], period))
+                     drift=_drift_of(done["E"], done["alpha0_dot"][-1] - done["E_dot"][-1], period))
     summary["mujoco_warnings"] = int(sum(w.number for w in d.warning))
     summary["analysis"] = analysis.as_dict()
     summary["controller_config"] = controller.describe()

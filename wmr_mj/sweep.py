@@ -47,9 +47,11 @@ from typing import Any
 import mujoco
 import numpy as np
 
+from .certificate import certificate_for
 from .errors import ParameterError, SchedulerError, UnknownNameError
 from .params import C80, C80Parameters, parameter_names
 from .plant import compile_model
+from .verdicts import drift, drift_window_steps
 from .simulate import (
     RunConfig,
     _controller,
@@ -76,13 +78,31 @@ __all__ = [
     "RESULT_COLUMNS",
     "read_results",
     "run_configs",
+    "flat_row",
     "config_from_dict",
     "connect",
 ]
 
 SAMPLINGS = ("uniform", "lhs", "grid")
-RESULT_COLUMNS = ("run", "m1", "sup_E", "sup_Edot", "sup_E_settled", "sup_Edot_settled", "E_max", "Edot_max",
-                  "E_ratio", "Edot_ratio", "inside", "saturated_fraction", "left_steering_range", "final_alpha")
+RESULT_COLUMNS = ("run", "m1", "verdict", "cert_valid", "cert_E_max", "cert_Edot_max", "cert_E_ratio",
+                  "cert_Edot_ratio", "cert_inside", "sup_E", "sup_Edot", "sup_E_settled", "sup_Edot_settled",
+                  "E_max", "Edot_max", "E_ratio", "Edot_ratio", "inside", "saturated_fraction",
+                  "left_steering_range", "final_alpha", "final_alpha_dot", "drift_growing")
+#: runs.csv columns taken from a run summary's nested certificate and drift (see flat_row)
+_FLAT = {"cert_valid": ("certificate", "certified"), "cert_E_max": ("certificate", "E_max"),
+         "cert_Edot_max": ("certificate", "Edot_max"), "cert_E_ratio": ("certificate", "E_ratio"),
+         "cert_Edot_ratio": ("certificate", "Edot_ratio"), "cert_inside": ("certificate", "inside"),
+         "final_alpha_dot": ("drift", "final_alpha_dot"), "drift_growing": ("drift", "growing")}
+
+
+def flat_row(summary: Mapping[str, Any]) -> dict[str, Any]:
+    """A run summary with the runs.csv columns of its certificate and drift added at the top level
+    (cert_valid, cert_E_max, cert_E_ratio, ..., final_alpha_dot, drift_growing)."""
+    out = dict(summary)
+    for col, (outer, inner) in _FLAT.items():
+        if col not in out:
+            out[col] = (summary.get(outer) or {}).get(inner)
+    return out
 
 
 def _check_range(name: str, lo: float, hi: float) -> tuple[float, float]:
@@ -245,6 +265,9 @@ class _BatchStats:
     final_alpha_after_step: np.ndarray = field(init=False)
     warnings: np.ndarray = field(init=False)
     law_nan: np.ndarray = field(init=False)  # the law gave NaN: re-run serially
+    drift_prev: np.ndarray = field(init=False)  # max |E| over the window before the last (wmr_mj.verdicts)
+    drift_last: np.ndarray = field(init=False)  # max |E| over the last window
+    final_alpha_dot: np.ndarray = field(init=False)  # alpha0' - E' of the last control step
     cpu_s: list[float] = field(default_factory=list)  # CPU time of each group's thread
 
     def __post_init__(self) -> None:
@@ -253,6 +276,8 @@ class _BatchStats:
         self.sup_E, self.sup_Ed, self.sup_E_s, self.sup_Ed_s = (np.zeros(n) for _ in range(4))
         self.saturated, self.warnings = np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64)
         self.left_at, self.final_alpha, self.final_alpha_after_step = (np.full(n, np.nan) for _ in range(3))
+        self.drift_prev, self.drift_last = np.zeros(n), np.zeros(n)
+        self.final_alpha_dot = np.full(n, np.nan)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -266,6 +291,7 @@ class _Loop:
     substeps: int
     period: float
     settle_k: int
+    drift_k: int  # control steps per drift window (wmr_mj.verdicts.drift_window_steps)
     block: int
     qpos_adr: int
     dof_adr: int
@@ -319,6 +345,7 @@ def _run_group(loop: _Loop, models: Sequence[mujoco.MjModel], idx: np.ndarray, t
         if stop.is_set():
             return
     stats.final_alpha[idx] = a_buf[count - 1]
+    stats.final_alpha_dot[idx] = loop.alpha0_dot[loop.n - 1] - Ed_buf[count - 1]  # as the serial run computes it
     stats.final_alpha_after_step[idx] = alpha_now
     stats.warnings[idx] = batch.warning[:, :, 1].sum(axis=1)  # (nsim, mjNWARNING, (lastinfo, number))
 
@@ -342,6 +369,11 @@ def _block_stats(loop: _Loop, stats: _BatchStats, idx: np.ndarray, k0: int, rows
     first = np.where(hit.any(axis=0), hit.argmax(axis=0), -1)
     new = np.isnan(stats.left_at[idx]) & (first >= 0)
     stats.left_at[idx[new]] = (k0 + first[new]) * loop.period
+    w = loop.drift_k
+    for lo_k, hi_k, out in ((loop.n - 2 * w, loop.n - w, stats.drift_prev), (loop.n - w, loop.n, stats.drift_last)):
+        a, b = max(lo_k - k0, 0), min(hi_k - k0, rows)
+        if a < b:
+            out[idx] = np.maximum(out[idx], E[a:b].max(axis=0))
 
 
 def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parameters = C80,
@@ -378,7 +410,8 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
     analysis = analysis_for(first, reference, estimate, estimate=_estimate_of(controller))
     loop = _Loop(alpha0=np.asarray(reference.alpha0), alpha0_dot=np.asarray(reference.alpha0_dot),
                  alpha0_ddot=np.asarray(reference.alpha0_ddot), n=n, substeps=substeps, period=period,
-                 settle_k=int(math.ceil(settle_s / period - 1e-9)), block=min(n, 1000),
+                 settle_k=int(math.ceil(settle_s / period - 1e-9)), drift_k=drift_window_steps(n, period),
+                 block=min(n, 1000),
                  qpos_adr=int(model.jnt_qposadr[model.joint("steer").id]),
                  dof_adr=int(model.jnt_dofadr[model.joint("steer").id]),
                  actuator=model.actuator("steering_motor").id, keyframe=model.key("home").id,
@@ -423,7 +456,9 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
                    saturated_fraction=stats.saturated[i] / n,
                    left_range_at=None if np.isnan(stats.left_at[i]) else float(stats.left_at[i]),
                    final_alpha=stats.final_alpha[i], control_steps=n, steps=n * substeps, wall_s=wall / nsim,
-                   status="completed")
+                   status="completed", certificate=certificate_for(c, reference, params=base),
+                   drift=drift(prev_window=float(stats.drift_prev[i]), last_window=float(stats.drift_last[i]),
+                               final_alpha_dot=float(stats.final_alpha_dot[i])))
         if stats.law_nan[i]:
             # NaN from the law: the serial loop applies 0 V, MuJoCo would zero every control of
             # the step (BADCTRL); the serial run is the truth
@@ -607,7 +642,7 @@ def run_sweep(spec: SweepSpec, *, out_dir: str | os.PathLike | None = None, chun
 
     def record(reports: list[dict[str, Any]]) -> None:
         for r in reports:
-            done[r["run"]] = r
+            done[r["run"]] = flat_row(r)
         if out is not None:
             write_text_atomic(out / "runs.csv", _csv_text(list(done.values()), extra))
         if progress is not None:

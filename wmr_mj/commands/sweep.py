@@ -30,8 +30,11 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def summarize_sweep(results: list[dict], wall_s: float) -> dict:
-    """The sweep's summary: counts inside/outside and worst ratios."""
+    """The sweep's summary: the count of each verdict, the worst certificate ratio sup|E|/E_max,
+    and the paper's claim (inside/outside its region, worst ratios)."""
     import math
+
+    from ..verdicts import count_verdicts
 
     def worst(key):
         vals = [r[key] for r in results if r.get(key) is not None]
@@ -42,6 +45,12 @@ def summarize_sweep(results: list[dict], wall_s: float) -> dict:
     first = results[0]
     return {
         "n": len(results),
+        "verdicts": count_verdicts(r["verdict"] for r in results),
+        "worst_certificate_ratio": worst("cert_E_ratio"),
+        "worst_certificate_Edot_ratio": worst("cert_Edot_ratio"),
+        "certificate_E_max": first.get("cert_E_max"),
+        "certificate_Edot_max": first.get("cert_Edot_max"),
+        "drift_growing": sum(1 for r in results if r.get("drift_growing")),
         "inside": inside,
         "outside": len(results) - inside,
         "worst_E_ratio": worst("E_ratio"),
@@ -100,10 +109,19 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print_json(summary)
         return 0
-    print(f"{summary['n']} runs ({base.model} model, m1 over {args.m1_range[0]:g}-{args.m1_range[1]:g} kg, "
-          f"{args.sampling}, seed {args.seed}): {summary['inside']} inside, {summary['outside']} outside the region")
     fmt = lambda x: "n/a" if x is None else f"{x:.3f}"  # noqa: E731
-    print(f"worst sup|E|/E_max = {fmt(summary['worst_E_ratio'])}, "
+    counts = summary["verdicts"]
+    print(f"{summary['n']} runs ({base.model} model, K_P = {base.kp:g}, K_D = {base.kd:g}, m1 over "
+          f"{args.m1_range[0]:g}-{args.m1_range[1]:g} kg, {args.sampling}, seed {args.seed}):")
+    print("verdicts: " + ", ".join(f"{v} {c}" for v, c in counts.items()))
+    if counts["certified-outside"]:
+        print(f"!!! {counts['certified-outside']} run(s) CERTIFIED-OUTSIDE: the certificate's assumptions hold and "
+              "the run is outside it: a bug or a modelling gap; see runs.csv !!!")
+    print(f"certificate: worst sup|E|/E_max = {fmt(summary['worst_certificate_ratio'])}, "
+          f"worst sup|E'|/Edot_max = {fmt(summary['worst_certificate_Edot_ratio'])}; "
+          f"{summary['drift_growing']} runs with |E| still growing at the end")
+    print(f"paper's claim: {summary['inside']} inside, {summary['outside']} outside its region; "
+          f"worst sup|E|/E_max = {fmt(summary['worst_E_ratio'])}, "
           f"worst sup|E'|/Edot_max = {fmt(summary['worst_Edot_ratio'])}; "
           f"{summary['hit_steering_stop']} runs hit the steering stop")
     print(f"{summary['steps']} steps in {wall:.1f} s ({summary['steps_per_s']:.3g} steps/s)")
@@ -121,9 +139,12 @@ def _plot(results: list[dict], summary: dict, stem: Path) -> Path:
     from ..plots import new_figure, save_figure
 
     fig, ax = new_figure(5.0, 4.0)
-    E_max, Ed_max = summary["E_max"], summary["Edot_max"]
-    if E_max is not None and Ed_max is not None and math.isfinite(E_max) and math.isfinite(Ed_max):
-        ax.add_patch(Rectangle((0, 0), E_max, Ed_max, alpha=0.15, color="C0", label="analytic bounds"))
+    for (E_max, Ed_max), colour, label in (
+            ((summary.get("certificate_E_max"), summary.get("certificate_Edot_max")), "C2",
+             "certificate's bounds"),
+            ((summary["E_max"], summary["Edot_max"]), "C0", "paper's claim")):
+        if E_max is not None and Ed_max is not None and math.isfinite(E_max) and math.isfinite(Ed_max):
+            ax.add_patch(Rectangle((0, 0), E_max, Ed_max, alpha=0.15, color=colour, label=label))
     sc = ax.scatter([r["sup_E"] for r in results], [r["sup_Edot"] for r in results], c=[r["m1"] for r in results],
                     s=12, label="runs")
     fig.colorbar(sc, ax=ax, label="m1 [kg]")
