@@ -51,7 +51,8 @@ def main() -> None:
         physics_wall.append(time.perf_counter() - t)
         # the law alone, on the run's states
         law = make_controller(config.controller, model_from_source(config.model, params=C80)).voltage_scalar
-        a, ad, a0, a0d, a0dd = (rows[key].tolist() for key in ("alpha", "alpha_dot", "alpha0", "alpha0_dot", "alpha0_ddot"))
+        a, ad, a0, a0d, a0dd = (rows[key].tolist()
+                                for key in ("alpha", "alpha_dot", "alpha0", "alpha0_dot", "alpha0_ddot"))
         t = time.perf_counter()
         for k in range(len(a)):
             law(a[k], ad[k], a0[k], a0d[k], a0dd[k])
@@ -63,7 +64,8 @@ def main() -> None:
           f"{1e6 * run_s / n:.2f} us/step")
     print(f"mj_step alone       : {phys_s:.3f} s wall, {35.0 / phys_s:6.1f}x real time, {1e6 * phys_s / n:.2f} us/step")
     print(f"controller law      : {1e6 * law_s / n:.2f} us/call = {100 * law_s / run_s:.1f}% of each closed-loop step")
-    print(f"rest of the loop    : {1e6 * (run_s - phys_s - law_s) / n:.2f} us/step (state reads, voltage limit, recording)")
+    print(f"rest of the loop    : {1e6 * (run_s - phys_s - law_s) / n:.2f} us/step "
+          "(state reads, voltage limit, recording)")
 
 
 if __name__ == "__main__":

@@ -28,7 +28,8 @@ def _bounds(reference):
                            sin_cos3_max=b["max_sin_cos3"])
 
 
-@pytest.mark.parametrize("friction_sign,width", [("measured", 0.0), ("reference", 0.0), ("measured", 0.05), ("none", 0.0)])
+@pytest.mark.parametrize("friction_sign,width",
+                         [("measured", 0.0), ("reference", 0.0), ("measured", 0.05), ("none", 0.0)])
 def test_scalar_and_vector_laws_are_bit_identical(friction_sign, width):
     rng = np.random.default_rng(1)
     a, ad, a0, a0d, a0dd = (rng.uniform(-0.8, 0.8, 200) for _ in range(5))
@@ -96,7 +97,8 @@ def test_control_period_holds_voltage():
         run_closed_loop(RunConfig(duration=10.0, control_period=0.0015), progress=False)
 
 
-@pytest.mark.parametrize("changes,error", [({"model": "magic"}, UnknownNameError), ({"controller": "lqr"}, UnknownNameError),
+@pytest.mark.parametrize("changes,error", [({"model": "magic"}, UnknownNameError),
+                                           ({"controller": "lqr"}, UnknownNameError),
                                             ({"kp": -1.0}, ParameterError), ({"m1": float("inf")}, ParameterError),
                                             ({"m1_range": (750.0, 550.0)}, ParameterError),
                                             ({"plant_overrides": {"wheelbase": 1.0}}, UnknownNameError)])

@@ -87,10 +87,11 @@ The sympy work (about 10 s in all) runs on first use and is cached
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from functools import lru_cache
+from functools import cache
 from types import MappingProxyType
-from typing import Any, Callable, Mapping
+from typing import Any
 
 import sympy as sp
 
@@ -384,7 +385,7 @@ def _contact_velocity(b: Body) -> sp.Matrix:
     return b.position.applyfunc(_dt_q) - b.radius * _QD_OF[b.spin] * e_w
 
 
-@lru_cache(maxsize=None)
+@cache
 def constraint_velocities() -> Mapping[sp.Symbol, sp.Expr]:
     """q' of every coordinate in terms of the generalized speeds (V_A, alpha').
 
@@ -450,7 +451,7 @@ def _total_dt(expr: sp.Expr) -> sp.Expr:
 # --------------------------------------------------------------------------
 # kinetic energy (2.2)-(2.3)
 # --------------------------------------------------------------------------
-@lru_cache(maxsize=None)
+@cache
 def kinetic_energy_full() -> sp.Expr:
     """T(q, q') of the unconstrained bodies; the rates are the symbols ``x_A'``, ... .
 
@@ -467,7 +468,7 @@ def kinetic_energy_full() -> sp.Expr:
     return sp.expand(T)
 
 
-@lru_cache(maxsize=None)
+@cache
 def _abcd() -> dict[str, sp.Expr]:
     E = kinetic_energy_full().subs(_qdot_map())
     if not is_zero(sp.diff(E, _th)):
@@ -611,7 +612,7 @@ def _sub_abcd(m: sp.Matrix | sp.Expr, in_abcd: bool) -> Any:
     return m if in_abcd else m.subs(_abcd_subs())
 
 
-@lru_cache(maxsize=None)
+@cache
 def lagrange_equations_paper(*, in_abcd: bool = True) -> LagrangeEquations:
     """(2.4): Lagrange's equations (2.1) applied to E of (2.2), q = (S_A, alpha).
 
@@ -670,7 +671,7 @@ class NonholonomicEquations:
         return [sp.Eq(self.lhs[i], self.forces[i]) for i in range(2)]
 
 
-@lru_cache(maxsize=None)
+@cache
 def _kane_rows() -> sp.Matrix:
     """-F_r* = sum over bodies of m a . dv/du_r + I_z yaw'' dyaw'/du_r + I_y spin'' dspin'/du_r."""
     qmap = _qdot_map()
@@ -690,7 +691,7 @@ def _kane_rows() -> sp.Matrix:
     return sp.Matrix(rows)
 
 
-@lru_cache(maxsize=None)
+@cache
 def nonholonomic_equations(*, in_abcd: bool = True) -> NonholonomicEquations:
     """Kane's equations of the constrained C80 (rolling without slip, no side slip).
 
@@ -717,7 +718,7 @@ def nonholonomic_equations(*, in_abcd: bool = True) -> NonholonomicEquations:
     )
 
 
-@lru_cache(maxsize=None)
+@cache
 def nonholonomic_equations_maggi() -> sp.Matrix:
     """The Kane rows again, from T(q, q') by Maggi's form: sum_i (dq_i'/du_r) E_i(T).
 
@@ -766,7 +767,7 @@ def nonholonomic_steering_equation(*, constant_speed: bool = False, in_J: bool =
     return sp.Eq(lhs + TAU_F * sp.sign(ad), _S["i2"] * _S["M2"])
 
 
-@lru_cache(maxsize=None)
+@cache
 def spurious_terms(*, in_abcd: bool = True) -> sp.Expr:
     """alpha row of Lagrange-on-(2.2) minus Kane's alpha row, read term by term.
 
@@ -783,7 +784,7 @@ def spurious_terms(*, in_abcd: bool = True) -> sp.Expr:
     return sp.Add(*terms)
 
 
-@lru_cache(maxsize=None)
+@cache
 def spurious_terms_from_momenta() -> sp.Expr:
     """The same difference from its origin: -sum_z p_z d(z')/d(alpha) at fixed speeds.
 
@@ -869,7 +870,7 @@ def voltage_equation(model: str) -> sp.Expr:
     return s["R_a"] / s["k_i"] * M2 + s["k_b"] * s["i2"] * ad
 
 
-@lru_cache(maxsize=None)
+@cache
 def voltage_coefficients_symbolic(model: str) -> dict[str, sp.Expr]:
     """P, C_V, F, K, gyro of ``model``, read off its voltage equation.
 
@@ -926,7 +927,7 @@ def symbol_values(params: C80Parameters) -> dict[sp.Symbol, float]:
     return {_S[k]: float(v) for k, v in values.items()}
 
 
-@lru_cache(maxsize=None)
+@cache
 def _lambdified(model: str) -> dict[str, Callable[..., float]]:
     args = [_S[k] for k in _PARAM_SYMBOLS]
     exprs = _abcd() if model == "kinetic" else voltage_coefficients_symbolic(model)

@@ -75,7 +75,7 @@ class SteeringModel:
             raise ParameterError(f"model coefficient F = {self.F} must be >= 0")
 
     @classmethod
-    def from_coefficients(cls, c: Coefficients, *, V_A: float, name: str = "custom") -> "SteeringModel":
+    def from_coefficients(cls, c: Coefficients, *, V_A: float, name: str = "custom") -> SteeringModel:
         return cls(P=c.P, C_V=c.C_V, F=c.F, K=c.K, gyro=c.gyro, V_A=V_A, name=name)
 
     @property
@@ -127,7 +127,7 @@ class SteeringModel:
         rest = self.velocity_terms(alpha, alpha_dot, friction_sign=friction_sign) + self.stiffness(alpha)
         return (np.asarray(u, dtype=float) - rest) / self.P
 
-    def with_coefficients(self, **changes: float) -> "SteeringModel":
+    def with_coefficients(self, **changes: float) -> SteeringModel:
         return replace(self, **changes)
 
 

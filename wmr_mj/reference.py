@@ -430,7 +430,8 @@ def lane_change(offset: float, length: float) -> Path:
     """
     d = _number("offset", offset)
     if d == 0.0:
-        raise ParameterError("offset = 0 is not accepted: a lane change needs a non-zero lateral offset (m); use line()")
+        raise ParameterError("offset = 0 is not accepted: a lane change needs a non-zero lateral offset (m); "
+                             "use line()")
     X = _positive("length", length, " m")
     opts = dict(epsabs=1e-14, epsrel=1e-13, limit=200)
 
@@ -752,7 +753,8 @@ class Reference:
             raise ParameterError("t must be finite")
         T = self.duration
         if tt.size and (tt.min() < -1e-9 or tt.max() > T + 1e-9):
-            raise ParameterError(f"t must lie in [0, {T:.6g}] s (the reference's duration), got {tt.min():.6g}..{tt.max():.6g}")
+            raise ParameterError(f"t must lie in [0, {T:.6g}] s (the reference's duration), "
+                                 f"got {tt.min():.6g}..{tt.max():.6g}")
         h = self.dt
         tc = np.clip(tt, 0.0, T)
         i = np.clip(np.floor(tc / h).astype(np.int64), 0, self.t.size - 2)
@@ -838,7 +840,8 @@ def make_reference(
     else:
         a0 = _number("initial_alpha", initial_alpha)
         if abs(a0) >= amax:
-            raise ParameterError(f"initial_alpha = {a0} rad is not accepted: |initial_alpha| must be below max_angle = {amax} rad")
+            raise ParameterError(f"initial_alpha = {a0} rad is not accepted: |initial_alpha| must be below "
+                                 f"max_angle = {amax} rad")
 
     run = _integrate(path, l1, V_A, a0, max_angle=amax, max_rate=rmax, max_accel=accmax, t_stop=T_req)
     T_path = run.t_end

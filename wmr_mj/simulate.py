@@ -123,7 +123,7 @@ class RunConfig:
             d["identified"] = dict(self.identified.get("identified", self.identified))
         return d
 
-    def replace(self, **changes: Any) -> "RunConfig":
+    def replace(self, **changes: Any) -> RunConfig:
         return dataclasses.replace(self, **changes)
 
 
@@ -358,8 +358,10 @@ def run_closed_loop(
     range_limit = params.steering_range - 1e-3
     k_i = params.k_i
     law = controller.voltage_scalar
-    r_t, r_a, r_ad, r_a0, r_a0d, r_a0dd = rows["t"], rows["alpha"], rows["alpha_dot"], rows["alpha0"], rows["alpha0_dot"], rows["alpha0_ddot"]
-    r_E, r_Ed, r_uc, r_u, r_i, r_tau, r_h = rows["E"], rows["E_dot"], rows["voltage_cmd"], rows["voltage"], rows["current"], rows["steer_torque"], rows["heading"]
+    r_t, r_a, r_ad, r_a0, r_a0d, r_a0dd = (rows[k] for k in ("t", "alpha", "alpha_dot", "alpha0", "alpha0_dot",
+                                                              "alpha0_ddot"))
+    r_E, r_Ed, r_uc, r_u, r_i, r_tau, r_h = (rows[k] for k in ("E", "E_dot", "voltage_cmd", "voltage", "current",
+                                                                "steer_torque", "heading"))
     saturated = 0
     left_range_at = None
     bar = progress_bar(n, desc="run", unit="step", unit_scale=True, enabled=progress)

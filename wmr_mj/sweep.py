@@ -51,7 +51,6 @@ from .certificate import certificate_for
 from .errors import ParameterError, SchedulerError, UnknownNameError
 from .params import C80, C80Parameters, parameter_names
 from .plant import compile_model
-from .verdicts import drift, drift_window_steps
 from .simulate import (
     RunConfig,
     _controller,
@@ -64,6 +63,7 @@ from .simulate import (
     report,
     run_closed_loop,
 )
+from .verdicts import drift, drift_window_steps
 
 __all__ = [
     "SweepSpec",

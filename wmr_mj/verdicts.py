@@ -122,7 +122,8 @@ def format_verdict(summary: Mapping[str, Any]) -> list[str]:
         lines.append("certificate NOT valid; assumptions not met: " + "; ".join(
             f"{a['name']} ({_num(a.get('value'), '.4g')} vs {_num(a.get('limit'), '.4g')})" for a in unmet))
     lines.append(f"certificate:   |E| <= {_num(cert.get('E_max'))} rad, |E'| <= {_num(cert.get('Edot_max'))} rad/s"
-                 f", (4.23) = {_num(cert.get('condition'), '.4f')}, run {'inside' if cert.get('inside') else 'OUTSIDE'}")
+                 f", (4.23) = {_num(cert.get('condition'), '.4f')}, run "
+                 f"{'inside' if cert.get('inside') else 'OUTSIDE'}")
     lines.append(f"paper's claim: |E| <= {_num(paper.get('E_max'))} rad, |E'| <= {_num(paper.get('Edot_max'))} rad/s"
                  f", (4.23) = {_num(paper.get('condition'), '.4f')}, run "
                  f"{'inside' if paper.get('inside') else 'OUTSIDE'}")

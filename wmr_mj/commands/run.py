@@ -12,10 +12,9 @@ def add_run_options(p: argparse.ArgumentParser) -> None:
     """Options shared by ``run`` and ``sweep`` (the closed-loop configuration)."""
     from controllers.computed_torque import CONTROLLER_NAMES, FRICTION_SIGNS, MODEL_SOURCES
 
+    from ..designs import PRESET_NAMES
     from ..plant import STEERING_FRICTION_MODELS, TYRE_CONTACT_MODELS
     from ..simulate import PATH_NAMES
-
-    from ..designs import PRESET_NAMES
 
     p.add_argument("--preset", default="paper",
                    help=f"controller design: one of {', '.join(PRESET_NAMES)} (default paper: paper model, K_P = 6, "
