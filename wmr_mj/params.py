@@ -82,7 +82,7 @@ UNCERTAINTY_SOURCES: dict[str, str] = {
 def uncertainty_ranges(name: str) -> dict[str, tuple[float, float]]:
     """The ranged parameters of uncertainty box ``name`` ('m1' or 'full'), name -> (lo, hi)."""
     if name not in _UNCERTAINTY:
-        raise UnknownNameError("uncertainty box", name, UNCERTAINTY_NAMES)
+        raise UnknownNameError("uncertainty box name", name, UNCERTAINTY_NAMES)
     return dict(_UNCERTAINTY[name])
 
 # One line per field: where its value comes from.
