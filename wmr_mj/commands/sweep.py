@@ -12,7 +12,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     from .run import add_run_options
 
     p = sub.add_parser("sweep",
-                       help="Monte-Carlo over m1 (and --uncertainty/--range) on mujoco.batch: per-run verdicts, table and plot")
+                       help="Monte-Carlo over m1 (and --uncertainty/--range) on mujoco.batch: per-run "
+                            "verdicts, table and plot")
     add_run_options(p)
     p.add_argument("--n", type=int, default=200, help="number of runs (default 200)")
     p.add_argument("--seed", type=int, default=0, help="seed of the draw (default 0)")
