@@ -1,13 +1,16 @@
-"""wmr-mj validate: the report folder, its numbers recomputed from the per-run CSVs, bad input."""
+"""wmr-mj validate: the report folder, its numbers recomputed from the per-run CSVs, the ladder,
+the search, the answer first, resume, bad input."""
 
 from __future__ import annotations
 
 import csv
 import json
 import os
+import re
 import subprocess
 import sys
 import xml.etree.ElementTree as ET
+from collections import Counter
 from pathlib import Path
 
 import matplotlib
@@ -17,11 +20,17 @@ matplotlib.use("Agg")
 import matplotlib.image as mpimg  # noqa: E402
 import pytest  # noqa: E402
 
-from wmr_mj import C80  # noqa: E402
-from wmr_mj.report import SOURCES, check_assumptions, summarise_runs  # noqa: E402
-from wmr_mj.robustness import ParameterBox  # noqa: E402
+from wmr_mj.designs import CERTIFIED, LADDER, PAPER  # noqa: E402
+from wmr_mj.report import ladder_changes, summarise_rung  # noqa: E402
+from wmr_mj.report_text import format_headline, render_markdown  # noqa: E402
+from wmr_mj.verdicts import VERDICTS  # noqa: E402
 
 N = 3
+# 10 s reaches the circle (C enters it at about 8.1 s); budget 5 = one generation per m1 search
+ARGS = ("validate", "--n", str(N), "--duration", "10", "--identify-duration", "10", "--search-budget", "5",
+        "--seed", "3")
+STEMS = ["ladder", *(f"rung_{k}_{d.name}" for k, d in enumerate(LADDER, start=1)), "history_paper",
+         "history_certified", "search_history", "fig4_trajectory", "fig5_alpha0", "fig6_alpha0_rates", "fig7_region"]
 
 
 def _cli(*args: str, timeout: float = 240) -> subprocess.CompletedProcess:
@@ -32,124 +41,172 @@ def _cli(*args: str, timeout: float = 240) -> subprocess.CompletedProcess:
 @pytest.fixture(scope="module")
 def validated(tmp_path_factory):
     folder = tmp_path_factory.mktemp("validate") / "report"
-    proc = _cli("validate", "--n", str(N), "--duration", "10", "--identify-duration", "10", "--seed", "3",
-                "--out", str(folder), "--json")
+    proc = _cli(*ARGS, "--out", str(folder), "--json")
     assert proc.returncode == 0, proc.stderr
     return folder, json.loads(proc.stdout), proc.stderr
 
 
-def _runs(folder: Path, src: str) -> list[dict[str, str]]:
-    with open(folder / f"sweep-{src}" / "runs.csv", newline="") as f:
+def _rows(folder: Path, rel: str) -> list[dict[str, str]]:
+    with open(folder / rel, newline="") as f:
         return list(csv.DictReader(f))
 
 
-def test_validate_writes_the_report_folder(validated):
-    folder, out, err = validated
-    for name in ("index.md", "index.html", "summary.json", "summary.csv", "identified.json"):
-        assert (folder / name).is_file() and (folder / name).stat().st_size > 100, name
-    stems = [f"region_{s}" for s in SOURCES] + [f"history_{s}" for s in SOURCES] + [
-        "fig4_trajectory", "fig5_alpha0", "fig6_alpha0_rates", "fig7_region"]
-    for stem in stems:
-        png, svg = folder / "figures" / f"{stem}.png", folder / "figures" / f"{stem}.svg"
-        assert mpimg.imread(png).ndim == 3
-        assert ET.parse(svg).getroot().tag.endswith("svg")
-    for src in SOURCES:
-        assert len(_runs(folder, src)) == N
-    md = (folder / "index.md").read_text()
-    html = (folder / "index.html").read_text()
-    for stem in stems:
-        assert f"figures/{stem}.png" in md and f"figures/{stem}.png" in html
+def _saved(folder: Path) -> dict:
+    return json.loads((folder / "summary.json").read_text())
+
+
+def test_the_folder_has_every_file_the_report_references(validated):
+    folder, _, err = validated
+    md, html = (folder / "index.md").read_text(), (folder / "index.html").read_text()
+    linked = set(re.findall(r"\]\(([^)]+)\)", md)) | set(re.findall(r"^- `([^`]+)`", md, re.M))
+    linked |= set(re.findall(r"(?:href|src)='([^']+)'", html))
+    assert linked, "the report references no file"
+    for rel in linked:
+        assert (folder / rel).is_file() and (folder / rel).stat().st_size > 0, rel
+    for stem in STEMS:
+        png, svg = f"figures/{stem}.png", f"figures/{stem}.svg"
+        assert png in md and png in html and svg in linked, stem
+        assert mpimg.imread(folder / png).ndim == 3
+        assert ET.parse(folder / svg).getroot().tag.endswith("svg")
+    for name in ("summary.json", "summary.csv", "identified.json"):
+        assert name in linked
     assert html.lstrip().startswith("<!DOCTYPE html>") and html.rstrip().endswith("</html>")
-    # the pointer beside the folder
     assert Path((folder.parent / "validate-latest").read_text().strip()) == folder.resolve()
-    # one stage line per stage on stderr (not a terminal: no counter), then the total
-    lines = err.strip().splitlines()
+    lines = err.strip().splitlines()  # one line per stage (stderr is not a terminal), then the total
     assert all(line.startswith("validate: ") for line in lines)
-    assert sum("sweep" in line for line in lines) == len(SOURCES)
+    assert sum(": rung " in line for line in lines) == len(LADDER)
+    assert sum(": search: " in line for line in lines) == 3
     assert "total wall time" in lines[-1]
 
 
-def test_json_summary_matches_summary_json(validated):
+def test_json_equals_summary_json(validated):
     folder, out, _ = validated
-    saved = json.loads((folder / "summary.json").read_text())
-    assert Path(out["folder"]) == folder
-    assert set(out["identification"]) >= {"P", "C_V", "F", "K", "gyro", "identified", "predicted"}
-    for src in SOURCES:
-        got = out["sources"][src]
-        for key in ("inside", "n", "worst_E_ratio", "worst_Edot_ratio", "assumptions_met", "condition"):
-            assert key in got
-            assert got[key] == saved["sources"][src][key]
-    assert saved["versions"]["mujoco"] and saved["settings"]["n"] == N and saved["seed"] == 3
+    assert out == _saved(folder)
+    assert out["settings"]["n"] == N and out["seed"] == 3 and out["versions"]["mujoco"]
 
 
-def test_summary_numbers_recomputed_from_runs_csv(validated):
+def test_verdict_counts_equal_those_recomputed_from_each_rungs_runs_csv(validated):
     folder, _, _ = validated
-    saved = json.loads((folder / "summary.json").read_text())
+    saved = _saved(folder)
     with open(folder / "summary.csv", newline="") as f:
-        table = {row["source"]: row for row in csv.DictReader(f)}
-    for src in SOURCES:
-        rows = _runs(folder, src)
-        inside = sum(r["inside"] == "True" for r in rows)
-        ratios_E = [float(r["E_ratio"]) for r in rows if r["E_ratio"] != ""]
-        ratios_Ed = [float(r["Edot_ratio"]) for r in rows if r["Edot_ratio"] != ""]
-        stop = sum(r["left_steering_range"] == "True" for r in rows) / len(rows)
-        sat = sum(float(r["saturated_fraction"]) for r in rows) / len(rows)
-        v = saved["sources"][src]
-        assert v["n"] == len(rows) == N
-        assert v["inside"] == inside
-        assert v["worst_E_ratio"] == (max(ratios_E) if ratios_E else None)
-        assert v["worst_Edot_ratio"] == (max(ratios_Ed) if ratios_Ed else None)
-        assert v["stop_fraction"] == pytest.approx(stop, abs=1e-15)
-        assert v["mean_saturated_fraction"] == pytest.approx(sat, rel=1e-12, abs=1e-15)
-        assert v["worst_sup_E"] == max(float(r["sup_E"]) for r in rows)
-        # the runs' own ratios agree with their sup and bound
-        for r in rows:
-            if r["E_ratio"]:
-                assert float(r["E_ratio"]) == pytest.approx(float(r["sup_E"]) / float(r["E_max"]), rel=1e-12)
-        assert int(table[src]["inside"]) == inside and int(table[src]["n"]) == N
+        table = {int(r["rung"]): r for r in csv.DictReader(f)}
+    for rung in saved["ladder"]:
+        rows = _rows(folder, rung["runs_csv"])
+        assert len(rows) == rung["n"] == N
+        counts = Counter(r["verdict"] for r in rows)
+        assert rung["verdicts"] == {v: counts.get(v, 0) for v in VERDICTS}
+        assert rung["passes"] == counts.get("certified-inside", 0)  # uncertified-* never count
+        assert rung["paper_inside"] == sum(r["inside"] == "True" for r in rows)
+        assert rung["hit_stop"] == sum(r["left_steering_range"] == "True" for r in rows)
+        assert rung["growing"] == sum(r["drift_growing"] == "True" for r in rows)
+        assert rung["worst_sup_E"] == max(float(r["sup_E"]) for r in rows)
+        ratios = [float(r["cert_E_ratio"]) for r in rows if r["cert_E_ratio"]]
+        assert rung["worst_certificate_ratio"] == (max(ratios) if ratios else None)
+        cert = rung["certificate"]  # the rung's certificate is the one every run was judged by
+        assert all((r["cert_valid"] == "True") is cert["certified"] for r in rows)
+        if cert["certified"]:
+            assert all(float(r["cert_E_max"]) == cert["E_max"] for r in rows)
+        row = table[rung["index"]]
+        assert [int(row[v]) for v in VERDICTS] == [rung["verdicts"][v] for v in VERDICTS]
+    assert saved["certified_outside"] == 0, "a certified-outside run: a bug or a modelling gap"
 
 
-def test_assumptions_met_follows_the_identified_plant_and_the_box(validated):
+def test_the_ladder_has_four_rungs_changing_one_thing_each(validated):
     folder, _, _ = validated
-    saved = json.loads((folder / "summary.json").read_text())
-    ident = json.loads((folder / "identified.json").read_text())["identified"]
-    for src in SOURCES:
-        box = ParameterBox.from_parameters(C80, m1_range=(550.0, 750.0),
-                                           model="paper" if src == "paper" else "nonholonomic")
-        inside = {k: getattr(box, k)[0] <= ident[k] <= getattr(box, k)[1] for k in ("P", "C_V", "F", "K")}
-        assert saved["sources"][src]["assumptions_met"] is all(inside.values())
-        if src == "paper":
-            lo, hi = box.K
-            assert not (lo <= ident["K"] <= hi), "the plant's K lies in the paper box: the premise changed"
-            assert saved["sources"][src]["assumptions_met"] is False
-            assert "K" in saved["sources"][src]["assumptions"]["outside"]
+    ladder = _saved(folder)["ladder"]
+    assert [r["name"] for r in ladder] == [d.name for d in LADDER] and len(ladder) == 4
+    assert ladder[0]["config"] == PAPER.config_changes() and ladder[-1]["config"] == CERTIFIED.config_changes()
+    groups = [{"model"}, {"friction_sign", "friction_width"}, {"kp", "kd"}, {"controller"}]
+    for before, after in zip(ladder, ladder[1:]):
+        changed = {k for k in before["config"] if before["config"][k] != after["config"][k]}
+        touched = [g for g in groups if g & changed]
+        assert len(touched) == 1 and changed <= touched[0], (after["name"], changed)
+        assert len(after["changed"]) == 1
+    # the paper's design against its own certificate: none, with the unmet assumptions and numbers
+    first, last = ladder[0]["certificate"], ladder[-1]["certificate"]
+    assert not first["certified"] and first["unmet"] and last["certified"] and not last["unmet"]
+    md = (folder / "index.md").read_text()
+    assert "Against its own certificate: there is none" in md and f"{first['dead_band']:.3g} rad" in md
 
 
-def test_check_assumptions_and_summarise_runs_units():
-    box = ParameterBox.paper()
-    ok = check_assumptions({"P": 0.38, "C_V": 4.77, "F": 1.51, "K": 5.3}, box)
-    assert ok["met"] and ok["outside"] == []
-    bad = check_assumptions({"P": 0.38, "C_V": 4.77, "F": 1.51, "K": 0.0}, box, {"K": 0.01})
-    assert not bad["met"] and bad["outside"] == ["K"]
-    assert bad["coefficients"]["K"]["outside_by"] == pytest.approx(-5.29)
-    assert bad["coefficients"]["K"]["outside_by_se"] == pytest.approx(-529.0)
-    rows = [dict(m1=600.0, sup_E=0.1, sup_Edot=0.2, sup_E_settled=0.05, sup_Edot_settled=0.05, E_max=0.2,
-                 Edot_max=0.1, E_ratio=0.5, Edot_ratio=2.0, inside=False, saturated_fraction=0.1,
-                 left_steering_range=True),
-            dict(m1=700.0, sup_E=0.1, sup_Edot=0.05, sup_E_settled=0.05, sup_Edot_settled=0.05, E_max=0.2,
-                 Edot_max=0.1, E_ratio=0.5, Edot_ratio=0.5, inside=True, saturated_fraction=0.0,
-                 left_steering_range=False)]
-    s = summarise_runs(rows)
-    assert (s["n"], s["inside"], s["inside_settled"]) == (2, 1, 2)
-    assert (s["worst_E_ratio"], s["worst_Edot_ratio"], s["stop_fraction"]) == (0.5, 2.0, 0.5)
-    assert s["mean_saturated_fraction"] == pytest.approx(0.05)
-    for r in rows:
-        r["E_ratio"] = r["Edot_ratio"] = None
-    assert summarise_runs(rows)["worst_E_ratio"] is None
+def test_ladder_changes_and_summarise_rung_units():
+    assert [ladder_changes(a, b) for a, b in zip(LADDER, LADDER[1:])] == [
+        ["model source"], ["compensation"], ["gains"]]
+    base = dict(sup_Edot=0.1, saturated_fraction=0.0, left_steering_range=False, drift_growing=False, E_ratio=None)
+    rows = [dict(base, m1=600.0, verdict="uncertified-inside", inside=True, sup_E=0.02, cert_E_ratio=None),
+            dict(base, m1=700.0, verdict="certified-inside", inside=False, sup_E=0.03, cert_E_ratio=0.6,
+                 left_steering_range=True, drift_growing=True)]
+    s = summarise_rung(rows)
+    assert s["passes"] == 1 and s["verdicts"]["uncertified-inside"] == 1  # uncertified-inside: no pass
+    assert (s["paper_inside"], s["hit_stop"], s["growing"]) == (1, 1, 1)
+    assert (s["worst_sup_E"], s["worst_sup_E_m1"], s["worst_certificate_ratio"]) == (0.03, 700.0, 0.6)
+
+
+def test_the_search_beside_the_monte_carlo_worst_and_the_certificate(validated):
+    from wmr_mj.logs import load_log
+
+    folder, _, _ = validated
+    saved = _saved(folder)
+    md = (folder / "index.md").read_text()
+    searches = {s["key"]: s for s in saved["searches"]}
+    assert list(searches) == ["paper", "certified", "certified-full"]
+    for s in searches.values():
+        runs = _rows(folder, s["evaluations_csv"])
+        values = [float(r["objective"]) for r in runs]
+        assert len(runs) == s["evaluations"] == len(s["values"]) and s["worst"]["objective"] == max(values)
+        log = load_log(folder / s["log"])
+        assert log.summary["sup_E"] == s["worst"]["sup_E"] and s["reproduced"]
+    for key, rung, column in (("paper", 1, "E_ratio"), ("certified", 4, "cert_E_ratio")):
+        s = searches[key]
+        mc = max(float(r[column]) for r in _rows(folder, saved["ladder"][rung - 1]["runs_csv"]))
+        assert s["mc"]["worst_objective"] == mc
+        if s["worst"]["objective"] >= mc:
+            assert s["search_at_least_mc"] is True
+        else:  # the report says so
+            assert s["search_at_least_mc"] is False and "did not beat the Monte-Carlo sample" in md
+    full = searches["certified-full"]
+    assert set(full["box"]) == {"m1", "mu", "ground_friction", "R_a", "V_A"}
+    assert full["certificate"]["unmet"] == ["within the supply"]
+    assert full["certificate"]["voltage_max"] > full["certificate"]["voltage_limit"] == 24.0
+    assert full["verdicts"]["certified-inside"] == full["verdicts"]["certified-outside"] == 0
+    assert "more than the 24 V supply" in md
+    cert = searches["certified"]
+    assert f"{cert['worst']['objective']:.4g}" in md and "Tightness" in md
+
+
+def test_a_rerun_resumes_and_prints_the_answer_first(validated):
+    folder, _, _ = validated
+    before = _saved(folder)
+    proc = _cli(*ARGS, "--out", str(folder))
+    assert proc.returncode == 0, proc.stderr
+    after = _saved(folder)
+    assert [r["verdicts"] for r in after["ladder"]] == [r["verdicts"] for r in before["ladder"]]
+    assert [s["worst"] for s in after["searches"]] == [s["worst"] for s in before["searches"]]
+    assert proc.stderr.count("read back from search-") == 3
+    out = proc.stdout.splitlines()
+    assert out[0].startswith("wmr-mj validate") and out[2] == "(a) The paper's design:"
+    heads = [line for line in out if re.match(r"^\([a-d]\) ", line)]
+    assert [h[:3] for h in heads] == ["(a)", "(b)", "(c)", "(d)"]
+    md = (folder / "index.md").read_text()
+    assert md.index("## (a) The paper's design") < md.index("## (b)") < md.index("## (c)") < md.index("## (d)")
+    assert md.index("## (d)") < md.index("## (e) Identification") < md.index("## (f) Findings")
+
+
+def test_certified_outside_is_announced_loudly_before_the_answer(validated):
+    folder, _, _ = validated
+    summary = _saved(folder)
+    rung = summary["ladder"][-1]
+    rung["verdicts"]["certified-outside"] = rung["certified_outside"] = 1
+    summary["certified_outside"] = 1
+    text, md = format_headline(summary), render_markdown(summary)
+    assert "!!! CERTIFIED-OUTSIDE: 1 run(s) (rung 4 (1))" in text
+    assert text.index("CERTIFIED-OUTSIDE") < text.index("(a) The paper's design")
+    assert md.index("CERTIFIED-OUTSIDE") < md.index("## (a)")
 
 
 @pytest.mark.parametrize("args", [("--n", "0"), ("--duration", "0"), ("--duration", "-3"), ("--sampling", "sobol"),
-                                  ("--identify-duration", "nan"), ("--nthread", "-1")])
+                                  ("--identify-duration", "nan"), ("--nthread", "-1"), ("--search-budget", "3"),
+                                  ("--search-budget", "-1"), ("--seed", "-1")])
 def test_bad_input_exits_2_with_one_line(args, tmp_path):
     proc = _cli("validate", *args, "--out", str(tmp_path / "x"), timeout=60)
     assert proc.returncode == 2

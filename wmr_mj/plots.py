@@ -20,6 +20,13 @@ second full-range panel and a note when data leave the region's scale),
 ``figure_time_history``. ``save_figure(fig, stem)`` writes stem.png and
 stem.svg atomically.
 
+The validation's figures (``wmr-mj validate``)::
+
+    figure_verdict_plane(sup_E, sup_Edot, verdicts, [Region("certificate", cert.vertices,
+                         gid=CERTIFICATE_GID)])      # every run of a sweep, by verdict, with regions
+    figure_ladder(labels, counts, paper_inside)      # verdict counts per rung, stacked bars
+    figure_search_history([SearchHistory(title, ylabel, values, mc_worst=..., bound=1.0)])
+
 The paper's figures::
 
     from wmr_mj.plots import paper_example, paper_figures, write_figures
@@ -50,7 +57,8 @@ matplotlib.use("Agg", force=False)  # headless; a no-op when Agg is already sele
 import numpy as np  # noqa: E402
 from matplotlib import rc_context  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
-from matplotlib.patches import Polygon  # noqa: E402
+from matplotlib.patches import Patch, Polygon  # noqa: E402
+from matplotlib.ticker import MaxNLocator  # noqa: E402
 
 __all__ = [
     "STYLE",
@@ -76,6 +84,16 @@ __all__ = [
     "paper_figures",
     "PAPER_FIGURE_NAMES",
     "REGION_GID",
+    "CERTIFICATE_GID",
+    "VERDICT_COLORS",
+    "PAPER_CLAIM_COLOR",
+    "Region",
+    "plot_region_polygon",
+    "plot_verdict_points",
+    "figure_verdict_plane",
+    "figure_ladder",
+    "SearchHistory",
+    "figure_search_history",
 ]
 
 #: Style for paper-quality output: readable at a single-column width, text kept as text in SVG.
@@ -101,12 +119,22 @@ STYLE: dict[str, Any] = {
 
 #: gid of the region polygon drawn by :func:`plot_region` (find it with ``patch.get_gid()``).
 REGION_GID = "robustness-region"
+#: gid of a certificate's region polygon in :func:`figure_verdict_plane`.
+CERTIFICATE_GID = "certificate-region"
 
 #: File stems of the paper's figures written by :func:`paper_figures`.
 PAPER_FIGURE_NAMES = ("fig4_trajectory", "fig5_alpha0", "fig6_alpha0_rates", "fig7_region")
 
 _COLORS = {"C": "#1f4e9c", "A": "#c0392b", "region": "#7fb3d5", "bound": "0.35",
-           "reduced": "#1e8449", "reduced2": "#7d3c98", "mujoco": "#d35400", "voltage": "#2c3e50"}
+           "reduced": "#1e8449", "reduced2": "#7d3c98", "mujoco": "#d35400", "voltage": "#2c3e50",
+           "paper": "#d35400"}
+#: Colour of the paper's claim (its region, drawn as a dashed outline beside a certificate's).
+PAPER_CLAIM_COLOR = _COLORS["paper"]
+#: Colour of each verdict of wmr_mj.verdicts (certified-outside: a bug or a modelling gap, in red).
+VERDICT_COLORS = {"certified-inside": "#1e8449", "certified-outside": "#e00000",
+                  "uncertified-inside": "#f0b000", "uncertified-outside": "#8c8c8c"}
+_VERDICT_MARKERS = {"certified-inside": "o", "certified-outside": "X", "uncertified-inside": "s",
+                    "uncertified-outside": "^"}
 # region extent above which data count as "leaving the region's scale" (drawn in a second panel)
 _ZOOM_FACTOR = 3.0
 
@@ -444,8 +472,13 @@ def figure_region(result, series: Sequence[Series] = (), *, title: str | None = 
 # --------------------------------------------------------------------------- time histories
 def plot_time_history(axes, rows: Mapping[str, np.ndarray], *, E_max: float | None = None,
                       Edot_max: float | None = None, voltage_limit: float | None = None,
-                      settle_s: float | None = None, stop_at: float | None = None) -> None:
-    """E(t), E'(t) and the armature voltage on three axes (bounds dashed, entry end dotted)."""
+                      settle_s: float | None = None, stop_at: float | None = None,
+                      bound_name: str | None = None) -> None:
+    """E(t), E'(t) and the armature voltage on three axes (bounds dashed, entry end dotted).
+
+    bound_name: whose bounds E_max, Edot_max are (e.g. "certificate"), shown in the legend.
+    """
+    whose = f" ({bound_name})" if bound_name else ""
     a1, a2, a3 = axes
     t = np.asarray(rows["t"])
     a1.plot(t, rows["E"], color=_COLORS["C"], label=r"$E = \alpha_0 - \alpha$")
@@ -454,9 +487,9 @@ def plot_time_history(axes, rows: Mapping[str, np.ndarray], *, E_max: float | No
         a3.plot(t, rows["voltage_cmd"], color="0.6", lw=0.8, label="commanded")
     a3.plot(t, rows["voltage"], color=_COLORS["voltage"], label="applied")
     if E_max is not None and math.isfinite(E_max):
-        _bound_lines(a1, E_max, rf"$\pm E_{{max}}$ = {E_max:.3g} rad")
+        _bound_lines(a1, E_max, rf"$\pm E_{{max}}${whose} = {E_max:.3g} rad")
     if Edot_max is not None and math.isfinite(Edot_max):
-        _bound_lines(a2, Edot_max, rf"$\pm \dot E_{{max}}$ = {Edot_max:.3g} rad/s")
+        _bound_lines(a2, Edot_max, rf"$\pm \dot E_{{max}}${whose} = {Edot_max:.3g} rad/s")
     if voltage_limit is not None:
         _bound_lines(a3, voltage_limit, rf"$\pm$ {voltage_limit:g} V supply")
     for ax in axes:
@@ -478,15 +511,210 @@ def plot_time_history(axes, rows: Mapping[str, np.ndarray], *, E_max: float | No
 
 
 def figure_time_history(rows: Mapping[str, np.ndarray], summary: Mapping[str, Any], *,
-                        voltage_limit: float | None = None, title: str | None = None) -> Figure:
-    """Three-panel time history of one run (``summary``: the run's report)."""
+                        voltage_limit: float | None = None, title: str | None = None,
+                        bounds: tuple[float | None, float | None] | None = None,
+                        bound_name: str | None = None) -> Figure:
+    """Three-panel time history of one run (``summary``: the run's report).
+
+    bounds: (E_max [rad], Edot_max [rad/s]) to draw, named ``bound_name``; default the
+    summary's E_max, Edot_max (the paper's claim).
+    """
     fig, axes = new_figure(5.6, 5.6, 3, 1, sharex=True)
-    E_max = summary.get("E_max")
-    Ed_max = summary.get("Edot_max")
+    E_max, Ed_max = bounds if bounds is not None else (summary.get("E_max"), summary.get("Edot_max"))
     plot_time_history(axes, rows, E_max=None if E_max is None else float(E_max),
                       Edot_max=None if Ed_max is None else float(Ed_max), voltage_limit=voltage_limit,
-                      settle_s=summary.get("settle_s"), stop_at=summary.get("left_steering_range_at_s"))
+                      settle_s=summary.get("settle_s"), stop_at=summary.get("left_steering_range_at_s"),
+                      bound_name=bound_name)
     axes[0].set_title(title or f"{summary.get('model', '')} model, plant m1 = {summary.get('m1', float('nan')):g} kg")
+    return fig
+
+
+# --------------------------------------------------------------------------- the validation's figures
+@dataclass(frozen=True)
+class Region:
+    """A region of the (||E||, ||E'||) plane to draw: its polygon and how.
+
+    vertices: the polygon (e.g. ``Certificate.vertices``, ``RobustnessResult.vertices``);
+    empty when the region does not exist. filled: a filled patch (else a dashed outline).
+    """
+
+    label: str
+    vertices: Sequence[tuple[float, float]]
+    color: str = _COLORS["region"]
+    filled: bool = True
+    gid: str | None = None
+
+    @property
+    def extent(self) -> tuple[float, float]:
+        """(max ||E||, max ||E'||) over the vertices; (0, 0) when empty."""
+        v = np.asarray(self.vertices, dtype=float).reshape(-1, 2)
+        return (float(v[:, 0].max()), float(v[:, 1].max())) if v.size else (0.0, 0.0)
+
+
+def plot_region_polygon(ax, region: Region):
+    """Draw ``region`` (its vertices exactly); the Polygon, or None when the region is empty."""
+    if not len(region.vertices):
+        return None
+    xy = np.asarray(region.vertices, dtype=float)
+    if region.filled:
+        poly = Polygon(xy, closed=True, facecolor=region.color, alpha=0.4, edgecolor=region.color, lw=1.0,
+                       zorder=1, label=region.label)
+    else:
+        poly = Polygon(xy, closed=True, fill=False, edgecolor=region.color, lw=1.3, ls="--", zorder=2,
+                       label=region.label)
+    if region.gid:
+        poly.set_gid(region.gid)
+    ax.add_patch(poly)
+    return poly
+
+
+def plot_verdict_points(ax, sup_E: Sequence[float], sup_Edot: Sequence[float], verdicts: Sequence[str]
+                        ) -> dict[str, Any]:
+    """One point per run at (sup|E|, sup|E'|), coloured and shaped by its verdict; the legend
+    label carries the count. certified-outside points are drawn large, on top. {verdict: scatter}."""
+    E = np.asarray(sup_E, dtype=float)
+    Ed = np.asarray(sup_Edot, dtype=float)
+    verdicts = np.asarray(list(verdicts), dtype=object)
+    out = {}
+    for verdict, color in VERDICT_COLORS.items():
+        mask = verdicts == verdict
+        if not mask.any():
+            continue
+        loud = verdict == "certified-outside"
+        out[verdict] = ax.scatter(E[mask], Ed[mask], s=60 if loud else 16, color=color, edgecolors="k",
+                                  linewidths=0.8 if loud else 0.3, marker=_VERDICT_MARKERS[verdict],
+                                  zorder=6 if loud else 4,
+                                  label=f"{verdict.upper() if loud else verdict}: {int(mask.sum())} runs")
+    return out
+
+
+def _plane_panel(ax, E, Ed, verdicts, regions: Sequence[Region], note: str | None) -> None:
+    for region in regions:
+        plot_region_polygon(ax, region)
+    plot_verdict_points(ax, E, Ed, verdicts)
+    ax.set_xlabel(r"$\|E\|$ = sup$|E|$ [rad]")
+    ax.set_ylabel(r"$\|\dot E\|$ = sup$|\dot E|$ [rad/s]")
+    if note:
+        ax.text(0.98, 0.97, note, transform=ax.transAxes, va="top", ha="right", multialignment="left",
+                fontsize=7, bbox=dict(boxstyle="round", fc="#fdebd0", ec="#d35400"), zorder=7)
+
+
+def figure_verdict_plane(sup_E: Sequence[float], sup_Edot: Sequence[float], verdicts: Sequence[str],
+                         regions: Sequence[Region] = (), *, title: str | None = None, note: str | None = None,
+                         zoom_factor: float = _ZOOM_FACTOR) -> Figure:
+    """Every run of a sweep at (sup|E|, sup|E'|) by verdict, with ``regions`` (e.g. the
+    certificate's, filled, and the paper's claim, dashed); ``note`` in a box (e.g. why there
+    is no certificate); legend below.
+
+    When runs lie beyond ``zoom_factor`` times the regions' extent, a left panel shows the
+    regions at their own scale (its title counts the runs beyond it) and a right panel the
+    full range with the left panel's window dashed.
+    """
+    E = np.asarray(sup_E, dtype=float)
+    Ed = np.asarray(sup_Edot, dtype=float)
+    extents = [r.extent for r in regions if len(r.vertices)]
+    xr = max((x for x, _ in extents), default=0.0)
+    yr = max((y for _, y in extents), default=0.0)
+    xm = max([xr, *E.tolist(), 1e-9])
+    ym = max([yr, *Ed.tolist(), 1e-9])
+    beyond = (E > zoom_factor * xr) | (Ed > zoom_factor * yr)
+    if not (xr > 0 and yr > 0 and beyond.any()):
+        fig, ax = new_figure(5.4, 5.0)
+        _plane_panel(ax, E, Ed, verdicts, regions, note)
+        ax.set_xlim(0.0, 1.12 * xm)
+        ax.set_ylim(0.0, 1.12 * ym)
+        _legend_below(fig, ax)
+        ax.set_title(title or "Runs by verdict in the error-magnitude plane")
+        return fig
+    fig, (az, af) = new_figure(9.6, 5.0, 1, 2)
+    near = ~beyond
+    xz = 1.35 * max([xr, *E[near].tolist()])
+    yz = 1.35 * max([yr, *Ed[near].tolist()])
+    _plane_panel(az, E, Ed, verdicts, regions, None)
+    az.set_xlim(0.0, xz)
+    az.set_ylim(0.0, yz)
+    out_of_view = int(np.sum((E > xz) | (Ed > yz)))
+    az.set_title(f"Region scale: {out_of_view} of {E.size} runs lie beyond it, up to sup|E| = {E.max():.3g} rad "
+                 f"({E.max() / xr:.1f}x), sup|E'| = {Ed.max():.3g} rad/s ({Ed.max() / yr:.1f}x)",
+                 fontsize=7.5, color="#a04000")
+    _plane_panel(af, E, Ed, verdicts, regions, note)
+    af.set_xlim(0.0, 1.08 * xm)
+    af.set_ylim(0.0, 1.08 * ym)
+    af.add_patch(Polygon([(0, 0), (xz, 0), (xz, yz), (0, yz)], closed=True, fill=False, ls="--", lw=0.8,
+                         ec="0.3", zorder=6))
+    af.annotate("left panel", (xz, yz), xytext=(4, 4), textcoords="offset points", fontsize=7, color="0.3")
+    af.set_title("Full range")
+    _legend_below(fig, az, ncols=2)
+    fig.suptitle(title or "Runs by verdict in the error-magnitude plane", fontsize=10)
+    return fig
+
+
+def figure_ladder(labels: Sequence[str], counts: Sequence[Mapping[str, int]], paper_inside: Sequence[int], *,
+                  title: str | None = None) -> Figure:
+    """Verdict counts per rung as stacked horizontal bars (first rung on top), each with its
+    count, and the runs inside the paper's claim beside each bar."""
+    fig, ax = new_figure(7.0, 0.55 * len(labels) + 1.6)
+    y = np.arange(len(labels))[::-1]
+    n = [sum(c.values()) for c in counts]
+    left = np.zeros(len(labels))
+    handles = []
+    for verdict, color in VERDICT_COLORS.items():
+        widths = np.array([c.get(verdict, 0) for c in counts], dtype=float)
+        handles.append(Patch(facecolor=color, edgecolor="k", lw=0.4, label=f"{verdict}: {int(widths.sum())}"))
+        bars = ax.barh(y, widths, left=left, color=color, edgecolor="k", lw=0.4)
+        for bar, w in zip(bars, widths):
+            if w:
+                ax.text(bar.get_x() + w / 2, bar.get_y() + bar.get_height() / 2, f"{int(w)}", ha="center",
+                        va="center", fontsize=7)
+        left += widths
+    for yi, k, total in zip(y, paper_inside, n):
+        ax.text(1.01 * max(n), yi, f"paper's claim: {k}/{total} inside", va="center", fontsize=7, color="#a04000")
+    ax.set_yticks(y, labels)
+    ax.set_xlim(0.0, 1.45 * max(n))
+    ax.set_xlabel("runs")
+    ax.grid(False)
+    fig.legend(handles=handles, loc="outside lower center", ncols=2, framealpha=0.9)
+    ax.set_title(title or "Verdicts per rung of the ladder")
+    return fig
+
+
+@dataclass
+class SearchHistory:
+    """One worst-case search for :func:`figure_search_history`: the objective of each run in
+    evaluation order (None: undefined), and the lines to compare with."""
+
+    title: str
+    ylabel: str
+    values: Sequence[float | None]
+    mc_worst: float | None = None  # worst of the Monte-Carlo sweep of the same design
+    mc_label: str = "Monte-Carlo worst"
+    bound: float | None = None  # e.g. 1.0 for a ratio to a region, or a certificate's E_max
+    bound_label: str = "bound"
+
+
+def figure_search_history(histories: Sequence[SearchHistory], *, title: str | None = None) -> Figure:
+    """One panel per search: each run's objective, the search's running worst, the
+    Monte-Carlo worst (dashed) and the bound (dotted)."""
+    fig, axes = new_figure(3.6 * len(histories) + 0.4, 3.6, 1, len(histories))
+    for ax, h in zip(np.atleast_1d(axes), histories):
+        v = np.array([np.nan if x is None else float(x) for x in h.values])
+        x = np.arange(1, v.size + 1)
+        ax.scatter(x, v, s=9, color="C3", alpha=0.55, linewidths=0)
+        running = np.fmax.accumulate(np.where(np.isnan(v), -np.inf, v)) if v.size else v
+        if v.size and np.isfinite(v).any():
+            ax.step(x, np.where(np.isfinite(running), running, np.nan), where="post", color="C3",
+                    label=f"search: worst {np.nanmax(v):.4g}")
+        if h.mc_worst is not None:
+            ax.axhline(h.mc_worst, color="0.35", ls="--", lw=1.0, label=f"{h.mc_label}: {h.mc_worst:.4g}")
+        if h.bound is not None:
+            ax.axhline(h.bound, color="#1b4f72", ls=":", lw=1.2, label=f"{h.bound_label}: {h.bound:.4g}")
+        ax.xaxis.set_major_locator(MaxNLocator(integer=True))
+        ax.set_xlabel("simulations of the search")
+        ax.set_ylabel(h.ylabel)
+        ax.set_title(h.title, fontsize=8.5)
+        ax.legend(loc="best", fontsize=6.5)
+    if title:
+        fig.suptitle(title, fontsize=10)
     return fig
 
 
