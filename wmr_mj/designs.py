@@ -1,8 +1,9 @@
 """Controller designs: the paper's, a certified one chosen by a rule, and the ladder between them.
 
-A design is what ``--preset`` sets for ``run``, ``sweep``, ``validate`` and ``falsify``:
-controller, model source of the estimate, gains and Coulomb compensation. Explicit
-options override a preset.
+A design is what ``--preset`` sets for ``run``, ``sweep``, ``falsify`` and
+``robustness --certificate``: controller, model source of the estimate, gains and
+Coulomb compensation. Explicit options override a preset. ``validate`` runs both
+designs and the ladder between them.
 
 ``paper``: the paper's design (5.1): the paper model (2.7), K_P = 6, K_D = 9, exact
 sign of alpha' in the compensation F^ sgn(alpha') (3.3).
