@@ -124,3 +124,20 @@ def test_bad_input_after_a_good_output_path_leaves_nothing(tmp_path, capsys):
     assert main(["sweep", "--n", "1", "--path", "no-such-path", "--out", str(tmp_path / "new" / "sweep")]) == 2
     assert "no-such-path" in _one_error_line(capsys)
     assert _tree(tmp_path) == []
+
+
+def test_a_gl_backend_that_cannot_load_is_one_line():
+    """MUJOCO_GL naming a backend whose library is missing breaks `import mujoco` itself."""
+    import os
+    import subprocess
+    import sys
+
+    env = {**os.environ, "MUJOCO_GL": "osmesa"}
+    probe = subprocess.run([sys.executable, "-c", "import mujoco"], env=env, capture_output=True, text=True)
+    if probe.returncode == 0:
+        pytest.skip("OSMesa is installed here: MUJOCO_GL=osmesa imports fine")
+    proc = subprocess.run([sys.executable, "-m", "wmr_mj.cli", "run", "--no-log"], env=env, capture_output=True,
+                          text=True, timeout=60)
+    assert proc.returncode == 2
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and "MUJOCO_GL='osmesa'" in lines[0] and "Traceback" not in proc.stderr

@@ -45,7 +45,26 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _mujoco_importable() -> str | None:
+    """None when MuJoCo imports; else one line naming the cause (a MUJOCO_GL backend that is not installed
+    makes ``import mujoco`` fail inside PyOpenGL, before any command runs)."""
+    import os
+
+    try:
+        import mujoco  # noqa: F401
+    except Exception as exc:  # noqa: BLE001  (any failure here ends in one line, not a traceback)
+        gl = os.environ.get("MUJOCO_GL")
+        hint = (f"MUJOCO_GL={gl!r} names a GL backend that cannot be loaded here; unset it or use egl, glfw or "
+                "osmesa with its library installed" if gl else "reinstall it: pip install mujoco")
+        return f"MuJoCo cannot be imported ({type(exc).__name__}: {exc}); {hint}"
+    return None
+
+
 def main(argv: Sequence[str] | None = None) -> int:
+    problem = _mujoco_importable()
+    if problem is not None:
+        print(f"wmr-mj: error: {problem}", file=sys.stderr)
+        return 2
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
