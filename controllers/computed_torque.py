@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from wmr_mj.errors import ParameterError, UnknownNameError
-from wmr_mj.params import C80, C80Parameters
+from wmr_mj.params import C80, PAPER_KD, PAPER_KP, C80Parameters
 from wmr_mj.reduced import MODEL_NAMES, SteeringModel, smooth_sign, steering_model
 
 from .base import SteeringController
@@ -129,8 +129,8 @@ class ComputedTorque(SteeringController):
         self,
         model: SteeringModel,
         *,
-        kp: float = 6.0,
-        kd: float = 9.0,
+        kp: float = PAPER_KP,
+        kd: float = PAPER_KD,
         friction_sign: str = "measured",
         friction_width: float = 0.0,
     ):
@@ -270,7 +270,7 @@ class PDController(SteeringController):
 
     name = "pd"
 
-    def __init__(self, model: SteeringModel, *, kp: float = 6.0, kd: float = 9.0):
+    def __init__(self, model: SteeringModel, *, kp: float = PAPER_KP, kd: float = PAPER_KD):
         self.model = model
         self.kp = _check_gain("K_P", kp)
         self.kd = _check_gain("K_D", kd)
@@ -303,7 +303,7 @@ class PDController(SteeringController):
                 "estimate": {"P": self._P}}
 
 
-def make_controller(name: str, model: SteeringModel, *, kp: float = 6.0, kd: float = 9.0,
+def make_controller(name: str, model: SteeringModel, *, kp: float = PAPER_KP, kd: float = PAPER_KD,
                     friction_sign: str = "measured", friction_width: float = 0.0) -> SteeringController:
     """A controller by name ('computed-torque' or 'pd')."""
     if name == "computed-torque":

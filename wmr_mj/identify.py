@@ -30,7 +30,7 @@ import mujoco
 import numpy as np
 
 from .errors import ParameterError
-from .params import C80, C80Parameters, Coefficients
+from .params import C80, M1_NOMINAL, C80Parameters, Coefficients
 from .plant import Plant
 
 __all__ = ["IdentificationResult", "fit_steering_model", "excite_plant", "identify_plant", "COEFFICIENT_NAMES"]
@@ -162,7 +162,7 @@ class IdentificationResult:
     identified: Coefficients
     predicted: dict[str, Coefficients]
     diagnostics: dict = field(default_factory=dict)
-    m1: float = 650.0
+    m1: float = M1_NOMINAL
     duration: float = 60.0
     seed: int = 0
 

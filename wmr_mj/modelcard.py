@@ -17,7 +17,7 @@ from .friction import (
     wheel_penetration,
 )
 from .identify import identify_plant
-from .params import C80, PARAMETER_SOURCES, C80Parameters, with_params
+from .params import C80, M1_RANGE, PARAMETER_SOURCES, C80Parameters, with_params
 from .plant import STEERING_FRICTION_MODELS, STICTION_SOLIMP, STICTION_SOLREF, TYRE_CONTACT_SOLREF, measure_side_slip
 
 __all__ = ["render_model_card"]
@@ -56,7 +56,7 @@ def _nums(values) -> str:
 
 def render_model_card(params: C80Parameters = C80) -> str:
     p = params
-    lo, hi = with_params(p, m1=550.0), with_params(p, m1=750.0)
+    lo, hi = (with_params(p, m1=m) for m in M1_RANGE)
     paper, nh = p.coefficients("paper"), p.coefficients("nonholonomic")
     paper_lo, paper_hi = lo.coefficients("paper"), hi.coefficients("paper")
     ke = p.kinetic_energy_coefficients()
@@ -111,8 +111,8 @@ def render_model_card(params: C80Parameters = C80) -> str:
     w("K spans the paper's interval because m1 changes as a compact payload at the chassis centre of mass "
       "(`m1_inertia='payload'`, the reading of (2.3), where I_z1 does not depend on m1). Scaling the chassis inertia "
       "with m1 instead (`m1_inertia='scale'`) gives K over "
-      f"({_g(with_params(p, m1=550.0, m1_inertia='scale').coefficients().K)}, "
-      f"{_g(with_params(p, m1=750.0, m1_inertia='scale').coefficients().K)}) V. "
+      f"({_g(with_params(p, m1=M1_RANGE[0], m1_inertia='scale').coefficients().K)}, "
+      f"{_g(with_params(p, m1=M1_RANGE[1], m1_inertia='scale').coefficients().K)}) V. "
       "F follows (2.7) with Q = (m1 + m2 + m3) g, so it spans a wider interval than (5.1) prints: the paper's F "
       "interval does not follow its own formula when m1 varies.")
     w("")

@@ -60,6 +60,8 @@ from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.patches import Patch, Polygon  # noqa: E402
 from matplotlib.ticker import MaxNLocator  # noqa: E402
 
+from .params import M1_NOMINAL, PAPER_KD, PAPER_KP  # noqa: E402
+
 __all__ = [
     "STYLE",
     "new_figure",
@@ -751,7 +753,7 @@ def paper_example(*, duration: float = 35.0, friction_width: float = 1e-3, mujoc
     if not (isinstance(duration, (int, float)) and math.isfinite(duration) and duration > 0):
         raise ParameterError(f"duration = {duration!r} s is not accepted; a finite number > 0 is required")
     box = ParameterBox.paper()
-    kp, kd = 6.0, 9.0
+    kp, kd = PAPER_KP, PAPER_KD
     result = analyse(box, kp=kp, kd=kd, bounds=ReferenceBounds())
     reference, settle_s = build_reference("paper-circle", C80, dt=1e-3, duration=float(duration))
     lo = {n: getattr(box, n)[0] for n in ("P", "C_V", "F", "K")}
@@ -779,7 +781,7 @@ def fig7_series(example: PaperExample) -> list[Series]:
         series.append(Series(label=f"(a) paper's view, reduced paper model as plant: {name}",
                              E=np.abs(rows["E"]), E_dot=np.abs(rows["E_dot"]), color=color, ls=ls, tag="(a)"))
     if example.mujoco_rows is not None:
-        m1 = example.mujoco_summary.get("m1", 650.0) if example.mujoco_summary else 650.0
+        m1 = example.mujoco_summary.get("m1", M1_NOMINAL) if example.mujoco_summary else M1_NOMINAL
         series.append(Series(label=f"(b) MuJoCo plant (m1 = {m1:g} kg), paper-model controller",
                              E=np.abs(example.mujoco_rows["E"]), E_dot=np.abs(example.mujoco_rows["E_dot"]),
                              color=_COLORS["mujoco"], ls="-", tag="(b) MuJoCo"))

@@ -92,6 +92,7 @@ from dataclasses import dataclass
 from typing import Any, Literal
 
 from .errors import ParameterError, UnknownNameError
+from .params import M1_RANGE, PAPER_KD, PAPER_KP
 
 __all__ = [
     "ParameterBox",
@@ -310,7 +311,7 @@ class ParameterBox:
         cls,
         params: Any,
         *,
-        m1_range: tuple[float, float] | None = (550.0, 750.0),
+        m1_range: tuple[float, float] | None = M1_RANGE,
         ranges: Mapping[str, tuple[float, float]] | None = None,
         model: str = "paper",
         m1_inertia: str = "payload",
@@ -553,8 +554,8 @@ def _max_tilde(box: ParameterBox, name: str, est: dict[str, float]) -> float:
 def analyse(
     box: ParameterBox,
     *,
-    kp: float = 6.0,
-    kd: float = 9.0,
+    kp: float = PAPER_KP,
+    kd: float = PAPER_KD,
     bounds: ReferenceBounds = ReferenceBounds(),
     reading: Reading = "corrected",
     gammas: GammaForm = "exact",

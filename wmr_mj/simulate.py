@@ -34,7 +34,7 @@ from controllers.computed_torque import CONTROLLER_NAMES, FRICTION_SIGNS, MODEL_
 from .certificate import certificate_for
 from .errors import ParameterError, UnknownNameError
 from .memory import require_run_memory
-from .params import C80, C80Parameters, parameter_names, with_params
+from .params import C80, M1_NOMINAL, M1_RANGE, PAPER_KD, PAPER_KP, C80Parameters, parameter_names, with_params
 from .plant import STEERING_FRICTION_MODELS, TIMESTEP, TYRE_CONTACT_MODELS, Plant
 from .progress import progress_bar
 from .summary import RunSummary
@@ -66,11 +66,11 @@ class RunConfig:
 
     controller: str = "computed-torque"
     model: str = "paper"  # model source of the controller's estimate
-    m1: float = 650.0  # plant chassis mass, kg
+    m1: float = M1_NOMINAL  # plant chassis mass, kg
     duration: float = 35.0  # s
     control_period: float | None = None  # s; None: every physics step
-    kp: float = 6.0
-    kd: float = 9.0
+    kp: float = PAPER_KP
+    kd: float = PAPER_KD
     friction_sign: str = "measured"
     friction_width: float = 0.0  # rad/s, tanh smoothing of the Coulomb sign (0: exact sign)
     path: str = "paper-circle"
@@ -79,7 +79,7 @@ class RunConfig:
     identified: Any = None  # path or mapping from `wmr-mj identify` for model='identified'
     coefficients: Mapping[str, float] | None = None  # for model='explicit'
     box: str = "derived"  # 'derived' from the parameter set over m1_range, or 'paper' (5.1)
-    m1_range: tuple[float, float] = (550.0, 750.0)
+    m1_range: tuple[float, float] = M1_RANGE
     box_ranges: Mapping[str, tuple[float, float]] = field(default_factory=dict)  # other ranged parameters
     seed: int = 0  # recorded; a single run draws nothing at random
     steering_friction: str = "stiction"  # plant's steering friction law: one of STEERING_FRICTION_MODELS

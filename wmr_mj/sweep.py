@@ -49,7 +49,7 @@ import numpy as np
 
 from .certificate import certificate_for
 from .errors import ParameterError, SchedulerError, UnknownNameError
-from .params import C80, C80Parameters, parameter_names
+from .params import C80, M1_NOMINAL, M1_RANGE, C80Parameters, parameter_names
 from .plant import compile_model
 from .simulate import (
     RunConfig,
@@ -123,7 +123,7 @@ class SweepSpec:
     n: int = 200
     seed: int = 0
     sampling: str = "lhs"
-    m1_range: tuple[float, float] = (550.0, 750.0)
+    m1_range: tuple[float, float] = M1_RANGE
     ranges: Mapping[str, tuple[float, float]] = field(default_factory=dict)
     base: RunConfig = field(default_factory=RunConfig)
 
@@ -391,9 +391,9 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
     if not configs:
         return []
     first = configs[0]
-    shared = first.replace(m1=650.0, plant_overrides={})
+    shared = first.replace(m1=M1_NOMINAL, plant_overrides={})
     for c in configs[1:]:
-        if c.replace(m1=650.0, plant_overrides={}) != shared:
+        if c.replace(m1=M1_NOMINAL, plant_overrides={}) != shared:
             raise ParameterError("run_batch needs configs that differ only in m1 and plant_overrides")
     estimate = estimate_parameters(base)
     controller = _controller(first, estimate)

@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import argparse
 
+from ..params import M1_NOMINAL
 from ._common import parse_assignments, positive_float
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("identify", help="excite the plant's steering and fit P, C_V, F, K, gyro by least squares")
-    p.add_argument("--m1", type=positive_float, default=650.0, help="chassis mass of the plant, kg (default 650)")
+    p.add_argument("--m1", type=positive_float, default=M1_NOMINAL, help="chassis mass of the plant, kg (default 650)")
     p.add_argument("--duration", type=positive_float, default=60.0, help="excitation length, s (default 60)")
     p.add_argument("--seed", type=int, default=0, help="seed of the excitation signal (default 0)")
     p.add_argument("--param", action="append", metavar="NAME=VALUE", help="override a plant parameter (repeatable)")

@@ -16,6 +16,7 @@ from __future__ import annotations
 import argparse
 import math
 
+from ..params import M1_NOMINAL, M1_RANGE, PAPER_KD, PAPER_KP
 from ._common import parse_assignments, parse_range, positive_float
 
 
@@ -138,8 +139,8 @@ def run(args: argparse.Namespace) -> int:
             raise ParameterError("--omega-r sets both gains by (3.6); it cannot be combined with --kp/--kd")
         kp, kd = gains_from_omega_r(args.omega_r)
     else:
-        kp = 6.0 if args.kp is None else args.kp
-        kd = 9.0 if args.kd is None else args.kd
+        kp = PAPER_KP if args.kp is None else args.kp
+        kd = PAPER_KD if args.kd is None else args.kd
 
     if args.box == "paper":
         used = [opt for opt, v in (("--m1-range", args.m1_range), ("--range", args.range), ("--model", args.model))
@@ -159,7 +160,7 @@ def run(args: argparse.Namespace) -> int:
             ranges[name] = span
         if "m1" in ranges and args.m1_range is not None:
             raise ParameterError("m1 given by both --m1-range and --range m1=LO:HI; give it once")
-        m1_range = tuple(args.m1_range) if args.m1_range is not None else (550.0, 750.0)
+        m1_range = tuple(args.m1_range) if args.m1_range is not None else M1_RANGE
         if "m1" in ranges:
             m1_range = ranges.pop("m1")
         model = args.model or "paper"
@@ -179,7 +180,7 @@ def run(args: argparse.Namespace) -> int:
     g1p, g2p = paper_gammas(kp, kd)
     rel = (result.condition - PAPER_CONDITION) / PAPER_CONDITION
     paper_example = (
-        args.box == "paper" and kp == 6.0 and kd == 9.0 and estimate is None and bounds == ReferenceBounds()
+        args.box == "paper" and kp == PAPER_KP and kd == PAPER_KD and estimate is None and bounds == ReferenceBounds()
     )
     if paper_example:
         paper_note = f"paper reports {PAPER_CONDITION} (rel. diff {rel:+.2%})"
@@ -236,7 +237,7 @@ def certificate_parser() -> argparse.ArgumentParser:
     add_run_options(p)
     taken = set(p._option_string_actions)
     if "--m1" not in taken:
-        p.add_argument("--m1", type=positive_float, default=650.0,
+        p.add_argument("--m1", type=positive_float, default=M1_NOMINAL,
                        help="plant chassis mass, kg (default 650); the certificate's box includes it")
     if "--range" not in taken:
         p.add_argument("--range", action="append", metavar="NAME=LO:HI",

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import math
 
+from ..params import M1_NOMINAL
 from ._common import box_ranges_from_args, parse_assignments, positive_float, positive_int
 
 
@@ -13,6 +14,7 @@ def add_run_options(p: argparse.ArgumentParser) -> None:
     from controllers.computed_torque import CONTROLLER_NAMES, FRICTION_SIGNS, MODEL_SOURCES
 
     from ..designs import PRESET_NAMES
+    from ..params import M1_RANGE
     from ..plant import STEERING_FRICTION_MODELS, TYRE_CONTACT_MODELS
     from ..simulate import PATH_NAMES
 
@@ -50,7 +52,7 @@ def add_run_options(p: argparse.ArgumentParser) -> None:
                    help="m1 changes as a compact payload at the CoM (default) or scales the chassis inertia")
     p.add_argument("--box", default="derived", help="parameter box of the analysis: derived (from the parameter set "
                                                      "over --m1-range) or paper (5.1)")
-    p.add_argument("--m1-range", nargs=2, type=positive_float, metavar=("LO", "HI"), default=(550.0, 750.0),
+    p.add_argument("--m1-range", nargs=2, type=positive_float, metavar=("LO", "HI"), default=M1_RANGE,
                    help="m1 range of the analysis box, kg (default 550 750)")
     from ..params import UNCERTAINTY_NAMES
 
@@ -102,7 +104,7 @@ def config_from_args(args: argparse.Namespace, **extra):
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("run", help="simulate the circle headless with a controller and report the errors")
     add_run_options(p)
-    p.add_argument("--m1", type=positive_float, default=650.0, help="plant chassis mass, kg (default 650)")
+    p.add_argument("--m1", type=positive_float, default=M1_NOMINAL, help="plant chassis mass, kg (default 650)")
     p.add_argument("--out", metavar="PATH", help="MCAP log path (default logs/run-<time>-<model>-m<m1>.mcap)")
     p.add_argument("--no-log", action="store_true", help="do not write an MCAP log")
     p.add_argument("--log-every", type=positive_int, default=1, help="log signals every k-th control step (default 1)")
