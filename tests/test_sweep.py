@@ -293,3 +293,17 @@ def test_certified_design_sweep_over_m1_is_certified_inside_for_every_run(tmp_pa
     saved = read_results(tmp_path / "runs.csv")  # the verdict columns survive the CSV
     assert [r["verdict"] for r in saved] == [r["verdict"] for r in rows]
     assert [r["cert_E_ratio"] for r in saved] == [r["cert_E_ratio"] for r in rows]
+
+
+def test_batch_split_into_groups_is_bit_identical_to_one_group(monkeypatch):
+    """Several groups on their own threads (what run_batch uses for large batches) give the same numbers."""
+    import wmr_mj.sweep as sweep_module
+
+    configs = [BASE.replace(m1=m) for m in (560.0, 610.0, 680.0, 745.0)]
+    one = run_batch(configs, nthread=2)
+    monkeypatch.setattr(sweep_module, "batch_groups",
+                        lambda nsim, threads: [(np.array([0, 1]), 1), (np.array([2, 3]), 1)])
+    two = run_batch(configs, nthread=2)
+    for a, b in zip(one, two):
+        for key in KEYS:
+            assert a[key] == b[key], key
