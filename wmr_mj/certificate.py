@@ -141,10 +141,11 @@ FRICTION_MODES = ("measured", "reference", "none")
 PLANT_K_BAND = 0.02
 PLANT_K_MEASURED = (-0.0052 - 2 * 0.0016, 0.018)
 #: The plant's gyro coefficient relative to P/l1 (the non-holonomic prediction).
-#: physics.md section 6: MuJoCo identification over excitation seeds 0-5 gave
-#: 0.704, 0.558, 0.620, 0.492, 0.509, 0.516 V s/m against P/l1 = 0.6291 (0.78-1.12 x);
-#: default soft contacts without steering friction 0.563-0.571; Drake 0.621-0.644; the
-#: stiction plant (30 s, seed 0) 0.6167.
+#: The band covers every plant variant the testbed runs and both engines: this plant
+#: (stiction, stiff tyre contacts) identifies 0.616-0.624 V s/m over seeds 0-5 (model
+#: card, 0.98-0.99 x P/l1 = 0.6291); with soft tyre contacts 0.575 (0.91 x); the earlier
+#: soft-friction plant scattered 0.492-0.704 over seeds 0-5 (0.78-1.12 x, physics.md
+#: section 6); Drake 0.621-0.644.
 GYRO_BAND = (0.75, 1.15)
 GYRO_MEASURED_RATIOS = (0.492 / 0.6291, 0.704 / 0.6291)
 #: The control period may use at most this fraction of the loop's delay margin.
