@@ -408,6 +408,16 @@ def _legend_below(fig, ax, ncols: int = 1) -> None:
         fig.legend(handles, labels, loc="outside lower center", ncols=ncols, framealpha=0.9)
 
 
+
+def _full_range_frame(af: Any, *, xm: float, ym: float, xz: float, yz: float) -> None:
+    """Limits of the full-range panel and the dashed outline of the zoomed (left) panel."""
+    af.set_xlim(0.0, 1.08 * xm)
+    af.set_ylim(0.0, 1.08 * ym)
+    af.add_patch(Polygon([(0, 0), (xz, 0), (xz, yz), (0, yz)], closed=True, fill=False, ls="--", lw=0.8,
+                         ec="0.3", zorder=6))
+    af.annotate("left panel", (xz, yz), xytext=(4, 4), textcoords="offset points", fontsize=7, color="0.3")
+    af.set_title("Full range")
+
 def figure_region(result, series: Sequence[Series] = (), *, title: str | None = None,
                   value_label: str = "plant m1 [kg]", region_label: str | None = None,
                   zoom_factor: float = _ZOOM_FACTOR) -> Figure:
@@ -460,12 +470,7 @@ def figure_region(result, series: Sequence[Series] = (), *, title: str | None = 
     _draw_series(af, result, series, value_label=value_label, colorbar=has_cbar, region_label=region_label)
     xm = max([xr] + [e for _, e, _ in sups])
     ym = max([yr] + [ed for _, _, ed in sups])
-    af.set_xlim(0.0, 1.08 * xm)
-    af.set_ylim(0.0, 1.08 * ym)
-    af.add_patch(Polygon([(0, 0), (xz, 0), (xz, yz), (0, yz)], closed=True, fill=False, ls="--", lw=0.8,
-                         ec="0.3", zorder=6))
-    af.annotate("left panel", (xz, yz), xytext=(4, 4), textcoords="offset points", fontsize=7, color="0.3")
-    af.set_title("Full range")
+    _full_range_frame(af, xm=xm, ym=ym, xz=xz, yz=yz)
     _legend_below(fig, az)
     fig.suptitle(title or "Robustness region in the error-magnitude plane", fontsize=10)
     return fig
@@ -640,12 +645,7 @@ def figure_verdict_plane(sup_E: Sequence[float], sup_Edot: Sequence[float], verd
                  f"({E.max() / xr:.1f}x), sup|E'| = {Ed.max():.3g} rad/s ({Ed.max() / yr:.1f}x)",
                  fontsize=7.5, color="#a04000")
     _plane_panel(af, E, Ed, verdicts, regions, note)
-    af.set_xlim(0.0, 1.08 * xm)
-    af.set_ylim(0.0, 1.08 * ym)
-    af.add_patch(Polygon([(0, 0), (xz, 0), (xz, yz), (0, yz)], closed=True, fill=False, ls="--", lw=0.8,
-                         ec="0.3", zorder=6))
-    af.annotate("left panel", (xz, yz), xytext=(4, 4), textcoords="offset points", fontsize=7, color="0.3")
-    af.set_title("Full range")
+    _full_range_frame(af, xm=xm, ym=ym, xz=xz, yz=yz)
     _legend_below(fig, az, ncols=2)
     fig.suptitle(title or "Runs by verdict in the error-magnitude plane", fontsize=10)
     return fig
