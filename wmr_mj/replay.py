@@ -205,14 +205,22 @@ def plot(log: RunLog, path: str | os.PathLike, rep: dict[str, Any]) -> Path:
         ax = fig.subplots(2, 2)
         a = ax[0, 0]
         a.plot(t, E, lw=0.9, color="C0", label="E = alpha0 - alpha")
+        cert = (log.summary or {}).get("certificate") or {}
+        if cert.get("E_max") is not None:
+            a.axhline(cert["E_max"], ls="-", lw=0.8, color="C2", label=f"certificate ±E_max = {cert['E_max']:.3g} rad")
+            a.axhline(-cert["E_max"], ls="-", lw=0.8, color="C2")
         if e_max is not None:
-            a.axhline(e_max, ls="--", lw=0.8, color="C3", label=f"±E_max = {e_max:.3g} rad")
+            a.axhline(e_max, ls="--", lw=0.8, color="C3", label=f"paper's claim ±E_max = {e_max:.3g} rad")
             a.axhline(-e_max, ls="--", lw=0.8, color="C3")
         a.set(xlabel="t [s]", ylabel="E [rad]", title="(a) steering error")
         b = ax[0, 1]
         b.plot(t, Ed, lw=0.9, color="C1", label="E' = alpha0' - alpha'")
+        if cert.get("Edot_max") is not None:
+            b.axhline(cert["Edot_max"], ls="-", lw=0.8, color="C2",
+                      label=f"certificate ±Edot_max = {cert['Edot_max']:.3g} rad/s")
+            b.axhline(-cert["Edot_max"], ls="-", lw=0.8, color="C2")
         if ed_max is not None:
-            b.axhline(ed_max, ls="--", lw=0.8, color="C3", label=f"±Edot_max = {ed_max:.3g} rad/s")
+            b.axhline(ed_max, ls="--", lw=0.8, color="C3", label=f"paper's claim ±Edot_max = {ed_max:.3g} rad/s")
             b.axhline(-ed_max, ls="--", lw=0.8, color="C3")
         b.set(xlabel="t [s]", ylabel="E' [rad/s]", title="(b) error rate")
         c = ax[1, 0]
@@ -253,10 +261,10 @@ def plot(log: RunLog, path: str | os.PathLike, rep: dict[str, Any]) -> Path:
         bits = [f"{k}={cfg[k]}" for k in ("controller", "path", "model", "seed")
                 if k in cfg and not isinstance(cfg[k], (dict, list))]
         key = "inside_after_settle" if rep.get("inside_after_settle") is not None else "inside"
-        verdict = {True: "inside bounds", False: "outside bounds", None: ""}[rep.get(key)]
+        verdict = {True: "inside the paper's claim", False: "outside the paper's claim", None: ""}[rep.get(key)]
         if verdict and key == "inside_after_settle":
             verdict += " after settling"
-        extra = [v for v in (verdict, "TRUNCATED" if log.truncated else "") if v]
+        extra = [v for v in (rep.get("verdict"), verdict, "TRUNCATED" if log.truncated else "") if v]
         fig.suptitle(f"{Path(str(log.path)).name}: " + ", ".join(bits + extra), fontsize=10)
         out = Path(path)
         out.parent.mkdir(parents=True, exist_ok=True)
