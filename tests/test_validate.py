@@ -213,3 +213,21 @@ def test_bad_input_exits_2_with_one_line(args, tmp_path):
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and "Traceback" not in proc.stderr and "error" in lines[0]
     assert not (tmp_path / "x").exists()
+
+
+def test_uncertainty_box_reaches_the_ladder_and_the_certificates():
+    from wmr_mj.designs import CERTIFIED
+    from wmr_mj.errors import UnknownNameError as _Unknown
+    from wmr_mj.params import uncertainty_ranges
+    from wmr_mj.report import ValidateSettings
+    from wmr_mj.report_search import search_plans
+
+    full = ValidateSettings(uncertainty="full")
+    expected = {k: v for k, v in uncertainty_ranges("full").items() if k != "m1"}
+    assert full.ranges == expected and full.config(CERTIFIED).box_ranges == expected
+    assert ValidateSettings().ranges == {} and ValidateSettings().config(CERTIFIED).box_ranges == {}
+    assert [(p.key, p.box) for p in search_plans(full)] == [("paper", "full"), ("certified", "full")]
+    with pytest.raises(_Unknown, match="full, m1"):
+        ValidateSettings(uncertainty="everything")
+    proc = _cli("validate", "--uncertainty", "everything")
+    assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1

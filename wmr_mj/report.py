@@ -98,7 +98,9 @@ class ValidateSettings:
 
     n: runs per rung; duration [s] per run; identify_duration [s] of excitation;
     search_budget: simulations of each m1-box search (the full box gets FULL_BOX_FACTOR
-    times as many; 0: no search); nthread: 0 = every core; m1_range, nominal_m1 [kg].
+    times as many; 0: no search); nthread: 0 = every core; m1_range, nominal_m1 [kg];
+    uncertainty: the box the ladder samples and the certificates cover ('m1', the paper's,
+    or 'full': wmr_mj.params.uncertainty_ranges), its m1 range replaced by m1_range.
     """
 
     n: int = DEFAULT_N
@@ -110,6 +112,7 @@ class ValidateSettings:
     nthread: int = 0
     m1_range: tuple[float, float] = M1_RANGE
     nominal_m1: float = M1_NOMINAL
+    uncertainty: str = "m1"
 
     def __post_init__(self) -> None:
         from .sweep import SAMPLINGS
@@ -128,11 +131,22 @@ class ValidateSettings:
         lo, hi = self.m1_range
         if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo < hi):
             raise ParameterError(f"m1_range = {self.m1_range!r} must be (lo, hi) with 0 < lo < hi")
+        from .params import UNCERTAINTY_NAMES
+
+        if self.uncertainty not in UNCERTAINTY_NAMES:
+            raise UnknownNameError("uncertainty box name", str(self.uncertainty), UNCERTAINTY_NAMES)
+
+    @property
+    def ranges(self) -> dict[str, tuple[float, float]]:
+        """The ranged parameters of the uncertainty box other than m1, name -> (lo, hi)."""
+        from .params import uncertainty_ranges
+
+        return {k: v for k, v in uncertainty_ranges(self.uncertainty).items() if k != "m1"}
 
     def config(self, design: Design) -> RunConfig:
         """The run of ``design`` these settings sweep (m1 at nominal; the sweep draws it)."""
         return RunConfig(**design.config_changes(), duration=self.duration, m1=self.nominal_m1,
-                         m1_range=tuple(self.m1_range), seed=self.seed)
+                         m1_range=tuple(self.m1_range), box_ranges=self.ranges, seed=self.seed)
 
     def as_dict(self) -> dict[str, Any]:
         d = asdict(self)
@@ -277,7 +291,7 @@ def run_rung(settings: ValidateSettings, k: int, design: Design, folder: Path, s
 
     base = settings.config(design)
     spec = SweepSpec(n=settings.n, seed=settings.seed, sampling=settings.sampling,
-                     m1_range=tuple(settings.m1_range), base=base)
+                     m1_range=tuple(settings.m1_range), ranges=settings.ranges, base=base)
     sweep_dir = folder / f"ladder-{k}-{design.name}"
     st.start(f"ladder-{k}", f"rung {k} ({design.label}): {settings.n} runs of {settings.duration:g} s over m1 "
                             f"{settings.m1_range[0]:g}-{settings.m1_range[1]:g} kg ({settings.sampling})")

@@ -248,7 +248,9 @@ def _search_bound_sentence(s: Mapping[str, Any], summary: Mapping[str, Any]) -> 
     worst_ratio = max(x for x in (w.get("objective"), (s.get("mc") or {}).get("worst_objective"), -math.inf)
                       if x is not None)
     if s["objective"] == "paper":
-        text = (f"The paper's claim is exceeded {worst_ratio:.3g} times over at its worst; the design has "
+        where = (f"is exceeded {worst_ratio:.3g} times over at its worst" if worst_ratio > 1.0 else
+                 f"holds at its worst, at {worst_ratio:.3g} of its bound")
+        text = (f"The paper's claim {where}; the design has "
                 f"{'a certificate' if cert.get('certified') else 'no certificate'} to compare with.")
         rung = summary["ladder"][(s.get("mc") or {}).get("rung", 1) - 1]
         if rung["hit_stop"] and cert.get("alpha0_max") is not None and cert.get("steering_range") is not None:
@@ -462,9 +464,11 @@ def answer_blocks(summary: Mapping[str, Any], *, brief: bool = False) -> list[Bl
 
 def _settings_line(summary: Mapping[str, Any]) -> str:
     s = summary["settings"]
-    search = (f"search budget {s['search_budget']} runs per m1-box search" if s["search_budget"] else "no search")
+    box = s.get("uncertainty", "m1")
+    search = (f"search budget {s['search_budget']} runs per {box}-box search" if s["search_budget"] else "no search")
+    others = "" if box == "m1" else " and the rest of the full uncertainty box (wmr_mj/params.py)"
     return (f"{s['n']} runs per rung, {s['sampling']} sampling of m1 over {s['m1_range'][0]:g}-{s['m1_range'][1]:g} "
-            f"kg, seed {s['seed']}, {s['duration']:g} s per run on the paper circle; {search}; identification "
+            f"kg{others}, seed {s['seed']}, {s['duration']:g} s per run on the paper circle; {search}; identification "
             f"{s['identify_duration']:g} s at m1 = {s['nominal_m1']:g} kg")
 
 

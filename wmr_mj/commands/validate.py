@@ -42,6 +42,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--search-budget", type=_nonneg_int, default=DEFAULT_SEARCH_BUDGET,
                    help=f"simulations of each m1-box search (default {DEFAULT_SEARCH_BUDGET}; the full-box search "
                         f"gets {FULL_BOX_FACTOR}x; 0: no search; else >= 5, one generation)")
+    p.add_argument("--uncertainty", default="m1",
+                   help="uncertainty box the ladder samples and its certificates cover: m1 (the paper's, default) or "
+                        "full (m1, steering and tyre friction, R_a, V_A; see wmr_mj/params.py)")
     p.add_argument("--nthread", type=_nonneg_int, default=0, help="simulation threads (default 0: all CPUs)")
     p.add_argument("--out", metavar="DIR",
                    help="report folder (default logs/validate-<timestamp>/; an existing folder resumes its sweeps)")
@@ -64,7 +67,7 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     settings = ValidateSettings(n=args.n, seed=args.seed, sampling=args.sampling, duration=args.duration,
                                 identify_duration=args.identify_duration, search_budget=args.search_budget,
-                                nthread=args.nthread)
+                                nthread=args.nthread, uncertainty=args.uncertainty)
     out = check_output_path(args.out or default_folder("validate"), kind="dir", option="--out")
     summary = run_validate(settings, out)
     pointer = write_pointer(out)
