@@ -389,3 +389,41 @@ def test_extreme_gains_certify_or_refuse_cleanly():
         assert c.verdict(0.01, 0.01) in VERDICTS
         made += 1
     assert made > 100
+
+
+# ----------------------------------------------------------------- F and P move together with R_a
+def test_correlated_friction_term_is_F_over_P_not_F_max_over_P_min():
+    """A plant family F = r P (R_a scales both): with friction_over_P = r the friction part of delta1
+    is r (closed form), not F_max/P_min; with a bound that does not bind it is the box's own."""
+    r, P = 4.0, (0.385, 0.5)
+    box = ParameterBox(P=P, C_V=(4.77, 4.77), F=(r * P[0], r * P[1]), K=(0.0, 0.0))
+    common = dict(box=box, gyro=(0.629, 0.629), V_A=(0.2, 0.2), P_hat=0.385, C_V_hat=4.77, F_hat=1.0, K_hat=0.0,
+                  gyro_hat=0.629, V_A_hat=0.2, kp=100.0, kd=20.0, friction_sign="none", **REF, **LIMITS)
+    loose = certify(**common)
+    tight = certify(**common, friction_over_P=r)
+    assert loose.friction_term == pytest.approx(r * P[1] / P[0], rel=1e-12)
+    assert tight.friction_term == pytest.approx(r, rel=1e-12)
+    assert tight.E_max < loose.E_max
+    same = certify(**common, friction_over_P=r * P[1] / P[0])  # F_max/P_min: binds nowhere
+    assert same.E_max == loose.E_max and same.delta1 == loose.delta1
+
+
+def test_friction_over_P_bounds_every_plant_of_the_full_box():
+    from wmr_mj.certificate import friction_over_P_max
+    from wmr_mj.params import uncertainty_ranges
+
+    full = {k: v for k, v in uncertainty_ranges("full").items() if k != "m1"}
+    ratio = friction_over_P_max(C80, (550.0, 750.0), "payload", tuple(sorted(full.items())))
+    rng = np.random.default_rng(0)
+    seen = []
+    for _ in range(200):  # random plants of the box: none above the bound, the top one at a corner
+        pick = {k: rng.uniform(*v) for k, v in full.items()}
+        c = with_params(C80, m1=rng.uniform(550.0, 750.0), **pick).coefficients("nonholonomic")
+        seen.append(c.F / c.P)
+    top = with_params(C80, m1=750.0, mu=full["mu"][1]).coefficients("nonholonomic")
+    assert max(seen) <= ratio and ratio == pytest.approx(top.F / top.P, rel=1e-12)
+    # F/P does not move with R_a (both scale with it)
+    a, b = (with_params(C80, R_a=x).coefficients("nonholonomic") for x in (1.0, 1.3))
+    assert a.F / a.P == pytest.approx(b.F / b.P, rel=1e-12)
+    # a parameter F/P is not monotone in gives no bound
+    assert friction_over_P_max(C80, (550.0, 750.0), "payload", (("l4", (0.2, 0.3)),)) is None

@@ -46,6 +46,11 @@ Friction term phi = sup |f - F^ s| over sliding and rest, by compensation mode:
 * 'reference' (s = sgn a0', moving with the reference, not with the joint): f and s are
   independent, phi = F_max + F^ (physics.md section 5).
 
+F and P move together. In volts F = (R_a/(k_i i2)) tau_f and P = (R_a/k_i) 2D/i2, so
+F/P = tau_f/(2D) does not depend on R_a: a box where R_a is uncertain holds no plant with
+F_max and P_min at once. With r >= F/P over the box (:func:`friction_over_P_max`) the
+friction level at P is min(F_max, r P), and phi/P is taken per P rather than F_max/P_min.
+
 gamma1 >= 1/K_P (the DC gain of 1/(s^2 + K_D s + K_P)), so no valid bound lies below
 the static dead band F_max/(P^ K_P): with P = P^ and nothing else uncertain, E_max is
 exactly F_max/(P^ K_P) for critical damping.
@@ -105,6 +110,7 @@ Usage::
 from __future__ import annotations
 
 import functools
+import itertools
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -115,6 +121,7 @@ from .params import C80, C80Parameters
 from .robustness import ParameterBox, _check_gains, damping_regime, exact_gammas
 
 __all__ = [
+    "friction_over_P_max",
     "VERDICTS",
     "FRICTION_MODES",
     "Assumption",
@@ -448,6 +455,7 @@ def certify(
     control_period: float,
     initial_error: tuple[float, float] = (0.0, 0.0),
     stated: Sequence[Assumption] = (),
+    friction_over_P: float | None = None,
 ) -> Certificate:
     """The certificate for the law (3.2)-(3.3) with estimate ^ on any plant in the box.
 
@@ -461,6 +469,12 @@ def certify(
     [rad/s^2]: the reference's bounds. steering_range [rad], voltage_limit [V],
     control_period [s]: the plant's stops, supply and the law's period.
     initial_error: (E(0), E'(0)). stated: caller's stated assumptions, appended.
+    friction_over_P [rad/s^2]: an upper bound on F/P over the plants of the box (F and P
+    both scale with R_a, so F/P does not move with it; see :func:`friction_over_P_max`).
+    With it the friction level at each P is min(F_max, friction_over_P P) rather than F_max
+    at every P; None: F and P independent, as the box alone says. delta1 is then maximised
+    over P in {P_min, P_max, P^, F_max/r, F^/r} (r = friction_over_P): between these points
+    each term of delta1 is monotone in P.
     """
     if not isinstance(box, ParameterBox):
         raise ParameterError(f"box must be a ParameterBox, got {type(box).__name__}")
@@ -492,7 +506,16 @@ def certify(
     P_lo, P_hi = box.P
     P_ff = P_hat if feedforward else 0.0
     P_corners = sorted({P_lo, P_hi, *([P_hat] if P_lo < P_hat < P_hi else [])})
-    phi = friction_term(friction_sign, F=box.F, F_hat=F_hat)
+    if friction_over_P is not None:
+        friction_over_P = _number("friction_over_P", friction_over_P, minimum=0.0, strict=True)
+        breaks = (box.F[1] / friction_over_P, F_hat / friction_over_P)
+        P_corners = sorted({*P_corners, *(b for b in breaks if P_lo < b < P_hi)})
+
+    def phi_at(p: float) -> float:  # sup |f - F^ s| for the plants with this P
+        F_p = box.F[1] if friction_over_P is None else min(box.F[1], friction_over_P * p)
+        return friction_term(friction_sign, F=(box.F[0], F_p), F_hat=F_hat)
+
+    phi = max(phi_at(p) for p in P_corners)
     dC_lo, dC_hi = box.C_V[0] - C_V_hat, box.C_V[1] - C_V_hat
     dC = max(abs(dC_lo), abs(dC_hi))
     dK = max(abs(box.K[0] - K_hat), abs(box.K[1] - K_hat))
@@ -505,8 +528,8 @@ def certify(
 
     def at(alpha_max: float) -> dict[str, float]:
         S, c2 = _S(alpha_max), math.cos(alpha_max) ** 2
-        rest = phi + dK * S + dC * a0d + dG * a0d / c2
-        delta1 = max((abs(p - P_ff) * a0dd + rest) / p for p in P_corners)
+        rest = dK * S + dC * a0d + dG * a0d / c2
+        delta1 = max((abs(p - P_ff) * a0dd + phi_at(p) + rest) / p for p in P_corners)
         delta3 = max(abs(mis[p] * kd - (c + g / cc) / p)
                      for p in P_corners for c in (dC_lo, dC_hi) for g in (dG_lo, dG_hi) for cc in (c2, 1.0))
         cond = g1 * delta2 + g2 * delta3
@@ -578,7 +601,7 @@ def certify(
         E_max=E_max, Edot_max=Edot_max, condition=cond, valid=valid, assumptions=assumptions,
         gamma1=g1, gamma2=g2, delta1=b["delta1"], delta2=delta2, delta3=b["delta3"],
         alpha_max=alpha_max, voltage_max=voltage_max,
-        friction_term=phi / P_lo, gyro_term=dG * a0d / c2 / P_lo, K_term=dK * S / P_lo,
+        friction_term=max(phi_at(p) / p for p in P_corners), gyro_term=dG * a0d / c2 / P_lo, K_term=dK * S / P_lo,
         P_term=max(abs(p - P_ff) / p for p in P_corners) * a0dd, C_V_term=dC * a0d / P_lo,
         gyro_Edot_term=dG / c2 / P_lo, dead_band=box.F[1] / (P_hat * kp),
         kp=kp, kd=kd, friction_sign=friction_sign, friction_width=friction_width,
@@ -620,6 +643,34 @@ def _derived_box(params: C80Parameters, m1_range: tuple[float, float], m1_inerti
     """simulate.analysis_box's derived box (cached: a sweep asks for the same box per run)."""
     return ParameterBox.from_parameters(params, m1_range=m1_range, model="nonholonomic", m1_inertia=m1_inertia,
                                         ranges=dict(ranges) or None)
+
+
+#: Parameters F/P = (l3 l4/l1) mu Q / (2D) is not monotone in (they enter D, or Q and D):
+#: with one of them ranged, :func:`friction_over_P_max` gives no bound.
+_F_OVER_P_NOT_MONOTONE = frozenset({"l4", "front_axle_mass", "front_wheel_mass", "r3", "front_wheel_width"})
+
+
+@functools.lru_cache(maxsize=32)
+def friction_over_P_max(params: C80Parameters, m1_range: tuple[float, float], m1_inertia: str,
+                        ranges: tuple[tuple[str, tuple[float, float]], ...]) -> float | None:
+    """max F/P [rad/s^2] over the box's plants: m1 over m1_range and the ranged parameters.
+
+    F/P = (R_a/(k_i i2)) tau_f / ((R_a/k_i) 2D/i2) = tau_f/(2D), tau_f = (l3 l4/l1) mu Q: it
+    does not depend on R_a, k_i, i2, V_A or the tyres, and is monotone in every other
+    parameter but those of :data:`_F_OVER_P_NOT_MONOTONE`, so its maximum is at a corner of
+    the box (all corners are evaluated). None when a non-monotone parameter is ranged.
+    """
+    from .params import with_params
+
+    if any(name in _F_OVER_P_NOT_MONOTONE for name, _ in ranges):
+        return None
+    axes = [("m1", m1_range), *ranges]
+    best = 0.0
+    for corner in itertools.product(*(span for _, span in axes)):
+        c = with_params(params, m1_inertia=m1_inertia, **dict(zip((n for n, _ in axes), corner))).coefficients(
+            "nonholonomic")
+        best = max(best, c.F / c.P)
+    return best
 
 
 def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
@@ -669,6 +720,15 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
         gyro = _hull(gyro, *spread.get("gyro", gyro))
         notes.append("identified +-2 sigma hulled in")
     plant_box = ParameterBox(P=P, C_V=C_V, F=(max(F[0], 0.0), F[1]), K=K)
+    # F and P both scale with R_a: bound F/P over the same plants (the run's own point included)
+    ratio = friction_over_P_max(estimate_params, tuple(float(v) for v in config.m1_range), config.m1_inertia,
+                                tuple(sorted(ranges.items())))
+    if ratio is not None:
+        ratio = max(ratio, point.F / point.P)
+        if config.model == "identified" and "F" in spread and "P" in spread:
+            ratio = max(ratio, spread["F"][1] / spread["P"][0])
+        if config.box == "paper":
+            ratio = None  # (5.1)'s printed intervals come with no such relation
 
     pd = controller.name == "pd"
     sign = "none" if pd else controller.friction_sign
@@ -701,7 +761,7 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
                    alpha0_max=bounds["max_abs_alpha0"], alpha0_dot_max=bounds["max_abs_alpha0_dot"],
                    alpha0_ddot_max=bounds["max_abs_alpha0_ddot"], steering_range=plant.steering_range,
                    voltage_limit=plant.voltage_limit, control_period=period, initial_error=initial,
-                   stated=stated)
+                   stated=stated, friction_over_P=ratio)
     inputs = dict(cert.inputs)
     inputs.update(model=config.model, controller=controller.name, box_rule=config.box,
                   m1_range=list(config.m1_range), box_ranges={k: list(v) for k, v in ranges.items()},
