@@ -93,8 +93,11 @@ def test_the_reported_worst_run_reproduces_exactly():
     base = RunConfig(model="nonholonomic", path="lane-change", duration=3.0)
     spec = FalsifySpec(base=base, box={"m1": (550.0, 750.0), "mu": (0.01, 0.03)}, objective="sup-E", budget=10,
                        seed=1)
-    result = falsify(spec, nthread=2)
+    seen = []  # the checkpoint sees every generation, then the random batch, as they finish
+    result = falsify(spec, nthread=2, checkpoint=lambda r: seen.append((len(r.search), len(r.random))))
     assert len(result.search) == len(result.random) == 10
+    assert seen[-1] == (10, 10) and seen[-2] == (10, 0) and len(seen) == result.generations + 1
+    assert all(a <= b for a, b in zip(seen, seen[1:]))
     worst = result.worst
     assert worst.objective == max(e.objective for e in result.search) == worst.sup_E
     serial = run_closed_loop(worst_config(result), progress=False).summary

@@ -344,12 +344,14 @@ class FalsifyResult:
 
 
 def falsify(spec: FalsifySpec, *, chunk: int = 128, nthread: int = 0, scheduler: str | None = None,
-            progress: Callable[[int, int], None] | None = None) -> FalsifyResult:
+            progress: Callable[[int, int], None] | None = None,
+            checkpoint: Callable[[FalsifyResult], None] | None = None) -> FalsifyResult:
     """Search ``spec.box`` for the worst run, then spend as many runs on a random sample.
 
     Each generation runs as one batch (locally in chunks of ``chunk`` on ``nthread``
     threads, or on the Dask ``scheduler``). progress(done, total) counts finished runs of
-    both phases.
+    both phases. checkpoint(partial result) is called after every generation (and the
+    random batch), so an interrupted search can leave what it evaluated on disk.
     """
     from .sweep import connect, run_configs
 
@@ -379,6 +381,10 @@ def falsify(spec: FalsifySpec, *, chunk: int = 128, nthread: int = 0, scheduler:
                     phase=phase, index=len(evaluations[phase]), generation=generation,
                     params={n: float(v) for n, v in zip(spec.names, p)},
                     objective=None if value is None else float(value), summary=r))
+            if checkpoint is not None:
+                checkpoint(FalsifyResult(spec=spec, search=list(evaluations["search"]),
+                                         random=list(evaluations["random"]),
+                                         objective_source=objective_source(reports[0], spec.objective)))
             return out
 
         return evaluate

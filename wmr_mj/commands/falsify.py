@@ -85,7 +85,8 @@ def run(args: argparse.Namespace) -> int:
                        population=args.population)
     with progress_bar(2 * spec.budget, desc="falsify", unit="runs") as bar:
         result = falsify(spec, chunk=args.chunk, nthread=args.nthread, scheduler=args.scheduler,
-                         progress=counter_callback(bar))
+                         progress=counter_callback(bar),  # evaluations.csv after every generation: Ctrl-C keeps them
+                         checkpoint=lambda partial: write_text_atomic(out / "evaluations.csv", _table(partial)))
     log_path = out / "worst.mcap"
     config = worst_config(result)
     logged = log_run(config, str(log_path))
