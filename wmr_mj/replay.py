@@ -185,6 +185,14 @@ def verify(log: RunLog) -> dict[str, Any]:
     return out
 
 
+
+def _band(ax: Any, bound: float | None, ls: str, color: str, label: str, unit: str) -> None:
+    """Horizontal lines at +-bound (nothing when the bound is None)."""
+    if bound is None:
+        return
+    ax.axhline(bound, ls=ls, lw=0.8, color=color, label=f"{label} = {bound:.3g} {unit}")
+    ax.axhline(-bound, ls=ls, lw=0.8, color=color)
+
 def plot(log: RunLog, path: str | os.PathLike, rep: dict[str, Any]) -> Path:
     """Write the replay figure (PNG) for ``rep`` = :func:`summarize` of ``log``; returns the path."""
     from matplotlib.figure import Figure
@@ -206,22 +214,13 @@ def plot(log: RunLog, path: str | os.PathLike, rep: dict[str, Any]) -> Path:
         a = ax[0, 0]
         a.plot(t, E, lw=0.9, color="C0", label="E = alpha0 - alpha")
         cert = (log.summary or {}).get("certificate") or {}
-        if cert.get("E_max") is not None:
-            a.axhline(cert["E_max"], ls="-", lw=0.8, color="C2", label=f"certificate ±E_max = {cert['E_max']:.3g} rad")
-            a.axhline(-cert["E_max"], ls="-", lw=0.8, color="C2")
-        if e_max is not None:
-            a.axhline(e_max, ls="--", lw=0.8, color="C3", label=f"paper's claim ±E_max = {e_max:.3g} rad")
-            a.axhline(-e_max, ls="--", lw=0.8, color="C3")
+        _band(a, cert.get("E_max"), "-", "C2", "certificate ±E_max", "rad")
+        _band(a, e_max, "--", "C3", "paper's claim ±E_max", "rad")
         a.set(xlabel="t [s]", ylabel="E [rad]", title="(a) steering error")
         b = ax[0, 1]
         b.plot(t, Ed, lw=0.9, color="C1", label="E' = alpha0' - alpha'")
-        if cert.get("Edot_max") is not None:
-            b.axhline(cert["Edot_max"], ls="-", lw=0.8, color="C2",
-                      label=f"certificate ±Edot_max = {cert['Edot_max']:.3g} rad/s")
-            b.axhline(-cert["Edot_max"], ls="-", lw=0.8, color="C2")
-        if ed_max is not None:
-            b.axhline(ed_max, ls="--", lw=0.8, color="C3", label=f"paper's claim ±Edot_max = {ed_max:.3g} rad/s")
-            b.axhline(-ed_max, ls="--", lw=0.8, color="C3")
+        _band(b, cert.get("Edot_max"), "-", "C2", "certificate ±Edot_max", "rad/s")
+        _band(b, ed_max, "--", "C3", "paper's claim ±Edot_max", "rad/s")
         b.set(xlabel="t [s]", ylabel="E' [rad/s]", title="(b) error rate")
         c = ax[1, 0]
         c.plot(t, sig["voltage_cmd"], lw=0.7, color="0.6", label="controller output")
