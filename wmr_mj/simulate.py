@@ -243,9 +243,10 @@ def report(config: RunConfig, *, analysis, params: C80Parameters, settle_s: floa
     (:func:`wmr_mj.verdicts.judge_run`: verdict, certificate, paper_region, drift).
     """
     sup_E, sup_Edot = float(sup_E), float(sup_Edot)
-    stable = bool(analysis.stable)
-    E_max = float(analysis.E_max) if stable else math.inf
-    Ed_max = float(analysis.Edot_max) if stable else math.inf
+    from .verdicts import judge_run, paper_region
+
+    paper = paper_region(analysis, sup_E, sup_Edot)
+    E_max, Ed_max = paper["E_max"], paper["Edot_max"]
     out: RunSummary = {
         "status": status,
         "controller": config.controller,
@@ -266,9 +267,9 @@ def report(config: RunConfig, *, analysis, params: C80Parameters, settle_s: floa
         "sup_Edot_settled": float(sup_Edot_settled),
         "E_max": E_max,
         "Edot_max": Ed_max,
-        "condition": float(analysis.condition),
-        "stable": stable,
-        "inside": bool(stable and sup_E <= E_max and sup_Edot <= Ed_max),
+        "condition": paper["condition"],
+        "stable": bool(analysis.stable),
+        "inside": paper["inside"],
         "E_ratio": sup_E / E_max if math.isfinite(E_max) and E_max > 0 else None,
         "Edot_ratio": sup_Edot / Ed_max if math.isfinite(Ed_max) and Ed_max > 0 else None,
         "saturated_fraction": float(saturated_fraction),
@@ -277,8 +278,6 @@ def report(config: RunConfig, *, analysis, params: C80Parameters, settle_s: floa
         "final_alpha": float(final_alpha),
     }
     if certificate is not None:
-        from .verdicts import judge_run
-
         out.update(judge_run(certificate=certificate, analysis=analysis, sup_E=sup_E, sup_Edot=sup_Edot,
                              drift=drift or {}))
     return out

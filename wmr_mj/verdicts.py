@@ -38,6 +38,7 @@ __all__ = [
     "drift",
     "drift_window_steps",
     "judge_run",
+    "paper_region",
     "is_pass",
     "count_verdicts",
 ]
@@ -67,19 +68,23 @@ def drift(*, prev_window: float, last_window: float, final_alpha_dot: float) -> 
             "window_s": DRIFT_WINDOW_S, "tolerance": DRIFT_TOLERANCE}
 
 
+def paper_region(analysis: Any, sup_E: float, sup_Edot: float) -> dict[str, Any]:
+    """The paper's claim judged: its bounds (inf when (4.23) fails) and whether the run is inside."""
+    stable = bool(analysis.stable)
+    E_max = float(analysis.E_max) if stable else math.inf
+    Ed_max = float(analysis.Edot_max) if stable else math.inf
+    return {"E_max": E_max, "Edot_max": Ed_max, "condition": float(analysis.condition),
+            "inside": bool(stable and sup_E <= E_max and sup_Edot <= Ed_max)}
+
+
 def judge_run(*, certificate: Certificate, analysis: Any, sup_E: float, sup_Edot: float,
               drift: Mapping[str, Any]) -> dict[str, Any]:
     """verdict, certificate (judged), paper_region (the paper's claim, judged) and drift of one run."""
     judged = judge(certificate, sup_E, sup_Edot)
-    stable = bool(analysis.stable)
-    E_max = float(analysis.E_max) if stable else math.inf
-    Ed_max = float(analysis.Edot_max) if stable else math.inf
-    paper_inside = bool(stable and sup_E <= E_max and sup_Edot <= Ed_max)
     return {
         "verdict": judged["verdict"],
         "certificate": judged,
-        "paper_region": {"E_max": E_max, "Edot_max": Ed_max, "condition": float(analysis.condition),
-                         "inside": paper_inside},
+        "paper_region": paper_region(analysis, sup_E, sup_Edot),
         "drift": dict(drift),
     }
 
