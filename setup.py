@@ -1,13 +1,19 @@
-"""Build hook: ship the repository's models/ inside the wheel as ``wmr_mj/models/``.
+"""Build hooks: ship the repository's models/ inside the wheel as ``wmr_mj/models/``, and
+build the steering law as MuJoCo's control callback (``wmr_mj._compiled_law``).
 
 All project metadata lives in pyproject.toml. An installed wheel has no
 repository beside it, so ``wmr_mj.resources.MODELS_DIR`` falls back to this copy
 (``wmr-mj model check`` then compares it with the parameter set).
+
+The compiled law reads mjModel and mjData, so it is built against the headers of the
+mujoco wheel of the build (pyproject's build requirements) and checks at import that it
+runs with the same MuJoCo. It is optional: without a C compiler the install goes on and
+the batch uses the NumPy law (``wmr_mj.compiled_law.unavailable_reason`` says so).
 """
 
 from pathlib import Path
 
-from setuptools import setup
+from setuptools import Extension, setup
 from setuptools.command.build_py import build_py
 
 MODEL_FILES = ("c80.xml", "scene.xml", "README.md")
@@ -27,4 +33,19 @@ class BuildPyWithModels(build_py):
             self.copy_file(str(source / name), str(target / name))
 
 
-setup(cmdclass={"build_py": BuildPyWithModels})
+def compiled_law_extensions() -> list[Extension]:
+    """wmr_mj._compiled_law, where the mujoco wheel with its C headers is importable."""
+    try:
+        import mujoco
+    except ImportError:
+        return []
+    include = Path(mujoco.__file__).resolve().parent / "include"
+    if not (include / "mujoco" / "mujoco.h").is_file():
+        return []
+    # -ffp-contract=off: no fused multiply-adds, so that the C law rounds as the Python law does
+    return [Extension("wmr_mj._compiled_law", sources=["wmr_mj/_compiled_law.c"], include_dirs=[str(include)],
+                      extra_compile_args=["-O2", "-ffp-contract=off", "-fno-fast-math"], libraries=["m"],
+                      optional=True)]
+
+
+setup(cmdclass={"build_py": BuildPyWithModels}, ext_modules=compiled_law_extensions())

@@ -11,20 +11,26 @@ physics steps per second (medians over repeats) of
             the timings), so that both loops do the same physics step for step (checked: the
             open loop ends where the closed loop did, to the bit); rollout records every
             step into output arrays allocated once;
-  closed:   ``wmr_mj.sweep.run_batch``: the vectorised law every 1 ms step on ``mujoco.batch``,
-            one group of simulations per thread (compilation and reference outside the timing);
+  compiled: ``wmr_mj.sweep.run_batch`` as it runs by default: the law in C as MuJoCo's control
+            callback (``wmr_mj.compiled_law``), ``Batch.rollout`` a block of 1000 closed-loop
+            steps per call, statistics folded per block (compilation and reference outside
+            the timing);
+  numpy:    ``run_batch(law="numpy")``: ``mujoco.batch.Batch.step`` every 1 ms step with the
+            vectorised NumPy law in between (the library-only path, shown beside ours);
 
-and their ratio (target >= 0.90); beside it the same ratio in CPU seconds of one thread's share
-(nsim/nthread runs on one thread each side), which other processes on the machine do not blur
-as they blur wall time. Then the whole sweep as ``wmr-mj sweep --n 32`` runs it
-(``run_sweep`` with its output folder: drawing, compilation, reference, statistics and the
-CSV included; the command's imports and plot excluded) against rollout of the same models
-(target >= 0.85). The machine may be shared: compare ratios, not absolute figures.
+and their ratios to rollout (target >= 0.90); beside them the same ratios in CPU seconds of one
+thread's share (nsim/nthread runs on one thread each side), which other processes on the
+machine do not blur as they blur wall time. Then the whole sweep as ``wmr-mj sweep --n 32``
+runs it (``run_sweep`` with its output folder: drawing, compilation, reference, statistics and
+the CSV included; the command's imports and plot excluded) against rollout of the same models
+(target >= 0.85), with either law. The machine may be shared: compare ratios, not absolute
+figures.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import statistics
 import sys
 import tempfile
@@ -82,6 +88,10 @@ class OpenLoop:
         return bool(np.array_equal(self.final_alpha, [r["final_alpha_after_step"] for r in reports]))
 
 
+def _median_ratio(num: list[float], den: list[float]) -> str:
+    return f"{statistics.median(num) / statistics.median(den):7.3f}" if num and den else f"{'-':>7s}"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--sizes", default="16,32,64,128,256", help="batch sizes, comma-separated")
@@ -90,11 +100,13 @@ def main() -> None:
     ap.add_argument("--nthread", type=int, default=2)
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--model", default="nonholonomic")
+    ap.add_argument("--laws", default="compiled,numpy", help="closed-loop laws to time, comma-separated")
     ap.add_argument("--sweep-n", type=int, default=32, help="runs of the whole-sweep comparison (0: skip it)")
     ap.add_argument("--sweep-seconds", type=float, default=35.0, help="simulated time per run of the whole sweep")
     ap.add_argument("--no-cpu", action="store_true", help="skip the one-thread CPU-time ratios")
     args = ap.parse_args()
     sizes = [int(x) for x in args.sizes.split(",") if x.strip()]
+    laws = [x.strip() for x in args.laws.split(",") if x.strip()]
 
     cases = {}
     for nsim in sizes:
@@ -105,11 +117,11 @@ def main() -> None:
         cases[nsim] = (configs, OpenLoop(configs, voltages, args.nthread),
                        OpenLoop(configs[:per_thread], voltages[:per_thread], 0))
     open_loop: dict[int, list[float]] = {n: [] for n in sizes}
-    closed: dict[int, list[float]] = {n: [] for n in sizes}
-    same: dict[int, bool] = {}
-    cpu: dict[int, list[float]] = {n: [] for n in sizes}
+    closed = {law: {n: [] for n in sizes} for law in laws}
+    cpu = {law: {n: [] for n in sizes} for law in laws}
+    same: dict[tuple[str, int], bool] = {}
     sweep_open: list[float] = []
-    sweep_closed: list[float] = []
+    sweep_closed: dict[str, list[float]] = {law: [] for law in laws}
     spec = (SweepSpec(n=args.sweep_n, seed=0, base=RunConfig(model=args.model, duration=args.sweep_seconds))
             if args.sweep_n else None)
     with (rollout.Rollout(nthread=args.nthread) as pool, rollout.Rollout(nthread=0) as caller,
@@ -124,39 +136,53 @@ def main() -> None:
             for nsim in sizes:
                 configs, ol, one = cases[nsim]
                 open_loop[nsim].append(ol.steps_per_s(pool))
-                reports = run_batch(configs, nthread=args.nthread)
-                closed[nsim].append(reports[0]["batch_steps_per_s"])
-                same[nsim] = ol.same_as(reports)
+                for law in laws:
+                    reports = run_batch(configs, nthread=args.nthread, law=law)
+                    closed[law][nsim].append(reports[0]["batch_steps_per_s"])
+                    same[law, nsim] = ol.same_as(reports)
                 if not args.no_cpu:  # CPU seconds of one thread's share: what a shared machine cannot blur
                     rollout_rate = one.steps_per_s(caller, clock=time.thread_time)
-                    closed_cpu = run_batch(configs[:len(one.models)], nthread=1)[0]["batch_cpu_s"]
-                    cpu[nsim].append(len(one.models) * one.nstep / closed_cpu / rollout_rate)
+                    for law in laws:
+                        closed_cpu = run_batch(configs[:len(one.models)], nthread=1, law=law)[0]["batch_cpu_s"]
+                        cpu[law][nsim].append(len(one.models) * one.nstep / closed_cpu / rollout_rate)
             if sweep_ol is not None:
                 sweep_open.append(sweep_ol.steps_per_s(pool))
-                t = time.perf_counter()
-                results = run_sweep(spec, out_dir=Path(tmp) / f"sweep-{rep}", chunk=128, nthread=args.nthread)
-                sweep_closed.append(sum(r["steps"] for r in results) / (time.perf_counter() - t))
+                for law in laws:
+                    # run_sweep takes the compiled law where it can run: the switch turns it off
+                    os.environ["WMR_MJ_COMPILED_LAW"] = "0" if law == "numpy" else "1"
+                    t = time.perf_counter()
+                    results = run_sweep(spec, out_dir=Path(tmp) / f"sweep-{law}-{rep}", chunk=128,
+                                        nthread=args.nthread)
+                    sweep_closed[law].append(sum(r["steps"] for r in results) / (time.perf_counter() - t))
+                    assert {r["batch_law"] for r in results} == {law}, "the sweep ran another law"
+                os.environ.pop("WMR_MJ_COMPILED_LAW")
 
     print(f"{args.model} model, m1 550-750 kg, {args.seconds:g} s per run, {args.nthread} threads, "
           f"{args.repeats} repeats (medians; ratio = median closed / median rollout, "
           "paired = median of the repeat-by-repeat ratios)")
-    print(f"{'nsim':>6s} {'rollout steps/s':>16s} {'closed steps/s':>16s} {'ratio':>7s} {'paired':>7s} "
-          f"{'cpu':>6s}  same physics")
+    header = f"{'nsim':>6s} {'rollout steps/s':>16s}"
+    for law in laws:
+        header += f" {law + ' steps/s':>17s} {'ratio':>7s} {'paired':>7s} {'cpu':>7s}"
+    print(header + "  same physics")
     for nsim in sizes:
-        ro, cl = statistics.median(open_loop[nsim]), statistics.median(closed[nsim])
-        paired = statistics.median(c / o for c, o in zip(closed[nsim], open_loop[nsim]))
-        cpu_ratio = f"{statistics.median(cpu[nsim]):6.3f}" if cpu[nsim] else f"{'-':>6s}"
-        print(f"{nsim:6d} {ro:16.0f} {cl:16.0f} {cl / ro:7.3f} {paired:7.3f} {cpu_ratio}  "
-              f"{'yes' if same[nsim] else 'NO'}")
+        line = f"{nsim:6d} {statistics.median(open_loop[nsim]):16.0f}"
+        for law in laws:
+            paired = statistics.median(c / o for c, o in zip(closed[law][nsim], open_loop[nsim]))
+            cpu_ratio = f"{statistics.median(cpu[law][nsim]):7.3f}" if cpu[law][nsim] else f"{'-':>7s}"
+            ratio = _median_ratio(closed[law][nsim], open_loop[nsim])
+            line += f" {statistics.median(closed[law][nsim]):17.0f} {ratio} {paired:7.3f} {cpu_ratio}"
+        print(line + "  " + " ".join(f"{law}:{'yes' if same[law, nsim] else 'NO'}" for law in laws))
     print("target: ratio >= 0.90 for every size. cpu: the same ratio in CPU seconds of one thread's share "
           "(nsim/nthread runs, one thread each side), which load from other processes does not blur. "
           "same physics: the open loop ends where the closed loop did, to the bit")
     if sweep_open:
-        ro, cl = statistics.median(sweep_open), statistics.median(sweep_closed)
-        paired = statistics.median(c / o for c, o in zip(sweep_closed, sweep_open))
-        print(f"whole sweep --n {args.sweep_n} ({args.sweep_seconds:g} s per run; run_sweep with drawing, compilation, "
-              f"reference, statistics, CSV): rollout {ro:.0f}, sweep {cl:.0f} steps/s, ratio {cl / ro:.3f}, "
-              f"paired {paired:.3f} (target >= 0.85)")
+        ro = statistics.median(sweep_open)
+        for law in laws:
+            cl = statistics.median(sweep_closed[law])
+            paired = statistics.median(c / o for c, o in zip(sweep_closed[law], sweep_open))
+            print(f"whole sweep --n {args.sweep_n} ({args.sweep_seconds:g} s per run; run_sweep with drawing, "
+                  f"compilation, reference, statistics, CSV), {law} law: rollout {ro:.0f}, sweep {cl:.0f} steps/s, "
+                  f"ratio {cl / ro:.3f}, paired {paired:.3f} (target >= 0.85)")
 
 
 if __name__ == "__main__":

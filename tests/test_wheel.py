@@ -28,7 +28,8 @@ from wmr_mj.cli import COMMANDS
 REPO = Path(__file__).resolve().parents[1]
 # what a build must not see: environments, build outputs, caches, run outputs
 _IGNORE = shutil.ignore_patterns(".git", ".venv", "build", "dist", "*.egg-info", "__pycache__", ".pytest_cache",
-                                 ".ruff_cache", "logs", ".gl", "node_modules", "MUJOCO_LOG.TXT")
+                                 ".ruff_cache", "logs", ".gl", "node_modules", "MUJOCO_LOG.TXT",
+                                 "*.so")  # the editable install's compiled law: the wheel builds its own
 # files of the source that are package data (everything else in a package folder is a module or a cache)
 _DATA_GLOBS = ("wmr_mj/schemas/*", "wmr_mj/data/*", "wmr_mj/py.typed", "controllers/py.typed")
 _MODEL_FILES = ("c80.xml", "scene.xml", "README.md")
@@ -90,6 +91,15 @@ def test_installed_package_is_the_wheel_not_the_checkout(installed):
     for line in out.split():
         assert Path(line).is_relative_to(bin_dir.parent), line
         assert not Path(line).is_relative_to(REPO), line
+
+
+def test_the_wheel_builds_the_compiled_law_and_it_runs(installed):
+    bin_dir, wheel, _, outside, env = installed
+    assert any(n.startswith("wmr_mj/_compiled_law.") and n.endswith(".so") for n in zipfile.ZipFile(wheel).namelist())
+    out = _run([str(bin_dir / "python"), "-c", "from wmr_mj import compiled_law, _compiled_law; "
+                "print(compiled_law.unavailable_reason()); print(_compiled_law.__file__)"], cwd=outside, env=env)
+    reason, path = out.split("\n")[:2]
+    assert reason == "None" and Path(path).is_relative_to(bin_dir.parent), out
 
 
 def test_help_lists_every_command(installed):

@@ -47,10 +47,10 @@ from typing import Any
 import mujoco
 import numpy as np
 
+from . import compiled_law
 from .certificate import certificate_for
 from .errors import ParameterError, SchedulerError, UnknownNameError
 from .params import C80, M1_NOMINAL, M1_RANGE, C80Parameters, parameter_names
-from .plant import compile_model
 from .simulate import (
     RunConfig,
     _controller,
@@ -72,6 +72,8 @@ __all__ = [
     "batch_model",
     "thread_count",
     "batch_groups",
+    "batch_law_backend",
+    "LAW_BACKENDS",
     "run_batch",
     "run_sweep",
     "SAMPLINGS",
@@ -84,6 +86,9 @@ __all__ = [
 ]
 
 SAMPLINGS = ("uniform", "lhs", "grid")
+#: how run_batch evaluates the law: "compiled" (C, in MuJoCo's control callback), "numpy"
+#: (the vectorised law between steps), "auto" (compiled where it can run)
+LAW_BACKENDS = ("auto", "compiled", "numpy")
 RESULT_COLUMNS = ("run", "m1", "verdict", "cert_valid", "cert_E_max", "cert_Edot_max", "cert_E_ratio",
                   "cert_Edot_ratio", "cert_inside", "sup_E", "sup_Edot", "sup_E_settled", "sup_Edot_settled",
                   "E_max", "Edot_max", "E_ratio", "Edot_ratio", "inside", "saturated_fraction",
@@ -211,21 +216,23 @@ def _plant_options(config: RunConfig) -> dict[str, Any]:
     return {name: getattr(config, name) for name in _PLANT_OPTIONS if hasattr(config, name)}
 
 
-def batch_model(params: C80Parameters, **plant_options: Any) -> mujoco.MjModel:
+def batch_model(params: C80Parameters, *, law: tuple[np.ndarray, Sequence[np.ndarray]] | None = None,
+                **plant_options: Any) -> mujoco.MjModel:
     """The plant of ``compile_model(params, ...)`` without its sky texture, for the batch.
 
     Generating the 512x3072 sky gradient is 95% of compiling the scene (11.6 of 12 ms
     measured); a texture touches no physics, and a test checks that every other model
-    field equals the serial run's. Falls back to compile_model where the plant has no spec.
+    field equals the serial run's. ``law`` = (law vector, reference rows) attaches the
+    compiled law (:func:`wmr_mj.compiled_law.attach`: two numerics and userdata, no physics).
     """
     from . import plant
 
-    if not hasattr(plant, "scene_spec"):
-        return compile_model(params, **plant_options)[0]
     spec = plant.scene_spec(params, **plant_options)
     for texture in list(spec.textures):
         if texture.type == mujoco.mjtTexture.mjTEXTURE_SKYBOX:
             spec.delete(texture)
+    if law is not None:
+        compiled_law.attach(spec, *law)
     return spec.compile()
 
 
@@ -352,6 +359,66 @@ def _run_group(loop: _Loop, models: Sequence[mujoco.MjModel], idx: np.ndarray, t
     stats.warnings[idx] = batch.warning[:, :, 1].sum(axis=1)  # (nsim, mjNWARNING, (lastinfo, number))
 
 
+def _run_group_compiled(loop: _Loop, models: Sequence[mujoco.MjModel], idx: np.ndarray, threads: int,
+                        stats: _BatchStats, stop: threading.Event,
+                        progress: Callable[[int, int], None] | None) -> None:
+    """The closed loop of simulations ``idx`` with the compiled law, a block of steps per call.
+
+    The law runs inside every mj_step (``wmr_mj.compiled_law``: mjcb_control), so
+    ``Batch.rollout`` runs a whole block of control steps in C on ``threads`` threads; the
+    block's userdata (alpha, E, E', the law's voltage at every control step) is then folded
+    into the statistics as the NumPy loop folds its buffers. Rollout stops a simulation whose
+    warning counters rise; run_batch re-runs those serially.
+    """
+    from mujoco.batch import Batch
+
+    g = len(idx)
+    batch = Batch(models[0], nsim=g, nthread=threads)
+    batch.set_models(list(models))
+    batch.reset(keyframe=loop.keyframe)
+    alpha_now = batch.bind("qpos")[:, loop.qpos_adr]
+    lo, hi = -loop.voltage_limit[idx], loop.voltage_limit[idx]
+    range_limit = loop.range_limit[idx]
+    substeps = loop.substeps
+    records: dict[int, dict[str, np.ndarray]] = {}  # one output buffer per block length, reused
+    for k0 in range(0, loop.n, loop.block):
+        count = min(loop.block, loop.n - k0)
+        out = records.setdefault(count, {"userdata": np.empty((g, count * substeps,
+                                                               len(compiled_law.USERDATA_FIELDS)))})
+        # the record after each physics step; a control step's values hold over its substeps
+        userdata = batch.rollout(count * substeps, record=("userdata",), out=out)["userdata"][:, ::substeps]
+        a_buf, E_buf, Ed_buf, u_buf = (userdata[:, :, j].T for j in range(4))  # (count, g) views
+        _block_stats(loop, stats, idx, k0, count, a_buf, E_buf, Ed_buf, u_buf, lo, hi, range_limit)
+        if progress is not None:
+            progress(k0 + count, loop.n)
+        if stop.is_set():
+            return
+    stats.final_alpha[idx] = a_buf[count - 1]
+    stats.final_alpha_dot[idx] = loop.alpha0_dot[loop.n - 1] - Ed_buf[count - 1]
+    stats.final_alpha_after_step[idx] = alpha_now
+    stats.warnings[idx] = batch.warning[:, :, 1].sum(axis=1)
+
+
+def batch_law_backend(controller: Any, law: str = "auto") -> str:
+    """'compiled' or 'numpy': how run_batch evaluates ``controller``'s law when asked for ``law``.
+
+    'auto' takes the compiled law where it can run (:mod:`wmr_mj.compiled_law`), else NumPy;
+    'compiled' raises ParameterError, saying why, where it cannot.
+    """
+    if law not in LAW_BACKENDS:
+        raise UnknownNameError("law backend", law, LAW_BACKENDS)
+    if law == "numpy":
+        return "numpy"
+    why = compiled_law.unavailable_reason()
+    if why is None and not compiled_law.supports(controller):
+        why = f"it implements ComputedTorque and PDController, not {type(controller).__name__}"
+    if why is None:
+        return "compiled"
+    if law == "compiled":
+        raise ParameterError(f"the compiled law cannot run: {why}")
+    return "numpy"
+
+
 def _block_stats(loop: _Loop, stats: _BatchStats, idx: np.ndarray, k0: int, rows: int, a_buf, E_buf, Ed_buf,
                  u_buf, lo, hi, range_limit) -> None:
     """Fold control steps k0 .. k0+rows-1 into the statistics (max and count are exact in bulk)."""
@@ -379,7 +446,7 @@ def _block_stats(loop: _Loop, stats: _BatchStats, idx: np.ndarray, k0: int, rows
 
 
 def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parameters = C80,
-              progress: Callable[[int, int], None] | None = None) -> list[dict[str, Any]]:
+              progress: Callable[[int, int], None] | None = None, law: str = "auto") -> list[dict[str, Any]]:
     """Run closed-loop configs that differ only in their plant parameters, all at once.
 
     The simulations are split into groups (:func:`batch_groups`: one per thread of
@@ -399,16 +466,26 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
             raise ParameterError("run_batch needs configs that differ only in m1 and plant_overrides")
     estimate = estimate_parameters(base)
     controller = _controller(first, estimate)
+    backend = batch_law_backend(controller, law)
     plants = [plant_parameters(c, base) for c in configs]
     options = _plant_options(first)
-    models = [batch_model(p, **options) for p in plants]
-    model = models[0]
+    model = batch_model(plants[0], **options)
     nsim = len(configs)
     dt = model.opt.timestep
     substeps = _substeps(first, dt)
     period = substeps * dt
     n = int(round(first.duration / period))
     reference, settle_s = build_reference(first.path, estimate, dt=period, duration=n * period)
+    if backend == "compiled":
+        compiled_law.install()
+        rows = (np.asarray(reference.alpha0), np.asarray(reference.alpha0_dot), np.asarray(reference.alpha0_ddot))
+        where = dict(substeps=substeps, nstep=n, qpos_adr=int(model.jnt_qposadr[model.joint("steer").id]),
+                     dof_adr=int(model.jnt_dofadr[model.joint("steer").id]),
+                     actuator=model.actuator("steering_motor").id)
+        models = [batch_model(p, law=(compiled_law.law_vector(controller, voltage_limit=p.voltage_limit, **where),
+                                      rows), **options) for p in plants]
+    else:
+        models = [model] + [batch_model(p, **options) for p in plants[1:]]
     analysis = analysis_for(first, reference, estimate, estimate=_estimate_of(controller))
     loop = _Loop(alpha0=np.asarray(reference.alpha0), alpha0_dot=np.asarray(reference.alpha0_dot),
                  alpha0_ddot=np.asarray(reference.alpha0_ddot), n=n, substeps=substeps, period=period,
@@ -420,15 +497,21 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
                  voltage_limit=np.array([p.voltage_limit for p in plants]),
                  range_limit=np.array([p.steering_range for p in plants]) - 1e-3)
     stats = _BatchStats(nsim)
-    groups = batch_groups(nsim, thread_count(nthread, nsim))
+    threads = thread_count(nthread, nsim)
+    # the compiled law holds no GIL: one batch on every thread
+    groups = [(np.arange(nsim), threads)] if backend == "compiled" else batch_groups(nsim, threads)
     stop = threading.Event()
     errors: list[BaseException] = []
 
     def work(idx: np.ndarray, threads: int, report_progress) -> None:
         try:
             cpu0 = time.thread_time()
-            _run_group(loop, [models[i] for i in idx], idx, threads, controller.batch_law(len(idx)), stats, stop,
-                       report_progress)
+            group_models = [models[i] for i in idx]
+            if backend == "compiled":
+                _run_group_compiled(loop, group_models, idx, threads, stats, stop, report_progress)
+            else:
+                _run_group(loop, group_models, idx, threads, controller.batch_law(len(idx)), stats, stop,
+                           report_progress)
             stats.cpu_s.append(time.thread_time() - cpu0)
         except BaseException as exc:  # noqa: BLE001  (re-raised on the calling thread)
             errors.append(exc)
@@ -461,9 +544,11 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
                    status="completed", certificate=certificate_for(c, reference, params=base),
                    drift=drift(prev_window=float(stats.drift_prev[i]), last_window=float(stats.drift_last[i]),
                                final_alpha_dot=float(stats.final_alpha_dot[i])))
-        if stats.law_nan[i]:
-            # NaN from the law: the serial loop applies 0 V, MuJoCo would zero every control of
-            # the step (BADCTRL); the serial run is the truth
+        if stats.law_nan[i] if backend == "numpy" else stats.warnings[i]:
+            # NumPy law: NaN from the law, where the serial loop applies 0 V and MuJoCo would zero
+            # every control of the step (BADCTRL); compiled law (which applies 0 V as the serial
+            # loop does): a warning, after which rollout stopped the simulation. The serial run
+            # is the truth
             serial = run_closed_loop(c, progress=False, base=base).summary
             r = {key: serial[key] for key in r}
             r["mujoco_warnings"] = serial["mujoco_warnings"]
@@ -474,6 +559,7 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
         r["batch_wall_s"] = wall
         r["batch_steps_per_s"] = nsim * n * substeps / wall if wall > 0 else None
         r["batch_cpu_s"] = sum(stats.cpu_s)  # robust to a shared machine, unlike the wall time
+        r["batch_law"] = backend
         reports.append(r)
     return reports
 
