@@ -7,7 +7,8 @@ STAMP := $(VENV)/.installed
 
 .PHONY: demo test lint venv bench clean foxglove-reader
 
-$(STAMP): pyproject.toml setup.py
+# the editable install builds the compiled law (wmr_mj/_compiled_law.c) in place: rebuild when it changes
+$(STAMP): pyproject.toml setup.py wmr_mj/_compiled_law.c
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
 	$(PY) -m pip install -q -e '.[test,dask,video]'
@@ -39,4 +40,4 @@ bench: $(STAMP)
 	$(PY) bench/bench_video.py
 
 clean:
-	rm -rf $(VENV) build dist *.egg-info .ruff_cache
+	rm -rf $(VENV) build dist *.egg-info .ruff_cache wmr_mj/_compiled_law.*.so

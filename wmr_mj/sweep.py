@@ -8,11 +8,15 @@ bit-identical).
 
 How a batch runs at the speed of open-loop ``mujoco.rollout`` (bench/bench_sweep.py):
 
-- the simulations are split into one group per thread; each group is a
-  ``mujoco.batch.Batch`` stepped on its own thread, with its own vectorised law
-  (``controller.batch_law``: NumPy ``out=`` buffers, nothing allocated per step).
-  The GIL is held only while a law runs, so one group's law overlaps the other
-  groups' physics, and no thread waits for another at the end of a step;
+- the law runs in C, inside every ``mj_step``, as MuJoCo's control callback
+  (:mod:`wmr_mj.compiled_law`: ``voltage_scalar`` operation for operation, bit-identical);
+  ``mujoco.batch.Batch.rollout`` then runs a block of 1000 closed-loop steps of every
+  simulation per call, on every thread, with no Python in between;
+- where the compiled law cannot run (not built, ``WMR_MJ_COMPILED_LAW=0``, a controller
+  subclass), the NumPy law: the simulations are split into groups, each a ``Batch``
+  stepped on its own thread with its own vectorised law (``controller.batch_law``: NumPy
+  ``out=`` buffers, nothing allocated per step), one group's law overlapping the others'
+  physics; ``run_batch(law=...)`` chooses;
 - statistics are folded in blocks of 1000 steps, not step by step;
 - models are compiled without the scene's sky texture (95% of compiling it).
 
@@ -50,6 +54,7 @@ import numpy as np
 from . import compiled_law
 from .certificate import certificate_for
 from .errors import ParameterError, SchedulerError, UnknownNameError
+from .memory import require_memory
 from .params import C80, M1_NOMINAL, M1_RANGE, C80Parameters, parameter_names
 from .simulate import (
     RunConfig,
@@ -449,13 +454,16 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
               progress: Callable[[int, int], None] | None = None, law: str = "auto") -> list[dict[str, Any]]:
     """Run closed-loop configs that differ only in their plant parameters, all at once.
 
-    The simulations are split into groups (:func:`batch_groups`: one per thread of
-    ``nthread``, 0: every core, up to sqrt(nsim) groups). Each group is a
-    ``mujoco.batch.Batch`` on its own Python thread with one compiled model per simulation
-    and its own vectorised law (``controller.batch_law``), so the law of one group runs
-    while the others step. Returns per-run reports, each bit-identical to
-    ``run_closed_loop`` of the same config. ``batch_cpu_s`` is the CPU time of the group
-    threads (a figure for benchmarks on a shared machine; batch-internal threads excluded).
+    ``law`` (:data:`LAW_BACKENDS`, :func:`batch_law_backend`): 'compiled' runs one
+    ``mujoco.batch.Batch`` of every simulation on ``nthread`` threads (0: every core) with
+    the law in MuJoCo's control callback, a block of steps per ``Batch.rollout`` call;
+    'numpy' splits the simulations into groups (:func:`batch_groups`), each a ``Batch`` on
+    its own Python thread with its own vectorised law (``controller.batch_law``), so that
+    the law of one group runs while the others step; 'auto' (the default) takes the
+    compiled law where it can run. Each simulation has its own compiled model. Returns
+    per-run reports, each bit-identical to ``run_closed_loop`` of the same config, whichever
+    the law. ``batch_cpu_s`` is the CPU time of the group threads (a figure for benchmarks
+    on a shared machine; batch-internal threads excluded), ``batch_law`` the law that ran.
     """
     if not configs:
         return []
@@ -477,6 +485,9 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
     n = int(round(first.duration / period))
     reference, settle_s = build_reference(first.path, estimate, dt=period, duration=n * period)
     if backend == "compiled":
+        # each model carries the reference (3 float64 per control step), for the callback
+        require_memory(nsim * n * 3 * 8, what=f"a batch of {nsim} runs of {n} control steps with the compiled law",
+                       hint="run fewer at once (a smaller chunk) or the NumPy law (WMR_MJ_COMPILED_LAW=0)")
         compiled_law.install()
         rows = (np.asarray(reference.alpha0), np.asarray(reference.alpha0_dot), np.asarray(reference.alpha0_ddot))
         where = dict(substeps=substeps, nstep=n, qpos_adr=int(model.jnt_qposadr[model.joint("steer").id]),
