@@ -149,6 +149,12 @@ class ComputedTorque(SteeringController):
         if friction_sign == "none":
             self._F = 0.0
 
+    def law_constants(self) -> dict[str, float | str]:
+        """The numbers the law uses: P^, K_P, K_D, C_V^, F^ (0 with friction_sign 'none'), K^,
+        gyro^ V_A (V s/rad), friction_width (rad/s) and friction_sign (what wmr_mj.compiled_law reads)."""
+        return {"P": self._P, "K_P": self.kp, "K_D": self.kd, "C_V": self._C_V, "F": self._F, "K": self._K,
+                "gyro_V": self._gyro_V, "friction_width": self.friction_width, "friction_sign": self.friction_sign}
+
     def _sign_source(self, alpha_dot, alpha0_dot):
         return alpha0_dot if self.friction_sign == "reference" else alpha_dot
 
@@ -282,6 +288,10 @@ class PDController(SteeringController):
 
     def voltage_scalar(self, alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot) -> float:
         return self._P * (self.kd * (alpha0_dot - alpha_dot) + self.kp * (alpha0 - alpha))
+
+    def law_constants(self) -> dict[str, float]:
+        """The numbers the law uses: P^, K_P, K_D."""
+        return {"P": self._P, "K_P": self.kp, "K_D": self.kd}
 
     def batch_law(self, n: int):
         """The PD law for n simulations with NumPy ``out=`` buffers: no allocation per call."""

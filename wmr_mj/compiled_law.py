@@ -120,19 +120,16 @@ def supports(controller: Any) -> bool:
 def law_vector(controller: Any, *, voltage_limit: float, substeps: int, nstep: int, qpos_adr: int, dof_adr: int,
                actuator: int) -> np.ndarray | None:
     """The numeric "wmr_mj_law" for ``controller``; None where :func:`supports` is False."""
-    from controllers import ComputedTorque, PDController
-
-    kind = type(controller)
-    if kind is ComputedTorque:
-        values = dict(kind=0.0, C_V=controller._C_V, F=controller._F, K=controller._K, gyro_V=controller._gyro_V,
-                      friction_width=controller.friction_width,
-                      friction_sign=2.0 if controller.friction_sign == "reference" else 1.0)
-    elif kind is PDController:
-        values = dict(kind=1.0, C_V=0.0, F=0.0, K=0.0, gyro_V=0.0, friction_width=0.0, friction_sign=1.0)
-    else:
+    if not supports(controller):
         return None
-    values.update(P=controller._P, K_P=controller.kp, K_D=controller.kd, voltage_limit=voltage_limit,
-                  substeps=substeps, nstep=nstep, qpos_adr=qpos_adr, dof_adr=dof_adr, actuator=actuator)
+    from controllers import ComputedTorque
+
+    values = {"C_V": 0.0, "F": 0.0, "K": 0.0, "gyro_V": 0.0, "friction_width": 0.0, "friction_sign": "measured"}
+    values.update(controller.law_constants())
+    values.update(kind=0.0 if type(controller) is ComputedTorque else 1.0,
+                  friction_sign=2.0 if values["friction_sign"] == "reference" else 1.0,
+                  voltage_limit=voltage_limit, substeps=substeps, nstep=nstep, qpos_adr=qpos_adr,
+                  dof_adr=dof_adr, actuator=actuator)
     return np.array([float(values[name]) for name in LAW_FIELDS])
 
 
