@@ -354,12 +354,23 @@ def _run_group(loop: _Loop, models: Sequence[mujoco.MjModel], idx: np.ndarray, t
             minimum(clipped, hi, out=ctrl_now)
             step(nstep=nstep)
         _block_stats(loop, stats, idx, k0, count, a_buf, E_buf, Ed_buf, u_buf, lo, hi, range_limit)
-        if progress is not None:
-            progress(k0 + count, loop.n)
-        if stop.is_set():
+        if _stopped(loop, k0 + count, stop, progress):
             return
-    stats.final_alpha[idx] = a_buf[count - 1]
-    stats.final_alpha_dot[idx] = loop.alpha0_dot[loop.n - 1] - Ed_buf[count - 1]  # as the serial run computes it
+    _final_stats(loop, stats, idx, batch, a_buf[count - 1], Ed_buf[count - 1], alpha_now)
+
+
+def _stopped(loop: _Loop, done: int, stop: threading.Event, progress: Callable[[int, int], None] | None) -> bool:
+    """Report ``done`` control steps; whether the group must stop (another group failed, Ctrl-C)."""
+    if progress is not None:
+        progress(done, loop.n)
+    return stop.is_set()
+
+
+def _final_stats(loop: _Loop, stats: _BatchStats, idx: np.ndarray, batch, last_alpha: np.ndarray,
+                 last_E_dot: np.ndarray, alpha_now: np.ndarray) -> None:
+    """The end-of-run figures of a group from its last control step and its final state."""
+    stats.final_alpha[idx] = last_alpha
+    stats.final_alpha_dot[idx] = loop.alpha0_dot[loop.n - 1] - last_E_dot  # as the serial run computes it
     stats.final_alpha_after_step[idx] = alpha_now
     stats.warnings[idx] = batch.warning[:, :, 1].sum(axis=1)  # (nsim, mjNWARNING, (lastinfo, number))
 
@@ -394,14 +405,9 @@ def _run_group_compiled(loop: _Loop, models: Sequence[mujoco.MjModel], idx: np.n
         userdata = batch.rollout(count * substeps, record=("userdata",), out=out)["userdata"][:, ::substeps]
         a_buf, E_buf, Ed_buf, u_buf = (userdata[:, :, j].T for j in range(4))  # (count, g) views
         _block_stats(loop, stats, idx, k0, count, a_buf, E_buf, Ed_buf, u_buf, lo, hi, range_limit)
-        if progress is not None:
-            progress(k0 + count, loop.n)
-        if stop.is_set():
+        if _stopped(loop, k0 + count, stop, progress):
             return
-    stats.final_alpha[idx] = a_buf[count - 1]
-    stats.final_alpha_dot[idx] = loop.alpha0_dot[loop.n - 1] - Ed_buf[count - 1]
-    stats.final_alpha_after_step[idx] = alpha_now
-    stats.warnings[idx] = batch.warning[:, :, 1].sum(axis=1)
+    _final_stats(loop, stats, idx, batch, a_buf[count - 1], Ed_buf[count - 1], alpha_now)
 
 
 def batch_law_backend(controller: Any, law: str = "auto") -> str:
