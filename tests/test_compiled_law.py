@@ -171,3 +171,23 @@ def test_attach_refuses_a_spec_it_would_misread():
         compiled_law.attach(spec, np.zeros(len(compiled_law.LAW_FIELDS)), REFERENCE)
     with pytest.raises(ValueError, match="LAW_FIELDS"):
         compiled_law.attach(mujoco.MjSpec(), np.zeros(3), REFERENCE)
+
+
+def test_a_law_built_for_another_mujoco_is_refused_with_the_reason(monkeypatch):
+    compiled_law._library.cache_clear()
+    monkeypatch.setattr(mujoco, "mj_version", lambda: 3_999_999)
+    try:
+        assert "built for MuJoCo 4" in compiled_law.unavailable_reason() and "this is 3999999" in \
+            compiled_law.unavailable_reason()
+        assert batch_law_backend(_controller(BASE, estimate_parameters())) == "numpy"
+    finally:
+        compiled_law._library.cache_clear()
+
+
+def test_a_compiled_batch_too_large_for_memory_is_refused_before_it_starts(monkeypatch):
+    from wmr_mj import memory
+    from wmr_mj.errors import NotEnoughMemoryError
+
+    monkeypatch.setattr(memory, "available_memory_bytes", lambda: 100_000)  # < 2 runs x 10,000 steps x 24 B
+    with pytest.raises(NotEnoughMemoryError, match="compiled law.*WMR_MJ_COMPILED_LAW=0"):
+        run_batch([BASE.replace(m1=600.0), BASE.replace(m1=700.0)], law="compiled")
