@@ -490,27 +490,24 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
     period = substeps * dt
     n = int(round(first.duration / period))
     reference, settle_s = build_reference(first.path, estimate, dt=period, duration=n * period)
+    rows = (np.asarray(reference.alpha0), np.asarray(reference.alpha0_dot), np.asarray(reference.alpha0_ddot))
+    steer = model.joint("steer").id
+    where = dict(qpos_adr=int(model.jnt_qposadr[steer]), dof_adr=int(model.jnt_dofadr[steer]),
+                 actuator=model.actuator("steering_motor").id)  # the same in every simulation's model
     if backend == "compiled":
         # each model carries the reference (3 float64 per control step), for the callback
         require_memory(nsim * n * 3 * 8, what=f"a batch of {nsim} runs of {n} control steps with the compiled law",
                        hint="run fewer at once (a smaller chunk) or the NumPy law (WMR_MJ_COMPILED_LAW=0)")
         compiled_law.install()
-        rows = (np.asarray(reference.alpha0), np.asarray(reference.alpha0_dot), np.asarray(reference.alpha0_ddot))
-        where = dict(substeps=substeps, nstep=n, qpos_adr=int(model.jnt_qposadr[model.joint("steer").id]),
-                     dof_adr=int(model.jnt_dofadr[model.joint("steer").id]),
-                     actuator=model.actuator("steering_motor").id)
-        models = [batch_model(p, law=(compiled_law.law_vector(controller, voltage_limit=p.voltage_limit, **where),
-                                      rows), **options) for p in plants]
+        models = [batch_model(p, law=(compiled_law.law_vector(controller, voltage_limit=p.voltage_limit,
+                                                              substeps=substeps, nstep=n, **where), rows),
+                              **options) for p in plants]
     else:
         models = [model] + [batch_model(p, **options) for p in plants[1:]]
     analysis = analysis_for(first, reference, estimate, estimate=_estimate_of(controller))
-    loop = _Loop(alpha0=np.asarray(reference.alpha0), alpha0_dot=np.asarray(reference.alpha0_dot),
-                 alpha0_ddot=np.asarray(reference.alpha0_ddot), n=n, substeps=substeps, period=period,
+    loop = _Loop(alpha0=rows[0], alpha0_dot=rows[1], alpha0_ddot=rows[2], n=n, substeps=substeps, period=period,
                  settle_k=int(math.ceil(settle_s / period - 1e-9)), drift_k=drift_window_steps(n, period),
-                 block=min(n, 1000),
-                 qpos_adr=int(model.jnt_qposadr[model.joint("steer").id]),
-                 dof_adr=int(model.jnt_dofadr[model.joint("steer").id]),
-                 actuator=model.actuator("steering_motor").id, keyframe=model.key("home").id,
+                 block=min(n, 1000), **where, keyframe=model.key("home").id,
                  voltage_limit=np.array([p.voltage_limit for p in plants]),
                  range_limit=np.array([p.steering_range for p in plants]) - 1e-3)
     stats = _BatchStats(nsim)
