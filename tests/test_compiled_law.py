@@ -191,3 +191,20 @@ def test_a_compiled_batch_too_large_for_memory_is_refused_before_it_starts(monke
     monkeypatch.setattr(memory, "available_memory_bytes", lambda: 100_000)  # < 2 runs x 10,000 steps x 24 B
     with pytest.raises(NotEnoughMemoryError, match="compiled law.*WMR_MJ_COMPILED_LAW=0"):
         run_batch([BASE.replace(m1=600.0), BASE.replace(m1=700.0)], law="compiled")
+
+
+def test_without_the_built_library_the_reason_says_so_and_the_batch_uses_numpy(monkeypatch):
+    import sys
+
+    compiled_law._library.cache_clear()
+    import wmr_mj
+
+    monkeypatch.setitem(sys.modules, "wmr_mj._compiled_law", None)  # what an install without a compiler has
+    monkeypatch.delattr(wmr_mj, "_compiled_law", raising=False)
+    try:
+        assert "is not built" in compiled_law.unavailable_reason()
+        reports = run_batch([BASE.replace(m1=600.0)], law="auto")
+        assert reports[0]["batch_law"] == "numpy"
+        assert reports[0]["sup_E"] == run_closed_loop(BASE.replace(m1=600.0), progress=False).summary["sup_E"]
+    finally:
+        compiled_law._library.cache_clear()

@@ -102,6 +102,17 @@ def test_the_wheel_builds_the_compiled_law_and_it_runs(installed):
     assert reason == "None" and Path(path).is_relative_to(bin_dir.parent), out
 
 
+def test_without_a_c_compiler_the_wheel_builds_without_the_compiled_law(installed, tmp_path):
+    _, _, src, _, env = installed
+    source = tmp_path / "src"
+    shutil.copytree(src, source, ignore=_IGNORE)
+    _run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "--no-index", "-q",
+          "-w", str(tmp_path / "wheels"), str(source)], cwd=tmp_path, env={**env, "CC": "/bin/false"})
+    (wheel,) = (tmp_path / "wheels").glob("wmr_mj-*.whl")
+    names = zipfile.ZipFile(wheel).namelist()
+    assert "wmr_mj/compiled_law.py" in names and not [n for n in names if n.endswith(".so")]
+
+
 def test_help_lists_every_command(installed):
     bin_dir, _, _, outside, env = installed
     out = _run([str(bin_dir / "wmr-mj"), "--help"], cwd=outside, env=env)
