@@ -230,6 +230,7 @@ def test_cli_sweep_json_and_files(tmp_path):
         assert key in obj
     rows = read_results(tmp_path / "runs.csv")
     assert obj["n"] == 3 and obj["inside"] + obj["outside"] == 3
+    assert obj["batch_law"] == ["compiled"]  # the default where the compiled law is built (tests/test_compiled_law.py)
     assert obj["inside"] == sum(r["inside"] for r in rows)
     assert obj["worst_E_ratio"] == max(r["E_ratio"] for r in rows)
     assert (tmp_path / "region.png").stat().st_size > 1000

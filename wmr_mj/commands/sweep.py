@@ -64,6 +64,8 @@ def summarize_sweep(results: list[dict], wall_s: float) -> dict:
         "steps": steps,
         "wall_s": wall_s,
         "steps_per_s": steps / wall_s if wall_s > 0 and math.isfinite(wall_s) else None,
+        # how the runs of this call evaluated the law (wmr_mj.sweep.LAW_BACKENDS; resumed runs: none)
+        "batch_law": sorted({r["batch_law"] for r in results if r.get("batch_law")}),
     }
 
 
@@ -125,7 +127,8 @@ def run(args: argparse.Namespace) -> int:
           f"worst sup|E|/E_max = {fmt(summary['worst_E_ratio'])}, "
           f"worst sup|E'|/Edot_max = {fmt(summary['worst_Edot_ratio'])}; "
           f"{summary['hit_steering_stop']} runs hit the steering stop")
-    print(f"{summary['steps']} steps in {wall:.1f} s ({summary['steps_per_s']:.3g} steps/s)")
+    law = f", {' and '.join(summary['batch_law'])} law" if summary["batch_law"] else ""
+    print(f"{summary['steps']} steps in {wall:.1f} s ({summary['steps_per_s']:.3g} steps/s{law})")
     print(f"table: {out / 'runs.csv'}\nplot:  {plot_path}")
     return 0
 
