@@ -11,7 +11,7 @@ physics steps per second (medians over repeats) of
             the timings), so that both loops do the same physics step for step (checked: the
             open loop ends where the closed loop did, to the bit); rollout records every
             step into output arrays allocated once;
-  compiled: ``wmr_mj.sweep.run_batch`` as it runs by default: the law in C as MuJoCo's control
+  compiled: ``wmr_mj.batch.run_batch`` as it runs by default: the law in C as MuJoCo's control
             callback (``wmr_mj.compiled_law``), ``Batch.rollout`` a block of 1000 closed-loop
             steps per call, statistics folded per block (compilation and reference outside
             the timing);
@@ -43,8 +43,9 @@ import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 from mujoco import rollout  # noqa: E402
 
+from wmr_mj.batch import batch_model, run_batch  # noqa: E402
 from wmr_mj.simulate import RunConfig, plant_parameters, run_closed_loop  # noqa: E402
-from wmr_mj.sweep import SweepSpec, batch_model, run_batch, run_sweep  # noqa: E402
+from wmr_mj.sweep import SweepSpec, run_sweep  # noqa: E402
 
 
 def applied_voltages(configs: list[RunConfig]) -> np.ndarray:

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from wmr_mj import compiled_law
+from wmr_mj.batch import batch_law_backend, batch_model, run_batch
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.simulate import RunConfig, _controller, estimate_parameters, plant_parameters, run_closed_loop
-from wmr_mj.sweep import batch_law_backend, batch_model, run_batch
 
 BASE = RunConfig(model="nonholonomic", duration=10.0)
 KEYS = ("sup_E", "sup_Edot", "sup_E_settled", "sup_Edot_settled", "E_max", "Edot_max", "saturated_fraction",
@@ -126,16 +126,16 @@ def test_a_compiled_batch_is_bit_identical_to_serial_runs_and_to_the_numpy_batch
 
 def test_a_simulation_with_a_warning_is_rerun_serially(monkeypatch):
     """Rollout stops a simulation whose warnings rise; run_batch then reports the serial run."""
-    from wmr_mj import sweep
+    from wmr_mj import batch
 
-    run_group = sweep._run_group_compiled
+    run_group = batch._run_group_compiled
 
     def with_a_warning(loop, models, idx, threads, stats, stop, progress):
         run_group(loop, models, idx, threads, stats, stop, progress)
         stats.sup_E[idx[1]] = 99.0  # what a stopped simulation might report
         stats.warnings[idx[1]] = 1
 
-    monkeypatch.setattr(sweep, "_run_group_compiled", with_a_warning)
+    monkeypatch.setattr(batch, "_run_group_compiled", with_a_warning)
     configs = [BASE.replace(m1=m) for m in (600.0, 700.0)]
     reports = run_batch(configs, nthread=1, law="compiled")
     serial = run_closed_loop(configs[1], progress=False).summary

@@ -1,6 +1,6 @@
 """The steering law compiled into MuJoCo's control callback, for batches of closed-loop runs.
 
-A batch of closed-loop runs (``wmr_mj.sweep.run_batch``) steps every simulation by one
+A batch of closed-loop runs (``wmr_mj.batch.run_batch``) steps every simulation by one
 control period, then evaluates the law for all of them in NumPy: about 20 small ufunc calls a
 step whose cost does not shrink with the batch. This module moves the law into C instead:
 ``wmr_mj/_compiled_law.c`` holds ``ComputedTorque.voltage_scalar`` and

@@ -12,7 +12,7 @@ Usage::
     result = run_closed_loop(RunConfig(model="nonholonomic", m1=700.0))
     print(result.summary["sup_E"], result.summary["E_max"], result.summary["inside"])
 
-``wmr_mj.sweep`` runs many of these at once on ``mujoco.batch``; a test keeps
+``wmr_mj.batch`` runs many of these at once on ``mujoco.batch``; a test keeps
 the two bit-identical.
 """
 

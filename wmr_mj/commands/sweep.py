@@ -64,7 +64,7 @@ def summarize_sweep(results: list[dict], wall_s: float) -> dict:
         "steps": steps,
         "wall_s": wall_s,
         "steps_per_s": steps / wall_s if wall_s > 0 and math.isfinite(wall_s) else None,
-        # how the runs of this call evaluated the law (wmr_mj.sweep.LAW_BACKENDS; resumed runs: none)
+        # how the runs of this call evaluated the law (wmr_mj.batch.LAW_BACKENDS; resumed runs: none)
         "batch_law": sorted({r["batch_law"] for r in results if r.get("batch_law")}),
     }
 
