@@ -167,9 +167,9 @@ def test_the_law_backend_is_chosen_and_refused_clearly(monkeypatch):
 def test_attach_refuses_a_spec_it_would_misread():
     spec = mujoco.MjSpec()
     spec.add_numeric(name="first", data=[1.0])
-    with pytest.raises(ValueError, match="first numeric"):
+    with pytest.raises(ParameterError, match="first numeric"):
         compiled_law.attach(spec, np.zeros(len(compiled_law.LAW_FIELDS)), REFERENCE)
-    with pytest.raises(ValueError, match="LAW_FIELDS"):
+    with pytest.raises(ParameterError, match="LAW_FIELDS"):
         compiled_law.attach(mujoco.MjSpec(), np.zeros(3), REFERENCE)
 
 
@@ -180,6 +180,8 @@ def test_a_law_built_for_another_mujoco_is_refused_with_the_reason(monkeypatch):
         assert "built for MuJoCo 4" in compiled_law.unavailable_reason() and "this is 3999999" in \
             compiled_law.unavailable_reason()
         assert batch_law_backend(_controller(BASE, estimate_parameters())) == "numpy"
+        with pytest.raises(ParameterError, match="cannot run: .*built for MuJoCo"):
+            compiled_law.install()
     finally:
         compiled_law._library.cache_clear()
 

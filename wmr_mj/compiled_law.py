@@ -47,6 +47,8 @@ from typing import Any
 import mujoco
 import numpy as np
 
+from .errors import ParameterError
+
 __all__ = ["LAW_FIELDS", "USERDATA_FIELDS", "unavailable_reason", "install", "supports", "law_vector", "attach"]
 
 #: The numeric "wmr_mj_law", in order (the enum of _compiled_law.c).
@@ -93,7 +95,7 @@ def unavailable_reason() -> str | None:
 
 
 def install() -> None:
-    """Install the law as mjcb_control (idempotent; raises RuntimeError where it cannot run).
+    """Install the law as mjcb_control (idempotent; raises ParameterError, saying why, where it cannot run).
 
     It stays installed: it returns at once for models without the law, and uninstalling it
     while another thread's batch runs would stop that batch's control.
@@ -101,7 +103,7 @@ def install() -> None:
     with _install_lock:
         why = unavailable_reason()
         if why is not None:
-            raise RuntimeError(why)
+            raise ParameterError(f"the compiled law cannot run: {why}")
         lib, _ = _library()
         if mujoco.get_mjcb_control() is None:
             mujoco.set_mjcb_control(lib.wmr_mj_control)
@@ -139,16 +141,16 @@ def attach(spec: mujoco.MjSpec, law: np.ndarray, reference: Sequence[np.ndarray]
     ``reference`` is (alpha0, alpha0', alpha0'') on the control grid, nstep samples each.
     """
     if len(spec.numerics):
-        raise ValueError("attach needs a spec without numerics: the law must be the model's first numeric")
+        raise ParameterError("attach needs a spec without numerics: the law must be the model's first numeric")
     if spec.nuserdata:
-        raise ValueError("attach needs a spec without userdata: the law writes userdata")
+        raise ParameterError("attach needs a spec without userdata: the law writes userdata")
     law = np.asarray(law, dtype=float)
     if law.shape != (len(LAW_FIELDS),):
-        raise ValueError(f"law must have the {len(LAW_FIELDS)} values of LAW_FIELDS")
+        raise ParameterError(f"law must have the {len(LAW_FIELDS)} values of LAW_FIELDS")
     nstep = int(law[LAW_FIELDS.index("nstep")])
     rows = np.stack([np.asarray(r, dtype=float)[:nstep] for r in reference], axis=1)
     if rows.shape != (nstep, 3):
-        raise ValueError(f"reference must be three rows of at least {nstep} samples")
+        raise ParameterError(f"reference must be three rows of at least {nstep} samples")
     spec.add_numeric(name=LAW_NUMERIC, data=law.tolist())
     spec.add_numeric(name=REFERENCE_NUMERIC, data=rows.ravel().tolist())
     spec.nuserdata = len(USERDATA_FIELDS)
