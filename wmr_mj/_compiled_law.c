@@ -1,9 +1,9 @@
 /* The steering law of controllers.computed_torque as MuJoCo's control callback (mjcb_control).
  *
- * wmr_mj.compiled_law installs wmr_mj_control through ctypes; wmr_mj.sweep's batch then runs
+ * wmr_mj.compiled_law installs wmr_mj_control through ctypes; wmr_mj.batch.run_batch then runs
  * whole blocks of closed-loop steps in C (mujoco.batch.Batch.rollout), with no Python per step.
  * The callback acts only on models that carry the numeric "wmr_mj_law" first and
- * "wmr_mj_reference" second (wmr_mj.compiled_law.law_model); on any other model it returns at
+ * "wmr_mj_reference" second (wmr_mj.compiled_law.attach); on any other model it returns at
  * once, so the serial loop and every other model of the process are untouched.
  *
  * The law is ComputedTorque.voltage_scalar / PDController.voltage_scalar, (3.2)-(3.3) of the
@@ -56,7 +56,7 @@ void wmr_mj_control(const mjModel* m, mjData* d) {
   const mjtNum* reference = m->numeric_data + m->numeric_adr[1];
   long long step = llround(d->time / m->opt.timestep);
   long long substeps = (long long)law[LAW_SUBSTEPS];
-  if (step < 0 || step % substeps) {
+  if (substeps < 1 || step < 0 || step % substeps) {
     return;  /* the control of the period's first step holds (zero-order hold) */
   }
   long long k = step / substeps;
