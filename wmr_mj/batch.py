@@ -251,8 +251,9 @@ def _run_group_compiled(loop: _Loop, models: Sequence[mujoco.MjModel], idx: np.n
     records: dict[int, dict[str, np.ndarray]] = {}  # one output buffer per block length, reused
     for k0 in range(0, loop.n, loop.block):
         count = min(loop.block, loop.n - k0)
-        out = records.setdefault(count, {"userdata": np.empty((g, count * substeps,
-                                                               len(compiled_law.USERDATA_FIELDS)))})
+        if count not in records:
+            records[count] = {"userdata": np.empty((g, count * substeps, len(compiled_law.USERDATA_FIELDS)))}
+        out = records[count]
         # the record after each physics step; a control step's values hold over its substeps
         userdata = batch.rollout(count * substeps, record=("userdata",), out=out)["userdata"][:, ::substeps]
         a_buf, E_buf, Ed_buf, u_buf = (userdata[:, :, j].T for j in range(4))  # (count, g) views
