@@ -7,8 +7,8 @@ STAMP := $(VENV)/.installed
 
 .PHONY: demo test lint venv bench clean foxglove-reader
 
-# the editable install builds the compiled law (wmr_mj/_compiled_law.c) in place: rebuild when it changes
-$(STAMP): pyproject.toml setup.py wmr_mj/_compiled_law.c
+# the editable install builds the compiled law (wmr_mj/sim/_compiled_law.c) in place: rebuild when it changes
+$(STAMP): pyproject.toml setup.py wmr_mj/sim/_compiled_law.c
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
 	$(PY) -m pip install -q -e '.[test,dask,video]'
@@ -40,4 +40,4 @@ bench: $(STAMP)
 	$(PY) bench/bench_video.py
 
 clean:
-	rm -rf $(VENV) build dist *.egg-info .ruff_cache wmr_mj/_compiled_law.*.so
+	rm -rf $(VENV) build dist *.egg-info .ruff_cache wmr_mj/sim/_compiled_law.*.so

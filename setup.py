@@ -1,14 +1,14 @@
 """Build hooks: ship the repository's models/ inside the wheel as ``wmr_mj/models/``, and
-build the steering law as MuJoCo's control callback (``wmr_mj._compiled_law``).
+build the steering law as MuJoCo's control callback (``wmr_mj.sim._compiled_law``).
 
 All project metadata lives in pyproject.toml. An installed wheel has no
-repository beside it, so ``wmr_mj.resources.MODELS_DIR`` falls back to this copy
+repository beside it, so ``wmr_mj._util.resources.MODELS_DIR`` falls back to this copy
 (``wmr-mj model check`` then compares it with the parameter set).
 
 The compiled law reads mjModel and mjData, so it is built against the headers of the
 mujoco wheel of the build (pyproject's build requirements) and checks at import that it
 runs with the same MuJoCo. It is optional: without a C compiler the install goes on and
-the batch uses the NumPy law (``wmr_mj.compiled_law.unavailable_reason`` says so).
+the batch uses the NumPy law (``wmr_mj.sim.compiled_law.unavailable_reason`` says so).
 """
 
 from pathlib import Path
@@ -34,7 +34,7 @@ class BuildPyWithModels(build_py):
 
 
 def compiled_law_extensions() -> list[Extension]:
-    """wmr_mj._compiled_law, where the mujoco wheel with its C headers is importable."""
+    """wmr_mj.sim._compiled_law, where the mujoco wheel with its C headers is importable."""
     try:
         import mujoco
     except ImportError:
@@ -43,7 +43,7 @@ def compiled_law_extensions() -> list[Extension]:
     if not (include / "mujoco" / "mujoco.h").is_file():
         return []
     # -ffp-contract=off: no fused multiply-adds, so that the C law rounds as the Python law does
-    return [Extension("wmr_mj._compiled_law", sources=["wmr_mj/_compiled_law.c"], include_dirs=[str(include)],
+    return [Extension("wmr_mj.sim._compiled_law", sources=["wmr_mj/sim/_compiled_law.c"], include_dirs=[str(include)],
                       extra_compile_args=["-O2", "-ffp-contract=off", "-fno-fast-math"], libraries=["m"],
                       optional=True)]
 

@@ -5,12 +5,12 @@
 All in one process, variants alternated within each repeat (so that a slow spell of a shared
 machine hits all of them), medians over --repeats:
 
-- run: wmr_mj.simulate.run_closed_loop (paper circle, --seconds long, 1 kHz control) without a
+- run: wmr_mj.sim.closed_loop.run_closed_loop (paper circle, --seconds long, 1 kHz control) without a
   log; with a null logger (the runner's own logging path: the per-step copies and the blocks,
-  nothing written); and with wmr_mj.mcaplog.RunLogger for each compression. Target: logged /
+  nothing written); and with wmr_mj.logs.writer.RunLogger for each compression. Target: logged /
   unlogged <= 1.3 for the default compression.
 - write: RunLogger alone on synthetic blocks of the same shape (us per logged row).
-- read: wmr_mj.logs.load_log + .signals + .state of the run's log; samples = scalar values
+- read: wmr_mj.logs.reader.load_log + .signals + .state of the run's log; samples = scalar values
   returned (signal fields incl. A_pos/C_pos columns, t/qpos/qvel/ctrl of /sim/state).
   Target >= 20 M samples/s.
 """
@@ -30,9 +30,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 
-from wmr_mj.logs import load_log  # noqa: E402
-from wmr_mj.mcaplog import COMPRESSIONS, RunLogger  # noqa: E402
-from wmr_mj.simulate import RunConfig, run_closed_loop  # noqa: E402
+from wmr_mj.logs.reader import load_log  # noqa: E402
+from wmr_mj.logs.writer import COMPRESSIONS, RunLogger  # noqa: E402
+from wmr_mj.sim.closed_loop import RunConfig, run_closed_loop  # noqa: E402
 
 RATIO_TARGET = 1.3
 READ_TARGET = 20e6
@@ -109,7 +109,7 @@ def synthetic_blocks(m: mujoco.MjModel, seconds: float, rate_hz: float = 1000.0)
 
 def bench_write(seconds: float, path: Path, repeats: int, compression: str) -> dict[str, float]:
     from wmr_mj.params import C80
-    from wmr_mj.plant import Plant
+    from wmr_mj.plant.mjcf import Plant
 
     plant = Plant(C80)
     m, xml = plant.model, plant.xml

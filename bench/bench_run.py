@@ -22,9 +22,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 import mujoco  # noqa: E402
 
 from controllers import make_controller, model_from_source  # noqa: E402
-from wmr_mj import C80  # noqa: E402
-from wmr_mj.plant import Plant  # noqa: E402
-from wmr_mj.simulate import RunConfig, run_closed_loop  # noqa: E402
+from wmr_mj import C80
+from wmr_mj.plant.mjcf import Plant  # noqa: E402
+from wmr_mj.sim.closed_loop import RunConfig, run_closed_loop  # noqa: E402
 
 
 def main() -> None:

@@ -11,8 +11,8 @@ physics steps per second (medians over repeats) of
             the timings), so that both loops do the same physics step for step (checked: the
             open loop ends where the closed loop did, to the bit); rollout records every
             step into output arrays allocated once;
-  compiled: ``wmr_mj.batch.run_batch`` as it runs by default: the law in C as MuJoCo's control
-            callback (``wmr_mj.compiled_law``), ``Batch.rollout`` a block of 1000 closed-loop
+  compiled: ``wmr_mj.sim.batch.run_batch`` as it runs by default: the law in C as MuJoCo's control
+            callback (``wmr_mj.sim.compiled_law``), ``Batch.rollout`` a block of 1000 closed-loop
             steps per call, statistics folded per block (compilation and reference outside
             the timing);
   numpy:    ``run_batch(law="numpy")``: ``mujoco.batch.Batch.step`` every 1 ms step with the
@@ -43,9 +43,9 @@ import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 from mujoco import rollout  # noqa: E402
 
-from wmr_mj.batch import batch_model, run_batch  # noqa: E402
-from wmr_mj.simulate import RunConfig, plant_parameters, run_closed_loop  # noqa: E402
-from wmr_mj.sweep import SweepSpec, run_sweep  # noqa: E402
+from wmr_mj.sim.batch import batch_model, run_batch  # noqa: E402
+from wmr_mj.sim.closed_loop import RunConfig, plant_parameters, run_closed_loop  # noqa: E402
+from wmr_mj.sim.sweep import SweepSpec, run_sweep  # noqa: E402
 
 
 def applied_voltages(configs: list[RunConfig]) -> np.ndarray:
@@ -129,7 +129,7 @@ def main() -> None:
           tempfile.TemporaryDirectory() as tmp):
         sweep_ol = None
         if spec is not None:
-            from wmr_mj.sweep import _run_configs, draw_samples
+            from wmr_mj.sim.sweep import _run_configs, draw_samples
 
             sweep_configs = _run_configs(spec, draw_samples(spec))
             sweep_ol = OpenLoop(sweep_configs, applied_voltages(sweep_configs), args.nthread)

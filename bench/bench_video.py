@@ -1,4 +1,4 @@
-"""Video rendering speed: `replay --video` before and after wmr_mj.video, in one process.
+"""Video rendering speed: `replay --video` before and after wmr_mj.logs.video, in one process.
 
     .venv/bin/python bench/bench_video.py [--repeats 2] [--duration 10] [--old-frames 30]
 
@@ -7,11 +7,11 @@ MuJoCo's Renderer (MUJOCO_GL, default egl) and prints medians over --repeats of:
   before: ms per frame of the former renderer's settings (960x540; the model's defaults:
           4096-pixel shadow map, floor reflection, skybox, 4x multisampling; mj_forward;
           400 path spheres), on --old-frames frames spread over the run; render only;
-  now:    wmr_mj.video.write_video on every frame (640x360; no shadow, reflection or sky;
+  now:    wmr_mj.logs.video.write_video on every frame (640x360; no shadow, reflection or sky;
           4x multisampling; mj_kinematics; the path as lines; overlay; H.264 encode), per stage;
   now at 960x540: the same, at the former size (what the settings alone save);
   ratio:  before / now per frame, and the estimate for the whole video before vs now;
-  end-to-end: wmr_mj.video.render_video (child process, backend probe, load, atomic write).
+  end-to-end: wmr_mj.logs.video.render_video (child process, backend probe, load, atomic write).
 """
 
 from __future__ import annotations
@@ -31,10 +31,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 
-from wmr_mj.logs import load_log  # noqa: E402
-from wmr_mj.mcaplog import RunLogger  # noqa: E402
-from wmr_mj.simulate import RunConfig, run_closed_loop  # noqa: E402
-from wmr_mj.video import render_video, write_video  # noqa: E402
+from wmr_mj.logs.reader import load_log  # noqa: E402
+from wmr_mj.logs.video import render_video, write_video  # noqa: E402
+from wmr_mj.logs.writer import RunLogger  # noqa: E402
+from wmr_mj.sim.closed_loop import RunConfig, run_closed_loop  # noqa: E402
 
 
 def old_ms_per_frame(log, n_frames: int, fps: int = 30) -> float:

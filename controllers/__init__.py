@@ -1,7 +1,7 @@
 """Steering controllers for wmr-mj: steering state and reference in, armature voltage out."""
 
-from .base import SteeringController, saturate
-from .computed_torque import (
+from controllers.base import SteeringController, saturate
+from controllers.computed_torque import (
     CONTROLLER_NAMES,
     FRICTION_SIGNS,
     MODEL_SOURCES,

@@ -8,7 +8,7 @@ simulations::
 
 ``voltage_scalar`` is the same law on Python floats, for the single-run loop
 where NumPy's per-call overhead would dominate, and ``batch_law(n)`` the same
-law for the batched loop of ``wmr_mj.sweep``: a callable that writes into
+law for the batched loop of ``wmr_mj.sim.sweep``: a callable that writes into
 buffers it owns, so that a control step allocates nothing (tests keep all three
 bit-identical)::
 

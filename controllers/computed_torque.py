@@ -1,7 +1,7 @@
 """Computed-torque steering control (3.2)-(3.3) and a PD baseline.
 
 The law of the paper, with the model-based part taken from a reduced model
-``model`` (:class:`wmr_mj.reduced.SteeringModel`, the estimate P^, K^, G^)::
+``model`` (:class:`wmr_mj.plant.reduced.SteeringModel`, the estimate P^, K^, G^)::
 
     u = P^ (alpha0'' + K_D E' + K_P E) + K^(alpha) + G^(alpha', alpha)        (3.2)-(3.3)
     E = alpha0 - alpha,   G^ = C_V^ alpha' + F^ s + gyro^ V_A alpha'/cos^2 alpha
@@ -32,11 +32,10 @@ from pathlib import Path
 
 import numpy as np
 
+from controllers.base import SteeringController
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import C80, PAPER_KD, PAPER_KP, C80Parameters
-from wmr_mj.reduced import MODEL_NAMES, SteeringModel, smooth_sign, steering_model
-
-from .base import SteeringController
+from wmr_mj.plant.reduced import MODEL_NAMES, SteeringModel, smooth_sign, steering_model
 
 __all__ = [
     "ComputedTorque",
@@ -151,7 +150,7 @@ class ComputedTorque(SteeringController):
 
     def law_constants(self) -> dict[str, float | str]:
         """The numbers the law uses: P^, K_P, K_D, C_V^, F^ (0 with friction_sign 'none'), K^,
-        gyro^ V_A (V s/rad), friction_width (rad/s) and friction_sign (what wmr_mj.compiled_law reads)."""
+        gyro^ V_A (V s/rad), friction_width (rad/s) and friction_sign (what wmr_mj.sim.compiled_law reads)."""
         return {"P": self._P, "K_P": self.kp, "K_D": self.kd, "C_V": self._C_V, "F": self._F, "K": self._K,
                 "gyro_V": self._gyro_V, "friction_width": self.friction_width, "friction_sign": self.friction_sign}
 

@@ -1,4 +1,4 @@
-"""The closed-loop batch (wmr_mj.batch): bit-identical to serial runs, the laws, the models, the groups."""
+"""The closed-loop batch (wmr_mj.sim.batch): bit-identical to serial runs, the laws, the models, the groups."""
 
 from __future__ import annotations
 
@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from wmr_mj.batch import batch_model, run_batch
-from wmr_mj.simulate import RunConfig, run_closed_loop
+from wmr_mj.sim.batch import batch_model, run_batch
+from wmr_mj.sim.closed_loop import RunConfig, run_closed_loop
 
 BASE = RunConfig(model="nonholonomic", duration=10.0)
 KEYS = ("sup_E", "sup_Edot", "sup_E_settled", "sup_Edot_settled", "E_max", "Edot_max", "saturated_fraction",
@@ -41,7 +41,7 @@ LAW_INPUTS = (np.array([0.0, 0.31, -0.62, 0.05, 0.8, -0.1, 0.2, 0.0]),  # alpha,
                                      dict(model="nonholonomic", friction_sign="reference", friction_width=0.01),
                                      dict(controller="pd", model="paper")])
 def test_batch_law_is_bit_identical_to_the_scalar_and_array_laws(options):
-    from wmr_mj.simulate import _controller, estimate_parameters
+    from wmr_mj.sim.closed_loop import _controller, estimate_parameters
 
     controller = _controller(RunConfig(**options), estimate_parameters())
     alpha, alpha_dot = LAW_INPUTS
@@ -61,8 +61,8 @@ def test_batch_law_is_bit_identical_to_the_scalar_and_array_laws(options):
 def test_batch_model_is_the_serial_model_but_for_the_sky():
     import mujoco
 
-    from wmr_mj.plant import compile_model
-    from wmr_mj.simulate import plant_parameters
+    from wmr_mj.plant.mjcf import compile_model
+    from wmr_mj.sim.closed_loop import plant_parameters
 
     cfg = BASE.replace(m1=612.3456789, plant_overrides={"mu": 0.0191234567, "V_A": 0.23})
     serial, _ = compile_model(plant_parameters(cfg), steering_friction=cfg.steering_friction)
@@ -85,7 +85,8 @@ def test_batch_model_is_the_serial_model_but_for_the_sky():
 
 def test_a_nan_voltage_applies_nothing_as_in_the_serial_run(monkeypatch):
     from controllers import ComputedTorque
-    from wmr_mj import batch, simulate
+    from wmr_mj.sim import batch
+    from wmr_mj.sim import closed_loop as simulate
 
     class NanWhileTurning(ComputedTorque):
         """The law of the paper, but NaN while the reference turns fast (a diverged law)."""
@@ -133,7 +134,7 @@ def test_paper_model_batch_matches_serial_including_steering_stop():
 
 def test_batch_split_into_groups_is_bit_identical_to_one_group(monkeypatch):
     """Several groups on their own threads (what run_batch uses for large batches) give the same numbers."""
-    import wmr_mj.batch as batch_module
+    import wmr_mj.sim.batch as batch_module
 
     configs = [BASE.replace(m1=m) for m in (560.0, 610.0, 680.0, 745.0)]
     one = run_batch(configs, nthread=2, law="numpy")  # groups are the NumPy law's (the compiled law runs one)

@@ -1,4 +1,4 @@
-"""Tests of the certificate (wmr_mj.certificate) against closed forms, a brute-force friction
+"""Tests of the certificate (wmr_mj.analysis.certificate) against closed forms, a brute-force friction
 enumeration, direct substitution of the fixed point, and one MuJoCo run at the dead band."""
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from wmr_mj import C80, with_params
-from wmr_mj.certificate import (
+from wmr_mj.analysis.certificate import (
     GYRO_BAND,
     PLANT_K_BAND,
     VERDICTS,
@@ -22,10 +22,10 @@ from wmr_mj.certificate import (
     judge,
     loop_crossover,
 )
-from wmr_mj.cli import main
+from wmr_mj.analysis.robustness import ParameterBox, analyse, exact_gammas
+from wmr_mj.cli.app import main
 from wmr_mj.errors import ParameterError, UnknownNameError
-from wmr_mj.robustness import ParameterBox, analyse, exact_gammas
-from wmr_mj.simulate import RunConfig, build_reference
+from wmr_mj.sim.closed_loop import RunConfig, build_reference
 
 
 def _S(a: float) -> float:
@@ -358,7 +358,7 @@ def test_cli_without_certificate_unchanged(capsys):
 def test_mujoco_none_at_high_gain_reaches_dead_band():
     """With no Coulomb compensation the PD must carry the whole friction while the joint slides:
     sup|E| = F/(P^ K_P) (critical damping does not overshoot). At m1 = 750 kg, F = F_max of the box."""
-    from wmr_mj.simulate import run_closed_loop
+    from wmr_mj.sim.closed_loop import run_closed_loop
 
     cfg = RunConfig(model="nonholonomic", kp=100.0, kd=20.0, friction_sign="none", m1=750.0, duration=12.0)
     result = run_closed_loop(cfg, progress=False)
@@ -409,7 +409,7 @@ def test_correlated_friction_term_is_F_over_P_not_F_max_over_P_min():
 
 
 def test_friction_over_P_bounds_every_plant_of_the_full_box():
-    from wmr_mj.certificate import friction_over_P_max
+    from wmr_mj.analysis.certificate import friction_over_P_max
     from wmr_mj.params import uncertainty_ranges
 
     full = {k: v for k, v in uncertainty_ranges("full").items() if k != "m1"}

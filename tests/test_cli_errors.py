@@ -9,9 +9,9 @@ from pathlib import Path
 
 import pytest
 
-from wmr_mj.cli import main
+from wmr_mj._util.files import check_output_path
+from wmr_mj.cli.app import main
 from wmr_mj.errors import NotEnoughMemoryError, OutputPathError
-from wmr_mj.io import check_output_path
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -96,8 +96,8 @@ def test_huge_run_is_refused_up_front():
 def test_library_refuses_a_run_that_does_not_fit(monkeypatch):
     """run_closed_loop itself refuses (not only the command): with 1 MiB available a 10 s run
     (10,000 rows of 320 bytes = 3.05 MiB) does not fit."""
-    from wmr_mj import memory
-    from wmr_mj.simulate import RunConfig, run_closed_loop
+    from wmr_mj._util import memory
+    from wmr_mj.sim.closed_loop import RunConfig, run_closed_loop
 
     monkeypatch.setattr(memory, "available_memory_bytes", lambda: 1 << 20)
     with pytest.raises(NotEnoughMemoryError, match=r"1e\+04 control steps.*3\.05 MiB of memory, 1 MiB is available"):
@@ -105,7 +105,7 @@ def test_library_refuses_a_run_that_does_not_fit(monkeypatch):
 
 
 def test_require_memory_compares_with_what_is_available(monkeypatch):
-    from wmr_mj import memory
+    from wmr_mj._util import memory
 
     monkeypatch.setattr(memory, "available_memory_bytes", lambda: 4 << 30)
     memory.require_memory(4 << 30, what="a job")  # exactly what is there: accepted
@@ -116,7 +116,7 @@ def test_require_memory_compares_with_what_is_available(monkeypatch):
 
 
 def test_available_memory_is_plausible():
-    available = __import__("wmr_mj.memory", fromlist=["x"]).available_memory_bytes()
+    available = __import__("wmr_mj._util.memory", fromlist=["x"]).available_memory_bytes()
     assert available is None or 16 << 20 < available < 1 << 50
 
 

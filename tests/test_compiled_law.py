@@ -1,4 +1,4 @@
-"""The compiled law (wmr_mj/_compiled_law.c as mjcb_control) against the Python law and the serial loop."""
+"""The compiled law (wmr_mj/sim/_compiled_law.c as mjcb_control) against the Python law and the serial loop."""
 
 from __future__ import annotations
 
@@ -8,10 +8,10 @@ import mujoco
 import numpy as np
 import pytest
 
-from wmr_mj import compiled_law
-from wmr_mj.batch import batch_law_backend, batch_model, run_batch
 from wmr_mj.errors import ParameterError, UnknownNameError
-from wmr_mj.simulate import RunConfig, _controller, estimate_parameters, plant_parameters, run_closed_loop
+from wmr_mj.sim import compiled_law
+from wmr_mj.sim.batch import batch_law_backend, batch_model, run_batch
+from wmr_mj.sim.closed_loop import RunConfig, _controller, estimate_parameters, plant_parameters, run_closed_loop
 
 BASE = RunConfig(model="nonholonomic", duration=10.0)
 KEYS = ("sup_E", "sup_Edot", "sup_E_settled", "sup_Edot_settled", "E_max", "Edot_max", "saturated_fraction",
@@ -126,7 +126,7 @@ def test_a_compiled_batch_is_bit_identical_to_serial_runs_and_to_the_numpy_batch
 
 def test_a_simulation_with_a_warning_is_rerun_serially(monkeypatch):
     """Rollout stops a simulation whose warnings rise; run_batch then reports the serial run."""
-    from wmr_mj import batch
+    from wmr_mj.sim import batch
 
     run_group = batch._run_group_compiled
 
@@ -187,7 +187,7 @@ def test_a_law_built_for_another_mujoco_is_refused_with_the_reason(monkeypatch):
 
 
 def test_a_compiled_batch_too_large_for_memory_is_refused_before_it_starts(monkeypatch):
-    from wmr_mj import memory
+    from wmr_mj._util import memory
     from wmr_mj.errors import NotEnoughMemoryError
 
     monkeypatch.setattr(memory, "available_memory_bytes", lambda: 100_000)  # < 2 runs x 10,000 steps x 24 B
@@ -199,10 +199,10 @@ def test_without_the_built_library_the_reason_says_so_and_the_batch_uses_numpy(m
     import sys
 
     compiled_law._library.cache_clear()
-    import wmr_mj
+    import wmr_mj.sim
 
-    monkeypatch.setitem(sys.modules, "wmr_mj._compiled_law", None)  # what an install without a compiler has
-    monkeypatch.delattr(wmr_mj, "_compiled_law", raising=False)
+    monkeypatch.setitem(sys.modules, "wmr_mj.sim._compiled_law", None)  # what an install without a compiler has
+    monkeypatch.delattr(wmr_mj.sim, "_compiled_law", raising=False)
     try:
         assert "is not built" in compiled_law.unavailable_reason()
         reports = run_batch([BASE.replace(m1=600.0)], law="auto")

@@ -1,4 +1,4 @@
-"""wmr_mj.derivation: the symbolic derivation of both reduced steering models.
+"""wmr_mj.plant.derivation: the symbolic derivation of both reduced steering models.
 
 Checks the derived (2.2) coefficients against params' closed forms
 (symbolically and numerically), the printed-departure bookkeeping, the
@@ -20,10 +20,10 @@ import sympy as sp
 from scipy.integrate import solve_ivp
 
 from wmr_mj import C80, with_params
-from wmr_mj import derivation as d
 from wmr_mj.errors import UnknownNameError
 from wmr_mj.params import C80Parameters
-from wmr_mj.reduced import steering_model
+from wmr_mj.plant import derivation as d
+from wmr_mj.plant.reduced import steering_model
 
 S = d.SYMBOLS
 V, Vd, al, ad, add = S["V"], S["V_d"], S["alpha"], S["alpha_d"], S["alpha_dd"]

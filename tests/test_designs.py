@@ -6,9 +6,9 @@ import argparse
 
 import pytest
 
-from wmr_mj.designs import CERTIFIED, ERROR_SPEC, LADDER, PAPER, PRESETS, certified_omega_r, preset
 from wmr_mj.errors import UnknownNameError
 from wmr_mj.params import PAPER_KD, PAPER_KP
+from wmr_mj.sim.designs import CERTIFIED, ERROR_SPEC, LADDER, PAPER, PRESETS, certified_omega_r, preset
 
 
 def test_certified_design_is_what_its_rule_gives():
@@ -47,7 +47,7 @@ def test_unknown_preset_lists_the_valid_ones():
 
 
 def _config(argv):
-    from wmr_mj.commands.run import add_run_options, config_from_args
+    from wmr_mj.cli.run import add_run_options, config_from_args
 
     p = argparse.ArgumentParser()
     add_run_options(p)

@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 from wmr_mj.errors import ParameterError, UnknownNameError
-from wmr_mj.falsify import (
+from wmr_mj.sim.closed_loop import RunConfig, run_closed_loop
+from wmr_mj.sim.falsify import (
     FalsifySpec,
     falsify,
     objective_source,
@@ -22,7 +23,6 @@ from wmr_mj.falsify import (
     search_worst,
     worst_config,
 )
-from wmr_mj.simulate import RunConfig, run_closed_loop
 
 BOX = np.array([[550.0, 750.0], [0.01, 0.03], [0.6, 1.0]])
 CORNER = np.array([550.0, 0.03, 0.6])  # the synthetic worst case: low, high, low
@@ -121,7 +121,7 @@ def test_spec_refuses_bad_boxes():
 
 
 def test_cli_falsify_json_files_and_replayable_log(tmp_path):
-    from wmr_mj.logs import load_log
+    from wmr_mj.logs.reader import load_log
 
     proc = subprocess.run([sys.executable, "-m", "wmr_mj.cli", "falsify", "--preset", "certified", "--path",
                            "lane-change", "--duration", "3", "--uncertainty", "m1", "--range", "mu=0.01:0.03",

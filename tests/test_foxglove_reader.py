@@ -18,8 +18,8 @@ import numpy as np
 import pytest
 from test_mcaplog import TEST_MJCF, synthetic_run
 
-from wmr_mj.foxglove import qmul, qrot
-from wmr_mj.logs import load_log
+from wmr_mj.logs.foxglove import qmul, qrot
+from wmr_mj.logs.reader import load_log
 
 CHECK = Path(__file__).parent / "foxglove_reader" / "check.mjs"
 

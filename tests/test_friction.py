@@ -16,9 +16,9 @@ import numpy as np
 import pytest
 
 from wmr_mj import C80, UnknownNameError
-from wmr_mj.cli import main
-from wmr_mj.friction import HOLD_RATE, constant_voltage_rates, measure_friction_law
-from wmr_mj.plant import STICTION_SOLIMP, STICTION_SOLREF, Plant, compile_model
+from wmr_mj.cli.app import main
+from wmr_mj.plant.friction import HOLD_RATE, constant_voltage_rates, measure_friction_law
+from wmr_mj.plant.mjcf import STICTION_SOLIMP, STICTION_SOLREF, Plant, compile_model
 
 F = C80.coefficients("paper").F  # V, friction voltage of (2.13)
 C_V = C80.coefficients("paper").C_V
@@ -91,7 +91,7 @@ def test_unknown_friction_model_is_an_unknown_name(call):
 
 
 def test_run_config_validates_and_passes_the_friction_model():
-    from wmr_mj.simulate import RunConfig, run_closed_loop
+    from wmr_mj.sim.closed_loop import RunConfig, run_closed_loop
 
     with pytest.raises(UnknownNameError, match="steering friction"):
         RunConfig(steering_friction="viscous")

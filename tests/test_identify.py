@@ -11,8 +11,8 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from wmr_mj import C80
-from wmr_mj.identify import fit_steering_model, identify_plant
-from wmr_mj.reduced import SteeringModel
+from wmr_mj.plant.identify import fit_steering_model, identify_plant
+from wmr_mj.plant.reduced import SteeringModel
 
 TRUE = dict(P=0.41, C_V=4.5, F=1.2, K=3.1, gyro=0.8)
 

@@ -1,5 +1,5 @@
-"""MCAP run logs: writer (wmr_mj.mcaplog), format (wmr_mj.logformat), Foxglove encoders
-(wmr_mj.foxglove) and reader (wmr_mj.logs).
+"""MCAP run logs: writer (wmr_mj.logs.writer), format (wmr_mj.logs.logformat), Foxglove encoders
+(wmr_mj.logs.foxglove) and reader (wmr_mj.logs.reader).
 
 A small cart model with the C80's body and joint names is compiled from a string, stepped
 with some ctrl, and logged with the runner's block contract. What is written is checked
@@ -23,11 +23,11 @@ import mujoco
 import numpy as np
 import pytest
 
-from wmr_mj import logformat
 from wmr_mj.errors import LogError, ParameterError
-from wmr_mj.logformat import foxglove_schema
-from wmr_mj.logs import load_log
-from wmr_mj.mcaplog import RunLogger, terminate_as_interrupt
+from wmr_mj.logs import logformat
+from wmr_mj.logs.logformat import foxglove_schema
+from wmr_mj.logs.reader import load_log
+from wmr_mj.logs.writer import RunLogger, terminate_as_interrupt
 
 TEST_MJCF = """
 <mujoco model="c80_test">
@@ -245,7 +245,7 @@ def test_cdr_channels_decode_with_an_independent_decoder(logged):
 
 
 def _compose(transforms):
-    from wmr_mj.foxglove import qmul, qrot
+    from wmr_mj.logs.foxglove import qmul, qrot
 
     world = {"world": (np.zeros(3), np.array([1.0, 0, 0, 0]))}
     for tr in transforms:
@@ -295,7 +295,7 @@ def test_scene_validates_and_shows_the_axles(logged):
 
 
 def test_foxglove_layout_names_what_the_log_has(logged):
-    from wmr_mj.foxglove import LAYOUT_PATH
+    from wmr_mj.logs.foxglove import LAYOUT_PATH
 
     path, _ = logged
     log = load_log(path)
@@ -567,7 +567,7 @@ _LOOP = textwrap.dedent(
     import numpy as np, mujoco
     sys.path.insert(0, {tests!r})
     from test_mcaplog import TEST_MJCF, _block
-    from wmr_mj.mcaplog import RunLogger, terminate_as_interrupt
+    from wmr_mj.logs.writer import RunLogger, terminate_as_interrupt
     m = mujoco.MjModel.from_xml_string(TEST_MJCF)
     s0 = np.empty(mujoco.mj_stateSize(m, mujoco.mjtState.mjSTATE_INTEGRATION))
     mujoco.mj_getState(m, mujoco.MjData(m), s0, mujoco.mjtState.mjSTATE_INTEGRATION)

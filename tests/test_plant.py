@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from wmr_mj import C80, ModelFileError, ParameterError, UnknownNameError, with_params
-from wmr_mj.plant import (
+from wmr_mj.plant.mjcf import (
     MODELS_DIR,
     STEERING_FRICTION_MODELS,
     TYRE_CONTACT_MODELS,
@@ -266,7 +266,7 @@ def test_cli_bad_parameter_exits_2_with_one_line(argv, needle):
 
 def test_wheels_roll_without_side_slip_at_paper_speed():
     """On the 1 m circle at 0.2 m/s the contact points slide sideways by < 1% of V_A."""
-    from wmr_mj.plant import measure_side_slip
+    from wmr_mj.plant.mjcf import measure_side_slip
 
     slip = measure_side_slip(C80, duration=15.0, settle=8.0)
     assert abs(slip["alpha"] - slip["alpha_target"]) < 0.02  # it was on the circle
@@ -275,7 +275,7 @@ def test_wheels_roll_without_side_slip_at_paper_speed():
 
 
 def test_model_card_is_a_fresh_rendering():
-    from wmr_mj.modelcard import render_model_card
+    from wmr_mj.plant.modelcard import render_model_card
 
     assert (MODELS_DIR / "README.md").read_text() == render_model_card(C80), "run: wmr-mj model card"
 

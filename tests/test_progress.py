@@ -1,4 +1,4 @@
-"""wmr_mj.progress (tqdm): silent off a terminal, counts right on one; the sweep command's outputs."""
+"""wmr_mj._util.progress (tqdm): silent off a terminal, counts right on one; the sweep command's outputs."""
 
 from __future__ import annotations
 
@@ -6,8 +6,8 @@ import csv
 import io
 import json
 
-from wmr_mj.cli import main
-from wmr_mj.progress import Stages, counter_callback, progress_bar
+from wmr_mj._util.progress import Stages, counter_callback, progress_bar
+from wmr_mj.cli.app import main
 
 
 class _Terminal(io.StringIO):

@@ -1,4 +1,4 @@
-"""Reference trajectories (wmr_mj.reference) against independent truths.
+"""Reference trajectories (wmr_mj.reference.paths) against independent truths.
 
 Geometry (circle fits), kinematics (an independent RK4 unicycle), calculus
 (numerical derivatives), the paper's bounds (5.1), continuity, feasibility and
@@ -15,7 +15,7 @@ import pytest
 
 from wmr_mj import C80, with_params
 from wmr_mj.errors import InfeasiblePathError, ParameterError
-from wmr_mj.reference import (
+from wmr_mj.reference.paths import (
     PAPER_BOUNDS,
     Path,
     Reference,

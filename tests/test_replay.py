@@ -1,4 +1,4 @@
-"""`wmr-mj replay` and wmr_mj.replay: summary, --json, --plot, --verify (bit for bit, on a
+"""`wmr-mj replay` and wmr_mj.logs.replay: summary, --json, --plot, --verify (bit for bit, on a
 synthetic log and on a real closed-loop run), --video and bad input."""
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from test_mcaplog import _chunk_spans, synthetic_run
 
-from wmr_mj.cli import main
+from wmr_mj.cli.app import main
 
 
 @pytest.fixture(scope="module")
@@ -112,7 +112,7 @@ def test_bad_input_exit_2_one_line(logs, capsys, monkeypatch, case):
             data[start + length - 20 - k] ^= 0xA5
         path.write_bytes(bytes(data))
     elif case == "unknown_version":
-        import wmr_mj.logformat as logformat
+        import wmr_mj.logs.logformat as logformat
 
         monkeypatch.setattr(logformat, "SCHEMA_VERSION", "1")  # what the hand-written writer made
         synthetic_run(path, 0.05)
@@ -134,7 +134,7 @@ def test_bad_input_subprocess_no_traceback(logs):
 
 
 def test_video_without_gl_backend_says_so(logs, capsys, monkeypatch):
-    import wmr_mj.video as video
+    import wmr_mj.logs.video as video
 
     monkeypatch.delenv("MUJOCO_GL", raising=False)
     monkeypatch.setattr(video, "BACKENDS", ("no-such-backend",))  # MuJoCo refuses this MUJOCO_GL
@@ -146,10 +146,10 @@ def test_video_without_gl_backend_says_so(logs, capsys, monkeypatch):
 
 def test_real_run_replays_bit_for_bit(tmp_path, capsys):
     """The closed-loop runner's own log (C80 plant, paper circle, interrupted after 3 s) verifies."""
-    from wmr_mj.logs import load_log
-    from wmr_mj.mcaplog import RunLogger
-    from wmr_mj.replay import summarize, verify
-    from wmr_mj.simulate import RunConfig, run_closed_loop
+    from wmr_mj.logs.reader import load_log
+    from wmr_mj.logs.replay import summarize, verify
+    from wmr_mj.logs.writer import RunLogger
+    from wmr_mj.sim.closed_loop import RunConfig, run_closed_loop
 
     path = tmp_path / "run.mcap"
 

@@ -1,4 +1,4 @@
-"""Tests of the section-4 robustness analysis (wmr_mj.robustness) and `wmr-mj robustness`."""
+"""Tests of the section-4 robustness analysis (wmr_mj.analysis.robustness) and `wmr-mj robustness`."""
 
 from __future__ import annotations
 
@@ -14,9 +14,7 @@ import pytest
 from scipy import integrate, optimize, signal
 
 from wmr_mj import C80
-from wmr_mj.cli import main
-from wmr_mj.errors import ParameterError, UnknownNameError, WmrMjError
-from wmr_mj.robustness import (
+from wmr_mj.analysis.robustness import (
     PAPER_CONDITION,
     ParameterBox,
     ReferenceBounds,
@@ -27,6 +25,8 @@ from wmr_mj.robustness import (
     impulse_responses,
     paper_gammas,
 )
+from wmr_mj.cli.app import main
+from wmr_mj.errors import ParameterError, UnknownNameError, WmrMjError
 
 REPO = Path(__file__).resolve().parents[1]
 

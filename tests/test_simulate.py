@@ -12,9 +12,9 @@ import pytest
 
 from controllers import ComputedTorque, PDController, gains_from_omega_r, model_from_source
 from wmr_mj import C80, ParameterError, UnknownNameError
-from wmr_mj.reduced import SteeringModel
-from wmr_mj.robustness import ParameterBox, ReferenceBounds, analyse
-from wmr_mj.simulate import RunConfig, build_reference, run_closed_loop, run_on_reduced_model
+from wmr_mj.analysis.robustness import ParameterBox, ReferenceBounds, analyse
+from wmr_mj.plant.reduced import SteeringModel
+from wmr_mj.sim.closed_loop import RunConfig, build_reference, run_closed_loop, run_on_reduced_model
 
 
 @pytest.fixture(scope="module")

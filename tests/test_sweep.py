@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from wmr_mj import ParameterError, SchedulerError, UnknownNameError
-from wmr_mj.simulate import RunConfig
-from wmr_mj.sweep import (
+from wmr_mj.sim.closed_loop import RunConfig
+from wmr_mj.sim.sweep import (
     SweepSpec,
     connect,
     draw_samples,
@@ -125,7 +125,7 @@ def test_cli_sweep_json_and_files(tmp_path):
 def test_uncertainty_box_and_ranges_from_the_command_line():
     import argparse
 
-    from wmr_mj.commands._common import box_ranges_from_args
+    from wmr_mj.cli._common import box_ranges_from_args
     from wmr_mj.params import uncertainty_ranges
 
     full = uncertainty_ranges("full")
@@ -149,7 +149,7 @@ def test_cli_sweep_bad_input_exits_2(argv, tmp_path):
 
 
 def test_cli_sweep_log_writes_replayable_mcap_per_run(tmp_path):
-    from wmr_mj.logs import load_log
+    from wmr_mj.logs.reader import load_log
 
     proc = subprocess.run([sys.executable, "-m", "wmr_mj.cli", "sweep", "--n", "2", "--model", "nonholonomic",
                            "--duration", "10", "--out", str(tmp_path), "--log", "--json"],
@@ -166,9 +166,9 @@ def test_cli_sweep_log_writes_replayable_mcap_per_run(tmp_path):
 
 def test_certified_design_sweep_over_m1_is_certified_inside_for_every_run(tmp_path):
     """Issue 8: a sweep of the certified design over m1 550-750 kg has no run outside certified-inside."""
-    from wmr_mj.designs import CERTIFIED
+    from wmr_mj.analysis.verdicts import count_verdicts
     from wmr_mj.params import M1_RANGE
-    from wmr_mj.verdicts import count_verdicts
+    from wmr_mj.sim.designs import CERTIFIED
 
     base = RunConfig(**CERTIFIED.config_changes(), duration=35.0)
     spec = SweepSpec(n=8, seed=0, sampling="lhs", m1_range=M1_RANGE, base=base)

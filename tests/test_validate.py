@@ -20,10 +20,10 @@ matplotlib.use("Agg")
 import matplotlib.image as mpimg  # noqa: E402
 import pytest  # noqa: E402
 
-from wmr_mj.designs import CERTIFIED, LADDER, PAPER  # noqa: E402
-from wmr_mj.report import ladder_changes, summarise_rung  # noqa: E402
-from wmr_mj.report_text import format_headline, render_markdown  # noqa: E402
-from wmr_mj.verdicts import VERDICTS  # noqa: E402
+from wmr_mj.analysis.verdicts import VERDICTS  # noqa: E402
+from wmr_mj.report.text import format_headline, render_markdown  # noqa: E402
+from wmr_mj.report.validate import ladder_changes, summarise_rung  # noqa: E402
+from wmr_mj.sim.designs import CERTIFIED, LADDER, PAPER  # noqa: E402
 
 N = 3
 # 10 s reaches the circle (C enters it at about 8.1 s); budget 5 = one generation per m1 search
@@ -143,7 +143,7 @@ def test_ladder_changes_and_summarise_rung_units():
 
 
 def test_the_search_beside_the_monte_carlo_worst_and_the_certificate(validated):
-    from wmr_mj.logs import load_log
+    from wmr_mj.logs.reader import load_log
 
     folder, _, _ = validated
     saved = _saved(folder)
@@ -168,10 +168,10 @@ def test_the_search_beside_the_monte_carlo_worst_and_the_certificate(validated):
     assert set(full["box"]) == {"m1", "mu", "ground_friction", "R_a", "V_A"}
     # the full-box certificate is the one certificate_for gives for that box, and the runs' verdicts follow it
     from wmr_mj import C80
-    from wmr_mj.certificate import certificate_for
-    from wmr_mj.designs import CERTIFIED
+    from wmr_mj.analysis.certificate import certificate_for
     from wmr_mj.params import uncertainty_ranges
-    from wmr_mj.simulate import RunConfig, build_reference
+    from wmr_mj.sim.closed_loop import RunConfig, build_reference
+    from wmr_mj.sim.designs import CERTIFIED
 
     extra = {k: v for k, v in uncertainty_ranges("full").items() if k != "m1"}
     cfg = RunConfig(**CERTIFIED.config_changes(), duration=35.0, box_ranges=extra)
@@ -227,11 +227,11 @@ def test_bad_input_exits_2_with_one_line(args, tmp_path):
 
 
 def test_uncertainty_box_reaches_the_ladder_and_the_certificates():
-    from wmr_mj.designs import CERTIFIED
     from wmr_mj.errors import UnknownNameError as _Unknown
     from wmr_mj.params import uncertainty_ranges
-    from wmr_mj.report import ValidateSettings
-    from wmr_mj.report_search import search_plans
+    from wmr_mj.report.search import search_plans
+    from wmr_mj.report.validate import ValidateSettings
+    from wmr_mj.sim.designs import CERTIFIED
 
     full = ValidateSettings(uncertainty="full")
     expected = {k: v for k, v in uncertainty_ranges("full").items() if k != "m1"}

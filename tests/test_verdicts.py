@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from wmr_mj.verdicts import DRIFT_TOLERANCE, VERDICTS, count_verdicts, drift, drift_window_steps, is_pass
+from wmr_mj.analysis.verdicts import DRIFT_TOLERANCE, VERDICTS, count_verdicts, drift, drift_window_steps, is_pass
 
 
 def test_drift_compares_the_last_two_windows():
@@ -31,7 +31,7 @@ def test_only_certified_inside_passes_and_counts_cover_all_four():
 def test_soft_friction_creep_shows_as_drift(friction, growing):
     """The known finding: with MuJoCo's soft frictionloss the exact-sign compensation keeps the joint
     creeping (|E| still growing at 35 s); with stiction it settles."""
-    from wmr_mj.simulate import RunConfig, run_closed_loop
+    from wmr_mj.sim.closed_loop import RunConfig, run_closed_loop
 
     s = run_closed_loop(RunConfig(model="nonholonomic", steering_friction=friction), progress=False).summary
     assert s["drift"]["growing"] is growing

@@ -1,4 +1,4 @@
-"""wmr_mj.video: the MP4 of a run log, what its frames show, and the error without OpenGL."""
+"""wmr_mj.logs.video: the MP4 of a run log, what its frames show, and the error without OpenGL."""
 
 from __future__ import annotations
 
@@ -7,9 +7,9 @@ import functools
 import numpy as np
 import pytest
 
-from wmr_mj import video
-from wmr_mj.cli import main
+from wmr_mj.cli.app import main
 from wmr_mj.errors import ParameterError
+from wmr_mj.logs import video
 
 FPS = 10
 WIDTH, HEIGHT = 640, 360
@@ -17,8 +17,8 @@ WIDTH, HEIGHT = 640, 360
 
 @pytest.fixture(scope="module")
 def log_path(tmp_path_factory):
-    from wmr_mj.mcaplog import RunLogger
-    from wmr_mj.simulate import RunConfig, run_closed_loop
+    from wmr_mj.logs.writer import RunLogger
+    from wmr_mj.sim.closed_loop import RunConfig, run_closed_loop
 
     path = tmp_path_factory.mktemp("video") / "run.mcap"
     # the paper circle needs more than 2 s of lead-in; the figure eight starts at once

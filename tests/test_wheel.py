@@ -23,7 +23,7 @@ from pathlib import Path
 
 import pytest
 
-from wmr_mj.cli import COMMANDS
+from wmr_mj.cli.app import COMMANDS
 
 REPO = Path(__file__).resolve().parents[1]
 # what a build must not see: environments, build outputs, caches, run outputs
@@ -78,7 +78,7 @@ def test_wheel_carries_every_module_and_data_file(installed):
     expected |= {p.relative_to(src).as_posix() for g in _DATA_GLOBS for p in src.glob(g)
                  if p.is_file() and not p.name.startswith(".")}  # hidden: an atomic write's temporary file
     expected |= {f"wmr_mj/models/{name}" for name in _MODEL_FILES}
-    assert "wmr_mj/commands/run.py" in expected and "wmr_mj/schemas/wmr_mj.channels.json" in expected
+    assert "wmr_mj/cli/run.py" in expected and "wmr_mj/schemas/wmr_mj.channels.json" in expected
     assert sorted(expected - names) == []
     for name in _MODEL_FILES:  # the shipped model files are the checkout's, byte for byte
         assert zipfile.ZipFile(wheel).read(f"wmr_mj/models/{name}") == (src / "models" / name).read_bytes()
@@ -95,8 +95,8 @@ def test_installed_package_is_the_wheel_not_the_checkout(installed):
 
 def test_the_wheel_builds_the_compiled_law_and_it_runs(installed):
     bin_dir, wheel, _, outside, env = installed
-    assert any(n.startswith("wmr_mj/_compiled_law.") and n.endswith(".so") for n in zipfile.ZipFile(wheel).namelist())
-    out = _run([str(bin_dir / "python"), "-c", "from wmr_mj import compiled_law, _compiled_law; "
+    assert any(n.startswith("wmr_mj/sim/_compiled_law.") and n.endswith(".so") for n in zipfile.ZipFile(wheel).namelist())
+    out = _run([str(bin_dir / "python"), "-c", "from wmr_mj.sim import compiled_law, _compiled_law; "
                 "print(compiled_law.unavailable_reason()); print(_compiled_law.__file__)"], cwd=outside, env=env)
     reason, path = out.split("\n")[:2]
     assert reason == "None" and Path(path).is_relative_to(bin_dir.parent), out
@@ -110,7 +110,7 @@ def test_without_a_c_compiler_the_wheel_builds_without_the_compiled_law(installe
           "-w", str(tmp_path / "wheels"), str(source)], cwd=tmp_path, env={**env, "CC": "/bin/false"})
     (wheel,) = (tmp_path / "wheels").glob("wmr_mj-*.whl")
     names = zipfile.ZipFile(wheel).namelist()
-    assert "wmr_mj/compiled_law.py" in names and not [n for n in names if n.endswith(".so")]
+    assert "wmr_mj/sim/compiled_law.py" in names and not [n for n in names if n.endswith(".so")]
 
 
 def test_help_lists_every_command(installed):

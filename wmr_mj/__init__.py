@@ -1,6 +1,6 @@
 """wmr-mj: a MuJoCo validation testbed for computed-torque steering control of the C80 cart."""
 
-from .errors import (
+from wmr_mj.errors import (
     InfeasiblePathError,
     LogError,
     ModelFileError,
@@ -9,9 +9,9 @@ from .errors import (
     UnknownNameError,
     WmrMjError,
 )
-from .params import C80, C80Parameters, Coefficients, parameter_names, with_params
+from wmr_mj.params import C80, C80Parameters, Coefficients, parameter_names, with_params
 
-__version__ = "0.1.0"
+from ._version import __version__ as __version__
 
 __all__ = [
     "C80",

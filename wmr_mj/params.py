@@ -32,7 +32,7 @@ import math
 from dataclasses import dataclass, fields
 from typing import Any
 
-from .errors import ParameterError, UnknownNameError
+from wmr_mj.errors import ParameterError, UnknownNameError
 
 __all__ = [
     "C80Parameters",
@@ -293,7 +293,7 @@ class C80Parameters:
     def kinetic_energy_coefficients(self) -> dict[str, float]:
         """A, B, C, D of E = A V^2 + B V^2 tan^2 a + C V a' tan a + D a'^2, (2.2).
 
-        Derived from the geometry (``wmr_mj.derivation`` regenerates them with
+        Derived from the geometry (``wmr_mj.plant.derivation`` regenerates them with
         sympy) with per-unit masses:
 
         A = (m1 + m2 + m3)/2 + I_y2/r2^2 + I_y3/r3^2
@@ -327,7 +327,7 @@ class C80Parameters:
 
         paper (2.7), (2.13): P = (R_a/k_i) 2D/i2, C_V = k_b i2,
             F = (R_a/k_i) (l3 l4/(l1 i2)) mu Q, K = (R_a/k_i) 2 B V_A^2 / i2, gyro = 0.
-        nonholonomic (see ``wmr_mj.reduced``): same P, C_V, F; K = 0;
+        nonholonomic (see ``wmr_mj.plant.reduced``): same P, C_V, F; K = 0;
             gyro = P / l1 (the chassis yaw acceleration V_A alpha'/(l1 cos^2)
             acting on the steering inertia).
         """

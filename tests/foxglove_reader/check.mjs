@@ -1,7 +1,7 @@
 // Read a wmr-mj run log the way Foxglove does: @mcap/core's indexed reader (with @mcap/support's
 // lz4/zstd decompressors), every ros2msg/cdr channel decoded by @foxglove/rosmsg2-serialization
 // from the schema text in the file, json channels by JSON.parse. Prints one JSON object that
-// tests/test_foxglove_reader.py compares with wmr_mj.logs.load_log.
+// tests/test_foxglove_reader.py compares with wmr_mj.logs.reader.load_log.
 //
 //   node tests/foxglove_reader/check.mjs LOG.mcap
 import { open } from "node:fs/promises";

@@ -1,0 +1,775 @@
+"""A certificate for the controller actually run on the plant actually simulated (section 4, redone).
+
+:mod:`wmr_mj.analysis.robustness` keeps the paper's region ("the paper's claim"). This module
+redoes the section-4 analysis for the computed-torque law (3.2)-(3.3) *as it is run*
+(its model source, its Coulomb compensation, its gains, its control period) against
+the plant *as it is simulated* (stiction at rest, a gyroscopic term, no sin/cos^3
+stiffness, the angle it actually reaches), and lists every assumption the bound rests
+on with its number and whether it holds.
+
+Plant and controller (voltage form, X~ = X - X^ truth minus estimate)::
+
+    plant:  P a'' + C_V a' + f + K S(a) + Gam a'/cos^2(a) = u,   S(a) = sin(a)/cos^3(a)
+            f = F sgn(a') while sliding, f anywhere in [-F, F] at rest (stiction)
+            Gam = gyro V_A  (the non-holonomic plant: gyro = P/l1; wmr_mj.plant.reduced)
+    law:    u = P^ (a0'' + K_D E' + K_P E) + K^ S(a) + C_V^ a' + F^ s + Gam^ a'/cos^2(a)   (3.2)-(3.3)
+            s: sgn(a') ('measured', exact or x/sqrt(x^2+w^2)), sgn(a0') ('reference'), 0 ('none')
+
+With a'' = a0'' - E'' and a' = a0' - E' the error equation is (4.10) with::
+
+    eta = (1 - P^/P)(K_D E' + K_P E)
+          + P^-1 [P~ a0'' + (f - F^ s) + K~ S(a) + C~_V a0' + Gam~ a0'/cos^2(a) - (C~_V + Gam~/cos^2(a)) E']
+
+so that, with alpha_max = max|a0| + E_max the largest reachable |a| (S and 1/cos^2 grow with |a|)::
+
+    ||eta|| <= delta1 + delta2 ||E|| + delta3 ||E'||                                       (4.19)
+    delta1 = max_P [ |P - P^| max|a0''| + phi + |K~| S(alpha_max) + |C~_V| max|a0'|
+                     + |Gam~| max|a0'| / cos^2(alpha_max) ] / P                           (4.18)
+    delta2 = max_P |1 - P^/P| K_P                              (coefficient of ||E||, corrected (4.20))
+    delta3 = max |(1 - P^/P) K_D - (C~_V + Gam~/c2)/P|  over P, C~_V, Gam~ corners, c2 in {cos^2(alpha_max), 1}
+    condition = gamma1 delta2 + gamma2 delta3 < 1                                         (4.23)
+    E_max = gamma1 delta1 / (1 - condition),   Edot_max = gamma2 delta1 / (1 - condition)  (4.21)
+
+(a PD controller has no feedforward: its a0'' term is |P - 0| max|a0''| / P = max|a0''|).
+
+Friction term phi = sup |f - F^ s| over sliding and rest, by compensation mode:
+
+* 'none' (F^ s = 0): |f| <= F at rest and sliding, phi = F_max.
+* 'measured' (s = sgn a', exact or smoothed; |s| <= 1 with the sign of a'). Sliding:
+  f - F^ s = sgn(a') (F - F^ |s|), so |.| <= max(F_max, F^ - F_min). At rest with s = 0
+  (exact sign of a' = 0): |f| <= F_max. A joint that creeps (soft friction, or a sampled
+  a' of a few urad/s) has s != 0 locked to the creep direction, which is the direction of
+  the net drive tau + F^ s (tau: every other term); it sticks while |tau + F^ s| <= F, and
+  then f - F^ s = tau with tau + F^ s of the sign of s, so -F^ |s| < tau sgn(s) <= F - F^ |s|:
+  |f - F^ s| <= max(F^, F_max). Over all cases: phi = max(F_max, F^) (= F_max when
+  F^ <= F_max, physics.md section 5).
+* 'reference' (s = sgn a0', moving with the reference, not with the joint): f and s are
+  independent, phi = F_max + F^ (physics.md section 5).
+
+F and P move together. In volts F = (R_a/(k_i i2)) tau_f and P = (R_a/k_i) 2D/i2, so
+F/P = tau_f/(2D) does not depend on R_a: a box where R_a is uncertain holds no plant with
+F_max and P_min at once. With r >= F/P over the box (:func:`friction_over_P_max`) the
+friction level at P is min(F_max, r P), and phi/P is taken per P rather than F_max/P_min.
+
+gamma1 >= 1/K_P (the DC gain of 1/(s^2 + K_D s + K_P)), so no valid bound lies below
+the static dead band F_max/(P^ K_P): with P = P^ and nothing else uncertain, E_max is
+exactly F_max/(P^ K_P) for critical damping.
+
+Reachable angle (fixed point). K~ S(a) and Gam~/cos^2(a) are bounded over the plant's
+angle, |a| <= max|a0| + E_max, so E_max = Phi(E_max) with Phi(x) the bound above at
+alpha_max = max|a0| + x. Phi is increasing; the iteration x <- Phi(x) from x = 0 rises to
+the least fixed point x*. Along a run x(T) = sup_[0,T] |E| is continuous from 0 and
+always satisfies x(T) <= Phi(x(T)), so it stays in [0, x*] provided Phi(x) < x just above
+x* (checked: a tangent fixed point is refused). If the iteration reaches pi/2 or (4.23)
+fails on the way, there is no certificate (``valid`` False, with the reason). The
+paper's own (5.1) example (K~ = 0.09 V, (4.23) = 0.26204) moves from E_max = 0.105 rad
+(sin/cos^3 = 1.24 at a0) to 0.1663 rad (alpha_max = 0.825 rad) under this alone.
+
+Assumptions (each an :class:`Assumption` with its value, limit and whether it is met;
+``verdict`` says "certified-*" only when all are met):
+
+* (4.23) condition < 1;
+* reachable angle: the fixed point exists, alpha_max < pi/2;
+* steering stops: alpha_max = max|a0| + E_max < steering_range (else the stop's
+  torque, outside the model, acts);
+* supply: the voltage the law needs anywhere in the region,
+  P^ (max|a0''| + K_D Edot_max + K_P E_max) + |K^| S(alpha_max) + |C_V^| (max|a0'| + Edot_max)
+  + F^ + |Gam^| (max|a0'| + Edot_max)/cos^2(alpha_max) <= voltage_limit (the analysis
+  has no saturation);
+* control period (stated, not bounded): the analysis is continuous time; the sampled
+  law holds u for T, a delay of at most T. The condition is T <= 0.1 x the loop's
+  delay margin PM/omega_c (omega_c the crossover of (K_D s + K_P)/s^2, PM its phase
+  margin), i.e. the hold costs at most a tenth of the phase margin;
+* zero initial error (the bound (4.17) is for zero initial conditions);
+* stated ones (``kind='stated'``) passed in by the caller, e.g. the plant's gyro band.
+
+A run is inside when (sup|E|, sup|E'|) satisfies both inequalities of (4.21), the
+region itself, which lies inside the rectangle E_max x Edot_max (a point of the
+rectangle outside the region contradicts the bound as much as one beyond E_max).
+
+Usage::
+
+    from wmr_mj import C80
+    from wmr_mj.analysis.certificate import certify, certificate_for, judge
+    from wmr_mj.analysis.robustness import ParameterBox
+    box = ParameterBox(P=(0.385, 0.385), C_V=(4.77, 4.77), F=(1.313, 1.724), K=(-0.02, 0.02))
+    cert = certify(box=box, gyro=(0.472, 0.723), V_A=(0.2, 0.2), P_hat=0.385, C_V_hat=4.77,
+                   F_hat=1.518, K_hat=0.0, gyro_hat=0.629, V_A_hat=0.2, kp=100.0, kd=20.0,
+                   friction_sign="measured", friction_width=0.01, alpha0_max=0.659,
+                   alpha0_dot_max=0.23, alpha0_ddot_max=0.155, steering_range=0.9,
+                   voltage_limit=24.0, control_period=0.001)
+    cert.E_max, cert.Edot_max, cert.voltage_max     # 0.0463 rad, 0.341 rad/s, 8.8 V
+    cert.verdict(0.031, 0.2)                         # 'certified-inside'
+    judge(cert, 0.031, 0.2)                          # JSON-ready, with inside, E_ratio, Edot_ratio
+
+    from wmr_mj.sim.closed_loop import RunConfig, build_reference
+    cfg = RunConfig(model="nonholonomic", kp=100.0, kd=20.0, friction_width=0.01)
+    cert = certificate_for(cfg, build_reference(cfg.path, C80, dt=1e-3, duration=35.0)[0])
+"""
+
+from __future__ import annotations
+
+import functools
+import itertools
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+from wmr_mj.analysis.robustness import ParameterBox, _check_gains, damping_regime, exact_gammas
+from wmr_mj.errors import ParameterError, UnknownNameError
+from wmr_mj.params import C80, C80Parameters
+
+__all__ = [
+    "friction_over_P_max",
+    "VERDICTS",
+    "FRICTION_MODES",
+    "Assumption",
+    "Certificate",
+    "certify",
+    "certificate_for",
+    "judge",
+    "friction_term",
+    "fixed_point",
+    "loop_crossover",
+    "PLANT_K_BAND",
+    "PLANT_K_MEASURED",
+    "GYRO_BAND",
+    "GYRO_MEASURED_RATIOS",
+    "CONTROL_PERIOD_FRACTION",
+]
+
+VERDICTS = ("certified-inside", "certified-outside", "uncertified-inside", "uncertified-outside")
+FRICTION_MODES = ("measured", "reference", "none")
+
+#: The plant's sin/cos^3 coefficient, V: |K| <= 0.02. Measured: MuJoCo identification
+#: K = -0.0052 +- 0.0016 V (model card, seed 0); Drake 0.018 V at 1e7 N/m contacts
+#: (physics.md section 6). The non-holonomic model has K = 0.
+PLANT_K_BAND = 0.02
+PLANT_K_MEASURED = (-0.0052 - 2 * 0.0016, 0.018)
+#: The plant's gyro coefficient relative to P/l1 (the non-holonomic prediction).
+#: The band covers every plant variant the testbed runs and both engines: this plant
+#: (stiction, stiff tyre contacts) identifies 0.616-0.624 V s/m over seeds 0-5 (model
+#: card, 0.98-0.99 x P/l1 = 0.6291); with soft tyre contacts 0.575 (0.91 x); the earlier
+#: soft-friction plant scattered 0.492-0.704 over seeds 0-5 (0.78-1.12 x, physics.md
+#: section 6); Drake 0.621-0.644.
+GYRO_BAND = (0.75, 1.15)
+GYRO_MEASURED_RATIOS = (0.492 / 0.6291, 0.704 / 0.6291)
+#: The control period may use at most this fraction of the loop's delay margin.
+CONTROL_PERIOD_FRACTION = 0.1
+
+_FIXED_POINT_ITERATIONS = 10000
+
+
+# --------------------------------------------------------------------------- records
+@dataclass(frozen=True)
+class Assumption:
+    """One assumption of the certificate: ``met`` when ``value`` is within ``limit``.
+
+    kind: 'checked' (computed from the certificate's numbers) or 'stated' (a modelling
+    choice with its source in ``note``; ``value``/``limit`` compare the measurements
+    behind it with the band chosen).
+    """
+
+    name: str
+    equation: str
+    met: bool
+    value: float
+    limit: float
+    note: str = ""
+    kind: str = "checked"
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"name": self.name, "equation": self.equation, "met": bool(self.met),
+                "value": _finite_or_none(self.value), "limit": _finite_or_none(self.limit),
+                "note": self.note, "kind": self.kind}
+
+
+def _finite_or_none(x: float) -> float | None:
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+@dataclass(frozen=True)
+class Certificate:
+    """The certified region for one controller on one plant box (see the module docstring).
+
+    E_max [rad], Edot_max [rad/s]: corner of the region (4.21); inf when not ``valid``.
+    condition: (4.23) at alpha_max (at max|a0| when no fixed point exists).
+    delta1 [rad/s^2], delta2 [1/s^2] (coefficient of ||E||), delta3 [1/s] (of ||E'||).
+    alpha_max [rad]: max|a0| + E_max. voltage_max [V]: the law's |u| bound in the region.
+    friction_term, gyro_term, K_term, P_term, C_V_term [rad/s^2]: the parts of delta1
+    (each at P_min); gyro_Edot_term [1/s]: the gyro part of delta3; dead_band [rad]:
+    F_max/(P^ K_P).
+    """
+
+    E_max: float
+    Edot_max: float
+    condition: float
+    valid: bool
+    assumptions: tuple[Assumption, ...]
+    gamma1: float
+    gamma2: float
+    delta1: float
+    delta2: float
+    delta3: float
+    alpha_max: float
+    voltage_max: float
+    friction_term: float
+    gyro_term: float
+    K_term: float = 0.0
+    P_term: float = 0.0
+    C_V_term: float = 0.0
+    gyro_Edot_term: float = 0.0
+    dead_band: float = 0.0
+    kp: float = 0.0
+    kd: float = 0.0
+    friction_sign: str = "measured"
+    friction_width: float = 0.0
+    reason: str = ""
+    iterations: int = 0
+    inputs: Mapping[str, Any] = field(default_factory=dict, compare=False, hash=False)
+
+    @property
+    def certified(self) -> bool:
+        """True when the bound exists and every assumption is met."""
+        return bool(self.valid and all(a.met for a in self.assumptions))
+
+    @property
+    def unmet(self) -> tuple[str, ...]:
+        """Names of the assumptions that are not met."""
+        return tuple(a.name for a in self.assumptions if not a.met)
+
+    @property
+    def vertices(self) -> tuple[tuple[float, float], ...]:
+        """The region's polygon in the (||E||, ||E'||) plane; () when not valid."""
+        if not self.valid:
+            return ()
+        g1, g2, d1 = self.gamma1, self.gamma2, self.delta1
+        return ((0.0, 0.0), (g1 * d1 / (1.0 - g1 * self.delta2), 0.0), (self.E_max, self.Edot_max),
+                (0.0, g2 * d1 / (1.0 - g2 * self.delta3)))
+
+    def region_ratio(self, sup_E: float, sup_Edot: float) -> float:
+        """max of the two sides of (4.21) at (sup|E|, sup|E'|): <= 1 inside the region.
+
+        ||E|| <= gamma1 (delta1 + delta2 ||E|| + delta3 ||E'||), and the same with gamma2
+        for ||E'||; inf when the certificate is not valid.
+        """
+        if not self.valid:
+            return math.inf
+        x, y = float(sup_E), float(sup_Edot)
+        eta = self.delta1 + self.delta2 * x + self.delta3 * y
+        return max(x / (self.gamma1 * eta), y / (self.gamma2 * eta))
+
+    def inside(self, sup_E: float, sup_Edot: float) -> bool:
+        """The run's sup|E|, sup|E'| lie in the certified region (4.21) (so also below E_max, Edot_max).
+
+        A diverged run (inf or NaN sup) is outside; a negative sup is refused.
+        """
+        for name, v in (("sup_E", sup_E), ("sup_Edot", sup_Edot)):
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or v < 0:
+                raise ParameterError(f"{name} = {v!r} is not accepted: a number >= 0 (inf or NaN: diverged) "
+                                     "is required")
+            if not math.isfinite(v):
+                return False
+        # 1e-12: the corner (E_max, Edot_max) lies on both lines; only rounding separates it from them
+        return bool(self.valid and sup_E <= self.E_max and sup_Edot <= self.Edot_max
+                    and self.region_ratio(sup_E, sup_Edot) <= 1.0 + 1e-12)
+
+    def verdict(self, sup_E: float, sup_Edot: float) -> str:
+        """One of VERDICTS: 'certified-*' only when every assumption is met."""
+        where = "inside" if self.inside(sup_E, sup_Edot) else "outside"
+        return f"{'certified' if self.certified else 'uncertified'}-{where}"
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready (inf -> None): the Interface keys E_max, Edot_max, condition, valid,
+        assumptions [{name, met, value, limit, ...}], and the terms behind them."""
+        out: dict[str, Any] = {
+            "E_max": _finite_or_none(self.E_max),
+            "Edot_max": _finite_or_none(self.Edot_max),
+            "condition": _finite_or_none(self.condition),
+            "valid": bool(self.valid),
+            "certified": self.certified,
+            "reason": self.reason,
+            "assumptions": [a.as_dict() for a in self.assumptions],
+            "unmet": list(self.unmet),
+        }
+        for name in ("gamma1", "gamma2", "delta1", "delta2", "delta3", "alpha_max", "voltage_max",
+                     "friction_term", "gyro_term", "K_term", "P_term", "C_V_term", "gyro_Edot_term",
+                     "dead_band", "kp", "kd", "friction_width"):
+            out[name] = _finite_or_none(getattr(self, name))
+        out["friction_sign"] = self.friction_sign
+        out["regime"] = damping_regime(self.kp, self.kd)
+        out["iterations"] = int(self.iterations)
+        out["vertices"] = [list(v) for v in self.vertices]
+        out["inputs"] = _clean_inputs(self.inputs)
+        return out
+
+
+def _clean_inputs(obj: Any) -> Any:
+    if isinstance(obj, Mapping):
+        return {str(k): _clean_inputs(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_clean_inputs(v) for v in obj]
+    if isinstance(obj, float):
+        return _finite_or_none(obj)
+    return obj
+
+
+def judge(cert: Certificate, sup_E: float, sup_Edot: float) -> dict[str, Any]:
+    """The certificate's JSON with the run judged against it.
+
+    Adds inside (region (4.21)), E_ratio = sup|E|/E_max, Edot_ratio = sup|E'|/Edot_max
+    (None when the bound is infinite), region_ratio (<= 1 inside) and verdict.
+    """
+    out = cert.as_dict()
+    inside = cert.inside(sup_E, sup_Edot)
+    ok = cert.valid and cert.E_max > 0 and cert.Edot_max > 0
+    out.update(
+        inside=inside,
+        E_ratio=_finite_or_none(float(sup_E) / cert.E_max) if ok else None,
+        Edot_ratio=_finite_or_none(float(sup_Edot) / cert.Edot_max) if ok else None,
+        region_ratio=_finite_or_none(cert.region_ratio(sup_E, sup_Edot)),
+        verdict=cert.verdict(sup_E, sup_Edot),
+        sup_E=_finite_or_none(sup_E),
+        sup_Edot=_finite_or_none(sup_Edot),
+    )
+    return out
+
+
+# --------------------------------------------------------------------------- pieces
+def friction_term(mode: str, *, F: tuple[float, float], F_hat: float) -> float:
+    """phi = sup |f - F^ s| [V] over sliding and rest (stiction), by compensation mode.
+
+    'measured' max(F_max, F^); 'none' F_max; 'reference' F_max + F^ (module docstring).
+    """
+    if mode not in FRICTION_MODES:
+        raise UnknownNameError("friction sign", str(mode), FRICTION_MODES)
+    F_max = float(F[1])
+    if mode == "none":
+        return F_max
+    if mode == "measured":
+        return max(F_max, abs(F_hat))
+    return F_max + abs(F_hat)
+
+
+def _S(alpha: float) -> float:
+    return math.sin(alpha) / math.cos(alpha) ** 3
+
+
+def fixed_point(phi: Callable[[float], float], alpha0_max: float, *,
+                max_iterations: int = _FIXED_POINT_ITERATIONS) -> tuple[float, int, str]:
+    """Least x >= 0 with x = phi(x), alpha = alpha0_max + x staying in (-pi/2, pi/2).
+
+    phi(x) is the bound at alpha_max = alpha0_max + x (increasing; inf where (4.23)
+    fails). Returns (x*, iterations, reason); x* = inf with the reason when the
+    iteration leaves (-pi/2, pi/2), (4.23) fails on the way, the fixed point is tangent
+    (phi(x) >= x just above it), or it does not settle.
+    """
+    x = 0.0
+    for k in range(1, max_iterations + 1):
+        if alpha0_max + x >= 0.5 * math.pi:
+            return math.inf, k, (f"no fixed point: the bound on |alpha| = max|alpha0| + E_max reaches pi/2 "
+                                 f"(iterate E_max = {x:.4g} rad), where sin/cos^3 and 1/cos^2 are unbounded")
+        nxt = phi(x)
+        if not math.isfinite(nxt):
+            return math.inf, k, (f"no fixed point: (4.23) fails at alpha_max = {alpha0_max + x:.4g} rad "
+                                 f"(iterate E_max = {x:.4g} rad)")
+        if nxt <= x * (1.0 + 1e-13) + 1e-300:
+            x = max(x, nxt)
+            break
+        x = nxt
+    else:
+        return math.inf, max_iterations, f"no fixed point: E_max did not settle in {max_iterations} iterations"
+    h = max(1e-6 * x, 1e-12)
+    if alpha0_max + x + h < 0.5 * math.pi and not phi(x + h) < x + h:
+        return math.inf, k, f"tangent fixed point at E_max = {x:.4g} rad: the bound does not confine the error"
+    return x, k, ""
+
+
+def loop_crossover(kp: float, kd: float) -> tuple[float, float]:
+    """(omega_c [rad/s], phase margin [rad]) of the loop (K_D s + K_P)/s^2 of (3.2).
+
+    |K_D j w + K_P| = w^2: w^2 = K_D^2 (1 + sqrt(1 + 4 q^2))/2 with q = K_P/K_D^2
+    (written to avoid overflow for extreme gains); PM = atan(K_D omega_c / K_P).
+    """
+    kp, kd = _check_gains(kp, kd)
+    q = (kp / kd) / kd
+    if q <= 1.0:
+        wc = kd * math.sqrt(0.5 * (1.0 + math.sqrt(1.0 + 4.0 * q * q)))
+    else:
+        iq = 1.0 / q
+        wc = math.sqrt(kp) * math.sqrt(0.5 * (iq + math.sqrt(iq * iq + 4.0)))
+    return wc, math.atan2(kd, kp / wc)
+
+
+def _interval(name: str, value: Any, *, positive: bool = False) -> tuple[float, float]:
+    try:
+        lo, hi = (float(v) for v in value)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name} must be a pair (lo, hi) of numbers, got {value!r}") from None
+    if not (math.isfinite(lo) and math.isfinite(hi)) or hi < lo:
+        raise ParameterError(f"{name} = ({lo}, {hi}) is not accepted: finite lo <= hi is required")
+    if positive and lo <= 0:
+        raise ParameterError(f"{name} = ({lo}, {hi}) is not accepted: lo > 0 is required")
+    return lo, hi
+
+
+def _number(name: str, value: Any, *, minimum: float | None = None, strict: bool = False) -> float:
+    if isinstance(value, bool):
+        raise ParameterError(f"{name} must be a number, got {value!r}")
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name} must be a number, got {value!r}") from None
+    if not math.isfinite(v):
+        raise ParameterError(f"{name} = {value!r} is not accepted: a finite number is required")
+    if minimum is not None and (v < minimum or (strict and v == minimum)):
+        need = ">" if strict else ">="
+        raise ParameterError(f"{name} = {value!r} is not accepted: a finite number {need} {minimum:g} is required")
+    return v
+
+
+# --------------------------------------------------------------------------- certify
+def certify(
+    *,
+    box: ParameterBox,
+    gyro: tuple[float, float],
+    V_A: tuple[float, float],
+    P_hat: float,
+    C_V_hat: float,
+    F_hat: float,
+    K_hat: float,
+    gyro_hat: float,
+    V_A_hat: float,
+    kp: float,
+    kd: float,
+    friction_sign: str = "measured",
+    friction_width: float = 0.0,
+    feedforward: bool = True,
+    alpha0_max: float,
+    alpha0_dot_max: float,
+    alpha0_ddot_max: float,
+    steering_range: float,
+    voltage_limit: float,
+    control_period: float,
+    initial_error: tuple[float, float] = (0.0, 0.0),
+    stated: Sequence[Assumption] = (),
+    friction_over_P: float | None = None,
+) -> Certificate:
+    """The certificate for the law (3.2)-(3.3) with estimate ^ on any plant in the box.
+
+    box: the plant's P [V s^2/rad], C_V [V s/rad], F [V] (Coulomb, break-away = sliding),
+    K [V] (sin/cos^3). gyro [V s/m] and V_A [m/s]: ranges of the plant's gyroscopic
+    coefficient and forward speed (Gam = gyro V_A). P_hat ... V_A_hat: the controller's
+    estimate (F_hat: the compensation amplitude, 0 for 'none'). friction_sign: the
+    compensation's sign ('measured', 'reference', 'none'); friction_width [rad/s]: its
+    smoothing (recorded; the friction term covers any |s| <= 1). feedforward: False for
+    a PD law without P^ a0''. alpha0_max [rad], alpha0_dot_max [rad/s], alpha0_ddot_max
+    [rad/s^2]: the reference's bounds. steering_range [rad], voltage_limit [V],
+    control_period [s]: the plant's stops, supply and the law's period.
+    initial_error: (E(0), E'(0)). stated: caller's stated assumptions, appended.
+    friction_over_P [rad/s^2]: an upper bound on F/P over the plants of the box (F and P
+    both scale with R_a, so F/P does not move with it; see :func:`friction_over_P_max`).
+    With it the friction level at each P is min(F_max, friction_over_P P) rather than F_max
+    at every P; None: F and P independent, as the box alone says. delta1 is then maximised
+    over P in {P_min, P_max, P^, F_max/r, F^/r} (r = friction_over_P): between these points
+    each term of delta1 is monotone in P.
+    """
+    if not isinstance(box, ParameterBox):
+        raise ParameterError(f"box must be a ParameterBox, got {type(box).__name__}")
+    if friction_sign not in FRICTION_MODES:
+        raise UnknownNameError("friction sign", str(friction_sign), FRICTION_MODES)
+    kp, kd = _check_gains(kp, kd)
+    gyro = _interval("gyro range", gyro)
+    V_A = _interval("V_A range", V_A)
+    P_hat = _number("P_hat", P_hat, minimum=0.0, strict=True)
+    C_V_hat, K_hat, gyro_hat, V_A_hat = (_number(n, v) for n, v in (
+        ("C_V_hat", C_V_hat), ("K_hat", K_hat), ("gyro_hat", gyro_hat), ("V_A_hat", V_A_hat)))
+    F_hat = _number("F_hat", F_hat, minimum=0.0)
+    friction_width = _number("friction_width", friction_width, minimum=0.0)
+    a0 = _number("alpha0_max", alpha0_max, minimum=0.0)
+    a0d = _number("alpha0_dot_max", alpha0_dot_max, minimum=0.0)
+    a0dd = _number("alpha0_ddot_max", alpha0_ddot_max, minimum=0.0)
+    steering_range = _number("steering_range", steering_range, minimum=0.0, strict=True)
+    voltage_limit = _number("voltage_limit", voltage_limit, minimum=0.0, strict=True)
+    control_period = _number("control_period", control_period, minimum=0.0, strict=True)
+    E0, Ed0 = (_number("initial_error", v) for v in initial_error)
+    if a0 >= 0.5 * math.pi:
+        raise ParameterError(f"alpha0_max = {a0} rad is not accepted: the reference must stay below pi/2")
+    if box.F[0] < 0.0:
+        raise ParameterError(f"box F = {box.F} is not accepted: a Coulomb level F >= 0 is required")
+    if not feedforward and friction_sign != "none":
+        raise ParameterError("a law without feedforward (PD) has no Coulomb compensation: use friction_sign='none'")
+
+    g1, g2 = exact_gammas(kp, kd)
+    P_lo, P_hi = box.P
+    P_ff = P_hat if feedforward else 0.0
+    P_corners = sorted({P_lo, P_hi, *([P_hat] if P_lo < P_hat < P_hi else [])})
+    if friction_over_P is not None:
+        friction_over_P = _number("friction_over_P", friction_over_P, minimum=0.0, strict=True)
+        breaks = (box.F[1] / friction_over_P, F_hat / friction_over_P)
+        P_corners = sorted({*P_corners, *(b for b in breaks if P_lo < b < P_hi)})
+
+    def phi_at(p: float) -> float:  # sup |f - F^ s| for the plants with this P
+        F_p = box.F[1] if friction_over_P is None else min(box.F[1], friction_over_P * p)
+        return friction_term(friction_sign, F=(box.F[0], F_p), F_hat=F_hat)
+
+    phi = max(phi_at(p) for p in P_corners)
+    dC_lo, dC_hi = box.C_V[0] - C_V_hat, box.C_V[1] - C_V_hat
+    dC = max(abs(dC_lo), abs(dC_hi))
+    dK = max(abs(box.K[0] - K_hat), abs(box.K[1] - K_hat))
+    Gam = [g * v for g in gyro for v in V_A]
+    Gam_hat = gyro_hat * V_A_hat
+    dG_lo, dG_hi = min(Gam) - Gam_hat, max(Gam) - Gam_hat
+    dG = max(abs(dG_lo), abs(dG_hi))
+    mis = {p: 1.0 - P_hat / p for p in P_corners}  # 1 - P^/P
+    delta2 = max(abs(m) for m in mis.values()) * kp
+
+    def at(alpha_max: float) -> dict[str, float]:
+        S, c2 = _S(alpha_max), math.cos(alpha_max) ** 2
+        rest = dK * S + dC * a0d + dG * a0d / c2
+        delta1 = max((abs(p - P_ff) * a0dd + phi_at(p) + rest) / p for p in P_corners)
+        delta3 = max(abs(mis[p] * kd - (c + g / cc) / p)
+                     for p in P_corners for c in (dC_lo, dC_hi) for g in (dG_lo, dG_hi) for cc in (c2, 1.0))
+        cond = g1 * delta2 + g2 * delta3
+        return {"delta1": delta1, "delta3": delta3, "condition": cond, "S": S, "c2": c2}
+
+    def phi_of(x: float) -> float:
+        b = at(a0 + x)
+        return g1 * b["delta1"] / (1.0 - b["condition"]) if b["condition"] < 1.0 else math.inf
+
+    E_max, iterations, reason = fixed_point(phi_of, a0)
+    valid = math.isfinite(E_max)
+    alpha_max = a0 + E_max if valid else math.inf
+    b = at(alpha_max if valid else a0)
+    cond = b["condition"]
+    if valid:
+        Edot_max = g2 * b["delta1"] / (1.0 - cond)
+    else:
+        Edot_max = math.inf
+        if cond >= 1.0:
+            reason = f"(4.23) fails: gamma1 delta2 + gamma2 delta3 = {cond:.4g} >= 1 already at alpha = max|alpha0|"
+
+    # voltage the law asks for anywhere in the region (triangle inequality on (3.2)-(3.3))
+    F_comp = 0.0 if friction_sign == "none" else F_hat
+    if valid:
+        rate = a0d + Edot_max
+        voltage_max = (P_hat * (P_ff / P_hat * a0dd + kd * Edot_max + kp * E_max) + abs(K_hat) * b["S"]
+                       + abs(C_V_hat) * rate + F_comp + abs(Gam_hat) * rate / b["c2"])
+    else:
+        voltage_max = math.inf
+
+    wc, pm = loop_crossover(kp, kd)
+    delay_margin = pm / wc
+    period_ratio = control_period * wc / pm if pm > 0.0 else math.inf  # no phase margin: no delay tolerated
+    init = max(abs(E0), abs(Ed0))
+
+    assumptions = (
+        Assumption("(4.23) small gain", "gamma1 delta2 + gamma2 delta3 < 1 (4.23)", cond < 1.0, cond, 1.0,
+                   "at alpha_max" if valid else "at alpha = max|alpha0|"),
+        Assumption("reachable angle", "alpha_max = max|alpha0| + E_max(alpha_max) < pi/2 (fixed point)", valid,
+                   alpha_max, 0.5 * math.pi, reason or f"{iterations} iterations"),
+        Assumption("inside the steering stops", "max|alpha0| + E_max < steering_range", alpha_max < steering_range,
+                   alpha_max, steering_range, "the stop's torque is not in the model"),
+        Assumption("within the supply", "P^(|a0''| + K_D Edot_max + K_P E_max) + |K^| S + |C_V^||a'| + F^ + "
+                   "|Gam^||a'|/cos^2 <= voltage_limit", voltage_max <= voltage_limit, voltage_max, voltage_limit,
+                   "the analysis has no saturation"),
+        Assumption("control period", f"T <= {CONTROL_PERIOD_FRACTION:g} x delay margin PM/omega_c "
+                   "(continuous-time analysis; stated, not bounded)", period_ratio <= CONTROL_PERIOD_FRACTION,
+                   period_ratio, CONTROL_PERIOD_FRACTION,
+                   f"T = {control_period:g} s, omega_c = {wc:.4g} rad/s, PM = {math.degrees(pm):.1f} deg, "
+                   f"delay margin {delay_margin:.4g} s"),
+        Assumption("zero initial error", "E(0) = E'(0) = 0 ((4.17) is for zero initial conditions)",
+                   init <= 1e-9, init, 1e-9, f"E(0) = {E0:g} rad, E'(0) = {Ed0:g} rad/s"),
+        *stated,
+    )
+    for a in assumptions:
+        if not isinstance(a, Assumption):
+            raise ParameterError(f"stated assumptions must be Assumption records, got {type(a).__name__}")
+
+    S, c2 = b["S"], b["c2"]
+    inputs = {
+        "box": box.as_dict(), "gyro": list(gyro), "V_A": list(V_A),
+        "estimate": {"P": P_hat, "C_V": C_V_hat, "F": F_hat, "K": K_hat, "gyro": gyro_hat, "V_A": V_A_hat},
+        "feedforward": bool(feedforward),
+        "reference": {"alpha0_max": a0, "alpha0_dot_max": a0d, "alpha0_ddot_max": a0dd},
+        "steering_range": steering_range, "voltage_limit": voltage_limit, "control_period": control_period,
+        "initial_error": [E0, Ed0], "friction_amplitude_phi": phi,
+    }
+    return Certificate(
+        E_max=E_max, Edot_max=Edot_max, condition=cond, valid=valid, assumptions=assumptions,
+        gamma1=g1, gamma2=g2, delta1=b["delta1"], delta2=delta2, delta3=b["delta3"],
+        alpha_max=alpha_max, voltage_max=voltage_max,
+        friction_term=max(phi_at(p) / p for p in P_corners), gyro_term=dG * a0d / c2 / P_lo, K_term=dK * S / P_lo,
+        P_term=max(abs(p - P_ff) / p for p in P_corners) * a0dd, C_V_term=dC * a0d / P_lo,
+        gyro_Edot_term=dG / c2 / P_lo, dead_band=box.F[1] / (P_hat * kp),
+        kp=kp, kd=kd, friction_sign=friction_sign, friction_width=friction_width,
+        reason=reason, iterations=iterations, inputs=inputs,
+    )
+
+
+# --------------------------------------------------------------------------- for a run
+def _hull(a: tuple[float, float], *values: float) -> tuple[float, float]:
+    return min(a[0], *values), max(a[1], *values)
+
+
+def _identified_spread(identified: Any) -> dict[str, tuple[float, float]]:
+    """{name: (x - 2 sigma, x + 2 sigma)} from `wmr-mj identify` output (path or mapping)."""
+    import json
+    from pathlib import Path
+
+    data = identified
+    if not isinstance(data, Mapping):
+        path = Path(identified)
+        try:
+            data = json.loads(path.read_text())
+        except (OSError, ValueError):
+            raise ParameterError(f"identified-model file {str(path)!r} is not readable JSON from "
+                                 "wmr-mj identify") from None
+    values = data.get("identified", data)
+    se = (data.get("diagnostics") or {}).get("std_error") or {}
+    out = {}
+    for name in ("P", "C_V", "F", "K", "gyro"):
+        if name in values:
+            x, s = float(values[name]), 2.0 * abs(float(se.get(name, 0.0)))
+            out[name] = (x - s, x + s)
+    return out
+
+
+@functools.lru_cache(maxsize=32)
+def _derived_box(params: C80Parameters, m1_range: tuple[float, float], m1_inertia: str,
+                 ranges: tuple[tuple[str, tuple[float, float]], ...]) -> ParameterBox:
+    """simulate.analysis_box's derived box (cached: a sweep asks for the same box per run)."""
+    return ParameterBox.from_parameters(params, m1_range=m1_range, model="nonholonomic", m1_inertia=m1_inertia,
+                                        ranges=dict(ranges) or None)
+
+
+#: Parameters F/P = (l3 l4/l1) mu Q / (2D) is not monotone in (they enter D, or Q and D):
+#: with one of them ranged, :func:`friction_over_P_max` gives no bound.
+_F_OVER_P_NOT_MONOTONE = frozenset({"l4", "front_axle_mass", "front_wheel_mass", "r3", "front_wheel_width"})
+
+
+@functools.lru_cache(maxsize=32)
+def friction_over_P_max(params: C80Parameters, m1_range: tuple[float, float], m1_inertia: str,
+                        ranges: tuple[tuple[str, tuple[float, float]], ...]) -> float | None:
+    """max F/P [rad/s^2] over the box's plants: m1 over m1_range and the ranged parameters.
+
+    F/P = (R_a/(k_i i2)) tau_f / ((R_a/k_i) 2D/i2) = tau_f/(2D), tau_f = (l3 l4/l1) mu Q: it
+    does not depend on R_a, k_i, i2, V_A or the tyres, and is monotone in every other
+    parameter but those of :data:`_F_OVER_P_NOT_MONOTONE`, so its maximum is at a corner of
+    the box (all corners are evaluated). None when a non-monotone parameter is ranged.
+    """
+    from wmr_mj.params import with_params
+
+    if any(name in _F_OVER_P_NOT_MONOTONE for name, _ in ranges):
+        return None
+    axes = [("m1", m1_range), *ranges]
+    best = 0.0
+    for corner in itertools.product(*(span for _, span in axes)):
+        c = with_params(params, m1_inertia=m1_inertia, **dict(zip((n for n, _ in axes), corner))).coefficients(
+            "nonholonomic")
+        best = max(best, c.F / c.P)
+    return best
+
+
+def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
+                    k_band: float = PLANT_K_BAND, gyro_band: tuple[float, float] = GYRO_BAND) -> Certificate:
+    """The certificate of a :class:`wmr_mj.sim.closed_loop.RunConfig` run on ``reference``.
+
+    Plant box: P, C_V, F by the rule of ``simulate.analysis_box``: derived from ``params``
+    over config.m1_range and config.box_ranges (both reduced models share P, C_V, F), and
+    for config.box = 'paper' hulled with the (5.1) intervals (whose F does not cover the
+    simulated m1 range); always hulled with the run's own plant point (m1, --param
+    overrides); for model 'identified' also with its +-2 sigma. The plant's K is not the
+    paper's (2.7) prediction (the plant has none): |K| <= k_band (:data:`PLANT_K_BAND`,
+    measured). gyro: gyro_band x P/l1 over the box (:data:`GYRO_BAND`, measured), V_A
+    over the box's range. Estimate: the controller as ``simulate`` builds it (the same
+    ``_controller`` on ``estimate_parameters(params)``). params: the base parameter set.
+    """
+    from wmr_mj.plant.mjcf import TIMESTEP
+    from wmr_mj.sim.closed_loop import _controller, estimate_parameters, plant_parameters
+
+    base = params
+    k_band = _number("k_band", k_band, minimum=0.0)
+    gyro_band = _interval("gyro_band", gyro_band, positive=True)
+    estimate_params = estimate_parameters(base)
+    controller = _controller(config, estimate_params)
+    model = controller.model
+    plant = plant_parameters(config, base)
+    point = plant.coefficients("nonholonomic")
+
+    ranges = {k: (float(v[0]), float(v[1])) for k, v in config.box_ranges.items()}
+    derived = _derived_box(estimate_params, tuple(float(v) for v in config.m1_range), config.m1_inertia,
+                           tuple(sorted(ranges.items())))
+    box = ParameterBox.paper() if config.box == "paper" else derived
+    P = _hull(_hull(box.P, *derived.P), point.P)
+    C_V = _hull(_hull(box.C_V, *derived.C_V), point.C_V)
+    F = _hull(_hull(box.F, *derived.F), point.F)
+    K = (-k_band, k_band)
+    l1_lo, l1_hi = _hull(ranges.get("l1", (base.l1, base.l1)), plant.l1)
+    gyro = (gyro_band[0] * P[0] / l1_hi, gyro_band[1] * P[1] / l1_lo)
+    V_A = _hull(ranges.get("V_A", (base.V_A, base.V_A)), plant.V_A)
+    notes = []
+    if config.model == "identified":
+        spread = _identified_spread(config.identified)
+        P = _hull(P, *spread.get("P", P))
+        C_V = _hull(C_V, *spread.get("C_V", C_V))
+        F = _hull(F, *spread.get("F", F))
+        K = _hull(K, *spread.get("K", K))
+        gyro = _hull(gyro, *spread.get("gyro", gyro))
+        notes.append("identified +-2 sigma hulled in")
+    plant_box = ParameterBox(P=P, C_V=C_V, F=(max(F[0], 0.0), F[1]), K=K)
+    # F and P both scale with R_a: bound F/P over the same plants (the run's own point included)
+    ratio = friction_over_P_max(estimate_params, tuple(float(v) for v in config.m1_range), config.m1_inertia,
+                                tuple(sorted(ranges.items())))
+    if ratio is not None:
+        ratio = max(ratio, point.F / point.P)
+        if config.model == "identified" and "F" in spread and "P" in spread:
+            ratio = max(ratio, spread["F"][1] / spread["P"][0])
+        if config.box == "paper":
+            ratio = None  # (5.1)'s printed intervals come with no such relation
+
+    pd = controller.name == "pd"
+    sign = "none" if pd else controller.friction_sign
+    width = 0.0 if pd else controller.friction_width
+    c = model.coefficients
+    est = {"P": c.P, "C_V": 0.0, "F": 0.0, "K": 0.0, "gyro": 0.0} if pd else {
+        "P": c.P, "C_V": c.C_V, "F": 0.0 if sign == "none" else c.F, "K": c.K, "gyro": c.gyro}
+
+    bounds = reference.bounds()
+    period = config.control_period if config.control_period is not None else TIMESTEP
+    initial = (float(reference.alpha0[0]), float(reference.alpha0_dot[0]))  # the plant starts at alpha = alpha' = 0
+
+    k_seen = max(abs(v) for v in PLANT_K_MEASURED)
+    g_lo, g_hi = GYRO_MEASURED_RATIOS
+    g_used = max((1.0 - g_lo) / (1.0 - gyro_band[0]) if gyro_band[0] < 1.0 else math.inf,
+                 (g_hi - 1.0) / (gyro_band[1] - 1.0) if gyro_band[1] > 1.0 else math.inf)
+    stated = (
+        Assumption("plant K band", f"|K_plant| <= {k_band:g} V (non-holonomic plant: K = 0)",
+                   k_seen <= k_band, k_seen, k_band,
+                   "MuJoCo identify K = -0.0052 +- 0.0016 V; Drake 0.018 V at 1e7 N/m (physics.md section 6)",
+                   kind="stated"),
+        Assumption("plant gyro band", f"{gyro_band[0]:g} P/l1 <= gyro <= {gyro_band[1]:g} P/l1",
+                   g_used <= 1.0, g_used, 1.0,
+                   "fraction of the band used by measurements: MuJoCo identify seeds 0-5 0.492-0.704 V s/m "
+                   "(0.78-1.12 P/l1), Drake 0.621-0.644 (physics.md section 6)", kind="stated"),
+    )
+    cert = certify(box=plant_box, gyro=gyro, V_A=V_A, P_hat=est["P"], C_V_hat=est["C_V"], F_hat=est["F"],
+                   K_hat=est["K"], gyro_hat=est["gyro"], V_A_hat=model.V_A, kp=config.kp, kd=config.kd,
+                   friction_sign=sign, friction_width=width, feedforward=not pd,
+                   alpha0_max=bounds["max_abs_alpha0"], alpha0_dot_max=bounds["max_abs_alpha0_dot"],
+                   alpha0_ddot_max=bounds["max_abs_alpha0_ddot"], steering_range=plant.steering_range,
+                   voltage_limit=plant.voltage_limit, control_period=period, initial_error=initial,
+                   stated=stated, friction_over_P=ratio)
+    inputs = dict(cert.inputs)
+    inputs.update(model=config.model, controller=controller.name, box_rule=config.box,
+                  m1_range=list(config.m1_range), box_ranges={k: list(v) for k, v in ranges.items()},
+                  plant_m1=plant.m1, notes=notes, steering_friction=getattr(config, "steering_friction", None))
+    return _replace_inputs(cert, inputs)
+
+
+def _replace_inputs(cert: Certificate, inputs: Mapping[str, Any]) -> Certificate:
+    import dataclasses
+
+    return dataclasses.replace(cert, inputs=inputs)

@@ -1,0 +1,139 @@
+"""Separated verdicts: how every run is judged (run, sweep, validate, the report, the MCAP summary).
+
+A run's (sup|E|, sup|E'|) is judged against the certificate of the controller actually
+run (:mod:`wmr_mj.analysis.certificate`), and, beside it, against the paper's claim (the region of
+:mod:`wmr_mj.analysis.robustness`, (4.21)-(4.23) as the paper bounds it):
+
+* ``certified-inside``: every assumption of the certificate holds and the run is inside it;
+* ``certified-outside``: the assumptions hold and the run is outside: a bug or a
+  modelling gap, printed loudly;
+* ``uncertified-inside`` / ``uncertified-outside``: an assumption is not met; never a pass.
+
+Beside the verdict: the paper's-claim verdict, the tightness sup|E|/E_max of the
+certificate, and the end-of-run drift: the final alpha' and whether |E| is still growing
+(the largest |E| of the last :data:`DRIFT_WINDOW_S` seconds exceeds that of the window
+before it by more than :data:`DRIFT_TOLERANCE`).
+
+Usage::
+
+    from wmr_mj.analysis.verdicts import judge_run, is_pass
+    judged = judge_run(certificate=cert, analysis=analysis, sup_E=0.03, sup_Edot=0.2,
+                       drift=drift(prev_window=0.02, last_window=0.02, final_alpha_dot=0.0))
+    judged["verdict"], judged["paper_region"]["inside"], judged["drift"]["growing"]
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping
+from typing import Any
+
+from wmr_mj.analysis.certificate import VERDICTS, Certificate, judge
+
+__all__ = [
+    "VERDICTS",
+    "PASS",
+    "DRIFT_WINDOW_S",
+    "DRIFT_TOLERANCE",
+    "drift",
+    "drift_window_steps",
+    "judge_run",
+    "paper_region",
+    "is_pass",
+    "count_verdicts",
+]
+
+PASS = "certified-inside"
+#: Length of each of the two windows that compare |E| at the end of a run, s.
+DRIFT_WINDOW_S = 5.0
+#: |E| grows when the last window's max exceeds the previous window's by more than this, rad.
+#: The stiction plant creeps at a few urad/s below break-away (model card): 25 urad per window.
+DRIFT_TOLERANCE = 1e-4
+
+
+def drift_window_steps(control_steps: int, period: float) -> int:
+    """Control steps per drift window: DRIFT_WINDOW_S, or a quarter of a shorter run (>= 1)."""
+    w = int(round(DRIFT_WINDOW_S / period))
+    return max(1, min(w, control_steps // 4))
+
+
+def drift(*, prev_window: float, last_window: float, final_alpha_dot: float) -> dict[str, Any]:
+    """The end-of-run drift from the max |E| of the two last windows (rad) and the final alpha' (rad/s)."""
+    growing = bool(math.isfinite(last_window) and math.isfinite(prev_window)
+                   and last_window - prev_window > DRIFT_TOLERANCE)
+    if not (math.isfinite(last_window) and math.isfinite(prev_window)):
+        growing = True  # a diverged run is not settled
+    return {"final_alpha_dot": float(final_alpha_dot), "growing": growing,
+            "E_last_window": float(last_window), "E_prev_window": float(prev_window),
+            "window_s": DRIFT_WINDOW_S, "tolerance": DRIFT_TOLERANCE}
+
+
+def paper_region(analysis: Any, sup_E: float, sup_Edot: float) -> dict[str, Any]:
+    """The paper's claim judged: its bounds (inf when (4.23) fails) and whether the run is inside."""
+    stable = bool(analysis.stable)
+    E_max = float(analysis.E_max) if stable else math.inf
+    Ed_max = float(analysis.Edot_max) if stable else math.inf
+    return {"E_max": E_max, "Edot_max": Ed_max, "condition": float(analysis.condition),
+            "inside": bool(stable and sup_E <= E_max and sup_Edot <= Ed_max)}
+
+
+def judge_run(*, certificate: Certificate, analysis: Any, sup_E: float, sup_Edot: float,
+              drift: Mapping[str, Any]) -> dict[str, Any]:
+    """verdict, certificate (judged), paper_region (the paper's claim, judged) and drift of one run."""
+    judged = judge(certificate, sup_E, sup_Edot)
+    return {
+        "verdict": judged["verdict"],
+        "certificate": judged,
+        "paper_region": paper_region(analysis, sup_E, sup_Edot),
+        "drift": dict(drift),
+    }
+
+
+def is_pass(verdict: str) -> bool:
+    """Only ``certified-inside`` is a pass."""
+    return verdict == PASS
+
+
+def count_verdicts(verdicts: Iterable[str]) -> dict[str, int]:
+    """{verdict: count} for each of the four verdicts (zeros included)."""
+    counts = dict.fromkeys(VERDICTS, 0)
+    for v in verdicts:
+        counts[v] = counts.get(v, 0) + 1
+    return counts
+
+
+def _num(x: Any, spec: str = ".5g") -> str:
+    return "n/a" if x is None or (isinstance(x, float) and not math.isfinite(x)) else format(x, spec)
+
+
+def format_verdict(summary: Mapping[str, Any]) -> list[str]:
+    """Text lines of a judged run summary: the verdict first, then both regions and the drift."""
+    verdict = summary.get("verdict")
+    if verdict is None:
+        return ["no certificate in this summary (written before verdicts existed)"]
+    cert = summary.get("certificate") or {}
+    paper = summary.get("paper_region") or {}
+    dr = summary.get("drift") or {}
+    lines = []
+    if verdict == "certified-outside":
+        lines.append("!!! CERTIFIED-OUTSIDE: every assumption of the certificate holds and the run is OUTSIDE it. "
+                     "This is a bug or a modelling gap: report it. !!!")
+    ratio = cert.get("E_ratio")
+    lines.append(f"verdict: {verdict.upper()}"
+                 + ("" if ratio is None else f"  (tightness sup|E|/E_max = {ratio:.3f})")
+                 + ("" if is_pass(verdict) else "  -- not a pass"))
+    unmet = [a for a in cert.get("assumptions", []) if not a.get("met")]
+    if unmet:
+        lines.append("certificate NOT valid; assumptions not met: " + "; ".join(
+            f"{a['name']} ({_num(a.get('value'), '.4g')} vs {_num(a.get('limit'), '.4g')})" for a in unmet))
+    lines.append(f"certificate:   |E| <= {_num(cert.get('E_max'))} rad, |E'| <= {_num(cert.get('Edot_max'))} rad/s"
+                 f", (4.23) = {_num(cert.get('condition'), '.4f')}, run "
+                 f"{'inside' if cert.get('inside') else 'OUTSIDE'}")
+    lines.append(f"paper's claim: |E| <= {_num(paper.get('E_max'))} rad, |E'| <= {_num(paper.get('Edot_max'))} rad/s"
+                 f", (4.23) = {_num(paper.get('condition'), '.4f')}, run "
+                 f"{'inside' if paper.get('inside') else 'OUTSIDE'}")
+    if dr:
+        lines.append(f"drift: final alpha' = {_num(dr.get('final_alpha_dot'), '.3g')} rad/s, |E| "
+                     f"{'STILL GROWING' if dr.get('growing') else 'not growing'} over the last "
+                     f"{_num(dr.get('window_s'), 'g')} s")
+    return lines

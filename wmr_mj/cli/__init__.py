@@ -1,0 +1,1 @@
+"""The ``wmr-mj`` command line: one thin module per command."""

@@ -1,0 +1,97 @@
+"""Argument helpers shared by the subcommands."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from typing import Any
+
+
+def positive_float(text: str) -> float:
+    """argparse type: a finite number > 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number; a finite number > 0 is accepted") from None
+    if not math.isfinite(value) or value <= 0:
+        raise argparse.ArgumentTypeError(f"{text!r} is not accepted; a finite number > 0 is required")
+    return value
+
+
+def int_at_least(minimum: int):
+    """argparse type factory: an integer >= minimum."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(
+                f"{text!r} is not an integer; an integer >= {minimum} is accepted") from None
+        if value < minimum:
+            raise argparse.ArgumentTypeError(f"{text!r} is not accepted; an integer >= {minimum} is required")
+        return value
+
+    parse.__name__ = f"integer >= {minimum}"
+    return parse
+
+
+positive_int = int_at_least(1)
+
+
+def parse_assignments(items: list[str] | None, *, option: str = "--param",
+                      example: str = "mu=0.02") -> dict[str, float]:
+    """``NAME=VALUE`` pairs (``--param l3=0.15``) into a dict; bad syntax raises ParameterError."""
+    from wmr_mj.errors import ParameterError
+
+    out: dict[str, float] = {}
+    for item in items or []:
+        name, sep, value = item.partition("=")
+        if not sep or not name.strip():
+            raise ParameterError(f"{option} {item!r} is not NAME=VALUE (e.g. {option} {example})")
+        try:
+            out[name.strip()] = float(value)
+        except ValueError:
+            raise ParameterError(f"{option} {item!r}: {value!r} is not a number") from None
+    return out
+
+
+def print_json(obj: Any) -> None:
+    """One JSON object on stdout; non-finite numbers become null."""
+    from wmr_mj._util.files import json_safe
+
+    json.dump(json_safe(obj), sys.stdout, indent=2, sort_keys=True, allow_nan=False, default=float)
+    sys.stdout.write("\n")
+
+
+def parse_range(item: str) -> tuple[str, tuple[float, float]]:
+    """``NAME=LO:HI`` (``--range mu=0.015:0.02``) into (name, (lo, hi)); bad syntax raises ParameterError."""
+    from wmr_mj.errors import ParameterError
+
+    name, sep, span = item.partition("=")
+    lo_s, sep2, hi_s = span.partition(":")
+    name = name.strip()
+    if not sep or not sep2 or not name or not lo_s.strip() or not hi_s.strip():
+        raise ParameterError(f"--range {item!r} is not NAME=LO:HI (e.g. --range mu=0.015:0.02)")
+    try:
+        lo, hi = float(lo_s), float(hi_s)
+    except ValueError:
+        raise ParameterError(f"--range {item!r}: LO and HI must be numbers") from None
+    return name, (lo, hi)
+
+
+def box_ranges_from_args(args: argparse.Namespace) -> dict[str, tuple[float, float]]:
+    """The ranged plant parameters besides m1 (whose range is --m1-range): those of the
+    --uncertainty box (``wmr_mj.params.uncertainty_ranges``; 'm1' when not given), then each
+    --range NAME=LO:HI, which adds a parameter or replaces its range."""
+    from wmr_mj.errors import ParameterError
+    from wmr_mj.params import uncertainty_ranges
+
+    ranges = {k: v for k, v in uncertainty_ranges(getattr(args, "uncertainty", None) or "m1").items() if k != "m1"}
+    for item in getattr(args, "range", None) or []:
+        name, span = parse_range(item)
+        if name == "m1":
+            raise ParameterError("give m1's range with --m1-range LO HI, not --range m1=...")
+        ranges[name] = span
+    return ranges

@@ -1,0 +1,86 @@
+"""The ``wmr-mj`` command line.
+
+Each subcommand lives in ``wmr_mj.cli.<name>`` and provides
+``register(subparsers)``, which adds its parser and sets ``func(args) -> int``.
+Command modules import heavy libraries inside ``func`` so that ``--help`` and
+argument errors stay fast.
+
+Bad input raises a :class:`wmr_mj.errors.WmrMjError`; it is printed here as one
+line ``wmr-mj: error: ...`` and the exit status is 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from collections.abc import Sequence
+
+from wmr_mj.errors import WmrMjError
+
+COMMANDS = ("identify", "robustness", "run", "replay", "sweep", "falsify", "validate", "figures", "model")
+
+
+class _OneLineParser(argparse.ArgumentParser):
+    """Argument errors as one line (no usage dump), exit status 2."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _OneLineParser(
+        prog="wmr-mj",
+        description="MuJoCo validation testbed for computed-torque steering control of the C80 cart.",
+    )
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    for name in COMMANDS:
+        try:
+            module = importlib.import_module(f"wmr_mj.cli.{name}")
+        except ModuleNotFoundError as exc:
+            if exc.name != f"wmr_mj.cli.{name}":
+                raise
+            continue  # command not built yet
+        module.register(sub)
+    return parser
+
+
+def _mujoco_importable() -> str | None:
+    """None when MuJoCo imports; else one line naming the cause (a MUJOCO_GL backend that is not installed
+    makes ``import mujoco`` fail inside PyOpenGL, before any command runs)."""
+    import os
+
+    try:
+        import mujoco  # noqa: F401
+    except Exception as exc:  # noqa: BLE001  (any failure here ends in one line, not a traceback)
+        gl = os.environ.get("MUJOCO_GL")
+        hint = (f"MUJOCO_GL={gl!r} names a GL backend that cannot be loaded here; unset it or use egl, glfw or "
+                "osmesa with its library installed" if gl else "reinstall it: pip install mujoco")
+        return f"MuJoCo cannot be imported ({type(exc).__name__}: {exc}); {hint}"
+    return None
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    problem = _mujoco_importable()
+    if problem is not None:
+        print(f"wmr-mj: error: {problem}", file=sys.stderr)
+        return 2
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except WmrMjError as exc:
+        print(f"wmr-mj: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("wmr-mj: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:  # output piped into `head` and friends
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,138 @@
+"""``wmr-mj falsify``: search the uncertainty box for the plant the controller tracks worst."""
+
+from __future__ import annotations
+
+import argparse
+
+from wmr_mj.cli._common import positive_int
+
+_AGAINST = ("certificate", "paper")
+_OBJECTIVE_KINDS = ("ratio", "sup-E")
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    from wmr_mj.cli.run import add_run_options
+
+    p = sub.add_parser("falsify", help="worst-case search over the uncertainty box (differential evolution on "
+                                       "mujoco.batch), beside the same budget spent at random")
+    add_run_options(p)
+    p.add_argument("--range", action="append", metavar="NAME=LO:HI",
+                   help="add a plant parameter to the box or replace its range (repeatable)")
+    p.add_argument("--against", default="certificate",
+                   help="the region of the ratio sup|E|/E_max: certificate (default) or paper (the paper's region)")
+    p.add_argument("--objective", default="ratio", help="what is maximised: ratio (default, see --against) or sup-E")
+    p.add_argument("--budget", type=positive_int, default=256,
+                   help="simulations of the search (default 256); the random sample gets as many")
+    p.add_argument("--population", type=int, default=None,
+                   help="members per generation (default: 10 per parameter, at most budget/8, at least 5)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the search and of the random sample (default 0)")
+    p.add_argument("--chunk", type=positive_int, default=128, help="simulations per batch (default 128)")
+    p.add_argument("--nthread", type=int, default=0, help="threads of the batch (default 0: all cores)")
+    p.add_argument("--scheduler", metavar="ADDRESS", help="run the batches on a Dask cluster (e.g. tcp://127.0.0.1:8786)")
+    p.add_argument("--out", metavar="DIR", help="output folder (default logs/falsify-<time>)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=run)
+
+
+def _objective(args: argparse.Namespace) -> str:
+    from wmr_mj.errors import UnknownNameError
+
+    if args.objective not in _OBJECTIVE_KINDS:
+        raise UnknownNameError("objective", args.objective, _OBJECTIVE_KINDS)
+    if args.against not in _AGAINST:
+        raise UnknownNameError("region", args.against, _AGAINST)
+    return "sup-E" if args.objective == "sup-E" else args.against
+
+
+def reproduce_command(config, params: dict[str, float], args: argparse.Namespace) -> str:
+    """A ``wmr-mj run`` line that repeats the worst run (parameters at full precision)."""
+    parts = ["wmr-mj run", f"--preset {args.preset}", f"--controller {config.controller}", f"--model {config.model}",
+             f"--kp {config.kp!r}", f"--kd {config.kd!r}", f"--friction-sign {config.friction_sign}",
+             f"--friction-width {config.friction_width!r}", f"--path {config.path}",
+             f"--duration {config.duration!r}", f"--m1 {config.m1!r}"]
+    if args.identified:
+        parts.append(f"--identified {args.identified}")
+    for name, value in (config.coefficients or {}).items():
+        parts.append(f"--coef {name}={value!r}")
+    if config.control_period is not None:
+        parts.append(f"--control-period {config.control_period!r}")
+    for name, value in config.plant_overrides.items():
+        parts.append(f"--param {name}={value!r}")
+    for option in ("steering_friction", "tyre_contact"):
+        if hasattr(config, option):
+            parts.append(f"--{option.replace('_', '-')} {getattr(config, option)}")
+    parts += [f"--m1-inertia {config.m1_inertia}", f"--box {config.box}",
+              f"--m1-range {config.m1_range[0]!r} {config.m1_range[1]!r}", f"--uncertainty {args.uncertainty}"]
+    return " ".join(parts)
+
+
+def run(args: argparse.Namespace) -> int:
+    import time
+
+    from wmr_mj._util.files import check_output_path, write_json_atomic, write_text_atomic
+    from wmr_mj._util.progress import counter_callback, progress_bar
+    from wmr_mj.cli._common import box_ranges_from_args, print_json
+    from wmr_mj.cli.run import config_from_args
+    from wmr_mj.report.plots import save_figure
+    from wmr_mj.sim.falsify import OBJECTIVE_LABELS, FalsifySpec, falsify, figure_history, log_run, worst_config
+
+    objective = _objective(args)
+    args.uncertainty = args.uncertainty or "full"
+    box = {"m1": tuple(args.m1_range), **box_ranges_from_args(args)}
+    out = check_output_path(args.out or f"logs/falsify-{time.strftime('%Y%m%d-%H%M%S')}", kind="dir", option="--out")
+    base = config_from_args(args)
+    spec = FalsifySpec(base=base, box=box, objective=objective, budget=args.budget, seed=args.seed,
+                       population=args.population)
+    with progress_bar(2 * spec.budget, desc="falsify", unit="runs") as bar:
+        result = falsify(spec, chunk=args.chunk, nthread=args.nthread, scheduler=args.scheduler,
+                         progress=counter_callback(bar),  # evaluations.csv after every generation: Ctrl-C keeps them
+                         checkpoint=lambda partial: write_text_atomic(out / "evaluations.csv", _table(partial)))
+    log_path = out / "worst.mcap"
+    config = worst_config(result)
+    logged = log_run(config, str(log_path))
+    worst = result.worst
+    summary = result.as_dict(log=str(log_path))
+    summary.update({
+        "reproduced": logged["sup_E"] == worst.sup_E,  # the serial re-run gives the batch's bits
+        "reproduce": reproduce_command(config, worst.params, args),
+        "uncertainty": args.uncertainty,
+        "folder": str(out),
+        "table": str(out / "evaluations.csv"),
+        "plot": [str(p) for p in save_figure(figure_history(result), out / "history")],
+    })
+    write_text_atomic(out / "evaluations.csv", _table(result))
+    write_json_atomic(out / "falsify.json", summary)
+    if args.json:
+        print_json(summary)
+        return 0 if summary["reproduced"] else 1
+    names = ", ".join(spec.names)
+    print(f"worst-case search over {len(spec.names)} parameter(s) ({names}; box {args.uncertainty}): differential "
+          f"evolution, {summary['population']} per generation x {summary['generations']} generations, seed {spec.seed}")
+    print(f"objective: {OBJECTIVE_LABELS[objective]}  [{result.objective_source}]")
+    fmt = lambda x: "n/a" if x is None else f"{x:.6g}"  # noqa: E731
+    print(f"search : worst objective {fmt(worst.objective)} in {len(result.search)} runs "
+          f"(sup|E| = {worst.sup_E:.6g} rad, sup|E'| = {worst.sup_Edot:.6g} rad/s, {worst.verdict})")
+    rw = result.random_worst
+    print(f"random : worst objective {fmt(rw.objective)} in {len(result.random)} runs (Latin hypercube, same seed)")
+    print("worst parameters: " + ", ".join(f"{k} = {v!r}" for k, v in worst.params.items()))
+    print(f"reproduce: {summary['reproduce']}")
+    if not summary["reproduced"]:
+        print(f"WARNING: the serial re-run gave sup|E| = {logged['sup_E']!r}, the search {worst.sup_E!r}",
+              flush=True)
+    print(f"log:   {log_path}\nplot:  {summary['plot'][0]}\ntable: {summary['table']}")
+    return 0 if summary["reproduced"] else 1
+
+
+def _table(result) -> str:
+    """evaluations.csv: every run of both phases, parameters at full precision."""
+    import csv
+    import io
+
+    names = list(result.spec.names)
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(["phase", "index", "generation", *names, "objective", "sup_E", "sup_Edot", "verdict"])
+    for e in (*result.search, *result.random):
+        w.writerow([e.phase, e.index, e.generation, *(repr(e.params[n]) for n in names),
+                    "" if e.objective is None else repr(e.objective), repr(e.sup_E), repr(e.sup_Edot), e.verdict])
+    return buf.getvalue()

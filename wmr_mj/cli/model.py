@@ -1,0 +1,92 @@
+"""``wmr-mj model``: write or check models/c80.xml and models/scene.xml, or print a parameter table."""
+
+from __future__ import annotations
+
+import argparse
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("model", help="write/check the MJCF files generated from the C80 parameter set")
+    p.add_argument("action", choices=("write", "check", "params", "slip", "friction", "card"),
+                   help="write: regenerate models/*.xml; check: exit 1 if they differ from the parameter set; "
+                        "params: print the parameter set with sources and the derived coefficients; "
+                        "slip: measure the wheels' side slip on the 1 m circle; friction: measure the steering "
+                        "joint's friction law (break-away, creep, sliding) for each friction model; "
+                        "card: write models/README.md")
+    p.add_argument("--param", action="append", metavar="NAME=VALUE", help="override a parameter (repeatable)")
+    p.add_argument("--json", action="store_true", help="with 'params', 'slip' or 'friction': print one JSON object")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from wmr_mj._util.resources import MODELS_IN_CHECKOUT
+    from wmr_mj.cli._common import parse_assignments, print_json
+    from wmr_mj.params import C80, PARAMETER_SOURCES, with_params
+    from wmr_mj.plant.mjcf import MODELS_DIR, robot_xml, scene_file_xml, write_model_files
+
+    params = with_params(C80, **parse_assignments(args.param))
+    if args.action == "write":
+        for path in write_model_files(params):
+            print(f"wrote {path}")
+        return 0
+    if args.action == "check":
+        stale = [name for name, text in (("c80.xml", robot_xml(params)), ("scene.xml", scene_file_xml(params)))
+                 if not (MODELS_DIR / name).is_file() or (MODELS_DIR / name).read_text() != text]
+        where = f"{MODELS_DIR} ({'checkout' if MODELS_IN_CHECKOUT else 'copy installed with the package'})"
+        if stale:
+            print(f"out of date in {where}: {', '.join(stale)} (run: wmr-mj model write)")
+            return 1
+        print(f"c80.xml and scene.xml in {where} match the parameter set")
+        return 0
+    if args.action == "card":
+        from wmr_mj._util.files import write_text_atomic
+        from wmr_mj.plant.modelcard import render_model_card
+
+        path = write_text_atomic(MODELS_DIR / "README.md", render_model_card(params))
+        print(f"wrote {path}")
+        return 0
+    if args.action == "friction":
+        from wmr_mj.plant.friction import measure_friction_law
+        from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS
+
+        laws = {name: measure_friction_law(params, steering_friction=name) for name in STEERING_FRICTION_MODELS}
+        if args.json:
+            print_json({name: law.as_dict() for name, law in laws.items()})
+            return 0
+        any_law = laws["stiction"]
+        print(f"steering friction: F = {any_law.friction_voltage:.5g} V "
+              f"({any_law.friction_torque:.5g} N m at the joint); constant voltage from the home keyframe, "
+              f"cart driving, rate over the last second of {any_law.duration:g} s; "
+              f"holds = rate <= {any_law.hold_rate:g} rad/s")
+        for name, law in laws.items():
+            lo = law.breakaway_voltage - law.breakaway_resolution
+            print(f"  {name:9s} break-away ({lo:.5g}, {law.breakaway_voltage:.5g}] V "
+                  f"= {law.breakaway_voltage / law.friction_voltage:.4f} F ({law.breakaway_torque:.4g} N m); "
+                  f"creep {law.creep_rates[0.5]:.3g} rad/s at 0.5 F, {law.creep_rates[0.9]:.3g} rad/s at 0.9 F; "
+                  f"{law.slide_rates[1.3]:.3g} rad/s at 1.3 F ((2.13): {law.predicted_slide_rates[1.3]:.3g}, "
+                  f"with gyro: {law.predicted_slide_rates_gyro[1.3]:.3g}); "
+                  f"{'holds below, slides above' if law.holds() else 'does NOT hold below break-away'}; "
+                  f"{law.mujoco_warnings} MuJoCo warnings")
+        return 0
+    if args.action == "slip":
+        from wmr_mj.plant.mjcf import measure_side_slip
+
+        slip = measure_side_slip(params)
+        if args.json:
+            print_json(slip)
+        else:
+            print(f"side slip on the 1 m circle at V_A = {params.V_A:g} m/s: "
+                  f"max {1e3 * slip['max_slip_m_s']:.3f} mm/s ({100 * slip['max_slip_fraction']:.2f}% of V_A, "
+                  f"slip angle {1e3 * slip['max_slip_angle_rad']:.2f} mrad), rms {1e3 * slip['rms_slip_m_s']:.3f} mm/s")
+        return 0
+    paper, nonholonomic = params.coefficients("paper"), params.coefficients("nonholonomic")
+    if args.json:
+        print_json({"parameters": params.as_dict(), "paper": paper.as_dict(), "nonholonomic": nonholonomic.as_dict(),
+                    "kinetic_energy": params.kinetic_energy_coefficients()})
+        return 0
+    for name, value in params.as_dict().items():
+        print(f"{name:22s} {value:12.6g}  {PARAMETER_SOURCES[name]}")
+    print()
+    for key in ("P", "C_V", "F", "K", "gyro"):
+        print(f"{key:5s} paper {getattr(paper, key):10.5g}   nonholonomic {getattr(nonholonomic, key):10.5g}")
+    return 0

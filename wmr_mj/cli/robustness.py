@@ -1,0 +1,368 @@
+"""``wmr-mj robustness``: the paper's section-4 robustness condition (4.23) and error bounds.
+
+Default: the paper's (5.1) example (box (5.1), K_D = 9, K_P = 6), corrected
+reading of (4.19)-(4.20), exact operator gains. See :mod:`wmr_mj.analysis.robustness`.
+
+``--certificate [options of wmr-mj run]``: the certificate for the controller actually
+run on the plant actually simulated (:mod:`wmr_mj.analysis.certificate`), every option after
+``--certificate`` read as by ``wmr-mj run``, e.g.::
+
+    wmr-mj robustness --certificate --model nonholonomic --omega-r 20 --friction-width 0.01
+    wmr-mj robustness --certificate --uncertainty full --model nonholonomic --omega-r 20 --json
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+
+from wmr_mj.cli._common import parse_assignments, parse_range, positive_float
+from wmr_mj.params import M1_NOMINAL, M1_RANGE, PAPER_KD, PAPER_KP
+
+
+def _nonneg_float(text: str) -> float:
+    """argparse type: a finite number >= 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number; a finite number >= 0 is accepted") from None
+    if not math.isfinite(value) or value < 0:
+        raise argparse.ArgumentTypeError(f"{text!r} is not accepted; a finite number >= 0 is required")
+    return value
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    p = subparsers.add_parser(
+        "robustness",
+        help="robustness condition (4.23) and error bounds of the computed-torque controller",
+        description=(
+            "Evaluate the robustness analysis of section 4: operator gains gamma1, gamma2 (4.14), "
+            "delta1 (4.18), the coefficients of ||E|| and ||E'|| in (4.19), condition (4.23) and the "
+            "bounds on ||E||, ||E'||. Default: the paper's (5.1) example."
+        ),
+    )
+    p.add_argument("--kp", type=positive_float, default=None, help="K_P [1/s^2] (default 6)")
+    p.add_argument("--kd", type=positive_float, default=None, help="K_D [1/s] (default 9)")
+    p.add_argument(
+        "--omega-r",
+        type=positive_float,
+        default=None,
+        help="critical damping (3.6): K_P = omega_r^2/4, K_D = omega_r (not with --kp/--kd)",
+    )
+    p.add_argument(
+        "--box",
+        choices=("paper", "derived"),
+        default=None,
+        help="uncertainty box: the paper's (5.1) intervals (default), or derived from the C80 parameter set",
+    )
+    p.add_argument(
+        "--m1-range",
+        nargs=2,
+        type=positive_float,
+        metavar=("LO", "HI"),
+        default=None,
+        help="chassis mass range [kg] for --box derived (default 550 750)",
+    )
+    p.add_argument(
+        "--range",
+        action="append",
+        default=None,
+        metavar="NAME=LO:HI",
+        help="extra C80 parameter range for --box derived (repeatable), e.g. mu=0.015:0.02",
+    )
+    p.add_argument(
+        "--model",
+        choices=("paper", "nonholonomic"),
+        default=None,
+        help="reduced model whose coefficients span --box derived (default paper)",
+    )
+    p.add_argument(
+        "--estimate",
+        action="append",
+        default=None,
+        metavar="NAME=VALUE",
+        help="fixed estimate of P, C_V, F or K (repeatable); others are anywhere in the box (4.2)",
+    )
+    p.add_argument(
+        "--reading",
+        choices=("corrected", "printed", "printed-literal"),
+        default=None,
+        help="reading of (4.19)-(4.20): corrected from (4.10) (default), printed labels, or (4.20) verbatim",
+    )
+    p.add_argument(
+        "--gammas",
+        choices=("exact", "paper"),
+        default=None,
+        help="operator gains: exact integrals (default) or the paper's (4.16) 1/K_P, 4/(e K_D)",
+    )
+    p.add_argument("--alpha-ddot", type=_nonneg_float, default=None, help="||alpha0''|| [rad/s^2] (default 0.4)")
+    p.add_argument("--alpha-dot", type=_nonneg_float, default=None, help="||alpha0'|| [rad/s] (default 0.23)")
+    p.add_argument("--sin-cos3", type=_nonneg_float, default=None, help="||sin/cos^3|| (default 1.24)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument(
+        "--certificate",
+        nargs=argparse.REMAINDER,
+        default=None,
+        metavar="RUN-OPTIONS",
+        help="print the certificate for a controller as `wmr-mj run` would run it; every option after "
+        "--certificate is one of run's (--model, --controller, --kp/--kd/--omega-r, --friction-sign, "
+        "--friction-width, --control-period, --m1, --box, --m1-range, --param) or --range NAME=LO:HI, "
+        "--uncertainty m1|full, --json (see: wmr-mj robustness --certificate --help)",
+    )
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from wmr_mj.analysis.robustness import (
+        PAPER_CONDITION,
+        ParameterBox,
+        ReferenceBounds,
+        analyse,
+        exact_gammas,
+        gains_from_omega_r,
+        paper_gammas,
+    )
+    from wmr_mj.cli._common import print_json
+    from wmr_mj.errors import ParameterError
+
+    if args.certificate is not None:
+        return run_certificate(args)
+    args.box = args.box or "paper"
+    args.reading = args.reading or "corrected"
+    args.gammas = args.gammas or "exact"
+    args.alpha_ddot = 0.4 if args.alpha_ddot is None else args.alpha_ddot
+    args.alpha_dot = 0.23 if args.alpha_dot is None else args.alpha_dot
+    args.sin_cos3 = 1.24 if args.sin_cos3 is None else args.sin_cos3
+
+    if args.omega_r is not None:
+        if args.kp is not None or args.kd is not None:
+            raise ParameterError("--omega-r sets both gains by (3.6); it cannot be combined with --kp/--kd")
+        kp, kd = gains_from_omega_r(args.omega_r)
+    else:
+        kp = PAPER_KP if args.kp is None else args.kp
+        kd = PAPER_KD if args.kd is None else args.kd
+
+    if args.box == "paper":
+        used = [opt for opt, v in (("--m1-range", args.m1_range), ("--range", args.range), ("--model", args.model))
+                if v]
+        if used:
+            raise ParameterError(f"{', '.join(used)} only apply to --box derived (got --box paper)")
+        box = ParameterBox.paper()
+        box_label = "paper (5.1)"
+    else:
+        from wmr_mj.params import C80
+
+        ranges: dict[str, tuple[float, float]] = {}
+        for item in args.range or []:
+            name, span = parse_range(item)
+            if name in ranges:
+                raise ParameterError(f"--range {name} given twice; give each parameter once")
+            ranges[name] = span
+        if "m1" in ranges and args.m1_range is not None:
+            raise ParameterError("m1 given by both --m1-range and --range m1=LO:HI; give it once")
+        m1_range = tuple(args.m1_range) if args.m1_range is not None else M1_RANGE
+        if "m1" in ranges:
+            m1_range = ranges.pop("m1")
+        model = args.model or "paper"
+        box = ParameterBox.from_parameters(C80, m1_range=m1_range, ranges=ranges, model=model)
+        spans = [f"m1 {m1_range[0]:g}-{m1_range[1]:g} kg"] + [f"{n} {lo:g}-{hi:g}" for n, (lo, hi) in ranges.items()]
+        box_label = f"derived from C80 ({model} model; {', '.join(spans)})"
+
+    bounds = ReferenceBounds(alpha_ddot_max=args.alpha_ddot, alpha_dot_max=args.alpha_dot, sin_cos3_max=args.sin_cos3)
+    estimate = parse_assignments(args.estimate, option="--estimate", example="P=0.385") if args.estimate else None
+    result = analyse(box, kp=kp, kd=kd, bounds=bounds, reading=args.reading, gammas=args.gammas, estimate=estimate)
+
+    if args.json:
+        print_json(result.as_dict())
+        return 0
+
+    g1e, g2e = exact_gammas(kp, kd)
+    g1p, g2p = paper_gammas(kp, kd)
+    rel = (result.condition - PAPER_CONDITION) / PAPER_CONDITION
+    paper_example = (
+        args.box == "paper" and kp == PAPER_KP and kd == PAPER_KD and estimate is None and bounds == ReferenceBounds()
+    )
+    if paper_example:
+        paper_note = f"paper reports {PAPER_CONDITION} (rel. diff {rel:+.2%})"
+    else:
+        paper_note = f"(the paper's (5.1) example gives {PAPER_CONDITION}; not this case)"
+
+    def fmt(x: float) -> str:
+        return f"{x:.5g}" if math.isfinite(x) else "unbounded"
+
+    rows = [
+        ("gains K_P, K_D", f"{kp:g}, {kd:g} ({result.regime})"),
+        ("box", box_label),
+        ("box P [V s^2/rad]", "({:.4g}, {:.4g})".format(*box.P)),
+        ("box C_V [V s/rad]", "({:.4g}, {:.4g})".format(*box.C_V)),
+        ("box F [V]", "({:.4g}, {:.4g})".format(*box.F)),
+        ("box K [V]", "({:.4g}, {:.4g})".format(*box.K)),
+        ("estimate", ", ".join(f"{k}^={v:g}" for k, v in (estimate or {}).items()) or "anywhere in the box (4.2)"),
+        ("reading / gammas", f"{args.reading} / {args.gammas}"),
+        ("gamma1 (4.14)", f"{fmt(result.gamma1)}   [exact {g1e:.5g}, paper (4.16) {g1p:.5g}]"),
+        ("gamma2 (4.14)", f"{fmt(result.gamma2)}   [exact {g2e:.5g}, paper (4.16) {g2p:.5g}]"),
+        ("delta1 (4.18)", fmt(result.delta1)),
+        ("delta2: coef of ||E||", fmt(result.delta_E)),
+        ("delta3: coef of ||E'||", fmt(result.delta_Edot)),
+        ("condition (4.23)", f"{fmt(result.condition)}   {paper_note}"),
+        ("stable (< 1)", "yes" if result.stable else "no"),
+        ("||E|| max [rad]", fmt(result.E_max)),
+        ("||E'|| max [rad/s]", fmt(result.Edot_max)),
+    ]
+    width = max(len(k) for k, _ in rows)
+    print("Robustness of computed-torque steering control (paper section 4)")
+    for key, value in rows:
+        print(f"  {key:<{width}}  {value}")
+    return 0
+
+
+# --------------------------------------------------------------------------- --certificate
+_OUTER_OPTIONS = (("--kp", "kp"), ("--kd", "kd"), ("--omega-r", "omega_r"), ("--box", "box"),
+                  ("--m1-range", "m1_range"), ("--range", "range"), ("--model", "model"), ("--estimate", "estimate"),
+                  ("--reading", "reading"), ("--gammas", "gammas"), ("--alpha-ddot", "alpha_ddot"),
+                  ("--alpha-dot", "alpha_dot"), ("--sin-cos3", "sin_cos3"))
+
+
+def certificate_parser() -> argparse.ArgumentParser:
+    """The options read after ``--certificate``: those of ``wmr-mj run`` plus the box's ranges."""
+    from wmr_mj.cli.app import _OneLineParser
+    from wmr_mj.cli.run import add_run_options
+    from wmr_mj.params import UNCERTAINTY_NAMES
+
+    p = _OneLineParser(
+        prog="wmr-mj robustness --certificate",
+        description="The certificate (wmr_mj.analysis.certificate) for the controller `wmr-mj run` would run with "
+        "these options, on the plant it would simulate: region, terms and every assumption with its number.",
+    )
+    add_run_options(p)
+    taken = set(p._option_string_actions)
+    if "--m1" not in taken:
+        p.add_argument("--m1", type=positive_float, default=M1_NOMINAL,
+                       help="plant chassis mass, kg (default 650); the certificate's box includes it")
+    if "--range" not in taken:
+        p.add_argument("--range", action="append", metavar="NAME=LO:HI",
+                       help="another ranged plant parameter of the box (repeatable), e.g. R_a=1.0:1.3")
+    if "--uncertainty" not in taken:
+        p.add_argument("--uncertainty", choices=UNCERTAINTY_NAMES, default=None,
+                       help="a named uncertainty box of wmr_mj.params: m1 (the paper's 550-750 kg) or full "
+                       "(m1, mu, ground_friction, R_a, V_A); --m1-range and --range override its entries")
+    if "--json" not in taken:
+        p.add_argument("--json", action="store_true", help="print one JSON object")
+    return p
+
+
+def _box_ranges(args: argparse.Namespace) -> tuple[tuple[float, float], dict[str, tuple[float, float]]]:
+    """(m1_range, other ranges) from --uncertainty, --m1-range and --range."""
+    from wmr_mj.errors import ParameterError
+    from wmr_mj.params import M1_RANGE, uncertainty_ranges
+
+    ranges = uncertainty_ranges(args.uncertainty) if getattr(args, "uncertainty", None) else {}
+    m1_range = ranges.pop("m1", M1_RANGE)
+    if tuple(args.m1_range) != tuple(M1_RANGE):
+        m1_range = tuple(args.m1_range)
+    seen: set[str] = set()
+    for item in getattr(args, "range", None) or []:
+        name, span = parse_range(item)
+        if name in seen:
+            raise ParameterError(f"--range {name} given twice; give each parameter once")
+        seen.add(name)
+        if name == "m1":
+            m1_range = span
+        else:
+            ranges[name] = span
+    return tuple(m1_range), ranges
+
+
+def _certificate_table(cert, config, paper) -> str:
+    inp = cert.inputs
+    box, est, ref = inp["box"], inp["estimate"], inp["reference"]
+
+    def fmt(x) -> str:
+        return "unbounded" if x is None or not math.isfinite(x) else f"{x:.4g}"
+
+    def span(v) -> str:
+        return f"({v[0]:.4g}, {v[1]:.4g})"
+
+    sign = cert.friction_sign + (f", smoothed w = {cert.friction_width:g} rad/s" if cert.friction_width > 0 else "")
+    rows = [
+        ("controller", f"{inp['controller']} ({inp['model']} model), K_P = {cert.kp:g}, K_D = {cert.kd:g} "
+                       f"({cert.as_dict()['regime']}), Coulomb sign {sign}"),
+        ("plant box P, C_V", f"{span(box['P'])} V s^2/rad, {span(box['C_V'])} V s/rad"),
+        ("plant box F, K", f"{span(box['F'])} V, {span(box['K'])} V"),
+        ("plant gyro, V_A", f"{span(inp['gyro'])} V s/m, {span(inp['V_A'])} m/s"),
+        ("box rule", f"{inp['box_rule']}, m1 {inp['m1_range'][0]:g}-{inp['m1_range'][1]:g} kg"
+                     + "".join(f", {k} {lo:g}-{hi:g}" for k, (lo, hi) in inp["box_ranges"].items())
+                     + f"; plant m1 = {inp['plant_m1']:g} kg"),
+        ("estimate", ", ".join(f"{k}^={v:.4g}" for k, v in est.items())),
+        ("reference", f"max|a0| {ref['alpha0_max']:.4g} rad, max|a0'| {ref['alpha0_dot_max']:.4g} rad/s, "
+                      f"max|a0''| {ref['alpha0_ddot_max']:.4g} rad/s^2"),
+        ("gamma1, gamma2 (4.14)", f"{cert.gamma1:.4g}, {cert.gamma2:.4g}"),
+        ("delta1 (4.18) [rad/s^2]", f"{fmt(cert.delta1)} = friction {cert.friction_term:.4g} "
+                                    f"+ K~ {cert.K_term:.3g} + gyro {cert.gyro_term:.3g} + P~ {cert.P_term:.3g} "
+                                    f"+ C_V~ {cert.C_V_term:.3g} (at P_min)"),
+        ("delta2, delta3", f"{fmt(cert.delta2)} (of ||E||), {fmt(cert.delta3)} "
+                           f"(of ||E'||; gyro {cert.gyro_Edot_term:.3g})"),
+        ("condition (4.23)", fmt(cert.condition)),
+        ("||E|| max [rad]", f"{fmt(cert.E_max)}   (dead band F_max/(P^ K_P) = {cert.dead_band:.4g})"),
+        ("||E'|| max [rad/s]", fmt(cert.Edot_max)),
+        ("alpha_max [rad]", fmt(cert.alpha_max)),
+        ("voltage needed [V]", fmt(cert.voltage_max)),
+        ("the paper's claim", f"E_max {fmt(paper.E_max)} rad, Edot_max {fmt(paper.Edot_max)} rad/s, "
+                              f"(4.23) {fmt(paper.condition)} (wmr_mj.analysis.robustness, as the paper bounds it)"),
+    ]
+    width = max(len(k) for k, _ in rows)
+    lines = ["Certificate for the controller as run on the plant as simulated (section 4 redone)"]
+    lines += [f"  {k:<{width}}  {v}" for k, v in rows]
+    lines.append("  assumptions:")
+    aw = max(len(a.name) for a in cert.assumptions)
+    for a in cert.assumptions:
+        mark = "met    " if a.met else "NOT met"
+        kind = " (stated)" if a.kind == "stated" else ""
+        lines.append(f"    [{mark}] {a.name:<{aw}}  {fmt(a.value)} vs {fmt(a.limit)}{kind}: {a.equation}")
+    if cert.reason:
+        lines.append(f"  no bound: {cert.reason}")
+    if cert.certified:
+        lines.append("  CERTIFIED: every assumption holds; a run inside the region is certified-inside")
+    else:
+        lines.append(f"  NOT CERTIFIED: {', '.join(cert.unmet)} not met; runs are uncertified-* whatever they do")
+    return "\n".join(lines)
+
+
+def run_certificate(args: argparse.Namespace) -> int:
+    """``wmr-mj robustness --certificate [run options]``."""
+    from wmr_mj.cli._common import print_json
+    from wmr_mj.errors import ParameterError
+
+    given = [opt for opt, name in _OUTER_OPTIONS if getattr(args, name) is not None]
+    if given:
+        raise ParameterError(f"{', '.join(given)} before --certificate: with --certificate give the controller "
+                             "as `wmr-mj run` takes it, after --certificate (e.g. --certificate --kp 100 --kd 20)")
+    inner = certificate_parser().parse_args(args.certificate)
+    as_json = bool(args.json or inner.json)
+
+    from wmr_mj.analysis.certificate import certificate_for
+    from wmr_mj.cli.run import config_from_args
+    from wmr_mj.params import C80
+    from wmr_mj.plant.mjcf import TIMESTEP
+    from wmr_mj.sim.closed_loop import _controller, _estimate_of, analysis_for, build_reference, estimate_parameters
+
+    m1_range, ranges = _box_ranges(inner)
+    inner.m1_range = m1_range
+    config = config_from_args(inner, m1=inner.m1)
+    config = config.replace(m1_range=m1_range, box_ranges=ranges)
+    period = config.control_period or TIMESTEP
+    n = int(round(config.duration / period))
+    estimate = estimate_parameters(C80)
+    reference, _ = build_reference(config.path, estimate, dt=period, duration=n * period)
+    cert = certificate_for(config, reference, params=C80)
+    paper = analysis_for(config, reference, estimate, estimate=_estimate_of(_controller(config, estimate)))
+    if as_json:
+        out = cert.as_dict()
+        out["paper_region"] = {"E_max": paper.E_max if paper.stable else None,
+                               "Edot_max": paper.Edot_max if paper.stable else None,
+                               "condition": paper.condition, "stable": bool(paper.stable)}
+        out["config"] = config.as_dict()
+        print_json(out)
+        return 0
+    print(_certificate_table(cert, config, paper))
+    return 0

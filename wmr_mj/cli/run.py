@@ -1,0 +1,193 @@
+"""``wmr-mj run``: one headless closed-loop run on the MuJoCo plant, reported against the region."""
+
+from __future__ import annotations
+
+import argparse
+import math
+
+from wmr_mj.cli._common import box_ranges_from_args, parse_assignments, positive_float, positive_int
+from wmr_mj.params import M1_NOMINAL
+
+
+def add_run_options(p: argparse.ArgumentParser) -> None:
+    """Options shared by ``run`` and ``sweep`` (the closed-loop configuration)."""
+    from controllers.computed_torque import CONTROLLER_NAMES, FRICTION_SIGNS, MODEL_SOURCES
+    from wmr_mj.params import M1_RANGE
+    from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS, TYRE_CONTACT_MODELS
+    from wmr_mj.sim.closed_loop import PATH_NAMES
+    from wmr_mj.sim.designs import PRESET_NAMES
+
+    p.add_argument("--preset", default="paper",
+                   help=f"controller design: one of {', '.join(PRESET_NAMES)} (default paper: paper model, K_P = 6, "
+                        "K_D = 9, exact sign; certified: see wmr_mj/sim/designs.py); explicit options override it")
+    p.add_argument("--controller", default=None, help=f"one of {', '.join(CONTROLLER_NAMES)} (default: the preset's)")
+    p.add_argument("--model", default=None,
+                   help=f"model source of the estimate: one of {', '.join(MODEL_SOURCES)} (default: the preset's)")
+    p.add_argument("--identified", metavar="PATH",
+                   help="JSON from `wmr-mj identify --out` for --model identified "
+                        "(default: identify the nominal plant now)")
+    p.add_argument("--coef", action="append", metavar="NAME=VALUE",
+                   help="coefficient for --model explicit (P, C_V, F, K, gyro)")
+    p.add_argument("--duration", type=positive_float, default=35.0, help="simulated time, s (default 35)")
+    p.add_argument("--control-period", type=positive_float, default=None,
+                   help="controller period, s, a multiple of the 1 ms physics step (default: every step)")
+    p.add_argument("--kp", type=positive_float, default=None, help="K_P, 1/s^2 (default: the preset's)")
+    p.add_argument("--kd", type=positive_float, default=None, help="K_D, 1/s (default: the preset's)")
+    p.add_argument("--omega-r", type=positive_float, default=None,
+                   help="gains by (3.6): K_P = omega_r^2/4, K_D = omega_r")
+    p.add_argument("--friction-sign", default=None,
+                   help=f"Coulomb compensation sign: one of {', '.join(FRICTION_SIGNS)} (default: the preset's)")
+    p.add_argument("--friction-width", type=float, default=None,
+                   help="smoothing of that sign, rad/s: x/sqrt(x^2+w^2) (0: exact sign; default: the preset's)")
+    p.add_argument("--path", default="paper-circle", help=f"reference path of point C: one of {', '.join(PATH_NAMES)}")
+    p.add_argument("--param", action="append", metavar="NAME=VALUE", help="override a plant parameter (repeatable)")
+    p.add_argument("--steering-friction", default="stiction",
+                   help=f"plant's steering friction law: one of {', '.join(STEERING_FRICTION_MODELS)} (default "
+                        "stiction: holds below break-away; soft: MuJoCo's default frictionloss, creeps at mrad/s)")
+    p.add_argument("--tyre-contact", default="stiff",
+                   help=f"plant's tyre-floor contacts: one of {', '.join(TYRE_CONTACT_MODELS)} (default stiff; "
+                        "soft: MuJoCo's default solref, see models/README.md)")
+    p.add_argument("--m1-inertia", default="payload", choices=("payload", "scale"),
+                   help="m1 changes as a compact payload at the CoM (default) or scales the chassis inertia")
+    p.add_argument("--box", default="derived", help="parameter box of the analysis: derived (from the parameter set "
+                                                     "over --m1-range) or paper (5.1)")
+    p.add_argument("--m1-range", nargs=2, type=positive_float, metavar=("LO", "HI"), default=M1_RANGE,
+                   help="m1 range of the analysis box, kg (default 550 750)")
+    from wmr_mj.params import UNCERTAINTY_NAMES
+
+    p.add_argument("--uncertainty", default=None,
+                   help=f"uncertainty box: one of {', '.join(UNCERTAINTY_NAMES)} (m1: the paper's 550-750 kg, "
+                        "the default of run and sweep; full: also steering and tyre friction, R_a and V_A, the "
+                        "default of falsify; sources in wmr_mj/params.py). A run draws nothing: the box is what "
+                        "its analysis covers; m1's range is --m1-range")
+
+
+def config_from_args(args: argparse.Namespace, **extra):
+    """A RunConfig from the shared options (raises WmrMjError on bad input)."""
+    from controllers import gains_from_omega_r
+    from wmr_mj.errors import ParameterError
+    from wmr_mj.sim.closed_loop import RunConfig
+    from wmr_mj.sim.designs import preset
+
+    design = preset(args.preset)
+    if args.omega_r is not None and (args.kp is not None or args.kd is not None):
+        raise ParameterError("give either --omega-r or --kp/--kd, not both")
+    if args.omega_r is not None:
+        kp, kd = gains_from_omega_r(args.omega_r)
+    else:
+        kp = design.kp if args.kp is None else args.kp
+        kd = design.kd if args.kd is None else args.kd
+    controller = design.controller if args.controller is None else args.controller
+    model = design.model if args.model is None else args.model
+    friction_sign = design.friction_sign if args.friction_sign is None else args.friction_sign
+    friction_width = design.friction_width if args.friction_width is None else args.friction_width
+    if not math.isfinite(friction_width) or friction_width < 0:
+        raise ParameterError(f"--friction-width {friction_width} must be finite and >= 0 (rad/s)")
+    identified = args.identified
+    if model == "identified" and identified is None:
+        from wmr_mj.params import C80
+        from wmr_mj.plant.identify import identify_plant
+
+        identified = identify_plant(C80, duration=30.0, seed=0).as_dict()
+    coefficients = parse_assignments(args.coef) if args.coef else None
+    return RunConfig(controller=controller, model=model, duration=args.duration,
+                     control_period=args.control_period, kp=kp, kd=kd, friction_sign=friction_sign,
+                     friction_width=friction_width, path=args.path,
+                     plant_overrides=parse_assignments(args.param), m1_inertia=args.m1_inertia,
+                     identified=identified, coefficients=coefficients, box=args.box,
+                     m1_range=tuple(args.m1_range), steering_friction=args.steering_friction,
+                     tyre_contact=args.tyre_contact, box_ranges=box_ranges_from_args(args), **extra)
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("run", help="simulate the circle headless with a controller and report the errors")
+    add_run_options(p)
+    p.add_argument("--m1", type=positive_float, default=M1_NOMINAL, help="plant chassis mass, kg (default 650)")
+    p.add_argument("--out", metavar="PATH", help="MCAP log path (default logs/run-<time>-<model>-m<m1>.mcap)")
+    p.add_argument("--no-log", action="store_true", help="do not write an MCAP log")
+    p.add_argument("--log-every", type=positive_int, default=1, help="log signals every k-th control step (default 1)")
+    p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
+                   help="progress bar (default: only on a terminal)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=run)
+
+
+def default_log_path(config) -> str:
+    """logs/run-<time>-<model>-m<m1>.mcap for a RunConfig or the run command's arguments."""
+    import time
+
+    stamp = time.strftime("%Y%m%d-%H%M%S")
+    return f"logs/run-{stamp}-{config.model}-m{config.m1:g}.mcap"
+
+
+def format_report(s: dict) -> str:
+    """Human-readable run report."""
+    from wmr_mj.analysis.verdicts import format_verdict
+
+    def ratio(x):
+        return "n/a" if x is None else f"{x:.3f}"
+
+    def num(x):
+        return "n/a" if x is None else f"{x:.5g}"
+
+    cert = s.get("certificate") or {}
+
+    after = f"after {s['settle_s']:.1f} s"
+    lines = [
+        f"controller {s['controller']} ({s['model']} model), plant m1 = {s['m1']:g} kg, K_P = {s['kp']:g}, "
+        f"K_D = {s['kd']:g}, {s['duration']:g} s, {s['steps']} steps in {s['wall_s']:.2f} s "
+        f"({s['realtime_factor']:.0f}x real time)",
+        *format_verdict(s),
+        f"{'':22s} {'whole run':>12s} {after:>12s} {'certificate':>12s} {'ratio':>8s} {'paper':>12s} {'ratio':>8s}",
+        f"{'sup|E|   [rad]':22s} {s['sup_E']:12.5g} {s['sup_E_settled']:12.5g} {num(cert.get('E_max')):>12s} "
+        f"{ratio(cert.get('E_ratio')):>8s} {s['E_max']:12.5g} {ratio(s['E_ratio']):>8s}",
+        f"{'sup|E|dot [rad/s]':22s} {s['sup_Edot']:12.5g} {s['sup_Edot_settled']:12.5g} "
+        f"{num(cert.get('Edot_max')):>12s} {ratio(cert.get('Edot_ratio')):>8s} {s['Edot_max']:12.5g} "
+        f"{ratio(s['Edot_ratio']):>8s}",
+        f"voltage saturated {100 * s['saturated_fraction']:.1f}% of the time",
+    ]
+    if s["left_steering_range"]:
+        lines.append(f"the steering reached its stop (+-range) at t = {s['left_steering_range_at_s']:.3f} s")
+    if s.get("status") != "completed":
+        lines.append(f"run {s['status']}: report covers the simulated part only")
+    return "\n".join(lines)
+
+
+def run(args: argparse.Namespace) -> int:
+    import functools
+    import sys
+
+    from wmr_mj._util.files import check_output_path
+    from wmr_mj._util.memory import require_run_memory
+    from wmr_mj.cli._common import print_json
+    from wmr_mj.plant.mjcf import TIMESTEP
+    from wmr_mj.sim.closed_loop import run_closed_loop
+
+    # refuse what cannot work before anything runs (an identification for --model identified)
+    require_run_memory(duration_s=args.duration, control_period_s=args.control_period or TIMESTEP)
+    path = None
+    if not args.no_log:
+        path = args.out or default_log_path(args)
+        check_output_path(path, kind="file", option="--out")
+    config = config_from_args(args, m1=args.m1)
+    factory = None
+    if path is not None:
+        from wmr_mj.logs.writer import RunLogger
+
+        factory = functools.partial(RunLogger, path, log_every=args.log_every)
+    from wmr_mj.logs.writer import terminate_as_interrupt
+
+    with terminate_as_interrupt():
+        result = run_closed_loop(config, logger_factory=factory, progress=args.progress)
+    summary = dict(result.summary)
+    summary["log"] = path
+    if args.json:
+        print_json(summary)
+    else:
+        print(format_report(summary))
+        if path:
+            print(f"log: {path}")
+    if result.status == "interrupted":
+        print("wmr-mj: interrupted; the log holds what was simulated", file=sys.stderr)
+        return 130
+    return 0

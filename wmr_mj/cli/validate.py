@@ -1,0 +1,83 @@
+"""``wmr-mj validate``: the headline report (``make demo``), the answer first.
+
+Runs the paper's design against the paper's claim and against its own certificate, the
+ladder from the paper's design to the certified one (one change per rung, a sweep of m1
+each), the worst-case search beside the Monte-Carlo worst and the certificate, and the
+plant's measured friction law, then writes a report folder (index.html, index.md,
+summary.json, summary.csv, per-run CSVs, the worst runs' MCAP logs, figures). Prints the
+answer on stdout and one line per stage on stderr. See :mod:`wmr_mj.report.validate`.
+
+Usage::
+
+    wmr-mj validate                      # make demo: 32 runs per rung, about a minute on 2 cores
+    wmr-mj validate --n 100 --out logs/full-counts
+    wmr-mj validate --search-budget 0 --json
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from wmr_mj.cli._common import int_at_least, positive_float, positive_int
+
+_nonneg_int = int_at_least(0)
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    from wmr_mj.report.validate import DEFAULT_DURATION, DEFAULT_N, DEFAULT_SEARCH_BUDGET, FULL_BOX_FACTOR
+    from wmr_mj.sim.sweep import SAMPLINGS
+
+    p = sub.add_parser("validate", help="headline report: the paper's design, the ladder to the certified design, "
+                                        "the worst-case search, the plant's friction law; writes index.html",
+                       description=__doc__.split("\n\n")[1] if __doc__ else None)
+    p.add_argument("--n", type=positive_int, default=DEFAULT_N,
+                   help=f"runs per rung of the ladder (default {DEFAULT_N}; --n 100 for the full counts)")
+    p.add_argument("--seed", type=_nonneg_int, default=0,
+                   help="seed of the m1 samples, the searches and the identification (default 0)")
+    p.add_argument("--sampling", choices=SAMPLINGS, default="lhs", help="sampling of m1 (default lhs)")
+    p.add_argument("--duration", type=positive_float, default=DEFAULT_DURATION,
+                   help=f"simulated time per run, s (default {DEFAULT_DURATION:g}; >= ~10 s reaches the circle)")
+    p.add_argument("--identify-duration", type=positive_float, default=60.0,
+                   help="excitation length of the identification, s (default 60)")
+    p.add_argument("--search-budget", type=_nonneg_int, default=DEFAULT_SEARCH_BUDGET,
+                   help=f"simulations of each m1-box search (default {DEFAULT_SEARCH_BUDGET}; the full-box search "
+                        f"gets {FULL_BOX_FACTOR}x; 0: no search; else >= 5, one generation)")
+    p.add_argument("--uncertainty", default="m1",
+                   help="uncertainty box the ladder samples and its certificates cover: m1 (the paper's, default) or "
+                        "full (m1, steering and tyre friction, R_a, V_A; see wmr_mj/params.py)")
+    p.add_argument("--nthread", type=_nonneg_int, default=0, help="simulation threads (default 0: all CPUs)")
+    p.add_argument("--out", metavar="DIR",
+                   help="report folder (default logs/validate-<timestamp>/; an existing folder resumes its sweeps)")
+    p.add_argument("--json", action="store_true", help="print the summary object (summary.json) on stdout")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    import json
+    import sys
+    import time
+    from pathlib import Path
+
+    from wmr_mj._util.files import check_output_path
+    from wmr_mj.cli._common import print_json
+    from wmr_mj.cli.figures import default_folder
+    from wmr_mj.report.text import format_headline
+    from wmr_mj.report.validate import ValidateSettings, run_validate, write_pointer
+
+    t0 = time.perf_counter()
+    settings = ValidateSettings(n=args.n, seed=args.seed, sampling=args.sampling, duration=args.duration,
+                                identify_duration=args.identify_duration, search_budget=args.search_budget,
+                                nthread=args.nthread, uncertainty=args.uncertainty)
+    out = check_output_path(args.out or default_folder("validate"), kind="dir", option="--out")
+    summary = run_validate(settings, out)
+    pointer = write_pointer(out)
+    wall = time.perf_counter() - t0
+    if args.json:
+        print_json(json.loads(Path(out, "summary.json").read_text()))
+        print(f"validate: total wall time {wall:.1f} s; report {out}/index.html", file=sys.stderr)
+        return 0
+    print(format_headline(summary))
+    print()
+    print(f"report: {out}/index.html (also index.md, summary.json, summary.csv); pointer: {pointer}")
+    print(f"total wall time {wall:.1f} s")
+    return 0

@@ -1,0 +1,1 @@
+"""Run logs: the MCAP format, writer, reader, Foxglove encoders, replay and video."""

@@ -1,0 +1,345 @@
+"""What ``wmr-mj replay`` does with a run log, as library functions.
+
+- :func:`summarize`: sup|E| and sup|E'| over the whole run and after ``settle_s``, against the
+  analytic bounds E_max, Edot_max of (4.21)-(4.23) when the log carries them (the run's summary,
+  else its config), with the run's status; a JSON-ready dict.
+- :func:`verify`: rebuild the model from the attached MJCF, set the attached initial state,
+  re-apply the logged ctrl and compare qpos and qvel at every control step, bit for bit.
+- :func:`plot`: E and E' over time with the bounds, the armature voltage with the supply limit,
+  and the (|E|, |E'|) plane with the bounds' rectangle and the region polygon (4.21).
+- :func:`format_summary`, :func:`format_verify`: the command's text.
+
+Usage::
+
+    from wmr_mj.logs.reader import load_log
+    from wmr_mj.logs.replay import summarize, verify
+    log = load_log("logs/run.mcap")
+    rep = summarize(log)                     # rep["sup_abs_E"], rep["E_max"], rep["inside"], ...
+    assert verify(log)["identical"]          # the run is reproduced bit for bit
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from wmr_mj.errors import LogError
+from wmr_mj.logs.reader import RunLog
+
+__all__ = ["summarize", "verify", "plot", "format_summary", "format_verify"]
+
+
+def _number(value: Any) -> float | None:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return None
+    return float(value) if math.isfinite(value) else None
+
+
+def _lookup(sources: list[dict[str, Any]], key: str) -> float | None:
+    """The first finite number under ``key`` in the summary, then the config (None: no bound)."""
+    for src in sources:
+        v = _number(src.get(key))
+        if v is not None:
+            return v
+    return None
+
+
+def _region_polygon(summary: dict[str, Any]) -> list[list[float]] | None:
+    """The region (4.21) of the run's analysis: its vertices in the (|E|, |E'|) plane."""
+    analysis = summary.get("analysis")
+    verts = analysis.get("vertices") if isinstance(analysis, dict) else None
+    if not isinstance(verts, list) or len(verts) < 3:
+        return None
+    try:
+        pts = [[float(a), float(b)] for a, b in verts]
+    except (TypeError, ValueError):
+        return None
+    return pts if all(math.isfinite(x) for p in pts for x in p) else None
+
+
+def _sup(x: Any) -> tuple[float | None, int]:
+    """(max |x| over the finite values, or None; number of non-finite values)."""
+    a = np.abs(np.asarray(x, float))
+    finite = a[np.isfinite(a)]
+    return (float(finite.max()) if finite.size else None), int(a.size - finite.size)
+
+
+def summarize(log: RunLog, settle_s: float | None = None) -> dict[str, Any]:
+    """The replay summary of a loaded log (JSON-ready). ``settle_s`` [s] defaults to the log's."""
+    sig = log.signals
+    summary = log.summary or {}
+    sources = [summary, log.config]
+    if settle_s is None:
+        settle_s = _lookup(sources, "settle_s")
+    t = sig.get("t", np.empty(0))
+    E = sig.get("E", np.empty(0))
+    Ed = sig.get("E_dot", np.empty(0))
+    out: dict[str, Any] = {
+        "file": str(log.path),
+        "status": log.status,
+        "truncated": bool(log.truncated),
+        "schema_version": log.info.get("schema_version"),
+        "rows": int(log.rows),
+        "signal_rows": int(t.size),
+        "log_every": log.log_every,
+        "timestep": log.timestep,
+        "control_substeps": log.control_substeps,
+        "duration_s": float(t[-1]) if t.size else None,
+        "seed": log.seed,
+        "config": log.config,
+    }
+    if log.truncated:
+        out["truncated_reason"] = log.truncated_reason
+    sE, badE = _sup(E)
+    sEd, badEd = _sup(Ed)
+    out.update(sup_abs_E=sE, sup_abs_E_dot=sEd, non_finite_E=badE + badEd, settle_s=settle_s)
+    out["sup_abs_E_after_settle"] = out["sup_abs_E_dot_after_settle"] = None
+    if settle_s is not None and t.size:
+        late = t >= settle_s
+        out["sup_abs_E_after_settle"], _ = _sup(E[late])
+        out["sup_abs_E_dot_after_settle"], _ = _sup(Ed[late])
+    if sig.get("voltage") is not None and sig["voltage"].size:
+        out["max_abs_voltage"], _ = _sup(sig["voltage"])
+        with np.errstate(invalid="ignore"):
+            sat = np.abs(sig["voltage_cmd"]) > np.abs(sig["voltage"]) + 1e-12
+        out["voltage_saturated_fraction"] = float(np.mean(sat))
+    e_max, ed_max = _lookup(sources, "E_max"), _lookup(sources, "Edot_max")
+    out.update(E_max=e_max, Edot_max=ed_max, region_polygon=_region_polygon(summary))
+    out["inside"] = out["inside_after_settle"] = None
+    if (e_max is not None or ed_max is not None) and t.size:  # the runner's test: sup|E| <= E_max, sup|E'| <= Edot_max
+        aE, aEd = np.abs(E), np.abs(Ed)
+        with np.errstate(invalid="ignore"):
+            ok = np.isfinite(aE) & np.isfinite(aEd)
+            if e_max is not None:
+                ok &= aE <= e_max
+            if ed_max is not None:
+                ok &= aEd <= ed_max
+        out["inside"] = bool(np.all(ok))
+        out["samples_outside"] = int(np.count_nonzero(~ok))
+        if settle_s is not None:
+            late = ok[t >= settle_s]
+            out["inside_after_settle"] = bool(np.all(late)) if late.size else None
+            out["samples_outside_after_settle"] = int(np.count_nonzero(~late))
+    out["verdict"] = summary.get("verdict")  # the runner's separated verdict (wmr_mj.analysis.verdicts)
+    out["summary"] = log.summary
+    out["versions"] = log.versions
+    return out
+
+
+def verify(log: RunLog) -> dict[str, Any]:
+    """Re-simulate from the attached MJCF and initial state with the logged ctrl; compare qpos and
+    qvel at every control step. {"identical": bool, "rows", "mj_steps", and where it first and
+    most differs}."""
+    import mujoco
+
+    try:
+        m = mujoco.MjModel.from_xml_string(log.mjcf_xml)
+    except ValueError as exc:
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else "compile error"
+        raise LogError(f"{log.path}: the attached MJCF does not compile ({first})") from None
+    d = mujoco.MjData(m)
+    spec = mujoco.mjtState.mjSTATE_INTEGRATION
+    s0 = np.asarray(log.initial_state, np.float64).ravel()
+    if s0.size != mujoco.mj_stateSize(m, spec):
+        raise LogError(f"{log.path}: the initial state has {s0.size} values; the attached model's integration "
+                       f"state has {mujoco.mj_stateSize(m, spec)}")
+    st = log.state
+    if not st:
+        raise LogError(f"{log.path}: the log has no /sim/state channel to verify against")
+    qpos, qvel, ctrl, t = st["qpos"], st["qvel"], st["ctrl"], st["t"]
+    n = len(t)
+    if qpos.shape[1:] != (m.nq,) or qvel.shape[1:] != (m.nv,) or ctrl.shape[1:] != (m.nu,):
+        raise LogError(f"{log.path}: /sim/state sizes (nq, nv, nu) do not match the attached model")
+    mujoco.mj_setState(m, d, s0, spec)
+    sub = log.control_substeps
+    sim_q, sim_v = np.empty_like(qpos), np.empty_like(qvel)
+    step = mujoco.mj_step
+    for k in range(n):  # the runner's loop: record, apply the row's ctrl, step
+        sim_q[k] = d.qpos
+        sim_v[k] = d.qvel
+        d.ctrl[:] = ctrl[k]
+        for _ in range(sub):
+            step(m, d)
+    same_q = (sim_q == qpos) | (np.isnan(sim_q) & np.isnan(qpos))
+    same_v = (sim_v == qvel) | (np.isnan(sim_v) & np.isnan(qvel))
+    row_ok = same_q.all(axis=1) & same_v.all(axis=1)
+    out: dict[str, Any] = {"rows": n, "mj_steps": n * sub, "identical": bool(row_ok.all())}
+    if not out["identical"]:
+        with np.errstate(invalid="ignore"):
+            dev = np.maximum(
+                np.where(same_q, 0.0, np.nan_to_num(np.abs(sim_q - qpos), nan=np.inf)).max(axis=1, initial=0.0),
+                np.where(same_v, 0.0, np.nan_to_num(np.abs(sim_v - qvel), nan=np.inf)).max(axis=1, initial=0.0),
+            )
+        k = int(np.argmax(dev))
+        first = int(np.flatnonzero(~row_ok)[0])
+        out.update(
+            max_deviation=float(dev[k]), max_deviation_t=float(t[k]), max_deviation_row=k,
+            max_deviation_in="qpos" if np.flatnonzero(~same_q[k]).size else "qvel",
+            first_mismatch_t=float(t[first]), first_mismatch_row=first,
+            mismatched_rows=int(np.count_nonzero(~row_ok)),
+        )  # fmt: skip
+    return out
+
+
+
+def _band(ax: Any, bound: float | None, ls: str, color: str, label: str, unit: str) -> None:
+    """Horizontal lines at +-bound (nothing when the bound is None)."""
+    if bound is None:
+        return
+    ax.axhline(bound, ls=ls, lw=0.8, color=color, label=f"{label} = {bound:.3g} {unit}")
+    ax.axhline(-bound, ls=ls, lw=0.8, color=color)
+
+def plot(log: RunLog, path: str | os.PathLike, rep: dict[str, Any]) -> Path:
+    """Write the replay figure (PNG) for ``rep`` = :func:`summarize` of ``log``; returns the path."""
+    from matplotlib.figure import Figure
+    from matplotlib.patches import Polygon, Rectangle
+
+    sig = log.signals
+    t = sig.get("t")
+    if t is None or t.size == 0:
+        raise LogError(f"{log.path}: the log has no signal rows to plot")
+    E, Ed = sig["E"], sig["E_dot"]
+    settle = rep.get("settle_s")
+    e_max, ed_max, poly = rep.get("E_max"), rep.get("Edot_max"), rep.get("region_polygon")
+    style = {"font.size": 9, "axes.grid": True, "grid.alpha": 0.3, "axes.spines.top": False, "axes.spines.right": False}
+    import matplotlib
+
+    with matplotlib.rc_context(style):
+        fig = Figure(figsize=(10, 6.8), constrained_layout=True)
+        ax = fig.subplots(2, 2)
+        a = ax[0, 0]
+        a.plot(t, E, lw=0.9, color="C0", label="E = alpha0 - alpha")
+        cert = (log.summary or {}).get("certificate") or {}
+        _band(a, cert.get("E_max"), "-", "C2", "certificate ±E_max", "rad")
+        _band(a, e_max, "--", "C3", "paper's claim ±E_max", "rad")
+        a.set(xlabel="t [s]", ylabel="E [rad]", title="(a) steering error")
+        b = ax[0, 1]
+        b.plot(t, Ed, lw=0.9, color="C1", label="E' = alpha0' - alpha'")
+        _band(b, cert.get("Edot_max"), "-", "C2", "certificate ±Edot_max", "rad/s")
+        _band(b, ed_max, "--", "C3", "paper's claim ±Edot_max", "rad/s")
+        b.set(xlabel="t [s]", ylabel="E' [rad/s]", title="(b) error rate")
+        c = ax[1, 0]
+        c.plot(t, sig["voltage_cmd"], lw=0.7, color="0.6", label="controller output")
+        c.plot(t, sig["voltage"], lw=0.9, color="C2", label="applied (limited)")
+        try:
+            vlim = _number(log.parameters.get("voltage_limit"))
+        except LogError:
+            vlim = None
+        if vlim is not None:
+            c.axhline(vlim, ls=":", lw=0.8, color="k", label=f"supply ±{vlim:g} V")
+            c.axhline(-vlim, ls=":", lw=0.8, color="k")
+        c.set(xlabel="t [s]", ylabel="u [V]", title="(c) armature voltage")
+        d = ax[1, 1]
+        aE, aEd = np.abs(E), np.abs(Ed)
+        late = t >= settle if settle is not None else np.ones(t.size, bool)
+        if settle is not None and np.any(~late):
+            d.plot(aE[~late], aEd[~late], lw=0.6, color="0.7", label=f"t < {settle:g} s")
+        d.plot(aE[late], aEd[late], lw=0.8, color="C0", label=f"t ≥ {settle:g} s" if settle is not None else "run")
+        fin = np.flatnonzero(np.isfinite(aE) & np.isfinite(aEd))
+        if fin.size:
+            d.plot(aE[fin[-1]], aEd[fin[-1]], "o", ms=4, color="C0", label=f"end (t = {t[fin[-1]]:.3g} s)")
+        if e_max is not None and ed_max is not None:
+            d.add_patch(Rectangle((0, 0), e_max, ed_max, fc="C3", alpha=0.15, ec="C3", ls="--", lw=0.9,
+                                  label="E_max x Edot_max"))
+        if poly:
+            d.add_patch(Polygon(np.asarray(poly), closed=True, fc="C4", alpha=0.1, ec="C4", lw=0.9,
+                                label="region (4.21)"))
+        d.set(xlabel="|E| [rad]", ylabel="|E'| [rad/s]", title="(d) error plane")
+        d.set_xlim(left=0)
+        d.set_ylim(bottom=0)
+        for axis in (a, b, c):
+            if settle is not None:
+                axis.axvline(settle, color="0.5", lw=0.6, ls="-.")
+        for axis in (a, b, c, d):
+            axis.legend(loc="best", fontsize=7, frameon=False)
+        cfg = log.config or {}
+        bits = [f"{k}={cfg[k]}" for k in ("controller", "path", "model", "seed")
+                if k in cfg and not isinstance(cfg[k], (dict, list))]
+        key = "inside_after_settle" if rep.get("inside_after_settle") is not None else "inside"
+        verdict = {True: "inside the paper's claim", False: "outside the paper's claim", None: ""}[rep.get(key)]
+        if verdict and key == "inside_after_settle":
+            verdict += " after settling"
+        extra = [v for v in (rep.get("verdict"), verdict, "TRUNCATED" if log.truncated else "") if v]
+        fig.suptitle(f"{Path(str(log.path)).name}: " + ", ".join(bits + extra), fontsize=10)
+        out = Path(path)
+        out.parent.mkdir(parents=True, exist_ok=True)
+        fig.savefig(out, dpi=200)
+    return out
+
+
+def _fmt(v: Any, unit: str = "") -> str:
+    if v is None:
+        return "n/a"
+    if isinstance(v, float):
+        return f"{v:.4g}{(' ' + unit) if unit else ''}"
+    return str(v)
+
+
+def format_summary(rep: dict[str, Any]) -> str:
+    """The text of ``wmr-mj replay`` for :func:`summarize`'s dict."""
+    lines = [f"log        {rep['file']}"]
+    dur = rep["duration_s"]
+    lines.append(
+        f"status     {rep['status']}: {rep['rows']} control steps, {rep['signal_rows']} signal rows"
+        + (f", t = 0 .. {dur:.4g} s" if dur is not None else "")
+        + f" (timestep {rep['timestep']:.4g} s x {rep['control_substeps']}, log every {rep['log_every']}; "
+        f"schema {rep['schema_version']})"
+    )
+    if rep["truncated"]:
+        lines.append(f"TRUNCATED  the file ends without its footer ({rep.get('truncated_reason')}): the run was "
+                     "killed; what was flushed is shown")
+    cfg = rep["config"] or {}
+    scalars = [f"{k}={v}" for k, v in cfg.items() if isinstance(v, (str, int, float, bool)) or v is None]
+    if scalars:
+        lines.append("config     " + "  ".join(scalars))
+    nested = [k for k, v in cfg.items() if isinstance(v, (dict, list))]
+    if nested:
+        lines.append("           (+ " + ", ".join(nested) + ": see --json)")
+    settle = rep["settle_s"]
+    after = f" (t >= {settle:g} s: " if settle is not None else None
+    lines.append(f"sup|E|     {_fmt(rep['sup_abs_E'], 'rad')}"
+                 + (f"{after}{_fmt(rep['sup_abs_E_after_settle'], 'rad')})" if after else ""))
+    lines.append(f"sup|E'|    {_fmt(rep['sup_abs_E_dot'], 'rad/s')}"
+                 + (f"{after}{_fmt(rep['sup_abs_E_dot_after_settle'], 'rad/s')})" if after else ""))
+    if rep["non_finite_E"]:
+        lines.append(f"non-finite {rep['non_finite_E']} values of E or E' are NaN/inf")
+    if rep.get("max_abs_voltage") is not None:
+        lines.append(f"voltage    max |u| = {_fmt(rep['max_abs_voltage'], 'V')}, saturated "
+                     f"{100 * rep['voltage_saturated_fraction']:.1f}% of rows")
+    if rep["E_max"] is not None or rep["Edot_max"] is not None:
+        def verdict(inside: Any, count: Any) -> str:
+            return {True: "INSIDE", False: f"OUTSIDE ({count} samples)", None: "n/a"}[inside]
+
+        text = f"paper's claim E_max = {_fmt(rep['E_max'], 'rad')}, Edot_max = {_fmt(rep['Edot_max'], 'rad/s')}: "
+        text += f"whole run {verdict(rep['inside'], rep.get('samples_outside'))}"
+        if settle is not None:
+            late = verdict(rep["inside_after_settle"], rep.get("samples_outside_after_settle"))
+            text += f"; after t = {settle:g} s {late}"
+        lines.append(text)
+    else:
+        lines.append("bounds     none in the log (no finite E_max / Edot_max in its summary or config)")
+    if rep.get("summary"):
+        from wmr_mj.analysis.verdicts import format_verdict
+
+        lines.extend("verdict    " + line for line in format_verdict(rep["summary"]))
+    if rep["summary"]:
+        extra = {k: v for k, v in rep["summary"].items() if k not in ("status", "rows", "last_t")}
+        sc = [f"{k}={_fmt(v) if isinstance(v, float) else v}" for k, v in extra.items()
+              if isinstance(v, (str, int, float, bool)) or v is None]
+        if sc:
+            lines.append("summary    " + "  ".join(sc))
+    return "\n".join(lines)
+
+
+def format_verify(ver: dict[str, Any]) -> str:
+    """One line for :func:`verify`'s dict."""
+    if ver["identical"]:
+        return (f"verify     bit-identical: qpos and qvel reproduced exactly at all {ver['rows']} control steps "
+                f"({ver['mj_steps']} mj_step calls)")
+    return (f"verify     MISMATCH: largest deviation {ver['max_deviation']:.3g} in {ver['max_deviation_in']} at "
+            f"t = {ver['max_deviation_t']:.6g} s (row {ver['max_deviation_row']}); first at "
+            f"t = {ver['first_mismatch_t']:.6g} s; {ver['mismatched_rows']} of {ver['rows']} rows differ")

@@ -1,0 +1,1 @@
+"""Reports: the validate stages, their text and HTML, figures."""

@@ -1,0 +1,114 @@
+"""Stage 6 of ``wmr-mj validate``: every figure of the report, PNG + SVG, in figures/.
+
+- ``ladder``: the verdict counts of each rung (:func:`wmr_mj.report.plots.figure_ladder`);
+- ``rung_<k>_<name>``: every run of rung k at (sup|E|, sup|E'|) by verdict, with the
+  certificate's region (when it exists) and the paper's claim
+  (:func:`wmr_mj.report.plots.figure_verdict_plane`);
+- ``history_paper``, ``history_certified``: the nominal runs' E, E', voltage against the
+  certificate's bounds, or the paper's claim where there is no certificate;
+- ``search_history``: each search's runs, its running worst, the Monte-Carlo worst;
+- the paper's Figs. 4-7 (:func:`wmr_mj.report.plots.paper_figures`), Fig. 7 with the paper's design
+  on the MuJoCo plant at m1 = 650 kg.
+
+Usage::
+
+    paths, fig7 = figures_stage(settings, folder, stages, rungs, searches, nominal)
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from wmr_mj._util.progress import Stages
+from wmr_mj.params import C80
+from wmr_mj.report.validate import ValidateSettings
+
+__all__ = ["figures_stage"]
+
+
+def _rung_figure(rung: Mapping[str, Any], folder: Path):
+    from wmr_mj.report import plots
+    from wmr_mj.sim.sweep import read_results
+
+    rows = read_results(folder / rung["runs_csv"])
+    cert, paper = rung["certificate"], rung["paper_region"]
+    regions = [plots.Region(f"certificate: |E| <= {cert['E_max']:.3g} rad, |E'| <= {cert['Edot_max']:.3g} rad/s",
+                            [tuple(v) for v in cert["vertices"]], gid=plots.CERTIFICATE_GID)] if cert["valid"] else []
+    if paper["vertices"]:
+        regions.append(plots.Region(f"paper's claim: |E| <= {paper['E_max']:.3g} rad, |E'| <= "
+                                    f"{paper['Edot_max']:.3g} rad/s", [tuple(v) for v in paper["vertices"]],
+                                    color=plots.PAPER_CLAIM_COLOR, filled=False, gid=plots.REGION_GID))
+    note = None if cert["valid"] else "no certificate:\n" + _wrap(cert["reason"] or ", ".join(cert["unmet"]), 48)
+    return plots.figure_verdict_plane([r["sup_E"] for r in rows], [r["sup_Edot"] for r in rows],
+                                      [r["verdict"] for r in rows], regions, note=note,
+                                      title=f"rung {rung['index']}: {rung['design']}")
+
+
+def _wrap(text: str, width: int) -> str:
+    import textwrap
+
+    return "\n".join(textwrap.wrap(text, width))
+
+
+def _history_figures(nominal: Mapping[str, Any]) -> dict[str, Any]:
+    from wmr_mj.report import plots
+
+    figs = {}
+    for name, run in nominal.items():
+        cert = run.summary["certificate"]
+        if cert.get("certified"):
+            bounds, whose = (cert["E_max"], cert["Edot_max"]), "certificate"
+        else:
+            bounds, whose = (run.summary["E_max"], run.summary["Edot_max"]), "paper's claim"
+        figs[f"history_{name}"] = plots.figure_time_history(
+            run.rows, run.summary, voltage_limit=C80.voltage_limit, bounds=bounds, bound_name=whose,
+            title=f"{name} design on the MuJoCo plant, m1 = {run.summary['m1']:g} kg: {run.summary['verdict']}")
+    return figs
+
+
+def _search_figure(searches: Sequence[Mapping[str, Any]], rungs: Sequence[Mapping[str, Any]]):
+    from wmr_mj.report import plots
+
+    histories = []
+    for s in searches:
+        mc = s.get("mc") or {}
+        ratio = s["objective"] != "sup-E"
+        histories.append(plots.SearchHistory(
+            title=f"{s['design']} design, {s['box_name']} box ({len(s['box'])} parameter(s))",
+            ylabel=s["objective_label"], values=s["values"], mc_worst=mc.get("worst_objective"),
+            mc_label=f"Monte Carlo, rung {mc.get('rung')} ({mc.get('n')} runs)",
+            bound=1.0 if ratio else rungs[-1]["certificate"].get("E_max"),
+            bound_label="region boundary" if ratio else "E_max of the m1-box certificate"))
+    return plots.figure_search_history(histories, title="worst-case search (differential evolution)")
+
+
+def figures_stage(settings: ValidateSettings, folder: Path, st: Stages, rungs: Sequence[Mapping[str, Any]],
+                  searches: Sequence[Mapping[str, Any]], nominal: Mapping[str, Any]
+                  ) -> tuple[dict[str, list[str]], dict[str, Any]]:
+    """Write every figure (PNG + SVG) into figures/: ({stem: [relative paths]}, Fig. 7's numbers)."""
+    from wmr_mj.report import plots
+
+    st.start("figures", "figures (PNG + SVG)")
+    figs: dict[str, Any] = {"ladder": plots.figure_ladder(
+        [f"{r['index']}. {r['label']}" for r in rungs], [r["verdicts"] for r in rungs],
+        [r["paper_inside"] for r in rungs], title=f"Verdicts per rung, {settings.n} runs over m1 each")}
+    for rung in rungs:
+        figs[f"rung_{rung['index']}_{rung['name']}"] = _rung_figure(rung, folder)
+    figs.update(_history_figures(nominal))
+    if searches:
+        figs["search_history"] = _search_figure(searches, rungs)
+    example = plots.paper_example(duration=settings.duration, mujoco=False)
+    example.mujoco_rows, example.mujoco_summary = nominal["paper"].rows, nominal["paper"].summary
+    figs.update(plots.paper_figures(example))
+    paths = {stem: [p.relative_to(folder).as_posix() for p in plots.save_figure(fig, folder / "figures" / stem)]
+             for stem, fig in figs.items()}
+    fig7 = {"condition": example.result.condition, "E_max": example.result.E_max,
+            "Edot_max": example.result.Edot_max,
+            "reduced": [{"case": name, "sup_E": float(np.max(np.abs(r["E"]))),
+                         "sup_Edot": float(np.max(np.abs(r["E_dot"])))} for name, r in example.reduced]}
+    st.done(f"{sum(len(v) for v in paths.values())} files")
+    return paths, fig7

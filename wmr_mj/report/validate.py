@@ -1,0 +1,412 @@
+"""The headline validation (``wmr-mj validate``): the answer first, every number from this run.
+
+:func:`run_validate` runs one function per stage, in this order, into one folder:
+
+1. :func:`identify_stage`: identify the plant at the nominal m1 (identified.json);
+2. :func:`friction_stage`: the steering joint's measured friction law, stiction and soft
+   (``wmr_mj.plant.friction.measure_friction_law``);
+3. :func:`ladder_stage`: for each rung of :data:`wmr_mj.sim.designs.LADDER` (the paper's design,
+   then one change per rung up to the certified design) a sweep of n runs over m1
+   (``run_sweep``, atomic and resumable in ladder-<k>-<name>/), judged by the separated
+   verdicts (:mod:`wmr_mj.analysis.verdicts`) and summarised from its runs.csv (:func:`summarise_rung`);
+4. :func:`wmr_mj.report.search.search_stage`: the worst-case search (differential evolution
+   on whole generations) for the paper's design against the paper's claim and for the
+   certified design against its certificate over the m1 box, beside the Monte-Carlo worst
+   of the same rung; and for the certified design over the 'full' uncertainty box;
+5. :func:`nominal_stage`: the paper's and the certified design at m1 = 650 kg (time histories);
+6. :func:`wmr_mj.report.figures.figures_stage`: PNG + SVG in figures/;
+7. :func:`write_report`: summary.json, summary.csv, index.md, index.html (atomic), rendered
+   by :mod:`wmr_mj.report.text`, which opens with the answer.
+
+A resumed folder reports exactly like a fresh one: every count is recomputed from the
+rung's runs.csv, and a search whose search.json matches its spec is read back.
+
+Usage::
+
+    from wmr_mj.report.validate import ValidateSettings, run_validate
+    from wmr_mj.report.text import format_headline
+    summary = run_validate(ValidateSettings(n=8, search_budget=10), "logs/my-validate")
+    print(format_headline(summary))
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+from wmr_mj._util.files import software_versions
+from wmr_mj._util.progress import Stages
+from wmr_mj.errors import ParameterError, UnknownNameError
+from wmr_mj.params import C80, M1_NOMINAL, M1_RANGE
+from wmr_mj.sim.closed_loop import RunConfig
+from wmr_mj.sim.designs import CERTIFIED, LADDER, PAPER, Design
+
+__all__ = [
+    "DEFAULT_N",
+    "DEFAULT_DURATION",
+    "DEFAULT_SEARCH_BUDGET",
+    "FULL_BOX_FACTOR",
+    "FRICTION_LAWS",
+    "LADDER_GROUPS",
+    "ValidateSettings",
+    "ladder_changes",
+    "summarise_rung",
+    "certificate_summary",
+    "identify_stage",
+    "friction_stage",
+    "ladder_stage",
+    "nominal_stage",
+    "write_report",
+    "run_validate",
+    "write_pointer",
+    "software_versions",
+]
+
+#: Defaults of ``wmr-mj validate``: 4 rungs x 32 runs of 35 s and 3 searches (30 + 30 + 56 runs) take
+#: about a minute on 2 cores, so ``make demo`` fits 3 minutes with the install; ``--n 100``: full counts.
+DEFAULT_N = 32
+DEFAULT_DURATION = 35.0
+#: Simulations of each m1-box search; the 5-parameter full-box search gets FULL_BOX_FACTOR times as many.
+DEFAULT_SEARCH_BUDGET = 30
+FULL_BOX_FACTOR = 2
+#: The steering joint's friction laws the report measures (wmr_mj.plant.mjcf.STEERING_FRICTION_MODELS).
+FRICTION_LAWS = ("stiction", "soft")
+#: What a ladder rung may change, in groups of RunConfig fields: each rung changes exactly one.
+LADDER_GROUPS = {"controller": ("controller",), "model source": ("model",),
+                 "compensation": ("friction_sign", "friction_width"), "gains": ("kp", "kd")}
+_MIN_POPULATION = 5  # differential evolution's smallest generation (wmr_mj.sim.falsify.MIN_POPULATION)
+
+# --------------------------------------------------------------------------- settings
+def _check_number(name: str, value: Any) -> None:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
+        raise ParameterError(f"{name} = {value!r} is not accepted; a finite number > 0 is required")
+
+
+def _check_int(name: str, value: Any, minimum: int, what: str) -> None:
+    if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
+        raise ParameterError(f"{name} = {value!r} is not accepted; {what}")
+
+
+@dataclass(frozen=True, kw_only=True)
+class ValidateSettings:
+    """What ``wmr-mj validate`` runs. Bad values raise ParameterError / UnknownNameError.
+
+    n: runs per rung; duration [s] per run; identify_duration [s] of excitation;
+    search_budget: simulations of each m1-box search (the full box gets FULL_BOX_FACTOR
+    times as many; 0: no search); nthread: 0 = every core; m1_range, nominal_m1 [kg];
+    uncertainty: the box the ladder samples and the certificates cover ('m1', the paper's,
+    or 'full': wmr_mj.params.uncertainty_ranges), its m1 range replaced by m1_range.
+    """
+
+    n: int = DEFAULT_N
+    seed: int = 0
+    sampling: str = "lhs"
+    duration: float = DEFAULT_DURATION
+    identify_duration: float = 60.0
+    search_budget: int = DEFAULT_SEARCH_BUDGET
+    nthread: int = 0
+    m1_range: tuple[float, float] = M1_RANGE
+    nominal_m1: float = M1_NOMINAL
+    uncertainty: str = "m1"
+
+    def __post_init__(self) -> None:
+        from wmr_mj.sim.sweep import SAMPLINGS
+
+        _check_int("n", self.n, 1, "the number of runs per rung must be an integer >= 1")
+        _check_int("seed", self.seed, 0, "an integer >= 0 is required")
+        if self.sampling not in SAMPLINGS:
+            raise UnknownNameError("sampling", str(self.sampling), SAMPLINGS)
+        for name in ("duration", "identify_duration", "nominal_m1"):
+            _check_number(name, getattr(self, name))
+        _check_int("nthread", self.nthread, 0, "an integer >= 0 (0: all CPUs) is required")
+        _check_int("search_budget", self.search_budget, 0, f"give 0 (no search) or an integer >= {_MIN_POPULATION}")
+        if 0 < self.search_budget < _MIN_POPULATION:
+            raise ParameterError(f"search_budget = {self.search_budget} is below one generation of differential "
+                                 f"evolution; give 0 (no search) or an integer >= {_MIN_POPULATION}")
+        lo, hi = self.m1_range
+        if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo < hi):
+            raise ParameterError(f"m1_range = {self.m1_range!r} must be (lo, hi) with 0 < lo < hi")
+        from wmr_mj.params import UNCERTAINTY_NAMES
+
+        if self.uncertainty not in UNCERTAINTY_NAMES:
+            raise UnknownNameError("uncertainty box name", str(self.uncertainty), UNCERTAINTY_NAMES)
+
+    @property
+    def ranges(self) -> dict[str, tuple[float, float]]:
+        """The ranged parameters of the uncertainty box other than m1, name -> (lo, hi)."""
+        from wmr_mj.params import uncertainty_ranges
+
+        return {k: v for k, v in uncertainty_ranges(self.uncertainty).items() if k != "m1"}
+
+    def config(self, design: Design) -> RunConfig:
+        """The run of ``design`` these settings sweep (m1 at nominal; the sweep draws it)."""
+        return RunConfig(**design.config_changes(), duration=self.duration, m1=self.nominal_m1,
+                         m1_range=tuple(self.m1_range), box_ranges=self.ranges, seed=self.seed)
+
+    def as_dict(self) -> dict[str, Any]:
+        d = asdict(self)
+        d["m1_range"] = list(self.m1_range)
+        return d
+
+
+# --------------------------------------------------------------------------- summaries
+def _max_at(rows: Sequence[Mapping[str, Any]], column: str) -> tuple[float | None, float | None]:
+    """(largest value of ``column``, the m1 of its run); (None, None) when the column is empty."""
+    best, m1 = None, None
+    for r in rows:
+        v = r.get(column)
+        if v is not None and (best is None or float(v) > best):
+            best, m1 = float(v), float(r["m1"])
+    return best, m1
+
+
+def summarise_rung(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
+    """The numbers of one rung from its runs (rows of runs.csv, ``sweep.read_results``).
+
+    verdicts: a count for each of the four verdicts; paper_inside: runs inside the paper's
+    claim; worst sup|E| (and its m1), worst sup|E|/E_max of the certificate and of the paper's
+    claim; hit_stop: runs that reached the steering stop; growing: runs whose |E| still grows.
+    """
+    from wmr_mj.analysis.verdicts import PASS, count_verdicts
+
+    if not rows:
+        raise ParameterError("no runs to summarise")
+    verdicts = count_verdicts(str(r["verdict"]) for r in rows if r.get("verdict"))
+    sup_E, sup_E_m1 = _max_at(rows, "sup_E")
+    cert_ratio, cert_m1 = _max_at(rows, "cert_E_ratio")
+    paper_ratio, paper_m1 = _max_at(rows, "E_ratio")
+    return {
+        "n": len(rows),
+        "verdicts": verdicts,
+        "passes": verdicts[PASS],
+        "certified_outside": verdicts["certified-outside"],
+        "paper_inside": sum(bool(r["inside"]) for r in rows),
+        "worst_sup_E": sup_E, "worst_sup_E_m1": sup_E_m1,
+        "worst_sup_Edot": max(float(r["sup_Edot"]) for r in rows),
+        "worst_certificate_ratio": cert_ratio, "worst_certificate_ratio_m1": cert_m1,
+        "worst_paper_ratio": paper_ratio, "worst_paper_ratio_m1": paper_m1,
+        "hit_stop": sum(bool(r["left_steering_range"]) for r in rows),
+        "growing": sum(bool(r.get("drift_growing")) for r in rows),
+        "mean_saturated_fraction": sum(float(r["saturated_fraction"]) for r in rows) / len(rows),
+        "m1_min": min(float(r["m1"]) for r in rows), "m1_max": max(float(r["m1"]) for r in rows),
+    }
+
+
+def ladder_changes(before: Design, after: Design) -> list[str]:
+    """The groups of :data:`LADDER_GROUPS` in which ``after`` differs from ``before``."""
+    a, b = before.config_changes(), after.config_changes()
+    return [group for group, fields in LADDER_GROUPS.items() if any(a[f] != b[f] for f in fields)]
+
+
+def _change_text(before: Design, after: Design) -> str:
+    a, b = before.config_changes(), after.config_changes()
+    parts = []
+    for group in ladder_changes(before, after):
+        fields = [f for f in LADDER_GROUPS[group] if a[f] != b[f]]
+        named = len(LADDER_GROUPS[group]) > 1  # name the field where the group has several
+        parts.append(f"{group}: " + ", ".join((f"{f} " if named else "") + (
+            f"{a[f]:g} -> {b[f]:g}" if isinstance(a[f], float) else f"{a[f]} -> {b[f]}") for f in fields))
+    return "; ".join(parts)
+
+
+def certificate_summary(cert: Any) -> dict[str, Any]:
+    """A certificate's numbers for the report: ``Certificate.as_dict()`` without the bulky
+    inputs, plus the reference's max|alpha0|, the steering range, the supply and the box."""
+    d = {k: v for k, v in cert.as_dict().items() if k != "inputs"}
+    inputs = cert.inputs
+    d["alpha0_max"] = inputs.get("reference", {}).get("alpha0_max")
+    d["steering_range"] = inputs.get("steering_range")
+    d["voltage_limit"] = inputs.get("voltage_limit")
+    d["m1_range"] = inputs.get("m1_range")
+    d["box_ranges"] = inputs.get("box_ranges", {})
+    return d
+
+
+def _reference(settings: ValidateSettings):
+    from wmr_mj.sim.closed_loop import build_reference
+
+    return build_reference("paper-circle", C80, dt=1e-3, duration=settings.duration)[0]
+
+
+def _paper_region(config: RunConfig, reference) -> dict[str, Any]:
+    """The paper's claim for ``config``: the region (4.21)-(4.23) its runs are judged by."""
+    from wmr_mj.sim.closed_loop import _controller, _estimate_of, analysis_for
+
+    analysis = analysis_for(config, reference, C80, estimate=_estimate_of(_controller(config, C80)))
+    d = analysis.as_dict()
+    return {k: d[k] for k in ("E_max", "Edot_max", "condition", "stable", "vertices")}
+
+
+# --------------------------------------------------------------------------- stages 1-2
+def identify_stage(settings: ValidateSettings, folder: Path, st: Stages) -> dict[str, Any]:
+    """Identify the plant at the nominal m1; writes identified.json; its ``as_dict`` and verdict."""
+    from wmr_mj._util.files import write_json_atomic
+    from wmr_mj.params import with_params
+    from wmr_mj.plant.identify import identify_plant
+
+    st.start("identify", f"identify the plant (m1 = {settings.nominal_m1:g} kg, {settings.identify_duration:g} s "
+                         "excitation)")
+    ident = identify_plant(with_params(C80, m1=settings.nominal_m1), duration=settings.identify_duration,
+                           seed=settings.seed)
+    out = ident.as_dict()
+    write_json_atomic(folder / "identified.json", out)
+    out["verdict"] = ident.verdict()
+    st.done(f"K = {ident.identified.K:.3g} V, gyro = {ident.identified.gyro:.3g} V s/m, "
+            f"{ident.diagnostics['samples']} samples")
+    return out
+
+
+def friction_stage(settings: ValidateSettings, st: Stages) -> dict[str, dict[str, Any]]:
+    """The steering joint's measured friction law for each of :data:`FRICTION_LAWS`."""
+    from wmr_mj.params import with_params
+    from wmr_mj.plant.friction import measure_friction_law
+
+    st.start("friction", "the steering joint's friction law (stiction, soft): constant voltages")
+    plant = with_params(C80, m1=settings.nominal_m1)
+    laws = {name: measure_friction_law(plant, steering_friction=name).as_dict() for name in FRICTION_LAWS}
+    st.done(", ".join(f"{name}: break-away {law['breakaway_voltage']:.3g} V, "
+                      f"{'holds' if law['holds'] else 'creeps'} below it" for name, law in laws.items()))
+    return laws
+
+
+# --------------------------------------------------------------------------- stage 3: the ladder
+def _stage_progress(st: Stages) -> Callable[[float, int], None]:
+    return lambda done, total: st.update(done, total)
+
+
+def _loud(count: int, where: str) -> str:
+    return (f" !!! {count} CERTIFIED-OUTSIDE run(s) in {where}: a bug or a modelling gap !!!" if count else "")
+
+
+def run_rung(settings: ValidateSettings, k: int, design: Design, folder: Path, st: Stages, reference,
+             before: Design | None) -> dict[str, Any]:
+    """Sweep one rung over m1 (resumable in ladder-<k>-<name>/) and summarise it."""
+    from wmr_mj.analysis.certificate import certificate_for
+    from wmr_mj.sim.sweep import SweepSpec, read_results, run_sweep
+
+    base = settings.config(design)
+    spec = SweepSpec(n=settings.n, seed=settings.seed, sampling=settings.sampling,
+                     m1_range=tuple(settings.m1_range), ranges=settings.ranges, base=base)
+    sweep_dir = folder / f"ladder-{k}-{design.name}"
+    st.start(f"ladder-{k}", f"rung {k} ({design.label}): {settings.n} runs of {settings.duration:g} s over m1 "
+                            f"{settings.m1_range[0]:g}-{settings.m1_range[1]:g} kg ({settings.sampling})")
+    run_sweep(spec, out_dir=sweep_dir, nthread=settings.nthread, progress=_stage_progress(st))
+    rung = summarise_rung(read_results(sweep_dir / "runs.csv"))
+    rung.update(index=k, name=design.name, label=design.label, design=design.describe(),
+                config=design.config_changes(), changed=[] if before is None else ladder_changes(before, design),
+                change="" if before is None else _change_text(before, design),
+                certificate=certificate_summary(certificate_for(base, reference)),
+                paper_region=_paper_region(base, reference),
+                runs_csv=(sweep_dir / "runs.csv").relative_to(folder).as_posix())
+    st.done(f"{rung['passes']}/{rung['n']} certified-inside, {rung['paper_inside']}/{rung['n']} inside the "
+            f"paper's claim" + _loud(rung["certified_outside"], f"rung {k}"))
+    return rung
+
+
+def ladder_stage(settings: ValidateSettings, folder: Path, st: Stages) -> list[dict[str, Any]]:
+    """Every rung of :data:`LADDER`, in order (see :func:`run_rung`)."""
+    reference = _reference(settings)
+    rungs = []
+    for k, design in enumerate(LADDER, start=1):
+        rungs.append(run_rung(settings, k, design, folder, st, reference, LADDER[k - 2] if k > 1 else None))
+    return rungs
+
+
+# --------------------------------------------------------------------------- stage 5: nominal runs
+def nominal_stage(settings: ValidateSettings, st: Stages) -> dict[str, Any]:
+    """The paper's and the certified design at the nominal m1: {name: RunResult}."""
+    from wmr_mj.sim.closed_loop import run_closed_loop
+
+    st.start("nominal", f"nominal runs at m1 = {settings.nominal_m1:g} kg (paper's and certified design)")
+    runs = {d.name: run_closed_loop(settings.config(d), progress=False) for d in (PAPER, CERTIFIED)}
+    st.done(", ".join(f"{name}: sup|E| = {r.summary['sup_E']:.3g} rad, {r.summary['verdict']}"
+                      for name, r in runs.items()))
+    return runs
+
+
+def _nominal_summary(run) -> dict[str, Any]:
+    s = run.summary
+    keys = ("m1", "sup_E", "sup_Edot", "settle_s", "sup_E_settled", "verdict", "inside", "E_ratio",
+            "left_steering_range_at_s", "final_alpha", "saturated_fraction")
+    out = {k: s.get(k) for k in keys}
+    out["certificate_E_ratio"] = (s.get("certificate") or {}).get("E_ratio")
+    out["drift"] = s.get("drift")
+    return out
+
+
+# --------------------------------------------------------------------------- stage 7: the report
+def write_report(summary: dict[str, Any], folder: Path) -> None:
+    """summary.csv, index.md, index.html and summary.json (last), each written atomically."""
+    from wmr_mj._util.files import write_json_atomic, write_text_atomic
+    from wmr_mj.report.text import render_html, render_markdown, summary_csv
+
+    write_text_atomic(folder / "summary.csv", summary_csv(summary))
+    write_text_atomic(folder / "index.md", render_markdown(summary))
+    write_text_atomic(folder / "index.html", render_html(summary))
+    write_json_atomic(folder / "summary.json", summary)
+
+
+def write_pointer(folder: str | os.PathLike) -> Path:
+    """Write ``<parent>/validate-latest``: a text file holding the folder's absolute path."""
+    from wmr_mj._util.files import write_text_atomic
+
+    folder = Path(folder)
+    return write_text_atomic(folder.parent / "validate-latest", str(folder.resolve()) + "\n")
+
+
+def _certified_rule() -> dict[str, Any]:
+    """The certified design's rule as designs.py writes it, and the omega_r it gives now."""
+    import re
+
+    from wmr_mj.sim import designs
+
+    doc = designs.__doc__ or ""
+    rule = doc.split("``certified``:", 1)[-1].split("The ladder", 1)[0]
+    rule = re.sub(r":\w+:`([^`]*)`", r"\1", rule).replace("``", "")
+    return {"text": " ".join(rule.split()), "error_spec": designs.ERROR_SPEC, "omega_r_grid_step":
+            designs.OMEGA_R_GRID[1] - designs.OMEGA_R_GRID[0], "omega_r_rule": designs.certified_omega_r(),
+            "omega_r_design": CERTIFIED.kd}
+
+
+def run_validate(settings: ValidateSettings, out_dir: str | os.PathLike, *, log: bool = True,
+                 stream=None, tty: bool | None = None) -> dict[str, Any]:
+    """Run the validation into ``out_dir`` (created; sweeps and searches resume there).
+
+    Returns the summary (what summary.json holds). Stage lines go to ``stream`` (default
+    stderr) when ``log``; ``tty`` forces or suppresses the live counter.
+    """
+    from wmr_mj.report.figures import figures_stage
+    from wmr_mj.report.search import search_stage
+    from wmr_mj.report.text import findings
+
+    wall0 = time.perf_counter()
+    folder = Path(out_dir)
+    folder.mkdir(parents=True, exist_ok=True)
+    st = Stages("validate", stream=stream, enabled=log, tty=tty)
+    identification = identify_stage(settings, folder, st)
+    friction = friction_stage(settings, st)
+    rungs = ladder_stage(settings, folder, st)
+    searches = search_stage(settings, folder, st, rungs)
+    nominal = nominal_stage(settings, st)
+    figures, fig7 = figures_stage(settings, folder, st, rungs, searches, nominal)
+    st.start("report", "summary.json, summary.csv, index.md, index.html")
+    summary: dict[str, Any] = {
+        "folder": str(folder), "created": time.strftime("%Y-%m-%d %H:%M:%S %z"), "settings": settings.as_dict(),
+        "seed": settings.seed, "ladder": rungs, "certified_rule": _certified_rule(), "searches": searches,
+        "nominal": {name: _nominal_summary(run) for name, run in nominal.items()}, "friction": friction,
+        "identification": identification, "paper_example": fig7, "figures": figures,
+        "certified_outside": sum(r["certified_outside"] for r in rungs)
+        + sum(s["verdicts"]["certified-outside"] for s in searches),
+        "versions": software_versions(),
+    }
+    summary["findings"] = findings(summary)
+    summary["timings_s"] = dict(st.timings)
+    summary["wall_s"] = time.perf_counter() - wall0
+    write_report(summary, folder)
+    st.done()
+    return summary

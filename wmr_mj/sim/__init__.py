@@ -1,0 +1,1 @@
+"""Simulation: run configuration, closed loop, batch engine and compiled law, sweeps, falsification, designs."""

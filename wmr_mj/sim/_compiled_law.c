@@ -1,0 +1,114 @@
+/* The steering law of controllers.computed_torque as MuJoCo's control callback (mjcb_control).
+ *
+ * wmr_mj.sim.compiled_law installs wmr_mj_control through ctypes; wmr_mj.sim.batch.run_batch then runs
+ * whole blocks of closed-loop steps in C (mujoco.batch.Batch.rollout), with no Python per step.
+ * The callback acts only on models that carry the numeric "wmr_mj_law" first and
+ * "wmr_mj_reference" second (wmr_mj.sim.compiled_law.attach); on any other model it returns at
+ * once, so the serial loop and every other model of the process are untouched.
+ *
+ * The law is ComputedTorque.voltage_scalar / PDController.voltage_scalar, (3.2)-(3.3) of the
+ * paper, term for term and in the same order of IEEE operations (no contraction into fused
+ * multiply-adds: built with -ffp-contract=off), and the voltage limit and NaN rule of the serial
+ * loop (wmr_mj.sim.closed_loop.run_closed_loop); tests/test_compiled_law.py checks the bits.
+ *
+ * userdata (4 per simulation), written at every control step for the statistics:
+ *   alpha (rad), E = alpha0 - alpha (rad), E' = alpha0' - alpha' (rad/s), unsaturated law (V).
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+
+#include <math.h>
+#include <string.h>
+
+#include <mujoco/mujoco.h>
+
+/* the numeric "wmr_mj_law": keep in step with wmr_mj/sim/compiled_law.py (LAW_FIELDS) */
+enum {
+  LAW_KIND,      /* 0: computed torque, 1: PD */
+  LAW_P,         /* P^, V s^2/rad */
+  LAW_KP,        /* K_P, 1/s^2 */
+  LAW_KD,        /* K_D, 1/s */
+  LAW_C_V,       /* C_V^, V s/rad */
+  LAW_F,         /* F^, V (0: no Coulomb term) */
+  LAW_K,         /* K^, V */
+  LAW_GYRO_V,    /* gyro^ V_A, V s/rad */
+  LAW_WIDTH,     /* width of the smoothed sign, rad/s (0: exact sign) */
+  LAW_SIGN,      /* 1: sign of alpha', 2: sign of alpha0' */
+  LAW_LIMIT,     /* voltage limit, V */
+  LAW_SUBSTEPS,  /* physics steps per control step */
+  LAW_NSTEP,     /* control steps in the reference */
+  LAW_QPOS,      /* qpos address of the steering joint */
+  LAW_DOF,       /* dof address of the steering joint */
+  LAW_ACTUATOR,  /* the steering motor */
+  LAW_SIZE
+};
+
+int wmr_mj_law_size(void) { return LAW_SIZE; }
+
+int wmr_mj_mujoco_version(void) { return mjVERSION_HEADER; }
+
+void wmr_mj_control(const mjModel* m, mjData* d) {
+  if (m->nnumeric < 2 || m->nuserdata < 4 || m->numeric_size[0] != LAW_SIZE ||
+      strcmp(m->names + m->name_numericadr[0], "wmr_mj_law") != 0) {
+    return;
+  }
+  const mjtNum* law = m->numeric_data + m->numeric_adr[0];
+  const mjtNum* reference = m->numeric_data + m->numeric_adr[1];
+  long long step = llround(d->time / m->opt.timestep);
+  long long substeps = (long long)law[LAW_SUBSTEPS];
+  if (substeps < 1 || step < 0 || step % substeps) {
+    return;  /* the control of the period's first step holds (zero-order hold) */
+  }
+  long long k = step / substeps;
+  if (k >= (long long)law[LAW_NSTEP] || 3 * k + 2 >= m->numeric_size[1]) {
+    return;  /* past the reference: the run is over */
+  }
+  double alpha = d->qpos[(int)law[LAW_QPOS]];
+  double alpha_dot = d->qvel[(int)law[LAW_DOF]];
+  double alpha0 = reference[3 * k], alpha0_dot = reference[3 * k + 1], alpha0_ddot = reference[3 * k + 2];
+  double u;
+  if (law[LAW_KIND] == 1.0) {
+    u = law[LAW_P] * (law[LAW_KD] * (alpha0_dot - alpha_dot) + law[LAW_KP] * (alpha0 - alpha));
+  } else {
+    double servo = alpha0_ddot + law[LAW_KD] * (alpha0_dot - alpha_dot) + law[LAW_KP] * (alpha0 - alpha);
+    double c = cos(alpha);
+    u = law[LAW_P] * servo;
+    if (law[LAW_K] != 0.0) {
+      u = u + law[LAW_K] * sin(alpha) / (c * c * c);
+    }
+    if (law[LAW_C_V] != 0.0) {
+      u = u + law[LAW_C_V] * alpha_dot;
+    }
+    if (law[LAW_F] != 0.0) {
+      double x = law[LAW_SIGN] == 2.0 ? alpha0_dot : alpha_dot;
+      double width = law[LAW_WIDTH], s;
+      if (width > 0.0) {
+        s = x / sqrt(x * x + width * width);
+      } else {
+        s = x > 0.0 ? 1.0 : (x < 0.0 ? -1.0 : 0.0);
+      }
+      u = u + law[LAW_F] * s;
+    }
+    if (law[LAW_GYRO_V] != 0.0) {
+      u = u + law[LAW_GYRO_V] * alpha_dot / (c * c);
+    }
+  }
+  double limit = law[LAW_LIMIT], applied;
+  if (u != u) {
+    applied = 0.0;  /* NaN from a diverged law: apply nothing, as the serial loop */
+  } else {
+    applied = u > limit ? limit : (u < -limit ? -limit : u);
+  }
+  d->ctrl[(int)law[LAW_ACTUATOR]] = applied;
+  d->userdata[0] = alpha;
+  d->userdata[1] = alpha0 - alpha;
+  d->userdata[2] = alpha0_dot - alpha_dot;
+  d->userdata[3] = u;
+}
+
+/* an importable module, so that setuptools builds and ships the library; ctypes finds the symbols */
+static struct PyModuleDef module = {
+    PyModuleDef_HEAD_INIT, "_compiled_law", "The steering law as a MuJoCo control callback (wmr_mj.sim.compiled_law).",
+    -1, NULL, NULL, NULL, NULL, NULL};
+
+PyMODINIT_FUNC PyInit__compiled_law(void) { return PyModule_Create(&module); }

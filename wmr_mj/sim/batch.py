@@ -1,0 +1,434 @@
+"""Many closed-loop runs at once on ``mujoco.batch``: the engine of sweeps and searches.
+
+``run_batch`` runs configs that differ only in their plant parameters (m1 and any other
+named parameter), each simulation on its own compiled model, and reports each run exactly
+as a single ``wmr_mj.sim.closed_loop.run_closed_loop`` would (tests keep them bit-identical).
+
+How a batch runs at the speed of open-loop ``mujoco.rollout`` (bench/bench_sweep.py):
+
+- the law runs in C, inside every ``mj_step``, as MuJoCo's control callback
+  (:mod:`wmr_mj.sim.compiled_law`: ``voltage_scalar`` operation for operation, bit-identical);
+  ``mujoco.batch.Batch.rollout`` then runs a block of 1000 closed-loop steps of every
+  simulation per call, on every thread, with no Python in between;
+- where the compiled law cannot run (not built, ``WMR_MJ_COMPILED_LAW=0``, a controller
+  subclass), the NumPy law: the simulations are split into groups, each a ``Batch``
+  stepped on its own thread with its own vectorised law (``controller.batch_law``: NumPy
+  ``out=`` buffers, nothing allocated per step), one group's law overlapping the others'
+  physics; ``run_batch(law=...)`` chooses;
+- statistics are folded in blocks of 1000 steps, not step by step;
+- models are compiled without the scene's sky texture (95% of compiling it).
+
+Usage::
+
+    from wmr_mj.sim.batch import run_batch
+    from wmr_mj.sim.closed_loop import RunConfig
+    base = RunConfig(model="nonholonomic", duration=20.0)
+    reports = run_batch([base.replace(m1=m) for m in (550.0, 650.0, 750.0)], nthread=2)
+    [r["sup_E"] for r in reports]        # each as run_closed_loop(config).summary["sup_E"]
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import threading
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import mujoco
+import numpy as np
+
+from wmr_mj._util.memory import require_memory
+from wmr_mj.analysis.certificate import certificate_for
+from wmr_mj.analysis.verdicts import drift, drift_window_steps
+from wmr_mj.errors import ParameterError, UnknownNameError
+from wmr_mj.params import C80, M1_NOMINAL, C80Parameters
+from wmr_mj.sim import compiled_law
+from wmr_mj.sim.closed_loop import (
+    RunConfig,
+    _controller,
+    _estimate_of,
+    _substeps,
+    analysis_for,
+    build_reference,
+    estimate_parameters,
+    plant_parameters,
+    report,
+    run_closed_loop,
+)
+
+__all__ = ["run_batch", "batch_model", "batch_law_backend", "LAW_BACKENDS", "thread_count", "batch_groups"]
+
+#: how run_batch evaluates the law: "compiled" (C, in MuJoCo's control callback), "numpy"
+#: (the vectorised law between steps), "auto" (compiled where it can run)
+LAW_BACKENDS = ("auto", "compiled", "numpy")
+
+_PLANT_OPTIONS = ("steering_friction", "tyre_contact")  # RunConfig fields that choose the plant's laws
+
+
+def _plant_options(config: RunConfig) -> dict[str, Any]:
+    """The plant-law keywords the config carries (compile_model and Plant take them)."""
+    return {name: getattr(config, name) for name in _PLANT_OPTIONS if hasattr(config, name)}
+
+
+def batch_model(params: C80Parameters, *, law: tuple[np.ndarray, Sequence[np.ndarray]] | None = None,
+                **plant_options: Any) -> mujoco.MjModel:
+    """The plant of ``compile_model(params, ...)`` without its sky texture, for the batch.
+
+    Generating the 512x3072 sky gradient is 95% of compiling the scene (11.6 of 12 ms
+    measured); a texture touches no physics, and a test checks that every other model
+    field equals the serial run's. ``law`` = (law vector, reference rows) attaches the
+    compiled law (:func:`wmr_mj.sim.compiled_law.attach`: two numerics and userdata, no physics).
+    """
+    from wmr_mj.plant import mjcf as plant
+
+    spec = plant.scene_spec(params, **plant_options)
+    for texture in list(spec.textures):
+        if texture.type == mujoco.mjtTexture.mjTEXTURE_SKYBOX:
+            spec.delete(texture)
+    if law is not None:
+        compiled_law.attach(spec, *law)
+    return spec.compile()
+
+
+def thread_count(nthread: int, nsim: int) -> int:
+    """Threads for nsim simulations: nthread, or every core this process may use when 0."""
+    if nthread < 0:
+        raise ParameterError(f"nthread = {nthread} is not accepted; give 0 (all cores) or a count >= 1")
+    if nthread == 0:
+        nthread = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    return max(1, min(nthread, nsim))
+
+
+def batch_groups(nsim: int, threads: int) -> list[tuple[np.ndarray, int]]:
+    """(simulation indices, batch threads) of each group: one Python thread per group.
+
+    min(threads, nsim // 32) groups, at least one: each law call costs about 5 us whatever
+    the group's size, under the GIL, so small groups pay it too often; the threads left
+    over step inside the groups' batches. Measured (2 threads, 10 s runs, run_batch wall):
+    16 simulations ran at 232.6k steps/s in one group against 216.2k in two, 32 at 247.2k
+    against 244.7k, 64 at 262.5k against 262.9k.
+    """
+    ngroups = max(1, min(threads, nsim // 32))
+    per_group = np.array_split(np.arange(threads), ngroups)
+    return [(idx, len(t)) for idx, t in zip(np.array_split(np.arange(nsim), ngroups), per_group)]
+
+
+@dataclass
+class _BatchStats:
+    """Per-simulation statistics of a batch, written by the group loops at their indices."""
+
+    nsim: int
+    sup_E: np.ndarray = field(init=False)
+    sup_Ed: np.ndarray = field(init=False)
+    sup_E_s: np.ndarray = field(init=False)
+    sup_Ed_s: np.ndarray = field(init=False)
+    saturated: np.ndarray = field(init=False)
+    left_at: np.ndarray = field(init=False)
+    final_alpha: np.ndarray = field(init=False)
+    final_alpha_after_step: np.ndarray = field(init=False)
+    warnings: np.ndarray = field(init=False)
+    law_nan: np.ndarray = field(init=False)  # the law gave NaN: re-run serially
+    drift_prev: np.ndarray = field(init=False)  # max |E| over the window before the last (wmr_mj.analysis.verdicts)
+    drift_last: np.ndarray = field(init=False)  # max |E| over the last window
+    final_alpha_dot: np.ndarray = field(init=False)  # alpha0' - E' of the last control step
+    cpu_s: list[float] = field(default_factory=list)  # CPU time of each group's thread
+
+    def __post_init__(self) -> None:
+        n = self.nsim
+        self.law_nan = np.zeros(n, dtype=bool)
+        self.sup_E, self.sup_Ed, self.sup_E_s, self.sup_Ed_s = (np.zeros(n) for _ in range(4))
+        self.saturated, self.warnings = np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64)
+        self.left_at, self.final_alpha, self.final_alpha_after_step = (np.full(n, np.nan) for _ in range(3))
+        self.drift_prev, self.drift_last = np.zeros(n), np.zeros(n)
+        self.final_alpha_dot = np.full(n, np.nan)
+
+
+@dataclass(frozen=True, kw_only=True)
+class _Loop:
+    """What every group's control loop shares: reference, timing, limits, indices."""
+
+    alpha0: np.ndarray
+    alpha0_dot: np.ndarray
+    alpha0_ddot: np.ndarray
+    n: int  # control steps
+    substeps: int
+    period: float
+    settle_k: int
+    drift_k: int  # control steps per drift window (wmr_mj.analysis.verdicts.drift_window_steps)
+    block: int
+    qpos_adr: int
+    dof_adr: int
+    actuator: int
+    keyframe: int
+    voltage_limit: np.ndarray  # (nsim,)
+    range_limit: np.ndarray  # (nsim,)
+
+
+def _run_group(loop: _Loop, models: Sequence[mujoco.MjModel], idx: np.ndarray, threads: int, law,
+               stats: _BatchStats, stop: threading.Event, progress: Callable[[int, int], None] | None) -> None:
+    """The closed loop of simulations ``idx`` on one thread, from the home keyframe to the end.
+
+    Groups share nothing but the GIL, held only while the law runs: while one thread
+    computes its law, the others step (mujoco.batch releases the GIL), and no thread
+    waits for another at the end of a step. The loop body is what a control step costs
+    beyond the physics (bench/bench_sweep.py): a copy, the law, two clips, the step call.
+    """
+    from mujoco.batch import Batch
+
+    g = len(idx)
+    batch = Batch(models[0], nsim=g, nthread=threads)
+    batch.set_models(list(models))
+    batch.reset(keyframe=loop.keyframe)
+    alpha_now = batch.bind("qpos")[:, loop.qpos_adr]  # views of the state rows: no copy
+    alpha_dot_now = batch.bind("qvel")[:, loop.dof_adr]
+    ctrl_now = batch.bind("ctrl")[:, loop.actuator]
+    block = loop.block
+    bufs = a_buf, E_buf, Ed_buf, u_buf = tuple(np.empty((block, g)) for _ in range(4))
+    rows = [list(buf) for buf in bufs]  # row views made once, not at every step
+    clipped = np.empty(g)
+    lo, hi = -loop.voltage_limit[idx], loop.voltage_limit[idx]
+    range_limit = loop.range_limit[idx]
+    step, nstep = batch.step, loop.substeps
+    maximum, minimum = np.maximum, np.minimum
+    for k0 in range(0, loop.n, block):
+        count = min(block, loop.n - k0)
+        reference = (loop.alpha0[k0:k0 + count].tolist(), loop.alpha0_dot[k0:k0 + count].tolist(),
+                     loop.alpha0_ddot[k0:k0 + count].tolist())
+        for alpha, E, E_dot, u, a0, a0d, a0dd in zip(*rows, *reference):
+            alpha[:] = alpha_now  # recorded: the state row changes with the step
+            law(alpha, alpha_dot_now, a0, a0d, a0dd, E, E_dot, u)
+            # the voltage limit; a NaN passes through to MuJoCo, which then warns (BADCTRL), and
+            # the simulation is re-run serially (run_batch), where NaN applies nothing
+            maximum(u, lo, out=clipped)
+            minimum(clipped, hi, out=ctrl_now)
+            step(nstep=nstep)
+        _block_stats(loop, stats, idx, k0, count, a_buf, E_buf, Ed_buf, u_buf, lo, hi, range_limit)
+        if _stopped(loop, k0 + count, stop, progress):
+            return
+    _final_stats(loop, stats, idx, batch, a_buf[count - 1], Ed_buf[count - 1], alpha_now)
+
+
+def _stopped(loop: _Loop, done: int, stop: threading.Event, progress: Callable[[int, int], None] | None) -> bool:
+    """Report ``done`` control steps; whether the group must stop (another group failed, Ctrl-C)."""
+    if progress is not None:
+        progress(done, loop.n)
+    return stop.is_set()
+
+
+def _final_stats(loop: _Loop, stats: _BatchStats, idx: np.ndarray, batch, last_alpha: np.ndarray,
+                 last_E_dot: np.ndarray, alpha_now: np.ndarray) -> None:
+    """The end-of-run figures of a group from its last control step and its final state."""
+    stats.final_alpha[idx] = last_alpha
+    stats.final_alpha_dot[idx] = loop.alpha0_dot[loop.n - 1] - last_E_dot  # as the serial run computes it
+    stats.final_alpha_after_step[idx] = alpha_now
+    stats.warnings[idx] = batch.warning[:, :, 1].sum(axis=1)  # (nsim, mjNWARNING, (lastinfo, number))
+
+
+def _run_group_compiled(loop: _Loop, models: Sequence[mujoco.MjModel], idx: np.ndarray, threads: int,
+                        stats: _BatchStats, stop: threading.Event,
+                        progress: Callable[[int, int], None] | None) -> None:
+    """The closed loop of simulations ``idx`` with the compiled law, a block of steps per call.
+
+    The law runs inside every mj_step (``wmr_mj.sim.compiled_law``: mjcb_control), so
+    ``Batch.rollout`` runs a whole block of control steps in C on ``threads`` threads; the
+    block's userdata (alpha, E, E', the law's voltage at every control step) is then folded
+    into the statistics as the NumPy loop folds its buffers. Rollout stops a simulation whose
+    warning counters rise; run_batch re-runs those serially.
+    """
+    from mujoco.batch import Batch
+
+    g = len(idx)
+    batch = Batch(models[0], nsim=g, nthread=threads)
+    batch.set_models(list(models))
+    batch.reset(keyframe=loop.keyframe)
+    alpha_now = batch.bind("qpos")[:, loop.qpos_adr]
+    lo, hi = -loop.voltage_limit[idx], loop.voltage_limit[idx]
+    range_limit = loop.range_limit[idx]
+    substeps = loop.substeps
+    records: dict[int, dict[str, np.ndarray]] = {}  # one output buffer per block length, reused
+    for k0 in range(0, loop.n, loop.block):
+        count = min(loop.block, loop.n - k0)
+        if count not in records:
+            records[count] = {"userdata": np.empty((g, count * substeps, len(compiled_law.USERDATA_FIELDS)))}
+        out = records[count]
+        # the record after each physics step; a control step's values hold over its substeps
+        userdata = batch.rollout(count * substeps, record=("userdata",), out=out)["userdata"][:, ::substeps]
+        a_buf, E_buf, Ed_buf, u_buf = (userdata[:, :, j].T for j in range(4))  # (count, g) views
+        _block_stats(loop, stats, idx, k0, count, a_buf, E_buf, Ed_buf, u_buf, lo, hi, range_limit)
+        if _stopped(loop, k0 + count, stop, progress):
+            return
+    _final_stats(loop, stats, idx, batch, a_buf[count - 1], Ed_buf[count - 1], alpha_now)
+
+
+def batch_law_backend(controller: Any, law: str = "auto") -> str:
+    """'compiled' or 'numpy': how run_batch evaluates ``controller``'s law when asked for ``law``.
+
+    'auto' takes the compiled law where it can run (:mod:`wmr_mj.sim.compiled_law`), else NumPy;
+    'compiled' raises ParameterError, saying why, where it cannot.
+    """
+    if law not in LAW_BACKENDS:
+        raise UnknownNameError("law backend", law, LAW_BACKENDS)
+    if law == "numpy":
+        return "numpy"
+    why = compiled_law.unavailable_reason()
+    if why is None and not compiled_law.supports(controller):
+        why = f"it implements ComputedTorque and PDController, not {type(controller).__name__}"
+    if why is None:
+        return "compiled"
+    if law == "compiled":
+        raise ParameterError(f"the compiled law cannot run: {why}")
+    return "numpy"
+
+
+def _block_stats(loop: _Loop, stats: _BatchStats, idx: np.ndarray, k0: int, rows: int, a_buf, E_buf, Ed_buf,
+                 u_buf, lo, hi, range_limit) -> None:
+    """Fold control steps k0 .. k0+rows-1 into the statistics (max and count are exact in bulk)."""
+    E = np.abs(E_buf[:rows])
+    Ed = np.abs(Ed_buf[:rows])
+    stats.sup_E[idx] = np.maximum(stats.sup_E[idx], E.max(axis=0))
+    stats.sup_Ed[idx] = np.maximum(stats.sup_Ed[idx], Ed.max(axis=0))
+    first_settled = max(loop.settle_k - k0, 0)
+    if first_settled < rows:
+        stats.sup_E_s[idx] = np.maximum(stats.sup_E_s[idx], E[first_settled:].max(axis=0))
+        stats.sup_Ed_s[idx] = np.maximum(stats.sup_Ed_s[idx], Ed[first_settled:].max(axis=0))
+    u = u_buf[:rows]
+    # saturated as in the serial loop: the applied voltage differs from the law's (NaN included)
+    stats.saturated[idx] += (~((u >= lo) & (u <= hi))).sum(axis=0)
+    stats.law_nan[idx] |= np.isnan(u).any(axis=0)
+    hit = np.abs(a_buf[:rows]) >= range_limit
+    first = np.where(hit.any(axis=0), hit.argmax(axis=0), -1)
+    new = np.isnan(stats.left_at[idx]) & (first >= 0)
+    stats.left_at[idx[new]] = (k0 + first[new]) * loop.period
+    w = loop.drift_k
+    for lo_k, hi_k, out in ((loop.n - 2 * w, loop.n - w, stats.drift_prev), (loop.n - w, loop.n, stats.drift_last)):
+        a, b = max(lo_k - k0, 0), min(hi_k - k0, rows)
+        if a < b:
+            out[idx] = np.maximum(out[idx], E[a:b].max(axis=0))
+
+
+def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parameters = C80,
+              progress: Callable[[int, int], None] | None = None, law: str = "auto") -> list[dict[str, Any]]:
+    """Run closed-loop configs that differ only in their plant parameters, all at once.
+
+    ``law`` (:data:`LAW_BACKENDS`, :func:`batch_law_backend`): 'compiled' runs one
+    ``mujoco.batch.Batch`` of every simulation on ``nthread`` threads (0: every core) with
+    the law in MuJoCo's control callback, a block of steps per ``Batch.rollout`` call;
+    'numpy' splits the simulations into groups (:func:`batch_groups`), each a ``Batch`` on
+    its own Python thread with its own vectorised law (``controller.batch_law``), so that
+    the law of one group runs while the others step; 'auto' (the default) takes the
+    compiled law where it can run. Each simulation has its own compiled model. Returns
+    per-run reports, each bit-identical to ``run_closed_loop`` of the same config, whichever
+    the law. ``batch_cpu_s`` is the CPU time of the group threads (a figure for benchmarks
+    on a shared machine; batch-internal threads excluded), ``batch_law`` the law that ran.
+    """
+    if not configs:
+        return []
+    first = configs[0]
+    shared = first.replace(m1=M1_NOMINAL, plant_overrides={})
+    for c in configs[1:]:
+        if c.replace(m1=M1_NOMINAL, plant_overrides={}) != shared:
+            raise ParameterError("run_batch needs configs that differ only in m1 and plant_overrides")
+    estimate = estimate_parameters(base)
+    controller = _controller(first, estimate)
+    backend = batch_law_backend(controller, law)
+    plants = [plant_parameters(c, base) for c in configs]
+    options = _plant_options(first)
+    model = batch_model(plants[0], **options)
+    nsim = len(configs)
+    dt = model.opt.timestep
+    substeps = _substeps(first, dt)
+    period = substeps * dt
+    n = int(round(first.duration / period))
+    reference, settle_s = build_reference(first.path, estimate, dt=period, duration=n * period)
+    rows = (np.asarray(reference.alpha0), np.asarray(reference.alpha0_dot), np.asarray(reference.alpha0_ddot))
+    steer = model.joint("steer").id
+    where = dict(qpos_adr=int(model.jnt_qposadr[steer]), dof_adr=int(model.jnt_dofadr[steer]),
+                 actuator=model.actuator("steering_motor").id)  # the same in every simulation's model
+    if backend == "compiled":
+        # each model carries the reference (3 float64 per control step), for the callback
+        require_memory(nsim * n * 3 * 8, what=f"a batch of {nsim} runs of {n} control steps with the compiled law",
+                       hint="run fewer at once (a smaller chunk) or the NumPy law (WMR_MJ_COMPILED_LAW=0)")
+        compiled_law.install()
+        models = [batch_model(p, law=(compiled_law.law_vector(controller, voltage_limit=p.voltage_limit,
+                                                              substeps=substeps, nstep=n, **where), rows),
+                              **options) for p in plants]
+    else:
+        models = [model] + [batch_model(p, **options) for p in plants[1:]]
+    analysis = analysis_for(first, reference, estimate, estimate=_estimate_of(controller))
+    loop = _Loop(alpha0=rows[0], alpha0_dot=rows[1], alpha0_ddot=rows[2], n=n, substeps=substeps, period=period,
+                 settle_k=int(math.ceil(settle_s / period - 1e-9)), drift_k=drift_window_steps(n, period),
+                 block=min(n, 1000), **where, keyframe=model.key("home").id,
+                 voltage_limit=np.array([p.voltage_limit for p in plants]),
+                 range_limit=np.array([p.steering_range for p in plants]) - 1e-3)
+    stats = _BatchStats(nsim)
+    threads = thread_count(nthread, nsim)
+    # the compiled law holds no GIL: one batch on every thread
+    groups = [(np.arange(nsim), threads)] if backend == "compiled" else batch_groups(nsim, threads)
+    stop = threading.Event()
+    errors: list[BaseException] = []
+
+    def work(idx: np.ndarray, threads: int, report_progress) -> None:
+        try:
+            cpu0 = time.thread_time()
+            group_models = [models[i] for i in idx]
+            if backend == "compiled":
+                _run_group_compiled(loop, group_models, idx, threads, stats, stop, report_progress)
+            else:
+                _run_group(loop, group_models, idx, threads, controller.batch_law(len(idx)), stats, stop,
+                           report_progress)
+            stats.cpu_s.append(time.thread_time() - cpu0)
+        except BaseException as exc:  # noqa: BLE001  (re-raised on the calling thread)
+            errors.append(exc)
+            stop.set()
+
+    wall0 = time.perf_counter()
+    workers = [threading.Thread(target=work, args=(idx, threads, None), daemon=True) for idx, threads in groups[1:]]
+    for w in workers:
+        w.start()
+    try:
+        work(*groups[0], progress)  # the calling thread runs the first group and reports progress
+    finally:
+        for w in workers:
+            while w.is_alive():
+                try:
+                    w.join()
+                except KeyboardInterrupt:  # stop the groups at their next block, then re-raise
+                    stop.set()
+                    raise
+    if errors:
+        raise errors[0]
+    wall = time.perf_counter() - wall0
+    reports = []
+    for i, (c, p) in enumerate(zip(configs, plants)):
+        r = report(c, analysis=analysis, params=p, settle_s=settle_s, sup_E=stats.sup_E[i], sup_Edot=stats.sup_Ed[i],
+                   sup_E_settled=stats.sup_E_s[i], sup_Edot_settled=stats.sup_Ed_s[i],
+                   saturated_fraction=stats.saturated[i] / n,
+                   left_range_at=None if np.isnan(stats.left_at[i]) else float(stats.left_at[i]),
+                   final_alpha=stats.final_alpha[i], control_steps=n, steps=n * substeps, wall_s=wall / nsim,
+                   status="completed", certificate=certificate_for(c, reference, params=base),
+                   drift=drift(prev_window=float(stats.drift_prev[i]), last_window=float(stats.drift_last[i]),
+                               final_alpha_dot=float(stats.final_alpha_dot[i])))
+        if stats.law_nan[i] if backend == "numpy" else stats.warnings[i]:
+            # NumPy law: NaN from the law, where the serial loop applies 0 V and MuJoCo would zero
+            # every control of the step (BADCTRL); compiled law (which applies 0 V as the serial
+            # loop does): a warning, after which rollout stopped the simulation. The serial run
+            # is the truth
+            serial = run_closed_loop(c, progress=False, base=base).summary
+            r = {key: serial[key] for key in r}
+            r["mujoco_warnings"] = serial["mujoco_warnings"]
+        else:
+            r["mujoco_warnings"] = int(stats.warnings[i])
+        r["final_alpha_after_step"] = float(stats.final_alpha_after_step[i])  # the serial run reports the last row
+        # batch-level figures for benchmarks
+        r["batch_wall_s"] = wall
+        r["batch_steps_per_s"] = nsim * n * substeps / wall if wall > 0 else None
+        r["batch_cpu_s"] = sum(stats.cpu_s)  # robust to a shared machine, unlike the wall time
+        r["batch_law"] = backend
+        reports.append(r)
+    return reports
+
+
+# -- sweeps: chunks, resume, Dask ---------------------------------------------------------

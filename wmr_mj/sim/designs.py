@@ -1,0 +1,133 @@
+"""Controller designs: the paper's, a certified one chosen by a rule, and the ladder between them.
+
+A design is what ``--preset`` sets for ``run``, ``sweep``, ``falsify`` and
+``robustness --certificate``: controller, model source of the estimate, gains and
+Coulomb compensation. Explicit options override a preset. ``validate`` runs both
+designs and the ladder between them.
+
+``paper``: the paper's design (5.1): the paper model (2.7), K_P = 6, K_D = 9, exact
+sign of alpha' in the compensation F^ sgn(alpha') (3.3).
+
+``certified``: chosen by a rule written down before any run (it uses the certificate,
+an analytic bound, never a simulation):
+
+1. model source ``nonholonomic``: the reduced model the multibody derivation gives
+   (K = 0, the gyroscopic term gyro V_A alpha'/cos^2 alpha), which needs no identification;
+2. compensation: sign of alpha', smoothed, x/sqrt(x^2 + w^2) with w = 0.01 rad/s: it
+   vanishes at rest, so under stiction the friction mismatch stays F_max
+   (:func:`wmr_mj.analysis.certificate.friction_term`), and it does not chatter on a 1 ms loop;
+3. gains: critical damping (3.6), K_P = omega_r^2/4, K_D = omega_r, with omega_r the
+   smallest value on a grid of 5 rad/s whose certificate over the paper's m1 box
+   (550-750 kg, the paper circle) is valid (every assumption met) and bounds the steering
+   error by :data:`ERROR_SPEC` = 0.05 rad (about 3 cm of lateral offset of C at the
+   0.612 m wheelbase). The smallest such gain leaves the most room to what the plant
+   model leaves out (sampling, unmodelled motor dynamics, sensor noise).
+
+:func:`certified_omega_r` evaluates the rule; a test keeps :data:`CERTIFIED` equal to it.
+
+The ladder (``LADDER``) goes from ``paper`` to ``certified`` changing one thing per
+rung: the model source, then the compensation, then the gains. Its verdict counts show
+what each of the paper's omissions costs.
+
+Usage::
+
+    from wmr_mj.sim.designs import PRESETS, LADDER, certified_omega_r
+    PRESETS["certified"].config_changes()     # {'model': 'nonholonomic', 'kp': 100.0, ...}
+    [rung.name for rung in LADDER]
+    certified_omega_r()                         # 20.0 (from certificates only)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from wmr_mj.errors import UnknownNameError
+from wmr_mj.params import PAPER_KD, PAPER_KP
+
+__all__ = [
+    "Design",
+    "PAPER",
+    "CERTIFIED",
+    "PRESETS",
+    "PRESET_NAMES",
+    "LADDER",
+    "ERROR_SPEC",
+    "OMEGA_R_GRID",
+    "certified_omega_r",
+    "preset",
+]
+
+#: The certified design's tracking specification: |E| <= 0.05 rad, set before any run.
+ERROR_SPEC = 0.05
+#: The grid of omega_r (rad/s) the rule searches, smallest first.
+OMEGA_R_GRID = tuple(float(w) for w in range(5, 105, 5))
+SMOOTHING_WIDTH = 0.01  # rad/s, the certified design's sign smoothing w
+
+
+@dataclass(frozen=True, kw_only=True)
+class Design:
+    """A controller configuration: what a preset or a ladder rung sets."""
+
+    name: str
+    label: str
+    controller: str = "computed-torque"
+    model: str = "paper"
+    kp: float = PAPER_KP  # 1/s^2
+    kd: float = PAPER_KD  # 1/s
+    friction_sign: str = "measured"
+    friction_width: float = 0.0  # rad/s; 0: exact sign
+
+    def config_changes(self) -> dict[str, Any]:
+        """The RunConfig fields this design sets."""
+        return {"controller": self.controller, "model": self.model, "kp": self.kp, "kd": self.kd,
+                "friction_sign": self.friction_sign, "friction_width": self.friction_width}
+
+    def describe(self) -> str:
+        sign = "exact sign" if self.friction_width == 0 else f"sign smoothed w = {self.friction_width:g} rad/s"
+        if self.friction_sign == "reference":
+            sign = "sign of alpha0'"
+        elif self.friction_sign == "none":
+            sign = "no compensation"
+        return f"{self.model} model, K_P = {self.kp:g}, K_D = {self.kd:g}, {sign}"
+
+
+PAPER = Design(name="paper", label="the paper's design")
+CERTIFIED = Design(name="certified", label="certified design", model="nonholonomic", kp=100.0, kd=20.0,
+                   friction_sign="measured", friction_width=SMOOTHING_WIDTH)
+PRESETS: dict[str, Design] = {"paper": PAPER, "certified": CERTIFIED}
+PRESET_NAMES = tuple(PRESETS)
+
+LADDER: tuple[Design, ...] = (
+    PAPER,
+    Design(name="model", label="+ non-holonomic model", model="nonholonomic"),
+    Design(name="compensation", label="+ smoothed compensation", model="nonholonomic",
+           friction_width=SMOOTHING_WIDTH),
+    Design(name="gains", label="+ gains omega_r = 20 (= certified)", model=CERTIFIED.model, kp=CERTIFIED.kp,
+           kd=CERTIFIED.kd, friction_sign=CERTIFIED.friction_sign, friction_width=CERTIFIED.friction_width),
+)
+
+
+def preset(name: str) -> Design:
+    """The design called ``name``; unknown names raise UnknownNameError listing the valid ones."""
+    if name not in PRESETS:
+        raise UnknownNameError("preset", name, PRESET_NAMES)
+    return PRESETS[name]
+
+
+def certified_omega_r(*, error_spec: float = ERROR_SPEC, grid: tuple[float, ...] = OMEGA_R_GRID) -> float | None:
+    """The rule of the certified design: the smallest omega_r of ``grid`` whose certificate
+    (non-holonomic model, smoothed sign, paper circle, m1 over 550-750 kg) is valid with
+    E_max <= error_spec. None when no grid point qualifies. No simulation is run."""
+    from wmr_mj.analysis.certificate import certificate_for
+    from wmr_mj.params import C80
+    from wmr_mj.sim.closed_loop import RunConfig, build_reference
+
+    reference, _ = build_reference("paper-circle", C80, dt=1e-3, duration=35.0)
+    for w in grid:
+        config = RunConfig(model=CERTIFIED.model, kp=w * w / 4.0, kd=w, friction_sign=CERTIFIED.friction_sign,
+                           friction_width=CERTIFIED.friction_width)
+        cert = certificate_for(config, reference)
+        if cert.certified and cert.E_max <= error_spec:
+            return w
+    return None

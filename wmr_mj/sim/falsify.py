@@ -1,0 +1,450 @@
+"""Worst-case search: the plant in the uncertainty box that the controller tracks worst.
+
+A robustness claim is only as credible as the worst case anyone looked for. Sweeps
+sample the box; ``falsify`` searches it, as falsification tools (S-TaLiRo, Breach) do:
+scipy's differential evolution maximises an objective of the closed-loop run over the
+ranged plant parameters, evaluating each generation as one batch
+(``wmr_mj.sim.sweep.run_configs``: ``mujoco.batch``, or Dask chunks), and the same number of
+simulations is spent on a seeded Latin-hypercube sample beside it, so the search can be
+judged against chance.
+
+Objectives (:data:`OBJECTIVES`), read from a run's summary by :func:`objective_value`:
+
+- ``certificate``: sup|E| / E_max of the run's certificate (the default);
+- ``paper``: sup|E| / E_max of the paper's region;
+- ``sup-E``: sup|E| itself, rad.
+
+Why differential evolution: it is derivative-free and global, takes the box as bounds,
+evaluates a whole population per generation (``vectorized=True``), which is what makes
+a batch of simulations pay, and ships with scipy (CMA-ES would add a dependency and
+bound handling for the same job).
+
+Usage::
+
+    from wmr_mj.sim.falsify import FalsifySpec, falsify
+    from wmr_mj.params import uncertainty_ranges
+    from wmr_mj.sim.closed_loop import RunConfig
+    spec = FalsifySpec(base=RunConfig(model="nonholonomic"), box=uncertainty_ranges("full"), budget=256)
+    result = falsify(spec)
+    print(result.worst.params, result.worst.objective, result.random_worst.objective)
+
+Every evaluation is a run that ``run_closed_loop`` reproduces bit for bit, so the worst
+run's parameters (kept at full precision) given back to ``wmr-mj run --m1 X --param
+NAME=VALUE ...`` give the same sup|E|; the same seed gives the same search.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from wmr_mj.errors import ParameterError, UnknownNameError
+from wmr_mj.params import parameter_names
+from wmr_mj.sim.closed_loop import RunConfig
+
+__all__ = [
+    "OBJECTIVES",
+    "OBJECTIVE_LABELS",
+    "FalsifySpec",
+    "FalsifyResult",
+    "Evaluation",
+    "Trace",
+    "objective_value",
+    "objective_source",
+    "population_size",
+    "search_worst",
+    "random_worst",
+    "falsify",
+    "worst_config",
+    "log_run",
+    "figure_history",
+]
+
+OBJECTIVES = ("certificate", "paper", "sup-E")
+OBJECTIVE_LABELS = {"certificate": "sup|E|/E_max of the certificate", "paper": "sup|E|/E_max of the paper's region",
+                    "sup-E": "sup|E| [rad]"}
+MIN_POPULATION = 5  # scipy's differential evolution needs at least 5 members
+
+
+# -- the objective, read from a run's summary ----------------------------------------------
+
+def _ratio(sup: float, bound: Any) -> float | None:
+    if bound is None:
+        return None
+    bound = float(bound)
+    return sup / bound if math.isfinite(bound) and bound > 0 else None
+
+
+def objective_value(summary: Mapping[str, Any], objective: str) -> float | None:
+    """The number falsify maximises for one run's summary (None where it is undefined,
+    e.g. a region that does not exist). The one place that reads it; see objective_source."""
+    if objective not in OBJECTIVES:
+        raise UnknownNameError("objective", objective, OBJECTIVES)
+    if objective == "sup-E":
+        return float(summary["sup_E"])
+    if objective == "paper":
+        region = summary.get("paper_region")
+        if isinstance(region, Mapping) and region.get("E_max") is not None:
+            return _ratio(float(summary["sup_E"]), region["E_max"])
+        return summary.get("E_ratio")
+    certificate = summary.get("certificate")
+    if isinstance(certificate, Mapping) and "E_ratio" in certificate:
+        return certificate["E_ratio"]
+    return summary.get("E_ratio")
+
+
+def objective_source(summary: Mapping[str, Any], objective: str) -> str:
+    """Which field of the summary :func:`objective_value` read, in words (for the report)."""
+    if objective == "sup-E":
+        return "sup_E"
+    if objective == "paper":
+        region = summary.get("paper_region")
+        if isinstance(region, Mapping) and region.get("E_max") is not None:
+            return "sup_E / paper_region.E_max"
+        return "E_ratio (the run's analysis region; the summary has no paper_region)"
+    certificate = summary.get("certificate")
+    if isinstance(certificate, Mapping) and "E_ratio" in certificate:
+        return "certificate.E_ratio"
+    return ("E_ratio of the run's analysis region: the run summary carries no certificate yet, so the "
+            "objective falls back to the region the run is judged by today")
+
+
+def _verdict(summary: Mapping[str, Any]) -> str:
+    verdict = summary.get("verdict")
+    if verdict is not None:
+        return str(verdict)
+    return "inside" if summary.get("inside") else "outside"
+
+
+# -- the search itself: any evaluate(points) -> values ----------------------------------------
+
+@dataclass(frozen=True)
+class Trace:
+    """Every point a search evaluated, in order: points (E, d), values (E,) (NaN: undefined),
+    generation (E,) (0: the initial population; the random sample is all 0)."""
+
+    points: np.ndarray
+    values: np.ndarray
+    generation: np.ndarray
+
+    @property
+    def best(self) -> int:
+        """Index of the largest value (the first of equals); -1 if none is defined."""
+        finite = np.where(np.isnan(self.values), -np.inf, self.values)
+        return int(np.argmax(finite)) if finite.size and np.isfinite(finite).any() else -1
+
+
+def population_size(budget: int, d: int) -> int:
+    """Members per generation: 10 per parameter, but at most an eighth of the budget (so
+    that at least 8 generations run), and never below scipy's minimum of 5."""
+    return max(MIN_POPULATION, min(10 * d, budget // 8))
+
+
+def _check_budget(budget: int, population: int) -> None:
+    if isinstance(budget, bool) or not isinstance(budget, int) or budget < 1:
+        raise ParameterError(f"budget = {budget!r} is not accepted; give the number of simulations, an integer >= 1")
+    if isinstance(population, bool) or not isinstance(population, int) or population < MIN_POPULATION:
+        raise ParameterError(f"population = {population!r} is not accepted; differential evolution needs an "
+                             f"integer >= {MIN_POPULATION}")
+    if budget < population:
+        raise ParameterError(f"budget = {budget} simulations is below one population of {population} (differential "
+                             f"evolution evaluates a whole population per generation); give a budget >= {population}")
+
+
+def _unit_to_box(unit: np.ndarray, bounds: np.ndarray) -> np.ndarray:
+    return bounds[:, 0] + unit * (bounds[:, 1] - bounds[:, 0])
+
+
+def _streams(seed: int) -> list[np.random.Generator]:
+    """Independent generators for the initial population, the evolution and the random sample."""
+    return [np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(3)]
+
+
+def search_worst(evaluate: Callable[[np.ndarray], np.ndarray], bounds: np.ndarray, *, budget: int, seed: int = 0,
+                 population: int | None = None) -> Trace:
+    """Maximise ``evaluate`` over the box ``bounds`` (d, 2) with differential evolution.
+
+    evaluate(points (S, d)) -> values (S,), NaN where undefined, is called once per
+    generation with the whole population. At most ``budget`` points are evaluated:
+    ``population`` (default :func:`population_size`) per generation, for
+    budget // population generations, the first a Latin hypercube. Seeded: the same
+    seed gives the same points.
+    """
+    from scipy.optimize import differential_evolution
+
+    from wmr_mj.sim.sweep import latin_hypercube
+
+    bounds = np.asarray(bounds, dtype=float)
+    d = len(bounds)
+    population = population_size(budget, d) if population is None else population
+    _check_budget(budget, population)
+    init_rng, evolve_rng, _ = _streams(seed)
+    init = _unit_to_box(latin_hypercube(population, d, init_rng), bounds)
+    points: list[np.ndarray] = []
+    values: list[np.ndarray] = []
+    generation: list[np.ndarray] = []
+
+    def energies(x: np.ndarray) -> np.ndarray:  # x: (d, S); DE minimises
+        batch = np.array(x.T, dtype=float)
+        v = np.asarray(evaluate(batch), dtype=float).reshape(-1)
+        if v.shape != (len(batch),):
+            raise ValueError(f"evaluate returned {v.shape} values for {len(batch)} points")
+        points.append(batch)
+        values.append(v)
+        generation.append(np.full(len(batch), len(generation)))
+        return np.where(np.isnan(v), np.inf, -v)
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # inf energies of undefined points
+        differential_evolution(energies, bounds, maxiter=budget // population - 1, init=init, polish=False,
+                               tol=0.0, atol=0.0, updating="deferred", vectorized=True, rng=evolve_rng)
+    return Trace(np.concatenate(points), np.concatenate(values), np.concatenate(generation))
+
+
+def random_worst(evaluate: Callable[[np.ndarray], np.ndarray], bounds: np.ndarray, *, n: int,
+                 seed: int = 0) -> Trace:
+    """The same budget spent at random: ``n`` Latin-hypercube points of the box, one call."""
+    from wmr_mj.sim.sweep import latin_hypercube
+
+    bounds = np.asarray(bounds, dtype=float)
+    points = _unit_to_box(latin_hypercube(n, len(bounds), _streams(seed)[2]), bounds)
+    values = np.asarray(evaluate(points), dtype=float).reshape(-1)
+    return Trace(points, values, np.zeros(n, dtype=int))
+
+
+# -- falsify: the search on closed-loop runs ------------------------------------------------
+
+@dataclass(frozen=True, kw_only=True)
+class FalsifySpec:
+    """Search ``box`` (parameter name -> (lo, hi), m1 included or fixed at base.m1) for the
+    run of ``base`` that maximises ``objective``, spending ``budget`` simulations (and as
+    many on the random sample)."""
+
+    base: RunConfig = field(default_factory=RunConfig)
+    box: Mapping[str, tuple[float, float]] = field(default_factory=dict)
+    objective: str = "certificate"
+    budget: int = 256
+    seed: int = 0
+    population: int | None = None
+
+    def __post_init__(self) -> None:
+        from wmr_mj.sim.sweep import _check_range
+
+        if self.objective not in OBJECTIVES:
+            raise UnknownNameError("objective", self.objective, OBJECTIVES)
+        if not self.box:
+            raise ParameterError("the box is empty; give at least one ranged parameter (e.g. --uncertainty m1)")
+        names = parameter_names()
+        for name, (lo, hi) in self.box.items():
+            if name not in names:
+                raise UnknownNameError("parameter", name, names)
+            _check_range(name, lo, hi)
+        if isinstance(self.seed, bool) or not isinstance(self.seed, int):
+            raise ParameterError(f"seed = {self.seed!r} is not accepted; give an integer")
+        _check_budget(self.budget, self.population_size)
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(self.box)
+
+    @property
+    def bounds(self) -> np.ndarray:
+        return np.array([self.box[n] for n in self.names], dtype=float)
+
+    @property
+    def population_size(self) -> int:
+        return population_size(self.budget, len(self.box)) if self.population is None else self.population
+
+    def config(self, point: Sequence[float]) -> RunConfig:
+        """The run at ``point`` (values in ``names`` order): m1 and the plant overrides set."""
+        values = {name: float(v) for name, v in zip(self.names, point)}
+        m1 = values.pop("m1", self.base.m1)
+        return self.base.replace(m1=m1, plant_overrides={**self.base.plant_overrides, **values})
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """One simulated run of the search or the random sample."""
+
+    phase: str  # "search" or "random"
+    index: int  # in its phase, in evaluation order
+    generation: int
+    params: dict[str, float]  # every ranged parameter, full precision
+    objective: float | None
+    summary: dict[str, Any]  # the run's report
+
+    @property
+    def sup_E(self) -> float:
+        return float(self.summary["sup_E"])
+
+    @property
+    def sup_Edot(self) -> float:
+        return float(self.summary["sup_Edot"])
+
+    @property
+    def verdict(self) -> str:
+        return _verdict(self.summary)
+
+
+@dataclass
+class FalsifyResult:
+    spec: FalsifySpec
+    search: list[Evaluation]
+    random: list[Evaluation]
+    objective_source: str
+
+    @staticmethod
+    def _worst(evals: list[Evaluation]) -> Evaluation:
+        best, value = None, -math.inf
+        for e in evals:  # the first of equals
+            if e.objective is not None and e.objective > value:
+                best, value = e, e.objective
+        if best is None:
+            raise ParameterError("the objective is undefined for every run: the design has no certificate over "
+                                 "this box (an assumption fails: see wmr-mj robustness --certificate) or the "
+                                 "region does not exist; search --objective sup-E or --against paper instead")
+        return best
+
+    @property
+    def worst(self) -> Evaluation:
+        return self._worst(self.search)
+
+    @property
+    def random_worst(self) -> Evaluation:
+        return self._worst(self.random)
+
+    @property
+    def generations(self) -> int:
+        return 1 + max((e.generation for e in self.search), default=-1)
+
+    def as_dict(self, *, log: str | None = None) -> dict[str, Any]:
+        """The ``wmr-mj falsify --json`` object."""
+        w, r = self.worst, self.random_worst
+        return {
+            "objective": self.spec.objective,
+            "objective_label": OBJECTIVE_LABELS[self.spec.objective],
+            "objective_source": self.objective_source,
+            "budget": self.spec.budget,
+            "evaluations": len(self.search),
+            "seed": self.spec.seed,
+            "population": self.spec.population_size,
+            "generations": self.generations,
+            "box": {k: [float(lo), float(hi)] for k, (lo, hi) in self.spec.box.items()},
+            "worst": {"params": dict(w.params), "objective": w.objective, "sup_E": w.sup_E, "sup_Edot": w.sup_Edot,
+                      "verdict": w.verdict, "generation": w.generation, "index": w.index},
+            "random": {"worst_objective": r.objective, "worst_params": dict(r.params), "evaluations": len(self.random),
+                       "sup_E": r.sup_E, "verdict": r.verdict},
+            "log": log,
+        }
+
+
+def falsify(spec: FalsifySpec, *, chunk: int = 128, nthread: int = 0, scheduler: str | None = None,
+            progress: Callable[[int, int], None] | None = None,
+            checkpoint: Callable[[FalsifyResult], None] | None = None) -> FalsifyResult:
+    """Search ``spec.box`` for the worst run, then spend as many runs on a random sample.
+
+    Each generation runs as one batch (locally in chunks of ``chunk`` on ``nthread``
+    threads, or on the Dask ``scheduler``). progress(done, total) counts finished runs of
+    both phases. checkpoint(partial result) is called after every generation (and the
+    random batch), so an interrupted search can leave what it evaluated on disk.
+    """
+    from wmr_mj.sim.sweep import connect, run_configs
+
+    client = connect(scheduler) if scheduler is not None else None
+    evaluations: dict[str, list[Evaluation]] = {"search": [], "random": []}
+    total = 2 * spec.budget  # refined once the search has run
+    done = 0
+
+    def evaluator(phase: str, generation_of: Callable[[], int]) -> Callable[[np.ndarray], np.ndarray]:
+        def evaluate(points: np.ndarray) -> np.ndarray:
+            nonlocal done
+            configs = [spec.config(p) for p in points]
+            base_done = done
+
+            def chunk_progress(k: int, n: int) -> None:
+                if progress is not None:
+                    progress(base_done + k, total)
+
+            reports = run_configs(configs, chunk=chunk, nthread=nthread, client=client, progress=chunk_progress)
+            done += len(reports)
+            out = np.full(len(points), np.nan)
+            generation = generation_of()
+            for i, (p, r) in enumerate(zip(points, reports)):
+                value = objective_value(r, spec.objective)
+                out[i] = np.nan if value is None else value
+                evaluations[phase].append(Evaluation(
+                    phase=phase, index=len(evaluations[phase]), generation=generation,
+                    params={n: float(v) for n, v in zip(spec.names, p)},
+                    objective=None if value is None else float(value), summary=r))
+            if checkpoint is not None:
+                checkpoint(FalsifyResult(spec=spec, search=list(evaluations["search"]),
+                                         random=list(evaluations["random"]),
+                                         objective_source=objective_source(reports[0], spec.objective)))
+            return out
+
+        return evaluate
+
+    generations = 0
+
+    def next_generation() -> int:
+        nonlocal generations
+        generations += 1
+        return generations - 1
+
+    try:
+        search_worst(evaluator("search", next_generation), spec.bounds, budget=spec.budget, seed=spec.seed,
+                     population=spec.population_size)
+        total = 2 * len(evaluations["search"])
+        random_worst(evaluator("random", lambda: 0), spec.bounds, n=len(evaluations["search"]), seed=spec.seed)
+    finally:
+        if client is not None:
+            client.close()
+    first = evaluations["search"][0].summary
+    return FalsifyResult(spec=spec, search=evaluations["search"], random=evaluations["random"],
+                         objective_source=objective_source(first, spec.objective))
+
+
+def worst_config(result: FalsifyResult) -> RunConfig:
+    """The worst run's config, rebuilt from its reported parameters."""
+    w = result.worst
+    return result.spec.config([w.params[n] for n in result.spec.names])
+
+
+def log_run(config: RunConfig, path: str) -> dict[str, Any]:
+    """Re-run ``config`` serially (``run_closed_loop``) with an MCAP log at ``path``; its summary."""
+    import functools
+
+    from wmr_mj.logs.writer import RunLogger
+    from wmr_mj.sim.closed_loop import run_closed_loop
+
+    return run_closed_loop(config, logger_factory=functools.partial(RunLogger, path), progress=False).summary
+
+
+def figure_history(result: FalsifyResult):
+    """The search's history: each run's objective in evaluation order, and the running worst
+    of the search and of the random sample (same budget)."""
+    from wmr_mj.report.plots import new_figure
+
+    fig, ax = new_figure(6.0, 3.6)
+    for evals, color, label in ((result.search, "C3", "differential evolution"),
+                                (result.random, "0.45", "random (Latin hypercube)")):
+        x = np.arange(1, len(evals) + 1)
+        y = np.array([np.nan if e.objective is None else e.objective for e in evals])
+        ax.scatter(x, y, s=8, color=color, alpha=0.45, linewidths=0)
+        running = np.fmax.accumulate(np.where(np.isnan(y), -np.inf, y))
+        ax.step(x, np.where(np.isfinite(running), running, np.nan), where="post", color=color,
+                label=f"{label}: worst {np.nanmax(y):.4g}" if np.isfinite(y).any() else label)
+    worst = max((e.objective for e in (*result.search, *result.random) if e.objective is not None), default=0.0)
+    if result.spec.objective != "sup-E" and worst >= 0.5:  # in view without squashing the data
+        ax.axhline(1.0, color="0.2", lw=0.8, ls="--", label="region boundary (ratio 1)")
+    ax.set_xlabel("simulations")
+    ax.set_ylabel(OBJECTIVE_LABELS[result.spec.objective])
+    ax.set_title(f"worst-case search, {len(result.spec.box)} parameters, budget {result.spec.budget}, "
+                 f"seed {result.spec.seed}", fontsize=9)
+    ax.legend(loc="best", fontsize=8)
+    return fig
