@@ -32,7 +32,8 @@ import numpy as np  # noqa: E402
 
 from wmr_mj.logs.reader import load_log  # noqa: E402
 from wmr_mj.logs.writer import COMPRESSIONS, RunLogger  # noqa: E402
-from wmr_mj.sim.closed_loop import RunConfig, run_closed_loop  # noqa: E402
+from wmr_mj.sim.closed_loop import run_closed_loop
+from wmr_mj.sim.config import RunConfig
 
 RATIO_TARGET = 1.3
 READ_TARGET = 20e6

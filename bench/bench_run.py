@@ -24,7 +24,8 @@ import mujoco  # noqa: E402
 from controllers import make_controller, model_from_source  # noqa: E402
 from wmr_mj import C80
 from wmr_mj.plant.mjcf import Plant  # noqa: E402
-from wmr_mj.sim.closed_loop import RunConfig, run_closed_loop  # noqa: E402
+from wmr_mj.sim.closed_loop import run_closed_loop
+from wmr_mj.sim.config import RunConfig
 
 
 def main() -> None:

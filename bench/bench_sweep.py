@@ -44,7 +44,8 @@ import numpy as np  # noqa: E402
 from mujoco import rollout  # noqa: E402
 
 from wmr_mj.sim.batch import batch_model, run_batch  # noqa: E402
-from wmr_mj.sim.closed_loop import RunConfig, plant_parameters, run_closed_loop  # noqa: E402
+from wmr_mj.sim.closed_loop import run_closed_loop
+from wmr_mj.sim.config import RunConfig, plant_parameters
 from wmr_mj.sim.sweep import SweepSpec, run_sweep  # noqa: E402
 
 

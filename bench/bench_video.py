@@ -34,7 +34,8 @@ import numpy as np  # noqa: E402
 from wmr_mj.logs.reader import load_log  # noqa: E402
 from wmr_mj.logs.video import render_video, write_video  # noqa: E402
 from wmr_mj.logs.writer import RunLogger  # noqa: E402
-from wmr_mj.sim.closed_loop import RunConfig, run_closed_loop  # noqa: E402
+from wmr_mj.sim.closed_loop import run_closed_loop
+from wmr_mj.sim.config import RunConfig
 
 
 def old_ms_per_frame(log, n_frames: int, fps: int = 30) -> float:

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from wmr_mj.sim.batch import batch_model, run_batch
-from wmr_mj.sim.closed_loop import RunConfig, run_closed_loop
+from wmr_mj.sim.closed_loop import run_closed_loop
+from wmr_mj.sim.config import RunConfig
 
 BASE = RunConfig(model="nonholonomic", duration=10.0)
 KEYS = ("sup_E", "sup_Edot", "sup_E_settled", "sup_Edot_settled", "E_max", "Edot_max", "saturated_fraction",
@@ -41,9 +42,9 @@ LAW_INPUTS = (np.array([0.0, 0.31, -0.62, 0.05, 0.8, -0.1, 0.2, 0.0]),  # alpha,
                                      dict(model="nonholonomic", friction_sign="reference", friction_width=0.01),
                                      dict(controller="pd", model="paper")])
 def test_batch_law_is_bit_identical_to_the_scalar_and_array_laws(options):
-    from wmr_mj.sim.closed_loop import _controller, estimate_parameters
+    from wmr_mj.sim.config import controller_for, estimate_parameters
 
-    controller = _controller(RunConfig(**options), estimate_parameters())
+    controller = controller_for(RunConfig(**options), estimate_parameters())
     alpha, alpha_dot = LAW_INPUTS
     law = controller.batch_law(len(alpha))
     E, E_dot, u = np.empty(len(alpha)), np.empty(len(alpha)), np.empty(len(alpha))
@@ -62,7 +63,7 @@ def test_batch_model_is_the_serial_model_but_for_the_sky():
     import mujoco
 
     from wmr_mj.plant.mjcf import compile_model
-    from wmr_mj.sim.closed_loop import plant_parameters
+    from wmr_mj.sim.config import plant_parameters
 
     cfg = BASE.replace(m1=612.3456789, plant_overrides={"mu": 0.0191234567, "V_A": 0.23})
     serial, _ = compile_model(plant_parameters(cfg), steering_friction=cfg.steering_friction)
@@ -110,9 +111,11 @@ def test_a_nan_voltage_applies_nothing_as_in_the_serial_run(monkeypatch):
         c = original(config, params)
         return NanWhileTurning(c.model, kp=c.kp, kd=c.kd)
 
-    original = simulate._controller
-    monkeypatch.setattr(simulate, "_controller", controller)
-    monkeypatch.setattr(batch, "_controller", controller)
+    from wmr_mj.sim import certify
+
+    original = simulate.controller_for
+    for module in (simulate, batch, certify):  # every module that builds the run's controller
+        monkeypatch.setattr(module, "controller_for", controller)
     configs = [BASE.replace(path="lane-change", duration=4.0, m1=m) for m in (560.0, 720.0)]
     for cfg, b in zip(configs, run_batch(configs, nthread=1)):
         s = run_closed_loop(cfg, progress=False).summary

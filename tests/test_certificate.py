@@ -15,7 +15,6 @@ from wmr_mj.analysis.certificate import (
     PLANT_K_BAND,
     VERDICTS,
     Assumption,
-    certificate_for,
     certify,
     fixed_point,
     friction_term,
@@ -25,7 +24,8 @@ from wmr_mj.analysis.certificate import (
 from wmr_mj.analysis.robustness import ParameterBox, analyse, exact_gammas
 from wmr_mj.cli.app import main
 from wmr_mj.errors import ParameterError, UnknownNameError
-from wmr_mj.sim.closed_loop import RunConfig, build_reference
+from wmr_mj.sim.certify import certificate_for
+from wmr_mj.sim.config import RunConfig, build_reference
 
 
 def _S(a: float) -> float:

@@ -97,7 +97,8 @@ def test_library_refuses_a_run_that_does_not_fit(monkeypatch):
     """run_closed_loop itself refuses (not only the command): with 1 MiB available a 10 s run
     (10,000 rows of 320 bytes = 3.05 MiB) does not fit."""
     from wmr_mj._util import memory
-    from wmr_mj.sim.closed_loop import RunConfig, run_closed_loop
+    from wmr_mj.sim.closed_loop import run_closed_loop
+    from wmr_mj.sim.config import RunConfig
 
     monkeypatch.setattr(memory, "available_memory_bytes", lambda: 1 << 20)
     with pytest.raises(NotEnoughMemoryError, match=r"1e\+04 control steps.*3\.05 MiB of memory, 1 MiB is available"):

@@ -11,7 +11,8 @@ import pytest
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.sim import compiled_law
 from wmr_mj.sim.batch import batch_law_backend, batch_model, run_batch
-from wmr_mj.sim.closed_loop import RunConfig, _controller, estimate_parameters, plant_parameters, run_closed_loop
+from wmr_mj.sim.closed_loop import run_closed_loop
+from wmr_mj.sim.config import RunConfig, controller_for, estimate_parameters, plant_parameters
 
 BASE = RunConfig(model="nonholonomic", duration=10.0)
 KEYS = ("sup_E", "sup_Edot", "sup_E_settled", "sup_Edot_settled", "E_max", "Edot_max", "saturated_fraction",
@@ -47,7 +48,7 @@ def test_the_compiled_law_is_built_and_runs_in_this_environment():
 @pytest.mark.parametrize("options", OPTIONS)
 def test_the_callback_is_bit_identical_to_the_scalar_law(options):
     compiled_law.install()
-    controller = _controller(RunConfig(**options), estimate_parameters())
+    controller = controller_for(RunConfig(**options), estimate_parameters())
     limit = 5.0  # low, so that some voltages are clipped
     m = law_model(controller, voltage_limit=limit)
     d = mujoco.MjData(m)
@@ -67,7 +68,7 @@ def test_the_callback_is_bit_identical_to_the_scalar_law(options):
 
 def test_the_law_holds_between_control_steps_and_stops_after_the_reference():
     compiled_law.install()
-    controller = _controller(BASE, estimate_parameters())
+    controller = controller_for(BASE, estimate_parameters())
     m = law_model(controller, voltage_limit=24.0, substeps=5)
     d = mujoco.MjData(m)
     act = m.actuator("steering_motor").id
@@ -83,7 +84,7 @@ def test_the_law_holds_between_control_steps_and_stops_after_the_reference():
 
 def test_a_nan_law_applies_nothing_as_the_serial_loop():
     compiled_law.install()
-    controller = _controller(BASE, estimate_parameters())
+    controller = controller_for(BASE, estimate_parameters())
     reference = tuple(np.array([math.nan, 0.2]) for _ in range(3))
     m = law_model(controller, voltage_limit=24.0, reference=reference)
     d = mujoco.MjData(m)
@@ -146,7 +147,7 @@ def test_a_simulation_with_a_warning_is_rerun_serially(monkeypatch):
 def test_the_law_backend_is_chosen_and_refused_clearly(monkeypatch):
     from controllers import ComputedTorque
 
-    controller = _controller(BASE, estimate_parameters())
+    controller = controller_for(BASE, estimate_parameters())
     assert batch_law_backend(controller) == "compiled" and batch_law_backend(controller, "numpy") == "numpy"
     with pytest.raises(UnknownNameError, match="auto"):
         batch_law_backend(controller, "fortran")
@@ -179,7 +180,7 @@ def test_a_law_built_for_another_mujoco_is_refused_with_the_reason(monkeypatch):
     try:
         assert "built for MuJoCo 4" in compiled_law.unavailable_reason() and "this is 3999999" in \
             compiled_law.unavailable_reason()
-        assert batch_law_backend(_controller(BASE, estimate_parameters())) == "numpy"
+        assert batch_law_backend(controller_for(BASE, estimate_parameters())) == "numpy"
         with pytest.raises(ParameterError, match="cannot run: .*built for MuJoCo"):
             compiled_law.install()
     finally:

@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 from wmr_mj.errors import ParameterError, UnknownNameError
-from wmr_mj.sim.closed_loop import RunConfig, run_closed_loop
+from wmr_mj.sim.closed_loop import run_closed_loop
+from wmr_mj.sim.config import RunConfig
 from wmr_mj.sim.falsify import (
     FalsifySpec,
     falsify,

@@ -91,7 +91,8 @@ def test_unknown_friction_model_is_an_unknown_name(call):
 
 
 def test_run_config_validates_and_passes_the_friction_model():
-    from wmr_mj.sim.closed_loop import RunConfig, run_closed_loop
+    from wmr_mj.sim.closed_loop import run_closed_loop
+    from wmr_mj.sim.config import RunConfig
 
     with pytest.raises(UnknownNameError, match="steering friction"):
         RunConfig(steering_friction="viscous")

@@ -149,7 +149,8 @@ def test_real_run_replays_bit_for_bit(tmp_path, capsys):
     from wmr_mj.logs.reader import load_log
     from wmr_mj.logs.replay import summarize, verify
     from wmr_mj.logs.writer import RunLogger
-    from wmr_mj.sim.closed_loop import RunConfig, run_closed_loop
+    from wmr_mj.sim.closed_loop import run_closed_loop
+    from wmr_mj.sim.config import RunConfig
 
     path = tmp_path / "run.mcap"
 

@@ -14,7 +14,8 @@ from controllers import ComputedTorque, PDController, gains_from_omega_r, model_
 from wmr_mj import C80, ParameterError, UnknownNameError
 from wmr_mj.analysis.robustness import ParameterBox, ReferenceBounds, analyse
 from wmr_mj.plant.reduced import SteeringModel
-from wmr_mj.sim.closed_loop import RunConfig, build_reference, run_closed_loop, run_on_reduced_model
+from wmr_mj.sim.closed_loop import run_closed_loop, run_on_reduced_model
+from wmr_mj.sim.config import RunConfig, build_reference
 
 
 @pytest.fixture(scope="module")

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from wmr_mj import ParameterError, SchedulerError, UnknownNameError
-from wmr_mj.sim.closed_loop import RunConfig
+from wmr_mj.sim.config import RunConfig
 from wmr_mj.sim.sweep import (
     SweepSpec,
     connect,

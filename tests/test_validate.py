@@ -168,9 +168,9 @@ def test_the_search_beside_the_monte_carlo_worst_and_the_certificate(validated):
     assert set(full["box"]) == {"m1", "mu", "ground_friction", "R_a", "V_A"}
     # the full-box certificate is the one certificate_for gives for that box, and the runs' verdicts follow it
     from wmr_mj import C80
-    from wmr_mj.analysis.certificate import certificate_for
     from wmr_mj.params import uncertainty_ranges
-    from wmr_mj.sim.closed_loop import RunConfig, build_reference
+    from wmr_mj.sim.certify import certificate_for
+    from wmr_mj.sim.config import RunConfig, build_reference
     from wmr_mj.sim.designs import CERTIFIED
 
     extra = {k: v for k, v in uncertainty_ranges("full").items() if k != "m1"}

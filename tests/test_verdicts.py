@@ -31,7 +31,8 @@ def test_only_certified_inside_passes_and_counts_cover_all_four():
 def test_soft_friction_creep_shows_as_drift(friction, growing):
     """The known finding: with MuJoCo's soft frictionloss the exact-sign compensation keeps the joint
     creeping (|E| still growing at 35 s); with stiction it settles."""
-    from wmr_mj.sim.closed_loop import RunConfig, run_closed_loop
+    from wmr_mj.sim.closed_loop import run_closed_loop
+    from wmr_mj.sim.config import RunConfig
 
     s = run_closed_loop(RunConfig(model="nonholonomic", steering_friction=friction), progress=False).summary
     assert s["drift"]["growing"] is growing

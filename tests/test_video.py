@@ -18,7 +18,8 @@ WIDTH, HEIGHT = 640, 360
 @pytest.fixture(scope="module")
 def log_path(tmp_path_factory):
     from wmr_mj.logs.writer import RunLogger
-    from wmr_mj.sim.closed_loop import RunConfig, run_closed_loop
+    from wmr_mj.sim.closed_loop import run_closed_loop
+    from wmr_mj.sim.config import RunConfig
 
     path = tmp_path_factory.mktemp("video") / "run.mcap"
     # the paper circle needs more than 2 s of lead-in; the figure eight starts at once

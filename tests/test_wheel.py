@@ -95,7 +95,8 @@ def test_installed_package_is_the_wheel_not_the_checkout(installed):
 
 def test_the_wheel_builds_the_compiled_law_and_it_runs(installed):
     bin_dir, wheel, _, outside, env = installed
-    assert any(n.startswith("wmr_mj/sim/_compiled_law.") and n.endswith(".so") for n in zipfile.ZipFile(wheel).namelist())
+    names = zipfile.ZipFile(wheel).namelist()
+    assert any(n.startswith("wmr_mj/sim/_compiled_law.") and n.endswith(".so") for n in names)
     out = _run([str(bin_dir / "python"), "-c", "from wmr_mj.sim import compiled_law, _compiled_law; "
                 "print(compiled_law.unavailable_reason()); print(_compiled_law.__file__)"], cwd=outside, env=env)
     reason, path = out.split("\n")[:2]

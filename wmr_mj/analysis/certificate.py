@@ -118,7 +118,7 @@ from typing import Any
 
 from wmr_mj.analysis.robustness import ParameterBox, _check_gains, damping_regime, exact_gammas
 from wmr_mj.errors import ParameterError, UnknownNameError
-from wmr_mj.params import C80, C80Parameters
+from wmr_mj.params import C80Parameters
 
 __all__ = [
     "friction_over_P_max",
@@ -127,7 +127,6 @@ __all__ = [
     "Assumption",
     "Certificate",
     "certify",
-    "certificate_for",
     "judge",
     "friction_term",
     "fixed_point",
@@ -614,31 +613,8 @@ def _hull(a: tuple[float, float], *values: float) -> tuple[float, float]:
     return min(a[0], *values), max(a[1], *values)
 
 
-def _identified_spread(identified: Any) -> dict[str, tuple[float, float]]:
-    """{name: (x - 2 sigma, x + 2 sigma)} from `wmr-mj identify` output (path or mapping)."""
-    import json
-    from pathlib import Path
-
-    data = identified
-    if not isinstance(data, Mapping):
-        path = Path(identified)
-        try:
-            data = json.loads(path.read_text())
-        except (OSError, ValueError):
-            raise ParameterError(f"identified-model file {str(path)!r} is not readable JSON from "
-                                 "wmr-mj identify") from None
-    values = data.get("identified", data)
-    se = (data.get("diagnostics") or {}).get("std_error") or {}
-    out = {}
-    for name in ("P", "C_V", "F", "K", "gyro"):
-        if name in values:
-            x, s = float(values[name]), 2.0 * abs(float(se.get(name, 0.0)))
-            out[name] = (x - s, x + s)
-    return out
-
-
 @functools.lru_cache(maxsize=32)
-def _derived_box(params: C80Parameters, m1_range: tuple[float, float], m1_inertia: str,
+def derived_box(params: C80Parameters, m1_range: tuple[float, float], m1_inertia: str,
                  ranges: tuple[tuple[str, tuple[float, float]], ...]) -> ParameterBox:
     """simulate.analysis_box's derived box (cached: a sweep asks for the same box per run)."""
     return ParameterBox.from_parameters(params, m1_range=m1_range, model="nonholonomic", m1_inertia=m1_inertia,
@@ -673,103 +649,7 @@ def friction_over_P_max(params: C80Parameters, m1_range: tuple[float, float], m1
     return best
 
 
-def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
-                    k_band: float = PLANT_K_BAND, gyro_band: tuple[float, float] = GYRO_BAND) -> Certificate:
-    """The certificate of a :class:`wmr_mj.sim.closed_loop.RunConfig` run on ``reference``.
-
-    Plant box: P, C_V, F by the rule of ``simulate.analysis_box``: derived from ``params``
-    over config.m1_range and config.box_ranges (both reduced models share P, C_V, F), and
-    for config.box = 'paper' hulled with the (5.1) intervals (whose F does not cover the
-    simulated m1 range); always hulled with the run's own plant point (m1, --param
-    overrides); for model 'identified' also with its +-2 sigma. The plant's K is not the
-    paper's (2.7) prediction (the plant has none): |K| <= k_band (:data:`PLANT_K_BAND`,
-    measured). gyro: gyro_band x P/l1 over the box (:data:`GYRO_BAND`, measured), V_A
-    over the box's range. Estimate: the controller as ``simulate`` builds it (the same
-    ``_controller`` on ``estimate_parameters(params)``). params: the base parameter set.
-    """
-    from wmr_mj.plant.mjcf import TIMESTEP
-    from wmr_mj.sim.closed_loop import _controller, estimate_parameters, plant_parameters
-
-    base = params
-    k_band = _number("k_band", k_band, minimum=0.0)
-    gyro_band = _interval("gyro_band", gyro_band, positive=True)
-    estimate_params = estimate_parameters(base)
-    controller = _controller(config, estimate_params)
-    model = controller.model
-    plant = plant_parameters(config, base)
-    point = plant.coefficients("nonholonomic")
-
-    ranges = {k: (float(v[0]), float(v[1])) for k, v in config.box_ranges.items()}
-    derived = _derived_box(estimate_params, tuple(float(v) for v in config.m1_range), config.m1_inertia,
-                           tuple(sorted(ranges.items())))
-    box = ParameterBox.paper() if config.box == "paper" else derived
-    P = _hull(_hull(box.P, *derived.P), point.P)
-    C_V = _hull(_hull(box.C_V, *derived.C_V), point.C_V)
-    F = _hull(_hull(box.F, *derived.F), point.F)
-    K = (-k_band, k_band)
-    l1_lo, l1_hi = _hull(ranges.get("l1", (base.l1, base.l1)), plant.l1)
-    gyro = (gyro_band[0] * P[0] / l1_hi, gyro_band[1] * P[1] / l1_lo)
-    V_A = _hull(ranges.get("V_A", (base.V_A, base.V_A)), plant.V_A)
-    notes = []
-    if config.model == "identified":
-        spread = _identified_spread(config.identified)
-        P = _hull(P, *spread.get("P", P))
-        C_V = _hull(C_V, *spread.get("C_V", C_V))
-        F = _hull(F, *spread.get("F", F))
-        K = _hull(K, *spread.get("K", K))
-        gyro = _hull(gyro, *spread.get("gyro", gyro))
-        notes.append("identified +-2 sigma hulled in")
-    plant_box = ParameterBox(P=P, C_V=C_V, F=(max(F[0], 0.0), F[1]), K=K)
-    # F and P both scale with R_a: bound F/P over the same plants (the run's own point included)
-    ratio = friction_over_P_max(estimate_params, tuple(float(v) for v in config.m1_range), config.m1_inertia,
-                                tuple(sorted(ranges.items())))
-    if ratio is not None:
-        ratio = max(ratio, point.F / point.P)
-        if config.model == "identified" and "F" in spread and "P" in spread:
-            ratio = max(ratio, spread["F"][1] / spread["P"][0])
-        if config.box == "paper":
-            ratio = None  # (5.1)'s printed intervals come with no such relation
-
-    pd = controller.name == "pd"
-    sign = "none" if pd else controller.friction_sign
-    width = 0.0 if pd else controller.friction_width
-    c = model.coefficients
-    est = {"P": c.P, "C_V": 0.0, "F": 0.0, "K": 0.0, "gyro": 0.0} if pd else {
-        "P": c.P, "C_V": c.C_V, "F": 0.0 if sign == "none" else c.F, "K": c.K, "gyro": c.gyro}
-
-    bounds = reference.bounds()
-    period = config.control_period if config.control_period is not None else TIMESTEP
-    initial = (float(reference.alpha0[0]), float(reference.alpha0_dot[0]))  # the plant starts at alpha = alpha' = 0
-
-    k_seen = max(abs(v) for v in PLANT_K_MEASURED)
-    g_lo, g_hi = GYRO_MEASURED_RATIOS
-    g_used = max((1.0 - g_lo) / (1.0 - gyro_band[0]) if gyro_band[0] < 1.0 else math.inf,
-                 (g_hi - 1.0) / (gyro_band[1] - 1.0) if gyro_band[1] > 1.0 else math.inf)
-    stated = (
-        Assumption("plant K band", f"|K_plant| <= {k_band:g} V (non-holonomic plant: K = 0)",
-                   k_seen <= k_band, k_seen, k_band,
-                   "MuJoCo identify K = -0.0052 +- 0.0016 V; Drake 0.018 V at 1e7 N/m (physics.md section 6)",
-                   kind="stated"),
-        Assumption("plant gyro band", f"{gyro_band[0]:g} P/l1 <= gyro <= {gyro_band[1]:g} P/l1",
-                   g_used <= 1.0, g_used, 1.0,
-                   "fraction of the band used by measurements: MuJoCo identify seeds 0-5 0.492-0.704 V s/m "
-                   "(0.78-1.12 P/l1), Drake 0.621-0.644 (physics.md section 6)", kind="stated"),
-    )
-    cert = certify(box=plant_box, gyro=gyro, V_A=V_A, P_hat=est["P"], C_V_hat=est["C_V"], F_hat=est["F"],
-                   K_hat=est["K"], gyro_hat=est["gyro"], V_A_hat=model.V_A, kp=config.kp, kd=config.kd,
-                   friction_sign=sign, friction_width=width, feedforward=not pd,
-                   alpha0_max=bounds["max_abs_alpha0"], alpha0_dot_max=bounds["max_abs_alpha0_dot"],
-                   alpha0_ddot_max=bounds["max_abs_alpha0_ddot"], steering_range=plant.steering_range,
-                   voltage_limit=plant.voltage_limit, control_period=period, initial_error=initial,
-                   stated=stated, friction_over_P=ratio)
-    inputs = dict(cert.inputs)
-    inputs.update(model=config.model, controller=controller.name, box_rule=config.box,
-                  m1_range=list(config.m1_range), box_ranges={k: list(v) for k, v in ranges.items()},
-                  plant_m1=plant.m1, notes=notes, steering_friction=getattr(config, "steering_friction", None))
-    return _replace_inputs(cert, inputs)
-
-
-def _replace_inputs(cert: Certificate, inputs: Mapping[str, Any]) -> Certificate:
+def replace_inputs(cert: Certificate, inputs: Mapping[str, Any]) -> Certificate:
     import dataclasses
 
     return dataclasses.replace(cert, inputs=inputs)

@@ -73,8 +73,9 @@ def run(args: argparse.Namespace) -> int:
     from wmr_mj._util.progress import counter_callback, progress_bar
     from wmr_mj.cli._common import box_ranges_from_args, print_json
     from wmr_mj.cli.run import config_from_args
-    from wmr_mj.report.plots import save_figure
-    from wmr_mj.sim.falsify import OBJECTIVE_LABELS, FalsifySpec, falsify, figure_history, log_run, worst_config
+    from wmr_mj.logs.writer import run_logged
+    from wmr_mj.report.plots import falsify_history, save_figure
+    from wmr_mj.sim.falsify import OBJECTIVE_LABELS, FalsifySpec, falsify, worst_config
 
     objective = _objective(args)
     args.uncertainty = args.uncertainty or "full"
@@ -89,7 +90,7 @@ def run(args: argparse.Namespace) -> int:
                          checkpoint=lambda partial: write_text_atomic(out / "evaluations.csv", _table(partial)))
     log_path = out / "worst.mcap"
     config = worst_config(result)
-    logged = log_run(config, str(log_path))
+    logged = run_logged(config, str(log_path))
     worst = result.worst
     summary = result.as_dict(log=str(log_path))
     summary.update({
@@ -98,7 +99,7 @@ def run(args: argparse.Namespace) -> int:
         "uncertainty": args.uncertainty,
         "folder": str(out),
         "table": str(out / "evaluations.csv"),
-        "plot": [str(p) for p in save_figure(figure_history(result), out / "history")],
+        "plot": [str(p) for p in save_figure(falsify_history(result), out / "history")],
     })
     write_text_atomic(out / "evaluations.csv", _table(result))
     write_json_atomic(out / "falsify.json", summary)

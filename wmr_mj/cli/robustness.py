@@ -340,11 +340,11 @@ def run_certificate(args: argparse.Namespace) -> int:
     inner = certificate_parser().parse_args(args.certificate)
     as_json = bool(args.json or inner.json)
 
-    from wmr_mj.analysis.certificate import certificate_for
     from wmr_mj.cli.run import config_from_args
     from wmr_mj.params import C80
     from wmr_mj.plant.mjcf import TIMESTEP
-    from wmr_mj.sim.closed_loop import _controller, _estimate_of, analysis_for, build_reference, estimate_parameters
+    from wmr_mj.sim.certify import certificate_for
+    from wmr_mj.sim.config import analysis_for, build_reference, controller_for, estimate_of, estimate_parameters
 
     m1_range, ranges = _box_ranges(inner)
     inner.m1_range = m1_range
@@ -355,7 +355,7 @@ def run_certificate(args: argparse.Namespace) -> int:
     estimate = estimate_parameters(C80)
     reference, _ = build_reference(config.path, estimate, dt=period, duration=n * period)
     cert = certificate_for(config, reference, params=C80)
-    paper = analysis_for(config, reference, estimate, estimate=_estimate_of(_controller(config, estimate)))
+    paper = analysis_for(config, reference, estimate, estimate=estimate_of(controller_for(config, estimate)))
     if as_json:
         out = cert.as_dict()
         out["paper_region"] = {"E_max": paper.E_max if paper.stable else None,

@@ -14,7 +14,7 @@ def add_run_options(p: argparse.ArgumentParser) -> None:
     from controllers.computed_torque import CONTROLLER_NAMES, FRICTION_SIGNS, MODEL_SOURCES
     from wmr_mj.params import M1_RANGE
     from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS, TYRE_CONTACT_MODELS
-    from wmr_mj.sim.closed_loop import PATH_NAMES
+    from wmr_mj.sim.config import PATH_NAMES
     from wmr_mj.sim.designs import PRESET_NAMES
 
     p.add_argument("--preset", default="paper",
@@ -66,7 +66,7 @@ def config_from_args(args: argparse.Namespace, **extra):
     """A RunConfig from the shared options (raises WmrMjError on bad input)."""
     from controllers import gains_from_omega_r
     from wmr_mj.errors import ParameterError
-    from wmr_mj.sim.closed_loop import RunConfig
+    from wmr_mj.sim.config import RunConfig
     from wmr_mj.sim.designs import preset
 
     design = preset(args.preset)

@@ -41,7 +41,7 @@ import threading
 import time
 from collections.abc import Iterator, Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -50,7 +50,10 @@ from wmr_mj.errors import LogError, OutputPathError, ParameterError
 from wmr_mj.logs import logformat as lf
 from wmr_mj.logs.foxglove import TF_SCHEMA_NAME, FrameTree, TfEncoder, scene_update, tf_schema_text
 
-__all__ = ["RunLogger", "terminate_as_interrupt", "measure_logging_overhead", "COMPRESSIONS", "STATUSES"]
+if TYPE_CHECKING:
+    from wmr_mj.sim.config import RunConfig
+
+__all__ = ["RunLogger", "run_logged", "terminate_as_interrupt", "measure_logging_overhead", "COMPRESSIONS", "STATUSES"]
 
 STATUSES = ("completed", "interrupted", "error")
 COMPRESSIONS = ("lz4", "zstd", "none")
@@ -433,3 +436,12 @@ def measure_logging_overhead(run: Any, log_path: str | os.PathLike, *, repeats: 
         logged.append(timed(log_path))
     u, lg = statistics.median(unlogged), statistics.median(logged)
     return {"unlogged_s": u, "logged_s": lg, "ratio": lg / u}
+
+
+def run_logged(config: RunConfig, path: str) -> dict[str, Any]:
+    """Re-run ``config`` serially (``run_closed_loop``) with an MCAP log at ``path``; its summary."""
+    import functools
+
+    from wmr_mj.sim.closed_loop import run_closed_loop
+
+    return run_closed_loop(config, logger_factory=functools.partial(RunLogger, path), progress=False).summary

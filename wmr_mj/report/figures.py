@@ -25,7 +25,7 @@ import numpy as np
 
 from wmr_mj._util.progress import Stages
 from wmr_mj.params import C80
-from wmr_mj.report.validate import ValidateSettings
+from wmr_mj.report.settings import ValidateSettings
 
 __all__ = ["figures_stage"]
 

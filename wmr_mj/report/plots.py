@@ -48,7 +48,7 @@ import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import matplotlib
 
@@ -62,9 +62,13 @@ from matplotlib.ticker import MaxNLocator  # noqa: E402
 
 from wmr_mj.params import M1_NOMINAL, PAPER_KD, PAPER_KP  # noqa: E402
 
+if TYPE_CHECKING:
+    from wmr_mj.sim.falsify import FalsifyResult
+
 __all__ = [
     "STYLE",
     "new_figure",
+    "falsify_history",
     "save_figure",
     "write_figures",
     "plot_paths",
@@ -747,7 +751,8 @@ def paper_example(*, duration: float = 35.0, friction_width: float = 1e-3, mujoc
     from wmr_mj.errors import ParameterError
     from wmr_mj.params import C80
     from wmr_mj.plant.reduced import SteeringModel
-    from wmr_mj.sim.closed_loop import RunConfig, build_reference, run_closed_loop, run_on_reduced_model
+    from wmr_mj.sim.closed_loop import run_closed_loop, run_on_reduced_model
+    from wmr_mj.sim.config import RunConfig, build_reference
 
     if not (isinstance(duration, (int, float)) and math.isfinite(duration) and duration > 0):
         raise ParameterError(f"duration = {duration!r} s is not accepted; a finite number > 0 is required")
@@ -812,3 +817,28 @@ def close_all(figures: Iterable[Figure]) -> None:
     """Drop the figures' canvases' caches (Figures without pyplot are freed by GC)."""
     for fig in figures:
         fig.clear()
+
+
+def falsify_history(result: FalsifyResult):
+    """The search's history: each run's objective in evaluation order, and the running worst
+    of the search and of the random sample (same budget)."""
+    from wmr_mj.sim.falsify import OBJECTIVE_LABELS
+
+    fig, ax = new_figure(6.0, 3.6)
+    for evals, color, label in ((result.search, "C3", "differential evolution"),
+                                (result.random, "0.45", "random (Latin hypercube)")):
+        x = np.arange(1, len(evals) + 1)
+        y = np.array([np.nan if e.objective is None else e.objective for e in evals])
+        ax.scatter(x, y, s=8, color=color, alpha=0.45, linewidths=0)
+        running = np.fmax.accumulate(np.where(np.isnan(y), -np.inf, y))
+        ax.step(x, np.where(np.isfinite(running), running, np.nan), where="post", color=color,
+                label=f"{label}: worst {np.nanmax(y):.4g}" if np.isfinite(y).any() else label)
+    worst = max((e.objective for e in (*result.search, *result.random) if e.objective is not None), default=0.0)
+    if result.spec.objective != "sup-E" and worst >= 0.5:  # in view without squashing the data
+        ax.axhline(1.0, color="0.2", lw=0.8, ls="--", label="region boundary (ratio 1)")
+    ax.set_xlabel("simulations")
+    ax.set_ylabel(OBJECTIVE_LABELS[result.spec.objective])
+    ax.set_title(f"worst-case search, {len(result.spec.box)} parameters, budget {result.spec.budget}, "
+                 f"seed {result.spec.seed}", fontsize=9)
+    ax.legend(loc="best", fontsize=8)
+    return fig

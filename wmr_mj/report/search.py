@@ -17,7 +17,7 @@ serially with an MCAP log) and is read back when its spec has not changed.
 
 Usage::
 
-    from wmr_mj.report.validate import ValidateSettings
+    from wmr_mj.report.settings import ValidateSettings
     from wmr_mj.report.search import search_plans
     [plan.key for plan in search_plans(ValidateSettings())]   # ['paper', 'certified', 'certified-full']
 """
@@ -37,14 +37,14 @@ import numpy as np
 
 from wmr_mj._util.progress import Stages
 from wmr_mj.params import uncertainty_ranges
-from wmr_mj.report.validate import (
+from wmr_mj.report.settings import (
     FULL_BOX_FACTOR,
     ValidateSettings,
-    _loud,
-    _max_at,
-    _reference,
-    _stage_progress,
     certificate_summary,
+    loud,
+    max_at,
+    paper_circle_reference,
+    stage_progress,
 )
 from wmr_mj.sim.designs import CERTIFIED, LADDER, PAPER, Design
 
@@ -156,7 +156,7 @@ def _compare(result: dict[str, Any], plan: SearchPlan, rungs: Sequence[Mapping[s
         result["mc"] = None
         return
     rung = rungs[plan.mc_rung - 1]
-    value, m1 = _max_at(read_results(folder / rung["runs_csv"]), plan.mc_column)
+    value, m1 = max_at(read_results(folder / rung["runs_csv"]), plan.mc_column)
     worst = (result["worst"] or {}).get("objective")
     result["mc"] = {"rung": plan.mc_rung, "n": rung["n"], "column": plan.mc_column, "worst_objective": value,
                     "worst_m1": m1, "runs_csv": rung["runs_csv"]}
@@ -199,8 +199,9 @@ def run_search(plan: SearchPlan, settings: ValidateSettings, folder: Path, st: S
     re-run its worst run with an MCAP log (worst.mcap: is the serial run's sup|E| the
     batch's?) and write evaluations.csv and search.json."""
     from wmr_mj._util.files import write_json_atomic, write_text_atomic
-    from wmr_mj.analysis.certificate import certificate_for
-    from wmr_mj.sim.falsify import OBJECTIVE_LABELS, log_run
+    from wmr_mj.logs.writer import run_logged
+    from wmr_mj.sim.certify import certificate_for
+    from wmr_mj.sim.falsify import OBJECTIVE_LABELS
 
     spec = _search_spec(plan, settings)
     out = folder / f"search-{plan.key}"
@@ -210,17 +211,17 @@ def run_search(plan: SearchPlan, settings: ValidateSettings, folder: Path, st: S
         _compare(result, plan, rungs, folder)  # the ladder's sweep may have changed since
         st.done(f"read back from search-{plan.key}/search.json")
         return result
-    runs = _evaluate_search(spec, nthread=settings.nthread, progress=_stage_progress(st))
+    runs = _evaluate_search(spec, nthread=settings.nthread, progress=stage_progress(st))
     worst = _worst_of(runs)
     out.mkdir(parents=True, exist_ok=True)
-    logged = log_run(spec.config([worst["params"][n] for n in spec.names]), str(out / "worst.mcap")) if worst else {}
+    logged = run_logged(spec.config([worst["params"][n] for n in spec.names]), str(out / "worst.mcap")) if worst else {}
     result = _result(plan, spec, runs, worst, bool(worst and logged.get("sup_E") == worst["sup_E"]),
                      certificate_for(spec.base, reference), out, folder)
     _compare(result, plan, rungs, folder)
     write_text_atomic(out / "evaluations.csv", _evaluations_csv(spec.names, runs))
     write_json_atomic(out / "search.json", result)
     st.done(f"worst {_num(worst and worst['objective'])} ({OBJECTIVE_LABELS[plan.objective]})"
-            + _loud(result["verdicts"]["certified-outside"], f"search {plan.key}"))
+            + loud(result["verdicts"]["certified-outside"], f"search {plan.key}"))
     return result
 
 
@@ -231,5 +232,5 @@ def _num(x: Any) -> str:
 def search_stage(settings: ValidateSettings, folder: Path, st: Stages, rungs: Sequence[Mapping[str, Any]]
                  ) -> list[dict[str, Any]]:
     """Every search of :func:`search_plans`, in order ([] when the search is disabled)."""
-    reference = _reference(settings)
+    reference = paper_circle_reference(settings)
     return [run_search(plan, settings, folder, st, rungs, reference) for plan in search_plans(settings)]

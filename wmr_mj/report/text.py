@@ -290,7 +290,7 @@ FRICTION_COLUMNS = ("plant law", "F (2.13) V", "break-away V", "creep at 0.5 F r
 
 def _friction_laws(summary: Mapping[str, Any]) -> list[tuple[str, Mapping[str, Any]]]:
     """The measured laws in the report's order (stiction first), whatever the mapping's order."""
-    from wmr_mj.report.validate import FRICTION_LAWS
+    from wmr_mj.report.settings import FRICTION_LAWS
 
     laws = summary["friction"]
     return [(n, laws[n]) for n in FRICTION_LAWS if n in laws] + [(n, v) for n, v in laws.items()

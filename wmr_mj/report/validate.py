@@ -31,19 +31,31 @@ Usage::
 
 from __future__ import annotations
 
-import math
 import os
 import time
-from collections.abc import Callable, Mapping, Sequence
-from dataclasses import asdict, dataclass
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 from wmr_mj._util.files import software_versions
 from wmr_mj._util.progress import Stages
-from wmr_mj.errors import ParameterError, UnknownNameError
-from wmr_mj.params import C80, M1_NOMINAL, M1_RANGE
-from wmr_mj.sim.closed_loop import RunConfig
+from wmr_mj.errors import ParameterError
+from wmr_mj.params import C80
+from wmr_mj.report.settings import (
+    DEFAULT_DURATION,
+    DEFAULT_N,
+    DEFAULT_SEARCH_BUDGET,
+    FRICTION_LAWS,
+    FULL_BOX_FACTOR,
+    LADDER_GROUPS,
+    ValidateSettings,
+    certificate_summary,
+    loud,
+    max_at,
+    paper_circle_reference,
+    stage_progress,
+)
+from wmr_mj.sim.config import RunConfig
 from wmr_mj.sim.designs import CERTIFIED, LADDER, PAPER, Design
 
 __all__ = [
@@ -67,104 +79,7 @@ __all__ = [
     "software_versions",
 ]
 
-#: Defaults of ``wmr-mj validate``: 4 rungs x 32 runs of 35 s and 3 searches (30 + 30 + 56 runs) take
-#: about a minute on 2 cores, so ``make demo`` fits 3 minutes with the install; ``--n 100``: full counts.
-DEFAULT_N = 32
-DEFAULT_DURATION = 35.0
-#: Simulations of each m1-box search; the 5-parameter full-box search gets FULL_BOX_FACTOR times as many.
-DEFAULT_SEARCH_BUDGET = 30
-FULL_BOX_FACTOR = 2
-#: The steering joint's friction laws the report measures (wmr_mj.plant.mjcf.STEERING_FRICTION_MODELS).
-FRICTION_LAWS = ("stiction", "soft")
-#: What a ladder rung may change, in groups of RunConfig fields: each rung changes exactly one.
-LADDER_GROUPS = {"controller": ("controller",), "model source": ("model",),
-                 "compensation": ("friction_sign", "friction_width"), "gains": ("kp", "kd")}
-_MIN_POPULATION = 5  # differential evolution's smallest generation (wmr_mj.sim.falsify.MIN_POPULATION)
-
-# --------------------------------------------------------------------------- settings
-def _check_number(name: str, value: Any) -> None:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
-        raise ParameterError(f"{name} = {value!r} is not accepted; a finite number > 0 is required")
-
-
-def _check_int(name: str, value: Any, minimum: int, what: str) -> None:
-    if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
-        raise ParameterError(f"{name} = {value!r} is not accepted; {what}")
-
-
-@dataclass(frozen=True, kw_only=True)
-class ValidateSettings:
-    """What ``wmr-mj validate`` runs. Bad values raise ParameterError / UnknownNameError.
-
-    n: runs per rung; duration [s] per run; identify_duration [s] of excitation;
-    search_budget: simulations of each m1-box search (the full box gets FULL_BOX_FACTOR
-    times as many; 0: no search); nthread: 0 = every core; m1_range, nominal_m1 [kg];
-    uncertainty: the box the ladder samples and the certificates cover ('m1', the paper's,
-    or 'full': wmr_mj.params.uncertainty_ranges), its m1 range replaced by m1_range.
-    """
-
-    n: int = DEFAULT_N
-    seed: int = 0
-    sampling: str = "lhs"
-    duration: float = DEFAULT_DURATION
-    identify_duration: float = 60.0
-    search_budget: int = DEFAULT_SEARCH_BUDGET
-    nthread: int = 0
-    m1_range: tuple[float, float] = M1_RANGE
-    nominal_m1: float = M1_NOMINAL
-    uncertainty: str = "m1"
-
-    def __post_init__(self) -> None:
-        from wmr_mj.sim.sweep import SAMPLINGS
-
-        _check_int("n", self.n, 1, "the number of runs per rung must be an integer >= 1")
-        _check_int("seed", self.seed, 0, "an integer >= 0 is required")
-        if self.sampling not in SAMPLINGS:
-            raise UnknownNameError("sampling", str(self.sampling), SAMPLINGS)
-        for name in ("duration", "identify_duration", "nominal_m1"):
-            _check_number(name, getattr(self, name))
-        _check_int("nthread", self.nthread, 0, "an integer >= 0 (0: all CPUs) is required")
-        _check_int("search_budget", self.search_budget, 0, f"give 0 (no search) or an integer >= {_MIN_POPULATION}")
-        if 0 < self.search_budget < _MIN_POPULATION:
-            raise ParameterError(f"search_budget = {self.search_budget} is below one generation of differential "
-                                 f"evolution; give 0 (no search) or an integer >= {_MIN_POPULATION}")
-        lo, hi = self.m1_range
-        if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo < hi):
-            raise ParameterError(f"m1_range = {self.m1_range!r} must be (lo, hi) with 0 < lo < hi")
-        from wmr_mj.params import UNCERTAINTY_NAMES
-
-        if self.uncertainty not in UNCERTAINTY_NAMES:
-            raise UnknownNameError("uncertainty box name", str(self.uncertainty), UNCERTAINTY_NAMES)
-
-    @property
-    def ranges(self) -> dict[str, tuple[float, float]]:
-        """The ranged parameters of the uncertainty box other than m1, name -> (lo, hi)."""
-        from wmr_mj.params import uncertainty_ranges
-
-        return {k: v for k, v in uncertainty_ranges(self.uncertainty).items() if k != "m1"}
-
-    def config(self, design: Design) -> RunConfig:
-        """The run of ``design`` these settings sweep (m1 at nominal; the sweep draws it)."""
-        return RunConfig(**design.config_changes(), duration=self.duration, m1=self.nominal_m1,
-                         m1_range=tuple(self.m1_range), box_ranges=self.ranges, seed=self.seed)
-
-    def as_dict(self) -> dict[str, Any]:
-        d = asdict(self)
-        d["m1_range"] = list(self.m1_range)
-        return d
-
-
 # --------------------------------------------------------------------------- summaries
-def _max_at(rows: Sequence[Mapping[str, Any]], column: str) -> tuple[float | None, float | None]:
-    """(largest value of ``column``, the m1 of its run); (None, None) when the column is empty."""
-    best, m1 = None, None
-    for r in rows:
-        v = r.get(column)
-        if v is not None and (best is None or float(v) > best):
-            best, m1 = float(v), float(r["m1"])
-    return best, m1
-
-
 def summarise_rung(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
     """The numbers of one rung from its runs (rows of runs.csv, ``sweep.read_results``).
 
@@ -177,9 +92,9 @@ def summarise_rung(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
     if not rows:
         raise ParameterError("no runs to summarise")
     verdicts = count_verdicts(str(r["verdict"]) for r in rows if r.get("verdict"))
-    sup_E, sup_E_m1 = _max_at(rows, "sup_E")
-    cert_ratio, cert_m1 = _max_at(rows, "cert_E_ratio")
-    paper_ratio, paper_m1 = _max_at(rows, "E_ratio")
+    sup_E, sup_E_m1 = max_at(rows, "sup_E")
+    cert_ratio, cert_m1 = max_at(rows, "cert_E_ratio")
+    paper_ratio, paper_m1 = max_at(rows, "E_ratio")
     return {
         "n": len(rows),
         "verdicts": verdicts,
@@ -214,30 +129,11 @@ def _change_text(before: Design, after: Design) -> str:
     return "; ".join(parts)
 
 
-def certificate_summary(cert: Any) -> dict[str, Any]:
-    """A certificate's numbers for the report: ``Certificate.as_dict()`` without the bulky
-    inputs, plus the reference's max|alpha0|, the steering range, the supply and the box."""
-    d = {k: v for k, v in cert.as_dict().items() if k != "inputs"}
-    inputs = cert.inputs
-    d["alpha0_max"] = inputs.get("reference", {}).get("alpha0_max")
-    d["steering_range"] = inputs.get("steering_range")
-    d["voltage_limit"] = inputs.get("voltage_limit")
-    d["m1_range"] = inputs.get("m1_range")
-    d["box_ranges"] = inputs.get("box_ranges", {})
-    return d
-
-
-def _reference(settings: ValidateSettings):
-    from wmr_mj.sim.closed_loop import build_reference
-
-    return build_reference("paper-circle", C80, dt=1e-3, duration=settings.duration)[0]
-
-
 def _paper_region(config: RunConfig, reference) -> dict[str, Any]:
     """The paper's claim for ``config``: the region (4.21)-(4.23) its runs are judged by."""
-    from wmr_mj.sim.closed_loop import _controller, _estimate_of, analysis_for
+    from wmr_mj.sim.config import analysis_for, controller_for, estimate_of
 
-    analysis = analysis_for(config, reference, C80, estimate=_estimate_of(_controller(config, C80)))
+    analysis = analysis_for(config, reference, C80, estimate=estimate_of(controller_for(config, C80)))
     d = analysis.as_dict()
     return {k: d[k] for k in ("E_max", "Edot_max", "condition", "stable", "vertices")}
 
@@ -275,18 +171,10 @@ def friction_stage(settings: ValidateSettings, st: Stages) -> dict[str, dict[str
 
 
 # --------------------------------------------------------------------------- stage 3: the ladder
-def _stage_progress(st: Stages) -> Callable[[float, int], None]:
-    return lambda done, total: st.update(done, total)
-
-
-def _loud(count: int, where: str) -> str:
-    return (f" !!! {count} CERTIFIED-OUTSIDE run(s) in {where}: a bug or a modelling gap !!!" if count else "")
-
-
 def run_rung(settings: ValidateSettings, k: int, design: Design, folder: Path, st: Stages, reference,
              before: Design | None) -> dict[str, Any]:
     """Sweep one rung over m1 (resumable in ladder-<k>-<name>/) and summarise it."""
-    from wmr_mj.analysis.certificate import certificate_for
+    from wmr_mj.sim.certify import certificate_for
     from wmr_mj.sim.sweep import SweepSpec, read_results, run_sweep
 
     base = settings.config(design)
@@ -295,7 +183,7 @@ def run_rung(settings: ValidateSettings, k: int, design: Design, folder: Path, s
     sweep_dir = folder / f"ladder-{k}-{design.name}"
     st.start(f"ladder-{k}", f"rung {k} ({design.label}): {settings.n} runs of {settings.duration:g} s over m1 "
                             f"{settings.m1_range[0]:g}-{settings.m1_range[1]:g} kg ({settings.sampling})")
-    run_sweep(spec, out_dir=sweep_dir, nthread=settings.nthread, progress=_stage_progress(st))
+    run_sweep(spec, out_dir=sweep_dir, nthread=settings.nthread, progress=stage_progress(st))
     rung = summarise_rung(read_results(sweep_dir / "runs.csv"))
     rung.update(index=k, name=design.name, label=design.label, design=design.describe(),
                 config=design.config_changes(), changed=[] if before is None else ladder_changes(before, design),
@@ -304,13 +192,13 @@ def run_rung(settings: ValidateSettings, k: int, design: Design, folder: Path, s
                 paper_region=_paper_region(base, reference),
                 runs_csv=(sweep_dir / "runs.csv").relative_to(folder).as_posix())
     st.done(f"{rung['passes']}/{rung['n']} certified-inside, {rung['paper_inside']}/{rung['n']} inside the "
-            f"paper's claim" + _loud(rung["certified_outside"], f"rung {k}"))
+            f"paper's claim" + loud(rung["certified_outside"], f"rung {k}"))
     return rung
 
 
 def ladder_stage(settings: ValidateSettings, folder: Path, st: Stages) -> list[dict[str, Any]]:
     """Every rung of :data:`LADDER`, in order (see :func:`run_rung`)."""
-    reference = _reference(settings)
+    reference = paper_circle_reference(settings)
     rungs = []
     for k, design in enumerate(LADDER, start=1):
         rungs.append(run_rung(settings, k, design, folder, st, reference, LADDER[k - 2] if k > 1 else None))

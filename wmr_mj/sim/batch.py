@@ -41,22 +41,20 @@ import mujoco
 import numpy as np
 
 from wmr_mj._util.memory import require_memory
-from wmr_mj.analysis.certificate import certificate_for
 from wmr_mj.analysis.verdicts import drift, drift_window_steps
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import C80, M1_NOMINAL, C80Parameters
 from wmr_mj.sim import compiled_law
-from wmr_mj.sim.closed_loop import (
+from wmr_mj.sim.certify import certificate_for
+from wmr_mj.sim.closed_loop import _substeps, report, run_closed_loop
+from wmr_mj.sim.config import (
     RunConfig,
-    _controller,
-    _estimate_of,
-    _substeps,
     analysis_for,
     build_reference,
+    controller_for,
+    estimate_of,
     estimate_parameters,
     plant_parameters,
-    report,
-    run_closed_loop,
 )
 
 __all__ = ["run_batch", "batch_model", "batch_law_backend", "LAW_BACKENDS", "thread_count", "batch_groups"]
@@ -332,7 +330,7 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
         if c.replace(m1=M1_NOMINAL, plant_overrides={}) != shared:
             raise ParameterError("run_batch needs configs that differ only in m1 and plant_overrides")
     estimate = estimate_parameters(base)
-    controller = _controller(first, estimate)
+    controller = controller_for(first, estimate)
     backend = batch_law_backend(controller, law)
     plants = [plant_parameters(c, base) for c in configs]
     options = _plant_options(first)
@@ -357,7 +355,7 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
                               **options) for p in plants]
     else:
         models = [model] + [batch_model(p, **options) for p in plants[1:]]
-    analysis = analysis_for(first, reference, estimate, estimate=_estimate_of(controller))
+    analysis = analysis_for(first, reference, estimate, estimate=estimate_of(controller))
     loop = _Loop(alpha0=rows[0], alpha0_dot=rows[1], alpha0_ddot=rows[2], n=n, substeps=substeps, period=period,
                  settle_k=int(math.ceil(settle_s / period - 1e-9)), drift_k=drift_window_steps(n, period),
                  block=min(n, 1000), **where, keyframe=model.key("home").id,

@@ -18,178 +18,38 @@ the two bit-identical.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import time
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import mujoco
 import numpy as np
 
-from controllers import SteeringController, make_controller, model_from_source
-from controllers.computed_torque import CONTROLLER_NAMES, FRICTION_SIGNS, MODEL_SOURCES
+from controllers import SteeringController
 from wmr_mj._util.memory import require_run_memory
 from wmr_mj._util.progress import progress_bar
-from wmr_mj.analysis.certificate import certificate_for
-from wmr_mj.errors import ParameterError, UnknownNameError
-from wmr_mj.params import C80, M1_NOMINAL, M1_RANGE, PAPER_KD, PAPER_KP, C80Parameters, parameter_names, with_params
-from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS, TIMESTEP, TYRE_CONTACT_MODELS, Plant
+from wmr_mj.errors import ParameterError
+from wmr_mj.params import C80, C80Parameters
+from wmr_mj.plant.mjcf import TIMESTEP, Plant
+from wmr_mj.sim.certify import certificate_for
+from wmr_mj.sim.config import (
+    RunConfig,
+    analysis_for,
+    build_reference,
+    controller_for,
+    estimate_of,
+    estimate_parameters,
+    plant_parameters,
+)
 from wmr_mj.sim.summary import RunSummary
 
-__all__ = [
-    "RunConfig",
-    "RunResult",
-    "run_closed_loop",
-    "build_reference",
-    "analysis_for",
-    "analysis_box",
-    "plant_parameters",
-    "estimate_parameters",
-    "report",
-    "run_on_reduced_model",
-    "PATH_NAMES",
-    "ROW_FIELDS",
-]
+__all__ = ["RunResult", "run_closed_loop", "report", "run_on_reduced_model", "ROW_FIELDS"]
 
-PATH_NAMES = ("paper-circle", "lane-change", "figure-eight")
 # scalar fields recorded for every control step (see RunResult.rows)
 ROW_FIELDS = ("t", "alpha", "alpha_dot", "alpha0", "alpha0_dot", "alpha0_ddot", "E", "E_dot",
               "voltage_cmd", "voltage", "current", "steer_torque", "heading")
-
-
-@dataclass(frozen=True, kw_only=True)
-class RunConfig:
-    """Everything that defines a closed-loop run (JSON-able via ``as_dict``)."""
-
-    controller: str = "computed-torque"
-    model: str = "paper"  # model source of the controller's estimate
-    m1: float = M1_NOMINAL  # plant chassis mass, kg
-    duration: float = 35.0  # s
-    control_period: float | None = None  # s; None: every physics step
-    kp: float = PAPER_KP
-    kd: float = PAPER_KD
-    friction_sign: str = "measured"
-    friction_width: float = 0.0  # rad/s, tanh smoothing of the Coulomb sign (0: exact sign)
-    path: str = "paper-circle"
-    plant_overrides: Mapping[str, float] = field(default_factory=dict)  # other plant parameters
-    m1_inertia: str = "payload"
-    identified: Any = None  # path or mapping from `wmr-mj identify` for model='identified'
-    coefficients: Mapping[str, float] | None = None  # for model='explicit'
-    box: str = "derived"  # 'derived' from the parameter set over m1_range, or 'paper' (5.1)
-    m1_range: tuple[float, float] = M1_RANGE
-    box_ranges: Mapping[str, tuple[float, float]] = field(default_factory=dict)  # other ranged parameters
-    seed: int = 0  # recorded; a single run draws nothing at random
-    steering_friction: str = "stiction"  # plant's steering friction law: one of STEERING_FRICTION_MODELS
-    tyre_contact: str = "stiff"  # plant's tyre-floor contact law: one of TYRE_CONTACT_MODELS
-
-    def __post_init__(self) -> None:
-        if self.controller not in CONTROLLER_NAMES:
-            raise UnknownNameError("controller", self.controller, CONTROLLER_NAMES)
-        if self.model not in MODEL_SOURCES:
-            raise UnknownNameError("model source", self.model, MODEL_SOURCES)
-        if self.friction_sign not in FRICTION_SIGNS:
-            raise UnknownNameError("friction sign", self.friction_sign, FRICTION_SIGNS)
-        if self.path not in PATH_NAMES:
-            raise UnknownNameError("path", self.path, PATH_NAMES)
-        if self.box not in ("derived", "paper"):
-            raise UnknownNameError("box", self.box, ("derived", "paper"))
-        if self.steering_friction not in STEERING_FRICTION_MODELS:
-            raise UnknownNameError("steering friction model", self.steering_friction, STEERING_FRICTION_MODELS)
-        if self.tyre_contact not in TYRE_CONTACT_MODELS:
-            raise UnknownNameError("tyre contact model", self.tyre_contact, TYRE_CONTACT_MODELS)
-        for name in ("m1", "duration", "kp", "kd"):
-            value = getattr(self, name)
-            if not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
-                raise ParameterError(f"{name} = {value!r} is not accepted; a finite number > 0 is required")
-        if self.control_period is not None and (not math.isfinite(self.control_period) or self.control_period <= 0):
-            raise ParameterError(f"control_period = {self.control_period!r} s must be finite and > 0")
-        lo, hi = self.m1_range
-        if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo < hi):
-            raise ParameterError(f"m1_range = {self.m1_range!r} must be (lo, hi) with 0 < lo < hi")
-        names = parameter_names()
-        for name in self.plant_overrides:
-            if name not in names:
-                raise UnknownNameError("parameter", name, names)
-
-    def as_dict(self) -> dict[str, Any]:
-        d = dataclasses.asdict(self)
-        d["plant_overrides"] = dict(self.plant_overrides)
-        d["m1_range"] = list(self.m1_range)
-        d["box_ranges"] = {k: list(v) for k, v in self.box_ranges.items()}
-        if self.identified is not None and not isinstance(self.identified, (str, bytes)):
-            d["identified"] = dict(self.identified.get("identified", self.identified))
-        return d
-
-    def replace(self, **changes: Any) -> RunConfig:
-        return dataclasses.replace(self, **changes)
-
-
-def plant_parameters(config: RunConfig, base: C80Parameters = C80) -> C80Parameters:
-    """The plant's parameter set: base with m1 and the overrides (mass and inertia consistent)."""
-    return with_params(base, m1_inertia=config.m1_inertia, m1=config.m1, **dict(config.plant_overrides))
-
-
-def estimate_parameters(base: C80Parameters = C80) -> C80Parameters:
-    """The controller's belief: the nominal parameter set (m1 = 650 kg)."""
-    return base
-
-
-def build_reference(path: str, params: C80Parameters, *, dt: float, duration: float):
-    """(reference, settle_s) for a named path of C on a grid of step dt.
-
-    settle_s is when the entry transient ends: for the paper's circle, the
-    time C enters the circle; 0 for the other paths.
-    """
-    from wmr_mj.reference import paths as ref
-
-    if path == "paper-circle":
-        p = ref.paper_circle(params, duration=duration)
-    elif path == "lane-change":
-        p = ref.line(0.5) + ref.lane_change(0.5, 4.0) + ref.line(max(duration * params.V_A, 1.0))
-    elif path == "figure-eight":
-        p = ref.line(0.5) + ref.figure_eight(1.5, laps=max(1, int(duration * params.V_A / 20.0) + 1))
-    else:
-        raise UnknownNameError("path", path, PATH_NAMES)
-    reference = ref.make_reference(p, params, dt=dt, duration=duration)
-    settle_s = 0.0
-    if path == "paper-circle":
-        circle_start = float(p.starts[-2])  # starts ends with the total length
-        reached = np.nonzero(np.asarray(reference.s) >= circle_start)[0]
-        settle_s = float(reference.t[reached[0]]) if reached.size else float(reference.t[-1])
-    return reference, settle_s
-
-
-def analysis_box(config: RunConfig, params: C80Parameters = C80):
-    """The parameter box of the analysis: the paper's (5.1), or derived from ``params`` over
-    the config's m1 range (and box ranges) with the model the controller's source stands on
-    ('nonholonomic' for nonholonomic and identified, 'paper' otherwise)."""
-    from wmr_mj.analysis.robustness import ParameterBox
-
-    if config.box == "paper":
-        return ParameterBox.paper()
-    box_model = "nonholonomic" if config.model in ("nonholonomic", "identified") else "paper"
-    return ParameterBox.from_parameters(params, m1_range=tuple(config.m1_range), model=box_model,
-                                        m1_inertia=config.m1_inertia,
-                                        ranges={k: tuple(v) for k, v in config.box_ranges.items()} or None)
-
-
-def analysis_for(config: RunConfig, reference, params: C80Parameters = C80, *, estimate=None):
-    """The robustness analysis (4.17)-(4.23) for the run's box, gains and reference bounds.
-
-    estimate: the controller's coefficients (P^, C_V^, F^, K^); the parameter
-    errors are then truth-anywhere-in-the-box minus this estimate. None: the
-    estimate is anywhere in the box too, as in the paper's (4.2).
-    """
-    from wmr_mj.analysis.robustness import ReferenceBounds, analyse
-
-    box = analysis_box(config, params)
-    b = reference.bounds()
-    bounds = ReferenceBounds(alpha_ddot_max=max(b["max_abs_alpha0_ddot"], 1e-12),
-                             alpha_dot_max=max(b["max_abs_alpha0_dot"], 1e-12),
-                             sin_cos3_max=max(b["max_sin_cos3"], 1e-12))
-    return analyse(box, kp=config.kp, kd=config.kd, bounds=bounds, estimate=estimate)
 
 
 @dataclass
@@ -200,23 +60,6 @@ class RunResult:
     rows: dict[str, np.ndarray]
     summary: RunSummary
     status: str = "completed"
-
-
-def _controller(config: RunConfig, params: C80Parameters) -> SteeringController:
-    model = model_from_source(config.model, params=params, identified=config.identified,
-                              coefficients=config.coefficients)
-    return make_controller(config.controller, model, kp=config.kp, kd=config.kd,
-                           friction_sign=config.friction_sign, friction_width=config.friction_width)
-
-
-def _estimate_of(controller: SteeringController) -> dict[str, float]:
-    """The coefficients the controller's model-based part uses (K^ etc.); a PD has none but P^."""
-    c = controller.model.coefficients.as_dict()
-    if controller.name == "pd":
-        return {"P": c["P"], "C_V": 0.0, "F": 0.0, "K": 0.0}
-    if getattr(controller, "friction_sign", None) == "none":
-        c["F"] = 0.0
-    return {k: c[k] for k in ("P", "C_V", "F", "K")}
 
 
 def _substeps(config: RunConfig, timestep: float) -> int:
@@ -316,7 +159,7 @@ def run_closed_loop(
     """
     params = plant_parameters(config, base)
     estimate = estimate_parameters(base)
-    controller = _controller(config, estimate)
+    controller = controller_for(config, estimate)
     plant = Plant(params, steering_friction=config.steering_friction, tyre_contact=config.tyre_contact)
     m, d = plant.model, plant.data
     dt = m.opt.timestep
@@ -325,7 +168,7 @@ def run_closed_loop(
     n = int(round(config.duration / period))
     require_run_memory(duration_s=n * period, control_period_s=period)  # before the arrays
     reference, settle_s = build_reference(config.path, estimate, dt=period, duration=n * period)
-    analysis = analysis_for(config, reference, estimate, estimate=_estimate_of(controller))
+    analysis = analysis_for(config, reference, estimate, estimate=estimate_of(controller))
     certificate = certificate_for(config, reference, params=base)
     a0_all, a0d_all, a0dd_all = reference.alpha0, reference.alpha0_dot, reference.alpha0_ddot
     if len(a0_all) < n:

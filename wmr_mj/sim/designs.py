@@ -119,9 +119,9 @@ def certified_omega_r(*, error_spec: float = ERROR_SPEC, grid: tuple[float, ...]
     """The rule of the certified design: the smallest omega_r of ``grid`` whose certificate
     (non-holonomic model, smoothed sign, paper circle, m1 over 550-750 kg) is valid with
     E_max <= error_spec. None when no grid point qualifies. No simulation is run."""
-    from wmr_mj.analysis.certificate import certificate_for
     from wmr_mj.params import C80
-    from wmr_mj.sim.closed_loop import RunConfig, build_reference
+    from wmr_mj.sim.certify import certificate_for
+    from wmr_mj.sim.config import RunConfig, build_reference
 
     reference, _ = build_reference("paper-circle", C80, dt=1e-3, duration=35.0)
     for w in grid:

@@ -45,7 +45,7 @@ import numpy as np
 
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import parameter_names
-from wmr_mj.sim.closed_loop import RunConfig
+from wmr_mj.sim.config import RunConfig
 
 __all__ = [
     "OBJECTIVES",
@@ -61,8 +61,6 @@ __all__ = [
     "random_worst",
     "falsify",
     "worst_config",
-    "log_run",
-    "figure_history",
 ]
 
 OBJECTIVES = ("certificate", "paper", "sup-E")
@@ -413,38 +411,3 @@ def worst_config(result: FalsifyResult) -> RunConfig:
     """The worst run's config, rebuilt from its reported parameters."""
     w = result.worst
     return result.spec.config([w.params[n] for n in result.spec.names])
-
-
-def log_run(config: RunConfig, path: str) -> dict[str, Any]:
-    """Re-run ``config`` serially (``run_closed_loop``) with an MCAP log at ``path``; its summary."""
-    import functools
-
-    from wmr_mj.logs.writer import RunLogger
-    from wmr_mj.sim.closed_loop import run_closed_loop
-
-    return run_closed_loop(config, logger_factory=functools.partial(RunLogger, path), progress=False).summary
-
-
-def figure_history(result: FalsifyResult):
-    """The search's history: each run's objective in evaluation order, and the running worst
-    of the search and of the random sample (same budget)."""
-    from wmr_mj.report.plots import new_figure
-
-    fig, ax = new_figure(6.0, 3.6)
-    for evals, color, label in ((result.search, "C3", "differential evolution"),
-                                (result.random, "0.45", "random (Latin hypercube)")):
-        x = np.arange(1, len(evals) + 1)
-        y = np.array([np.nan if e.objective is None else e.objective for e in evals])
-        ax.scatter(x, y, s=8, color=color, alpha=0.45, linewidths=0)
-        running = np.fmax.accumulate(np.where(np.isnan(y), -np.inf, y))
-        ax.step(x, np.where(np.isfinite(running), running, np.nan), where="post", color=color,
-                label=f"{label}: worst {np.nanmax(y):.4g}" if np.isfinite(y).any() else label)
-    worst = max((e.objective for e in (*result.search, *result.random) if e.objective is not None), default=0.0)
-    if result.spec.objective != "sup-E" and worst >= 0.5:  # in view without squashing the data
-        ax.axhline(1.0, color="0.2", lw=0.8, ls="--", label="region boundary (ratio 1)")
-    ax.set_xlabel("simulations")
-    ax.set_ylabel(OBJECTIVE_LABELS[result.spec.objective])
-    ax.set_title(f"worst-case search, {len(result.spec.box)} parameters, budget {result.spec.budget}, "
-                 f"seed {result.spec.seed}", fontsize=9)
-    ax.legend(loc="best", fontsize=8)
-    return fig

@@ -40,7 +40,7 @@ import numpy as np
 from wmr_mj.errors import ParameterError, SchedulerError, UnknownNameError
 from wmr_mj.params import M1_RANGE, parameter_names
 from wmr_mj.sim.batch import run_batch
-from wmr_mj.sim.closed_loop import RunConfig
+from wmr_mj.sim.config import RunConfig
 
 __all__ = [
     "SweepSpec",

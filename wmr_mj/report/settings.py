@@ -1,0 +1,161 @@
+"""What ``wmr-mj validate`` runs (its settings and defaults) and the helpers its stages share.
+
+Usage::
+
+    from wmr_mj.report.settings import ValidateSettings
+    settings = ValidateSettings(n=8, search_budget=10)
+    print(settings.config(CERTIFIED))
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import asdict, dataclass
+from typing import Any
+
+from wmr_mj._util.progress import Stages
+from wmr_mj.errors import ParameterError, UnknownNameError
+from wmr_mj.params import C80, M1_NOMINAL, M1_RANGE
+from wmr_mj.sim.config import RunConfig, build_reference
+from wmr_mj.sim.designs import Design
+
+__all__ = [
+    "DEFAULT_N",
+    "DEFAULT_DURATION",
+    "DEFAULT_SEARCH_BUDGET",
+    "FULL_BOX_FACTOR",
+    "FRICTION_LAWS",
+    "LADDER_GROUPS",
+    "ValidateSettings",
+    "max_at",
+    "certificate_summary",
+    "paper_circle_reference",
+    "stage_progress",
+    "loud",
+]
+
+#: Defaults of ``wmr-mj validate``: 4 rungs x 32 runs of 35 s and 3 searches (30 + 30 + 56 runs) take
+#: about a minute on 2 cores, so ``make demo`` fits 3 minutes with the install; ``--n 100``: full counts.
+DEFAULT_N = 32
+DEFAULT_DURATION = 35.0
+#: Simulations of each m1-box search; the 5-parameter full-box search gets FULL_BOX_FACTOR times as many.
+DEFAULT_SEARCH_BUDGET = 30
+FULL_BOX_FACTOR = 2
+#: The steering joint's friction laws the report measures (wmr_mj.plant.mjcf.STEERING_FRICTION_MODELS).
+FRICTION_LAWS = ("stiction", "soft")
+#: What a ladder rung may change, in groups of RunConfig fields: each rung changes exactly one.
+LADDER_GROUPS = {"controller": ("controller",), "model source": ("model",),
+                 "compensation": ("friction_sign", "friction_width"), "gains": ("kp", "kd")}
+_MIN_POPULATION = 5  # differential evolution's smallest generation (wmr_mj.sim.falsify.MIN_POPULATION)
+
+# --------------------------------------------------------------------------- settings
+def _check_number(name: str, value: Any) -> None:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
+        raise ParameterError(f"{name} = {value!r} is not accepted; a finite number > 0 is required")
+
+
+def _check_int(name: str, value: Any, minimum: int, what: str) -> None:
+    if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
+        raise ParameterError(f"{name} = {value!r} is not accepted; {what}")
+
+
+@dataclass(frozen=True, kw_only=True)
+class ValidateSettings:
+    """What ``wmr-mj validate`` runs. Bad values raise ParameterError / UnknownNameError.
+
+    n: runs per rung; duration [s] per run; identify_duration [s] of excitation;
+    search_budget: simulations of each m1-box search (the full box gets FULL_BOX_FACTOR
+    times as many; 0: no search); nthread: 0 = every core; m1_range, nominal_m1 [kg];
+    uncertainty: the box the ladder samples and the certificates cover ('m1', the paper's,
+    or 'full': wmr_mj.params.uncertainty_ranges), its m1 range replaced by m1_range.
+    """
+
+    n: int = DEFAULT_N
+    seed: int = 0
+    sampling: str = "lhs"
+    duration: float = DEFAULT_DURATION
+    identify_duration: float = 60.0
+    search_budget: int = DEFAULT_SEARCH_BUDGET
+    nthread: int = 0
+    m1_range: tuple[float, float] = M1_RANGE
+    nominal_m1: float = M1_NOMINAL
+    uncertainty: str = "m1"
+
+    def __post_init__(self) -> None:
+        from wmr_mj.sim.sweep import SAMPLINGS
+
+        _check_int("n", self.n, 1, "the number of runs per rung must be an integer >= 1")
+        _check_int("seed", self.seed, 0, "an integer >= 0 is required")
+        if self.sampling not in SAMPLINGS:
+            raise UnknownNameError("sampling", str(self.sampling), SAMPLINGS)
+        for name in ("duration", "identify_duration", "nominal_m1"):
+            _check_number(name, getattr(self, name))
+        _check_int("nthread", self.nthread, 0, "an integer >= 0 (0: all CPUs) is required")
+        _check_int("search_budget", self.search_budget, 0, f"give 0 (no search) or an integer >= {_MIN_POPULATION}")
+        if 0 < self.search_budget < _MIN_POPULATION:
+            raise ParameterError(f"search_budget = {self.search_budget} is below one generation of differential "
+                                 f"evolution; give 0 (no search) or an integer >= {_MIN_POPULATION}")
+        lo, hi = self.m1_range
+        if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo < hi):
+            raise ParameterError(f"m1_range = {self.m1_range!r} must be (lo, hi) with 0 < lo < hi")
+        from wmr_mj.params import UNCERTAINTY_NAMES
+
+        if self.uncertainty not in UNCERTAINTY_NAMES:
+            raise UnknownNameError("uncertainty box name", str(self.uncertainty), UNCERTAINTY_NAMES)
+
+    @property
+    def ranges(self) -> dict[str, tuple[float, float]]:
+        """The ranged parameters of the uncertainty box other than m1, name -> (lo, hi)."""
+        from wmr_mj.params import uncertainty_ranges
+
+        return {k: v for k, v in uncertainty_ranges(self.uncertainty).items() if k != "m1"}
+
+    def config(self, design: Design) -> RunConfig:
+        """The run of ``design`` these settings sweep (m1 at nominal; the sweep draws it)."""
+        return RunConfig(**design.config_changes(), duration=self.duration, m1=self.nominal_m1,
+                         m1_range=tuple(self.m1_range), box_ranges=self.ranges, seed=self.seed)
+
+    def as_dict(self) -> dict[str, Any]:
+        d = asdict(self)
+        d["m1_range"] = list(self.m1_range)
+        return d
+
+
+def max_at(rows: Sequence[Mapping[str, Any]], column: str) -> tuple[float | None, float | None]:
+    """(largest value of ``column``, the m1 of its run); (None, None) when the column is empty."""
+    best, m1 = None, None
+    for r in rows:
+        v = r.get(column)
+        if v is not None and (best is None or float(v) > best):
+            best, m1 = float(v), float(r["m1"])
+    return best, m1
+
+
+def certificate_summary(cert: Any) -> dict[str, Any]:
+    """A certificate's numbers for the report: ``Certificate.as_dict()`` without the bulky
+    inputs, plus the reference's max|alpha0|, the steering range, the supply and the box."""
+    d = {k: v for k, v in cert.as_dict().items() if k != "inputs"}
+    inputs = cert.inputs
+    d["alpha0_max"] = inputs.get("reference", {}).get("alpha0_max")
+    d["steering_range"] = inputs.get("steering_range")
+    d["voltage_limit"] = inputs.get("voltage_limit")
+    d["m1_range"] = inputs.get("m1_range")
+    d["box_ranges"] = inputs.get("box_ranges", {})
+    return d
+
+
+def paper_circle_reference(settings: ValidateSettings):
+    """The paper circle's reference for runs of ``settings.duration`` on the 1 ms grid."""
+    return build_reference("paper-circle", C80, dt=1e-3, duration=settings.duration)[0]
+
+
+
+def stage_progress(st: Stages) -> Callable[[float, int], None]:
+    return lambda done, total: st.update(done, total)
+
+
+def loud(count: int, where: str) -> str:
+    return (f" !!! {count} CERTIFIED-OUTSIDE run(s) in {where}: a bug or a modelling gap !!!" if count else "")
+
+
