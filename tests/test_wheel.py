@@ -27,9 +27,18 @@ from wmr_mj.cli.app import COMMANDS
 
 REPO = Path(__file__).resolve().parents[1]
 # what a build must not see: environments, build outputs, caches, run outputs
-_IGNORE = shutil.ignore_patterns(".git", ".venv", "build", "dist", "*.egg-info", "__pycache__", ".pytest_cache",
-                                 ".ruff_cache", "logs", ".gl", "node_modules", "MUJOCO_LOG.TXT",
-                                 "*.so")  # the editable install's compiled law: the wheel builds its own
+_IGNORE_ANYWHERE = shutil.ignore_patterns(".git", ".venv", "build", "dist", "*.egg-info", "__pycache__",
+                                          ".pytest_cache", ".ruff_cache", ".gl", "node_modules", "MUJOCO_LOG.TXT",
+                                          "*.so")  # the editable install's compiled law: the wheel builds its own
+
+
+def _IGNORE(folder: str, names: list[str]) -> set[str]:
+    """What the copy of the source leaves out; the run-output folder logs/ only at the project's root
+    (wmr_mj/logs/ is a subpackage)."""
+    ignored = set(_IGNORE_ANYWHERE(folder, names))
+    if "pyproject.toml" in names and "logs" in names:
+        ignored.add("logs")
+    return ignored
 # files of the source that are package data (everything else in a package folder is a module or a cache)
 _DATA_GLOBS = ("wmr_mj/schemas/*", "wmr_mj/data/*", "wmr_mj/py.typed", "controllers/py.typed")
 _MODEL_FILES = ("c80.xml", "scene.xml", "README.md")
