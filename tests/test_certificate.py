@@ -159,9 +159,9 @@ def test_design_fixed_point_by_substitution(circle):
     G_hat = C80.coefficients("nonholonomic").gyro * C80.V_A
     G_lo, G_hi = GYRO_BAND[0] * G_hat, GYRO_BAND[1] * G_hat  # P fixed over m1
     dG = max(G_hat - G_lo, G_hi - G_hat)
-    a_max = b["max_abs_alpha0"] + c.E_max
+    a_max = b.alpha_max + c.E_max
     c2 = math.cos(a_max) ** 2
-    d1 = (F_max + PLANT_K_BAND * _S(a_max) + dG * b["max_abs_alpha0_dot"] / c2) / P
+    d1 = (F_max + PLANT_K_BAND * _S(a_max) + dG * b.alpha_dot_max / c2) / P
     d3 = dG / c2 / P
     g1, g2 = exact_gammas(100.0, 20.0)
     cond = g2 * d3
@@ -169,7 +169,7 @@ def test_design_fixed_point_by_substitution(circle):
     assert c.condition == pytest.approx(cond, rel=1e-12)
     assert c.E_max == pytest.approx(g1 * d1 / (1 - cond), rel=1e-11)
     assert c.Edot_max == pytest.approx(g2 * d1 / (1 - cond), rel=1e-11)
-    assert c.alpha_max == pytest.approx(b["max_abs_alpha0"] + c.E_max)
+    assert c.alpha_max == pytest.approx(b.alpha_max + c.E_max)
 
 
 @pytest.mark.parametrize("omega_r", [20.0, 40.0])

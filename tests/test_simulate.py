@@ -25,8 +25,8 @@ def reference():
 
 def _bounds(reference):
     b = reference.bounds()
-    return ReferenceBounds(alpha_ddot_max=b["max_abs_alpha0_ddot"], alpha_dot_max=b["max_abs_alpha0_dot"],
-                           sin_cos3_max=b["max_sin_cos3"])
+    return ReferenceBounds(alpha_ddot_max=b.alpha_ddot_max, alpha_dot_max=b.alpha_dot_max,
+                           sin_cos3_max=b.sin_cos3_max)
 
 
 @pytest.mark.parametrize("friction_sign,width",

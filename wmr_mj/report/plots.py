@@ -747,10 +747,11 @@ def paper_example(*, duration: float = 35.0, friction_width: float = 1e-3, mujoc
     (b) ``run_closed_loop(RunConfig(model='paper'))`` on the MuJoCo plant.
     """
     from controllers import ComputedTorque
-    from wmr_mj.analysis.robustness import ParameterBox, ReferenceBounds, analyse
+    from wmr_mj.analysis.robustness import ParameterBox, analyse
     from wmr_mj.errors import ParameterError
     from wmr_mj.params import C80
     from wmr_mj.plant.reduced import SteeringModel
+    from wmr_mj.reference.bounds import ReferenceBounds
     from wmr_mj.sim.closed_loop import run_closed_loop, run_on_reduced_model
     from wmr_mj.sim.config import RunConfig, build_reference
 
@@ -794,15 +795,15 @@ def fig7_series(example: PaperExample) -> list[Series]:
 
 def paper_figures(example: PaperExample) -> dict[str, Figure]:
     """{stem: Figure} of Figs. 4-7 (stems :data:`PAPER_FIGURE_NAMES`)."""
-    from wmr_mj.reference.paths import PAPER_BOUNDS
+    from wmr_mj.reference.bounds import PAPER_BOUNDS
 
     ref = example.reference
     r = example.result
     figs = {
         "fig4_trajectory": figure_paths(ref),
         "fig5_alpha0": figure_alpha0(ref),
-        "fig6_alpha0_rates": figure_alpha0_rates(ref, rate_bound=PAPER_BOUNDS["max_abs_alpha0_dot"],
-                                                 accel_bound=PAPER_BOUNDS["max_abs_alpha0_ddot"]),
+        "fig6_alpha0_rates": figure_alpha0_rates(ref, rate_bound=PAPER_BOUNDS.alpha_dot_max,
+                                                 accel_bound=PAPER_BOUNDS.alpha_ddot_max),
         "fig7_region": figure_region(
             r, fig7_series(example),
             title=(f"Fig. 7  Region of the (5.1) example (paper box, K_P = {r.kp:g}, K_D = {r.kd:g}): "

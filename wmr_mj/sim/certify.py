@@ -146,8 +146,8 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
     cert = certify(box=plant_box, gyro=gyro, V_A=V_A, P_hat=est["P"], C_V_hat=est["C_V"], F_hat=est["F"],
                    K_hat=est["K"], gyro_hat=est["gyro"], V_A_hat=model.V_A, kp=config.kp, kd=config.kd,
                    friction_sign=sign, friction_width=width, feedforward=not pd,
-                   alpha0_max=bounds["max_abs_alpha0"], alpha0_dot_max=bounds["max_abs_alpha0_dot"],
-                   alpha0_ddot_max=bounds["max_abs_alpha0_ddot"], steering_range=plant.steering_range,
+                   alpha0_max=bounds.alpha_max, alpha0_dot_max=bounds.alpha_dot_max,
+                   alpha0_ddot_max=bounds.alpha_ddot_max, steering_range=plant.steering_range,
                    voltage_limit=plant.voltage_limit, control_period=period, initial_error=initial,
                    stated=stated, friction_over_P=ratio)
     inputs = dict(cert.inputs)
