@@ -261,15 +261,16 @@ def test_verdict_table():
     assert g.vertices[1][0] == pytest.approx(g.gamma1 * g.delta1)
     assert not g.inside(0.999 * g.E_max, 0.0)  # inside the rectangle, outside the region
     assert g.inside(0.999 * g.gamma1 * g.delta1, 0.0)
-    j = judge(good, 0.5 * E, 0.25 * Ed)
+    judged = judge(good, 0.5 * E, 0.25 * Ed)
+    j = judged.to_dict()
     for key in ("E_max", "Edot_max", "condition", "valid", "assumptions", "inside", "E_ratio", "Edot_ratio",
                 "verdict"):
         assert key in j
-    assert j["E_ratio"] == pytest.approx(0.5) and j["Edot_ratio"] == pytest.approx(0.25)
+    assert judged.E_ratio == pytest.approx(0.5) and judged.Edot_ratio == pytest.approx(0.25)
     assert all({"name", "met", "value", "limit"} <= set(a) for a in j["assumptions"])
     json.dumps(j, allow_nan=False)
     assert good.verdict(math.nan, 0.0) == "certified-outside"  # a diverged run is outside
-    assert judge(good, math.inf, 0.0)["E_ratio"] is None
+    assert judge(good, math.inf, 0.0).E_ratio is None
     with pytest.raises(ParameterError, match="sup_E"):
         good.inside(-1.0, 0.0)
 
@@ -364,13 +365,13 @@ def test_mujoco_none_at_high_gain_reaches_dead_band():
     result = run_closed_loop(cfg, progress=False)
     reference = build_reference(cfg.path, C80, dt=1e-3, duration=cfg.duration)[0]
     cert = certificate_for(cfg, reference)
-    sup_E = result.summary["sup_E"]
+    sup_E = result.summary.sup_E
     F_plant = with_params(C80, m1=750.0).coefficients("nonholonomic").F
     assert cert.inputs["box"]["F"][1] == pytest.approx(F_plant, rel=1e-12)  # m1 = 750 kg is the box's F_max
     assert cert.dead_band == pytest.approx(F_plant / (C80.coefficients("nonholonomic").P * 100.0), rel=1e-12)
     assert sup_E == pytest.approx(cert.dead_band, rel=0.03)
     assert sup_E < cert.E_max
-    assert cert.verdict(sup_E, result.summary["sup_Edot"]) == "certified-inside"
+    assert cert.verdict(sup_E, result.summary.sup_Edot) == "certified-inside"
 
 
 def test_extreme_gains_certify_or_refuse_cleanly():

@@ -100,7 +100,7 @@ Usage::
                    voltage_limit=24.0, control_period=0.001)
     cert.E_max, cert.Edot_max, cert.voltage_max     # 0.0463 rad, 0.341 rad/s, 8.8 V
     cert.verdict(0.031, 0.2)                         # 'certified-inside'
-    judge(cert, 0.031, 0.2)                          # JSON-ready, with inside, E_ratio, Edot_ratio
+    judge(cert, 0.031, 0.2).E_ratio                  # a CertificateJudgement; .to_dict() for JSON
 
     from wmr_mj.sim.closed_loop import RunConfig, build_reference
     cfg = RunConfig(model="nonholonomic", kp=100.0, kd=20.0, friction_width=0.01)
@@ -126,6 +126,7 @@ __all__ = [
     "FRICTION_MODES",
     "Assumption",
     "Certificate",
+    "CertificateJudgement",
     "certify",
     "judge",
     "friction_term",
@@ -315,16 +316,93 @@ def _clean_inputs(obj: Any) -> Any:
     return obj
 
 
-def judge(cert: Certificate, sup_E: float, sup_Edot: float) -> dict[str, Any]:
-    """The certificate's JSON with the run judged against it.
+@dataclass(frozen=True)
+class CertificateJudgement:
+    """The certificate with one run judged against it (:func:`judge`); read by attribute.
 
-    Adds inside (region (4.21)), E_ratio = sup|E|/E_max, Edot_ratio = sup|E'|/Edot_max
-    (None when the bound is infinite), region_ratio (<= 1 inside) and verdict.
+    Attributes:
+        certificate: the certificate the run is judged by.
+        inside: the run's (sup|E|, sup|E'|) lies in the region (4.21).
+        E_ratio: sup|E| / E_max [-]; None when there is no finite bound.
+        Edot_ratio: sup|E'| / Edot_max [-]; None when there is no finite bound.
+        region_ratio: max of the two sides of (4.21) [-], <= 1 inside; None when not valid.
+        verdict: one of :data:`VERDICTS`.
+        sup_E: the run's sup|E| [rad]; None when not finite (a diverged run).
+        sup_Edot: the run's sup|E'| [rad/s]; None when not finite.
     """
-    out = cert.as_dict()
+
+    certificate: Certificate
+    inside: bool
+    E_ratio: float | None
+    Edot_ratio: float | None
+    region_ratio: float | None
+    verdict: str
+    sup_E: float | None
+    sup_Edot: float | None
+
+    @property
+    def E_max(self) -> float | None:
+        """The certificate's bound on |E| [rad]; None when there is none (as the JSON writes it)."""
+        return _finite_or_none(self.certificate.E_max)
+
+    @property
+    def Edot_max(self) -> float | None:
+        """The certificate's bound on |E'| [rad/s]; None when there is none."""
+        return _finite_or_none(self.certificate.Edot_max)
+
+    @property
+    def condition(self) -> float | None:
+        """The left side of (4.23) [-]; None when not finite."""
+        return _finite_or_none(self.certificate.condition)
+
+    @property
+    def valid(self) -> bool:
+        """The bound exists (fixed point found, (4.23) < 1)."""
+        return bool(self.certificate.valid)
+
+    @property
+    def certified(self) -> bool:
+        """The bound exists and every assumption is met."""
+        return self.certificate.certified
+
+    @property
+    def assumptions(self) -> tuple[Assumption, ...]:
+        """Every assumption, checked and stated, with its value and limit."""
+        return self.certificate.assumptions
+
+    @property
+    def unmet(self) -> tuple[str, ...]:
+        """Names of the assumptions that are not met."""
+        return self.certificate.unmet
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready: the certificate's :meth:`Certificate.as_dict` with inside, E_ratio, Edot_ratio,
+        region_ratio, verdict, sup_E and sup_Edot added (the keys of the run summary's certificate)."""
+        out = self.certificate.as_dict()
+        out.update(inside=self.inside, E_ratio=self.E_ratio, Edot_ratio=self.Edot_ratio,
+                   region_ratio=self.region_ratio, verdict=self.verdict, sup_E=self.sup_E, sup_Edot=self.sup_Edot)
+        return out
+
+
+def judge(cert: Certificate, sup_E: float, sup_Edot: float) -> CertificateJudgement:
+    """The certificate with the run judged against it.
+
+    Args:
+        cert: the certificate.
+        sup_E: the run's sup|E| [rad] (inf or NaN: diverged).
+        sup_Edot: the run's sup|E'| [rad/s].
+
+    Returns:
+        CertificateJudgement: inside (region (4.21)), E_ratio = sup|E|/E_max, Edot_ratio =
+        sup|E'|/Edot_max (None when the bound is infinite), region_ratio (<= 1 inside) and verdict.
+
+    Raises:
+        ParameterError: a negative sup.
+    """
     inside = cert.inside(sup_E, sup_Edot)
     ok = cert.valid and cert.E_max > 0 and cert.Edot_max > 0
-    out.update(
+    return CertificateJudgement(
+        certificate=cert,
         inside=inside,
         E_ratio=_finite_or_none(float(sup_E) / cert.E_max) if ok else None,
         Edot_ratio=_finite_or_none(float(sup_Edot) / cert.Edot_max) if ok else None,
@@ -333,7 +411,6 @@ def judge(cert: Certificate, sup_E: float, sup_Edot: float) -> dict[str, Any]:
         sup_E=_finite_or_none(sup_E),
         sup_Edot=_finite_or_none(sup_Edot),
     )
-    return out
 
 
 # --------------------------------------------------------------------------- pieces

@@ -212,19 +212,20 @@ def nominal_stage(settings: ValidateSettings, st: Stages) -> dict[str, Any]:
 
     st.start("nominal", f"nominal runs at m1 = {settings.nominal_m1:g} kg (paper's and certified design)")
     runs = {d.name: run_closed_loop(settings.config(d), progress=False) for d in (PAPER, CERTIFIED)}
-    st.done(", ".join(f"{name}: sup|E| = {r.summary['sup_E']:.3g} rad, {r.summary['verdict']}"
+    st.done(", ".join(f"{name}: sup|E| = {r.summary.sup_E:.3g} rad, {r.summary.verdict}"
                       for name, r in runs.items()))
     return runs
 
 
 def _nominal_summary(run) -> dict[str, Any]:
+    """The report's JSON of one nominal run (keys of its summary, the certificate's ratio, the drift)."""
     s = run.summary
-    keys = ("m1", "sup_E", "sup_Edot", "settle_s", "sup_E_settled", "verdict", "inside", "E_ratio",
-            "left_steering_range_at_s", "final_alpha", "saturated_fraction")
-    out = {k: s.get(k) for k in keys}
-    out["certificate_E_ratio"] = (s.get("certificate") or {}).get("E_ratio")
-    out["drift"] = s.get("drift")
-    return out
+    return {"m1": s.m1, "sup_E": s.sup_E, "sup_Edot": s.sup_Edot, "settle_s": s.settle_s,
+            "sup_E_settled": s.sup_E_settled, "verdict": s.verdict, "inside": s.inside, "E_ratio": s.E_ratio,
+            "left_steering_range_at_s": s.left_steering_range_at_s, "final_alpha": s.final_alpha,
+            "saturated_fraction": s.saturated_fraction,
+            "certificate_E_ratio": None if s.certificate is None else s.certificate.E_ratio,
+            "drift": None if s.drift is None else s.drift.to_dict()}
 
 
 # --------------------------------------------------------------------------- stage 7: the report

@@ -14,7 +14,7 @@ Usage::
     from wmr_mj.sim.closed_loop import RunConfig
     from wmr_mj.sim.sweep import SweepSpec, run_sweep
     spec = SweepSpec(n=64, seed=1, sampling="lhs", base=RunConfig(model="nonholonomic", duration=20.0))
-    results = run_sweep(spec)             # list of per-run report dicts, in run order
+    results = run_sweep(spec)             # per-run rows (a summary's JSON, flat), in run order
 
 ``run_sweep(spec, out_dir=...)`` writes ``runs.csv`` after every chunk and
 resumes from it; ``scheduler="tcp://host:8786"`` runs the chunks on a Dask
@@ -41,6 +41,7 @@ from wmr_mj.errors import ParameterError, SchedulerError, UnknownNameError
 from wmr_mj.params import M1_RANGE, parameter_names
 from wmr_mj.sim.batch import run_batch
 from wmr_mj.sim.config import RunConfig
+from wmr_mj.sim.summary import RunSummary
 
 __all__ = [
     "SweepSpec",
@@ -178,16 +179,23 @@ def _run_configs(spec: SweepSpec, samples: np.ndarray) -> list[RunConfig]:
 
 def _run_chunk(spec_json: str, indices: list[int], nthread: int,
                progress: Callable[[int, int], None] | None = None) -> list[dict[str, Any]]:
-    """Run the sweep's runs ``indices`` (a Dask task: arguments and result are plain data)."""
+    """Run the sweep's runs ``indices`` (a Dask task: arguments and result are plain data).
+
+    Returns:
+        One row per run: its summary's JSON (``RunSummary.to_dict()``) with ``run`` (its index)
+        and the value of each ranged parameter added.
+    """
     spec = spec_from_json(spec_json)
     samples = draw_samples(spec)
     configs = _run_configs(spec, samples[indices])
-    reports = run_batch(configs, nthread=nthread, progress=progress)
-    for i, r in zip(indices, reports):
+    rows = []
+    for i, summary in zip(indices, run_batch(configs, nthread=nthread, progress=progress)):
+        r = summary.to_dict()
         r["run"] = int(i)
         for name, value in zip(spec.names[1:], samples[i][1:]):
             r[name] = float(value)
-    return reports
+        rows.append(r)
+    return rows
 
 
 def spec_to_json(spec: SweepSpec) -> str:
@@ -210,14 +218,14 @@ def config_from_dict(obj: Mapping[str, Any]) -> RunConfig:
     return RunConfig(**d)
 
 
-def _run_config_chunk(config_dicts: list[dict[str, Any]], nthread: int) -> list[dict[str, Any]]:
-    """Reports of configs given as ``as_dict()`` (a Dask task: arguments and result are plain data)."""
+def _run_config_chunk(config_dicts: list[dict[str, Any]], nthread: int) -> list[RunSummary]:
+    """Summaries of configs given as ``as_dict()`` (a Dask task: plain data in, frozen records out)."""
     return run_batch([config_from_dict(d) for d in config_dicts], nthread=nthread)
 
 
 def run_configs(configs: Sequence[RunConfig], *, chunk: int = 128, nthread: int = 0, client: Any = None,
-                progress: Callable[[int, int], None] | None = None) -> list[dict[str, Any]]:
-    """Reports of ``configs`` (differing only in plant parameters), in order.
+                progress: Callable[[int, int], None] | None = None) -> list[RunSummary]:
+    """Summaries of ``configs`` (differing only in plant parameters), in order.
 
     Locally: batches of at most ``chunk`` simulations (``run_batch``). With a Dask
     ``client`` (see :func:`connect`): one task per chunk, the same numbers.
@@ -226,7 +234,7 @@ def run_configs(configs: Sequence[RunConfig], *, chunk: int = 128, nthread: int 
     if chunk < 1:
         raise ParameterError(f"chunk = {chunk} must be >= 1")
     parts = [list(configs[i:i + chunk]) for i in range(0, len(configs), chunk)]
-    reports: list[dict[str, Any]] = []
+    reports: list[RunSummary] = []
     if client is not None:
         futures = [client.submit(_run_config_chunk, [c.as_dict() for c in part], 1, pure=False) for part in parts]
         for fut in futures:
