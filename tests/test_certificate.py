@@ -15,6 +15,11 @@ from wmr_mj.analysis.certificate import (
     PLANT_K_BAND,
     VERDICTS,
     Assumption,
+    Compensation,
+    Estimate,
+    Gains,
+    PlantBox,
+    PlantLimits,
     certify,
     fixed_point,
     friction_term,
@@ -24,6 +29,7 @@ from wmr_mj.analysis.certificate import (
 from wmr_mj.analysis.robustness import ParameterBox, analyse, exact_gammas
 from wmr_mj.cli.app import main
 from wmr_mj.errors import ParameterError, UnknownNameError
+from wmr_mj.reference.bounds import ReferenceBounds
 from wmr_mj.sim.certify import certificate_for
 from wmr_mj.sim.config import RunConfig, build_reference
 
@@ -46,7 +52,22 @@ def _certify(*, F=(1.313, 1.724), F_hat=1.518, K=(0.0, 0.0), K_hat=0.0, gyro=Non
                 F_hat=F_hat, K_hat=K_hat, gyro_hat=g if gyro_hat is None else gyro_hat, V_A_hat=EXACT["V_A"],
                 kp=kp, kd=kd, friction_sign=sign, **REF, **LIMITS)
     args.update(kw)
-    return certify(**args)
+    return _certify_flat(**args)
+
+
+def _certify_flat(*, box, gyro, V_A, P_hat, C_V_hat, F_hat, K_hat, gyro_hat, V_A_hat, kp, kd, friction_sign="measured",
+                  friction_width=0.0, feedforward=True, alpha0_max, alpha0_dot_max, alpha0_ddot_max, steering_range,
+                  voltage_limit, control_period, initial_error=(0.0, 0.0), stated=(), friction_over_P=None):
+    """certify() of the inputs named one by one (the groups built here)."""
+    return certify(plant=PlantBox(box=box, gyro=gyro, V_A=V_A, friction_over_P=friction_over_P),
+                   estimate=Estimate(P=P_hat, C_V=C_V_hat, F=F_hat, K=K_hat, gyro=gyro_hat, V_A=V_A_hat),
+                   gains=Gains(kp=kp, kd=kd),
+                   reference=ReferenceBounds(alpha_max=alpha0_max, alpha_dot_max=alpha0_dot_max,
+                                             alpha_ddot_max=alpha0_ddot_max),
+                   limits=PlantLimits(steering_range=steering_range, voltage_limit=voltage_limit),
+                   compensation=Compensation(friction_sign=friction_sign, friction_width=friction_width,
+                                             feedforward=feedforward),
+                   control_period=control_period, initial_error=initial_error, stated=stated)
 
 
 @pytest.fixture(scope="module")
@@ -400,12 +421,12 @@ def test_correlated_friction_term_is_F_over_P_not_F_max_over_P_min():
     box = ParameterBox(P=P, C_V=(4.77, 4.77), F=(r * P[0], r * P[1]), K=(0.0, 0.0))
     common = dict(box=box, gyro=(0.629, 0.629), V_A=(0.2, 0.2), P_hat=0.385, C_V_hat=4.77, F_hat=1.0, K_hat=0.0,
                   gyro_hat=0.629, V_A_hat=0.2, kp=100.0, kd=20.0, friction_sign="none", **REF, **LIMITS)
-    loose = certify(**common)
-    tight = certify(**common, friction_over_P=r)
+    loose = _certify_flat(**common)
+    tight = _certify_flat(**common, friction_over_P=r)
     assert loose.friction_term == pytest.approx(r * P[1] / P[0], rel=1e-12)
     assert tight.friction_term == pytest.approx(r, rel=1e-12)
     assert tight.E_max < loose.E_max
-    same = certify(**common, friction_over_P=r * P[1] / P[0])  # F_max/P_min: binds nowhere
+    same = _certify_flat(**common, friction_over_P=r * P[1] / P[0])  # F_max/P_min: binds nowhere
     assert same.E_max == loose.E_max and same.delta1 == loose.delta1
 
 
