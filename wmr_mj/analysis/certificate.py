@@ -709,9 +709,9 @@ def certify(
     valid = math.isfinite(E_max)
     alpha_max = a0 + E_max if valid else math.inf
     b = bound.at(alpha_max if valid else a0)
-    cond = b["condition"]
+    cond = b.condition
     if valid:
-        Edot_max = bound.g2 * b["delta1"] / (1.0 - cond)
+        Edot_max = bound.g2 * b.delta1 / (1.0 - cond)
     else:
         Edot_max = math.inf
         if cond >= 1.0:
@@ -720,11 +720,11 @@ def certify(
     assumptions = _assumptions(cond=cond, valid=valid, alpha_max=alpha_max, reason=reason, iterations=iterations,
                                voltage_max=voltage_max, limits=limits, gains=gains, control_period=control_period,
                                initial_error=(E0, Ed0), stated=stated)
-    S, c2 = b["S"], b["c2"]
+    S, c2 = b.S, b.c2
     P_lo = plant.box.P[0]
     return Certificate(
         E_max=E_max, Edot_max=Edot_max, condition=cond, valid=valid, assumptions=assumptions,
-        gamma1=bound.g1, gamma2=bound.g2, delta1=b["delta1"], delta2=bound.delta2, delta3=b["delta3"],
+        gamma1=bound.g1, gamma2=bound.g2, delta1=b.delta1, delta2=bound.delta2, delta3=b.delta3,
         alpha_max=alpha_max, voltage_max=voltage_max,
         friction_term=max(bound.phi_at(p) / p for p in bound.P_corners), gyro_term=bound.dG * bound.a0d / c2 / P_lo,
         K_term=bound.dK * S / P_lo, P_term=max(abs(p - bound.P_ff) / p for p in bound.P_corners) * bound.a0dd,
@@ -742,6 +742,21 @@ def _check_groups(plant: Any, estimate: Any, gains: Any, reference: Any, limits:
                               ("compensation", compensation, Compensation)):
         if not isinstance(value, kind):
             raise ParameterError(f"{name} must be a {kind.__name__}, got {type(value).__name__}")
+
+
+@dataclass(frozen=True)
+class _AtAngle:
+    """The terms of the bound that grow with the plant's angle, at alpha_max.
+
+    delta1 [rad/s^2], delta3 [1/s], condition: the left side of (4.23), S = sin/cos^3(alpha_max) [-],
+    c2 = cos^2(alpha_max) [-].
+    """
+
+    delta1: float
+    delta3: float
+    condition: float
+    S: float
+    c2: float
 
 
 @dataclass(frozen=True)
@@ -813,8 +828,8 @@ class _Bound:
         """sup |f - F^ s| [V] over the box."""
         return max(self.phi_at(p) for p in self.P_corners)
 
-    def at(self, alpha_max: float) -> dict[str, float]:
-        """delta1 [rad/s^2], delta3 [1/s], condition (4.23), S(alpha_max), cos^2(alpha_max)."""
+    def at(self, alpha_max: float) -> _AtAngle:
+        """delta1, delta3 and (4.23) with the plant's angle up to ``alpha_max`` [rad]."""
         S, c2 = _S(alpha_max), math.cos(alpha_max) ** 2
         rest = self.dK * S + self.dC * self.a0d + self.dG * self.a0d / c2
         delta1 = max((abs(p - self.P_ff) * self.a0dd + self.phi_at(p) + rest) / p for p in self.P_corners)
@@ -822,19 +837,19 @@ class _Bound:
                      for p in self.P_corners for c in (self.dC_lo, self.dC_hi) for g in (self.dG_lo, self.dG_hi)
                      for cc in (c2, 1.0))
         cond = self.g1 * self.delta2 + self.g2 * delta3
-        return {"delta1": delta1, "delta3": delta3, "condition": cond, "S": S, "c2": c2}
+        return _AtAngle(delta1=delta1, delta3=delta3, condition=cond, S=S, c2=c2)
 
     def E_max_at(self, x: float) -> float:
         """The bound on |E| [rad] at alpha_max = max|alpha0| + x: Phi(x) of the fixed point."""
         b = self.at(self.a0 + x)
-        return self.g1 * b["delta1"] / (1.0 - b["condition"]) if b["condition"] < 1.0 else math.inf
+        return self.g1 * b.delta1 / (1.0 - b.condition) if b.condition < 1.0 else math.inf
 
-def _voltage_max(bound: _Bound, b: Mapping[str, float], E_max: float, Edot_max: float) -> float:
+def _voltage_max(bound: _Bound, b: _AtAngle, E_max: float, Edot_max: float) -> float:
     """The voltage [V] the law asks for anywhere in the region (triangle inequality on (3.2)-(3.3))."""
     est = bound.estimate
     rate = bound.a0d + Edot_max
     return (est.P * (bound.P_ff / est.P * bound.a0dd + bound.kd * Edot_max + bound.kp * E_max)
-            + abs(est.K) * b["S"] + abs(est.C_V) * rate + bound.F_comp + abs(bound.Gam_hat) * rate / b["c2"])
+            + abs(est.K) * b.S + abs(est.C_V) * rate + bound.F_comp + abs(bound.Gam_hat) * rate / b.c2)
 
 
 def _assumptions(*, cond: float, valid: bool, alpha_max: float, reason: str, iterations: int, voltage_max: float,

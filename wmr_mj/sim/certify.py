@@ -127,8 +127,9 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
     sign = "none" if pd else controller.friction_sign
     width = 0.0 if pd else controller.friction_width
     c = model.coefficients
-    est = {"P": c.P, "C_V": 0.0, "F": 0.0, "K": 0.0, "gyro": 0.0} if pd else {
-        "P": c.P, "C_V": c.C_V, "F": 0.0 if sign == "none" else c.F, "K": c.K, "gyro": c.gyro}
+    # a PD law has no model but P^ (its gain scale); F^ is the compensation's amplitude
+    estimate = Estimate(P=c.P, C_V=0.0, F=0.0, K=0.0, gyro=0.0, V_A=model.V_A) if pd else Estimate(
+        P=c.P, C_V=c.C_V, F=0.0 if sign == "none" else c.F, K=c.K, gyro=c.gyro, V_A=model.V_A)
 
     period = config.control_period if config.control_period is not None else TIMESTEP
     initial = (float(reference.alpha0[0]), float(reference.alpha0_dot[0]))  # the plant starts at alpha = alpha' = 0
@@ -148,7 +149,7 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
                    "(0.78-1.12 P/l1), Drake 0.621-0.644 (physics.md section 6)", kind="stated"),
     )
     cert = certify(plant=PlantBox(box=plant_box, gyro=gyro, V_A=V_A, friction_over_P=ratio),
-                   estimate=Estimate(V_A=model.V_A, **est), gains=Gains(kp=config.kp, kd=config.kd),
+                   estimate=estimate, gains=Gains(kp=config.kp, kd=config.kd),
                    reference=reference.bounds(),
                    limits=PlantLimits(steering_range=plant.steering_range, voltage_limit=plant.voltage_limit),
                    compensation=Compensation(friction_sign=sign, friction_width=width, feedforward=not pd),
