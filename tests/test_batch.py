@@ -23,11 +23,11 @@ def test_batch_is_bit_identical_to_runs_one_by_one():
     configs.append(BASE.replace(m1=700.0, plant_overrides={"mu": 0.001}))
     batch = run_batch(configs, nthread=2)
     for cfg, b in zip(configs, batch):
-        serial = run_closed_loop(cfg, progress=False).summary
+        serial, b = run_closed_loop(cfg, progress=False).summary.to_dict(), b.to_dict()
         for key in KEYS:
             assert serial[key] == b[key], (cfg.m1, key, serial[key], b[key])
     # the runs really differ: the comparison is not between copies
-    assert len({b["sup_E"] for b in batch}) == len(batch)
+    assert len({b.sup_E for b in batch}) == len(batch)
 
 
 
@@ -118,7 +118,7 @@ def test_a_nan_voltage_applies_nothing_as_in_the_serial_run(monkeypatch):
         monkeypatch.setattr(module, "controller_for", controller)
     configs = [BASE.replace(path="lane-change", duration=4.0, m1=m) for m in (560.0, 720.0)]
     for cfg, b in zip(configs, run_batch(configs, nthread=1)):
-        s = run_closed_loop(cfg, progress=False).summary
+        s, b = run_closed_loop(cfg, progress=False).summary.to_dict(), b.to_dict()
         assert s["saturated_fraction"] > 0  # the NaN steps happened (counted as saturated)
         for key in KEYS:
             assert s[key] == b[key], key
@@ -130,8 +130,8 @@ def test_paper_model_batch_matches_serial_including_steering_stop():
     # two runs on two threads: one group whose batch steps on both threads (batch.batch_groups)
     for cfg, b in zip(configs, run_batch(configs, nthread=2)):
         s = run_closed_loop(cfg, progress=False).summary
-        assert b["left_steering_range"] and b["left_steering_range_at_s"] == s["left_steering_range_at_s"]
-        assert b["sup_Edot"] == s["sup_Edot"]
+        assert b.left_steering_range and b.left_steering_range_at_s == s.left_steering_range_at_s
+        assert b.sup_Edot == s.sup_Edot
 
 
 
@@ -145,5 +145,6 @@ def test_batch_split_into_groups_is_bit_identical_to_one_group(monkeypatch):
                         lambda nsim, threads: [(np.array([0, 1]), 1), (np.array([2, 3]), 1)])
     two = run_batch(configs, nthread=2, law="numpy")
     for a, b in zip(one, two):
+        a, b = a.to_dict(), b.to_dict()
         for key in KEYS:
             assert a[key] == b[key], key

@@ -15,6 +15,11 @@ from wmr_mj.analysis.certificate import (
     PLANT_K_BAND,
     VERDICTS,
     Assumption,
+    Compensation,
+    Estimate,
+    Gains,
+    PlantBox,
+    PlantLimits,
     certify,
     fixed_point,
     friction_term,
@@ -24,6 +29,7 @@ from wmr_mj.analysis.certificate import (
 from wmr_mj.analysis.robustness import ParameterBox, analyse, exact_gammas
 from wmr_mj.cli.app import main
 from wmr_mj.errors import ParameterError, UnknownNameError
+from wmr_mj.reference.bounds import ReferenceBounds
 from wmr_mj.sim.certify import certificate_for
 from wmr_mj.sim.config import RunConfig, build_reference
 
@@ -46,7 +52,22 @@ def _certify(*, F=(1.313, 1.724), F_hat=1.518, K=(0.0, 0.0), K_hat=0.0, gyro=Non
                 F_hat=F_hat, K_hat=K_hat, gyro_hat=g if gyro_hat is None else gyro_hat, V_A_hat=EXACT["V_A"],
                 kp=kp, kd=kd, friction_sign=sign, **REF, **LIMITS)
     args.update(kw)
-    return certify(**args)
+    return _certify_flat(**args)
+
+
+def _certify_flat(*, box, gyro, V_A, P_hat, C_V_hat, F_hat, K_hat, gyro_hat, V_A_hat, kp, kd, friction_sign="measured",
+                  friction_width=0.0, feedforward=True, alpha0_max, alpha0_dot_max, alpha0_ddot_max, steering_range,
+                  voltage_limit, control_period, initial_error=(0.0, 0.0), stated=(), friction_over_P=None):
+    """certify() of the inputs named one by one (the groups built here)."""
+    return certify(plant=PlantBox(box=box, gyro=gyro, V_A=V_A, friction_over_P=friction_over_P),
+                   estimate=Estimate(P=P_hat, C_V=C_V_hat, F=F_hat, K=K_hat, gyro=gyro_hat, V_A=V_A_hat),
+                   gains=Gains(kp=kp, kd=kd),
+                   reference=ReferenceBounds(alpha_max=alpha0_max, alpha_dot_max=alpha0_dot_max,
+                                             alpha_ddot_max=alpha0_ddot_max),
+                   limits=PlantLimits(steering_range=steering_range, voltage_limit=voltage_limit),
+                   compensation=Compensation(friction_sign=friction_sign, friction_width=friction_width,
+                                             feedforward=feedforward),
+                   control_period=control_period, initial_error=initial_error, stated=stated)
 
 
 @pytest.fixture(scope="module")
@@ -159,9 +180,9 @@ def test_design_fixed_point_by_substitution(circle):
     G_hat = C80.coefficients("nonholonomic").gyro * C80.V_A
     G_lo, G_hi = GYRO_BAND[0] * G_hat, GYRO_BAND[1] * G_hat  # P fixed over m1
     dG = max(G_hat - G_lo, G_hi - G_hat)
-    a_max = b["max_abs_alpha0"] + c.E_max
+    a_max = b.alpha_max + c.E_max
     c2 = math.cos(a_max) ** 2
-    d1 = (F_max + PLANT_K_BAND * _S(a_max) + dG * b["max_abs_alpha0_dot"] / c2) / P
+    d1 = (F_max + PLANT_K_BAND * _S(a_max) + dG * b.alpha_dot_max / c2) / P
     d3 = dG / c2 / P
     g1, g2 = exact_gammas(100.0, 20.0)
     cond = g2 * d3
@@ -169,7 +190,7 @@ def test_design_fixed_point_by_substitution(circle):
     assert c.condition == pytest.approx(cond, rel=1e-12)
     assert c.E_max == pytest.approx(g1 * d1 / (1 - cond), rel=1e-11)
     assert c.Edot_max == pytest.approx(g2 * d1 / (1 - cond), rel=1e-11)
-    assert c.alpha_max == pytest.approx(b["max_abs_alpha0"] + c.E_max)
+    assert c.alpha_max == pytest.approx(b.alpha_max + c.E_max)
 
 
 @pytest.mark.parametrize("omega_r", [20.0, 40.0])
@@ -261,15 +282,16 @@ def test_verdict_table():
     assert g.vertices[1][0] == pytest.approx(g.gamma1 * g.delta1)
     assert not g.inside(0.999 * g.E_max, 0.0)  # inside the rectangle, outside the region
     assert g.inside(0.999 * g.gamma1 * g.delta1, 0.0)
-    j = judge(good, 0.5 * E, 0.25 * Ed)
+    judged = judge(good, 0.5 * E, 0.25 * Ed)
+    j = judged.to_dict()
     for key in ("E_max", "Edot_max", "condition", "valid", "assumptions", "inside", "E_ratio", "Edot_ratio",
                 "verdict"):
         assert key in j
-    assert j["E_ratio"] == pytest.approx(0.5) and j["Edot_ratio"] == pytest.approx(0.25)
+    assert judged.E_ratio == pytest.approx(0.5) and judged.Edot_ratio == pytest.approx(0.25)
     assert all({"name", "met", "value", "limit"} <= set(a) for a in j["assumptions"])
     json.dumps(j, allow_nan=False)
     assert good.verdict(math.nan, 0.0) == "certified-outside"  # a diverged run is outside
-    assert judge(good, math.inf, 0.0)["E_ratio"] is None
+    assert judge(good, math.inf, 0.0).E_ratio is None
     with pytest.raises(ParameterError, match="sup_E"):
         good.inside(-1.0, 0.0)
 
@@ -364,13 +386,13 @@ def test_mujoco_none_at_high_gain_reaches_dead_band():
     result = run_closed_loop(cfg, progress=False)
     reference = build_reference(cfg.path, C80, dt=1e-3, duration=cfg.duration)[0]
     cert = certificate_for(cfg, reference)
-    sup_E = result.summary["sup_E"]
+    sup_E = result.summary.sup_E
     F_plant = with_params(C80, m1=750.0).coefficients("nonholonomic").F
     assert cert.inputs["box"]["F"][1] == pytest.approx(F_plant, rel=1e-12)  # m1 = 750 kg is the box's F_max
     assert cert.dead_band == pytest.approx(F_plant / (C80.coefficients("nonholonomic").P * 100.0), rel=1e-12)
     assert sup_E == pytest.approx(cert.dead_band, rel=0.03)
     assert sup_E < cert.E_max
-    assert cert.verdict(sup_E, result.summary["sup_Edot"]) == "certified-inside"
+    assert cert.verdict(sup_E, result.summary.sup_Edot) == "certified-inside"
 
 
 def test_extreme_gains_certify_or_refuse_cleanly():
@@ -399,12 +421,12 @@ def test_correlated_friction_term_is_F_over_P_not_F_max_over_P_min():
     box = ParameterBox(P=P, C_V=(4.77, 4.77), F=(r * P[0], r * P[1]), K=(0.0, 0.0))
     common = dict(box=box, gyro=(0.629, 0.629), V_A=(0.2, 0.2), P_hat=0.385, C_V_hat=4.77, F_hat=1.0, K_hat=0.0,
                   gyro_hat=0.629, V_A_hat=0.2, kp=100.0, kd=20.0, friction_sign="none", **REF, **LIMITS)
-    loose = certify(**common)
-    tight = certify(**common, friction_over_P=r)
+    loose = _certify_flat(**common)
+    tight = _certify_flat(**common, friction_over_P=r)
     assert loose.friction_term == pytest.approx(r * P[1] / P[0], rel=1e-12)
     assert tight.friction_term == pytest.approx(r, rel=1e-12)
     assert tight.E_max < loose.E_max
-    same = certify(**common, friction_over_P=r * P[1] / P[0])  # F_max/P_min: binds nowhere
+    same = _certify_flat(**common, friction_over_P=r * P[1] / P[0])  # F_max/P_min: binds nowhere
     assert same.E_max == loose.E_max and same.delta1 == loose.delta1
 
 

@@ -117,12 +117,12 @@ def test_a_compiled_batch_is_bit_identical_to_serial_runs_and_to_the_numpy_batch
     configs.append(BASE.replace(m1=640.0, plant_overrides={"mu": 0.03, "R_a": 1.25}, **options))
     compiled = run_batch(configs, nthread=2, law="compiled")
     numpy_law = run_batch(configs, nthread=2, law="numpy")
-    assert {r["batch_law"] for r in compiled} == {"compiled"} and {r["batch_law"] for r in numpy_law} == {"numpy"}
+    assert {r.batch.law for r in compiled} == {"compiled"} and {r.batch.law for r in numpy_law} == {"numpy"}
     for cfg, c, n in zip(configs, compiled, numpy_law):
-        serial = run_closed_loop(cfg, progress=False).summary
+        serial, c, n = run_closed_loop(cfg, progress=False).summary.to_dict(), c.to_dict(), n.to_dict()
         for key in KEYS:
             assert c[key] == serial[key] == n[key], (cfg, key)
-    assert len({r["sup_E"] for r in compiled}) == len(configs)  # the runs differ: not copies compared
+    assert len({r.sup_E for r in compiled}) == len(configs)  # the runs differ: not copies compared
 
 
 def test_a_simulation_with_a_warning_is_rerun_serially(monkeypatch):
@@ -140,8 +140,8 @@ def test_a_simulation_with_a_warning_is_rerun_serially(monkeypatch):
     configs = [BASE.replace(m1=m) for m in (600.0, 700.0)]
     reports = run_batch(configs, nthread=1, law="compiled")
     serial = run_closed_loop(configs[1], progress=False).summary
-    assert reports[1]["sup_E"] == serial["sup_E"] != 99.0
-    assert reports[1]["mujoco_warnings"] == serial["mujoco_warnings"]
+    assert reports[1].sup_E == serial.sup_E != 99.0
+    assert reports[1].mujoco_warnings == serial.mujoco_warnings
 
 
 def test_the_law_backend_is_chosen_and_refused_clearly(monkeypatch):
@@ -207,7 +207,7 @@ def test_without_the_built_library_the_reason_says_so_and_the_batch_uses_numpy(m
     try:
         assert "is not built" in compiled_law.unavailable_reason()
         reports = run_batch([BASE.replace(m1=600.0)], law="auto")
-        assert reports[0]["batch_law"] == "numpy"
-        assert reports[0]["sup_E"] == run_closed_loop(BASE.replace(m1=600.0), progress=False).summary["sup_E"]
+        assert reports[0].batch.law == "numpy"
+        assert reports[0].sup_E == run_closed_loop(BASE.replace(m1=600.0), progress=False).summary.sup_E
     finally:
         compiled_law._library.cache_clear()

@@ -102,11 +102,11 @@ def test_the_reported_worst_run_reproduces_exactly():
     worst = result.worst
     assert worst.objective == max(e.objective for e in result.search) == worst.sup_E
     serial = run_closed_loop(worst_config(result), progress=False).summary
-    assert serial["sup_E"] == worst.sup_E and serial["sup_Edot"] == worst.sup_Edot  # to the bit
+    assert serial.sup_E == worst.sup_E and serial.sup_Edot == worst.sup_Edot  # to the bit
     # the parameters as printed (repr) give the same run
     again = run_closed_loop(base.replace(m1=float(repr(worst.params["m1"])),
                                          plant_overrides={"mu": float(repr(worst.params["mu"]))}), progress=False)
-    assert again.summary["sup_E"] == worst.sup_E
+    assert again.summary.sup_E == worst.sup_E
     out = result.as_dict(log="x.mcap")
     assert set(out["worst"]["params"]) == {"m1", "mu"} and out["evaluations"] == 10 and out["budget"] == 10
     assert out["random"]["worst_objective"] == result.random_worst.objective

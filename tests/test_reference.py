@@ -160,10 +160,10 @@ def test_derivatives_match_numerical(name: str, request: pytest.FixtureRequest) 
 # (d) the paper's bounds (5.1)
 def test_paper_circle_bounds(paper_ref: Reference) -> None:
     b = paper_ref.bounds()
-    assert b["max_abs_alpha0_dot"] == pytest.approx(PAPER_BOUNDS["max_abs_alpha0_dot"], rel=0.03)
-    assert b["max_abs_alpha0_ddot"] <= PAPER_BOUNDS["max_abs_alpha0_ddot"]
-    assert 1.23 <= b["max_sin_cos3"] <= 1.25
-    assert b["max_abs_alpha0"] == pytest.approx(math.asin(L1), abs=1e-9)
+    assert b.alpha_dot_max == pytest.approx(PAPER_BOUNDS.alpha_dot_max, rel=0.03)
+    assert b.alpha_ddot_max <= PAPER_BOUNDS.alpha_ddot_max
+    assert 1.23 <= b.sin_cos3_max <= 1.25
+    assert b.alpha_max == pytest.approx(math.asin(L1), abs=1e-9)
     assert paper_ref.duration == pytest.approx(35.0, abs=1e-9)
     assert len(paper_ref) == 35001
     assert paper_ref.s[-1] == pytest.approx(paper_circle(C80).length, abs=1e-6)
@@ -174,9 +174,9 @@ def test_paper_circle_bounds(paper_ref: Reference) -> None:
 def test_paper_circle_blend_entry(blend_ref: Reference) -> None:
     b = blend_ref.bounds()
     # the acceleration bound binds; a monotone curvature cannot give more than V_A/R
-    assert b["max_abs_alpha0_ddot"] == pytest.approx(0.4, rel=1e-3)
-    assert b["max_abs_alpha0_ddot"] <= 0.4 + 1e-9
-    assert b["max_abs_alpha0_dot"] < VA / 1.0
+    assert b.alpha_ddot_max == pytest.approx(0.4, rel=1e-3)
+    assert b.alpha_ddot_max <= 0.4 + 1e-9
+    assert b.alpha_dot_max < VA / 1.0
     assert np.all(np.diff(blend_ref.kappa) >= -1e-12) and blend_ref.kappa.max() <= 1.0 + 1e-12
     assert blend_ref.duration == pytest.approx(35.0, abs=1e-9)
 
@@ -184,8 +184,8 @@ def test_paper_circle_blend_entry(blend_ref: Reference) -> None:
 def test_paper_circle_other_speed() -> None:
     fast = with_params(C80, V_A=0.3)
     b = make_reference(paper_circle(fast, duration=20.0), fast).bounds()
-    assert b["max_abs_alpha0_dot"] == pytest.approx(0.23, rel=0.01)
-    assert b["max_abs_alpha0_ddot"] <= 0.4
+    assert b.alpha_dot_max == pytest.approx(0.23, rel=0.01)
+    assert b.alpha_ddot_max <= 0.4
 
 
 # --------------------------------------------------------------------------
@@ -336,7 +336,7 @@ def test_reference_fields(paper_ref: Reference) -> None:
     assert paper_ref.A_xy.shape == (n, 2) and paper_ref.C_xy.shape == (n, 2)
     assert np.allclose(np.diff(paper_ref.t), 1e-3)
     assert np.allclose(np.hypot(*(paper_ref.C_xy - paper_ref.A_xy).T), L1)
-    assert set(paper_ref.bounds()) == {"max_abs_alpha0_dot", "max_abs_alpha0_ddot", "max_sin_cos3", "max_abs_alpha0"}
+    assert set(paper_ref.bounds().as_dict()) == {"alpha_dot_max", "alpha_ddot_max", "sin_cos3_max", "alpha_max"}
 
 
 def test_pose_and_duration_options() -> None:

@@ -167,11 +167,11 @@ def test_real_run_replays_bit_for_bit(tmp_path, capsys):
     assert log.status == "interrupted" and not log.truncated and log.rows == 3000
     assert np.array_equal(log.signals["E"], result.rows["E"])
     rep = summarize(log)
-    assert rep["E_max"] == result.summary["E_max"] and rep["sup_abs_E"] == result.summary["sup_E"]
-    assert rep["region_polygon"] == result.summary["analysis"]["vertices"]
+    assert rep["E_max"] == result.summary.E_max and rep["sup_abs_E"] == result.summary.sup_E
+    assert rep["region_polygon"] == result.summary.analysis["vertices"]
     ver = verify(log)
     assert ver == {"rows": 3000, "mj_steps": 3000, "identical": True}
     bounds = log.channel("/bounds")  # the certificate's bound (NaN where it has none: no line drawn)
-    cert_E_max = result.summary["certificate"]["E_max"]
+    cert_E_max = result.summary.certificate.E_max
     expected = np.nan if cert_E_max is None else cert_E_max
     np.testing.assert_array_equal(bounds["e_max"], np.full(len(bounds["e_max"]), expected))

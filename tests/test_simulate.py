@@ -25,8 +25,8 @@ def reference():
 
 def _bounds(reference):
     b = reference.bounds()
-    return ReferenceBounds(alpha_ddot_max=b["max_abs_alpha0_ddot"], alpha_dot_max=b["max_abs_alpha0_dot"],
-                           sin_cos3_max=b["max_sin_cos3"])
+    return ReferenceBounds(alpha_ddot_max=b.alpha_ddot_max, alpha_dot_max=b.alpha_dot_max,
+                           sin_cos3_max=b.sin_cos3_max)
 
 
 @pytest.mark.parametrize("friction_sign,width",
@@ -80,20 +80,20 @@ def test_mismatched_model_on_reduced_plant_stays_inside_region(reference):
 def test_mujoco_runs_report_honestly(model):
     r = run_closed_loop(RunConfig(model=model, duration=20.0), progress=False)
     s = r.summary
-    assert s["status"] == "completed" and s["control_steps"] == 20_000
+    assert s.status == "completed" and s.control_steps == 20_000
     for key in ("sup_E", "sup_Edot", "E_max", "Edot_max", "inside", "m1", "model", "controller", "steps", "wall_s"):
-        assert key in s
-    assert s["sup_E"] == pytest.approx(np.max(np.abs(r.rows["E"])))
-    assert s["inside"] == (s["sup_E"] <= s["E_max"] and s["sup_Edot"] <= s["Edot_max"])
+        assert key in s.to_dict()
+    assert s.sup_E == pytest.approx(np.max(np.abs(r.rows["E"])))
+    assert s.inside == (s.sup_E <= s.E_max and s.sup_Edot <= s.Edot_max)
     if model == "paper":
         # the K^ sin/cos^3 term the plant does not have drives the steering into its stop
-        assert s["left_steering_range"] and s["left_steering_range_at_s"] < 15.0
-    assert s["mujoco_warnings"] == 0
+        assert s.left_steering_range and s.left_steering_range_at_s < 15.0
+    assert s.mujoco_warnings == 0
 
 
 def test_control_period_holds_voltage():
     r = run_closed_loop(RunConfig(model="nonholonomic", duration=10.0, control_period=0.005), progress=False)
-    assert r.summary["control_steps"] == 2000 and r.summary["steps"] == 10_000
+    assert r.summary.control_steps == 2000 and r.summary.steps == 10_000
     with pytest.raises(ParameterError, match="multiple"):
         run_closed_loop(RunConfig(duration=10.0, control_period=0.0015), progress=False)
 

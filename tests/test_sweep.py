@@ -87,6 +87,7 @@ def test_dask_gives_the_same_numbers_as_local(tmp_path):
         for key in KEYS + ("m1", "run"):
             assert a[key] == b[key]
     for a, b in zip(run_configs(configs, chunk=2, nthread=1), remote_configs):
+        a, b = a.to_dict(), b.to_dict()
         for key in KEYS + ("m1",):
             assert a[key] == b[key]
 

@@ -8,10 +8,10 @@ from wmr_mj.analysis.verdicts import DRIFT_TOLERANCE, VERDICTS, count_verdicts, 
 
 
 def test_drift_compares_the_last_two_windows():
-    assert drift(prev_window=0.01, last_window=0.01 + 2 * DRIFT_TOLERANCE, final_alpha_dot=0.0)["growing"]
-    assert not drift(prev_window=0.01, last_window=0.01 + 0.5 * DRIFT_TOLERANCE, final_alpha_dot=0.0)["growing"]
-    assert not drift(prev_window=0.02, last_window=0.01, final_alpha_dot=0.0)["growing"]
-    assert drift(prev_window=0.01, last_window=float("nan"), final_alpha_dot=0.0)["growing"]
+    assert drift(prev_window=0.01, last_window=0.01 + 2 * DRIFT_TOLERANCE, final_alpha_dot=0.0).growing
+    assert not drift(prev_window=0.01, last_window=0.01 + 0.5 * DRIFT_TOLERANCE, final_alpha_dot=0.0).growing
+    assert not drift(prev_window=0.02, last_window=0.01, final_alpha_dot=0.0).growing
+    assert drift(prev_window=0.01, last_window=float("nan"), final_alpha_dot=0.0).growing
 
 
 def test_drift_windows():
@@ -35,10 +35,10 @@ def test_soft_friction_creep_shows_as_drift(friction, growing):
     from wmr_mj.sim.config import RunConfig
 
     s = run_closed_loop(RunConfig(model="nonholonomic", steering_friction=friction), progress=False).summary
-    assert s["drift"]["growing"] is growing
+    assert s.drift.growing is growing
     if growing:
-        assert abs(s["drift"]["final_alpha_dot"]) > 1e-3  # creeping at mrad/s
+        assert abs(s.drift.final_alpha_dot) > 1e-3  # creeping at mrad/s
     else:
-        assert abs(s["drift"]["final_alpha_dot"]) < 1e-4
+        assert abs(s.drift.final_alpha_dot) < 1e-4
     # the paper's gains leave the non-holonomic design without a certificate: never a pass
-    assert s["verdict"].startswith("uncertified-")
+    assert s.verdict.startswith("uncertified-")

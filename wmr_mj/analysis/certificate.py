@@ -90,19 +90,24 @@ rectangle outside the region contradicts the bound as much as one beyond E_max).
 Usage::
 
     from wmr_mj import C80
-    from wmr_mj.analysis.certificate import certify, certificate_for, judge
+    from wmr_mj.analysis.certificate import (Compensation, Estimate, Gains, PlantBox, PlantLimits, certify,
+                                             judge)
     from wmr_mj.analysis.robustness import ParameterBox
+    from wmr_mj.reference.bounds import ReferenceBounds
     box = ParameterBox(P=(0.385, 0.385), C_V=(4.77, 4.77), F=(1.313, 1.724), K=(-0.02, 0.02))
-    cert = certify(box=box, gyro=(0.472, 0.723), V_A=(0.2, 0.2), P_hat=0.385, C_V_hat=4.77,
-                   F_hat=1.518, K_hat=0.0, gyro_hat=0.629, V_A_hat=0.2, kp=100.0, kd=20.0,
-                   friction_sign="measured", friction_width=0.01, alpha0_max=0.659,
-                   alpha0_dot_max=0.23, alpha0_ddot_max=0.155, steering_range=0.9,
-                   voltage_limit=24.0, control_period=0.001)
+    cert = certify(plant=PlantBox(box=box, gyro=(0.472, 0.723), V_A=(0.2, 0.2)),
+                   estimate=Estimate(P=0.385, C_V=4.77, F=1.518, K=0.0, gyro=0.629, V_A=0.2),
+                   gains=Gains(kp=100.0, kd=20.0),
+                   reference=ReferenceBounds(alpha_max=0.659, alpha_dot_max=0.23, alpha_ddot_max=0.155),
+                   limits=PlantLimits(steering_range=0.9, voltage_limit=24.0),
+                   compensation=Compensation(friction_sign="measured", friction_width=0.01),
+                   control_period=0.001)
     cert.E_max, cert.Edot_max, cert.voltage_max     # 0.0463 rad, 0.341 rad/s, 8.8 V
     cert.verdict(0.031, 0.2)                         # 'certified-inside'
-    judge(cert, 0.031, 0.2)                          # JSON-ready, with inside, E_ratio, Edot_ratio
+    judge(cert, 0.031, 0.2).E_ratio                  # a CertificateJudgement; .to_dict() for JSON
 
-    from wmr_mj.sim.closed_loop import RunConfig, build_reference
+    from wmr_mj.sim.certify import certificate_for          # the certificate of a configured run
+    from wmr_mj.sim.config import RunConfig, build_reference
     cfg = RunConfig(model="nonholonomic", kp=100.0, kd=20.0, friction_width=0.01)
     cert = certificate_for(cfg, build_reference(cfg.path, C80, dt=1e-3, duration=35.0)[0])
 """
@@ -119,6 +124,7 @@ from typing import Any
 from wmr_mj.analysis.robustness import ParameterBox, _check_gains, damping_regime, exact_gammas
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import C80Parameters
+from wmr_mj.reference.bounds import ReferenceBounds
 
 __all__ = [
     "friction_over_P_max",
@@ -126,6 +132,13 @@ __all__ = [
     "FRICTION_MODES",
     "Assumption",
     "Certificate",
+    "CertificateJudgement",
+    "PlantBox",
+    "Estimate",
+    "Gains",
+    "PlantLimits",
+    "Compensation",
+    "MEASURED_SIGN",
     "certify",
     "judge",
     "friction_term",
@@ -315,16 +328,93 @@ def _clean_inputs(obj: Any) -> Any:
     return obj
 
 
-def judge(cert: Certificate, sup_E: float, sup_Edot: float) -> dict[str, Any]:
-    """The certificate's JSON with the run judged against it.
+@dataclass(frozen=True)
+class CertificateJudgement:
+    """The certificate with one run judged against it (:func:`judge`); read by attribute.
 
-    Adds inside (region (4.21)), E_ratio = sup|E|/E_max, Edot_ratio = sup|E'|/Edot_max
-    (None when the bound is infinite), region_ratio (<= 1 inside) and verdict.
+    Attributes:
+        certificate: the certificate the run is judged by.
+        inside: the run's (sup|E|, sup|E'|) lies in the region (4.21).
+        E_ratio: sup|E| / E_max [-]; None when there is no finite bound.
+        Edot_ratio: sup|E'| / Edot_max [-]; None when there is no finite bound.
+        region_ratio: max of the two sides of (4.21) [-], <= 1 inside; None when not valid.
+        verdict: one of :data:`VERDICTS`.
+        sup_E: the run's sup|E| [rad]; None when not finite (a diverged run).
+        sup_Edot: the run's sup|E'| [rad/s]; None when not finite.
     """
-    out = cert.as_dict()
+
+    certificate: Certificate
+    inside: bool
+    E_ratio: float | None
+    Edot_ratio: float | None
+    region_ratio: float | None
+    verdict: str
+    sup_E: float | None
+    sup_Edot: float | None
+
+    @property
+    def E_max(self) -> float | None:
+        """The certificate's bound on |E| [rad]; None when there is none (as the JSON writes it)."""
+        return _finite_or_none(self.certificate.E_max)
+
+    @property
+    def Edot_max(self) -> float | None:
+        """The certificate's bound on |E'| [rad/s]; None when there is none."""
+        return _finite_or_none(self.certificate.Edot_max)
+
+    @property
+    def condition(self) -> float | None:
+        """The left side of (4.23) [-]; None when not finite."""
+        return _finite_or_none(self.certificate.condition)
+
+    @property
+    def valid(self) -> bool:
+        """The bound exists (fixed point found, (4.23) < 1)."""
+        return bool(self.certificate.valid)
+
+    @property
+    def certified(self) -> bool:
+        """The bound exists and every assumption is met."""
+        return self.certificate.certified
+
+    @property
+    def assumptions(self) -> tuple[Assumption, ...]:
+        """Every assumption, checked and stated, with its value and limit."""
+        return self.certificate.assumptions
+
+    @property
+    def unmet(self) -> tuple[str, ...]:
+        """Names of the assumptions that are not met."""
+        return self.certificate.unmet
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready: the certificate's :meth:`Certificate.as_dict` with inside, E_ratio, Edot_ratio,
+        region_ratio, verdict, sup_E and sup_Edot added (the keys of the run summary's certificate)."""
+        out = self.certificate.as_dict()
+        out.update(inside=self.inside, E_ratio=self.E_ratio, Edot_ratio=self.Edot_ratio,
+                   region_ratio=self.region_ratio, verdict=self.verdict, sup_E=self.sup_E, sup_Edot=self.sup_Edot)
+        return out
+
+
+def judge(cert: Certificate, sup_E: float, sup_Edot: float) -> CertificateJudgement:
+    """The certificate with the run judged against it.
+
+    Args:
+        cert: the certificate.
+        sup_E: the run's sup|E| [rad] (inf or NaN: diverged).
+        sup_Edot: the run's sup|E'| [rad/s].
+
+    Returns:
+        CertificateJudgement: inside (region (4.21)), E_ratio = sup|E|/E_max, Edot_ratio =
+        sup|E'|/Edot_max (None when the bound is infinite), region_ratio (<= 1 inside) and verdict.
+
+    Raises:
+        ParameterError: a negative sup.
+    """
     inside = cert.inside(sup_E, sup_Edot)
     ok = cert.valid and cert.E_max > 0 and cert.Edot_max > 0
-    out.update(
+    return CertificateJudgement(
+        certificate=cert,
         inside=inside,
         E_ratio=_finite_or_none(float(sup_E) / cert.E_max) if ok else None,
         Edot_ratio=_finite_or_none(float(sup_Edot) / cert.Edot_max) if ok else None,
@@ -333,7 +423,6 @@ def judge(cert: Certificate, sup_E: float, sup_Edot: float) -> dict[str, Any]:
         sup_E=_finite_or_none(sup_E),
         sup_Edot=_finite_or_none(sup_Edot),
     )
-    return out
 
 
 # --------------------------------------------------------------------------- pieces
@@ -429,141 +518,350 @@ def _number(name: str, value: Any, *, minimum: float | None = None, strict: bool
     return v
 
 
+# --------------------------------------------------------------------------- certify: inputs
+@dataclass(frozen=True)
+class PlantBox:
+    """The plants the certificate covers.
+
+    Attributes:
+        box: the plant's P [V s^2/rad], C_V [V s/rad], F [V] (Coulomb, break-away = sliding;
+            F >= 0) and K [V] (sin/cos^3) ranges.
+        gyro: (lo, hi) of the plant's gyroscopic coefficient [V s/m] (Gam = gyro V_A).
+        V_A: (lo, hi) of the forward speed [m/s].
+        friction_over_P: an upper bound on F/P over the plants of the box [rad/s^2] (F and P
+            both scale with R_a, so F/P does not move with it; see :func:`friction_over_P_max`).
+            With it the friction level at each P is min(F_max, friction_over_P P) rather than
+            F_max at every P; None: F and P independent, as the box alone says.
+
+    Raises:
+        ParameterError: a box that is not a ParameterBox, F < 0, a range that is not finite lo <= hi,
+            friction_over_P <= 0.
+    """
+
+    box: ParameterBox
+    gyro: tuple[float, float]
+    V_A: tuple[float, float]
+    friction_over_P: float | None = None
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.box, ParameterBox):
+            raise ParameterError(f"box must be a ParameterBox, got {type(self.box).__name__}")
+        object.__setattr__(self, "gyro", _interval("gyro range", self.gyro))
+        object.__setattr__(self, "V_A", _interval("V_A range", self.V_A))
+        if self.box.F[0] < 0.0:
+            raise ParameterError(f"box F = {self.box.F} is not accepted: a Coulomb level F >= 0 is required")
+        if self.friction_over_P is not None:
+            object.__setattr__(self, "friction_over_P",
+                               _number("friction_over_P", self.friction_over_P, minimum=0.0, strict=True))
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """The controller's estimate ^ of the plant (the law (3.2)-(3.3) uses these).
+
+    Attributes:
+        P: P^ [V s^2/rad], > 0.
+        C_V: C_V^ [V s/rad].
+        F: F^ [V], >= 0: the Coulomb compensation's amplitude (0 for 'none').
+        K: K^ [V] (sin/cos^3).
+        gyro: gyro^ [V s/m].
+        V_A: V_A^ [m/s].
+
+    Raises:
+        ParameterError: a value that is not a finite number, P <= 0 or F < 0.
+    """
+
+    P: float
+    C_V: float
+    F: float
+    K: float
+    gyro: float
+    V_A: float
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "P", _number("P_hat", self.P, minimum=0.0, strict=True))
+        for name in ("C_V", "K", "gyro", "V_A"):
+            object.__setattr__(self, name, _number(f"{name}_hat", getattr(self, name)))
+        object.__setattr__(self, "F", _number("F_hat", self.F, minimum=0.0))
+
+
+@dataclass(frozen=True)
+class Gains:
+    """The PD servo's gains of (3.2).
+
+    Attributes:
+        kp: K_P [1/s^2], > 0.
+        kd: K_D [1/s], > 0.
+
+    Raises:
+        ParameterError: a gain that is not a finite normal number > 0.
+    """
+
+    kp: float
+    kd: float
+
+    def __post_init__(self) -> None:
+        kp, kd = _check_gains(self.kp, self.kd)
+        object.__setattr__(self, "kp", kp)
+        object.__setattr__(self, "kd", kd)
+
+
+@dataclass(frozen=True)
+class PlantLimits:
+    """The plant's limits the certified region must respect.
+
+    Attributes:
+        steering_range: the steering stops, |alpha| [rad], > 0.
+        voltage_limit: the supply [V], > 0.
+
+    Raises:
+        ParameterError: a limit that is not a finite number > 0.
+    """
+
+    steering_range: float
+    voltage_limit: float
+
+    def __post_init__(self) -> None:
+        for name in ("steering_range", "voltage_limit"):
+            object.__setattr__(self, name, _number(name, getattr(self, name), minimum=0.0, strict=True))
+
+
+@dataclass(frozen=True)
+class Compensation:
+    """How the law compensates Coulomb friction, and whether it has the feedforward P^ a0''.
+
+    Attributes:
+        friction_sign: the sign it multiplies F^ by: 'measured' (sgn a'), 'reference' (sgn a0')
+            or 'none' (:data:`FRICTION_MODES`).
+        friction_width: the sign's smoothing w [rad/s], >= 0 (recorded; the friction term covers
+            any |s| <= 1).
+        feedforward: False for a PD law without P^ a0'' (which has no compensation either).
+
+    Raises:
+        UnknownNameError: an unknown friction_sign.
+        ParameterError: friction_width < 0, or compensation without feedforward.
+    """
+
+    friction_sign: str = "measured"
+    friction_width: float = 0.0
+    feedforward: bool = True
+
+    def __post_init__(self) -> None:
+        if self.friction_sign not in FRICTION_MODES:
+            raise UnknownNameError("friction sign", str(self.friction_sign), FRICTION_MODES)
+        object.__setattr__(self, "friction_width", _number("friction_width", self.friction_width, minimum=0.0))
+        if not self.feedforward and self.friction_sign != "none":
+            raise ParameterError("a law without feedforward (PD) has no Coulomb compensation: use friction_sign='none'")
+
+
+#: The computed-torque law's compensation by default: the sign of the measured a', exact.
+MEASURED_SIGN = Compensation()
+
+
 # --------------------------------------------------------------------------- certify
 def certify(
     *,
-    box: ParameterBox,
-    gyro: tuple[float, float],
-    V_A: tuple[float, float],
-    P_hat: float,
-    C_V_hat: float,
-    F_hat: float,
-    K_hat: float,
-    gyro_hat: float,
-    V_A_hat: float,
-    kp: float,
-    kd: float,
-    friction_sign: str = "measured",
-    friction_width: float = 0.0,
-    feedforward: bool = True,
-    alpha0_max: float,
-    alpha0_dot_max: float,
-    alpha0_ddot_max: float,
-    steering_range: float,
-    voltage_limit: float,
+    plant: PlantBox,
+    estimate: Estimate,
+    gains: Gains,
+    reference: ReferenceBounds,
+    limits: PlantLimits,
+    compensation: Compensation = MEASURED_SIGN,
     control_period: float,
     initial_error: tuple[float, float] = (0.0, 0.0),
     stated: Sequence[Assumption] = (),
-    friction_over_P: float | None = None,
 ) -> Certificate:
-    """The certificate for the law (3.2)-(3.3) with estimate ^ on any plant in the box.
+    """The certificate for the law (3.2)-(3.3) with ``estimate`` on any plant of ``plant``.
 
-    box: the plant's P [V s^2/rad], C_V [V s/rad], F [V] (Coulomb, break-away = sliding),
-    K [V] (sin/cos^3). gyro [V s/m] and V_A [m/s]: ranges of the plant's gyroscopic
-    coefficient and forward speed (Gam = gyro V_A). P_hat ... V_A_hat: the controller's
-    estimate (F_hat: the compensation amplitude, 0 for 'none'). friction_sign: the
-    compensation's sign ('measured', 'reference', 'none'); friction_width [rad/s]: its
-    smoothing (recorded; the friction term covers any |s| <= 1). feedforward: False for
-    a PD law without P^ a0''. alpha0_max [rad], alpha0_dot_max [rad/s], alpha0_ddot_max
-    [rad/s^2]: the reference's bounds. steering_range [rad], voltage_limit [V],
-    control_period [s]: the plant's stops, supply and the law's period.
-    initial_error: (E(0), E'(0)). stated: caller's stated assumptions, appended.
-    friction_over_P [rad/s^2]: an upper bound on F/P over the plants of the box (F and P
-    both scale with R_a, so F/P does not move with it; see :func:`friction_over_P_max`).
-    With it the friction level at each P is min(F_max, friction_over_P P) rather than F_max
-    at every P; None: F and P independent, as the box alone says. delta1 is then maximised
-    over P in {P_min, P_max, P^, F_max/r, F^/r} (r = friction_over_P): between these points
-    each term of delta1 is monotone in P.
+    Args:
+        plant: the plants covered (P, C_V, F, K ranges, gyro, V_A, and the bound on F/P).
+        estimate: the controller's estimate ^ (F: the compensation's amplitude, 0 for 'none').
+        gains: K_P [1/s^2], K_D [1/s].
+        reference: the reference's bounds; alpha_max (max|alpha0|) [rad], alpha_dot_max [rad/s],
+            alpha_ddot_max [rad/s^2] are read.
+        limits: the plant's steering stops [rad] and supply [V].
+        compensation: the law's friction sign and smoothing, and whether it has feedforward.
+        control_period: the law's period [s], > 0.
+        initial_error: (E(0) [rad], E'(0) [rad/s]).
+        stated: the caller's stated assumptions, appended to the checked ones.
+
+    Returns:
+        Certificate: E_max, Edot_max and every assumption with its value and limit; ``valid``
+        False (E_max = inf, with the reason) when there is no bound. With
+        ``plant.friction_over_P`` = r, delta1 is maximised over P in {P_min, P_max, P^, F_max/r,
+        F^/r}: between these points each term of delta1 is monotone in P.
+
+    Raises:
+        ParameterError: a group of the wrong type, max|alpha0| unknown or >= pi/2, a control period
+            or initial error that is not a finite number (> 0 for the period).
     """
-    if not isinstance(box, ParameterBox):
-        raise ParameterError(f"box must be a ParameterBox, got {type(box).__name__}")
-    if friction_sign not in FRICTION_MODES:
-        raise UnknownNameError("friction sign", str(friction_sign), FRICTION_MODES)
-    kp, kd = _check_gains(kp, kd)
-    gyro = _interval("gyro range", gyro)
-    V_A = _interval("V_A range", V_A)
-    P_hat = _number("P_hat", P_hat, minimum=0.0, strict=True)
-    C_V_hat, K_hat, gyro_hat, V_A_hat = (_number(n, v) for n, v in (
-        ("C_V_hat", C_V_hat), ("K_hat", K_hat), ("gyro_hat", gyro_hat), ("V_A_hat", V_A_hat)))
-    F_hat = _number("F_hat", F_hat, minimum=0.0)
-    friction_width = _number("friction_width", friction_width, minimum=0.0)
-    a0 = _number("alpha0_max", alpha0_max, minimum=0.0)
-    a0d = _number("alpha0_dot_max", alpha0_dot_max, minimum=0.0)
-    a0dd = _number("alpha0_ddot_max", alpha0_ddot_max, minimum=0.0)
-    steering_range = _number("steering_range", steering_range, minimum=0.0, strict=True)
-    voltage_limit = _number("voltage_limit", voltage_limit, minimum=0.0, strict=True)
-    control_period = _number("control_period", control_period, minimum=0.0, strict=True)
-    E0, Ed0 = (_number("initial_error", v) for v in initial_error)
+    _check_groups(plant, estimate, gains, reference, limits, compensation)
+    if reference.alpha_max is None:
+        raise ParameterError("alpha0_max (the reference's max|alpha0|, ReferenceBounds.alpha_max) is required")
+    a0 = reference.alpha_max
     if a0 >= 0.5 * math.pi:
         raise ParameterError(f"alpha0_max = {a0} rad is not accepted: the reference must stay below pi/2")
-    if box.F[0] < 0.0:
-        raise ParameterError(f"box F = {box.F} is not accepted: a Coulomb level F >= 0 is required")
-    if not feedforward and friction_sign != "none":
-        raise ParameterError("a law without feedforward (PD) has no Coulomb compensation: use friction_sign='none'")
+    control_period = _number("control_period", control_period, minimum=0.0, strict=True)
+    E0, Ed0 = (_number("initial_error", v) for v in initial_error)
 
-    g1, g2 = exact_gammas(kp, kd)
-    P_lo, P_hi = box.P
-    P_ff = P_hat if feedforward else 0.0
-    P_corners = sorted({P_lo, P_hi, *([P_hat] if P_lo < P_hat < P_hi else [])})
-    if friction_over_P is not None:
-        friction_over_P = _number("friction_over_P", friction_over_P, minimum=0.0, strict=True)
-        breaks = (box.F[1] / friction_over_P, F_hat / friction_over_P)
-        P_corners = sorted({*P_corners, *(b for b in breaks if P_lo < b < P_hi)})
-
-    def phi_at(p: float) -> float:  # sup |f - F^ s| for the plants with this P
-        F_p = box.F[1] if friction_over_P is None else min(box.F[1], friction_over_P * p)
-        return friction_term(friction_sign, F=(box.F[0], F_p), F_hat=F_hat)
-
-    phi = max(phi_at(p) for p in P_corners)
-    dC_lo, dC_hi = box.C_V[0] - C_V_hat, box.C_V[1] - C_V_hat
-    dC = max(abs(dC_lo), abs(dC_hi))
-    dK = max(abs(box.K[0] - K_hat), abs(box.K[1] - K_hat))
-    Gam = [g * v for g in gyro for v in V_A]
-    Gam_hat = gyro_hat * V_A_hat
-    dG_lo, dG_hi = min(Gam) - Gam_hat, max(Gam) - Gam_hat
-    dG = max(abs(dG_lo), abs(dG_hi))
-    mis = {p: 1.0 - P_hat / p for p in P_corners}  # 1 - P^/P
-    delta2 = max(abs(m) for m in mis.values()) * kp
-
-    def at(alpha_max: float) -> dict[str, float]:
-        S, c2 = _S(alpha_max), math.cos(alpha_max) ** 2
-        rest = dK * S + dC * a0d + dG * a0d / c2
-        delta1 = max((abs(p - P_ff) * a0dd + phi_at(p) + rest) / p for p in P_corners)
-        delta3 = max(abs(mis[p] * kd - (c + g / cc) / p)
-                     for p in P_corners for c in (dC_lo, dC_hi) for g in (dG_lo, dG_hi) for cc in (c2, 1.0))
-        cond = g1 * delta2 + g2 * delta3
-        return {"delta1": delta1, "delta3": delta3, "condition": cond, "S": S, "c2": c2}
-
-    def phi_of(x: float) -> float:
-        b = at(a0 + x)
-        return g1 * b["delta1"] / (1.0 - b["condition"]) if b["condition"] < 1.0 else math.inf
-
-    E_max, iterations, reason = fixed_point(phi_of, a0)
+    bound = _Bound.of(plant, estimate, gains, reference, compensation, a0)
+    E_max, iterations, reason = fixed_point(bound.E_max_at, a0)
     valid = math.isfinite(E_max)
     alpha_max = a0 + E_max if valid else math.inf
-    b = at(alpha_max if valid else a0)
-    cond = b["condition"]
+    b = bound.at(alpha_max if valid else a0)
+    cond = b.condition
     if valid:
-        Edot_max = g2 * b["delta1"] / (1.0 - cond)
+        Edot_max = bound.g2 * b.delta1 / (1.0 - cond)
     else:
         Edot_max = math.inf
         if cond >= 1.0:
             reason = f"(4.23) fails: gamma1 delta2 + gamma2 delta3 = {cond:.4g} >= 1 already at alpha = max|alpha0|"
+    voltage_max = _voltage_max(bound, b, E_max, Edot_max) if valid else math.inf
+    assumptions = _assumptions(cond=cond, valid=valid, alpha_max=alpha_max, reason=reason, iterations=iterations,
+                               voltage_max=voltage_max, limits=limits, gains=gains, control_period=control_period,
+                               initial_error=(E0, Ed0), stated=stated)
+    S, c2 = b.S, b.c2
+    P_lo = plant.box.P[0]
+    return Certificate(
+        E_max=E_max, Edot_max=Edot_max, condition=cond, valid=valid, assumptions=assumptions,
+        gamma1=bound.g1, gamma2=bound.g2, delta1=b.delta1, delta2=bound.delta2, delta3=b.delta3,
+        alpha_max=alpha_max, voltage_max=voltage_max,
+        friction_term=max(bound.phi_at(p) / p for p in bound.P_corners), gyro_term=bound.dG * bound.a0d / c2 / P_lo,
+        K_term=bound.dK * S / P_lo, P_term=max(abs(p - bound.P_ff) / p for p in bound.P_corners) * bound.a0dd,
+        C_V_term=bound.dC * bound.a0d / P_lo, gyro_Edot_term=bound.dG / c2 / P_lo,
+        dead_band=plant.box.F[1] / (estimate.P * gains.kp),
+        kp=gains.kp, kd=gains.kd, friction_sign=compensation.friction_sign,
+        friction_width=compensation.friction_width, reason=reason, iterations=iterations,
+        inputs=_inputs_record(plant, estimate, compensation, a0, bound, limits, control_period, (E0, Ed0)),
+    )
 
-    # voltage the law asks for anywhere in the region (triangle inequality on (3.2)-(3.3))
-    F_comp = 0.0 if friction_sign == "none" else F_hat
-    if valid:
-        rate = a0d + Edot_max
-        voltage_max = (P_hat * (P_ff / P_hat * a0dd + kd * Edot_max + kp * E_max) + abs(K_hat) * b["S"]
-                       + abs(C_V_hat) * rate + F_comp + abs(Gam_hat) * rate / b["c2"])
-    else:
-        voltage_max = math.inf
 
-    wc, pm = loop_crossover(kp, kd)
+def _check_groups(plant: Any, estimate: Any, gains: Any, reference: Any, limits: Any, compensation: Any) -> None:
+    for name, value, kind in (("plant", plant, PlantBox), ("estimate", estimate, Estimate), ("gains", gains, Gains),
+                              ("reference", reference, ReferenceBounds), ("limits", limits, PlantLimits),
+                              ("compensation", compensation, Compensation)):
+        if not isinstance(value, kind):
+            raise ParameterError(f"{name} must be a {kind.__name__}, got {type(value).__name__}")
+
+
+@dataclass(frozen=True)
+class _AtAngle:
+    """The terms of the bound that grow with the plant's angle, at alpha_max.
+
+    delta1 [rad/s^2], delta3 [1/s], condition: the left side of (4.23), S = sin/cos^3(alpha_max) [-],
+    c2 = cos^2(alpha_max) [-].
+    """
+
+    delta1: float
+    delta3: float
+    condition: float
+    S: float
+    c2: float
+
+
+@dataclass(frozen=True)
+class _Bound:
+    """The parts of (4.18)-(4.23) that do not depend on the angle reached: the mismatches, the
+    corners of P and the friction term; :meth:`at` gives delta1, delta3 and (4.23) at alpha_max."""
+
+    g1: float
+    g2: float
+    kp: float
+    kd: float
+    a0: float  # max|alpha0| [rad]
+    a0d: float  # max|alpha0'| [rad/s]
+    a0dd: float  # max|alpha0''| [rad/s^2]
+    P_ff: float  # the feedforward's P^ (0 without feedforward) [V s^2/rad]
+    P_hat: float
+    P_corners: tuple[float, ...]
+    mis: Mapping[float, float]  # 1 - P^/P at each corner
+    delta2: float
+    dC_lo: float
+    dC_hi: float
+    dC: float
+    dK: float
+    dG_lo: float
+    dG_hi: float
+    dG: float
+    Gam_hat: float
+    F_comp: float  # the compensation's amplitude, 0 for 'none' [V]
+    estimate: Estimate
+    plant: PlantBox
+    friction_sign: str
+
+    @classmethod
+    def of(cls, plant: PlantBox, estimate: Estimate, gains: Gains, reference: ReferenceBounds,
+           compensation: Compensation, a0: float) -> _Bound:
+        kp, kd = gains.kp, gains.kd
+        box, F_hat, friction_over_P = plant.box, estimate.F, plant.friction_over_P
+        g1, g2 = exact_gammas(kp, kd)
+        P_lo, P_hi = box.P
+        P_hat = estimate.P
+        P_corners = sorted({P_lo, P_hi, *([P_hat] if P_lo < P_hat < P_hi else [])})
+        if friction_over_P is not None:
+            breaks = (box.F[1] / friction_over_P, F_hat / friction_over_P)
+            P_corners = sorted({*P_corners, *(b for b in breaks if P_lo < b < P_hi)})
+        dC_lo, dC_hi = box.C_V[0] - estimate.C_V, box.C_V[1] - estimate.C_V
+        Gam = [g * v for g in plant.gyro for v in plant.V_A]
+        Gam_hat = estimate.gyro * estimate.V_A
+        dG_lo, dG_hi = min(Gam) - Gam_hat, max(Gam) - Gam_hat
+        mis = {p: 1.0 - P_hat / p for p in P_corners}  # 1 - P^/P
+        return cls(
+            g1=g1, g2=g2, kp=kp, kd=kd, a0=a0, a0d=reference.alpha_dot_max, a0dd=reference.alpha_ddot_max,
+            P_ff=P_hat if compensation.feedforward else 0.0, P_hat=P_hat, P_corners=tuple(P_corners), mis=mis,
+            delta2=max(abs(m) for m in mis.values()) * kp,
+            dC_lo=dC_lo, dC_hi=dC_hi, dC=max(abs(dC_lo), abs(dC_hi)),
+            dK=max(abs(box.K[0] - estimate.K), abs(box.K[1] - estimate.K)),
+            dG_lo=dG_lo, dG_hi=dG_hi, dG=max(abs(dG_lo), abs(dG_hi)), Gam_hat=Gam_hat,
+            F_comp=0.0 if compensation.friction_sign == "none" else F_hat, estimate=estimate, plant=plant,
+            friction_sign=compensation.friction_sign,
+        )
+
+    def phi_at(self, p: float) -> float:
+        """sup |f - F^ s| [V] for the plants with this P."""
+        F, r = self.plant.box.F, self.plant.friction_over_P
+        F_p = F[1] if r is None else min(F[1], r * p)
+        return friction_term(self.friction_sign, F=(F[0], F_p), F_hat=self.estimate.F)
+
+    @property
+    def phi(self) -> float:
+        """sup |f - F^ s| [V] over the box."""
+        return max(self.phi_at(p) for p in self.P_corners)
+
+    def at(self, alpha_max: float) -> _AtAngle:
+        """delta1, delta3 and (4.23) with the plant's angle up to ``alpha_max`` [rad]."""
+        S, c2 = _S(alpha_max), math.cos(alpha_max) ** 2
+        rest = self.dK * S + self.dC * self.a0d + self.dG * self.a0d / c2
+        delta1 = max((abs(p - self.P_ff) * self.a0dd + self.phi_at(p) + rest) / p for p in self.P_corners)
+        delta3 = max(abs(self.mis[p] * self.kd - (c + g / cc) / p)
+                     for p in self.P_corners for c in (self.dC_lo, self.dC_hi) for g in (self.dG_lo, self.dG_hi)
+                     for cc in (c2, 1.0))
+        cond = self.g1 * self.delta2 + self.g2 * delta3
+        return _AtAngle(delta1=delta1, delta3=delta3, condition=cond, S=S, c2=c2)
+
+    def E_max_at(self, x: float) -> float:
+        """The bound on |E| [rad] at alpha_max = max|alpha0| + x: Phi(x) of the fixed point."""
+        b = self.at(self.a0 + x)
+        return self.g1 * b.delta1 / (1.0 - b.condition) if b.condition < 1.0 else math.inf
+
+def _voltage_max(bound: _Bound, b: _AtAngle, E_max: float, Edot_max: float) -> float:
+    """The voltage [V] the law asks for anywhere in the region (triangle inequality on (3.2)-(3.3))."""
+    est = bound.estimate
+    rate = bound.a0d + Edot_max
+    return (est.P * (bound.P_ff / est.P * bound.a0dd + bound.kd * Edot_max + bound.kp * E_max)
+            + abs(est.K) * b.S + abs(est.C_V) * rate + bound.F_comp + abs(bound.Gam_hat) * rate / b.c2)
+
+
+def _assumptions(*, cond: float, valid: bool, alpha_max: float, reason: str, iterations: int, voltage_max: float,
+                 limits: PlantLimits, gains: Gains, control_period: float, initial_error: tuple[float, float],
+                 stated: Sequence[Assumption]) -> tuple[Assumption, ...]:
+    """The checked assumptions, then the caller's stated ones (each an :class:`Assumption`)."""
+    wc, pm = loop_crossover(gains.kp, gains.kd)
     delay_margin = pm / wc
     period_ratio = control_period * wc / pm if pm > 0.0 else math.inf  # no phase margin: no delay tolerated
+    E0, Ed0 = initial_error
     init = max(abs(E0), abs(Ed0))
-
+    steering_range, voltage_limit = limits.steering_range, limits.voltage_limit
     assumptions = (
         Assumption("(4.23) small gain", "gamma1 delta2 + gamma2 delta3 < 1 (4.23)", cond < 1.0, cond, 1.0,
                    "at alpha_max" if valid else "at alpha = max|alpha0|"),
@@ -586,26 +884,21 @@ def certify(
     for a in assumptions:
         if not isinstance(a, Assumption):
             raise ParameterError(f"stated assumptions must be Assumption records, got {type(a).__name__}")
+    return assumptions
 
-    S, c2 = b["S"], b["c2"]
-    inputs = {
-        "box": box.as_dict(), "gyro": list(gyro), "V_A": list(V_A),
-        "estimate": {"P": P_hat, "C_V": C_V_hat, "F": F_hat, "K": K_hat, "gyro": gyro_hat, "V_A": V_A_hat},
-        "feedforward": bool(feedforward),
-        "reference": {"alpha0_max": a0, "alpha0_dot_max": a0d, "alpha0_ddot_max": a0dd},
-        "steering_range": steering_range, "voltage_limit": voltage_limit, "control_period": control_period,
-        "initial_error": [E0, Ed0], "friction_amplitude_phi": phi,
+
+def _inputs_record(plant: PlantBox, estimate: Estimate, compensation: Compensation, a0: float, bound: _Bound,
+                   limits: PlantLimits, control_period: float, initial_error: tuple[float, float]) -> dict[str, Any]:
+    """What the certificate rests on, as ``Certificate.inputs`` (JSON keys as they have always been)."""
+    return {
+        "box": plant.box.as_dict(), "gyro": list(plant.gyro), "V_A": list(plant.V_A),
+        "estimate": {"P": estimate.P, "C_V": estimate.C_V, "F": estimate.F, "K": estimate.K, "gyro": estimate.gyro,
+                     "V_A": estimate.V_A},
+        "feedforward": bool(compensation.feedforward),
+        "reference": {"alpha0_max": a0, "alpha0_dot_max": bound.a0d, "alpha0_ddot_max": bound.a0dd},
+        "steering_range": limits.steering_range, "voltage_limit": limits.voltage_limit,
+        "control_period": control_period, "initial_error": list(initial_error), "friction_amplitude_phi": bound.phi,
     }
-    return Certificate(
-        E_max=E_max, Edot_max=Edot_max, condition=cond, valid=valid, assumptions=assumptions,
-        gamma1=g1, gamma2=g2, delta1=b["delta1"], delta2=delta2, delta3=b["delta3"],
-        alpha_max=alpha_max, voltage_max=voltage_max,
-        friction_term=max(phi_at(p) / p for p in P_corners), gyro_term=dG * a0d / c2 / P_lo, K_term=dK * S / P_lo,
-        P_term=max(abs(p - P_ff) / p for p in P_corners) * a0dd, C_V_term=dC * a0d / P_lo,
-        gyro_Edot_term=dG / c2 / P_lo, dead_band=box.F[1] / (P_hat * kp),
-        kp=kp, kd=kd, friction_sign=friction_sign, friction_width=friction_width,
-        reason=reason, iterations=iterations, inputs=inputs,
-    )
 
 
 # --------------------------------------------------------------------------- for a run

@@ -83,7 +83,6 @@ Usage::
 
 from __future__ import annotations
 
-import dataclasses
 import itertools
 import math
 import sys
@@ -93,6 +92,7 @@ from typing import Any, Literal
 
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import M1_RANGE, PAPER_KD, PAPER_KP
+from wmr_mj.reference.bounds import PAPER_BOUNDS, ReferenceBounds
 
 __all__ = [
     "ParameterBox",
@@ -368,35 +368,6 @@ class ParameterBox:
         return {n: list(getattr(self, n)) for n in COEFFICIENT_NAMES}
 
 
-@dataclass(frozen=True)
-class ReferenceBounds:
-    """Bounds on the desired trajectory, the paper's (5.1).
-
-    alpha_ddot_max = ||a0''|| [rad/s^2], alpha_dot_max = ||a0'|| [rad/s],
-    sin_cos3_max = ||sin(a)/cos^3(a)|| [-].
-    """
-
-    alpha_ddot_max: float = 0.4
-    alpha_dot_max: float = 0.23
-    sin_cos3_max: float = 1.24
-
-    def __post_init__(self) -> None:
-        for f in dataclasses.fields(self):
-            value = getattr(self, f.name)
-            try:
-                v = float(value)
-            except (TypeError, ValueError):
-                raise ParameterError(f"reference bound {f.name} must be a number, got {value!r}") from None
-            if not math.isfinite(v) or v < 0.0:
-                raise ParameterError(
-                    f"reference bound {f.name} = {value!r} is not accepted: a finite number >= 0 is required"
-                )
-            object.__setattr__(self, f.name, v)
-
-    def as_dict(self) -> dict[str, float]:
-        return dataclasses.asdict(self)
-
-
 # --------------------------------------------------------------------------- result
 def _finite_or_none(x: float) -> float | None:
     return x if math.isfinite(x) else None
@@ -556,7 +527,7 @@ def analyse(
     *,
     kp: float = PAPER_KP,
     kd: float = PAPER_KD,
-    bounds: ReferenceBounds = ReferenceBounds(),
+    bounds: ReferenceBounds = PAPER_BOUNDS,
     reading: Reading = "corrected",
     gammas: GammaForm = "exact",
     estimate: Mapping[str, float] | Any | None = None,

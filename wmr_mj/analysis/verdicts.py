@@ -19,22 +19,26 @@ Usage::
     from wmr_mj.analysis.verdicts import judge_run, is_pass
     judged = judge_run(certificate=cert, analysis=analysis, sup_E=0.03, sup_Edot=0.2,
                        drift=drift(prev_window=0.02, last_window=0.02, final_alpha_dot=0.0))
-    judged["verdict"], judged["paper_region"]["inside"], judged["drift"]["growing"]
+    judged.verdict, judged.paper_region.inside, judged.drift.growing
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
 from typing import Any
 
-from wmr_mj.analysis.certificate import VERDICTS, Certificate, judge
+from wmr_mj.analysis.certificate import VERDICTS, Certificate, CertificateJudgement, judge
 
 __all__ = [
     "VERDICTS",
     "PASS",
     "DRIFT_WINDOW_S",
     "DRIFT_TOLERANCE",
+    "Drift",
+    "PaperRegion",
+    "RunJudgement",
     "drift",
     "drift_window_steps",
     "judge_run",
@@ -57,36 +61,114 @@ def drift_window_steps(control_steps: int, period: float) -> int:
     return max(1, min(w, control_steps // 4))
 
 
-def drift(*, prev_window: float, last_window: float, final_alpha_dot: float) -> dict[str, Any]:
-    """The end-of-run drift from the max |E| of the two last windows (rad) and the final alpha' (rad/s)."""
+@dataclass(frozen=True)
+class Drift:
+    """End of the run: is |E| still growing? (:func:`drift`)
+
+    Attributes:
+        final_alpha_dot: alpha' at the last control step [rad/s].
+        growing: the last window's max |E| exceeds the previous window's by more than ``tolerance``
+            (or either is not finite: a diverged run is not settled).
+        E_last_window: max |E| over the last window [rad].
+        E_prev_window: max |E| over the window before it [rad].
+        window_s: the length of each window [s] (:data:`DRIFT_WINDOW_S`).
+        tolerance: the growth that counts [rad] (:data:`DRIFT_TOLERANCE`).
+    """
+
+    final_alpha_dot: float
+    growing: bool
+    E_last_window: float
+    E_prev_window: float
+    window_s: float = DRIFT_WINDOW_S
+    tolerance: float = DRIFT_TOLERANCE
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready, the run summary's drift keys."""
+        return {"final_alpha_dot": self.final_alpha_dot, "growing": self.growing,
+                "E_last_window": self.E_last_window, "E_prev_window": self.E_prev_window,
+                "window_s": self.window_s, "tolerance": self.tolerance}
+
+
+@dataclass(frozen=True)
+class PaperRegion:
+    """The paper's claim judged for one run: the region (4.21)-(4.23) as the paper bounds it.
+
+    Attributes:
+        E_max: the bound on |E| [rad]; inf when (4.23) fails.
+        Edot_max: the bound on |E'| [rad/s]; inf when (4.23) fails.
+        condition: the left side of (4.23) [-].
+        inside: the run's sup|E| <= E_max and sup|E'| <= Edot_max (and (4.23) holds).
+    """
+
+    E_max: float
+    Edot_max: float
+    condition: float
+    inside: bool
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready, the run summary's paper_region keys (inf stays inf; the writers make it null)."""
+        return {"E_max": self.E_max, "Edot_max": self.Edot_max, "condition": self.condition, "inside": self.inside}
+
+
+@dataclass(frozen=True)
+class RunJudgement:
+    """:func:`judge_run`: the verdict of one run and what it rests on."""
+
+    verdict: str
+    certificate: CertificateJudgement
+    paper_region: PaperRegion
+    drift: Drift
+
+
+def drift(*, prev_window: float, last_window: float, final_alpha_dot: float) -> Drift:
+    """The end-of-run drift.
+
+    Args:
+        prev_window: max |E| over the window before the last [rad].
+        last_window: max |E| over the last window [rad].
+        final_alpha_dot: alpha' at the last control step [rad/s].
+
+    Returns:
+        Drift: growing when the last window exceeds the previous by more than
+        :data:`DRIFT_TOLERANCE`, or either is not finite.
+    """
     growing = bool(math.isfinite(last_window) and math.isfinite(prev_window)
                    and last_window - prev_window > DRIFT_TOLERANCE)
     if not (math.isfinite(last_window) and math.isfinite(prev_window)):
         growing = True  # a diverged run is not settled
-    return {"final_alpha_dot": float(final_alpha_dot), "growing": growing,
-            "E_last_window": float(last_window), "E_prev_window": float(prev_window),
-            "window_s": DRIFT_WINDOW_S, "tolerance": DRIFT_TOLERANCE}
+    return Drift(final_alpha_dot=float(final_alpha_dot), growing=growing, E_last_window=float(last_window),
+                 E_prev_window=float(prev_window), window_s=DRIFT_WINDOW_S, tolerance=DRIFT_TOLERANCE)
 
 
-def paper_region(analysis: Any, sup_E: float, sup_Edot: float) -> dict[str, Any]:
-    """The paper's claim judged: its bounds (inf when (4.23) fails) and whether the run is inside."""
+def paper_region(analysis: Any, sup_E: float, sup_Edot: float) -> PaperRegion:
+    """The paper's claim judged: its bounds (inf when (4.23) fails) and whether the run is inside.
+
+    Args:
+        analysis: a :class:`wmr_mj.analysis.robustness.RobustnessResult`.
+        sup_E: the run's sup|E| [rad].
+        sup_Edot: the run's sup|E'| [rad/s].
+    """
     stable = bool(analysis.stable)
     E_max = float(analysis.E_max) if stable else math.inf
     Ed_max = float(analysis.Edot_max) if stable else math.inf
-    return {"E_max": E_max, "Edot_max": Ed_max, "condition": float(analysis.condition),
-            "inside": bool(stable and sup_E <= E_max and sup_Edot <= Ed_max)}
+    return PaperRegion(E_max=E_max, Edot_max=Ed_max, condition=float(analysis.condition),
+                       inside=bool(stable and sup_E <= E_max and sup_Edot <= Ed_max))
 
 
 def judge_run(*, certificate: Certificate, analysis: Any, sup_E: float, sup_Edot: float,
-              drift: Mapping[str, Any]) -> dict[str, Any]:
-    """verdict, certificate (judged), paper_region (the paper's claim, judged) and drift of one run."""
+              drift: Drift) -> RunJudgement:
+    """verdict, certificate (judged), paper_region (the paper's claim, judged) and drift of one run.
+
+    Args:
+        certificate: the run's certificate.
+        analysis: the paper's region for the run (a ``RobustnessResult``).
+        sup_E: the run's sup|E| [rad].
+        sup_Edot: the run's sup|E'| [rad/s].
+        drift: the run's end-of-run drift (:func:`drift`).
+    """
     judged = judge(certificate, sup_E, sup_Edot)
-    return {
-        "verdict": judged["verdict"],
-        "certificate": judged,
-        "paper_region": paper_region(analysis, sup_E, sup_Edot),
-        "drift": dict(drift),
-    }
+    return RunJudgement(verdict=judged.verdict, certificate=judged,
+                        paper_region=paper_region(analysis, sup_E, sup_Edot), drift=drift)
 
 
 def is_pass(verdict: str) -> bool:
@@ -107,7 +189,12 @@ def _num(x: Any, spec: str = ".5g") -> str:
 
 
 def format_verdict(summary: Mapping[str, Any]) -> list[str]:
-    """Text lines of a judged run summary: the verdict first, then both regions and the drift."""
+    """Text lines of a judged run summary: the verdict first, then both regions and the drift.
+
+    Args:
+        summary: the summary as written (``RunSummary.to_dict()``, or an MCAP log's summary,
+            also one written before verdicts existed).
+    """
     verdict = summary.get("verdict")
     if verdict is None:
         return ["no certificate in this summary (written before verdicts existed)"]

@@ -94,7 +94,7 @@ def run(args: argparse.Namespace) -> int:
     worst = result.worst
     summary = result.as_dict(log=str(log_path))
     summary.update({
-        "reproduced": logged["sup_E"] == worst.sup_E,  # the serial re-run gives the batch's bits
+        "reproduced": logged.sup_E == worst.sup_E,  # the serial re-run gives the batch's bits
         "reproduce": reproduce_command(config, worst.params, args),
         "uncertainty": args.uncertainty,
         "folder": str(out),

@@ -113,20 +113,30 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from wmr_mj.analysis.robustness import (
-        PAPER_CONDITION,
-        ParameterBox,
-        ReferenceBounds,
-        analyse,
-        exact_gammas,
-        gains_from_omega_r,
-        paper_gammas,
-    )
+    """``wmr-mj robustness``: the paper's region (4.17)-(4.23) for a box, gains and reference bounds."""
+    from wmr_mj.analysis.robustness import ReferenceBounds, analyse
     from wmr_mj.cli._common import print_json
-    from wmr_mj.errors import ParameterError
 
     if args.certificate is not None:
         return run_certificate(args)
+    _fill_defaults(args)
+    kp, kd = _gains(args)
+    box, box_label = _box(args)
+    bounds = ReferenceBounds(alpha_ddot_max=args.alpha_ddot, alpha_dot_max=args.alpha_dot, sin_cos3_max=args.sin_cos3)
+    estimate = parse_assignments(args.estimate, option="--estimate", example="P=0.385") if args.estimate else None
+    result = analyse(box, kp=kp, kd=kd, bounds=bounds, reading=args.reading, gammas=args.gammas, estimate=estimate)
+    if args.json:
+        print_json(result.as_dict())
+        return 0
+    paper_example = (
+        args.box == "paper" and kp == PAPER_KP and kd == PAPER_KD and estimate is None and bounds == ReferenceBounds()
+    )
+    print(_analysis_table(args, result, (kp, kd), (box, box_label), estimate, paper_example))
+    return 0
+
+
+def _fill_defaults(args: argparse.Namespace) -> None:
+    """The defaults of the options left out (None: so that --certificate can tell them from given ones)."""
     args.box = args.box or "paper"
     args.reading = args.reading or "corrected"
     args.gammas = args.gammas or "exact"
@@ -134,54 +144,59 @@ def run(args: argparse.Namespace) -> int:
     args.alpha_dot = 0.23 if args.alpha_dot is None else args.alpha_dot
     args.sin_cos3 = 1.24 if args.sin_cos3 is None else args.sin_cos3
 
+
+def _gains(args: argparse.Namespace) -> tuple[float, float]:
+    """(K_P [1/s^2], K_D [1/s]) from --omega-r, or --kp/--kd (default the paper's)."""
+    from wmr_mj.analysis.robustness import gains_from_omega_r
+    from wmr_mj.errors import ParameterError
+
     if args.omega_r is not None:
         if args.kp is not None or args.kd is not None:
             raise ParameterError("--omega-r sets both gains by (3.6); it cannot be combined with --kp/--kd")
-        kp, kd = gains_from_omega_r(args.omega_r)
-    else:
-        kp = PAPER_KP if args.kp is None else args.kp
-        kd = PAPER_KD if args.kd is None else args.kd
+        return gains_from_omega_r(args.omega_r)
+    return (PAPER_KP if args.kp is None else args.kp), (PAPER_KD if args.kd is None else args.kd)
+
+
+def _box(args: argparse.Namespace):
+    """(the ParameterBox, its label): the paper's (5.1) intervals, or derived from C80 over the ranges."""
+    from wmr_mj.analysis.robustness import ParameterBox
+    from wmr_mj.errors import ParameterError
 
     if args.box == "paper":
         used = [opt for opt, v in (("--m1-range", args.m1_range), ("--range", args.range), ("--model", args.model))
                 if v]
         if used:
             raise ParameterError(f"{', '.join(used)} only apply to --box derived (got --box paper)")
-        box = ParameterBox.paper()
-        box_label = "paper (5.1)"
-    else:
-        from wmr_mj.params import C80
+        return ParameterBox.paper(), "paper (5.1)"
+    from wmr_mj.params import C80
 
-        ranges: dict[str, tuple[float, float]] = {}
-        for item in args.range or []:
-            name, span = parse_range(item)
-            if name in ranges:
-                raise ParameterError(f"--range {name} given twice; give each parameter once")
-            ranges[name] = span
-        if "m1" in ranges and args.m1_range is not None:
-            raise ParameterError("m1 given by both --m1-range and --range m1=LO:HI; give it once")
-        m1_range = tuple(args.m1_range) if args.m1_range is not None else M1_RANGE
-        if "m1" in ranges:
-            m1_range = ranges.pop("m1")
-        model = args.model or "paper"
-        box = ParameterBox.from_parameters(C80, m1_range=m1_range, ranges=ranges, model=model)
-        spans = [f"m1 {m1_range[0]:g}-{m1_range[1]:g} kg"] + [f"{n} {lo:g}-{hi:g}" for n, (lo, hi) in ranges.items()]
-        box_label = f"derived from C80 ({model} model; {', '.join(spans)})"
+    ranges: dict[str, tuple[float, float]] = {}
+    for item in args.range or []:
+        name, span = parse_range(item)
+        if name in ranges:
+            raise ParameterError(f"--range {name} given twice; give each parameter once")
+        ranges[name] = span
+    if "m1" in ranges and args.m1_range is not None:
+        raise ParameterError("m1 given by both --m1-range and --range m1=LO:HI; give it once")
+    m1_range = tuple(args.m1_range) if args.m1_range is not None else M1_RANGE
+    if "m1" in ranges:
+        m1_range = ranges.pop("m1")
+    model = args.model or "paper"
+    box = ParameterBox.from_parameters(C80, m1_range=m1_range, ranges=ranges, model=model)
+    spans = [f"m1 {m1_range[0]:g}-{m1_range[1]:g} kg"] + [f"{n} {lo:g}-{hi:g}" for n, (lo, hi) in ranges.items()]
+    return box, f"derived from C80 ({model} model; {', '.join(spans)})"
 
-    bounds = ReferenceBounds(alpha_ddot_max=args.alpha_ddot, alpha_dot_max=args.alpha_dot, sin_cos3_max=args.sin_cos3)
-    estimate = parse_assignments(args.estimate, option="--estimate", example="P=0.385") if args.estimate else None
-    result = analyse(box, kp=kp, kd=kd, bounds=bounds, reading=args.reading, gammas=args.gammas, estimate=estimate)
 
-    if args.json:
-        print_json(result.as_dict())
-        return 0
+def _analysis_table(args: argparse.Namespace, result, gains: tuple[float, float], box_and_label,
+                    estimate, paper_example: bool) -> str:
+    """The text report of :func:`wmr_mj.analysis.robustness.analyse`'s result, gammas beside the paper's."""
+    from wmr_mj.analysis.robustness import PAPER_CONDITION, exact_gammas, paper_gammas
 
+    kp, kd = gains
+    box, box_label = box_and_label
     g1e, g2e = exact_gammas(kp, kd)
     g1p, g2p = paper_gammas(kp, kd)
     rel = (result.condition - PAPER_CONDITION) / PAPER_CONDITION
-    paper_example = (
-        args.box == "paper" and kp == PAPER_KP and kd == PAPER_KD and estimate is None and bounds == ReferenceBounds()
-    )
     if paper_example:
         paper_note = f"paper reports {PAPER_CONDITION} (rel. diff {rel:+.2%})"
     else:
@@ -210,10 +225,9 @@ def run(args: argparse.Namespace) -> int:
         ("||E'|| max [rad/s]", fmt(result.Edot_max)),
     ]
     width = max(len(k) for k, _ in rows)
-    print("Robustness of computed-torque steering control (paper section 4)")
-    for key, value in rows:
-        print(f"  {key:<{width}}  {value}")
-    return 0
+    lines = ["Robustness of computed-torque steering control (paper section 4)"]
+    lines += [f"  {key:<{width}}  {value}" for key, value in rows]
+    return "\n".join(lines)
 
 
 # --------------------------------------------------------------------------- --certificate

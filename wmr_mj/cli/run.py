@@ -4,9 +4,13 @@ from __future__ import annotations
 
 import argparse
 import math
+from typing import TYPE_CHECKING
 
 from wmr_mj.cli._common import box_ranges_from_args, parse_assignments, positive_float, positive_int
 from wmr_mj.params import M1_NOMINAL
+
+if TYPE_CHECKING:
+    from wmr_mj.sim.summary import RunSummary
 
 
 def add_run_options(p: argparse.ArgumentParser) -> None:
@@ -120,8 +124,8 @@ def default_log_path(config) -> str:
     return f"logs/run-{stamp}-{config.model}-m{config.m1:g}.mcap"
 
 
-def format_report(s: dict) -> str:
-    """Human-readable run report."""
+def format_report(s: RunSummary) -> str:
+    """Human-readable run report of the summary ``s``."""
     from wmr_mj.analysis.verdicts import format_verdict
 
     def ratio(x):
@@ -130,26 +134,28 @@ def format_report(s: dict) -> str:
     def num(x):
         return "n/a" if x is None else f"{x:.5g}"
 
-    cert = s.get("certificate") or {}
+    cert = s.certificate
+    cert_E_max, cert_Edot_max = (None, None) if cert is None else (cert.E_max, cert.Edot_max)
+    cert_E_ratio, cert_Edot_ratio = (None, None) if cert is None else (cert.E_ratio, cert.Edot_ratio)
 
-    after = f"after {s['settle_s']:.1f} s"
+    after = f"after {s.settle_s:.1f} s"
     lines = [
-        f"controller {s['controller']} ({s['model']} model), plant m1 = {s['m1']:g} kg, K_P = {s['kp']:g}, "
-        f"K_D = {s['kd']:g}, {s['duration']:g} s, {s['steps']} steps in {s['wall_s']:.2f} s "
-        f"({s['realtime_factor']:.0f}x real time)",
-        *format_verdict(s),
+        f"controller {s.controller} ({s.model} model), plant m1 = {s.m1:g} kg, K_P = {s.kp:g}, "
+        f"K_D = {s.kd:g}, {s.duration:g} s, {s.steps} steps in {s.wall_s:.2f} s "
+        f"({s.realtime_factor:.0f}x real time)",
+        *format_verdict(s.to_dict()),
         f"{'':22s} {'whole run':>12s} {after:>12s} {'certificate':>12s} {'ratio':>8s} {'paper':>12s} {'ratio':>8s}",
-        f"{'sup|E|   [rad]':22s} {s['sup_E']:12.5g} {s['sup_E_settled']:12.5g} {num(cert.get('E_max')):>12s} "
-        f"{ratio(cert.get('E_ratio')):>8s} {s['E_max']:12.5g} {ratio(s['E_ratio']):>8s}",
-        f"{'sup|E|dot [rad/s]':22s} {s['sup_Edot']:12.5g} {s['sup_Edot_settled']:12.5g} "
-        f"{num(cert.get('Edot_max')):>12s} {ratio(cert.get('Edot_ratio')):>8s} {s['Edot_max']:12.5g} "
-        f"{ratio(s['Edot_ratio']):>8s}",
-        f"voltage saturated {100 * s['saturated_fraction']:.1f}% of the time",
+        f"{'sup|E|   [rad]':22s} {s.sup_E:12.5g} {s.sup_E_settled:12.5g} {num(cert_E_max):>12s} "
+        f"{ratio(cert_E_ratio):>8s} {s.E_max:12.5g} {ratio(s.E_ratio):>8s}",
+        f"{'sup|E|dot [rad/s]':22s} {s.sup_Edot:12.5g} {s.sup_Edot_settled:12.5g} "
+        f"{num(cert_Edot_max):>12s} {ratio(cert_Edot_ratio):>8s} {s.Edot_max:12.5g} "
+        f"{ratio(s.Edot_ratio):>8s}",
+        f"voltage saturated {100 * s.saturated_fraction:.1f}% of the time",
     ]
-    if s["left_steering_range"]:
-        lines.append(f"the steering reached its stop (+-range) at t = {s['left_steering_range_at_s']:.3f} s")
-    if s.get("status") != "completed":
-        lines.append(f"run {s['status']}: report covers the simulated part only")
+    if s.left_steering_range:
+        lines.append(f"the steering reached its stop (+-range) at t = {s.left_steering_range_at_s:.3f} s")
+    if s.status != "completed":
+        lines.append(f"run {s.status}: report covers the simulated part only")
     return "\n".join(lines)
 
 
@@ -179,12 +185,10 @@ def run(args: argparse.Namespace) -> int:
 
     with terminate_as_interrupt():
         result = run_closed_loop(config, logger_factory=factory, progress=args.progress)
-    summary = dict(result.summary)
-    summary["log"] = path
     if args.json:
-        print_json(summary)
+        print_json({**result.summary.to_dict(), "log": path})
     else:
-        print(format_report(summary))
+        print(format_report(result.summary))
         if path:
             print(f"log: {path}")
     if result.status == "interrupted":

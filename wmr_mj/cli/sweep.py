@@ -4,8 +4,12 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from wmr_mj.cli._common import positive_int
+
+if TYPE_CHECKING:
+    from wmr_mj.sim.sweep import SweepSummary
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -30,45 +34,6 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-def summarize_sweep(results: list[dict], wall_s: float) -> dict:
-    """The sweep's summary: the count of each verdict, the worst certificate ratio sup|E|/E_max,
-    and the paper's claim (inside/outside its region, worst ratios)."""
-    import math
-
-    from wmr_mj.analysis.verdicts import count_verdicts
-
-    def worst(key):
-        vals = [r[key] for r in results if r.get(key) is not None]
-        return max(vals) if vals else None
-
-    steps = sum(int(r["steps"]) for r in results if r.get("steps") is not None)
-    inside = sum(1 for r in results if r["inside"])
-    first = results[0]
-    return {
-        "n": len(results),
-        "verdicts": count_verdicts(r["verdict"] for r in results),
-        "worst_certificate_ratio": worst("cert_E_ratio"),
-        "worst_certificate_Edot_ratio": worst("cert_Edot_ratio"),
-        "certificate_E_max": first.get("cert_E_max"),
-        "certificate_Edot_max": first.get("cert_Edot_max"),
-        "drift_growing": sum(1 for r in results if r.get("drift_growing")),
-        "inside": inside,
-        "outside": len(results) - inside,
-        "worst_E_ratio": worst("E_ratio"),
-        "worst_Edot_ratio": worst("Edot_ratio"),
-        "worst_sup_E": worst("sup_E"),
-        "worst_sup_Edot": worst("sup_Edot"),
-        "E_max": first["E_max"],
-        "Edot_max": first["Edot_max"],
-        "hit_steering_stop": sum(1 for r in results if r["left_steering_range"]),
-        "steps": steps,
-        "wall_s": wall_s,
-        "steps_per_s": steps / wall_s if wall_s > 0 and math.isfinite(wall_s) else None,
-        # how the runs of this call evaluated the law (wmr_mj.sim.batch.LAW_BACKENDS; resumed runs: none)
-        "batch_law": sorted({r["batch_law"] for r in results if r.get("batch_law")}),
-    }
-
-
 def run(args: argparse.Namespace) -> int:
     import functools
     import time
@@ -78,7 +43,7 @@ def run(args: argparse.Namespace) -> int:
     from wmr_mj.cli._common import box_ranges_from_args, print_json
     from wmr_mj.cli.run import config_from_args
     from wmr_mj.errors import ParameterError
-    from wmr_mj.sim.sweep import SweepSpec, run_sweep
+    from wmr_mj.sim.sweep import SweepSpec, SweepSummary, run_sweep
 
     if args.n < 1:
         raise ParameterError(f"--n {args.n} is not accepted; the number of runs must be >= 1")
@@ -92,11 +57,12 @@ def run(args: argparse.Namespace) -> int:
         results = run_sweep(spec, out_dir=out, chunk=args.chunk, nthread=args.nthread, scheduler=args.scheduler,
                             progress=counter_callback(bar))
     wall = time.perf_counter() - t0
-    summary = summarize_sweep(results, wall)
+    runs = SweepSummary.of(results)  # the one aggregator of sweep and validate
+    summary = runs.sweep_dict(wall)
     summary.update({"folder": str(out), "model": base.model, "controller": base.controller, "seed": args.seed,
                     "sampling": args.sampling,
                     "ranges": {"m1": list(args.m1_range), **{k: list(v) for k, v in ranges.items()}}})
-    plot_path = _plot(results, summary, out / "region")
+    plot_path = _plot(results, runs, out / "region")
     summary["plot"] = str(plot_path)
     if args.log:
         from wmr_mj.logs.writer import RunLogger
@@ -113,27 +79,26 @@ def run(args: argparse.Namespace) -> int:
         print_json(summary)
         return 0
     fmt = lambda x: "n/a" if x is None else f"{x:.3f}"  # noqa: E731
-    counts = summary["verdicts"]
-    print(f"{summary['n']} runs ({base.model} model, K_P = {base.kp:g}, K_D = {base.kd:g}, m1 over "
+    print(f"{runs.n} runs ({base.model} model, K_P = {base.kp:g}, K_D = {base.kd:g}, m1 over "
           f"{args.m1_range[0]:g}-{args.m1_range[1]:g} kg, {args.sampling}, seed {args.seed}):")
-    print("verdicts: " + ", ".join(f"{v} {c}" for v, c in counts.items()))
-    if counts["certified-outside"]:
-        print(f"!!! {counts['certified-outside']} run(s) CERTIFIED-OUTSIDE: the certificate's assumptions hold and "
+    print("verdicts: " + ", ".join(f"{v} {c}" for v, c in runs.verdicts.items()))
+    if runs.certified_outside:
+        print(f"!!! {runs.certified_outside} run(s) CERTIFIED-OUTSIDE: the certificate's assumptions hold and "
               "the run is outside it: a bug or a modelling gap; see runs.csv !!!")
-    print(f"certificate: worst sup|E|/E_max = {fmt(summary['worst_certificate_ratio'])}, "
-          f"worst sup|E'|/Edot_max = {fmt(summary['worst_certificate_Edot_ratio'])}; "
-          f"{summary['drift_growing']} runs with |E| still growing at the end")
-    print(f"paper's claim: {summary['inside']} inside, {summary['outside']} outside its region; "
-          f"worst sup|E|/E_max = {fmt(summary['worst_E_ratio'])}, "
-          f"worst sup|E'|/Edot_max = {fmt(summary['worst_Edot_ratio'])}; "
-          f"{summary['hit_steering_stop']} runs hit the steering stop")
-    law = f", {' and '.join(summary['batch_law'])} law" if summary["batch_law"] else ""
-    print(f"{summary['steps']} steps in {wall:.1f} s ({summary['steps_per_s']:.3g} steps/s{law})")
+    print(f"certificate: worst sup|E|/E_max = {fmt(runs.certificate_E_ratio.value)}, "
+          f"worst sup|E'|/Edot_max = {fmt(runs.certificate_Edot_ratio.value)}; "
+          f"{runs.growing} runs with |E| still growing at the end")
+    print(f"paper's claim: {runs.paper_inside} inside, {runs.n - runs.paper_inside} outside its region; "
+          f"worst sup|E|/E_max = {fmt(runs.paper_E_ratio.value)}, "
+          f"worst sup|E'|/Edot_max = {fmt(runs.paper_Edot_ratio.value)}; "
+          f"{runs.hit_stop} runs hit the steering stop")
+    law = f", {' and '.join(runs.batch_law)} law" if runs.batch_law else ""
+    print(f"{runs.steps} steps in {wall:.1f} s ({summary['steps_per_s']:.3g} steps/s{law})")
     print(f"table: {out / 'runs.csv'}\nplot:  {plot_path}")
     return 0
 
 
-def _plot(results: list[dict], summary: dict, stem: Path) -> Path:
+def _plot(results: list[dict], runs: SweepSummary, stem: Path) -> Path:
     """Fig.-7-style plot ``<stem>.png``: the bounds a run is judged by (sup|E| <= E_max and
     sup|E'| <= E'_max, the sweep's inside/outside) and every run's (sup|E|, sup|E'|)."""
     import math
@@ -144,9 +109,8 @@ def _plot(results: list[dict], summary: dict, stem: Path) -> Path:
 
     fig, ax = new_figure(5.0, 4.0)
     for (E_max, Ed_max), colour, label in (
-            ((summary.get("certificate_E_max"), summary.get("certificate_Edot_max")), "C2",
-             "certificate's bounds"),
-            ((summary["E_max"], summary["Edot_max"]), "C0", "paper's claim")):
+            ((runs.certificate_E_max, runs.certificate_Edot_max), "C2", "certificate's bounds"),
+            ((runs.paper_E_max, runs.paper_Edot_max), "C0", "paper's claim")):
         if E_max is not None and Ed_max is not None and math.isfinite(E_max) and math.isfinite(Ed_max):
             ax.add_patch(Rectangle((0, 0), E_max, Ed_max, alpha=0.15, color=colour, label=label))
     sc = ax.scatter([r["sup_E"] for r in results], [r["sup_Edot"] for r in results], c=[r["m1"] for r in results],

@@ -52,6 +52,7 @@ from wmr_mj.logs.foxglove import TF_SCHEMA_NAME, FrameTree, TfEncoder, scene_upd
 
 if TYPE_CHECKING:
     from wmr_mj.sim.config import RunConfig
+    from wmr_mj.sim.summary import RunSummary
 
 __all__ = ["RunLogger", "run_logged", "terminate_as_interrupt", "measure_logging_overhead", "COMPRESSIONS", "STATUSES"]
 
@@ -438,7 +439,7 @@ def measure_logging_overhead(run: Any, log_path: str | os.PathLike, *, repeats: 
     return {"unlogged_s": u, "logged_s": lg, "ratio": lg / u}
 
 
-def run_logged(config: RunConfig, path: str) -> dict[str, Any]:
+def run_logged(config: RunConfig, path: str) -> RunSummary:
     """Re-run ``config`` serially (``run_closed_loop``) with an MCAP log at ``path``; its summary."""
     import functools
 

@@ -66,7 +66,7 @@ Usage::
     from wmr_mj.reference.paths import make_reference, paper_circle, line, circle, transition
 
     ref = make_reference(paper_circle(C80), C80)           # Figs. 4-6
-    ref.bounds()        # {'max_abs_alpha0_dot': 0.23, 'max_abs_alpha0_ddot': ..., ...}
+    ref.bounds()        # ReferenceBounds(alpha_ddot_max=..., alpha_dot_max=0.23, ...)
     a0, a0_dot, a0_ddot = ref.at(12.3456)                   # vectorised in t
 
     path = line(0.5) + transition(1.0, to_radius=-2.0) + circle(-2.0, angle=1.5)
@@ -91,6 +91,7 @@ from scipy.optimize import brentq
 
 from wmr_mj.errors import InfeasiblePathError, ParameterError
 from wmr_mj.params import C80, C80Parameters
+from wmr_mj.reference.bounds import PAPER_BOUNDS, ReferenceBounds
 
 __all__ = [
     "Segment",
@@ -109,12 +110,6 @@ __all__ = [
     "PAPER_BOUNDS",
 ]
 
-#: The reference bounds of the paper's numerical example (5.1).
-PAPER_BOUNDS: dict[str, float] = {
-    "max_abs_alpha0_dot": 0.23,
-    "max_abs_alpha0_ddot": 0.4,
-    "max_sin_cos3": 1.24,
-}
 
 SegmentKind = Literal["line", "arc", "transition", "ramp", "lane_change"]
 
@@ -771,19 +766,21 @@ class Reference:
             return float(alpha), float(alpha_d), float(alpha_dd)
         return alpha, alpha_d, alpha_dd
 
-    def bounds(self) -> dict[str, float]:
+    def bounds(self) -> ReferenceBounds:
         """Maxima over the grid, the quantities of (5.1).
 
-        max_abs_alpha0_dot, max_abs_alpha0_ddot, max_sin_cos3
-        (max |sin(alpha0)/cos^3(alpha0)|), max_abs_alpha0.
+        Returns:
+            ReferenceBounds: alpha_ddot_max = max|alpha0''| [rad/s^2], alpha_dot_max =
+            max|alpha0'| [rad/s], sin_cos3_max = max|sin(alpha0)/cos^3(alpha0)| [-],
+            alpha_max = max|alpha0| [rad].
         """
         a = self.alpha0
-        return {
-            "max_abs_alpha0_dot": float(np.max(np.abs(self.alpha0_dot))),
-            "max_abs_alpha0_ddot": float(np.max(np.abs(self.alpha0_ddot))),
-            "max_sin_cos3": float(np.max(np.abs(np.sin(a) / np.cos(a) ** 3))),
-            "max_abs_alpha0": float(np.max(np.abs(a))),
-        }
+        return ReferenceBounds(
+            alpha_ddot_max=float(np.max(np.abs(self.alpha0_ddot))),
+            alpha_dot_max=float(np.max(np.abs(self.alpha0_dot))),
+            sin_cos3_max=float(np.max(np.abs(np.sin(a) / np.cos(a) ** 3))),
+            alpha_max=float(np.max(np.abs(a))),
+        )
 
 
 def make_reference(
@@ -912,8 +909,8 @@ def paper_circle(
     duration: float = 35.0,
     entry: Literal["ramp", "blend"] = "ramp",
     transition: float | None = None,
-    peak_rate: float = PAPER_BOUNDS["max_abs_alpha0_dot"],
-    peak_accel: float = PAPER_BOUNDS["max_abs_alpha0_ddot"],
+    peak_rate: float = PAPER_BOUNDS.alpha_dot_max,
+    peak_accel: float = PAPER_BOUNDS.alpha_ddot_max,
 ) -> Path:
     """The paper's experiment (Figs. 4-6): C on a circle of ``radius`` m at params.V_A.
 

@@ -59,14 +59,14 @@ def _history_figures(nominal: Mapping[str, Any]) -> dict[str, Any]:
 
     figs = {}
     for name, run in nominal.items():
-        cert = run.summary["certificate"]
-        if cert.get("certified"):
-            bounds, whose = (cert["E_max"], cert["Edot_max"]), "certificate"
+        s = run.summary
+        if s.certificate is not None and s.certificate.certified:
+            bounds, whose = (s.certificate.E_max, s.certificate.Edot_max), "certificate"
         else:
-            bounds, whose = (run.summary["E_max"], run.summary["Edot_max"]), "paper's claim"
+            bounds, whose = (s.E_max, s.Edot_max), "paper's claim"
         figs[f"history_{name}"] = plots.figure_time_history(
-            run.rows, run.summary, voltage_limit=C80.voltage_limit, bounds=bounds, bound_name=whose,
-            title=f"{name} design on the MuJoCo plant, m1 = {run.summary['m1']:g} kg: {run.summary['verdict']}")
+            run.rows, s, voltage_limit=C80.voltage_limit, bounds=bounds, bound_name=whose,
+            title=f"{name} design on the MuJoCo plant, m1 = {s.m1:g} kg: {s.verdict}")
     return figs
 
 

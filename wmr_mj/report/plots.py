@@ -64,6 +64,7 @@ from wmr_mj.params import M1_NOMINAL, PAPER_KD, PAPER_KP  # noqa: E402
 
 if TYPE_CHECKING:
     from wmr_mj.sim.falsify import FalsifyResult
+    from wmr_mj.sim.summary import RunSummary
 
 __all__ = [
     "STYLE",
@@ -521,22 +522,28 @@ def plot_time_history(axes, rows: Mapping[str, np.ndarray], *, E_max: float | No
         ax.legend(loc="upper right", fontsize=6.5, framealpha=0.9)
 
 
-def figure_time_history(rows: Mapping[str, np.ndarray], summary: Mapping[str, Any], *,
+def figure_time_history(rows: Mapping[str, np.ndarray], summary: RunSummary, *,
                         voltage_limit: float | None = None, title: str | None = None,
                         bounds: tuple[float | None, float | None] | None = None,
                         bound_name: str | None = None) -> Figure:
-    """Three-panel time history of one run (``summary``: the run's report).
+    """Three-panel time history of one run.
 
-    bounds: (E_max [rad], Edot_max [rad/s]) to draw, named ``bound_name``; default the
-    summary's E_max, Edot_max (the paper's claim).
+    Args:
+        rows: the run's rows (``RunResult.rows``).
+        summary: the run's summary.
+        voltage_limit: the supply to draw [V]; None: none.
+        title: the figure's title; default the model and m1.
+        bounds: (E_max [rad], Edot_max [rad/s]) to draw, named ``bound_name``; default the
+            summary's E_max, Edot_max (the paper's claim).
+        bound_name: the legend's name of ``bounds``.
     """
     fig, axes = new_figure(5.6, 5.6, 3, 1, sharex=True)
-    E_max, Ed_max = bounds if bounds is not None else (summary.get("E_max"), summary.get("Edot_max"))
+    E_max, Ed_max = bounds if bounds is not None else (summary.E_max, summary.Edot_max)
     plot_time_history(axes, rows, E_max=None if E_max is None else float(E_max),
                       Edot_max=None if Ed_max is None else float(Ed_max), voltage_limit=voltage_limit,
-                      settle_s=summary.get("settle_s"), stop_at=summary.get("left_steering_range_at_s"),
+                      settle_s=summary.settle_s, stop_at=summary.left_steering_range_at_s,
                       bound_name=bound_name)
-    axes[0].set_title(title or f"{summary.get('model', '')} model, plant m1 = {summary.get('m1', float('nan')):g} kg")
+    axes[0].set_title(title or f"{summary.model} model, plant m1 = {summary.m1:g} kg")
     return fig
 
 
@@ -734,7 +741,7 @@ class PaperExample:
     result: Any  # RobustnessResult of (5.1)
     reduced: list[tuple[str, dict[str, np.ndarray]]] = field(default_factory=list)
     mujoco_rows: dict[str, np.ndarray] | None = None
-    mujoco_summary: dict[str, Any] | None = None
+    mujoco_summary: RunSummary | None = None
 
 
 def paper_example(*, duration: float = 35.0, friction_width: float = 1e-3, mujoco: bool = True) -> PaperExample:
@@ -747,10 +754,11 @@ def paper_example(*, duration: float = 35.0, friction_width: float = 1e-3, mujoc
     (b) ``run_closed_loop(RunConfig(model='paper'))`` on the MuJoCo plant.
     """
     from controllers import ComputedTorque
-    from wmr_mj.analysis.robustness import ParameterBox, ReferenceBounds, analyse
+    from wmr_mj.analysis.robustness import ParameterBox, analyse
     from wmr_mj.errors import ParameterError
     from wmr_mj.params import C80
     from wmr_mj.plant.reduced import SteeringModel
+    from wmr_mj.reference.bounds import ReferenceBounds
     from wmr_mj.sim.closed_loop import run_closed_loop, run_on_reduced_model
     from wmr_mj.sim.config import RunConfig, build_reference
 
@@ -785,7 +793,7 @@ def fig7_series(example: PaperExample) -> list[Series]:
         series.append(Series(label=f"(a) paper's view, reduced paper model as plant: {name}",
                              E=np.abs(rows["E"]), E_dot=np.abs(rows["E_dot"]), color=color, ls=ls, tag="(a)"))
     if example.mujoco_rows is not None:
-        m1 = example.mujoco_summary.get("m1", M1_NOMINAL) if example.mujoco_summary else M1_NOMINAL
+        m1 = example.mujoco_summary.m1 if example.mujoco_summary else M1_NOMINAL
         series.append(Series(label=f"(b) MuJoCo plant (m1 = {m1:g} kg), paper-model controller",
                              E=np.abs(example.mujoco_rows["E"]), E_dot=np.abs(example.mujoco_rows["E_dot"]),
                              color=_COLORS["mujoco"], ls="-", tag="(b) MuJoCo"))
@@ -794,15 +802,15 @@ def fig7_series(example: PaperExample) -> list[Series]:
 
 def paper_figures(example: PaperExample) -> dict[str, Figure]:
     """{stem: Figure} of Figs. 4-7 (stems :data:`PAPER_FIGURE_NAMES`)."""
-    from wmr_mj.reference.paths import PAPER_BOUNDS
+    from wmr_mj.reference.bounds import PAPER_BOUNDS
 
     ref = example.reference
     r = example.result
     figs = {
         "fig4_trajectory": figure_paths(ref),
         "fig5_alpha0": figure_alpha0(ref),
-        "fig6_alpha0_rates": figure_alpha0_rates(ref, rate_bound=PAPER_BOUNDS["max_abs_alpha0_dot"],
-                                                 accel_bound=PAPER_BOUNDS["max_abs_alpha0_ddot"]),
+        "fig6_alpha0_rates": figure_alpha0_rates(ref, rate_bound=PAPER_BOUNDS.alpha_dot_max,
+                                                 accel_bound=PAPER_BOUNDS.alpha_ddot_max),
         "fig7_region": figure_region(
             r, fig7_series(example),
             title=(f"Fig. 7  Region of the (5.1) example (paper box, K_P = {r.kp:g}, K_D = {r.kd:g}): "

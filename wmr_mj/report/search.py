@@ -117,11 +117,11 @@ def _evaluate_search(spec, *, nthread: int, progress: Callable[[float, int], Non
                               progress=lambda k, n: progress(len(runs) + k, spec.budget))
         values = []
         for p, r in zip(points, reports):
-            v = objective_value(r, spec.objective)
+            v = objective_value(r.to_dict(), spec.objective)
             values.append(np.nan if v is None else v)
             runs.append({"generation": generation[0], "params": {n: float(x) for n, x in zip(spec.names, p)},
-                         "objective": None if v is None else float(v), "sup_E": float(r["sup_E"]),
-                         "sup_Edot": float(r["sup_Edot"]), "verdict": str(r.get("verdict"))})
+                         "objective": None if v is None else float(v), "sup_E": float(r.sup_E),
+                         "sup_Edot": float(r.sup_Edot), "verdict": str(r.verdict)})
         generation[0] += 1
         return np.array(values)
 
@@ -214,8 +214,10 @@ def run_search(plan: SearchPlan, settings: ValidateSettings, folder: Path, st: S
     runs = _evaluate_search(spec, nthread=settings.nthread, progress=stage_progress(st))
     worst = _worst_of(runs)
     out.mkdir(parents=True, exist_ok=True)
-    logged = run_logged(spec.config([worst["params"][n] for n in spec.names]), str(out / "worst.mcap")) if worst else {}
-    result = _result(plan, spec, runs, worst, bool(worst and logged.get("sup_E") == worst["sup_E"]),
+    logged = None
+    if worst:
+        logged = run_logged(spec.config([worst["params"][n] for n in spec.names]), str(out / "worst.mcap"))
+    result = _result(plan, spec, runs, worst, bool(worst and logged is not None and logged.sup_E == worst["sup_E"]),
                      certificate_for(spec.base, reference), out, folder)
     _compare(result, plan, rungs, folder)
     write_text_atomic(out / "evaluations.csv", _evaluations_csv(spec.names, runs))

@@ -10,7 +10,7 @@ Usage::
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from typing import Any
 
@@ -19,6 +19,7 @@ from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import C80, M1_NOMINAL, M1_RANGE
 from wmr_mj.sim.config import RunConfig, build_reference
 from wmr_mj.sim.designs import Design
+from wmr_mj.sim.sweep import max_at  # noqa: F401  (re-exported: the report reads runs.csv with it)
 
 __all__ = [
     "DEFAULT_N",
@@ -120,16 +121,6 @@ class ValidateSettings:
         d = asdict(self)
         d["m1_range"] = list(self.m1_range)
         return d
-
-
-def max_at(rows: Sequence[Mapping[str, Any]], column: str) -> tuple[float | None, float | None]:
-    """(largest value of ``column``, the m1 of its run); (None, None) when the column is empty."""
-    best, m1 = None, None
-    for r in rows:
-        v = r.get(column)
-        if v is not None and (best is None or float(v) > best):
-            best, m1 = float(v), float(r["m1"])
-    return best, m1
 
 
 def certificate_summary(cert: Any) -> dict[str, Any]:

@@ -39,7 +39,6 @@ from typing import Any
 
 from wmr_mj._util.files import software_versions
 from wmr_mj._util.progress import Stages
-from wmr_mj.errors import ParameterError
 from wmr_mj.params import C80
 from wmr_mj.report.settings import (
     DEFAULT_DURATION,
@@ -51,7 +50,6 @@ from wmr_mj.report.settings import (
     ValidateSettings,
     certificate_summary,
     loud,
-    max_at,
     paper_circle_reference,
     stage_progress,
 )
@@ -83,33 +81,18 @@ __all__ = [
 def summarise_rung(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
     """The numbers of one rung from its runs (rows of runs.csv, ``sweep.read_results``).
 
-    verdicts: a count for each of the four verdicts; paper_inside: runs inside the paper's
-    claim; worst sup|E| (and its m1), worst sup|E|/E_max of the certificate and of the paper's
-    claim; hit_stop: runs that reached the steering stop; growing: runs whose |E| still grows.
-    """
-    from wmr_mj.analysis.verdicts import PASS, count_verdicts
+    :meth:`wmr_mj.sim.sweep.SweepSummary.rung_dict` of the sweep's one aggregator: verdicts
+    (a count for each of the four), passes, certified_outside, paper_inside (runs inside the
+    paper's claim), the worst sup|E| [rad] (and its m1 [kg]), sup|E'| [rad/s], sup|E|/E_max of
+    the certificate and of the paper's claim (and their m1), hit_stop (runs that reached the
+    steering stop), growing (runs whose |E| still grows), mean_saturated_fraction, m1_min, m1_max.
 
-    if not rows:
-        raise ParameterError("no runs to summarise")
-    verdicts = count_verdicts(str(r["verdict"]) for r in rows if r.get("verdict"))
-    sup_E, sup_E_m1 = max_at(rows, "sup_E")
-    cert_ratio, cert_m1 = max_at(rows, "cert_E_ratio")
-    paper_ratio, paper_m1 = max_at(rows, "E_ratio")
-    return {
-        "n": len(rows),
-        "verdicts": verdicts,
-        "passes": verdicts[PASS],
-        "certified_outside": verdicts["certified-outside"],
-        "paper_inside": sum(bool(r["inside"]) for r in rows),
-        "worst_sup_E": sup_E, "worst_sup_E_m1": sup_E_m1,
-        "worst_sup_Edot": max(float(r["sup_Edot"]) for r in rows),
-        "worst_certificate_ratio": cert_ratio, "worst_certificate_ratio_m1": cert_m1,
-        "worst_paper_ratio": paper_ratio, "worst_paper_ratio_m1": paper_m1,
-        "hit_stop": sum(bool(r["left_steering_range"]) for r in rows),
-        "growing": sum(bool(r.get("drift_growing")) for r in rows),
-        "mean_saturated_fraction": sum(float(r["saturated_fraction"]) for r in rows) / len(rows),
-        "m1_min": min(float(r["m1"]) for r in rows), "m1_max": max(float(r["m1"]) for r in rows),
-    }
+    Raises:
+        ParameterError: no rows.
+    """
+    from wmr_mj.sim.sweep import SweepSummary
+
+    return SweepSummary.of(rows).rung_dict()
 
 
 def ladder_changes(before: Design, after: Design) -> list[str]:
@@ -212,19 +195,20 @@ def nominal_stage(settings: ValidateSettings, st: Stages) -> dict[str, Any]:
 
     st.start("nominal", f"nominal runs at m1 = {settings.nominal_m1:g} kg (paper's and certified design)")
     runs = {d.name: run_closed_loop(settings.config(d), progress=False) for d in (PAPER, CERTIFIED)}
-    st.done(", ".join(f"{name}: sup|E| = {r.summary['sup_E']:.3g} rad, {r.summary['verdict']}"
+    st.done(", ".join(f"{name}: sup|E| = {r.summary.sup_E:.3g} rad, {r.summary.verdict}"
                       for name, r in runs.items()))
     return runs
 
 
 def _nominal_summary(run) -> dict[str, Any]:
+    """The report's JSON of one nominal run (keys of its summary, the certificate's ratio, the drift)."""
     s = run.summary
-    keys = ("m1", "sup_E", "sup_Edot", "settle_s", "sup_E_settled", "verdict", "inside", "E_ratio",
-            "left_steering_range_at_s", "final_alpha", "saturated_fraction")
-    out = {k: s.get(k) for k in keys}
-    out["certificate_E_ratio"] = (s.get("certificate") or {}).get("E_ratio")
-    out["drift"] = s.get("drift")
-    return out
+    return {"m1": s.m1, "sup_E": s.sup_E, "sup_Edot": s.sup_Edot, "settle_s": s.settle_s,
+            "sup_E_settled": s.sup_E_settled, "verdict": s.verdict, "inside": s.inside, "E_ratio": s.E_ratio,
+            "left_steering_range_at_s": s.left_steering_range_at_s, "final_alpha": s.final_alpha,
+            "saturated_fraction": s.saturated_fraction,
+            "certificate_E_ratio": None if s.certificate is None else s.certificate.E_ratio,
+            "drift": None if s.drift is None else s.drift.to_dict()}
 
 
 # --------------------------------------------------------------------------- stage 7: the report

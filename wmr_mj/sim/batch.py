@@ -24,11 +24,12 @@ Usage::
     from wmr_mj.sim.closed_loop import RunConfig
     base = RunConfig(model="nonholonomic", duration=20.0)
     reports = run_batch([base.replace(m1=m) for m in (550.0, 650.0, 750.0)], nthread=2)
-    [r["sup_E"] for r in reports]        # each as run_closed_loop(config).summary["sup_E"]
+    [r.sup_E for r in reports]           # each a RunSummary, as run_closed_loop(config).summary
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import threading
@@ -56,6 +57,7 @@ from wmr_mj.sim.config import (
     estimate_parameters,
     plant_parameters,
 )
+from wmr_mj.sim.summary import BatchFigures, RunSummary
 
 __all__ = ["run_batch", "batch_model", "batch_law_backend", "LAW_BACKENDS", "thread_count", "batch_groups"]
 
@@ -308,7 +310,7 @@ def _block_stats(loop: _Loop, stats: _BatchStats, idx: np.ndarray, k0: int, rows
 
 
 def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parameters = C80,
-              progress: Callable[[int, int], None] | None = None, law: str = "auto") -> list[dict[str, Any]]:
+              progress: Callable[[int, int], None] | None = None, law: str = "auto") -> list[RunSummary]:
     """Run closed-loop configs that differ only in their plant parameters, all at once.
 
     ``law`` (:data:`LAW_BACKENDS`, :func:`batch_law_backend`): 'compiled' runs one
@@ -318,9 +320,10 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
     its own Python thread with its own vectorised law (``controller.batch_law``), so that
     the law of one group runs while the others step; 'auto' (the default) takes the
     compiled law where it can run. Each simulation has its own compiled model. Returns
-    per-run reports, each bit-identical to ``run_closed_loop`` of the same config, whichever
-    the law. ``batch_cpu_s`` is the CPU time of the group threads (a figure for benchmarks
-    on a shared machine; batch-internal threads excluded), ``batch_law`` the law that ran.
+    per-run :class:`RunSummary` records, each bit-identical to ``run_closed_loop`` of the same
+    config, whichever the law. Their ``batch.cpu_s`` is the CPU time of the group threads (a
+    figure for benchmarks on a shared machine; batch-internal threads excluded), ``batch.law``
+    the law that ran.
     """
     if not configs:
         return []
@@ -415,16 +418,15 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
             # loop does): a warning, after which rollout stopped the simulation. The serial run
             # is the truth
             serial = run_closed_loop(c, progress=False, base=base).summary
-            r = {key: serial[key] for key in r}
-            r["mujoco_warnings"] = serial["mujoco_warnings"]
+            r = dataclasses.replace(serial, analysis=None, controller_config=None)  # report's fields and the warnings
         else:
-            r["mujoco_warnings"] = int(stats.warnings[i])
-        r["final_alpha_after_step"] = float(stats.final_alpha_after_step[i])  # the serial run reports the last row
-        # batch-level figures for benchmarks
-        r["batch_wall_s"] = wall
-        r["batch_steps_per_s"] = nsim * n * substeps / wall if wall > 0 else None
-        r["batch_cpu_s"] = sum(stats.cpu_s)  # robust to a shared machine, unlike the wall time
-        r["batch_law"] = backend
+            r = dataclasses.replace(r, mujoco_warnings=int(stats.warnings[i]))
+        r = dataclasses.replace(r, batch=BatchFigures(
+            final_alpha_after_step=float(stats.final_alpha_after_step[i]),  # the serial run reports the last row
+            # batch-level figures for benchmarks
+            wall_s=wall, steps_per_s=nsim * n * substeps / wall if wall > 0 else None,
+            cpu_s=sum(stats.cpu_s),  # robust to a shared machine, unlike the wall time
+            law=backend))
         reports.append(r)
     return reports
 

@@ -24,6 +24,11 @@ from wmr_mj.analysis.certificate import (
     PLANT_K_MEASURED,
     Assumption,
     Certificate,
+    Compensation,
+    Estimate,
+    Gains,
+    PlantBox,
+    PlantLimits,
     _hull,
     _interval,
     _number,
@@ -122,10 +127,10 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
     sign = "none" if pd else controller.friction_sign
     width = 0.0 if pd else controller.friction_width
     c = model.coefficients
-    est = {"P": c.P, "C_V": 0.0, "F": 0.0, "K": 0.0, "gyro": 0.0} if pd else {
-        "P": c.P, "C_V": c.C_V, "F": 0.0 if sign == "none" else c.F, "K": c.K, "gyro": c.gyro}
+    # a PD law has no model but P^ (its gain scale); F^ is the compensation's amplitude
+    estimate = Estimate(P=c.P, C_V=0.0, F=0.0, K=0.0, gyro=0.0, V_A=model.V_A) if pd else Estimate(
+        P=c.P, C_V=c.C_V, F=0.0 if sign == "none" else c.F, K=c.K, gyro=c.gyro, V_A=model.V_A)
 
-    bounds = reference.bounds()
     period = config.control_period if config.control_period is not None else TIMESTEP
     initial = (float(reference.alpha0[0]), float(reference.alpha0_dot[0]))  # the plant starts at alpha = alpha' = 0
 
@@ -143,13 +148,12 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
                    "fraction of the band used by measurements: MuJoCo identify seeds 0-5 0.492-0.704 V s/m "
                    "(0.78-1.12 P/l1), Drake 0.621-0.644 (physics.md section 6)", kind="stated"),
     )
-    cert = certify(box=plant_box, gyro=gyro, V_A=V_A, P_hat=est["P"], C_V_hat=est["C_V"], F_hat=est["F"],
-                   K_hat=est["K"], gyro_hat=est["gyro"], V_A_hat=model.V_A, kp=config.kp, kd=config.kd,
-                   friction_sign=sign, friction_width=width, feedforward=not pd,
-                   alpha0_max=bounds["max_abs_alpha0"], alpha0_dot_max=bounds["max_abs_alpha0_dot"],
-                   alpha0_ddot_max=bounds["max_abs_alpha0_ddot"], steering_range=plant.steering_range,
-                   voltage_limit=plant.voltage_limit, control_period=period, initial_error=initial,
-                   stated=stated, friction_over_P=ratio)
+    cert = certify(plant=PlantBox(box=plant_box, gyro=gyro, V_A=V_A, friction_over_P=ratio),
+                   estimate=estimate, gains=Gains(kp=config.kp, kd=config.kd),
+                   reference=reference.bounds(),
+                   limits=PlantLimits(steering_range=plant.steering_range, voltage_limit=plant.voltage_limit),
+                   compensation=Compensation(friction_sign=sign, friction_width=width, feedforward=not pd),
+                   control_period=period, initial_error=initial, stated=stated)
     inputs = dict(cert.inputs)
     inputs.update(model=config.model, controller=controller.name, box_rule=config.box,
                   m1_range=list(config.m1_range), box_ranges={k: list(v) for k, v in ranges.items()},

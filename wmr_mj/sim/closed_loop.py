@@ -10,7 +10,7 @@ Usage::
 
     from wmr_mj.sim.closed_loop import RunConfig, run_closed_loop
     result = run_closed_loop(RunConfig(model="nonholonomic", m1=700.0))
-    print(result.summary["sup_E"], result.summary["E_max"], result.summary["inside"])
+    print(result.summary.sup_E, result.summary.E_max, result.summary.inside)
 
 ``wmr_mj.sim.batch`` runs many of these at once on ``mujoco.batch``; a test keeps
 the two bit-identical.
@@ -18,9 +18,10 @@ the two bit-identical.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -30,6 +31,7 @@ import numpy as np
 from controllers import SteeringController
 from wmr_mj._util.memory import require_run_memory
 from wmr_mj._util.progress import progress_bar
+from wmr_mj.analysis.verdicts import Drift
 from wmr_mj.errors import ParameterError
 from wmr_mj.params import C80, C80Parameters
 from wmr_mj.plant.mjcf import TIMESTEP, Plant
@@ -54,7 +56,7 @@ ROW_FIELDS = ("t", "alpha", "alpha_dot", "alpha0", "alpha0_dot", "alpha0_ddot", 
 
 @dataclass
 class RunResult:
-    """Time histories (one row per control step) and the run's summary."""
+    """Time histories (one row per control step) and the run's summary (a :class:`RunSummary`)."""
 
     config: RunConfig
     rows: dict[str, np.ndarray]
@@ -75,61 +77,71 @@ def _substeps(config: RunConfig, timestep: float) -> int:
 def report(config: RunConfig, *, analysis, params: C80Parameters, settle_s: float, sup_E: float, sup_Edot: float,
            sup_E_settled: float, sup_Edot_settled: float, saturated_fraction: float, left_range_at: float | None,
            final_alpha: float, control_steps: int, steps: int, wall_s: float, status: str,
-           certificate=None, drift: Mapping[str, Any] | None = None) -> RunSummary:
+           certificate=None, drift: Drift | None = None) -> RunSummary:
     """The run's report: sup errors (whole run and after the entry transient) against the region.
 
-    Shared by the serial runner and the batched sweep so both report alike. E_max,
-    Edot_max, inside, E_ratio, Edot_ratio are the paper's claim (``analysis``); with a
-    ``certificate`` (:mod:`wmr_mj.analysis.certificate`) and the end-of-run ``drift``
-    (:func:`wmr_mj.analysis.verdicts.drift`) the separated verdict is added
-    (:func:`wmr_mj.analysis.verdicts.judge_run`: verdict, certificate, paper_region, drift).
+    Shared by the serial runner and the batched sweep so both report alike.
+
+    Args:
+        config: the run's configuration.
+        analysis: the paper's region (``RobustnessResult``): the summary's E_max, Edot_max, inside,
+            E_ratio, Edot_ratio are the paper's claim.
+        params: the plant's parameters (its m1 [kg]).
+        settle_s: end of the entry transient [s].
+        sup_E, sup_Edot: sup |E| [rad], sup |E'| [rad/s] over the run.
+        sup_E_settled, sup_Edot_settled: the same after ``settle_s``.
+        saturated_fraction: fraction of control steps whose voltage was limited [-].
+        left_range_at: when the steering first reached its stop [s]; None if never.
+        final_alpha: alpha at the last control step [rad].
+        control_steps, steps: control and physics steps simulated.
+        wall_s: wall time [s].
+        status: 'completed' or 'interrupted'.
+        certificate: the run's :class:`wmr_mj.analysis.certificate.Certificate`; with it and the
+            end-of-run ``drift`` (:func:`wmr_mj.analysis.verdicts.drift`) the separated verdict is
+            added (:func:`wmr_mj.analysis.verdicts.judge_run`).
+
+    Returns:
+        RunSummary: ``to_dict()`` writes the JSON interface.
     """
     sup_E, sup_Edot = float(sup_E), float(sup_Edot)
     from wmr_mj.analysis.verdicts import judge_run, paper_region
 
-    paper = paper_region(analysis, sup_E, sup_Edot)
-    E_max, Ed_max = paper["E_max"], paper["Edot_max"]
-    out: RunSummary = {
-        "status": status,
-        "controller": config.controller,
-        "model": config.model,
-        "m1": float(params.m1),
-        "kp": config.kp,
-        "kd": config.kd,
-        "path": config.path,
-        "duration": steps * TIMESTEP,
-        "steps": int(steps),
-        "control_steps": int(control_steps),
-        "wall_s": float(wall_s),
-        "realtime_factor": float(steps * TIMESTEP / wall_s) if wall_s > 0 else None,
-        "sup_E": float(sup_E),
-        "sup_Edot": float(sup_Edot),
-        "settle_s": float(settle_s),
-        "sup_E_settled": float(sup_E_settled),
-        "sup_Edot_settled": float(sup_Edot_settled),
-        "E_max": E_max,
-        "Edot_max": Ed_max,
-        "condition": paper["condition"],
-        "stable": bool(analysis.stable),
-        "inside": paper["inside"],
-        "E_ratio": sup_E / E_max if math.isfinite(E_max) and E_max > 0 else None,
-        "Edot_ratio": sup_Edot / Ed_max if math.isfinite(Ed_max) and Ed_max > 0 else None,
-        "saturated_fraction": float(saturated_fraction),
-        "left_steering_range": left_range_at is not None,
-        "left_steering_range_at_s": left_range_at,
-        "final_alpha": float(final_alpha),
-    }
+    judged = None
     if certificate is not None:
-        out.update(judge_run(certificate=certificate, analysis=analysis, sup_E=sup_E, sup_Edot=sup_Edot,
-                             drift=drift or {}))
-    return out
+        judged = judge_run(certificate=certificate, analysis=analysis, sup_E=sup_E, sup_Edot=sup_Edot, drift=drift)
+    return RunSummary(
+        status=status,
+        controller=config.controller,
+        model=config.model,
+        m1=float(params.m1),
+        kp=config.kp,
+        kd=config.kd,
+        path=config.path,
+        duration=steps * TIMESTEP,
+        steps=int(steps),
+        control_steps=int(control_steps),
+        wall_s=float(wall_s),
+        realtime_factor=float(steps * TIMESTEP / wall_s) if wall_s > 0 else None,
+        sup_E=sup_E,
+        sup_Edot=sup_Edot,
+        settle_s=float(settle_s),
+        sup_E_settled=float(sup_E_settled),
+        sup_Edot_settled=float(sup_Edot_settled),
+        stable=bool(analysis.stable),
+        saturated_fraction=float(saturated_fraction),
+        left_steering_range_at_s=left_range_at,
+        final_alpha=float(final_alpha),
+        paper_region=paper_region(analysis, sup_E, sup_Edot) if judged is None else judged.paper_region,
+        certificate=None if judged is None else judged.certificate,
+        drift=None if judged is None else judged.drift,
+    )
 
 
 def _sup(x: np.ndarray) -> float:
     return float(np.max(np.abs(x))) if x.size else 0.0
 
 
-def _drift_of(E: np.ndarray, final_alpha_dot: float, period: float) -> dict[str, Any]:
+def _drift_of(E: np.ndarray, final_alpha_dot: float, period: float) -> Drift:
     """End-of-run drift from the serial rows (the batch computes the same windows per block).
 
     final_alpha_dot: alpha' of the last control step, as alpha0' - E' (the batch keeps E', not alpha').
@@ -281,12 +293,11 @@ def run_closed_loop(
                      left_range_at=left_range_at, final_alpha=done["alpha"][-1], control_steps=k,
                      steps=k * substeps, wall_s=wall, status=status, certificate=certificate,
                      drift=_drift_of(done["E"], done["alpha0_dot"][-1] - done["E_dot"][-1], period))
-    summary["mujoco_warnings"] = int(sum(w.number for w in d.warning))
-    summary["analysis"] = analysis.as_dict()
-    summary["controller_config"] = controller.describe()
+    summary = dataclasses.replace(summary, mujoco_warnings=int(sum(w.number for w in d.warning)),
+                                  analysis=analysis.as_dict(), controller_config=controller.describe())
     if logger is not None:
         flush(k)
-        logger.close(summary, status=status)
+        logger.close(summary.to_dict(), status=status)
     return RunResult(config=config, rows=done, summary=summary, status=status)
 
 

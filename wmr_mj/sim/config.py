@@ -163,13 +163,13 @@ def analysis_for(config: RunConfig, reference, params: C80Parameters = C80, *, e
     errors are then truth-anywhere-in-the-box minus this estimate. None: the
     estimate is anywhere in the box too, as in the paper's (4.2).
     """
-    from wmr_mj.analysis.robustness import ReferenceBounds, analyse
+    from wmr_mj.analysis.robustness import analyse
+    from wmr_mj.reference.bounds import ReferenceBounds
 
     box = analysis_box(config, params)
     b = reference.bounds()
-    bounds = ReferenceBounds(alpha_ddot_max=max(b["max_abs_alpha0_ddot"], 1e-12),
-                             alpha_dot_max=max(b["max_abs_alpha0_dot"], 1e-12),
-                             sin_cos3_max=max(b["max_sin_cos3"], 1e-12))
+    bounds = ReferenceBounds(alpha_ddot_max=max(b.alpha_ddot_max, 1e-12), alpha_dot_max=max(b.alpha_dot_max, 1e-12),
+                             sin_cos3_max=max(b.sin_cos3_max, 1e-12))
     return analyse(box, kp=config.kp, kd=config.kd, bounds=bounds, estimate=estimate)
 
 

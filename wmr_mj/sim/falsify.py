@@ -368,7 +368,8 @@ def falsify(spec: FalsifySpec, *, chunk: int = 128, nthread: int = 0, scheduler:
                 if progress is not None:
                     progress(base_done + k, total)
 
-            reports = run_configs(configs, chunk=chunk, nthread=nthread, client=client, progress=chunk_progress)
+            reports = [s.to_dict() for s in  # the summaries' JSON, what a search writes and reads back
+                       run_configs(configs, chunk=chunk, nthread=nthread, client=client, progress=chunk_progress)]
             done += len(reports)
             out = np.full(len(points), np.nan)
             generation = generation_of()

@@ -1,113 +1,212 @@
 """The run summary: one typed record shared by run, sweep, falsify, the report, the MCAP log and replay.
 
 ``wmr_mj.sim.closed_loop.report`` builds it (the serial runner and the batched sweep both call
-it, so both report alike); it is written as JSON into the MCAP log's metadata and into
-``runs.csv`` rows, and read back by ``wmr_mj.logs.replay`` and ``wmr_mj.report.validate``. The keys are
-typed here once (a ``TypedDict``: a plain, JSON-ready dict at run time, checked by a type
-checker), with their units.
+it, so both report alike). It is a frozen dataclass read by attribute; :meth:`RunSummary.to_dict`
+writes the JSON interface (``run --json``, the MCAP log's summary metadata, the rows of
+``runs.csv``), with the keys and values it has always had, so that scripts and logs written
+before keep reading. An MCAP log's summary is read back as that JSON (``wmr_mj.logs.reader``).
 
 Usage::
 
     from wmr_mj.sim.summary import RunSummary
-    def worst(rows: list[RunSummary]) -> float:
-        return max(r["certificate"]["E_ratio"] or 0.0 for r in rows)
+    def worst(summaries: list[RunSummary]) -> float:
+        return max(s.certificate.E_ratio or 0.0 for s in summaries)
+    summary.to_dict()["certificate"]["E_ratio"]      # the same number, as JSON
 """
 
 from __future__ import annotations
 
-from typing import Any, TypedDict
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
 
-__all__ = ["RunSummary", "PaperRegion", "Drift", "CertificateJudgement", "AssumptionRecord"]
+from wmr_mj.analysis.certificate import Assumption, CertificateJudgement
+from wmr_mj.analysis.verdicts import Drift, PaperRegion
 
-
-class AssumptionRecord(TypedDict):
-    """One assumption of the certificate: met when value <= limit (or as its equation says)."""
-
-    name: str
-    equation: str
-    met: bool
-    value: float | None
-    limit: float | None
-    note: str
-    kind: str  # 'checked' or 'stated'
+__all__ = ["RunSummary", "PaperRegion", "Drift", "CertificateJudgement", "Assumption", "BatchFigures"]
 
 
-class CertificateJudgement(TypedDict, total=False):
-    """``wmr_mj.analysis.certificate.judge``: the certificate with one run judged against it."""
+@dataclass(frozen=True)
+class BatchFigures:
+    """What a run of a batch (``wmr_mj.sim.batch.run_batch``) adds to its summary.
 
-    E_max: float | None  # rad; None when there is no certificate
-    Edot_max: float | None  # rad/s
-    condition: float | None  # left side of (4.23)
-    valid: bool
-    certified: bool  # every assumption met
-    assumptions: list[AssumptionRecord]
-    unmet: list[str]
-    inside: bool  # the run's (sup|E|, sup|E'|) inside region (4.21)
-    E_ratio: float | None  # sup|E| / E_max
-    Edot_ratio: float | None  # sup|E'| / Edot_max
-    region_ratio: float | None  # <= 1 inside
-    verdict: str
+    Attributes:
+        final_alpha_after_step: alpha after the last physics step [rad] (the serial run reports
+            the last row's, ``RunSummary.final_alpha``).
+        wall_s: the whole batch's wall time [s].
+        steps_per_s: physics steps of the whole batch per wall second [1/s]; None for no time.
+        cpu_s: CPU time of the batch's threads [s] (robust to a shared machine).
+        law: how the batch evaluated the law (``wmr_mj.sim.batch.LAW_BACKENDS``).
+    """
 
+    final_alpha_after_step: float
+    wall_s: float
+    steps_per_s: float | None
+    cpu_s: float
+    law: str
 
-class PaperRegion(TypedDict):
-    """The paper's claim: the region of wmr_mj.analysis.robustness (4.21)-(4.23), as the paper bounds it."""
-
-    E_max: float  # rad (inf when (4.23) fails)
-    Edot_max: float  # rad/s
-    condition: float
-    inside: bool
-
-
-class Drift(TypedDict, total=False):
-    """End of the run: is |E| still growing? (wmr_mj.analysis.verdicts.drift)"""
-
-    final_alpha_dot: float  # rad/s
-    growing: bool
-    E_last_window: float  # rad, max |E| over the last window
-    E_prev_window: float  # rad, over the window before it
-    window_s: float
-    tolerance: float  # rad
+    def to_dict(self) -> dict[str, Any]:
+        """The summary keys final_alpha_after_step, batch_wall_s, batch_steps_per_s, batch_cpu_s, batch_law."""
+        return {"final_alpha_after_step": self.final_alpha_after_step, "batch_wall_s": self.wall_s,
+                "batch_steps_per_s": self.steps_per_s, "batch_cpu_s": self.cpu_s, "batch_law": self.law}
 
 
-class RunSummary(TypedDict, total=False):
-    """What one closed-loop run reports (``RunResult.summary``, a row of a sweep, ``run --json``)."""
+@dataclass(frozen=True)
+class RunSummary:
+    """What one closed-loop run reports (``RunResult.summary``, a run of a sweep, ``run --json``).
 
-    status: str  # 'completed' or 'interrupted'
+    Attributes:
+        status: 'completed' or 'interrupted'.
+        controller: the controller's name.
+        model: the model source of the controller's estimate.
+        m1: the plant's chassis mass [kg].
+        kp: K_P [1/s^2].
+        kd: K_D [1/s].
+        path: the reference path's name.
+        duration: time simulated [s].
+        steps: physics steps.
+        control_steps: control steps.
+        wall_s: wall time of the run [s] (a batch: its share of the batch).
+        realtime_factor: simulated over wall time [-]; None for no wall time.
+        sup_E: sup |E| over the whole run [rad].
+        sup_Edot: sup |E'| over the whole run [rad/s].
+        settle_s: end of the entry transient [s].
+        sup_E_settled: sup |E| after settle_s [rad].
+        sup_Edot_settled: sup |E'| after settle_s [rad/s].
+        stable: (4.23) of the paper's claim holds.
+        saturated_fraction: fraction of the control steps whose voltage was limited [-].
+        left_steering_range_at_s: when |alpha| first reached the steering stop [s]; None if never.
+        final_alpha: alpha at the last control step [rad].
+        paper_region: the paper's claim, judged (its E_max, Edot_max, condition, inside).
+        certificate: the certificate, judged; None when the run was reported without one.
+        drift: the end-of-run drift; None when the run was reported without a certificate.
+        mujoco_warnings: MuJoCo's warning count (added by the runners).
+        analysis: the paper's region as ``RobustnessResult.as_dict()`` (the serial runner).
+        controller_config: the controller's ``describe()`` (the serial runner).
+        batch: what a batch adds (``run_batch``).
+    """
+
+    status: str
     controller: str
-    model: str  # model source of the estimate
-    m1: float  # kg, the plant's chassis mass
-    kp: float  # 1/s^2
-    kd: float  # 1/s
+    model: str
+    m1: float
+    kp: float
+    kd: float
     path: str
-    duration: float  # s simulated
-    steps: int  # physics steps
+    duration: float
+    steps: int
     control_steps: int
     wall_s: float
     realtime_factor: float | None
-    sup_E: float  # rad, whole run
-    sup_Edot: float  # rad/s
-    settle_s: float  # s, end of the entry transient
+    sup_E: float
+    sup_Edot: float
+    settle_s: float
     sup_E_settled: float
     sup_Edot_settled: float
-    # the paper's claim, flat (today's keys; also under paper_region)
-    E_max: float
-    Edot_max: float
-    condition: float
     stable: bool
-    inside: bool
-    E_ratio: float | None
-    Edot_ratio: float | None
     saturated_fraction: float
-    left_steering_range: bool
     left_steering_range_at_s: float | None
-    final_alpha: float  # rad
-    # the separated verdict (wmr_mj.analysis.verdicts)
-    verdict: str  # one of wmr_mj.analysis.verdicts.VERDICTS
-    certificate: CertificateJudgement
+    final_alpha: float
     paper_region: PaperRegion
-    drift: Drift
-    # added by the runners
-    mujoco_warnings: int
-    analysis: dict[str, Any]  # wmr_mj.analysis.robustness.RobustnessResult.as_dict()
-    controller_config: dict[str, Any]
-    log: str | None  # the MCAP path (run command)
+    certificate: CertificateJudgement | None = None
+    drift: Drift | None = None
+    mujoco_warnings: int | None = None
+    analysis: Mapping[str, Any] | None = None
+    controller_config: Mapping[str, Any] | None = None
+    batch: BatchFigures | None = None
+
+    # the paper's claim, read through paper_region (the JSON also writes these at the top level)
+    @property
+    def E_max(self) -> float:
+        """The paper's bound on |E| [rad]; inf when (4.23) fails."""
+        return self.paper_region.E_max
+
+    @property
+    def Edot_max(self) -> float:
+        """The paper's bound on |E'| [rad/s]; inf when (4.23) fails."""
+        return self.paper_region.Edot_max
+
+    @property
+    def condition(self) -> float:
+        """The left side of the paper's (4.23) [-]."""
+        return self.paper_region.condition
+
+    @property
+    def inside(self) -> bool:
+        """The run is inside the paper's claim."""
+        return self.paper_region.inside
+
+    @property
+    def E_ratio(self) -> float | None:
+        """sup|E| / the paper's E_max [-]; None when that bound is not finite and positive."""
+        E_max = self.paper_region.E_max
+        return self.sup_E / E_max if math.isfinite(E_max) and E_max > 0 else None
+
+    @property
+    def Edot_ratio(self) -> float | None:
+        """sup|E'| / the paper's Edot_max [-]; None when that bound is not finite and positive."""
+        Ed_max = self.paper_region.Edot_max
+        return self.sup_Edot / Ed_max if math.isfinite(Ed_max) and Ed_max > 0 else None
+
+    @property
+    def left_steering_range(self) -> bool:
+        """The steering reached its stop during the run."""
+        return self.left_steering_range_at_s is not None
+
+    @property
+    def verdict(self) -> str | None:
+        """The separated verdict (``wmr_mj.analysis.verdicts``); None without a certificate."""
+        return None if self.certificate is None else self.certificate.verdict
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON interface: every key the summary has always written, with the same values.
+
+        inf stays inf (the JSON writers write null); the keys of the verdict (verdict,
+        certificate, paper_region, drift) appear only with a certificate, those the runners
+        add (mujoco_warnings, analysis, controller_config, the batch's) only when set.
+        """
+        out: dict[str, Any] = {
+            "status": self.status,
+            "controller": self.controller,
+            "model": self.model,
+            "m1": self.m1,
+            "kp": self.kp,
+            "kd": self.kd,
+            "path": self.path,
+            "duration": self.duration,
+            "steps": self.steps,
+            "control_steps": self.control_steps,
+            "wall_s": self.wall_s,
+            "realtime_factor": self.realtime_factor,
+            "sup_E": self.sup_E,
+            "sup_Edot": self.sup_Edot,
+            "settle_s": self.settle_s,
+            "sup_E_settled": self.sup_E_settled,
+            "sup_Edot_settled": self.sup_Edot_settled,
+            "E_max": self.E_max,
+            "Edot_max": self.Edot_max,
+            "condition": self.condition,
+            "stable": self.stable,
+            "inside": self.inside,
+            "E_ratio": self.E_ratio,
+            "Edot_ratio": self.Edot_ratio,
+            "saturated_fraction": self.saturated_fraction,
+            "left_steering_range": self.left_steering_range,
+            "left_steering_range_at_s": self.left_steering_range_at_s,
+            "final_alpha": self.final_alpha,
+        }
+        if self.certificate is not None:
+            out["verdict"] = self.certificate.verdict
+            out["certificate"] = self.certificate.to_dict()
+            out["paper_region"] = self.paper_region.to_dict()
+            out["drift"] = {} if self.drift is None else self.drift.to_dict()
+        if self.mujoco_warnings is not None:
+            out["mujoco_warnings"] = self.mujoco_warnings
+        if self.analysis is not None:
+            out["analysis"] = dict(self.analysis)
+        if self.controller_config is not None:
+            out["controller_config"] = dict(self.controller_config)
+        if self.batch is not None:
+            out.update(self.batch.to_dict())
+        return out

@@ -14,7 +14,7 @@ Usage::
     from wmr_mj.sim.closed_loop import RunConfig
     from wmr_mj.sim.sweep import SweepSpec, run_sweep
     spec = SweepSpec(n=64, seed=1, sampling="lhs", base=RunConfig(model="nonholonomic", duration=20.0))
-    results = run_sweep(spec)             # list of per-run report dicts, in run order
+    results = run_sweep(spec)             # per-run rows (a summary's JSON, flat), in run order
 
 ``run_sweep(spec, out_dir=...)`` writes ``runs.csv`` after every chunk and
 resumes from it; ``scheduler="tcp://host:8786"`` runs the chunks on a Dask
@@ -41,6 +41,7 @@ from wmr_mj.errors import ParameterError, SchedulerError, UnknownNameError
 from wmr_mj.params import M1_RANGE, parameter_names
 from wmr_mj.sim.batch import run_batch
 from wmr_mj.sim.config import RunConfig
+from wmr_mj.sim.summary import RunSummary
 
 __all__ = [
     "SweepSpec",
@@ -52,6 +53,9 @@ __all__ = [
     "read_results",
     "run_configs",
     "flat_row",
+    "max_at",
+    "Worst",
+    "SweepSummary",
     "config_from_dict",
     "connect",
 ]
@@ -178,16 +182,23 @@ def _run_configs(spec: SweepSpec, samples: np.ndarray) -> list[RunConfig]:
 
 def _run_chunk(spec_json: str, indices: list[int], nthread: int,
                progress: Callable[[int, int], None] | None = None) -> list[dict[str, Any]]:
-    """Run the sweep's runs ``indices`` (a Dask task: arguments and result are plain data)."""
+    """Run the sweep's runs ``indices`` (a Dask task: arguments and result are plain data).
+
+    Returns:
+        One row per run: its summary's JSON (``RunSummary.to_dict()``) with ``run`` (its index)
+        and the value of each ranged parameter added.
+    """
     spec = spec_from_json(spec_json)
     samples = draw_samples(spec)
     configs = _run_configs(spec, samples[indices])
-    reports = run_batch(configs, nthread=nthread, progress=progress)
-    for i, r in zip(indices, reports):
+    rows = []
+    for i, summary in zip(indices, run_batch(configs, nthread=nthread, progress=progress)):
+        r = summary.to_dict()
         r["run"] = int(i)
         for name, value in zip(spec.names[1:], samples[i][1:]):
             r[name] = float(value)
-    return reports
+        rows.append(r)
+    return rows
 
 
 def spec_to_json(spec: SweepSpec) -> str:
@@ -210,14 +221,14 @@ def config_from_dict(obj: Mapping[str, Any]) -> RunConfig:
     return RunConfig(**d)
 
 
-def _run_config_chunk(config_dicts: list[dict[str, Any]], nthread: int) -> list[dict[str, Any]]:
-    """Reports of configs given as ``as_dict()`` (a Dask task: arguments and result are plain data)."""
+def _run_config_chunk(config_dicts: list[dict[str, Any]], nthread: int) -> list[RunSummary]:
+    """Summaries of configs given as ``as_dict()`` (a Dask task: plain data in, frozen records out)."""
     return run_batch([config_from_dict(d) for d in config_dicts], nthread=nthread)
 
 
 def run_configs(configs: Sequence[RunConfig], *, chunk: int = 128, nthread: int = 0, client: Any = None,
-                progress: Callable[[int, int], None] | None = None) -> list[dict[str, Any]]:
-    """Reports of ``configs`` (differing only in plant parameters), in order.
+                progress: Callable[[int, int], None] | None = None) -> list[RunSummary]:
+    """Summaries of ``configs`` (differing only in plant parameters), in order.
 
     Locally: batches of at most ``chunk`` simulations (``run_batch``). With a Dask
     ``client`` (see :func:`connect`): one task per chunk, the same numbers.
@@ -226,7 +237,7 @@ def run_configs(configs: Sequence[RunConfig], *, chunk: int = 128, nthread: int 
     if chunk < 1:
         raise ParameterError(f"chunk = {chunk} must be >= 1")
     parts = [list(configs[i:i + chunk]) for i in range(0, len(configs), chunk)]
-    reports: list[dict[str, Any]] = []
+    reports: list[RunSummary] = []
     if client is not None:
         futures = [client.submit(_run_config_chunk, [c.as_dict() for c in part], 1, pure=False) for part in parts]
         for fut in futures:
@@ -360,3 +371,180 @@ def run_sweep(spec: SweepSpec, *, out_dir: str | os.PathLike | None = None, chun
         for c in chunks:
             record(_run_chunk(spec_json, c, nthread, _chunk_progress(progress, len(done), len(c), spec.n)))
     return [done[i] for i in range(spec.n)]
+
+
+# -- the summary of a sweep's runs (sweep --json and validate's rungs) ------------------------
+
+def max_at(rows: Sequence[Mapping[str, Any]], column: str) -> tuple[float | None, float | None]:
+    """The largest value of ``column`` and the m1 of its run (the first of equals).
+
+    Args:
+        rows: runs (rows of runs.csv or of :func:`run_sweep`).
+        column: the column to maximise; rows where it is None are skipped.
+
+    Returns:
+        (value, m1 [kg]); (None, None) when the column is empty.
+    """
+    best, m1 = None, None
+    for r in rows:
+        v = r.get(column)
+        if v is not None and (best is None or float(v) > best):
+            best, m1 = float(v), float(r["m1"])
+    return best, m1
+
+
+@dataclass(frozen=True)
+class Worst:
+    """The largest value of one quantity over a sweep's runs, and where.
+
+    Attributes:
+        value: the largest value (units of the quantity); None when no run has one.
+        m1: the m1 of its run [kg]; None with the value.
+    """
+
+    value: float | None
+    m1: float | None
+
+
+@dataclass(frozen=True)
+class SweepSummary:
+    """What a sweep's runs add up to: the one aggregator of ``wmr-mj sweep`` and validate's rungs.
+
+    :meth:`of` reads rows of runs.csv (or of :func:`run_sweep`, which carry the same columns);
+    :meth:`sweep_dict` writes ``wmr-mj sweep --json``'s keys, :meth:`rung_dict` validate's.
+
+    Attributes:
+        n: number of runs.
+        verdicts: the count of each verdict (``wmr_mj.analysis.verdicts.VERDICTS``, zeros included).
+        paper_inside: runs inside the paper's claim.
+        sup_E: the worst sup|E| [rad].
+        sup_Edot: the worst sup|E'| [rad/s].
+        certificate_E_ratio: the worst sup|E|/E_max of the certificate [-].
+        certificate_Edot_ratio: the worst sup|E'|/Edot_max of the certificate [-].
+        paper_E_ratio: the worst sup|E|/E_max of the paper's claim [-].
+        paper_Edot_ratio: the worst sup|E'|/Edot_max of the paper's claim [-].
+        certificate_E_max: the certificate's E_max of the first run [rad]; None where it has none.
+        certificate_Edot_max: its Edot_max [rad/s].
+        paper_E_max: the paper's E_max of the first run [rad] (inf or None where (4.23) fails).
+        paper_Edot_max: its Edot_max [rad/s].
+        hit_stop: runs that reached the steering stop.
+        growing: runs whose |E| still grows at the end.
+        mean_saturated_fraction: the mean fraction of control steps at the voltage limit [-].
+        m1_min: the smallest m1 [kg].
+        m1_max: the largest m1 [kg].
+        steps: physics steps of the runs simulated by this call (resumed runs have none).
+        batch_law: how this call's batches evaluated the law (``wmr_mj.sim.batch.LAW_BACKENDS``).
+    """
+
+    n: int
+    verdicts: Mapping[str, int]
+    paper_inside: int
+    sup_E: Worst
+    sup_Edot: Worst
+    certificate_E_ratio: Worst
+    certificate_Edot_ratio: Worst
+    paper_E_ratio: Worst
+    paper_Edot_ratio: Worst
+    certificate_E_max: float | None
+    certificate_Edot_max: float | None
+    paper_E_max: float | None
+    paper_Edot_max: float | None
+    hit_stop: int
+    growing: int
+    mean_saturated_fraction: float
+    m1_min: float
+    m1_max: float
+    steps: int
+    batch_law: tuple[str, ...]
+
+    @classmethod
+    def of(cls, rows: Sequence[Mapping[str, Any]]) -> SweepSummary:
+        """Summarise ``rows`` (runs.csv columns: :data:`RESULT_COLUMNS`).
+
+        Raises:
+            ParameterError: no rows.
+        """
+        from wmr_mj.analysis.verdicts import count_verdicts
+
+        if not rows:
+            raise ParameterError("no runs to summarise")
+        first = rows[0]
+        return cls(
+            n=len(rows),
+            verdicts=count_verdicts(str(r["verdict"]) for r in rows if r.get("verdict")),
+            paper_inside=sum(bool(r["inside"]) for r in rows),
+            sup_E=Worst(*max_at(rows, "sup_E")),
+            sup_Edot=Worst(*max_at(rows, "sup_Edot")),
+            certificate_E_ratio=Worst(*max_at(rows, "cert_E_ratio")),
+            certificate_Edot_ratio=Worst(*max_at(rows, "cert_Edot_ratio")),
+            paper_E_ratio=Worst(*max_at(rows, "E_ratio")),
+            paper_Edot_ratio=Worst(*max_at(rows, "Edot_ratio")),
+            certificate_E_max=first.get("cert_E_max"),
+            certificate_Edot_max=first.get("cert_Edot_max"),
+            paper_E_max=first.get("E_max"),
+            paper_Edot_max=first.get("Edot_max"),
+            hit_stop=sum(bool(r["left_steering_range"]) for r in rows),
+            growing=sum(bool(r.get("drift_growing")) for r in rows),
+            mean_saturated_fraction=sum(float(r["saturated_fraction"]) for r in rows) / len(rows),
+            m1_min=min(float(r["m1"]) for r in rows),
+            m1_max=max(float(r["m1"]) for r in rows),
+            steps=sum(int(r["steps"]) for r in rows if r.get("steps") is not None),
+            batch_law=tuple(sorted({r["batch_law"] for r in rows if r.get("batch_law")})),
+        )
+
+    @property
+    def passes(self) -> int:
+        """Runs ``certified-inside``, the only pass."""
+        from wmr_mj.analysis.verdicts import PASS
+
+        return self.verdicts[PASS]
+
+    @property
+    def certified_outside(self) -> int:
+        """Runs ``certified-outside``: a bug or a modelling gap."""
+        return self.verdicts["certified-outside"]
+
+    def sweep_dict(self, wall_s: float) -> dict[str, Any]:
+        """``wmr-mj sweep --json``'s keys (summary.json of a sweep folder); ``wall_s``: the sweep's wall time [s]."""
+        return {
+            "n": self.n,
+            "verdicts": dict(self.verdicts),
+            "worst_certificate_ratio": self.certificate_E_ratio.value,
+            "worst_certificate_Edot_ratio": self.certificate_Edot_ratio.value,
+            "certificate_E_max": self.certificate_E_max,
+            "certificate_Edot_max": self.certificate_Edot_max,
+            "drift_growing": self.growing,
+            "inside": self.paper_inside,
+            "outside": self.n - self.paper_inside,
+            "worst_E_ratio": self.paper_E_ratio.value,
+            "worst_Edot_ratio": self.paper_Edot_ratio.value,
+            "worst_sup_E": self.sup_E.value,
+            "worst_sup_Edot": self.sup_Edot.value,
+            "E_max": self.paper_E_max,
+            "Edot_max": self.paper_Edot_max,
+            "hit_steering_stop": self.hit_stop,
+            "steps": self.steps,
+            "wall_s": wall_s,
+            "steps_per_s": self.steps / wall_s if wall_s > 0 and math.isfinite(wall_s) else None,
+            # how the runs of this call evaluated the law (wmr_mj.sim.batch.LAW_BACKENDS; resumed runs: none)
+            "batch_law": list(self.batch_law),
+        }
+
+    def rung_dict(self) -> dict[str, Any]:
+        """The keys of one rung of ``wmr-mj validate``'s ladder (summary.json's ``ladder``)."""
+        return {
+            "n": self.n,
+            "verdicts": dict(self.verdicts),
+            "passes": self.passes,
+            "certified_outside": self.certified_outside,
+            "paper_inside": self.paper_inside,
+            "worst_sup_E": self.sup_E.value, "worst_sup_E_m1": self.sup_E.m1,
+            "worst_sup_Edot": self.sup_Edot.value,
+            "worst_certificate_ratio": self.certificate_E_ratio.value,
+            "worst_certificate_ratio_m1": self.certificate_E_ratio.m1,
+            "worst_paper_ratio": self.paper_E_ratio.value, "worst_paper_ratio_m1": self.paper_E_ratio.m1,
+            "hit_stop": self.hit_stop,
+            "growing": self.growing,
+            "mean_saturated_fraction": self.mean_saturated_fraction,
+            "m1_min": self.m1_min, "m1_max": self.m1_max,
+        }
