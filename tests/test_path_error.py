@@ -136,3 +136,45 @@ def test_bad_input(straight):
         path_errors(straight, straight.t, C, straight.theta)
     with pytest.raises(ParameterError, match="Reference"):
         path_errors(object(), [0.0], [[0.0, 0.0]], [0.0])
+
+
+def test_replay_reports_the_path_of_c(tmp_path, capsys):
+    """A real logged run (certified design, lane change, 6 s): `replay` prints C's path errors,
+    --json carries them, --plot draws the path panels; they equal the errors computed directly."""
+    import json
+
+    from wmr_mj.cli.app import main
+    from wmr_mj.logs.reader import load_log
+    from wmr_mj.logs.writer import RunLogger
+    from wmr_mj.sim.closed_loop import run_closed_loop
+    from wmr_mj.sim.config import RunConfig, build_reference
+    from wmr_mj.sim.designs import CERTIFIED
+
+    path = tmp_path / "run.mcap"
+    config = RunConfig(**CERTIFIED.config_changes(), path="lane-change", duration=6.0)
+    run_closed_loop(config, logger_factory=lambda **kw: RunLogger(path, **kw), progress=False)
+    assert main(["replay", str(path), "--json"]) == 0
+    rep = json.loads(capsys.readouterr().out)
+    pe = rep["path_errors"]
+    log = load_log(path)
+    ref, _ = build_reference("lane-change", C80, dt=1e-3, duration=6.0)
+    direct = path_errors(ref, log.signals["t"], log.signals["C_pos"], log.signals["heading"],
+                         settle_s=rep["settle_s"])
+    assert pe == direct.to_dict()
+    assert 0.0 < pe["cross_track_max"] < 0.05 and abs(pe["along_track_final"]) < 0.05
+    png = tmp_path / "run.png"
+    assert main(["replay", str(path), "--plot", str(png)]) == 0
+    out = capsys.readouterr().out
+    assert "path of C  cross-track max" in out and "along-track final" in out
+    assert png.stat().st_size > 20000
+
+
+def test_replay_without_a_path_says_why(tmp_path, capsys):
+    from test_mcaplog import synthetic_run
+
+    from wmr_mj.cli.app import main
+
+    path = tmp_path / "synthetic.mcap"
+    synthetic_run(path, 0.2, block_rows=100)
+    assert main(["replay", str(path)]) == 0
+    assert "path of C  n/a: the log's configuration names no path" in capsys.readouterr().out

@@ -62,14 +62,15 @@ def wrap_angle(x: ArrayLike) -> np.ndarray:
 class PathErrorSeries:
     """Per-sample errors of C (arrays of length n, read-only).
 
-    t [s]; s [m]: arc length of C's projection on the desired path; s_ref [m]: the timed
-    reference's arc length at t; cross_track [m] (> 0: left of the path); along_track [m]
-    (s - s_ref, > 0: ahead); heading_error [rad] (chassis heading minus the desired one at
-    the projection, wrapped); beyond_end: the projection fell on a continuation of the
-    path past its start or end.
+    t [s]; C_xy [m] (n, 2): C's positions judged; s [m]: arc length of C's projection on the
+    desired path; s_ref [m]: the timed reference's arc length at t; cross_track [m] (> 0:
+    left of the path); along_track [m] (s - s_ref, > 0: ahead); heading_error [rad] (chassis
+    heading minus the desired one at the projection, wrapped); beyond_end: the projection
+    fell on a continuation of the path past its start or end.
     """
 
     t: np.ndarray
+    C_xy: np.ndarray
     s: np.ndarray
     s_ref: np.ndarray
     cross_track: np.ndarray
@@ -252,7 +253,7 @@ def path_error_series(reference: Any, t: ArrayLike, C_xy: ArrayLike, heading: Ar
     s_ref = np.where(tt > rt[-1], rs[-1] + (tt - rt[-1]) * v1, s_ref)
     s, d = _project(gs, gxy, gk, X, float(s_ref[0]), win)
     theta_des = np.interp(s, gs, gth)
-    arrays = dict(t=tt, s=s, s_ref=s_ref, cross_track=d, along_track=s - s_ref,
+    arrays = dict(t=tt, C_xy=X.copy(), s=s, s_ref=s_ref, cross_track=d, along_track=s - s_ref,
                   heading_error=wrap_angle(h - theta_des), beyond_end=(s < s_lo - 1e-9) | (s > s_hi + 1e-9))
     for v in arrays.values():
         v.setflags(write=False)
