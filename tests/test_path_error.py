@@ -162,10 +162,13 @@ def test_replay_reports_the_path_of_c(tmp_path, capsys):
                          settle_s=rep["settle_s"])
     assert pe == direct.to_dict()
     assert 0.0 < pe["cross_track_max"] < 0.05 and abs(pe["along_track_final"]) < 0.05
+    # a lane change has straights: the certificate gives no Cartesian guarantee there
+    assert rep["path_bound"]["cross_track_bound"] is None and rep["path_verdict"]["verdict"] == "no-guarantee"
     png = tmp_path / "run.png"
     assert main(["replay", str(path), "--plot", str(png)]) == 0
     out = capsys.readouterr().out
     assert "path of C  cross-track max" in out and "along-track final" in out
+    assert "path bound no-guarantee: no Cartesian guarantee" in out
     assert png.stat().st_size > 20000
 
 

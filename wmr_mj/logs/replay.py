@@ -77,18 +77,23 @@ def _sup(x: Any) -> tuple[float | None, int]:
 class LogPath:
     """C's path in a log: the desired one (``reference``, rebuilt from the log's configuration),
     the per-sample errors (``series``, a PathErrorSeries) and their summary (``errors``,
-    a PathErrors); or, when they cannot be had, ``reason`` (and the rest None)."""
+    a PathErrors), what the run's certificate implies for the path (``bound``, a PathBound) and
+    the run judged against it (``verdict``, a PathVerdict); or, when they cannot be had,
+    ``reason`` (and the rest None)."""
 
     reference: Any = None
     series: Any = None
     errors: Any = None
     reason: str | None = None
+    bound: Any = None  # PathBound: what the run's certificate implies for the path
+    verdict: Any = None  # PathVerdict: the run's cross-track against it
 
 
 def path_of_log(log: RunLog, settle_s: float | None = None) -> LogPath:
     """C's Cartesian errors in ``log``: the desired path rebuilt as the run built it (its path, the
     controller's parameter set, its control period and duration), C's logged positions and the
     chassis heading. Never raises for a log without them: ``reason`` says why."""
+    from wmr_mj.analysis.path_bound import path_bound, path_verdict
     from wmr_mj.analysis.path_error import path_error_series, summarize_series
     from wmr_mj.params import C80
     from wmr_mj.sim.config import build_reference, estimate_parameters
@@ -111,7 +116,19 @@ def path_of_log(log: RunLog, settle_s: float | None = None) -> LogPath:
         series = path_error_series(reference, t[ok], C[ok], h[ok])
     except WmrMjError as exc:
         return LogPath(reason=f"C's desired path cannot be rebuilt ({exc})")
-    return LogPath(reference=reference, series=series, errors=summarize_series(series, settle_s))
+    errors = summarize_series(series, settle_s)
+    cert = (log.summary or {}).get("certificate")
+    E_max = _number(cert.get("E_max")) if isinstance(cert, dict) and cert.get("valid") else None
+    try:
+        stops = _number(log.parameters.get("steering_range"))
+    except LogError:
+        stops = None
+    try:
+        bound = path_bound(reference, E_max, settle_s=settle_s, max_angle=stops)
+    except WmrMjError:
+        bound = path_bound(reference, E_max, max_angle=stops)
+    return LogPath(reference=reference, series=series, errors=errors, bound=bound,
+                   verdict=path_verdict(errors, bound))
 
 
 def summarize(log: RunLog, settle_s: float | None = None) -> dict[str, Any]:
@@ -173,6 +190,8 @@ def summarize(log: RunLog, settle_s: float | None = None) -> dict[str, Any]:
     out["verdict"] = summary.get("verdict")  # the runner's separated verdict (wmr_mj.analysis.verdicts)
     lp = path_of_log(log, settle_s)
     out["path_errors"] = None if lp.errors is None else lp.errors.to_dict()
+    out["path_bound"] = None if lp.bound is None else lp.bound.to_dict()
+    out["path_verdict"] = None if lp.verdict is None else lp.verdict.to_dict()
     if lp.reason is not None:
         out["path_errors_note"] = lp.reason
     out["summary"] = log.summary
@@ -415,6 +434,8 @@ def format_summary(rep: dict[str, Any]) -> str:
         lines.append(f"           along-track final {signed(pe['along_track_final'], 'ahead', 'behind')} of the "
                      f"timed reference, max {pe['along_track_max']:.4g} m; heading error max "
                      f"{pe['heading_error_max']:.4g} rad, final {pe['heading_error_final']:+.4g} rad")
+        if rep.get("path_verdict"):
+            lines.append(f"path bound {rep['path_verdict']['verdict']}: {rep['path_verdict']['text']}")
     elif rep.get("path_errors_note"):
         lines.append(f"path of C  n/a: {rep['path_errors_note']}")
     if rep["summary"]:
