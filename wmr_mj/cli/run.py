@@ -43,7 +43,10 @@ def add_run_options(p: argparse.ArgumentParser) -> None:
                    help=f"Coulomb compensation sign: one of {', '.join(FRICTION_SIGNS)} (default: the preset's)")
     p.add_argument("--friction-width", type=float, default=None,
                    help="smoothing of that sign, rad/s: x/sqrt(x^2+w^2) (0: exact sign; default: the preset's)")
-    p.add_argument("--path", default="paper-circle", help=f"reference path of point C: one of {', '.join(PATH_NAMES)}")
+    p.add_argument("--path", default="paper-circle", metavar="NAME|FILE",
+                   help=f"reference path of point C: one of {', '.join(PATH_NAMES)}, a packaged route "
+                        "(agv-loop), or a route file (.toml/.json: segments or waypoints; see "
+                        "wmr_mj/reference/route.py)")
     p.add_argument("--param", action="append", metavar="NAME=VALUE", help="override a plant parameter (repeatable)")
     p.add_argument("--steering-friction", default="stiction",
                    help=f"plant's steering friction law: one of {', '.join(STEERING_FRICTION_MODELS)} (default "

@@ -5,8 +5,12 @@
   else its config), with the run's status; a JSON-ready dict.
 - :func:`verify`: rebuild the model from the attached MJCF, set the attached initial state,
   re-apply the logged ctrl and compare qpos and qvel at every control step, bit for bit.
+- :func:`path_of_log`: C's Cartesian errors (:mod:`wmr_mj.analysis.path_error`) against the desired
+  path of C, rebuilt from the log's configuration as the run built it; :func:`summarize` adds
+  their sup, RMS and final values under ``path_errors``.
 - :func:`plot`: E and E' over time with the bounds, the armature voltage with the supply limit,
-  and the (|E|, |E'|) plane with the bounds' rectangle and the region polygon (4.21).
+  the (|E|, |E'|) plane with the bounds' rectangle and the region polygon (4.21), and C's path:
+  desired against actual, and the cross-track and along-track errors over time.
 - :func:`format_summary`, :func:`format_verify`: the command's text.
 
 Usage::
@@ -22,15 +26,16 @@ from __future__ import annotations
 
 import math
 import os
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from wmr_mj.errors import LogError
+from wmr_mj.errors import LogError, WmrMjError
 from wmr_mj.logs.reader import RunLog
 
-__all__ = ["summarize", "verify", "plot", "format_summary", "format_verify"]
+__all__ = ["summarize", "verify", "plot", "format_summary", "format_verify", "path_of_log", "LogPath"]
 
 
 def _number(value: Any) -> float | None:
@@ -66,6 +71,64 @@ def _sup(x: Any) -> tuple[float | None, int]:
     a = np.abs(np.asarray(x, float))
     finite = a[np.isfinite(a)]
     return (float(finite.max()) if finite.size else None), int(a.size - finite.size)
+
+
+@dataclass(frozen=True, eq=False)
+class LogPath:
+    """C's path in a log: the desired one (``reference``, rebuilt from the log's configuration),
+    the per-sample errors (``series``, a PathErrorSeries) and their summary (``errors``,
+    a PathErrors), what the run's certificate implies for the path (``bound``, a PathBound) and
+    the run judged against it (``verdict``, a PathVerdict); or, when they cannot be had,
+    ``reason`` (and the rest None)."""
+
+    reference: Any = None
+    series: Any = None
+    errors: Any = None
+    reason: str | None = None
+    bound: Any = None  # PathBound: what the run's certificate implies for the path
+    verdict: Any = None  # PathVerdict: the run's cross-track against it
+
+
+def path_of_log(log: RunLog, settle_s: float | None = None) -> LogPath:
+    """C's Cartesian errors in ``log``: the desired path rebuilt as the run built it (its path, the
+    controller's parameter set, its control period and duration), C's logged positions and the
+    chassis heading. Never raises for a log without them: ``reason`` says why."""
+    from wmr_mj.analysis.path_bound import path_bound, path_verdict
+    from wmr_mj.analysis.path_error import path_error_series, summarize_series
+    from wmr_mj.params import C80
+    from wmr_mj.sim.config import build_reference, estimate_parameters
+
+    sig, cfg = log.signals, log.config or {}
+    missing = [k for k in ("t", "C_pos", "heading") if sig.get(k) is None or not np.asarray(sig[k]).size]
+    if missing:
+        return LogPath(reason=f"the log has no {', '.join(missing)} rows")
+    path, duration = cfg.get("path"), _number(cfg.get("duration"))
+    if not isinstance(path, str) or duration is None:
+        return LogPath(reason="the log's configuration names no path and duration to rebuild C's desired path from")
+    period = log.timestep * log.control_substeps
+    if not (math.isfinite(period) and period > 0):
+        return LogPath(reason="the log has no control period")
+    n = int(round(duration / period))
+    try:
+        reference, _ = build_reference(path, estimate_parameters(C80), dt=period, duration=n * period)
+        t, C, h = np.asarray(sig["t"], float), np.asarray(sig["C_pos"], float), np.asarray(sig["heading"], float)
+        ok = np.isfinite(t) & np.isfinite(C).all(axis=1) & np.isfinite(h)
+        series = path_error_series(reference, t[ok], C[ok], h[ok])
+    except WmrMjError as exc:
+        return LogPath(reason=f"C's desired path cannot be rebuilt ({exc})")
+    errors = summarize_series(series, settle_s)
+    cert = (log.summary or {}).get("certificate")
+    E_max = _number(cert.get("E_max")) if isinstance(cert, dict) and cert.get("valid") else None
+    try:
+        stops = _number(log.parameters.get("steering_range"))
+    except LogError:
+        stops = None
+    try:
+        bound = path_bound(reference, E_max, settle_s=settle_s, max_angle=stops)
+    except WmrMjError:
+        bound = path_bound(reference, E_max, max_angle=stops)
+    return LogPath(reference=reference, series=series, errors=errors, bound=bound,
+                   verdict=path_verdict(errors, bound))
 
 
 def summarize(log: RunLog, settle_s: float | None = None) -> dict[str, Any]:
@@ -125,6 +188,12 @@ def summarize(log: RunLog, settle_s: float | None = None) -> dict[str, Any]:
             out["inside_after_settle"] = bool(np.all(late)) if late.size else None
             out["samples_outside_after_settle"] = int(np.count_nonzero(~late))
     out["verdict"] = summary.get("verdict")  # the runner's separated verdict (wmr_mj.analysis.verdicts)
+    lp = path_of_log(log, settle_s)
+    out["path_errors"] = None if lp.errors is None else lp.errors.to_dict()
+    out["path_bound"] = None if lp.bound is None else lp.bound.to_dict()
+    out["path_verdict"] = None if lp.verdict is None else lp.verdict.to_dict()
+    if lp.reason is not None:
+        out["path_errors_note"] = lp.reason
     out["summary"] = log.summary
     out["versions"] = log.versions
     return out
@@ -193,6 +262,32 @@ def _band(ax: Any, bound: float | None, ls: str, color: str, label: str, unit: s
     ax.axhline(bound, ls=ls, lw=0.8, color=color, label=f"{label} = {bound:.3g} {unit}")
     ax.axhline(-bound, ls=ls, lw=0.8, color=color)
 
+def _path_panels(e: Any, f: Any, lp: LogPath, settle: float | None) -> None:
+    """(e) C's desired path against the actual one; (f) cross-track and along-track over time."""
+    e.set(xlabel="x [m]", ylabel="y [m]", title="(e) path of C")
+    f.set(xlabel="t [s]", ylabel="error [m]", title="(f) path errors of C")
+    if lp.errors is None:
+        for axis in (e, f):
+            axis.text(0.5, 0.5, f"n/a: {lp.reason}", ha="center", va="center", wrap=True, fontsize=8,
+                      transform=axis.transAxes)
+        return
+    ref, ser, err = lp.reference, lp.series, lp.errors
+    des = np.asarray(ref.C_xy)
+    e.plot(des[:, 0], des[:, 1], lw=1.6, color="0.6", label="desired")
+    e.plot(ser.C_xy[:, 0], ser.C_xy[:, 1], lw=0.9, color="C0", label="actual")
+    e.plot(des[0, 0], des[0, 1], "o", ms=4, color="0.4", label="start")
+    e.set_aspect("equal", adjustable="datalim")
+    e.legend(loc="best", fontsize=7, frameon=False)
+    f.plot(ser.t, ser.cross_track, lw=0.9, color="C0",
+           label=f"cross-track (> 0 left), max {err.cross_track_max:.3g} m")
+    f.plot(ser.t, ser.along_track, lw=0.9, color="C1",
+           label=f"along-track (> 0 ahead), final {err.along_track_final:+.3g} m")
+    if settle is not None:
+        f.axvline(settle, color="0.5", lw=0.6, ls="-.")
+    f.axhline(0.0, color="k", lw=0.5)
+    f.legend(loc="best", fontsize=7, frameon=False)
+
+
 def plot(log: RunLog, path: str | os.PathLike, rep: dict[str, Any]) -> Path:
     """Write the replay figure (PNG) for ``rep`` = :func:`summarize` of ``log``; returns the path."""
     from matplotlib.figure import Figure
@@ -209,8 +304,8 @@ def plot(log: RunLog, path: str | os.PathLike, rep: dict[str, Any]) -> Path:
     import matplotlib
 
     with matplotlib.rc_context(style):
-        fig = Figure(figsize=(10, 6.8), constrained_layout=True)
-        ax = fig.subplots(2, 2)
+        fig = Figure(figsize=(15, 6.8), constrained_layout=True)
+        ax = fig.subplots(2, 3)
         a = ax[0, 0]
         a.plot(t, E, lw=0.9, color="C0", label="E = alpha0 - alpha")
         cert = (log.summary or {}).get("certificate") or {}
@@ -254,6 +349,7 @@ def plot(log: RunLog, path: str | os.PathLike, rep: dict[str, Any]) -> Path:
         for axis in (a, b, c):
             if settle is not None:
                 axis.axvline(settle, color="0.5", lw=0.6, ls="-.")
+        _path_panels(ax[0, 2], ax[1, 2], path_of_log(log, settle), settle)
         for axis in (a, b, c, d):
             axis.legend(loc="best", fontsize=7, frameon=False)
         cfg = log.config or {}
@@ -326,6 +422,22 @@ def format_summary(rep: dict[str, Any]) -> str:
         from wmr_mj.analysis.verdicts import format_verdict
 
         lines.extend("verdict    " + line for line in format_verdict(rep["summary"]))
+    pe = rep.get("path_errors")
+    if pe:
+        def signed(v: float, pos: str, neg: str) -> str:
+            return f"{v:+.4g} m ({pos if v > 0 else neg})" if v else "0 m"
+
+        lines.append(f"path of C  cross-track max {pe['cross_track_max']:.4g} m, rms {pe['cross_track_rms']:.4g} m, "
+                     f"final {signed(pe['cross_track_final'], 'left', 'right')}"
+                     + (f"; max after t = {pe['settle_s']:g} s {pe['cross_track_max_after_settle']:.4g} m"
+                        if pe.get("cross_track_max_after_settle") is not None else ""))
+        lines.append(f"           along-track final {signed(pe['along_track_final'], 'ahead', 'behind')} of the "
+                     f"timed reference, max {pe['along_track_max']:.4g} m; heading error max "
+                     f"{pe['heading_error_max']:.4g} rad, final {pe['heading_error_final']:+.4g} rad")
+        if rep.get("path_verdict"):
+            lines.append(f"path bound {rep['path_verdict']['verdict']}: {rep['path_verdict']['text']}")
+    elif rep.get("path_errors_note"):
+        lines.append(f"path of C  n/a: {rep['path_errors_note']}")
     if rep["summary"]:
         extra = {k: v for k, v in rep["summary"].items() if k not in ("status", "rows", "last_t")}
         sc = [f"{k}={_fmt(v) if isinstance(v, float) else v}" for k, v in extra.items()

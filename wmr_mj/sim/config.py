@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -53,6 +54,8 @@ class RunConfig:
     kd: float = PAPER_KD
     friction_sign: str = "measured"
     friction_width: float = 0.0  # rad/s, tanh smoothing of the Coulomb sign (0: exact sign)
+    # C's path: one of PATH_NAMES, a packaged route name (wmr_mj.reference.route.route_names()), a
+    # .toml/.json route file, or canonical route JSON; a Path or Route object is stored as its canonical JSON
     path: str = "paper-circle"
     plant_overrides: Mapping[str, float] = field(default_factory=dict)  # other plant parameters
     m1_inertia: str = "payload"
@@ -72,8 +75,7 @@ class RunConfig:
             raise UnknownNameError("model source", self.model, MODEL_SOURCES)
         if self.friction_sign not in FRICTION_SIGNS:
             raise UnknownNameError("friction sign", self.friction_sign, FRICTION_SIGNS)
-        if self.path not in PATH_NAMES:
-            raise UnknownNameError("path", self.path, PATH_NAMES)
+        _check_path(self)
         if self.box not in ("derived", "paper"):
             raise UnknownNameError("box", self.box, ("derived", "paper"))
         if self.steering_friction not in STEERING_FRICTION_MODELS:
@@ -107,6 +109,26 @@ class RunConfig:
         return dataclasses.replace(self, **changes)
 
 
+def _check_path(config: RunConfig) -> None:
+    """Accept a path name, a route (name, file, canonical JSON) or a Path/Route object (stored as its
+    canonical JSON, so the config stays hashable and JSON-able); a malformed route raises here."""
+    from wmr_mj.reference.paths import Path
+    from wmr_mj.reference.route import Route, is_route_spec, load_route, route_from_path, route_names
+
+    p = config.path
+    if isinstance(p, Path):
+        object.__setattr__(config, "path", route_from_path(p).text)
+    elif isinstance(p, Route):
+        object.__setattr__(config, "path", p.text if p.source == "<text>" or not os.path.isfile(p.source)
+                           else p.source)
+    elif not isinstance(p, str):
+        raise ParameterError(f"path = {p!r} is not accepted: a path name, a route file or a Path")
+    elif p not in PATH_NAMES:
+        if not is_route_spec(p):
+            raise UnknownNameError("path", p, PATH_NAMES + route_names() + ("<route file .toml/.json>",))
+        load_route(p)  # malformed: ParameterError naming the file and the segment
+
+
 def plant_parameters(config: RunConfig, base: C80Parameters = C80) -> C80Parameters:
     """The plant's parameter set: base with m1 and the overrides (mass and inertia consistent)."""
     return with_params(base, m1_inertia=config.m1_inertia, m1=config.m1, **dict(config.plant_overrides))
@@ -118,13 +140,21 @@ def estimate_parameters(base: C80Parameters = C80) -> C80Parameters:
 
 
 def build_reference(path: str, params: C80Parameters, *, dt: float, duration: float):
-    """(reference, settle_s) for a named path of C on a grid of step dt.
+    """(reference, settle_s) for a path of C on a grid of step dt: a named path (PATH_NAMES) or
+    a route (a packaged route name, a route file, canonical route JSON; a closed route is
+    repeated lap after lap to fill the duration).
 
     settle_s is when the entry transient ends: for the paper's circle, the
     time C enters the circle; 0 for the other paths.
     """
     from wmr_mj.reference import paths as ref
 
+    if path not in PATH_NAMES:
+        from wmr_mj.reference.route import is_route_spec, load_route, route_names, route_reference
+
+        if not is_route_spec(path):
+            raise UnknownNameError("path", path, PATH_NAMES + route_names() + ("<route file .toml/.json>",))
+        return route_reference(load_route(path), params, dt=dt, duration=duration), 0.0
     if path == "paper-circle":
         p = ref.paper_circle(params, duration=duration)
     elif path == "lane-change":

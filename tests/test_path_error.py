@@ -1,0 +1,183 @@
+"""Cartesian errors of C (wmr_mj.analysis.path_error) against closed forms."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from wmr_mj import C80
+from wmr_mj.analysis.path_error import PathErrors, path_error_series, path_errors, wrap_angle
+from wmr_mj.errors import ParameterError
+from wmr_mj.reference.paths import circle, figure_eight, line, make_reference
+
+L1, VA = C80.l1, C80.V_A
+
+
+@pytest.fixture(scope="module")
+def straight():
+    return make_reference(line(3.0), C80, dt=2e-3)
+
+
+def _normal(ref):
+    phi = np.asarray(ref.theta) + np.asarray(ref.alpha0)  # C's direction of travel
+    return np.column_stack([-np.sin(phi), np.cos(phi)])
+
+
+def test_exact_tracking_gives_zero(straight):
+    e = path_errors(straight, straight.t, straight.C_xy, straight.theta)
+    assert isinstance(e, PathErrors)
+    assert e.cross_track_max < 1e-9 and e.along_track_max < 1e-9 and e.heading_error_max < 1e-12
+    assert e.beyond_end_samples == 0 and e.samples == len(straight)
+
+
+@pytest.mark.parametrize("d", [0.05, -0.3])
+def test_lateral_offset_from_a_straight_line(straight, d):
+    C = np.asarray(straight.C_xy) + [0.0, d]
+    e = path_errors(straight, straight.t, C, straight.theta)
+    assert e.cross_track_max == pytest.approx(abs(d), abs=1e-12)
+    assert e.cross_track_final == pytest.approx(d, abs=1e-12)  # > 0: left of the direction of travel
+    assert e.cross_track_rms == pytest.approx(abs(d), abs=1e-12)
+    assert e.along_track_max < 1e-9
+
+
+@pytest.mark.parametrize("R", [1.0, -1.5])
+@pytest.mark.parametrize("d", [0.02, -0.2])
+def test_concentric_circle(R, d):
+    ref = make_reference(circle(R, turns=1.3), C80, dt=2e-3)
+    phi = np.asarray(ref.theta) + np.asarray(ref.alpha0)
+    C = np.asarray(ref.C_xy)
+    centre = C[0] + np.array([-math.sin(phi[0]), math.cos(phi[0])]) * R
+    # C on the concentric circle of radius |R| + d, at the reference's angle
+    rad = C - centre
+    C_off = centre + rad * (abs(R) + d) / abs(R)
+    e = path_errors(ref, ref.t, C_off, ref.theta)
+    # outside a left turn is to the right: cross-track = -d for R > 0, +d for R < 0
+    want = -d if R > 0 else d
+    assert e.cross_track_final == pytest.approx(want, abs=2e-6)
+    assert e.cross_track_max == pytest.approx(abs(d), abs=2e-6)
+    assert e.along_track_max < 2e-6  # the radial projection keeps the reference's arc length
+    assert e.beyond_end_samples == 0
+
+
+@pytest.mark.parametrize("path", ["line", "circle"])
+def test_timed_lag_gives_minus_lag_times_speed(path):
+    ref = make_reference(line(3.0) if path == "line" else circle(1.0, turns=1.2), C80, dt=1e-3)
+    lag = 0.5
+    t = np.asarray(ref.t)
+    k = int(round(lag / ref.dt))
+    C = np.asarray(ref.C_xy)[:-k]
+    th = np.asarray(ref.theta)[:-k]
+    e = path_errors(ref, t[k:], C, th)  # C at time t is where the reference was at t - lag
+    V_C = VA / math.cos(float(ref.alpha0[-1]))  # C's speed: V_A on the line, V_A / cos(alpha0) on the circle
+    assert e.along_track_final == pytest.approx(-lag * V_C, rel=1e-6)
+    assert e.along_track_max == pytest.approx(lag * V_C, rel=1e-6)
+    assert e.cross_track_max < 2e-6 and e.heading_error_max < 1e-9
+
+
+def test_heading_error_is_wrapped(straight):
+    h = np.asarray(straight.theta) + 0.1 + 4.0 * math.pi
+    e = path_errors(straight, straight.t, straight.C_xy, h)
+    assert e.heading_error_final == pytest.approx(0.1, abs=1e-12)
+    assert e.heading_error_max == pytest.approx(0.1, abs=1e-12)
+    assert float(wrap_angle(math.pi)) == pytest.approx(math.pi)
+    assert float(wrap_angle(-math.pi)) == pytest.approx(math.pi)
+
+
+def test_figure_eight_crossing_does_not_jump():
+    """A lateral offset through a figure eight's crossing: a global nearest point would jump to
+    the other branch there (distance 0 at the crossing); the continuous projection does not."""
+    ref = make_reference(line(0.5) + figure_eight(1.5, laps=2), C80, dt=2e-3)
+    d = 0.1
+    C = np.asarray(ref.C_xy) + d * _normal(ref)
+    ser = path_error_series(ref, ref.t, C, ref.theta)
+    assert np.max(np.abs(ser.cross_track - d)) < 2e-5
+    assert np.max(np.abs(ser.along_track)) < 2e-5
+    assert np.all(np.diff(ser.s) > 0)
+    # the path does cross itself: the same point is passed at two arc lengths
+    crossings = np.nonzero(np.diff(np.sign(np.asarray(ref.C_xy)[:, 1] - ref.C_xy[0, 1])))[0]
+    assert crossings.size >= 4
+
+
+def test_ahead_of_the_path_end_is_continued():
+    ref = make_reference(circle(1.0, turns=0.5), C80, dt=2e-3)
+    lead = 0.3
+    k = int(round(lead / ref.dt))
+    C = np.asarray(ref.C_xy)[k:]
+    e = path_errors(ref, np.asarray(ref.t)[:-k], C, np.asarray(ref.theta)[k:])
+    assert e.along_track_final == pytest.approx(lead * VA / math.cos(float(ref.alpha0[-1])), rel=1e-6)
+    assert e.cross_track_max < 2e-6
+    assert e.beyond_end_samples == 0  # no sample needs the continuation here...
+    ser = path_error_series(ref, np.asarray(ref.t)[-1:] + 0.2, C[-1:] + [0.0, 0.0], ref.theta[-1:])
+    assert ser.cross_track.shape == (1,)
+
+
+def test_settle_and_to_dict(straight):
+    C = np.asarray(straight.C_xy) + np.where(np.asarray(straight.t)[:, None] < 1.0, [0.0, 0.2], [0.0, 0.01])
+    e = path_errors(straight, straight.t, C, straight.theta, settle_s=1.0)
+    assert e.cross_track_max == pytest.approx(0.2)
+    assert e.cross_track_max_after_settle == pytest.approx(0.01)
+    d = e.to_dict()
+    for key in ("cross_track_max", "cross_track_rms", "cross_track_final", "along_track_final", "along_track_max",
+                "heading_error_max", "heading_error_final"):
+        assert isinstance(d[key], float)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        e.cross_track_max = 0.0
+
+
+def test_bad_input(straight):
+    with pytest.raises(ParameterError, match="must agree"):
+        path_errors(straight, straight.t, np.zeros((3, 2)), straight.theta)
+    with pytest.raises(ParameterError, match="finite"):
+        C = np.array(straight.C_xy)
+        C[3, 0] = np.nan
+        path_errors(straight, straight.t, C, straight.theta)
+    with pytest.raises(ParameterError, match="Reference"):
+        path_errors(object(), [0.0], [[0.0, 0.0]], [0.0])
+
+
+def test_replay_reports_the_path_of_c(tmp_path, capsys):
+    """A real logged run (certified design, lane change, 6 s): `replay` prints C's path errors,
+    --json carries them, --plot draws the path panels; they equal the errors computed directly."""
+    import json
+
+    from wmr_mj.cli.app import main
+    from wmr_mj.logs.reader import load_log
+    from wmr_mj.logs.writer import RunLogger
+    from wmr_mj.sim.closed_loop import run_closed_loop
+    from wmr_mj.sim.config import RunConfig, build_reference
+    from wmr_mj.sim.designs import CERTIFIED
+
+    path = tmp_path / "run.mcap"
+    config = RunConfig(**CERTIFIED.config_changes(), path="lane-change", duration=6.0)
+    run_closed_loop(config, logger_factory=lambda **kw: RunLogger(path, **kw), progress=False)
+    assert main(["replay", str(path), "--json"]) == 0
+    rep = json.loads(capsys.readouterr().out)
+    pe = rep["path_errors"]
+    log = load_log(path)
+    ref, _ = build_reference("lane-change", C80, dt=1e-3, duration=6.0)
+    direct = path_errors(ref, log.signals["t"], log.signals["C_pos"], log.signals["heading"],
+                         settle_s=rep["settle_s"])
+    assert pe == direct.to_dict()
+    assert 0.0 < pe["cross_track_max"] < 0.05 and abs(pe["along_track_final"]) < 0.05
+    # a lane change has straights: the certificate gives no Cartesian guarantee there
+    assert rep["path_bound"]["cross_track_bound"] is None and rep["path_verdict"]["verdict"] == "no-guarantee"
+    png = tmp_path / "run.png"
+    assert main(["replay", str(path), "--plot", str(png)]) == 0
+    out = capsys.readouterr().out
+    assert "path of C  cross-track max" in out and "along-track final" in out
+    assert "path bound no-guarantee: no Cartesian guarantee" in out
+    assert png.stat().st_size > 20000
+
+
+def test_replay_without_a_path_says_why(tmp_path, capsys):
+    from test_mcaplog import synthetic_run
+
+    from wmr_mj.cli.app import main
+
+    path = tmp_path / "synthetic.mcap"
+    synthetic_run(path, 0.2, block_rows=100)
+    assert main(["replay", str(path)]) == 0
+    assert "path of C  n/a: the log's configuration names no path" in capsys.readouterr().out

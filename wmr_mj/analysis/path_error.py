@@ -1,0 +1,291 @@
+"""Cartesian errors of point C against its desired path: cross-track, along-track, heading.
+
+The steering error E = alpha0 - alpha says how well the joint follows alpha0(t); it does not
+say where C goes. This module measures that, from C's positions and the chassis heading at
+the run's sample times, against the :class:`~wmr_mj.reference.paths.Reference` the run was
+given (C's desired path C_xy over its arc length s, the timed s(t), the desired chassis
+heading theta).
+
+- **cross-track** [m]: signed distance of C from the desired path, > 0 to the left of the
+  direction of travel (the sign convention of the paths' radii). C is projected onto the path
+  *with arc-length continuity*: each sample's projection is searched within ``window`` m of arc
+  length around the previous one (plus the distance C travelled since), never over the whole
+  path, so a figure eight's crossing or a second lap cannot make the projection jump. Beyond
+  the path's ends the path is continued by arcs of its end curvatures.
+- **along-track** [m]: arc length of the projection minus the timed reference's s(t): > 0 ahead
+  of the reference, < 0 behind. A timed lag of tau s at C's speed V_C gives -tau V_C.
+- **heading error** [rad]: chassis heading minus the desired chassis heading at the projection,
+  wrapped to (-pi, pi]. The desired chassis heading is the reference's theta; it is C's path
+  tangent minus alpha0 (C moves along theta + alpha), so a cart exactly on its path and its
+  reference has heading error 0, while the raw tangent of C's path differs from the chassis
+  heading by alpha0 (0.659 rad on the paper's 1 m circle).
+
+Each with its sup (largest magnitude), RMS and final value, in :class:`PathErrors`.
+
+Usage::
+
+    from wmr_mj.analysis.path_error import path_errors
+    err = path_errors(reference, rows["t"], C_xy, heading)      # C_xy (n, 2) m, heading (n,) rad
+    err.cross_track_max, err.along_track_final, err.to_dict()
+
+Pure NumPy: no simulation, no file.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from wmr_mj.errors import ParameterError
+
+__all__ = ["PathErrors", "PathErrorSeries", "path_error_series", "path_errors", "wrap_angle"]
+
+#: spacing of the polyline the projection searches [m]; a sagitta correction from the
+#: reference's curvature removes the chord's offset (kappa ds^2 / 8: 2 um at 1/m)
+POLYLINE_SPACING = 4e-3
+#: default half-width of the arc-length window around the previous projection [m]
+WINDOW = 0.1
+_BLOCK = 128  # samples projected together (each block searches one window)
+
+
+def wrap_angle(x: ArrayLike) -> np.ndarray:
+    """Angles wrapped to (-pi, pi] [rad]."""
+    a = np.asarray(x, dtype=float)
+    return np.pi - np.mod(np.pi - a, 2.0 * np.pi)
+
+
+@dataclass(frozen=True, eq=False)
+class PathErrorSeries:
+    """Per-sample errors of C (arrays of length n, read-only).
+
+    t [s]; C_xy [m] (n, 2): C's positions judged; s [m]: arc length of C's projection on the
+    desired path; s_ref [m]: the timed reference's arc length at t; cross_track [m] (> 0:
+    left of the path); along_track [m] (s - s_ref, > 0: ahead); heading_error [rad] (chassis
+    heading minus the desired one at the projection, wrapped); beyond_end: the projection
+    fell on a continuation of the path past its start or end.
+    """
+
+    t: np.ndarray
+    C_xy: np.ndarray
+    s: np.ndarray
+    s_ref: np.ndarray
+    cross_track: np.ndarray
+    along_track: np.ndarray
+    heading_error: np.ndarray
+    beyond_end: np.ndarray
+
+
+@dataclass(frozen=True)
+class PathErrors:
+    """Summary of C's Cartesian errors over a run (see the module docstring for signs).
+
+    Fields (max = largest magnitude, rms = root mean square of the signed values, final =
+    signed value at the last sample):
+    """
+
+    cross_track_max: float
+    """sup |cross-track| [m]."""
+    cross_track_rms: float
+    """RMS cross-track [m]."""
+    cross_track_final: float
+    """cross-track at the last sample [m], > 0 left of the path."""
+    along_track_max: float
+    """sup |along-track| [m]."""
+    along_track_rms: float
+    """RMS along-track [m]."""
+    along_track_final: float
+    """along-track at the last sample [m], > 0 ahead of the timed reference, < 0 behind."""
+    heading_error_max: float
+    """sup |heading error| [rad]."""
+    heading_error_rms: float
+    """RMS heading error [rad]."""
+    heading_error_final: float
+    """heading error at the last sample [rad]."""
+    cross_track_max_after_settle: float | None
+    """sup |cross-track| over t >= settle_s [m]; None when no settle_s was given."""
+    settle_s: float | None
+    """the settling time used [s], or None."""
+    samples: int
+    """number of samples judged."""
+    beyond_end_samples: int
+    """samples whose projection fell on the path's continuation past its start or end."""
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict: the fields under their names (units as in the field docs)."""
+        return asdict(self)
+
+
+def _as_reference_arrays(reference: Any) -> tuple[np.ndarray, ...]:
+    try:
+        t = np.asarray(reference.t, float)
+        s = np.asarray(reference.s, float)
+        C = np.asarray(reference.C_xy, float)
+        theta = np.asarray(reference.theta, float)
+        alpha0 = np.asarray(reference.alpha0, float)
+        kappa = np.asarray(reference.kappa, float)
+    except AttributeError:
+        raise ParameterError("reference must be a wmr_mj.reference.paths.Reference (t, s, C_xy, theta, alpha0, "
+                             f"kappa), got {type(reference).__name__}") from None
+    if t.size < 2 or C.shape != (t.size, 2):
+        raise ParameterError("reference must hold at least 2 samples with C_xy of shape (n, 2)")
+    return t, s, C, theta, alpha0, kappa
+
+
+def _continuation(C: np.ndarray, phi: float, kappa: float, alpha0: float, lengths: np.ndarray, sign: float):
+    """Points at arc lengths sign*lengths from C along an arc of curvature kappa leaving at phi."""
+    u = sign * lengths
+    if abs(kappa) < 1e-12:
+        x = C[0] + u * math.cos(phi)
+        y = C[1] + u * math.sin(phi)
+    else:
+        r = 1.0 / kappa
+        x = C[0] + r * (np.sin(phi + kappa * u) - math.sin(phi))
+        y = C[1] - r * (np.cos(phi + kappa * u) - math.cos(phi))
+    ph = phi + kappa * u
+    return np.column_stack([x, y]), ph - alpha0, np.full(u.shape, kappa)
+
+
+def _geometry(reference: Any, spacing: float, extend: float):
+    """Polyline of C's desired path: (s, xy, theta, kappa, lo, hi) with the continuations."""
+    t, s, C, theta, alpha0, kappa = _as_reference_arrays(reference)
+    step = max(1, int(spacing / max(float(np.median(np.diff(s))), 1e-12)))
+    idx = np.arange(0, s.size, step)
+    if idx[-1] != s.size - 1:
+        idx = np.append(idx, s.size - 1)
+    ext = np.arange(1, int(math.ceil(extend / spacing)) + 1) * spacing
+    phi0, phi1 = theta[0] + alpha0[0], theta[-1] + alpha0[-1]
+    pre_xy, pre_th, pre_k = _continuation(C[0], phi0, float(kappa[0]), float(alpha0[0]), ext[::-1], -1.0)
+    post_xy, post_th, post_k = _continuation(C[-1], phi1, float(kappa[-1]), float(alpha0[-1]), ext, 1.0)
+    gs = np.concatenate([s[0] - ext[::-1], s[idx], s[-1] + ext])
+    gxy = np.concatenate([pre_xy, C[idx], post_xy])
+    gth = np.concatenate([pre_th, theta[idx], post_th])
+    gk = np.concatenate([pre_k, kappa[idx], post_k])
+    return gs, gxy, gth, gk, float(s[0]), float(s[-1])
+
+
+def _project(gs: np.ndarray, gxy: np.ndarray, gk: np.ndarray, X: np.ndarray, s_start: float, window: float):
+    """Continuous projection of the points X (n, 2) on the polyline: (s, signed distance)."""
+    n = X.shape[0]
+    out_s, out_d = np.empty(n), np.empty(n)
+    A = gxy[:-1]
+    D = np.diff(gxy, axis=0)
+    L2 = np.einsum("ij,ij->i", D, D)
+    L2 = np.where(L2 > 0.0, L2, 1e-300)
+    seg_len = np.diff(gs)
+    kmid = 0.5 * (gk[:-1] + gk[1:])
+    steps = np.concatenate([[0.0], np.hypot(*np.diff(X, axis=0).T)])
+    s_prev = s_start
+    b = 0
+    while b < n:
+        Xb = X[b:b + _BLOCK]
+        travel = float(np.sum(steps[b + 1:b + Xb.shape[0]]))
+        lo = np.searchsorted(gs, s_prev - window - travel, side="right") - 1
+        hi = np.searchsorted(gs, s_prev + window + travel, side="left")
+        lo, hi = max(lo, 0), min(max(hi, lo + 1), len(A))
+        Ab, Db, Lb = A[lo:hi], D[lo:hi], L2[lo:hi]
+        rel = Xb[:, None, :] - Ab[None, :, :]
+        u_raw = np.einsum("bmk,mk->bm", rel, Db) / Lb
+        u = np.clip(u_raw, 0.0, 1.0)
+        diff = rel - u[..., None] * Db[None, :, :]
+        dist2 = np.einsum("bmk,bmk->bm", diff, diff)
+        j = np.argmin(dist2, axis=1)
+        rows = np.arange(Xb.shape[0])
+        uj = u[rows, j]
+        # a minimum on the window's edge is no local minimum: the projection moves on past it;
+        # keep the samples before the first such one, restart there with the window moved
+        edge = ((j == 0) & (uj == 0.0) & (lo > 0)) | ((j == hi - lo - 1) & (uj == 1.0) & (hi < len(A)))
+        m = int(np.argmax(edge)) if edge.any() else Xb.shape[0]
+        seg = lo + j[:m]
+        uj = uj[:m]
+        rows = rows[:m]
+        cross = Db[j[:m], 0] * rel[rows, j[:m], 1] - Db[j[:m], 1] * rel[rows, j[:m], 0]
+        d = np.sign(cross) * np.sqrt(dist2[rows, j[:m]])
+        # the polyline is the curve's chords; the curve lies kappa L^2 u (1-u) / 2 to their right
+        d += 0.5 * kmid[seg] * seg_len[seg] ** 2 * uj * (1.0 - uj)
+        # and a point d to the left of an arc of curvature kappa projects on the chord at a
+        # tangential distance scaled by 1 - kappa d from the arc's: undo that about the midpoint
+        scale = 1.0 - kmid[seg] * d
+        u_arc = 0.5 + (u_raw[rows, j[:m]] - 0.5) / np.where(scale > 0.0, scale, 1.0)
+        uj = np.where(scale > 0.0, np.clip(u_arc, 0.0, 1.0), uj)
+        out_s[b:b + m] = gs[seg] + uj * seg_len[seg]
+        out_d[b:b + m] = d
+        s_prev = float(out_s[b + m - 1]) if m == Xb.shape[0] else float(gs[lo] if j[m] == 0 else gs[hi])
+        b += m
+    return out_s, out_d
+
+
+def path_error_series(reference: Any, t: ArrayLike, C_xy: ArrayLike, heading: ArrayLike, *,
+                      window: float = WINDOW, spacing: float = POLYLINE_SPACING) -> PathErrorSeries:
+    """Per-sample cross-track, along-track and heading errors of C (see the module docstring).
+
+    reference: the run's :class:`~wmr_mj.reference.paths.Reference` (C's desired path and its
+    timing); t (n,) [s] sample times; C_xy (n, 2) [m] C's positions; heading (n,) [rad] the
+    chassis heading (any branch: the error is wrapped). window [m]: half-width of the
+    arc-length search around the previous projection (keep it below half the arc length
+    between two parts of the path that come close, e.g. a figure eight's crossing);
+    spacing [m]: the search polyline's spacing.
+    """
+    tt = np.asarray(t, dtype=float).ravel()
+    X = np.asarray(C_xy, dtype=float)
+    h = np.asarray(heading, dtype=float).ravel()
+    if X.ndim != 2 or X.shape[1] != 2 or X.shape[0] != tt.size or h.size != tt.size:
+        raise ParameterError(f"t (n,), C_xy (n, 2) and heading (n,) must agree; got {tt.shape}, {X.shape}, "
+                             f"{h.shape}")
+    if tt.size == 0:
+        raise ParameterError("no samples: t, C_xy and heading are empty")
+    if not (np.all(np.isfinite(tt)) and np.all(np.isfinite(X)) and np.all(np.isfinite(h))):
+        raise ParameterError("t, C_xy and heading must be finite")
+    win = float(window)
+    if not (math.isfinite(win) and win > 0.0):
+        raise ParameterError(f"window = {window!r} m must be finite and > 0")
+    rt, rs = _as_reference_arrays(reference)[:2]
+    extend = max(4.0 * win, float(rs[-1] - rs[0]))
+    gs, gxy, gth, gk, s_lo, s_hi = _geometry(reference, float(spacing), extend)
+    # the timed reference's s(t), continued at its end speeds
+    s_ref = np.interp(tt, rt, rs)
+    v0 = (rs[1] - rs[0]) / (rt[1] - rt[0])
+    v1 = (rs[-1] - rs[-2]) / (rt[-1] - rt[-2])
+    s_ref = np.where(tt < rt[0], rs[0] + (tt - rt[0]) * v0, s_ref)
+    s_ref = np.where(tt > rt[-1], rs[-1] + (tt - rt[-1]) * v1, s_ref)
+    s, d = _project(gs, gxy, gk, X, float(s_ref[0]), win)
+    theta_des = np.interp(s, gs, gth)
+    arrays = dict(t=tt, C_xy=X.copy(), s=s, s_ref=s_ref, cross_track=d, along_track=s - s_ref,
+                  heading_error=wrap_angle(h - theta_des), beyond_end=(s < s_lo - 1e-9) | (s > s_hi + 1e-9))
+    for v in arrays.values():
+        v.setflags(write=False)
+    return PathErrorSeries(**arrays)
+
+
+def _stats(x: np.ndarray) -> tuple[float, float, float]:
+    return float(np.max(np.abs(x))), float(np.sqrt(np.mean(x * x))), float(x[-1])
+
+
+def summarize_series(series: PathErrorSeries, settle_s: float | None = None) -> PathErrors:
+    """The :class:`PathErrors` of a :class:`PathErrorSeries` (sup, RMS, final; sup after settle_s)."""
+    ct, at, he = _stats(series.cross_track), _stats(series.along_track), _stats(series.heading_error)
+    after = None
+    if settle_s is not None:
+        late = series.t >= float(settle_s)
+        after = float(np.max(np.abs(series.cross_track[late]))) if np.any(late) else None
+    return PathErrors(
+        cross_track_max=ct[0], cross_track_rms=ct[1], cross_track_final=ct[2],
+        along_track_max=at[0], along_track_rms=at[1], along_track_final=at[2],
+        heading_error_max=he[0], heading_error_rms=he[1], heading_error_final=he[2],
+        cross_track_max_after_settle=after, settle_s=None if settle_s is None else float(settle_s),
+        samples=int(series.t.size), beyond_end_samples=int(np.count_nonzero(series.beyond_end)),
+    )
+
+
+def path_errors(reference: Any, t: ArrayLike, C_xy: ArrayLike, heading: ArrayLike, *,
+                settle_s: float | None = None, window: float = WINDOW) -> PathErrors:
+    """C's cross-track, along-track and heading errors over a run, summarised.
+
+    reference: the run's Reference; t (n,) [s]; C_xy (n, 2) [m]; heading (n,) [rad] (the
+    chassis yaw); settle_s [s]: also the sup cross-track from then on. See
+    :func:`path_error_series` for the per-sample values and ``window``.
+    """
+    return summarize_series(path_error_series(reference, t, C_xy, heading, window=window), settle_s)
