@@ -83,9 +83,9 @@ def test_route_runs_closed_loop_and_config_stays_json(tmp_path):
         json.dumps(cfg.as_dict())
     a = run_closed_loop(by_file, progress=False)
     b = run_closed_loop(by_path, progress=False)
-    assert a.status == "completed" and a.summary["steps"] == 5000
+    assert a.status == "completed" and a.summary.steps == 5000
     assert np.array_equal(a.rows["E"], b.rows["E"])  # the same route, to the bit
-    assert a.summary["path"] == str(f)
+    assert a.summary.path == str(f)
     ref, settle = build_reference(str(f), C80, dt=1e-3, duration=5.0)
     assert settle == 0.0 and np.array_equal(ref.alpha0[:5000], a.rows["alpha0"])
 
