@@ -117,7 +117,7 @@ class RunJudgement:
     verdict: str
     certificate: CertificateJudgement
     paper_region: PaperRegion
-    drift: Drift
+    drift: Drift | None
 
 
 def drift(*, prev_window: float, last_window: float, final_alpha_dot: float) -> Drift:
@@ -156,7 +156,7 @@ def paper_region(analysis: Any, sup_E: float, sup_Edot: float) -> PaperRegion:
 
 
 def judge_run(*, certificate: Certificate, analysis: Any, sup_E: float, sup_Edot: float,
-              drift: Drift) -> RunJudgement:
+              drift: Drift | None) -> RunJudgement:
     """verdict, certificate (judged), paper_region (the paper's claim, judged) and drift of one run.
 
     Args:
@@ -164,7 +164,7 @@ def judge_run(*, certificate: Certificate, analysis: Any, sup_E: float, sup_Edot
         analysis: the paper's region for the run (a ``RobustnessResult``).
         sup_E: the run's sup|E| [rad].
         sup_Edot: the run's sup|E'| [rad/s].
-        drift: the run's end-of-run drift (:func:`drift`).
+        drift: the run's end-of-run drift (:func:`drift`); None: not measured.
     """
     judged = judge(certificate, sup_E, sup_Edot)
     return RunJudgement(verdict=judged.verdict, certificate=judged,

@@ -118,7 +118,7 @@ def run(args: argparse.Namespace) -> int:
     print("worst parameters: " + ", ".join(f"{k} = {v!r}" for k, v in worst.params.items()))
     print(f"reproduce: {summary['reproduce']}")
     if not summary["reproduced"]:
-        print(f"WARNING: the serial re-run gave sup|E| = {logged['sup_E']!r}, the search {worst.sup_E!r}",
+        print(f"WARNING: the serial re-run gave sup|E| = {logged.sup_E!r}, the search {worst.sup_E!r}",
               flush=True)
     print(f"log:   {log_path}\nplot:  {summary['plot'][0]}\ntable: {summary['table']}")
     return 0 if summary["reproduced"] else 1
