@@ -541,46 +541,13 @@ def analyse(
     :class:`wmr_mj.params.Coefficients`); named coefficients use that estimate and
     the truth ranges over the box; the others are "anywhere in the box" (4.2).
     """
-    if not isinstance(box, ParameterBox):
-        raise ParameterError(f"box must be a ParameterBox, got {type(box).__name__}")
-    if not isinstance(bounds, ReferenceBounds):
-        raise ParameterError(f"bounds must be a ReferenceBounds, got {type(bounds).__name__}")
-    if reading not in READINGS:
-        raise UnknownNameError("reading", str(reading), READINGS)
-    if gammas not in GAMMA_FORMS:
-        raise UnknownNameError("gamma form", str(gammas), GAMMA_FORMS)
+    _check_analysis_inputs(box, bounds, reading, gammas)
     kp, kd = _check_gains(kp, kd)
     est = _normalise_estimate(estimate)
-
     g1, g2 = exact_gammas(kp, kd) if gammas == "exact" else paper_gammas(kp, kd)
-
-    # Worst cases of |X~| for the additive terms (independent of the P corners).
-    dC = _max_tilde(box, "C_V", est)
-    dF = _max_tilde(box, "F", est)
-    dK = _max_tilde(box, "K", est)
-    P_true, P_est = _candidates(box, "P", est)
-    # Inside each sup the expression is monotone in P between kinks, so box
-    # corners (and P = P^ when an estimate lies in the box) suffice.
-    if "P" in est and box.P[0] < est["P"] < box.P[1]:
-        P_true = P_true + [est["P"]]
-    pairs = [(p, ph) for p in P_true for ph in P_est]
-
-    rest = dF + dC * bounds.alpha_dot_max + dK * bounds.sin_cos3_max
-    delta1 = max((abs(p - ph) * bounds.alpha_ddot_max + rest) / p for p, ph in pairs)  # (4.18)
-
-    def mis(p: float, ph: float) -> float:  # 1 - P^-1 P^
-        return 1.0 - ph / p
-
-    term_kp = max(abs(mis(p, ph)) * kp for p, ph in pairs)
-    c_scale = (lambda p: 1.0) if reading == "printed-literal" else (lambda p: 1.0 / p)
-    # C~_V = C_V - C_V^: both signs up to the box width, or truth-in-box minus a fixed estimate.
-    c_tilde = [box.C_V[0] - est["C_V"], box.C_V[1] - est["C_V"]] if "C_V" in est else [-dC, dC]
-    term_kd = max(abs(mis(p, ph) * kd - ct * c_scale(p)) for p, ph in pairs for ct in c_tilde)
-    if reading == "corrected":
-        delta_E, delta_Edot = term_kp, term_kd
-    else:
-        delta_E, delta_Edot = term_kd, term_kp
-
+    pairs = _P_pairs(box, est)
+    delta1 = _delta1(box, est, bounds, pairs)
+    delta_E, delta_Edot = _error_coefficients(box, est, pairs, kp, kd, reading)
     condition = g1 * delta_E + g2 * delta_Edot  # (4.23)
     stable = condition < 1.0
     if stable:
@@ -606,3 +573,54 @@ def analyse(
         bounds=bounds,
         estimate=dict(est) if est else None,
     )
+
+
+def _check_analysis_inputs(box: Any, bounds: Any, reading: Any, gammas: Any) -> None:
+    if not isinstance(box, ParameterBox):
+        raise ParameterError(f"box must be a ParameterBox, got {type(box).__name__}")
+    if not isinstance(bounds, ReferenceBounds):
+        raise ParameterError(f"bounds must be a ReferenceBounds, got {type(bounds).__name__}")
+    if reading not in READINGS:
+        raise UnknownNameError("reading", str(reading), READINGS)
+    if gammas not in GAMMA_FORMS:
+        raise UnknownNameError("gamma form", str(gammas), GAMMA_FORMS)
+
+
+def _P_pairs(box: ParameterBox, est: dict[str, float]) -> list[tuple[float, float]]:
+    """The (P, P^) pairs the sups of (4.18)-(4.20) are taken over.
+
+    Inside each sup the expression is monotone in P between kinks, so box corners (and
+    P = P^ when an estimate lies in the box) suffice.
+    """
+    P_true, P_est = _candidates(box, "P", est)
+    if "P" in est and box.P[0] < est["P"] < box.P[1]:
+        P_true = P_true + [est["P"]]
+    return [(p, ph) for p in P_true for ph in P_est]
+
+
+def _delta1(box: ParameterBox, est: dict[str, float], bounds: ReferenceBounds,
+            pairs: list[tuple[float, float]]) -> float:
+    """delta1 of (4.18) [rad/s^2]: the worst cases of |X~| for the additive terms, over the P pairs."""
+    dC = _max_tilde(box, "C_V", est)
+    dF = _max_tilde(box, "F", est)
+    dK = _max_tilde(box, "K", est)
+    rest = dF + dC * bounds.alpha_dot_max + dK * bounds.sin_cos3_max
+    return max((abs(p - ph) * bounds.alpha_ddot_max + rest) / p for p, ph in pairs)  # (4.18)
+
+
+def _error_coefficients(box: ParameterBox, est: dict[str, float], pairs: list[tuple[float, float]], kp: float,
+                        kd: float, reading: str) -> tuple[float, float]:
+    """(coefficient of ||E|| [1/s^2], of ||E'|| [1/s]) in (4.19), as ``reading`` reads (4.20)."""
+
+    def mis(p: float, ph: float) -> float:  # 1 - P^-1 P^
+        return 1.0 - ph / p
+
+    term_kp = max(abs(mis(p, ph)) * kp for p, ph in pairs)
+    c_scale = (lambda p: 1.0) if reading == "printed-literal" else (lambda p: 1.0 / p)
+    # C~_V = C_V - C_V^: both signs up to the box width, or truth-in-box minus a fixed estimate.
+    dC = _max_tilde(box, "C_V", est)
+    c_tilde = [box.C_V[0] - est["C_V"], box.C_V[1] - est["C_V"]] if "C_V" in est else [-dC, dC]
+    term_kd = max(abs(mis(p, ph) * kd - ct * c_scale(p)) for p, ph in pairs for ct in c_tilde)
+    if reading == "corrected":
+        return term_kp, term_kd
+    return term_kd, term_kp
