@@ -239,24 +239,11 @@ def write_video(
     import imageio.v2 as imageio
     import mujoco
 
-    from wmr_mj.errors import LogError
-
     _check_options(fps, width, height)
     clock = time.perf_counter
     t_start = clock()
     seconds = dict.fromkeys(("load", "kinematics", "scene", "render", "overlay", "encode"), 0.0)
-    state = log.state
-    t_state = np.asarray(state.get("t", np.empty(0)), float)
-    qpos = state.get("qpos")
-    if t_state.size == 0 or qpos is None:
-        raise LogError(f"{log.path}: the log has no /sim/state rows to render")
-    try:
-        model = mujoco.MjModel.from_xml_string(log.mjcf_xml)
-    except Exception as exc:
-        raise LogError(f"{log.path}: the attached MJCF does not compile ({_first_line(exc)})") from None
-    if qpos.shape[1:] != (model.nq,):
-        raise LogError(f"{log.path}: /sim/state qpos has {qpos.shape[1:]} values per row; "
-                       f"the attached model has nq = {model.nq}")
+    model, t_state, qpos = _log_model(log)
     ids = _style_model(model, width=width, height=height, chassis_alpha=chassis_alpha)
     data = mujoco.MjData(model)
 
@@ -283,6 +270,8 @@ def write_video(
                                 macro_block_size=2, ffmpeg_log_level="error")  # fmt: skip
     seconds["load"] = clock() - t_start
     try:
+        # One pass per frame, long on purpose: each stage is timed in place (``seconds``), and the
+        # renderer, scene and camera are reused from frame to frame.
         for k in range(n_frames):
             t0 = clock()
             data.qpos[:] = qpos[rows[k]]
@@ -320,6 +309,31 @@ def write_video(
     backend = os.environ.get("MUJOCO_GL", "")
     return VideoResult(path=str(out), frames=n_frames, fps=fps, width=width, height=height, backend=backend,
                        seconds=seconds)
+
+
+def _log_model(log: Any) -> tuple[Any, np.ndarray, np.ndarray]:
+    """(the compiled model attached to the log, /sim/state t [s], qpos rows) of a loaded RunLog.
+
+    Raises:
+        LogError: no /sim/state rows, an MJCF that does not compile, or qpos rows of another size.
+    """
+    import mujoco
+
+    from wmr_mj.errors import LogError
+
+    state = log.state
+    t_state = np.asarray(state.get("t", np.empty(0)), float)
+    qpos = state.get("qpos")
+    if t_state.size == 0 or qpos is None:
+        raise LogError(f"{log.path}: the log has no /sim/state rows to render")
+    try:
+        model = mujoco.MjModel.from_xml_string(log.mjcf_xml)
+    except Exception as exc:
+        raise LogError(f"{log.path}: the attached MJCF does not compile ({_first_line(exc)})") from None
+    if qpos.shape[1:] != (model.nq,):
+        raise LogError(f"{log.path}: /sim/state qpos has {qpos.shape[1:]} values per row; "
+                       f"the attached model has nq = {model.nq}")
+    return model, t_state, qpos
 
 
 def _make_renderer(model: Any, width: int, height: int, *, max_geom: int) -> Any:
