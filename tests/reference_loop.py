@@ -8,6 +8,7 @@ compares rows, summaries and logs.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections.abc import Callable
@@ -173,10 +174,9 @@ def reference_run(
                      left_range_at=left_range_at, final_alpha=done["alpha"][-1], control_steps=k,
                      steps=k * substeps, wall_s=wall, status=status, certificate=certificate,
                      drift=_drift_of(done["E"], done["alpha0_dot"][-1] - done["E_dot"][-1], period))
-    summary["mujoco_warnings"] = int(sum(w.number for w in d.warning))
-    summary["analysis"] = analysis.as_dict()
-    summary["controller_config"] = controller.describe()
+    summary = dataclasses.replace(summary, mujoco_warnings=int(sum(w.number for w in d.warning)),
+                                  analysis=analysis.as_dict(), controller_config=controller.describe())
     if logger is not None:
         flush(k)
-        logger.close(summary, status=status)
+        logger.close(summary.to_dict(), status=status)
     return RunResult(config=config, rows=done, summary=summary, status=status)
