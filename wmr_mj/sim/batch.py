@@ -36,14 +36,13 @@ import threading
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Any
 
 import mujoco
 import numpy as np
 
 from wmr_mj._util.memory import require_memory
 from wmr_mj.analysis.verdicts import drift, drift_window_steps
-from wmr_mj.errors import ParameterError, UnknownNameError
+from wmr_mj.errors import ParameterError
 from wmr_mj.params import C80, M1_NOMINAL, C80Parameters
 from wmr_mj.sim import compiled_law
 from wmr_mj.sim.certify import certificate_for
@@ -57,41 +56,11 @@ from wmr_mj.sim.config import (
     estimate_parameters,
     plant_parameters,
 )
+from wmr_mj.sim.engine import LAW_BACKENDS, batch_law_backend, batch_model
+from wmr_mj.sim.engine import plant_options as _plant_options
 from wmr_mj.sim.summary import BatchFigures, RunSummary
 
 __all__ = ["run_batch", "batch_model", "batch_law_backend", "LAW_BACKENDS", "thread_count", "batch_groups"]
-
-#: how run_batch evaluates the law: "compiled" (C, in MuJoCo's control callback), "numpy"
-#: (the vectorised law between steps), "auto" (compiled where it can run)
-LAW_BACKENDS = ("auto", "compiled", "numpy")
-
-_PLANT_OPTIONS = ("steering_friction", "tyre_contact")  # RunConfig fields that choose the plant's laws
-
-
-def _plant_options(config: RunConfig) -> dict[str, Any]:
-    """The plant-law keywords the config carries (compile_model and Plant take them)."""
-    return {name: getattr(config, name) for name in _PLANT_OPTIONS if hasattr(config, name)}
-
-
-def batch_model(params: C80Parameters, *, law: tuple[np.ndarray, Sequence[np.ndarray]] | None = None,
-                **plant_options: Any) -> mujoco.MjModel:
-    """The plant of ``compile_model(params, ...)`` without its sky texture, for the batch.
-
-    Generating the 512x3072 sky gradient is 95% of compiling the scene (11.6 of 12 ms
-    measured); a texture touches no physics, and a test checks that every other model
-    field equals the serial run's. ``law`` = (law vector, reference rows) attaches the
-    compiled law (:func:`wmr_mj.sim.compiled_law.attach`: two numerics and userdata, no physics).
-    """
-    from wmr_mj.plant import mjcf as plant
-
-    spec = plant.scene_spec(params, **plant_options)
-    for texture in list(spec.textures):
-        if texture.type == mujoco.mjtTexture.mjTEXTURE_SKYBOX:
-            spec.delete(texture)
-    if law is not None:
-        compiled_law.attach(spec, *law)
-    return spec.compile()
-
 
 def thread_count(nthread: int, nsim: int) -> int:
     """Threads for nsim simulations: nthread, or every core this process may use when 0."""
@@ -261,26 +230,6 @@ def _run_group_compiled(loop: _Loop, models: Sequence[mujoco.MjModel], idx: np.n
         if _stopped(loop, k0 + count, stop, progress):
             return
     _final_stats(loop, stats, idx, batch, a_buf[count - 1], Ed_buf[count - 1], alpha_now)
-
-
-def batch_law_backend(controller: Any, law: str = "auto") -> str:
-    """'compiled' or 'numpy': how run_batch evaluates ``controller``'s law when asked for ``law``.
-
-    'auto' takes the compiled law where it can run (:mod:`wmr_mj.sim.compiled_law`), else NumPy;
-    'compiled' raises ParameterError, saying why, where it cannot.
-    """
-    if law not in LAW_BACKENDS:
-        raise UnknownNameError("law backend", law, LAW_BACKENDS)
-    if law == "numpy":
-        return "numpy"
-    why = compiled_law.unavailable_reason()
-    if why is None and not compiled_law.supports(controller):
-        why = f"it implements ComputedTorque and PDController, not {type(controller).__name__}"
-    if why is None:
-        return "compiled"
-    if law == "compiled":
-        raise ParameterError(f"the compiled law cannot run: {why}")
-    return "numpy"
 
 
 def _block_stats(loop: _Loop, stats: _BatchStats, idx: np.ndarray, k0: int, rows: int, a_buf, E_buf, Ed_buf,

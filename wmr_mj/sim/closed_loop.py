@@ -19,7 +19,6 @@ the two bit-identical.
 from __future__ import annotations
 
 import dataclasses
-import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -45,13 +44,11 @@ from wmr_mj.sim.config import (
     estimate_parameters,
     plant_parameters,
 )
+from wmr_mj.sim.engine import ROW_FIELDS, plant_options, run_engine
 from wmr_mj.sim.summary import RunSummary
 
 __all__ = ["RunResult", "run_closed_loop", "report", "run_on_reduced_model", "ROW_FIELDS"]
 
-# scalar fields recorded for every control step (see RunResult.rows)
-ROW_FIELDS = ("t", "alpha", "alpha_dot", "alpha0", "alpha0_dot", "alpha0_ddot", "E", "E_dot",
-              "voltage_cmd", "voltage", "current", "steer_torque", "heading")
 
 
 @dataclass
@@ -62,6 +59,8 @@ class RunResult:
     rows: dict[str, np.ndarray]
     summary: RunSummary
     status: str = "completed"
+    law: str = "compiled"  # the law that ran: "compiled" (C, MuJoCo's control callback) or "python"
+    law_note: str | None = None  # why the Python law ran
 
 
 def _substeps(config: RunConfig, timestep: float) -> int:
@@ -160,8 +159,13 @@ def run_closed_loop(
     logger_factory: Callable[..., Any] | None = None,
     progress: bool | None = None,
     base: C80Parameters = C80,
+    law: str = "auto",
 ) -> RunResult:
     """Run ``config`` on the MuJoCo plant; optionally stream rows to an MCAP logger.
+
+    The run is a batch of one on :func:`wmr_mj.sim.engine.run_engine`: the compiled law where it
+    can run, else the Python law (``RunResult.law``, ``RunResult.law_note`` say which and why);
+    ``law`` ("auto", "compiled", "numpy") chooses as ``run_batch`` does.
 
     logger_factory(mjcf_xml=..., config=..., parameters=..., initial_state=..., timestep=...,
     control_substeps=..., reference_path=..., bounds={"E_max", "Edot_max"}, model=the compiled
@@ -172,9 +176,7 @@ def run_closed_loop(
     params = plant_parameters(config, base)
     estimate = estimate_parameters(base)
     controller = controller_for(config, estimate)
-    plant = Plant(params, steering_friction=config.steering_friction, tyre_contact=config.tyre_contact)
-    m, d = plant.model, plant.data
-    dt = m.opt.timestep
+    dt = TIMESTEP
     substeps = _substeps(config, dt)
     period = substeps * dt
     n = int(round(config.duration / period))
@@ -186,16 +188,10 @@ def run_closed_loop(
     if len(a0_all) < n:
         raise ParameterError(f"reference shorter than the run: {len(a0_all)} < {n} samples")
 
-    full = logger_factory is not None
-    block_len = max(1, int(round(1.0 / period)))  # one simulated second per block
-    rows = {k: np.empty(n) for k in ROW_FIELDS}
-    if full:  # per logged row: qpos, qvel, ctrl in one mj_getState call, and the site positions
-        log_spec = int(mujoco.mjtState.mjSTATE_QPOS | mujoco.mjtState.mjSTATE_QVEL | mujoco.mjtState.mjSTATE_CTRL)
-        log_state = np.empty((block_len, mujoco.mj_stateSize(m, log_spec)))
-        log_sites = np.empty((block_len, m.nsite, 3))
-        state_rows, site_rows, get_state = list(log_state), list(log_sites), mujoco.mj_getState  # cheaper per step
     logger = None
-    if full:
+    if logger_factory is not None:  # the log carries the scene as the plant compiles it (sky included)
+        plant = Plant(params, steering_friction=config.steering_friction, tyre_contact=config.tyre_contact)
+        m, d = plant.model, plant.data
         state = np.empty(mujoco.mj_stateSize(m, mujoco.mjtState.mjSTATE_INTEGRATION))
         mujoco.mj_getState(m, d, state, mujoco.mjtState.mjSTATE_INTEGRATION)
         logger = logger_factory(mjcf_xml=plant.xml, config=config.as_dict(), parameters=params.as_dict(),
@@ -203,102 +199,33 @@ def run_closed_loop(
                                 bounds={"E_max": certificate.E_max, "Edot_max": certificate.Edot_max}, model=m,
                                 reference_path=np.asarray(reference.C_xy)[::max(1, len(reference.C_xy) // 2000)])
 
-    qpos, qvel, ctrl = d.qpos, d.qvel, d.ctrl
-    qa, dv, act = plant.steer_qpos, plant.steer_dof, plant.steer_actuator
-    chassis, site_A, site_C = plant.chassis_body, plant.site_A, plant.site_C
-    xquat, site_xpos, act_force, qfrc_act = d.xquat, d.site_xpos, d.actuator_force, d.qfrc_actuator
-    limit = params.voltage_limit
-    range_limit = params.steering_range - 1e-3
-    k_i = params.k_i
-    law = controller.voltage_scalar
-    r_t, r_a, r_ad, r_a0, r_a0d, r_a0dd = (rows[k] for k in ("t", "alpha", "alpha_dot", "alpha0", "alpha0_dot",
-                                                              "alpha0_ddot"))
-    r_E, r_Ed, r_uc, r_u, r_i, r_tau, r_h = (rows[k] for k in ("E", "E_dot", "voltage_cmd", "voltage", "current",
-                                                                "steer_torque", "heading"))
-    saturated = 0
-    left_range_at = None
     bar = progress_bar(n, desc="run", unit="step", unit_scale=True, enabled=progress)
-    status = "completed"
-    k = 0
-    block_start = 0
     wall0 = time.perf_counter()
-
-    def flush(upto: int) -> None:
-        nonlocal block_start
-        if logger is None or upto <= block_start:
-            return
-        sl = slice(block_start, upto)
-        block = {key: rows[key][sl] for key in ROW_FIELDS}
-        cnt = upto - block_start
-        st, nq, nv = log_state[:cnt], m.nq, m.nv
-        block.update(qpos=st[:, :nq].copy(), qvel=st[:, nq:nq + nv].copy(), ctrl=st[:, nq + nv:].copy(),
-                     A_pos=log_sites[:cnt, site_A, :2].copy(), C_pos=log_sites[:cnt, site_C, :2].copy())
-        block_start = upto  # first: an interrupt raised as the block is written must not send it twice
-        logger.write_block(block)
-
     try:
-        while k < n:
-            a = float(qpos[qa])
-            ad = float(qvel[dv])
-            a0, a0d, a0dd = float(a0_all[k]), float(a0d_all[k]), float(a0dd_all[k])
-            u_cmd = law(a, ad, a0, a0d, a0dd)
-            if u_cmd != u_cmd:  # NaN from a diverged law: apply nothing, keep the record
-                u = 0.0
-            else:
-                u = limit if u_cmd > limit else (-limit if u_cmd < -limit else u_cmd)
-            if u != u_cmd:
-                saturated += 1
-            ctrl[act] = u
-            if full:
-                j = k - block_start
-                get_state(m, d, state_rows[j], log_spec)
-            for _ in range(substeps):
-                mujoco.mj_step(m, d)
-            # after mj_step, forces and kinematics belong to the state the step started from
-            r_t[k] = k * period
-            r_a[k] = a
-            r_ad[k] = ad
-            r_a0[k] = a0
-            r_a0d[k] = a0d
-            r_a0dd[k] = a0dd
-            r_E[k] = a0 - a
-            r_Ed[k] = a0d - ad
-            r_uc[k] = u_cmd
-            r_u[k] = u
-            r_i[k] = act_force[act] / k_i
-            r_tau[k] = qfrc_act[dv]
-            q = xquat[chassis]
-            r_h[k] = math.atan2(2.0 * (q[0] * q[3] + q[1] * q[2]), 1.0 - 2.0 * (q[2] * q[2] + q[3] * q[3]))
-            if full:
-                site_rows[j][...] = site_xpos
-            if left_range_at is None and abs(a) >= range_limit:
-                left_range_at = k * period
-            k += 1
-            if full and k - block_start == block_len:
-                flush(k)
-            if k & 1023 == 0:
-                bar.update(1024)
-    except KeyboardInterrupt:
-        status = "interrupted"
+        run = run_engine(params=params, controller=controller, options=plant_options(config),
+                         reference=(a0_all, a0d_all, a0dd_all), n=n, substeps=substeps, period=period, law=law,
+                         on_block=None if logger is None else logger.write_block, on_progress=bar.update)
     finally:
         bar.close()
     wall = time.perf_counter() - wall0
-    done = {key: v[:k] for key, v in rows.items()}
+    done, k, status = run.rows, run.steps, run.status
     if k == 0:
         raise KeyboardInterrupt  # nothing simulated: nothing to report
     after = done["t"] >= settle_s
+    saturated = int(np.count_nonzero(done["voltage"] != done["voltage_cmd"]))  # NaN included: 0 V applied
+    hit = np.flatnonzero(np.abs(done["alpha"]) >= params.steering_range - 1e-3)
+    left_range_at = int(hit[0]) * period if hit.size else None
     summary = report(config, analysis=analysis, params=params, settle_s=settle_s, sup_E=_sup(done["E"]),
                      sup_Edot=_sup(done["E_dot"]), sup_E_settled=_sup(done["E"][after]),
                      sup_Edot_settled=_sup(done["E_dot"][after]), saturated_fraction=saturated / k,
                      left_range_at=left_range_at, final_alpha=done["alpha"][-1], control_steps=k,
                      steps=k * substeps, wall_s=wall, status=status, certificate=certificate,
                      drift=_drift_of(done["E"], done["alpha0_dot"][-1] - done["E_dot"][-1], period))
-    summary = dataclasses.replace(summary, mujoco_warnings=int(sum(w.number for w in d.warning)),
-                                  analysis=analysis.as_dict(), controller_config=controller.describe())
+    summary = dataclasses.replace(summary, mujoco_warnings=run.warnings, analysis=analysis.as_dict(),
+                                  controller_config=controller.describe())
     if logger is not None:
-        flush(k)
         logger.close(summary.to_dict(), status=status)
-    return RunResult(config=config, rows=done, summary=summary, status=status)
+    return RunResult(config=config, rows=done, summary=summary, status=status, law=run.law, law_note=run.law_note)
 
 
 def run_on_reduced_model(

@@ -1,0 +1,359 @@
+"""The one closed-loop engine: a single run is a batch of one, stepped in blocks through the compiled law.
+
+``wmr_mj.sim.closed_loop.run_closed_loop`` (``wmr-mj run``, replay's re-runs, ``identify``,
+``validate``) hands a run to :func:`run_engine`, which steps it one simulated second at a time:
+
+- with the compiled law (:mod:`wmr_mj.sim.compiled_law`: the law in MuJoCo's control callback),
+  one ``mujoco.batch.Batch.rollout`` call per block runs every physics step of that second in C
+  and records, after each step, what the rows and the log need (userdata: alpha, E, E', the law's
+  voltage; qvel, ctrl, the steering actuator's force, qfrc_actuator, xquat; for a log also qpos
+  and the site positions); the rows are then made from these arrays with NumPy, bit for bit
+  what one ``mj_step`` at a time gives (tests/test_engine.py against tests/reference_loop.py);
+- where the compiled law cannot run (not built, ``WMR_MJ_COMPILED_LAW=0``, a controller
+  subclass), the same engine steps the block with the Python law (``voltage_scalar``), one
+  ``mj_step`` per physics step, into the same record arrays, and says so (``EngineRun.law_note``);
+- a block in which MuJoCo warns (rollout stops a simulation whose warnings rise) is stepped again
+  from its first state with the Python law, which, as ``mj_step`` does, goes on after a warning;
+  the rest of the run keeps the Python law.
+
+Each block is handed to ``on_block`` (the MCAP logger) as arrays: the rows plus qpos, qvel, ctrl
+at every control step's start and the positions of sites A and C.
+
+The models: :func:`batch_model` (the scene without its sky texture, with the law attached or
+not), shared with ``wmr_mj.sim.batch``; :func:`batch_law_backend` chooses the law.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import mujoco
+import numpy as np
+
+from wmr_mj.errors import ParameterError, UnknownNameError
+from wmr_mj.params import C80Parameters
+from wmr_mj.sim import compiled_law
+
+__all__ = ["run_engine", "EngineRun", "batch_model", "batch_law_backend", "LAW_BACKENDS", "plant_options",
+           "ROW_FIELDS"]
+
+# scalar fields recorded for every control step (see wmr_mj.sim.closed_loop.RunResult.rows)
+ROW_FIELDS = ("t", "alpha", "alpha_dot", "alpha0", "alpha0_dot", "alpha0_ddot", "E", "E_dot",
+              "voltage_cmd", "voltage", "current", "steer_torque", "heading")
+
+#: how a run evaluates the law: "compiled" (C, in MuJoCo's control callback), "numpy"
+#: (Python: the vectorised law of a batch, ``voltage_scalar`` of a single run), "auto"
+#: (compiled where it can run)
+LAW_BACKENDS = ("auto", "compiled", "numpy")
+
+_PLANT_OPTIONS = ("steering_friction", "tyre_contact")  # RunConfig fields that choose the plant's laws
+
+
+def plant_options(config: Any) -> dict[str, Any]:
+    """The plant-law keywords the config carries (compile_model and Plant take them)."""
+    return {name: getattr(config, name) for name in _PLANT_OPTIONS if hasattr(config, name)}
+
+
+def batch_model(params: C80Parameters, *, law: tuple[np.ndarray, Sequence[np.ndarray]] | None = None,
+                **plant_options: Any) -> mujoco.MjModel:
+    """The plant of ``compile_model(params, ...)`` without its sky texture, for the engine and the batch.
+
+    Generating the 512x3072 sky gradient is 95% of compiling the scene (11.6 of 12 ms
+    measured); a texture touches no physics, and a test checks that every other model
+    field equals the serial run's. ``law`` = (law vector, reference rows) attaches the
+    compiled law (:func:`wmr_mj.sim.compiled_law.attach`: two numerics and userdata, no physics).
+    """
+    from wmr_mj.plant import mjcf as plant
+
+    spec = plant.scene_spec(params, **plant_options)
+    for texture in list(spec.textures):
+        if texture.type == mujoco.mjtTexture.mjTEXTURE_SKYBOX:
+            spec.delete(texture)
+    if law is not None:
+        compiled_law.attach(spec, *law)
+    return spec.compile()
+
+
+def batch_law_backend(controller: Any, law: str = "auto") -> str:
+    """'compiled' or 'numpy': how a run evaluates ``controller``'s law when asked for ``law``.
+
+    'auto' takes the compiled law where it can run (:mod:`wmr_mj.sim.compiled_law`), else NumPy;
+    'compiled' raises ParameterError, saying why, where it cannot.
+    """
+    return _backend(controller, law)[0]
+
+
+def _backend(controller: Any, law: str) -> tuple[str, str | None]:
+    """(backend, why the compiled law does not run or None)."""
+    if law not in LAW_BACKENDS:
+        raise UnknownNameError("law backend", law, LAW_BACKENDS)
+    if law == "numpy":
+        return "numpy", "the Python law was asked for"
+    why = compiled_law.unavailable_reason()
+    if why is None and not compiled_law.supports(controller):
+        why = f"it implements ComputedTorque and PDController, not {type(controller).__name__}"
+    if why is None:
+        return "compiled", None
+    if law == "compiled":
+        raise ParameterError(f"the compiled law cannot run: {why}")
+    return "numpy", why
+
+
+@dataclass
+class EngineRun:
+    """What :func:`run_engine` simulated: ``steps`` control steps of rows, and how."""
+
+    rows: dict[str, np.ndarray]  # ROW_FIELDS, the first `steps` control steps
+    steps: int
+    status: str  # "completed" or "interrupted"
+    warnings: int  # MuJoCo's warning counters, summed
+    law: str  # "compiled" or "python"
+    law_note: str | None  # why the Python law ran, None with the compiled law
+
+
+class _Plant:
+    """Indices and constants the engine reads, from a compiled model."""
+
+    def __init__(self, m: mujoco.MjModel) -> None:
+        steer = m.joint("steer").id
+        self.qpos = int(m.jnt_qposadr[steer])
+        self.dof = int(m.jnt_dofadr[steer])
+        self.actuator = int(m.actuator("steering_motor").id)
+        self.chassis = int(m.body("chassis").id)
+        self.site_A, self.site_C = int(m.site("A").id), int(m.site("C").id)
+        self.keyframe = int(m.key("home").id)
+
+
+class _Block:
+    """One block's records, (count, ...) per control step, as both steppers fill them.
+
+    alpha, alpha_dot, voltage_cmd: at the control step's start (what the law saw);
+    ctrl, force (the steering actuator's), torque (qfrc_actuator at the steering dof), quat (the
+    chassis's xquat), sites: after the control step's last mj_step, i.e. of the state that step
+    started from, as the serial loop read them; qpos, qvel: at the control step's start (logs only).
+    """
+
+    def __init__(self, count: int, m: mujoco.MjModel, log: bool) -> None:
+        self.alpha, self.alpha_dot, self.voltage_cmd, self.force, self.torque = (np.empty(count) for _ in range(5))
+        self.ctrl = np.empty((count, m.nu))
+        self.quat = np.empty((count, 4))
+        self.qpos = np.empty((count, m.nq)) if log else None
+        self.qvel = np.empty((count, m.nv)) if log else None
+        self.sites = np.empty((count, m.nsite, 3)) if log else None
+
+
+def _heading(quat: np.ndarray) -> np.ndarray:
+    """Yaw of unit quaternions (w, x, y, z), element for element the serial loop's math.atan2."""
+    w, x, y, z = quat[:, 0], quat[:, 1], quat[:, 2], quat[:, 3]
+    num = 2.0 * (w * z + x * y)
+    den = 1.0 - 2.0 * (y * y + z * z)
+    return np.fromiter(map(math.atan2, num.tolist(), den.tolist()), dtype=np.float64, count=len(num))
+
+
+class _CompiledStepper:
+    """A batch of one with the law in MuJoCo's control callback: one rollout call per block."""
+
+    def __init__(self, model: mujoco.MjModel, where: _Plant, substeps: int, log: bool) -> None:
+        from mujoco.batch import Batch
+
+        self.model, self.where, self.substeps, self.log = model, where, substeps, log
+        self.batch = Batch(model, nsim=1, nthread=1)
+        self.batch.reset(keyframe=where.keyframe)
+        self.record = ["userdata", "qvel", "ctrl", "actuator_force", "qfrc_actuator", "xquat"]
+        if log:
+            self.record += ["qpos", "site_xpos"]
+        self._out: dict[int, dict[Any, np.ndarray]] = {}  # record buffers per block length, reused
+        # the state at the next control step's start (the rollout records the state after each step)
+        self._qvel = self.batch.qvel[0].copy()
+        self._qpos = self.batch.qpos[0].copy()
+
+    def warnings(self) -> int:
+        return int(self.batch.warning[0, :, 1].sum())  # (nsim, mjNWARNING, (lastinfo, number))
+
+    def state(self) -> np.ndarray:
+        return self.batch.state[0].copy()  # mjSTATE_INTEGRATION of the model with the law
+
+    def step(self, block: _Block, k0: int, count: int) -> None:
+        S, w = self.substeps, self.where
+        out = self._out.get(count)
+        if out is None:
+            out = self._out[count] = {}
+        rec = self.batch.rollout(count * S, record=self.record, out=out)
+        out.update(rec)
+        end = {key: rec[key][0, S - 1::S] for key in self.record}  # after each control step's last substep
+        ud = end["userdata"]  # the callback writes it at a control step's first substep; it holds
+        block.alpha[:] = ud[:, 0]
+        block.voltage_cmd[:] = ud[:, 3]
+        block.alpha_dot[0] = self._qvel[w.dof]
+        block.alpha_dot[1:] = end["qvel"][:-1, w.dof]
+        block.ctrl[:] = end["ctrl"]
+        block.force[:] = end["actuator_force"][:, w.actuator]
+        block.torque[:] = end["qfrc_actuator"][:, w.dof]
+        block.quat[:] = end["xquat"][:, w.chassis]
+        if self.log:
+            block.qpos[0], block.qpos[1:] = self._qpos, end["qpos"][:-1]
+            block.qvel[0], block.qvel[1:] = self._qvel, end["qvel"][:-1]
+            block.sites[:] = end["site_xpos"].reshape(count, -1, 3)
+            self._qpos = end["qpos"][-1].copy()
+        self._qvel = end["qvel"][-1].copy()
+
+
+class _PythonStepper:
+    """The same closed loop with the Python law, one mj_step at a time (no compiled law, or after a warning)."""
+
+    def __init__(self, model: mujoco.MjModel, where: _Plant, substeps: int, log: bool, law: Callable[..., float],
+                 reference: tuple[np.ndarray, np.ndarray, np.ndarray], voltage_limit: float) -> None:
+        self.model, self.where, self.substeps, self.log = model, where, substeps, log
+        self.data = mujoco.MjData(model)
+        mujoco.mj_resetDataKeyframe(model, self.data, where.keyframe)
+        mujoco.mj_forward(model, self.data)
+        self.law, self.reference, self.limit = law, reference, voltage_limit
+
+    def warnings(self) -> int:
+        return int(sum(w.number for w in self.data.warning))
+
+    def set_state(self, model: mujoco.MjModel, state: np.ndarray) -> None:
+        """Continue from ``state`` (mjSTATE_INTEGRATION of ``model``, which may carry the law's userdata)."""
+        spec = int(mujoco.mjtState.mjSTATE_INTEGRATION) & ~int(mujoco.mjtState.mjSTATE_USERDATA)
+        full = mujoco.MjData(model)
+        mujoco.mj_setState(model, full, state, mujoco.mjtState.mjSTATE_INTEGRATION)
+        values = np.empty(mujoco.mj_stateSize(model, spec))
+        mujoco.mj_getState(model, full, values, spec)
+        mujoco.mj_setState(self.model, self.data, values, spec)
+
+    def step(self, block: _Block, k0: int, count: int) -> None:
+        m, d, w = self.model, self.data, self.where
+        qpos, qvel, ctrl = d.qpos, d.qvel, d.ctrl
+        qa, dv, act, chassis = w.qpos, w.dof, w.actuator, w.chassis
+        xquat, site_xpos, act_force, qfrc_act = d.xquat, d.site_xpos, d.actuator_force, d.qfrc_actuator
+        limit, law, substeps, log, step = self.limit, self.law, self.substeps, self.log, mujoco.mj_step
+        a0_all, a0d_all, a0dd_all = (r[k0:k0 + count].tolist() for r in self.reference)
+        for j in range(count):
+            a = float(qpos[qa])
+            ad = float(qvel[dv])
+            u_cmd = law(a, ad, a0_all[j], a0d_all[j], a0dd_all[j])
+            if u_cmd != u_cmd:  # NaN from a diverged law: apply nothing, keep the record
+                u = 0.0
+            else:
+                u = limit if u_cmd > limit else (-limit if u_cmd < -limit else u_cmd)
+            ctrl[act] = u
+            if log:
+                block.qpos[j] = qpos
+                block.qvel[j] = qvel
+            for _ in range(substeps):
+                step(m, d)
+            # after mj_step, forces and kinematics belong to the state the step started from
+            block.alpha[j] = a
+            block.alpha_dot[j] = ad
+            block.voltage_cmd[j] = u_cmd
+            block.ctrl[j] = ctrl
+            block.force[j] = act_force[act]
+            block.torque[j] = qfrc_act[dv]
+            block.quat[j] = xquat[chassis]
+            if log:
+                block.sites[j] = site_xpos
+
+
+def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any],
+               reference: tuple[np.ndarray, np.ndarray, np.ndarray], n: int, substeps: int, period: float,
+               law: str = "auto", on_block: Callable[[dict[str, np.ndarray]], None] | None = None,
+               on_progress: Callable[[int], None] | None = None) -> EngineRun:
+    """Run ``n`` control steps of ``controller`` on the plant of ``params``; rows of every control step.
+
+    ``reference`` = (alpha0, alpha0', alpha0'') on the control grid (at least n samples);
+    ``on_block(block)``, where given, receives the rows of every simulated second with qpos,
+    qvel, ctrl (at each control step's start, ctrl as applied), A_pos and C_pos (xy of sites A
+    and C); ``on_progress(steps)`` the control steps of each block. KeyboardInterrupt (Ctrl-C,
+    SIGTERM made one) ends the run as "interrupted" with the blocks simulated so far; a block
+    committed but not yet handed to ``on_block`` is handed over before returning.
+    """
+    backend, note = _backend(controller, law)
+    plain = batch_model(params, **options)
+    where = _Plant(plain)
+    log = on_block is not None
+    a0_all, a0d_all, a0dd_all = (np.asarray(r, dtype=np.float64) for r in reference)
+    if len(a0_all) < n:
+        raise ParameterError(f"reference shorter than the run: {len(a0_all)} < {n} samples")
+
+    def python_stepper() -> _PythonStepper:
+        return _PythonStepper(plain, where, substeps, log, controller.voltage_scalar, (a0_all, a0d_all, a0dd_all),
+                              params.voltage_limit)
+
+    lawful = None
+    stepper: _CompiledStepper | _PythonStepper
+    if backend == "compiled":
+        compiled_law.install()
+        vector = compiled_law.law_vector(controller, voltage_limit=params.voltage_limit, substeps=substeps, nstep=n,
+                                         qpos_adr=where.qpos, dof_adr=where.dof, actuator=where.actuator)
+        lawful = batch_model(params, law=(vector, (a0_all, a0d_all, a0dd_all)), **options)
+        stepper = _CompiledStepper(lawful, where, substeps, log)
+    else:
+        stepper = python_stepper()
+    used = "compiled" if backend == "compiled" else "python"
+    rows = {key: np.empty(n) for key in ROW_FIELDS}
+    block_len = max(1, int(round(1.0 / period)))  # one simulated second per block
+    blocks: dict[int, _Block] = {}
+    k_i = params.k_i
+    warned = 0  # warnings counted by a stepper left behind
+    status = "completed"
+    k = sent = 0
+
+    def hand_over(upto: int) -> None:
+        nonlocal sent
+        if on_block is None or upto <= sent:
+            return
+        sl = slice(sent, upto)
+        block = {key: rows[key][sl] for key in ROW_FIELDS}
+        b = blocks[cnt]
+        lo = sent - k0  # the rows of this block not handed over yet
+        block.update(qpos=b.qpos[lo:], qvel=b.qvel[lo:], ctrl=b.ctrl[lo:],
+                     A_pos=b.sites[lo:, where.site_A, :2], C_pos=b.sites[lo:, where.site_C, :2])
+        sent = upto  # first: an interrupt raised as the block is written must not send it twice
+        on_block(block)
+
+    k0 = cnt = 0
+    try:
+        for k0 in range(0, n, block_len):
+            cnt = min(block_len, n - k0)
+            b = blocks.get(cnt)
+            if b is None:
+                b = blocks[cnt] = _Block(cnt, plain, log)
+            if isinstance(stepper, _CompiledStepper):
+                before, start = stepper.warnings(), stepper.state()
+                stepper.step(b, k0, cnt)
+                if stepper.warnings() != before:  # rollout stopped the simulation: this block again, stepwise
+                    python = python_stepper()
+                    python.set_state(lawful, start)
+                    warned, stepper, used = before, python, "python"
+                    note = "MuJoCo warned; the run went on from that block with the Python law"
+                    stepper.step(b, k0, cnt)
+            else:
+                stepper.step(b, k0, cnt)
+            sl = slice(k0, k0 + cnt)
+            rows["t"][sl] = np.arange(k0, k0 + cnt) * period
+            rows["alpha"][sl] = b.alpha
+            rows["alpha_dot"][sl] = b.alpha_dot
+            rows["alpha0"][sl] = a0_all[sl]
+            rows["alpha0_dot"][sl] = a0d_all[sl]
+            rows["alpha0_ddot"][sl] = a0dd_all[sl]
+            np.subtract(a0_all[sl], b.alpha, out=rows["E"][sl])
+            np.subtract(a0d_all[sl], b.alpha_dot, out=rows["E_dot"][sl])
+            rows["voltage_cmd"][sl] = b.voltage_cmd
+            rows["voltage"][sl] = b.ctrl[:, where.actuator]
+            np.divide(b.force, k_i, out=rows["current"][sl])
+            rows["steer_torque"][sl] = b.torque
+            rows["heading"][sl] = _heading(b.quat)
+            k = k0 + cnt
+            hand_over(k)
+            if on_progress is not None:
+                on_progress(cnt)
+    except KeyboardInterrupt:
+        status = "interrupted"
+    if k:
+        hand_over(k)  # a block interrupted between its rows and its hand-over
+    done = {key: v[:k] for key, v in rows.items()}
+    return EngineRun(rows=done, steps=k, status=status, warnings=warned + stepper.warnings(), law=used,
+                     law_note=note)
