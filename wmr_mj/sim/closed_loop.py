@@ -19,7 +19,6 @@ the two bit-identical.
 from __future__ import annotations
 
 import dataclasses
-import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -61,6 +60,7 @@ class RunResult:
     status: str = "completed"
     law: str = "compiled"  # the law that ran: "compiled" (C, MuJoCo's control callback) or "python"
     law_note: str | None = None  # why the Python law ran
+    cpu_s: float | None = None  # CPU time of the run's loop on its thread (wall_s is in the summary)
 
 
 def _substeps(config: RunConfig, timestep: float) -> int:
@@ -200,15 +200,13 @@ def run_closed_loop(
                                 reference_path=np.asarray(reference.C_xy)[::max(1, len(reference.C_xy) // 2000)])
 
     bar = progress_bar(n, desc="run", unit="step", unit_scale=True, enabled=progress)
-    wall0 = time.perf_counter()
     try:
         run = run_engine(params=params, controller=controller, options=plant_options(config),
                          reference=(a0_all, a0d_all, a0dd_all), n=n, substeps=substeps, period=period, law=law,
                          on_block=None if logger is None else logger.write_block, on_progress=bar.update)
     finally:
         bar.close()
-    wall = time.perf_counter() - wall0
-    done, k, status = run.rows, run.steps, run.status
+    done, k, status, wall = run.rows, run.steps, run.status, run.wall_s
     if k == 0:
         raise KeyboardInterrupt  # nothing simulated: nothing to report
     after = done["t"] >= settle_s
@@ -225,7 +223,8 @@ def run_closed_loop(
                                   controller_config=controller.describe())
     if logger is not None:
         logger.close(summary.to_dict(), status=status)
-    return RunResult(config=config, rows=done, summary=summary, status=status, law=run.law, law_note=run.law_note)
+    return RunResult(config=config, rows=done, summary=summary, status=status, law=run.law, law_note=run.law_note,
+                     cpu_s=run.cpu_s)
 
 
 def run_on_reduced_model(

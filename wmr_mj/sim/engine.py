@@ -26,6 +26,7 @@ not), shared with ``wmr_mj.sim.batch``; :func:`batch_law_backend` chooses the la
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -112,6 +113,8 @@ class EngineRun:
     warnings: int  # MuJoCo's warning counters, summed
     law: str  # "compiled" or "python"
     law_note: str | None  # why the Python law ran, None with the compiled law
+    wall_s: float  # the block loop's wall time: stepping, recording, rows, hand-over (models built before)
+    cpu_s: float  # the block loop's CPU time on the calling thread (the batch of one steps on it)
 
 
 class _Plant:
@@ -315,6 +318,7 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
         on_block(block)
 
     k0 = cnt = 0
+    wall0, cpu0 = time.perf_counter(), time.thread_time()
     try:
         for k0 in range(0, n, block_len):
             cnt = min(block_len, n - k0)
@@ -354,6 +358,7 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
         status = "interrupted"
     if k:
         hand_over(k)  # a block interrupted between its rows and its hand-over
+    wall, cpu = time.perf_counter() - wall0, time.thread_time() - cpu0
     done = {key: v[:k] for key, v in rows.items()}
     return EngineRun(rows=done, steps=k, status=status, warnings=warned + stepper.warnings(), law=used,
-                     law_note=note)
+                     law_note=note, wall_s=wall, cpu_s=cpu)
