@@ -60,8 +60,10 @@ def test_the_callback_is_bit_identical_to_the_scalar_law(options):
             d.qpos[qa], d.qvel[dv], d.time = alpha, alpha_dot, k * m.opt.timestep
             mujoco.mj_forward(m, d)  # mjcb_control runs inside it, as inside mj_step
             u = controller.voltage_scalar(alpha, alpha_dot, *ref)
-            assert d.userdata.tolist() == [alpha, ref[0] - alpha, ref[1] - alpha_dot, u]
-            assert d.ctrl[act] == min(max(u, -limit), limit)
+            applied = min(max(u, -limit), limit)
+            assert d.userdata[:6].tolist() == [alpha, ref[0] - alpha, ref[1] - alpha_dot, u, alpha_dot, applied]
+            assert d.ctrl[act] == applied
+            assert d.userdata[6] == 0.0  # no chassis named: no heading
             clipped += abs(u) > limit
     assert 0 < clipped < len(ALPHA) * len(REFERENCE[0])
 

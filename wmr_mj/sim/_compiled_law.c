@@ -11,8 +11,12 @@
  * multiply-adds: built with -ffp-contract=off), and the voltage limit and NaN rule of the serial
  * loop (wmr_mj.sim.closed_loop.run_closed_loop); tests/test_compiled_law.py checks the bits.
  *
- * userdata (4 per simulation), written at every control step for the statistics:
- *   alpha (rad), E = alpha0 - alpha (rad), E' = alpha0' - alpha' (rad/s), unsaturated law (V).
+ * userdata (7 per simulation), written at every control step for the statistics and the rows of a
+ * single run (wmr_mj.sim.engine):
+ *   alpha (rad), E = alpha0 - alpha (rad), E' = alpha0' - alpha' (rad/s), unsaturated law (V),
+ *   alpha' (rad/s), applied voltage (V),
+ * and at every physics step, where the law names the chassis body (LAW_CHASSIS >= 0):
+ *   heading (rad), the chassis's yaw from xquat as the serial loop computed it.
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
@@ -40,6 +44,7 @@ enum {
   LAW_QPOS,      /* qpos address of the steering joint */
   LAW_DOF,       /* dof address of the steering joint */
   LAW_ACTUATOR,  /* the steering motor */
+  LAW_CHASSIS,   /* the chassis body, for the heading (-1: no heading) */
   LAW_SIZE
 };
 
@@ -48,12 +53,18 @@ int wmr_mj_law_size(void) { return LAW_SIZE; }
 int wmr_mj_mujoco_version(void) { return mjVERSION_HEADER; }
 
 void wmr_mj_control(const mjModel* m, mjData* d) {
-  if (m->nnumeric < 2 || m->nuserdata < 4 || m->numeric_size[0] != LAW_SIZE ||
+  if (m->nnumeric < 2 || m->nuserdata < 7 || m->numeric_size[0] != LAW_SIZE ||
       strcmp(m->names + m->name_numericadr[0], "wmr_mj_law") != 0) {
     return;
   }
   const mjtNum* law = m->numeric_data + m->numeric_adr[0];
   const mjtNum* reference = m->numeric_data + m->numeric_adr[1];
+  int chassis = (int)law[LAW_CHASSIS];
+  if (chassis >= 0 && chassis < m->nbody) {
+    /* the kinematics of the state this step starts from are current (mj_fwdPosition ran) */
+    const mjtNum* q = d->xquat + 4 * chassis;
+    d->userdata[6] = atan2(2.0 * (q[0] * q[3] + q[1] * q[2]), 1.0 - 2.0 * (q[2] * q[2] + q[3] * q[3]));
+  }
   long long step = llround(d->time / m->opt.timestep);
   long long substeps = (long long)law[LAW_SUBSTEPS];
   if (substeps < 1 || step < 0 || step % substeps) {
@@ -104,6 +115,8 @@ void wmr_mj_control(const mjModel* m, mjData* d) {
   d->userdata[1] = alpha0 - alpha;
   d->userdata[2] = alpha0_dot - alpha_dot;
   d->userdata[3] = u;
+  d->userdata[4] = alpha_dot;
+  d->userdata[5] = applied;
 }
 
 /* an importable module, so that setuptools builds and ships the library; ctypes finds the symbols */

@@ -53,9 +53,10 @@ __all__ = ["LAW_FIELDS", "USERDATA_FIELDS", "unavailable_reason", "install", "su
 
 #: The numeric "wmr_mj_law", in order (the enum of _compiled_law.c).
 LAW_FIELDS = ("kind", "P", "K_P", "K_D", "C_V", "F", "K", "gyro_V", "friction_width", "friction_sign",
-              "voltage_limit", "substeps", "nstep", "qpos_adr", "dof_adr", "actuator")
-#: userdata of a model with the law, written at every control step.
-USERDATA_FIELDS = ("alpha", "E", "E_dot", "voltage_cmd")
+              "voltage_limit", "substeps", "nstep", "qpos_adr", "dof_adr", "actuator", "chassis")
+#: userdata of a model with the law, written at every control step (heading: at every physics step,
+#: where the law names the chassis body).
+USERDATA_FIELDS = ("alpha", "E", "E_dot", "voltage_cmd", "alpha_dot", "voltage", "heading")
 LAW_NUMERIC, REFERENCE_NUMERIC = "wmr_mj_law", "wmr_mj_reference"
 _ENV = "WMR_MJ_COMPILED_LAW"
 _install_lock = threading.Lock()
@@ -120,8 +121,12 @@ def supports(controller: Any) -> bool:
 
 
 def law_vector(controller: Any, *, voltage_limit: float, substeps: int, nstep: int, qpos_adr: int, dof_adr: int,
-               actuator: int) -> np.ndarray | None:
-    """The numeric "wmr_mj_law" for ``controller``; None where :func:`supports` is False."""
+               actuator: int, chassis: int = -1) -> np.ndarray | None:
+    """The numeric "wmr_mj_law" for ``controller``; None where :func:`supports` is False.
+
+    ``chassis``: the chassis body, whose heading the callback then writes at every physics step
+    (-1: none, as in a batch, which does not record it).
+    """
     if not supports(controller):
         return None
     from controllers import ComputedTorque
@@ -131,7 +136,7 @@ def law_vector(controller: Any, *, voltage_limit: float, substeps: int, nstep: i
     values.update(kind=0.0 if type(controller) is ComputedTorque else 1.0,
                   friction_sign=2.0 if values["friction_sign"] == "reference" else 1.0,
                   voltage_limit=voltage_limit, substeps=substeps, nstep=nstep, qpos_adr=qpos_adr,
-                  dof_adr=dof_adr, actuator=actuator)
+                  dof_adr=dof_adr, actuator=actuator, chassis=chassis)
     return np.array([float(values[name]) for name in LAW_FIELDS])
 
 

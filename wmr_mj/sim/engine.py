@@ -6,9 +6,10 @@
 - with the compiled law (:mod:`wmr_mj.sim.compiled_law`: the law in MuJoCo's control callback),
   one ``mujoco.batch.Batch.rollout`` call per block runs every physics step of that second in C
   and records, after each step, what the rows and the log need (userdata: alpha, E, E', the law's
-  voltage; qvel, ctrl, the steering actuator's force, qfrc_actuator, xquat; for a log also qpos
-  and the site positions); the rows are then made from these arrays with NumPy, bit for bit
-  what one ``mj_step`` at a time gives (tests/test_engine.py against tests/reference_loop.py);
+  voltage, alpha', the applied voltage and the chassis's heading; the steering actuator's force and
+  qfrc_actuator; for a log also qpos, qvel, ctrl and the site positions); the rows are then made
+  from these arrays with NumPy, bit for bit what one ``mj_step`` at a time gives
+  (tests/test_engine.py against tests/reference_loop.py);
 - where the compiled law cannot run (not built, ``WMR_MJ_COMPILED_LAW=0``, a controller
   subclass), the same engine steps the block with the Python law (``voltage_scalar``), one
   ``mj_step`` per physics step, into the same record arrays, and says so (``EngineRun.law_note``);
@@ -133,18 +134,19 @@ class _Plant:
 class _Block:
     """One block's records, (count, ...) per control step, as both steppers fill them.
 
-    alpha, alpha_dot, voltage_cmd: at the control step's start (what the law saw);
-    ctrl, force (the steering actuator's), torque (qfrc_actuator at the steering dof), quat (the
-    chassis's xquat), sites: after the control step's last mj_step, i.e. of the state that step
-    started from, as the serial loop read them; qpos, qvel: at the control step's start (logs only).
+    alpha, alpha_dot, voltage_cmd, voltage: at the control step's start (what the law saw, what
+    it applied); force (the steering actuator's), torque (qfrc_actuator at the steering dof),
+    heading (of the chassis), sites: after the control step's last mj_step, i.e. of the state
+    that step started from, as the serial loop read them; qpos, qvel, ctrl: at the control
+    step's start, ctrl as applied (logs only).
     """
 
     def __init__(self, count: int, m: mujoco.MjModel, log: bool) -> None:
-        self.alpha, self.alpha_dot, self.voltage_cmd, self.force, self.torque = (np.empty(count) for _ in range(5))
-        self.ctrl = np.empty((count, m.nu))
-        self.quat = np.empty((count, 4))
+        self.alpha, self.alpha_dot, self.voltage_cmd, self.voltage, self.force, self.torque, self.heading = (
+            np.empty(count) for _ in range(7))
         self.qpos = np.empty((count, m.nq)) if log else None
         self.qvel = np.empty((count, m.nv)) if log else None
+        self.ctrl = np.empty((count, m.nu)) if log else None
         self.sites = np.empty((count, m.nsite, 3)) if log else None
 
 
@@ -157,7 +159,13 @@ def _heading(quat: np.ndarray) -> np.ndarray:
 
 
 class _CompiledStepper:
-    """A batch of one with the law in MuJoCo's control callback: one rollout call per block."""
+    """A batch of one with the law in MuJoCo's control callback: one rollout call per block.
+
+    The callback writes what the rows need into userdata (:data:`compiled_law.USERDATA_FIELDS`:
+    alpha, E, E', the law's and the applied voltage, alpha' at each control step, the heading at
+    each physics step); the rollout records it after every physics step, with the steering
+    actuator's force and qfrc_actuator (computed after the callback), and for a log the state.
+    """
 
     def __init__(self, model: mujoco.MjModel, where: _Plant, substeps: int, log: bool) -> None:
         from mujoco.batch import Batch
@@ -165,13 +173,13 @@ class _CompiledStepper:
         self.model, self.where, self.substeps, self.log = model, where, substeps, log
         self.batch = Batch(model, nsim=1, nthread=1)
         self.batch.reset(keyframe=where.keyframe)
-        self.record = ["userdata", "qvel", "ctrl", "actuator_force", "qfrc_actuator", "xquat"]
+        self.record = ["userdata", "actuator_force", "qfrc_actuator"]
         if log:
-            self.record += ["qpos", "site_xpos"]
+            self.record += ["qpos", "qvel", "ctrl", "site_xpos"]
+            # the state at the next control step's start (the rollout records the state after each step)
+            self._qpos, self._qvel = self.batch.qpos[0].copy(), self.batch.qvel[0].copy()
         self._out: dict[int, dict[Any, np.ndarray]] = {}  # record buffers per block length, reused
-        # the state at the next control step's start (the rollout records the state after each step)
-        self._qvel = self.batch.qvel[0].copy()
-        self._qpos = self.batch.qpos[0].copy()
+        self._fields = {name: i for i, name in enumerate(compiled_law.USERDATA_FIELDS)}
 
     def warnings(self) -> int:
         return int(self.batch.warning[0, :, 1].sum())  # (nsim, mjNWARNING, (lastinfo, number))
@@ -180,28 +188,25 @@ class _CompiledStepper:
         return self.batch.state[0].copy()  # mjSTATE_INTEGRATION of the model with the law
 
     def step(self, block: _Block, k0: int, count: int) -> None:
-        S, w = self.substeps, self.where
-        out = self._out.get(count)
-        if out is None:
-            out = self._out[count] = {}
+        S, w, f = self.substeps, self.where, self._fields
+        out = self._out.setdefault(count, {})
         rec = self.batch.rollout(count * S, record=self.record, out=out)
         out.update(rec)
         end = {key: rec[key][0, S - 1::S] for key in self.record}  # after each control step's last substep
-        ud = end["userdata"]  # the callback writes it at a control step's first substep; it holds
-        block.alpha[:] = ud[:, 0]
-        block.voltage_cmd[:] = ud[:, 3]
-        block.alpha_dot[0] = self._qvel[w.dof]
-        block.alpha_dot[1:] = end["qvel"][:-1, w.dof]
-        block.ctrl[:] = end["ctrl"]
+        ud = end["userdata"]  # written at a control step's first substep, held over the others
+        block.alpha[:] = ud[:, f["alpha"]]
+        block.alpha_dot[:] = ud[:, f["alpha_dot"]]
+        block.voltage_cmd[:] = ud[:, f["voltage_cmd"]]
+        block.voltage[:] = ud[:, f["voltage"]]
+        block.heading[:] = ud[:, f["heading"]]  # written at every substep: the last one's
         block.force[:] = end["actuator_force"][:, w.actuator]
         block.torque[:] = end["qfrc_actuator"][:, w.dof]
-        block.quat[:] = end["xquat"][:, w.chassis]
         if self.log:
             block.qpos[0], block.qpos[1:] = self._qpos, end["qpos"][:-1]
             block.qvel[0], block.qvel[1:] = self._qvel, end["qvel"][:-1]
+            block.ctrl[:] = end["ctrl"]
             block.sites[:] = end["site_xpos"].reshape(count, -1, 3)
-            self._qpos = end["qpos"][-1].copy()
-        self._qvel = end["qvel"][-1].copy()
+            self._qpos, self._qvel = end["qpos"][-1].copy(), end["qvel"][-1].copy()
 
 
 class _PythonStepper:
@@ -234,6 +239,7 @@ class _PythonStepper:
         xquat, site_xpos, act_force, qfrc_act = d.xquat, d.site_xpos, d.actuator_force, d.qfrc_actuator
         limit, law, substeps, log, step = self.limit, self.law, self.substeps, self.log, mujoco.mj_step
         a0_all, a0d_all, a0dd_all = (r[k0:k0 + count].tolist() for r in self.reference)
+        quat = np.empty((count, 4))
         for j in range(count):
             a = float(qpos[qa])
             ad = float(qvel[dv])
@@ -252,12 +258,14 @@ class _PythonStepper:
             block.alpha[j] = a
             block.alpha_dot[j] = ad
             block.voltage_cmd[j] = u_cmd
-            block.ctrl[j] = ctrl
+            block.voltage[j] = u
             block.force[j] = act_force[act]
             block.torque[j] = qfrc_act[dv]
-            block.quat[j] = xquat[chassis]
+            quat[j] = xquat[chassis]
             if log:
+                block.ctrl[j] = ctrl
                 block.sites[j] = site_xpos
+        block.heading[:] = _heading(quat)
 
 
 def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any],
@@ -290,7 +298,8 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
     if backend == "compiled":
         compiled_law.install()
         vector = compiled_law.law_vector(controller, voltage_limit=params.voltage_limit, substeps=substeps, nstep=n,
-                                         qpos_adr=where.qpos, dof_adr=where.dof, actuator=where.actuator)
+                                         qpos_adr=where.qpos, dof_adr=where.dof, actuator=where.actuator,
+                                         chassis=where.chassis)
         lawful = batch_model(params, law=(vector, (a0_all, a0d_all, a0dd_all)), **options)
         stepper = _CompiledStepper(lawful, where, substeps, log)
     else:
@@ -346,10 +355,10 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
             np.subtract(a0_all[sl], b.alpha, out=rows["E"][sl])
             np.subtract(a0d_all[sl], b.alpha_dot, out=rows["E_dot"][sl])
             rows["voltage_cmd"][sl] = b.voltage_cmd
-            rows["voltage"][sl] = b.ctrl[:, where.actuator]
+            rows["voltage"][sl] = b.voltage
             np.divide(b.force, k_i, out=rows["current"][sl])
             rows["steer_torque"][sl] = b.torque
-            rows["heading"][sl] = _heading(b.quat)
+            rows["heading"][sl] = b.heading
             k = k0 + cnt
             hand_over(k)
             if on_progress is not None:
