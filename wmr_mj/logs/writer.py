@@ -109,6 +109,67 @@ def _signals_deferred() -> Iterator[None]:
 # --------------------------------------------------------------------------- writer
 
 
+class _BulkMessages:
+    """Many messages of one channel into the open chunk of an ``mcap.writer.Writer`` at once, with NumPy.
+
+    The records, the chunk's message index and the file's statistics come out exactly as
+    ``Writer.add_message`` called once per row would leave them (same bytes, same order), without
+    its Python per message: a block's Foxglove channels are a few hundred messages a simulated
+    second. It reaches into the writer's chunk builder and statistics (mcap 1.x); :meth:`attach`
+    returns None where they are not as expected, and the writer then adds one message at a time.
+    """
+
+    _HEADER = 1 + 8 + 2 + 4 + 8 + 8  # opcode, record length, channel, sequence, log time, publish time
+
+    def __init__(self, writer: Any, builder: Any, statistics: Any) -> None:
+        self._w, self._builder, self._stats = writer, builder, statistics
+        self._finalize = writer._Writer__maybe_finalize_chunk
+
+    @classmethod
+    def attach(cls, writer: Any) -> _BulkMessages | None:
+        builder = getattr(writer, "_Writer__chunk_builder", None)
+        stats = getattr(writer, "_Writer__statistics", None)
+        needed = (hasattr(builder, "record_writer") and hasattr(builder, "message_indices")
+                  and hasattr(builder, "num_messages") and hasattr(stats, "channel_message_counts")
+                  and hasattr(writer, "_Writer__maybe_finalize_chunk"))
+        return cls(writer, builder, stats) if needed else None
+
+    def add(self, cid: int, log_times: np.ndarray, payloads: np.ndarray, seq: int) -> None:
+        from mcap.opcode import Opcode
+        from mcap.records import MessageIndex
+
+        n = len(log_times)
+        data = np.ascontiguousarray(payloads).view(np.uint8).reshape(n, -1)
+        size = data.shape[1]
+        rec = np.empty(n, np.dtype([("op", "u1"), ("len", "<u8"), ("ch", "<u2"), ("seq", "<u4"), ("log", "<u8"),
+                                    ("pub", "<u8"), ("data", "u1", (size,))]))  # packed, as the records are
+        rec["op"] = int(Opcode.MESSAGE)
+        rec["len"] = self._HEADER - 9 + size
+        rec["ch"] = cid
+        rec["seq"] = (seq + np.arange(n, dtype=np.int64)) & 0xFFFFFFFF
+        rec["log"] = log_times
+        rec["pub"] = log_times
+        rec["data"] = data
+        b, st = self._builder, self._stats
+        first = b.record_writer.count
+        times = log_times.tolist()
+        lo, hi = min(times), max(times)
+        b.message_start_time = lo if b.num_messages == 0 else min(b.message_start_time, lo)
+        b.message_end_time = max(b.message_end_time, hi)
+        index = b.message_indices.get(cid)
+        if not index:
+            index = b.message_indices[cid] = MessageIndex(channel_id=cid, records=[])
+        index.records.extend(zip(times, range(first, first + n * rec.itemsize, rec.itemsize)))
+        b.num_messages += n
+        b.record_writer.write(rec.tobytes())
+        st.message_start_time = lo if st.message_count == 0 else min(st.message_start_time, lo)
+        st.message_end_time = max(st.message_end_time, hi)
+        st.channel_message_counts[cid] += n
+        st.message_count += n
+        self._finalize()
+
+
+
 class RunLogger:
     """Write one run to an MCAP file (see the module docstring).
 
@@ -195,6 +256,7 @@ class RunLogger:
             comp = {"lz4": CompressionType.LZ4, "zstd": CompressionType.ZSTD, "none": CompressionType.NONE}
             # chunks are cut by flush() only: one block of full-rate data, one of Foxglove data
             self._w = Writer(self._f, chunk_size=1 << 62, compression=comp[compression])
+            self._bulk = _BulkMessages.attach(self._w)  # None: one add_message per row
             from wmr_mj._version import __version__
 
             self._w.start(profile="", library=f"wmr-mj/{__version__}; {LIBRARY_IDENTIFIER}")
@@ -277,12 +339,16 @@ class RunLogger:
         """One message per row of ``payloads`` ((n, L) uint8 or (n,) structured)."""
         cid = self._cid[topic]
         seq = self._seq[cid]
-        raw = memoryview(payloads.tobytes())  # slices of it are not copied
-        size = len(raw) // max(len(log_times), 1)
-        add = self._w.add_message
-        for i, t in enumerate(log_times.tolist()):
-            add(cid, t, raw[i * size : (i + 1) * size], t, (seq + i) & 0xFFFFFFFF)
-        self._seq[cid] = seq + len(log_times)
+        n = len(log_times)
+        if n and self._bulk is not None:
+            self._bulk.add(cid, np.asarray(log_times, dtype=np.int64), payloads, seq)
+        else:
+            raw = memoryview(payloads.tobytes())  # slices of it are not copied
+            size = len(raw) // max(n, 1)
+            add = self._w.add_message
+            for i, t in enumerate(log_times.tolist()):
+                add(cid, t, raw[i * size : (i + 1) * size], t, (seq + i) & 0xFFFFFFFF)
+        self._seq[cid] = seq + n
 
     # ---- blocks
     def write_block(self, block: Mapping[str, np.ndarray]) -> None:
