@@ -292,3 +292,12 @@ def test_every_model_file_steps_without_warnings(path):
     raised = [mujoco.mjtWarning(i).name for i, w in enumerate(data.warning) if w.number]
     assert not raised, raised
     assert np.all(np.isfinite(data.qpos))
+
+
+@pytest.mark.parametrize("options", [dict(), dict(steering_friction="soft"), dict(tyre_contact="soft")])
+def test_scene_xml_is_to_xml_without_the_sky_pixels(options):
+    """scene_xml writes the spec with a 1x6 sky and puts the size back: to_xml's text, to the character."""
+    from wmr_mj.plant import mjcf
+
+    params = with_params(C80, m1=612.5)
+    assert mjcf.scene_xml(params, **options) == mjcf.scene_spec(params, **options).to_xml()

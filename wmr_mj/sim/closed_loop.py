@@ -32,7 +32,7 @@ from wmr_mj._util.progress import progress_bar
 from wmr_mj.analysis.verdicts import Drift
 from wmr_mj.errors import ParameterError
 from wmr_mj.params import C80, C80Parameters
-from wmr_mj.plant.mjcf import TIMESTEP, Plant
+from wmr_mj.plant.mjcf import TIMESTEP, scene_xml
 from wmr_mj.sim.certify import certificate_for
 from wmr_mj.sim.config import (
     RunConfig,
@@ -43,7 +43,7 @@ from wmr_mj.sim.config import (
     estimate_parameters,
     plant_parameters,
 )
-from wmr_mj.sim.engine import ROW_FIELDS, plant_options, run_engine
+from wmr_mj.sim.engine import ROW_FIELDS, batch_model, plant_options, run_engine
 from wmr_mj.sim.summary import RunSummary
 
 __all__ = ["RunResult", "run_closed_loop", "report", "run_on_reduced_model", "ROW_FIELDS"]
@@ -188,20 +188,25 @@ def run_closed_loop(
     if len(a0_all) < n:
         raise ParameterError(f"reference shorter than the run: {len(a0_all)} < {n} samples")
 
+    options = plant_options(config)
+    plain = batch_model(params, **options)  # the plant without its sky texture (no physics in it)
     logger = None
-    if logger_factory is not None:  # the log carries the scene as the plant compiles it (sky included)
-        plant = Plant(params, steering_friction=config.steering_friction, tyre_contact=config.tyre_contact)
-        m, d = plant.model, plant.data
+    if logger_factory is not None:
+        m, d = plain, mujoco.MjData(plain)
+        mujoco.mj_resetDataKeyframe(m, d, m.key("home").id)
+        mujoco.mj_forward(m, d)
         state = np.empty(mujoco.mj_stateSize(m, mujoco.mjtState.mjSTATE_INTEGRATION))
         mujoco.mj_getState(m, d, state, mujoco.mjtState.mjSTATE_INTEGRATION)
-        logger = logger_factory(mjcf_xml=plant.xml, config=config.as_dict(), parameters=params.as_dict(),
-                                initial_state=state, timestep=dt, control_substeps=substeps,
-                                bounds={"E_max": certificate.E_max, "Edot_max": certificate.Edot_max}, model=m,
+        # the log carries the scene's MJCF as the plant compiles it, sky included
+        logger = logger_factory(mjcf_xml=scene_xml(params, **options), config=config.as_dict(),
+                                parameters=params.as_dict(), initial_state=state, timestep=dt,
+                                control_substeps=substeps, model=m,
+                                bounds={"E_max": certificate.E_max, "Edot_max": certificate.Edot_max},
                                 reference_path=np.asarray(reference.C_xy)[::max(1, len(reference.C_xy) // 2000)])
 
     bar = progress_bar(n, desc="run", unit="step", unit_scale=True, enabled=progress)
     try:
-        run = run_engine(params=params, controller=controller, options=plant_options(config),
+        run = run_engine(params=params, controller=controller, options=options, model=plain,
                          reference=(a0_all, a0d_all, a0dd_all), n=n, substeps=substeps, period=period, law=law,
                          on_block=None if logger is None else logger.write_block, on_progress=bar.update)
     finally:

@@ -271,7 +271,7 @@ class _PythonStepper:
 def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any],
                reference: tuple[np.ndarray, np.ndarray, np.ndarray], n: int, substeps: int, period: float,
                law: str = "auto", on_block: Callable[[dict[str, np.ndarray]], None] | None = None,
-               on_progress: Callable[[int], None] | None = None) -> EngineRun:
+               on_progress: Callable[[int], None] | None = None, model: mujoco.MjModel | None = None) -> EngineRun:
     """Run ``n`` control steps of ``controller`` on the plant of ``params``; rows of every control step.
 
     ``reference`` = (alpha0, alpha0', alpha0'') on the control grid (at least n samples);
@@ -279,10 +279,11 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
     qvel, ctrl (at each control step's start, ctrl as applied), A_pos and C_pos (xy of sites A
     and C); ``on_progress(steps)`` the control steps of each block. KeyboardInterrupt (Ctrl-C,
     SIGTERM made one) ends the run as "interrupted" with the blocks simulated so far; a block
-    committed but not yet handed to ``on_block`` is handed over before returning.
+    committed but not yet handed to ``on_block`` is handed over before returning. ``model``:
+    ``batch_model(params, **options)`` where the caller has it already.
     """
     backend, note = _backend(controller, law)
-    plain = batch_model(params, **options)
+    plain = batch_model(params, **options) if model is None else model
     where = _Plant(plain)
     log = on_block is not None
     a0_all, a0d_all, a0dd_all = (np.asarray(r, dtype=np.float64) for r in reference)
