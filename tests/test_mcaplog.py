@@ -675,6 +675,14 @@ def test_bulk_messages_are_the_messages_added_one_by_one(tmp_path):
         return msgs, (stats.message_count, dict(stats.channel_message_counts), stats.message_start_time,
                       stats.message_end_time, stats.chunk_count)
 
+    def indexes(path):  # every message index record: (channel, [(log time, offset in the chunk)])
+        from mcap.records import MessageIndex
+        from mcap.stream_reader import StreamReader
+
+        with open(path, "rb") as f:
+            return [(r.channel_id, list(r.records)) for r in StreamReader(f).records if isinstance(r, MessageIndex)]
+
     fast, slow = messages(files[True]), messages(files[False])
     assert len(fast[0]) > 700 and fast == slow
+    assert indexes(files[True]) == indexes(files[False]) != []
     assert load_log(files[True]).rows == 2437

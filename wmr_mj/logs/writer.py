@@ -44,6 +44,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from mcap.opcode import Opcode
+from mcap.records import MessageIndex
 
 from wmr_mj._util.files import json_safe, software_versions
 from wmr_mj.errors import LogError, OutputPathError, ParameterError
@@ -109,6 +111,17 @@ def _signals_deferred() -> Iterator[None]:
 # --------------------------------------------------------------------------- writer
 
 
+class _MessageIndex(MessageIndex):
+    """mcap's MessageIndex record, its (log time, offset) entries written with one NumPy call."""
+
+    def write(self, stream: Any) -> None:
+        stream.start_record(Opcode.MESSAGE_INDEX)
+        stream.write2(self.channel_id)
+        stream.write4(len(self.records) * 16)
+        stream.write(np.asarray(self.records, dtype="<u8").reshape(-1, 2).tobytes())  # time, offset, time, ...
+        stream.finish_record()
+
+
 class _BulkMessages:
     """Many messages of one channel into the open chunk of an ``mcap.writer.Writer`` at once, with NumPy.
 
@@ -135,9 +148,6 @@ class _BulkMessages:
         return cls(writer, builder, stats) if needed else None
 
     def add(self, cid: int, log_times: np.ndarray, payloads: np.ndarray, seq: int) -> None:
-        from mcap.opcode import Opcode
-        from mcap.records import MessageIndex
-
         n = len(log_times)
         data = np.ascontiguousarray(payloads).view(np.uint8).reshape(n, -1)
         size = data.shape[1]
@@ -158,7 +168,7 @@ class _BulkMessages:
         b.message_end_time = max(b.message_end_time, hi)
         index = b.message_indices.get(cid)
         if not index:
-            index = b.message_indices[cid] = MessageIndex(channel_id=cid, records=[])
+            index = b.message_indices[cid] = _MessageIndex(channel_id=cid, records=[])
         index.records.extend(zip(times, range(first, first + n * rec.itemsize, rec.itemsize)))
         b.num_messages += n
         b.record_writer.write(rec.tobytes())
