@@ -107,7 +107,14 @@ def config_from_args(args: argparse.Namespace, **extra):
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("run", help="simulate the circle headless with a controller and report the errors")
+    p = sub.add_parser(
+        "run", help="simulate the circle headless with a controller and report the errors",
+        description="One closed-loop run on the MuJoCo plant, reported against the regions. The run is a "
+                    "batch of one: the steering law runs compiled in MuJoCo's control callback and "
+                    "mujoco.batch steps a simulated second per call, recording every control step as "
+                    "arrays (the rows and the MCAP log, flushed every simulated second). Where the "
+                    "compiled law cannot run (no C compiler at install, WMR_MJ_COMPILED_LAW=0) the same "
+                    "engine evaluates the Python law, with the same numbers, and says so on stderr.")
     add_run_options(p)
     p.add_argument("--m1", type=positive_float, default=M1_NOMINAL, help="plant chassis mass, kg (default 650)")
     p.add_argument("--out", metavar="PATH", help="MCAP log path (default logs/run-<time>-<model>-m<m1>.mcap)")
@@ -188,6 +195,9 @@ def run(args: argparse.Namespace) -> int:
 
     with terminate_as_interrupt():
         result = run_closed_loop(config, logger_factory=factory, progress=args.progress)
+    if result.law_note:
+        print(f"wmr-mj: the Python law ran ({result.law_note}); the numbers are the same, the run slower",
+              file=sys.stderr)
     if args.json:
         print_json({**result.summary.to_dict(), "log": path})
     else:

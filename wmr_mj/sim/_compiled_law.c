@@ -4,19 +4,21 @@
  * whole blocks of closed-loop steps in C (mujoco.batch.Batch.rollout), with no Python per step.
  * The callback acts only on models that carry the numeric "wmr_mj_law" first and
  * "wmr_mj_reference" second (wmr_mj.sim.compiled_law.attach); on any other model it returns at
- * once, so the serial loop and every other model of the process are untouched.
+ * once, so the Python-law engine and every other model of the process are untouched. A single
+ * run (wmr_mj.sim.engine) is a batch of one through this callback.
  *
  * The law is ComputedTorque.voltage_scalar / PDController.voltage_scalar, (3.2)-(3.3) of the
  * paper, term for term and in the same order of IEEE operations (no contraction into fused
  * multiply-adds: built with -ffp-contract=off), and the voltage limit and NaN rule of the serial
- * loop (wmr_mj.sim.closed_loop.run_closed_loop); tests/test_compiled_law.py checks the bits.
+ * loop it replaced (tests/reference_loop.py); tests/test_compiled_law.py and tests/test_engine.py
+ * check the bits.
  *
  * userdata (7 per simulation), written at every control step for the statistics and the rows of a
  * single run (wmr_mj.sim.engine):
  *   alpha (rad), E = alpha0 - alpha (rad), E' = alpha0' - alpha' (rad/s), unsaturated law (V),
  *   alpha' (rad/s), applied voltage (V),
  * and at every physics step, where the law names the chassis body (LAW_CHASSIS >= 0):
- *   heading (rad), the chassis's yaw from xquat as the serial loop computed it.
+ *   heading (rad), the chassis's yaw from xquat as the serial loop computed it (math.atan2).
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
@@ -106,7 +108,7 @@ void wmr_mj_control(const mjModel* m, mjData* d) {
   }
   double limit = law[LAW_LIMIT], applied;
   if (u != u) {
-    applied = 0.0;  /* NaN from a diverged law: apply nothing, as the serial loop */
+    applied = 0.0;  /* NaN from a diverged law: apply nothing, as the Python law */
   } else {
     applied = u > limit ? limit : (u < -limit ? -limit : u);
   }

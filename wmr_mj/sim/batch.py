@@ -99,7 +99,7 @@ class _BatchStats:
     final_alpha: np.ndarray = field(init=False)
     final_alpha_after_step: np.ndarray = field(init=False)
     warnings: np.ndarray = field(init=False)
-    law_nan: np.ndarray = field(init=False)  # the law gave NaN: re-run serially
+    law_nan: np.ndarray = field(init=False)  # the law gave NaN: re-run as a single run
     drift_prev: np.ndarray = field(init=False)  # max |E| over the window before the last (wmr_mj.analysis.verdicts)
     drift_last: np.ndarray = field(init=False)  # max |E| over the last window
     final_alpha_dot: np.ndarray = field(init=False)  # alpha0' - E' of the last control step
@@ -205,7 +205,7 @@ def _run_group_compiled(loop: _Loop, models: Sequence[mujoco.MjModel], idx: np.n
     ``Batch.rollout`` runs a whole block of control steps in C on ``threads`` threads; the
     block's userdata (alpha, E, E', the law's voltage at every control step) is then folded
     into the statistics as the NumPy loop folds its buffers. Rollout stops a simulation whose
-    warning counters rise; run_batch re-runs those serially.
+    warning counters rise; run_batch re-runs those as single runs (run_closed_loop).
     """
     from mujoco.batch import Batch
 

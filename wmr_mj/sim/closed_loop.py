@@ -1,8 +1,13 @@
 """Closed-loop runs: the computed-torque law of the reduced model on the MuJoCo plant.
 
-One run steps the C80 scene with ``mj_step`` and calls the controller every
-``control_period`` (default: every 1 ms physics step), holding the voltage in
-between; the motor's voltage limit is applied to what the controller asks for.
+One run steps the C80 scene and applies the controller every ``control_period``
+(default: every 1 ms physics step), holding the voltage in between; the motor's
+voltage limit is applied to what the controller asks for. The run is a batch of one
+on :mod:`wmr_mj.sim.engine`: the law compiled into MuJoCo's control callback, a
+simulated second of steps per ``mujoco.batch`` rollout call, every control step
+recorded as arrays (the Python law in the same engine where the compiled one cannot
+run). tests/test_engine.py holds it to the bit against the serial loop it replaced
+(tests/reference_loop.py).
 The tracking errors E = alpha0 - alpha, E' are compared with the analytic
 region of ``wmr_mj.analysis.robustness`` (4.21)-(4.23) for the parameter box in use.
 
@@ -79,7 +84,7 @@ def report(config: RunConfig, *, analysis, params: C80Parameters, settle_s: floa
            certificate=None, drift: Drift | None = None) -> RunSummary:
     """The run's report: sup errors (whole run and after the entry transient) against the region.
 
-    Shared by the serial runner and the batched sweep so both report alike.
+    Shared by the single run and the batched sweep so both report alike.
 
     Args:
         config: the run's configuration.
@@ -141,7 +146,7 @@ def _sup(x: np.ndarray) -> float:
 
 
 def _drift_of(E: np.ndarray, final_alpha_dot: float, period: float) -> Drift:
-    """End-of-run drift from the serial rows (the batch computes the same windows per block).
+    """End-of-run drift from a run's rows (the batch computes the same windows per block).
 
     final_alpha_dot: alpha' of the last control step, as alpha0' - E' (the batch keeps E', not alpha').
     """

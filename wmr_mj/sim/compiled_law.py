@@ -19,16 +19,17 @@ steps with no Python in between. The law's constants and the reference travel in
         # Batch.rollout(..., record=("userdata",)) then records USERDATA_FIELDS every step
 
 The callback acts only on models that carry the law (``attach``); every other model of the
-process, the serial loop's included, steps as before. Per control step it computes, with
+process (the Python-law engine's included) steps as before. Per control step it computes, with
 E = alpha0 - alpha (3.2)-(3.3)::
 
     u = P^ (alpha0'' + K_D E' + K_P E) + K^ sin(alpha)/cos^3(alpha) + C_V^ alpha'
         + F^ s + gyro^ V_A alpha'/cos^2(alpha)                         (computed torque)
     u = P^ (K_D E' + K_P E)                                            (PD)
 
-and applies clip(u, +-voltage_limit), 0 V where u is NaN, as the serial loop does
-(``wmr_mj.sim.closed_loop.run_closed_loop``). tests/test_compiled_law.py checks the callback against
-``voltage_scalar`` and whole batches against serial runs, to the bit.
+and applies clip(u, +-voltage_limit), 0 V where u is NaN, as the Python law of
+``wmr_mj.sim.engine`` does; a single run (``wmr_mj.sim.engine.run_engine``) reads its rows from
+the userdata too (alpha', the applied voltage, the chassis heading). tests/test_compiled_law.py
+checks the callback against ``voltage_scalar`` and whole batches against single runs, to the bit.
 
 It is built by ``pip install`` (setup.py, with the MuJoCo headers of the mujoco wheel) where a
 C compiler is found; without it, or with ``WMR_MJ_COMPILED_LAW=0`` in the environment,
