@@ -58,7 +58,8 @@ def bench_run(seconds: float, folder: Path, repeats: int, compressions: list[str
     cfg = RunConfig(duration=seconds)
     variants: dict[str, object] = {"unlogged": None, "null": lambda **kw: NullLogger(**kw)}
     for c in compressions:
-        variants[c] = lambda c=c, **kw: RunLogger(folder / f"run-{c}.mcap", compression=c, **kw)
+        # as `wmr-mj run` writes: a writer thread compresses and writes each second while the next steps
+        variants[c] = lambda c=c, **kw: RunLogger(folder / f"run-{c}.mcap", compression=c, background=True, **kw)
     run_closed_loop(cfg, progress=False)  # warm up (imports, caches)
     wall: dict[str, list[float]] = {k: [] for k in variants}
     cpu: dict[str, list[float]] = {k: [] for k in variants}

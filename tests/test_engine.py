@@ -65,7 +65,8 @@ def test_a_logged_run_writes_the_serial_loops_log(tmp_path):
     from wmr_mj.logs.writer import RunLogger
 
     cfg = RunConfig(duration=12.5)  # a last block shorter than a second
-    new = run_closed_loop(cfg, logger_factory=functools.partial(RunLogger, tmp_path / "new.mcap"), progress=False)
+    new = run_closed_loop(cfg, logger_factory=functools.partial(RunLogger, tmp_path / "new.mcap", background=True),
+                          progress=False)  # as wmr-mj run logs: a writer thread
     old = reference_run(cfg, logger_factory=functools.partial(RunLogger, tmp_path / "old.mcap"), progress=False)
     assert new.law == "compiled"
     assert_identical(new, old)
@@ -98,3 +99,24 @@ def test_a_block_with_a_warning_is_stepped_again_with_the_python_law(monkeypatch
     assert new.law == "python" and "warned" in new.law_note and len(calls) == 3
     # the stopped attempt's records and warning are dropped: the block as the serial loop steps it
     assert_identical(new, reference_run(cfg, progress=False))
+
+
+@pytest.mark.parametrize("background", [False, True])
+def test_an_interrupted_logged_run_leaves_a_finished_log_of_its_rows(tmp_path, background):
+    from wmr_mj.logs.reader import load_log
+    from wmr_mj.logs.writer import RunLogger
+
+    path = tmp_path / "run.mcap"
+
+    class StopAfter(RunLogger):  # Ctrl-C after the third simulated second
+        def write_block(self, block):
+            super().write_block(block)
+            if self.rows >= 3000:
+                raise KeyboardInterrupt
+
+    result = run_closed_loop(RunConfig(duration=12.0), progress=False,
+                             logger_factory=lambda **kw: StopAfter(path, background=background, **kw))
+    assert result.status == "interrupted" and len(result.rows["t"]) == 3000
+    log = load_log(path)
+    assert log.status == "interrupted" and not log.truncated and log.rows == 3000
+    assert log.signals["E"].tobytes() == result.rows["E"].tobytes()

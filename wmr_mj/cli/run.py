@@ -190,7 +190,7 @@ def run(args: argparse.Namespace) -> int:
     if path is not None:
         from wmr_mj.logs.writer import RunLogger
 
-        factory = functools.partial(RunLogger, path, log_every=args.log_every)
+        factory = functools.partial(RunLogger, path, log_every=args.log_every, background=True)
     from wmr_mj.logs.writer import terminate_as_interrupt
 
     with terminate_as_interrupt():

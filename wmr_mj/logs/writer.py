@@ -108,6 +108,12 @@ def _signals_deferred() -> Iterator[None]:
         signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
+def _block_signals() -> None:
+    """In the writer thread: leave SIGINT/SIGTERM to the main thread, which defers them around writes."""
+    if hasattr(signal, "pthread_sigmask"):
+        signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
+
+
 # --------------------------------------------------------------------------- writer
 
 
@@ -192,7 +198,11 @@ class RunLogger:
     ``mjcf_xml``, to skip compiling it again; ``compression``: "lz4" (default: about 20 % smaller
     files than "none" for 2 % more run time), "zstd" (about 25 % smaller again, for some 6 % more
     run time; bench/bench_logging.py measures them) or "none"; ``fsync``: make each flush durable
-    against power loss, not only against the process being killed.
+    against power loss, not only against the process being killed; ``background``: a writer thread
+    encodes, compresses and writes each flushed second while the runner simulates the next
+    (NumPy, lz4 and the file write release the GIL, as ``mujoco.batch`` does): ``write_block``
+    then returns once every second before the one it hands over is on disk, so a hard kill loses
+    at most the second in flight; ``close`` and ``flush`` wait for it.
     """
 
     def __init__(
@@ -214,6 +224,7 @@ class RunLogger:
         model: Any = None,
         compression: str = "lz4",
         fsync: bool = False,
+        background: bool = False,
     ):
         import mujoco
         from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
@@ -253,6 +264,10 @@ class RunLogger:
         self._last_t = 0.0
         self._pending: list[dict[str, np.ndarray]] = []
         self._pending_rows = 0
+        self._taken_rows = 0  # rows handed to _write_rows, written or in flight
+        self._background = bool(background)
+        self._in_flight: Any = None  # the writer thread's job (concurrent.futures.Future), background only
+        self._executor: Any = None
         self._seq: dict[int, int] = {}
         self._tf = TfEncoder(FrameTree(m))
 
@@ -386,25 +401,51 @@ class RunLogger:
                 if a.size != math.prod(want):
                     raise ParameterError(f"block[{k!r}] has shape {a.shape}; {want} is expected")
                 a = a.reshape(want)
-            clean[k] = a
+            clean[k] = np.array(a) if self._background else a  # the runner may reuse its buffers
         self._pending.append(clean)
         self._pending_rows += n
         if self._pending_rows * self.dt_row >= self.flush_period_s - 0.5 * self.dt_row:
             self.flush()
 
     def _take_pending(self) -> dict[str, np.ndarray]:
+        self._taken_rows += self._pending_rows
         blocks, self._pending, self._pending_rows = self._pending, [], 0
         return blocks[0] if len(blocks) == 1 else {k: np.concatenate([b[k] for b in blocks]) for k in lf.BLOCK_KEYS}
 
     def flush(self) -> None:
-        """Write the pending rows as two complete chunks and flush them to the file."""
+        """Write the pending rows as two complete chunks and flush them to the file.
+
+        In the background, hand them to the writer thread once the second before is on disk.
+        """
+        self._wait()
         if not self._pending:
             return
+        if self._background:
+            import concurrent.futures
+
+            if self._executor is None:
+                self._executor = concurrent.futures.ThreadPoolExecutor(1, thread_name_prefix="wmr-mj-log",
+                                                                       initializer=_block_signals)
+            self._in_flight = self._executor.submit(self._write_and_flush, self._take_pending())
+            return
         with _signals_deferred():  # a signal arriving now is raised after the chunks are out
-            self._write_rows(self._take_pending())
-            self._w.flush()
-            if self._fsync:
-                os.fsync(self._f.fileno())
+            self._write_and_flush(self._take_pending())
+
+    def _write_and_flush(self, rows: Mapping[str, np.ndarray]) -> None:
+        self._write_rows(rows)
+        self._w.flush()
+        if self._fsync:
+            os.fsync(self._f.fileno())
+
+    def _wait(self) -> None:
+        """Wait for the writer thread's second (re-raising its error); nothing in flight after it returns."""
+        job = self._in_flight
+        if job is not None:
+            try:
+                job.result()
+            finally:
+                if job.done():  # not when an interrupt ended the wait: close waits again
+                    self._in_flight = None
 
     def _write_rows(self, b: Mapping[str, np.ndarray]) -> None:
         t = b["t"]
@@ -454,6 +495,10 @@ class RunLogger:
         summary = dict(summary or {})
         try:
             with _signals_deferred():
+                with contextlib.suppress(Exception):  # the second in flight; its error must not cost the footer
+                    self._wait()
+                if self._executor is not None:
+                    self._executor.shutdown(wait=True)
                 if self._pending:
                     with contextlib.suppress(Exception):  # never lose the footer because of one bad block
                         self._write_rows(self._take_pending())
@@ -475,8 +520,8 @@ class RunLogger:
 
     @property
     def rows(self) -> int:
-        """Rows written so far (flushed or pending)."""
-        return self._rows + self._pending_rows
+        """Rows written so far (flushed, in flight or pending)."""
+        return self._taken_rows + self._pending_rows
 
     def __enter__(self) -> RunLogger:
         return self
