@@ -1,4 +1,4 @@
-# wmr-mj: `make demo` runs the headline job headless; `make test` lints, then runs the suite
+# wmr-mj: `make demo` runs the headline job headless; `make test` lints (ruff, mypy), then runs the suite
 # (tests/test_wheel.py included: it builds the wheel and runs it from a fresh virtualenv).
 PYTHON ?= python3
 VENV := .venv
@@ -21,6 +21,7 @@ demo: $(STAMP)
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check .
+	$(VENV)/bin/mypy
 
 # Foxglove's own MCAP reader (@mcap/core, pinned in tests/foxglove_reader/package-lock.json) for
 # tests/test_foxglove_reader.py; best effort: without node/npm that test skips and says why.

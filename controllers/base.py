@@ -22,9 +22,13 @@ from __future__ import annotations
 
 import abc
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
+
+if TYPE_CHECKING:
+    from wmr_mj.plant.reduced import SteeringModel
 
 __all__ = ["SteeringController", "BatchLaw", "saturate"]
 
@@ -39,6 +43,8 @@ class SteeringController(abc.ABC):
     """Steering state and reference in (rad, rad/s, rad/s^2), armature voltage out (V)."""
 
     name: str = "controller"
+    #: the reduced model the law stands on (its estimate P^, C_V^, F^, K^); the certificate reads it
+    model: SteeringModel
 
     @abc.abstractmethod
     def voltage(

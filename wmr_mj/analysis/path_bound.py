@@ -300,7 +300,7 @@ def path_verdict(errors: Any, bound: PathBound) -> PathVerdict:
     e = errors if isinstance(errors, Mapping) else errors.to_dict()
     late = e.get("cross_track_max_after_settle")
     use_late = bound.settle_s is not None and late is not None
-    ct = float(late if use_late else e["cross_track_max"])
+    ct = float(late) if use_late and late is not None else float(e["cross_track_max"])
     span = f"after t = {bound.settle_s:g} s" if use_late else "whole run"
     if bound.cross_track_bound is None:
         return PathVerdict("no-guarantee", ct, None, None,

@@ -183,8 +183,8 @@ def _project(gs: np.ndarray, gxy: np.ndarray, gk: np.ndarray, X: np.ndarray, s_s
     while b < n:
         Xb = X[b:b + _BLOCK]
         travel = float(np.sum(steps[b + 1:b + Xb.shape[0]]))
-        lo = np.searchsorted(gs, s_prev - window - travel, side="right") - 1
-        hi = np.searchsorted(gs, s_prev + window + travel, side="left")
+        lo = int(np.searchsorted(gs, s_prev - window - travel, side="right")) - 1
+        hi = int(np.searchsorted(gs, s_prev + window + travel, side="left"))
         lo, hi = max(lo, 0), min(max(hi, lo + 1), len(A))
         Ab, Db, Lb = A[lo:hi], D[lo:hi], L2[lo:hi]
         rel = Xb[:, None, :] - Ab[None, :, :]

@@ -212,6 +212,7 @@ def exact_gammas(kp: float, kd: float) -> tuple[float, float]:
     if ordinary or y > -1e-6:
         at_peak = _peak_time_scaled(y, one_minus_y, log_r)
     if y >= 0.0:
+        assert at_peak is not None  # y >= 0 > -1e-6: computed above
         # h_peak = exp(-a t*) / sqrt(K_P); in logs when exp(-a t*) would underflow
         h_peak = math.exp(-at_peak) / math.sqrt(kp) if at_peak < 700.0 else math.exp(-at_peak - 0.5 * math.log(kp))
         gamma1, gamma2 = 1.0 / kp, 2.0 * h_peak
@@ -348,17 +349,17 @@ class ParameterBox:
         axes = []
         for lo, hi in spans.values():
             axes.append(sorted({lo, hi, *(lo + (hi - lo) * k / (grid - 1) for k in range(grid))}))
-        lo_v = {n: math.inf for n in COEFFICIENT_NAMES}
-        hi_v = {n: -math.inf for n in COEFFICIENT_NAMES}
+        lo_v = {name: math.inf for name in COEFFICIENT_NAMES}
+        hi_v = {name: -math.inf for name in COEFFICIENT_NAMES}
         for point in itertools.product(*axes):
             changes = dict(zip(spans, point))
             p = with_params(params, m1_inertia=m1_inertia, **changes) if changes else params
             c = p.coefficients(model)
-            for n in COEFFICIENT_NAMES:
-                v = float(getattr(c, n))
-                lo_v[n] = min(lo_v[n], v)
-                hi_v[n] = max(hi_v[n], v)
-        return cls(**{n: (lo_v[n], hi_v[n]) for n in COEFFICIENT_NAMES})
+            for name in COEFFICIENT_NAMES:
+                v = float(getattr(c, name))
+                lo_v[name] = min(lo_v[name], v)
+                hi_v[name] = max(hi_v[name], v)
+        return cls(**{name: (lo_v[name], hi_v[name]) for name in COEFFICIENT_NAMES})
 
     def width(self, name: str) -> float:
         lo, hi = getattr(self, name)

@@ -41,7 +41,7 @@ positive_int = int_at_least(1)
 
 
 def parse_assignments(items: list[str] | None, *, option: str = "--param",
-                      example: str = "mu=0.02") -> dict[str, float]:
+                      example: str = "mu=0.02") -> dict[str, Any]:
     """``NAME=VALUE`` pairs (``--param l3=0.15``) into a dict; bad syntax raises ParameterError."""
     from wmr_mj.errors import ParameterError
 

@@ -267,6 +267,7 @@ def certificate_parser() -> argparse.ArgumentParser:
 
 def _box_ranges(args: argparse.Namespace) -> tuple[tuple[float, float], dict[str, tuple[float, float]]]:
     """(m1_range, other ranges) from --uncertainty, --m1-range and --range."""
+    from wmr_mj._util.checks import as_pair
     from wmr_mj.errors import ParameterError
     from wmr_mj.params import M1_RANGE, uncertainty_ranges
 
@@ -284,7 +285,7 @@ def _box_ranges(args: argparse.Namespace) -> tuple[tuple[float, float], dict[str
             m1_range = span
         else:
             ranges[name] = span
-    return tuple(m1_range), ranges
+    return as_pair(m1_range), ranges
 
 
 def _certificate_table(cert, config, paper) -> str:

@@ -230,7 +230,7 @@ class RunLog:
             raise self._fail(f"messages of {topic} are {sorted(sizes)} bytes; their schema needs {dt.itemsize}")
         arr = np.frombuffer(b"".join(p for _, p in msgs), dt)
         out = {"log_time": np.fromiter((t for t, _ in msgs), np.uint64, len(msgs))}
-        for name in dt.names:
+        for name in dt.names or ():
             if not name.startswith("__"):
                 out[name] = np.ascontiguousarray(arr[name])
         return out
@@ -333,9 +333,9 @@ def _load_indexed(log: RunLog, f: Any) -> None:
                 log._counts[summary.channels[cid].topic] = int(n)
     for rec in reader.iter_metadata():
         log.metadata[rec.name] = dict(rec.metadata)
-    for rec in reader.iter_attachments():
-        log.attachments[rec.name] = bytes(rec.data)
-        log.attachment_types[rec.name] = rec.media_type
+    for att in reader.iter_attachments():
+        log.attachments[att.name] = bytes(att.data)
+        log.attachment_types[att.name] = att.media_type
     log._indexed = True
     packed = {c.id for c in summary.channels.values() if c.topic in (lf.SIGNALS_TOPIC, lf.STATE_TOPIC)}
     for ci in summary.chunk_indexes:  # chunks that the packed read below does not check

@@ -28,12 +28,15 @@ import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from wmr_mj.errors import LogError, WmrMjError
 from wmr_mj.logs.reader import RunLog
+
+if TYPE_CHECKING:
+    from matplotlib.typing import RcKeyType
 
 __all__ = ["summarize", "verify", "plot", "format_summary", "format_verify", "path_of_log", "LogPath"]
 
@@ -208,8 +211,8 @@ def verify(log: RunLog) -> dict[str, Any]:
     try:
         m = mujoco.MjModel.from_xml_string(log.mjcf_xml)
     except ValueError as exc:
-        first = str(exc).strip().splitlines()[0] if str(exc).strip() else "compile error"
-        raise LogError(f"{log.path}: the attached MJCF does not compile ({first})") from None
+        why = str(exc).strip().splitlines()[0] if str(exc).strip() else "compile error"
+        raise LogError(f"{log.path}: the attached MJCF does not compile ({why})") from None
     d = mujoco.MjData(m)
     spec = mujoco.mjtState.mjSTATE_INTEGRATION
     s0 = np.asarray(log.initial_state, np.float64).ravel()
@@ -300,7 +303,8 @@ def plot(log: RunLog, path: str | os.PathLike, rep: dict[str, Any]) -> Path:
     E, Ed = sig["E"], sig["E_dot"]
     settle = rep.get("settle_s")
     e_max, ed_max, poly = rep.get("E_max"), rep.get("Edot_max"), rep.get("region_polygon")
-    style = {"font.size": 9, "axes.grid": True, "grid.alpha": 0.3, "axes.spines.top": False, "axes.spines.right": False}
+    style: dict[RcKeyType, Any] = {"font.size": 9, "axes.grid": True, "grid.alpha": 0.3, "axes.spines.top": False,
+                                   "axes.spines.right": False}
     import matplotlib
 
     with matplotlib.rc_context(style):

@@ -510,15 +510,19 @@ def _add_steering_needles(scene: Any, data: Any, ids: dict[str, int], error: flo
 def _bound_and_verdict(summary: dict[str, Any] | None) -> tuple[float | None, str]:
     """E_max ((4.21) under (4.23)) and the verdict line from the log's summary (its certificate when it has one)."""
     summary = summary or {}
-    cert = summary.get("certificate") if isinstance(summary.get("certificate"), dict) else {}
-    e_max = cert.get("E_max", summary.get("E_max"))
-    finite = isinstance(e_max, (int, float)) and not isinstance(e_max, bool) and math.isfinite(e_max)
-    e_max = float(e_max) if finite and e_max > 0 else None
+    cert = summary.get("certificate")
+    if not isinstance(cert, dict):
+        cert = {}
+    raw = cert.get("E_max", summary.get("E_max"))
+    e_max = None
+    if isinstance(raw, (int, float)) and not isinstance(raw, bool) and math.isfinite(raw) and raw > 0:
+        e_max = float(raw)
     verdict = summary.get("verdict")
     if not isinstance(verdict, str) or not verdict:
         inside = summary.get("inside")
-        verdict = {True: "errors inside the analytic bounds",
-                   False: "errors OUTSIDE the analytic bounds"}.get(inside, "no verdict in the log")  # fmt: skip
+        lines: dict[object, str] = {True: "errors inside the analytic bounds",
+                                    False: "errors OUTSIDE the analytic bounds"}
+        verdict = lines.get(inside, "no verdict in the log")
     return e_max, verdict
 
 

@@ -234,10 +234,10 @@ class RunLogger:
         for name, value in (("log_every", log_every), ("control_substeps", control_substeps)):
             if int(value) != value or int(value) < 1:
                 raise ParameterError(f"{name} = {value!r}; an integer >= 1 is accepted")
-        for name, value in (("timestep", timestep), ("plot_rate_hz", plot_rate_hz), ("tf_rate_hz", tf_rate_hz),
-                            ("flush_period_s", flush_period_s)):
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-                raise ParameterError(f"{name} = {value!r}; a finite number > 0 is accepted")
+        for name, x in (("timestep", timestep), ("plot_rate_hz", plot_rate_hz), ("tf_rate_hz", tf_rate_hz),
+                        ("flush_period_s", flush_period_s)):
+            if not (isinstance(x, (int, float)) and math.isfinite(x) and x > 0):
+                raise ParameterError(f"{name} = {x!r}; a finite number > 0 is accepted")
         self.path = Path(path)
         self.timestep = float(timestep)
         self.control_substeps = int(control_substeps)
@@ -372,7 +372,8 @@ class RunLogger:
             size = len(raw) // max(n, 1)
             add = self._w.add_message
             for i, t in enumerate(log_times.tolist()):
-                add(cid, t, raw[i * size : (i + 1) * size], t, (seq + i) & 0xFFFFFFFF)
+                # mcap annotates data as bytes; it takes any buffer, and a memoryview slice is not a copy
+                add(cid, t, raw[i * size : (i + 1) * size], t, (seq + i) & 0xFFFFFFFF)  # type: ignore[arg-type]
         self._seq[cid] = seq + n
 
     # ---- blocks

@@ -628,8 +628,7 @@ def lagrange_equations_paper(*, in_abcd: bool = True) -> LagrangeEquations:
     lhs = lhs.applyfunc(sp.simplify)
     M, Vm = _split_rows(lhs)
     M = M.applyfunc(sp.simplify)
-    return LagrangeEquations(*(_sub_abcd(m, in_abcd) for m in (M, Vm)), _forces(),
-                             _sub_abcd(lhs, in_abcd))
+    return LagrangeEquations(_sub_abcd(M, in_abcd), _sub_abcd(Vm, in_abcd), _forces(), _sub_abcd(lhs, in_abcd))
 
 
 def paper_steering_equation(*, sign: str = "lagrange", in_abcd: bool = True) -> sp.Eq:

@@ -135,13 +135,16 @@ def measure_friction_law(params: C80Parameters = C80, *, steering_friction: str 
     coeffs = params.coefficients("nonholonomic")
     F, C_V, gyro = coeffs.F, coeffs.C_V, coeffs.gyro
     torque_per_volt = params.i2 * math.sqrt(params.k_i * params.k_b) / params.R_a  # at rest, (2.9)-(2.10)
-    kw = dict(steering_friction=steering_friction, tyre_contact=tyre_contact, duration=duration)
+    def rates_at(voltages: np.ndarray) -> tuple[np.ndarray, int]:
+        return constant_voltage_rates(params, voltages, steering_friction=steering_friction,
+                                      tyre_contact=tyre_contact, duration=duration)
+
     fractions = (*CREEP_FRACTIONS, SLIDE_FRACTION)
-    rates, warnings = constant_voltage_rates(params, np.array(fractions) * F, **kw)
+    rates, warnings = rates_at(np.array(fractions) * F)
     lo, hi = 0.0, 2.0 * F
     for _ in range(rounds):
         trial = np.linspace(lo, hi, grid + 2)[1:-1]
-        r, w = constant_voltage_rates(params, trial, **kw)
+        r, w = rates_at(trial)
         warnings += w
         moving = np.flatnonzero(np.abs(r) > hold_rate)
         if moving.size:

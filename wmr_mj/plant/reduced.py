@@ -26,6 +26,7 @@ Usage::
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -128,7 +129,7 @@ class SteeringModel:
         return (np.asarray(u, dtype=float) - rest) / self.P
 
     def with_coefficients(self, **changes: float) -> SteeringModel:
-        return replace(self, **changes)
+        return replace(self, **cast("dict[str, Any]", changes))  # the plugin would check each float against name: str
 
 
 def steering_model(name: str, params: C80Parameters) -> SteeringModel:

@@ -82,7 +82,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -134,6 +134,13 @@ def _positive(name: str, value: object, unit: str = "") -> float:
     if x <= 0.0:
         raise ParameterError(f"{name} = {value!r}{unit} is not accepted: it must be finite and > 0")
     return x
+
+
+def _terminal_event(fn: Callable[..., float], *, direction: int) -> Callable[..., float]:
+    """``fn`` as a terminal event of ``solve_ivp``, which reads the two attributes off the function."""
+    fn.terminal = True  # type: ignore[attr-defined]  # solve_ivp's event protocol: attributes on a function
+    fn.direction = direction  # type: ignore[attr-defined]
+    return fn
 
 
 def _radius_curvature(name: str, value: object) -> float:
@@ -608,19 +615,15 @@ def _integrate(
             ad, add = _alpha_dots(a, float(seg.curvature(s)), float(seg.curvature_rate(s)), l1, V_A)
             return (max_angle - abs(a), max_rate - abs(ad), max_accel - abs(add))
 
-        events = []
+        events: list[Callable[..., float]] = []
         for j in range(3):
             def ev(s, z, j=j, margins=margins):
                 return margins(s, z)[j]
-            ev.terminal = True
-            ev.direction = -1
-            events.append(ev)
+            events.append(_terminal_event(ev, direction=-1))
         if t_stop is not None:
             def ev_t(s, z):
                 return z[1] - t_stop
-            ev_t.terminal = True
-            ev_t.direction = 1
-            events.append(ev_t)
+            events.append(_terminal_event(ev_t, direction=1))
 
         names = ("angle", "rate", "accel")
         m0 = margins(0.0, y)
@@ -736,7 +739,7 @@ class Reference:
     def __len__(self) -> int:
         return int(self.t.size)
 
-    def at(self, t: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def at(self, t: ArrayLike) -> tuple[Any, Any, Any]:
         """(alpha0, alpha0', alpha0'') at times t, vectorised; floats for a scalar t.
 
         Cubic Hermite between grid samples for alpha0 (slopes alpha0') and for

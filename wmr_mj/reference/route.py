@@ -59,14 +59,14 @@ import re
 import tomllib
 from dataclasses import dataclass, fields
 from pathlib import Path as FilePath
-from typing import Any
+from typing import Any, Literal, overload
 
 import numpy as np
 
 from wmr_mj._util.resources import DATA_DIR
 from wmr_mj.errors import InfeasiblePathError, ParameterError, UnknownNameError
 from wmr_mj.params import C80Parameters
-from wmr_mj.reference.paths import Path, Reference, Segment, _s5_int, make_reference
+from wmr_mj.reference.paths import Path, Reference, Segment, SegmentKind, _s5_int, make_reference
 
 __all__ = ["Route", "ROUTES_DIR", "route_names", "load_route", "parse_route", "route_from_path",
            "is_route_spec", "route_reference"]
@@ -126,6 +126,12 @@ class _Where:
         return ParameterError(f"route {self.source}: {where}: {why}")
 
 
+@overload
+def _num(w: _Where, where: str, table: dict, key: str, *, positive: bool = ..., unit: str = ...,
+         required: Literal[True] = ...) -> float: ...
+@overload
+def _num(w: _Where, where: str, table: dict, key: str, *, positive: bool = ..., unit: str = ...,
+         required: bool) -> float | None: ...
 def _num(w: _Where, where: str, table: dict, key: str, *, positive: bool = False, unit: str = "m",
          required: bool = True) -> float | None:
     if key not in table:
@@ -152,7 +158,7 @@ def _segments_route(w: _Where, head: dict, items: Any) -> tuple[Path, tuple]:
         raise w.fail("segment", "a non-empty list of [[segment]] tables is required")
     blend = _num(w, "[route]", head, "transition", positive=True, required=False)
     # first pass: each item -> (kind, length, curvature) with transitions to resolve
-    raw: list[tuple[str, float, float, str]] = []
+    raw: list[tuple[SegmentKind, float, float, str]] = []
     for i, item in enumerate(items):
         where = f"segment {i}"
         if not isinstance(item, dict):
@@ -301,9 +307,12 @@ def _waypoints_route(w: _Where, head: dict, closed: bool) -> tuple[Path, tuple]:
         d = turn.get(c, 0.0)
         if d == 0.0:
             return []
-        k = math.copysign(1.0 / radii[c], d)
-        L_arc = abs(d) / abs(k) - b
-        return [Segment("transition", b, 0.0, k), Segment("arc", L_arc, k, k), Segment("transition", b, k, 0.0)]
+        radius, blend = radii[c], b
+        assert radius is not None and blend is not None  # a corner that turns has both (checked above)
+        k = math.copysign(1.0 / radius, d)
+        L_arc = abs(d) / abs(k) - blend
+        return [Segment("transition", blend, 0.0, k), Segment("arc", L_arc, k, k),
+                Segment("transition", blend, k, 0.0)]
 
     if closed:
         add(line_of(0.5 * straight[0]), "leg from waypoint 0 to 1")

@@ -63,6 +63,8 @@ from matplotlib.ticker import MaxNLocator  # noqa: E402
 from wmr_mj.params import M1_NOMINAL, PAPER_KD, PAPER_KP  # noqa: E402
 
 if TYPE_CHECKING:
+    from matplotlib.typing import RcKeyType
+
     from wmr_mj.sim.falsify import FalsifyResult
     from wmr_mj.sim.summary import RunSummary
 
@@ -104,7 +106,7 @@ __all__ = [
 ]
 
 #: Style for paper-quality output: readable at a single-column width, text kept as text in SVG.
-STYLE: dict[str, Any] = {
+STYLE: dict[RcKeyType, Any] = {
     "font.size": 9.0,
     "axes.titlesize": 9.5,
     "axes.labelsize": 9.0,
@@ -592,10 +594,10 @@ def plot_verdict_points(ax, sup_E: Sequence[float], sup_Edot: Sequence[float], v
     label carries the count. certified-outside points are drawn large, on top. {verdict: scatter}."""
     E = np.asarray(sup_E, dtype=float)
     Ed = np.asarray(sup_Edot, dtype=float)
-    verdicts = np.asarray(list(verdicts), dtype=object)
+    names = np.asarray(list(verdicts), dtype=object)
     out = {}
     for verdict, color in VERDICT_COLORS.items():
-        mask = verdicts == verdict
+        mask = names == verdict
         if not mask.any():
             continue
         loud = verdict == "certified-outside"

@@ -35,6 +35,7 @@ from typing import Any
 
 import numpy as np
 
+from wmr_mj._util.checks import as_pair
 from wmr_mj._util.progress import Stages
 from wmr_mj.params import uncertainty_ranges
 from wmr_mj.report.settings import (
@@ -93,7 +94,7 @@ def _search_spec(plan: SearchPlan, settings: ValidateSettings):
 
     extra = {k: v for k, v in uncertainty_ranges(plan.box).items() if k != "m1"}
     base = settings.config(plan.design).replace(box_ranges=extra)
-    return FalsifySpec(base=base, box={"m1": tuple(settings.m1_range), **extra}, objective=plan.objective,
+    return FalsifySpec(base=base, box={"m1": as_pair(settings.m1_range), **extra}, objective=plan.objective,
                        budget=plan.budget, seed=settings.seed)
 
 

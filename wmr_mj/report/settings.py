@@ -14,6 +14,7 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from typing import Any
 
+from wmr_mj._util.checks import as_pair
 from wmr_mj._util.progress import Stages
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import C80, M1_NOMINAL, M1_RANGE
@@ -115,7 +116,7 @@ class ValidateSettings:
     def config(self, design: Design) -> RunConfig:
         """The run of ``design`` these settings sweep (m1 at nominal; the sweep draws it)."""
         return RunConfig(**design.config_changes(), duration=self.duration, m1=self.nominal_m1,
-                         m1_range=tuple(self.m1_range), box_ranges=self.ranges, seed=self.seed)
+                         m1_range=as_pair(self.m1_range), box_ranges=self.ranges, seed=self.seed)
 
     def as_dict(self) -> dict[str, Any]:
         d = asdict(self)

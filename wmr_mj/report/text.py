@@ -437,7 +437,7 @@ def answer_blocks(summary: Mapping[str, Any], *, brief: bool = False) -> list[Bl
     sentence and the assumptions without their equations."""
     rung = summary["ladder"][-1]
     assumptions = assumption_rows(rung["certificate"])
-    header = ASSUMPTION_COLUMNS
+    header: tuple[str, ...] = ASSUMPTION_COLUMNS
     if brief:
         header, assumptions = tuple(c for c in header if c != "equation"), [r[:1] + r[2:] for r in assumptions]
     return [

@@ -37,6 +37,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from wmr_mj._util.checks import as_pair
 from wmr_mj._util.files import software_versions
 from wmr_mj._util.progress import Stages
 from wmr_mj.params import C80
@@ -162,7 +163,7 @@ def run_rung(settings: ValidateSettings, k: int, design: Design, folder: Path, s
 
     base = settings.config(design)
     spec = SweepSpec(n=settings.n, seed=settings.seed, sampling=settings.sampling,
-                     m1_range=tuple(settings.m1_range), ranges=settings.ranges, base=base)
+                     m1_range=as_pair(settings.m1_range), ranges=settings.ranges, base=base)
     sweep_dir = folder / f"ladder-{k}-{design.name}"
     st.start(f"ladder-{k}", f"rung {k} ({design.label}): {settings.n} runs of {settings.duration:g} s over m1 "
                             f"{settings.m1_range[0]:g}-{settings.m1_range[1]:g} kg ({settings.sampling})")

@@ -302,7 +302,8 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
         require_memory(nsim * n * 3 * 8, what=f"a batch of {nsim} runs of {n} control steps with the compiled law",
                        hint="run fewer at once (a smaller chunk) or the NumPy law (WMR_MJ_COMPILED_LAW=0)")
         compiled_law.install()
-        models = [batch_model(p, law=(compiled_law.law_vector(controller, voltage_limit=p.voltage_limit,
+        # law_vector is None only for a law supports() refuses, and then the backend is not 'compiled'
+        models = [batch_model(p, law=(compiled_law.law_vector(controller, voltage_limit=p.voltage_limit,  # type: ignore[arg-type]
                                                               substeps=substeps, nstep=n, **where), rows),
                               **options) for p in plants]
     else:
@@ -339,7 +340,8 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
     for w in workers:
         w.start()
     try:
-        work(*groups[0], progress)  # the calling thread runs the first group and reports progress
+        idx0, threads0 = groups[0]
+        work(idx0, threads0, progress)  # the calling thread runs the first group and reports progress
     finally:
         for w in workers:
             while w.is_alive():

@@ -17,6 +17,7 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
+from controllers import ComputedTorque
 from wmr_mj.analysis.certificate import (
     GYRO_BAND,
     GYRO_MEASURED_RATIOS,
@@ -124,8 +125,10 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
             ratio = None  # (5.1)'s printed intervals come with no such relation
 
     pd = controller.name == "pd"
-    sign = "none" if pd else controller.friction_sign
-    width = 0.0 if pd else controller.friction_width
+    if isinstance(controller, ComputedTorque):
+        sign, width = controller.friction_sign, controller.friction_width
+    else:  # a PD (controller_for builds no other): no compensation
+        sign, width = "none", 0.0
     c = model.coefficients
     # a PD law has no model but P^ (its gain scale); F^ is the compensation's amplitude
     estimate = Estimate(P=c.P, C_V=0.0, F=0.0, K=0.0, gyro=0.0, V_A=model.V_A) if pd else Estimate(

@@ -67,7 +67,7 @@ _install_lock = threading.Lock()
 def _library() -> tuple[ctypes.CDLL | None, str | None]:
     """(the loaded library, None) or (None, why not)."""
     try:
-        from wmr_mj.sim import _compiled_law
+        from wmr_mj.sim import _compiled_law  # type: ignore[attr-defined]  # a C extension, built in place
     except ImportError as exc:
         return None, f"wmr_mj.sim._compiled_law is not built ({exc}); install with a C compiler to build it"
     lib = ctypes.CDLL(_compiled_law.__file__)
@@ -107,6 +107,7 @@ def install() -> None:
         if why is not None:
             raise ParameterError(f"the compiled law cannot run: {why}")
         lib, _ = _library()
+        assert lib is not None  # unavailable_reason() is None only when the library loaded
         if mujoco.get_mjcb_control() is None:
             mujoco.set_mjcb_control(lib.wmr_mj_control)
 
@@ -132,7 +133,8 @@ def law_vector(controller: Any, *, voltage_limit: float, substeps: int, nstep: i
         return None
     from controllers import ComputedTorque
 
-    values = {"C_V": 0.0, "F": 0.0, "K": 0.0, "gyro_V": 0.0, "friction_width": 0.0, "friction_sign": "measured"}
+    values: dict[str, Any] = {"C_V": 0.0, "F": 0.0, "K": 0.0, "gyro_V": 0.0, "friction_width": 0.0,
+                              "friction_sign": "measured"}
     values.update(controller.law_constants())
     values.update(kind=0.0 if type(controller) is ComputedTorque else 1.0,
                   friction_sign=2.0 if values["friction_sign"] == "reference" else 1.0,

@@ -22,6 +22,7 @@ import numpy as np
 
 from controllers import SteeringController, make_controller, model_from_source
 from controllers.computed_torque import CONTROLLER_NAMES, FRICTION_SIGNS, MODEL_SOURCES
+from wmr_mj._util.checks import as_pair
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import C80, M1_NOMINAL, M1_RANGE, PAPER_KD, PAPER_KP, C80Parameters, parameter_names, with_params
 from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS, TYRE_CONTACT_MODELS
@@ -181,9 +182,9 @@ def analysis_box(config: RunConfig, params: C80Parameters = C80):
     if config.box == "paper":
         return ParameterBox.paper()
     box_model = "nonholonomic" if config.model in ("nonholonomic", "identified") else "paper"
-    return ParameterBox.from_parameters(params, m1_range=tuple(config.m1_range), model=box_model,
+    return ParameterBox.from_parameters(params, m1_range=as_pair(config.m1_range), model=box_model,
                                         m1_inertia=config.m1_inertia,
-                                        ranges={k: tuple(v) for k, v in config.box_ranges.items()} or None)
+                                        ranges={k: as_pair(v) for k, v in config.box_ranges.items()} or None)
 
 
 def analysis_for(config: RunConfig, reference, params: C80Parameters = C80, *, estimate=None):

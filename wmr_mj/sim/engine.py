@@ -138,16 +138,17 @@ class _Block:
     it applied); force (the steering actuator's), torque (qfrc_actuator at the steering dof),
     heading (of the chassis), sites: after the control step's last mj_step, i.e. of the state
     that step started from, as the serial loop read them; qpos, qvel, ctrl: at the control
-    step's start, ctrl as applied (logs only).
+    step's start, ctrl as applied (logs only: without a log they have no rows).
     """
 
     def __init__(self, count: int, m: mujoco.MjModel, log: bool) -> None:
         self.alpha, self.alpha_dot, self.voltage_cmd, self.voltage, self.force, self.torque, self.heading = (
             np.empty(count) for _ in range(7))
-        self.qpos = np.empty((count, m.nq)) if log else None
-        self.qvel = np.empty((count, m.nv)) if log else None
-        self.ctrl = np.empty((count, m.nu)) if log else None
-        self.sites = np.empty((count, m.nsite, 3)) if log else None
+        rows = count if log else 0
+        self.qpos = np.empty((rows, m.nq))
+        self.qvel = np.empty((rows, m.nv))
+        self.ctrl = np.empty((rows, m.nu))
+        self.sites = np.empty((rows, m.nsite, 3))
 
 
 def _heading(quat: np.ndarray) -> np.ndarray:
@@ -301,6 +302,7 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
         vector = compiled_law.law_vector(controller, voltage_limit=params.voltage_limit, substeps=substeps, nstep=n,
                                          qpos_adr=where.qpos, dof_adr=where.dof, actuator=where.actuator,
                                          chassis=where.chassis)
+        assert vector is not None  # the backend is 'compiled' only where compiled_law.supports(controller)
         lawful = batch_model(params, law=(vector, (a0_all, a0d_all, a0dd_all)), **options)
         stepper = _CompiledStepper(lawful, where, substeps, log)
     else:

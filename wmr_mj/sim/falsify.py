@@ -343,7 +343,7 @@ class FalsifyResult:
 
 def falsify(spec: FalsifySpec, *, chunk: int = 128, nthread: int = 0, scheduler: str | None = None,
             progress: Callable[[int, int], None] | None = None,
-            checkpoint: Callable[[FalsifyResult], None] | None = None) -> FalsifyResult:
+            checkpoint: Callable[[FalsifyResult], object] | None = None) -> FalsifyResult:
     """Search ``spec.box`` for the worst run, then spend as many runs on a random sample.
 
     Each generation runs as one batch (locally in chunks of ``chunk`` on ``nthread``

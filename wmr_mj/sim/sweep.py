@@ -319,7 +319,8 @@ def _chunk_progress(progress: Callable[[float, int], None] | None, done: int, si
 
 
 def run_sweep(spec: SweepSpec, *, out_dir: str | os.PathLike | None = None, chunk: int = 128, nthread: int = 0,
-              scheduler: str | None = None, progress: Callable[[int, int], None] | None = None) -> list[dict[str, Any]]:
+              scheduler: str | None = None,
+              progress: Callable[[float, int], None] | None = None) -> list[dict[str, Any]]:
     """All runs of ``spec``, in run order. With ``out_dir``: runs.csv (atomic, after every chunk) and resume.
 
     progress(done, total) is called as runs finish and, locally, as a chunk steps (done
