@@ -17,6 +17,7 @@ KEYS = ("sup_E", "sup_Edot", "sup_E_settled", "sup_Edot_settled", "E_max", "Edot
         "verdict", "certificate", "paper_region", "drift")
 
 
+@pytest.mark.slow
 def test_batch_is_bit_identical_to_runs_one_by_one():
     configs = [BASE.replace(m1=m) for m in (552.5, 650.0, 749.0)]
     configs.append(BASE.replace(m1=600.0, plant_overrides={"mu": 0.03, "l4": 0.27}))
@@ -135,6 +136,7 @@ def test_paper_model_batch_matches_serial_including_steering_stop():
 
 
 
+@pytest.mark.slow
 def test_batch_split_into_groups_is_bit_identical_to_one_group(monkeypatch):
     """Several groups on their own threads (what run_batch uses for large batches) give the same numbers."""
     import wmr_mj.sim.batch as batch_module

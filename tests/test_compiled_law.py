@@ -110,6 +110,7 @@ def test_models_without_the_law_step_as_if_no_callback_were_installed():
         assert (d.ctrl == 0.25).all() and not d.userdata.any()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("options", [dict(), dict(model="paper"), dict(control_period=0.005),
                                      dict(friction_sign="reference", friction_width=0.01),
                                      dict(controller="pd", model="paper", kp=25.0, kd=10.0),

@@ -25,6 +25,8 @@ from wmr_mj.params import C80Parameters
 from wmr_mj.plant import derivation as d
 from wmr_mj.plant.reduced import steering_model
 
+pytestmark = pytest.mark.slow  # symbolic derivations (sympy): seconds each, even cached
+
 S = d.SYMBOLS
 V, Vd, al, ad, add = S["V"], S["V_d"], S["alpha"], S["alpha_d"], S["alpha_dd"]
 A_, B_, C_, D_ = sp.symbols("A B C D", positive=True)
@@ -118,6 +120,7 @@ def test_kinetic_energy_coefficients_match_params_closed_forms_symbolically():
     assert _exact_equal(J.subs(sub), p.steering_inertia)
 
 
+@pytest.mark.slow
 def test_voltage_coefficients_match_params_symbolically():
     p = _symbolic_params()
     sub = _body_substitution(p)
@@ -210,6 +213,7 @@ def test_lagrange_steering_row_has_sin_cos3_and_no_alpha_dot_term():
 # ---------------------------------------------------------------------------
 # the non-holonomic model
 # ---------------------------------------------------------------------------
+@pytest.mark.slow
 def test_nonholonomic_row_no_sin_cos3_and_gyro_J_over_l1():
     J = d.steering_inertia_symbolic()
     l1 = S["l1"]
@@ -226,6 +230,7 @@ def test_nonholonomic_row_no_sin_cos3_and_gyro_J_over_l1():
     assert d.is_zero(eq.lhs.subs(Jsym, J) - expected - tau_f * sp.sign(ad))
 
 
+@pytest.mark.slow
 def test_kane_equals_maggi_and_spurious_terms():
     kane = d.nonholonomic_equations()
     maggi = d.nonholonomic_equations_maggi()

@@ -121,6 +121,7 @@ def test_spec_refuses_bad_boxes():
         FalsifySpec(box={"m1": (550.0, 750.0)}, budget=3)
 
 
+@pytest.mark.slow
 def test_cli_falsify_json_files_and_replayable_log(tmp_path):
     from wmr_mj.logs.reader import load_log
 
@@ -140,8 +141,9 @@ def test_cli_falsify_json_files_and_replayable_log(tmp_path):
     assert all((tmp_path / f"history.{ext}").stat().st_size > 1000 for ext in ("png", "svg"))
 
 
-@pytest.mark.parametrize("argv", [["--uncertainty", "nope"], ["--budget", "3"], ["--against", "moon"],
-                                  ["--range", "nope=1:2"]])
+@pytest.mark.parametrize("argv", [["--uncertainty", "nope"], ["--budget", "3"],
+                                  pytest.param(["--against", "moon"], marks=pytest.mark.slow),
+                                  pytest.param(["--range", "nope=1:2"], marks=pytest.mark.slow)])
 def test_cli_falsify_bad_input_exits_2(argv, tmp_path):
     proc = subprocess.run([sys.executable, "-m", "wmr_mj.cli", "falsify", "--duration", "3", "--path", "lane-change",
                            "--out", str(tmp_path), *argv], capture_output=True, text=True, timeout=120)

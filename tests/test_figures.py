@@ -50,6 +50,7 @@ def _region_patches(fig):
     return [p for ax in fig.axes for p in ax.patches if p.get_gid() == REGION_GID]
 
 
+@pytest.mark.slow
 def test_figures_command_writes_png_and_svg_of_figs_4_to_7(written):
     rc, out, printed = written
     assert rc == 0
@@ -65,6 +66,7 @@ def test_figures_command_writes_png_and_svg_of_figs_4_to_7(written):
             assert root.tag.endswith("svg")
 
 
+@pytest.mark.slow
 def test_fig7_svg_carries_the_region_polygon(written):
     _, out, _ = written
     root = ET.parse(out / "fig7_region.svg").getroot()
@@ -72,6 +74,7 @@ def test_fig7_svg_carries_the_region_polygon(written):
     assert REGION_GID in ids
 
 
+@pytest.mark.slow
 def test_fig7_region_polygon_is_the_analysis_vertices(example):
     expected = analyse(ParameterBox.paper(), kp=6.0, kd=9.0).vertices  # the (5.1) example, independently
     assert len(expected) == 4
@@ -85,6 +88,7 @@ def test_fig7_region_polygon_is_the_analysis_vertices(example):
         np.testing.assert_allclose(xy, np.asarray(expected), rtol=0, atol=0)
 
 
+@pytest.mark.slow
 def test_fig7_shows_both_views_and_says_when_the_mujoco_run_leaves_the_range(example):
     fig = paper_figures(example)["fig7_region"]
     labels = [t.get_text() for leg in fig.legends for t in leg.get_texts()]
@@ -197,6 +201,7 @@ def test_search_history_running_worst_and_reference_lines():
     assert len(fig.axes) == 2
 
 
+@pytest.mark.slow
 def test_time_history_draws_the_bounds_it_is_given(example):
     from wmr_mj.report.plots import figure_time_history
 

@@ -21,6 +21,8 @@ from test_mcaplog import TEST_MJCF, synthetic_run
 from wmr_mj.logs.foxglove import qmul, qrot
 from wmr_mj.logs.reader import load_log
 
+pytestmark = pytest.mark.npm  # Foxglove's reader from npm: `make test-fast` leaves it out
+
 CHECK = Path(__file__).parent / "foxglove_reader" / "check.mjs"
 
 

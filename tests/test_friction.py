@@ -66,6 +66,7 @@ def test_soft_friction_creeps_at_mrad_per_s_as_first_found(rates):
     assert r[2] == pytest.approx(rates["stiction"][0][2], rel=0.02)  # sliding is the same law
 
 
+@pytest.mark.slow
 def test_measured_breakaway_brackets_the_friction_voltage():
     law = measure_friction_law(C80, steering_friction="stiction", rounds=2)
     lo, hi = law.breakaway_voltage - law.breakaway_resolution, law.breakaway_voltage
@@ -108,6 +109,7 @@ def test_run_config_validates_and_passes_the_friction_model():
     assert final["soft"] > 0.05
 
 
+@pytest.mark.slow
 def test_cli_friction_json(capsys):
     assert main(["model", "friction", "--json"]) == 0
     obj = json.loads(capsys.readouterr().out)

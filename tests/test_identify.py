@@ -51,6 +51,7 @@ def _synthetic(model: SteeringModel, *, duration=40.0, dt=1e-3, seed=3):
     return a, ad, add, u, v
 
 
+@pytest.mark.slow
 def test_fit_recovers_known_coefficients_from_synthetic_plant():
     model = SteeringModel(**TRUE, V_A=0.2)
     a, ad, add, u, v = _synthetic(model)
@@ -61,6 +62,7 @@ def test_fit_recovers_known_coefficients_from_synthetic_plant():
     assert diag["samples"] > 1000
 
 
+@pytest.mark.slow
 def test_mujoco_plant_p_and_cv_match_parameter_set():
     result = identify_plant(C80, duration=30.0, seed=0)
     pred = result.predicted["paper"]
@@ -75,6 +77,7 @@ def test_mujoco_plant_p_and_cv_match_parameter_set():
     assert f"{result.identified.K:.4g}" in result.verdict()
 
 
+@pytest.mark.slow
 def test_cli_json_keys_and_three_way_comparison():
     proc = subprocess.run([sys.executable, "-m", "wmr_mj.cli", "identify", "--duration", "10", "--json"],
                           capture_output=True, text=True, check=True)

@@ -626,6 +626,7 @@ def test_sigkill_leaves_readable_truncated_log(tmp_path):
     assert rows == log.rows
 
 
+@pytest.mark.slow
 def test_sigterm_finishes_file_as_interrupted(tmp_path):
     proc, path = _start_loop(tmp_path, "termed.mcap")
     proc.send_signal(signal.SIGTERM)

@@ -218,6 +218,7 @@ def test_scene_file_compiles_and_has_home_keyframe():
     assert model.geom("floor").id >= 0
 
 
+@pytest.mark.slow
 def test_scene_drives_circle_for_60_s_without_warnings():
     """Hold the steady-circle steering angle with a PD on the dcmotor for 60 s; no MuJoCo warning."""
     plant = Plant(C80)
@@ -274,6 +275,7 @@ def test_wheels_roll_without_side_slip_at_paper_speed():
     assert slip["max_slip_m_s"] > 0.0  # soft contacts do slip a little: the measurement is live
 
 
+@pytest.mark.slow
 def test_model_card_is_a_fresh_rendering():
     from wmr_mj.plant.modelcard import render_model_card
 

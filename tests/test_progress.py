@@ -6,6 +6,8 @@ import csv
 import io
 import json
 
+import pytest
+
 from wmr_mj._util.progress import Stages, counter_callback, progress_bar
 from wmr_mj.cli.app import main
 
@@ -64,6 +66,7 @@ def test_stages_show_a_live_count_on_a_terminal():
     assert "\rvalidate: sweep paper ... " in text and text.endswith(" s: 8/8 inside\n")  # bar erased, then the line
 
 
+@pytest.mark.slow
 def test_sweep_command_writes_table_summary_and_plot(tmp_path, capsys):
     out = tmp_path / "sweep"
     code = main(["sweep", "--n", "2", "--duration", "10", "--chunk", "2", "--nthread", "1", "--out", str(out),

@@ -130,6 +130,7 @@ def test_paper_circle_on_the_circle(paper_ref: Reference) -> None:
 
 # --------------------------------------------------------------------------
 # (b) independent kinematics
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["paper_ref", "blend_ref", "lane_ref", "eight_ref"])
 def test_A_and_C_from_independent_unicycle(name: str, request: pytest.FixtureRequest) -> None:
     ref: Reference = request.getfixturevalue(name)

@@ -82,6 +82,7 @@ def test_exact_gammas_match_quadrature(kp, kd):
     assert g2 == pytest.approx(_abs_integral(g, kp, kd), rel=1e-7)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kp,kd", [(6.0, 9.0), (4.0, 1.0), (4.0, 4.0)])
 def test_exact_gammas_match_scipy_impulse(kp, kd):
     t = np.linspace(0.0, 45.0 / min(abs(np.roots([1.0, kd, kp]).real)), 400001)

@@ -57,12 +57,14 @@ def test_computed_torque_is_equation_3_2():
     assert gains_from_omega_r(6.0) == (9.0, 6.0)
 
 
+@pytest.mark.slow
 def test_exact_model_on_reduced_plant_tracks_to_1e_6(reference):
     plant = SteeringModel(P=0.385, C_V=4.77, F=1.52, K=5.33, gyro=0.0, V_A=0.2)
     r = run_on_reduced_model(ComputedTorque(plant, friction_width=1e-3), plant, reference, friction_width=1e-3)
     assert np.max(np.abs(r["E"])) < 1e-6
 
 
+@pytest.mark.slow
 def test_mismatched_model_on_reduced_plant_stays_inside_region(reference):
     """Plant and estimate at opposite corners of the paper's (5.1) box: inside (4.21)."""
     plant = SteeringModel(P=0.37, C_V=4.81, F=1.53, K=5.38, gyro=0.0, V_A=0.2)
@@ -108,6 +110,7 @@ def test_bad_config_raises(changes, error):
         RunConfig(**changes)
 
 
+@pytest.mark.slow
 def test_cli_run_json():
     proc = subprocess.run([sys.executable, "-m", "wmr_mj.cli", "run", "--model", "nonholonomic", "--duration", "12",
                            "--no-log", "--json"], capture_output=True, text=True, check=True)

@@ -50,6 +50,7 @@ def test_sampling_is_seeded_and_covers_the_range():
     assert 550 <= uni[:, 0].min() and uni[:, 0].max() <= 750 and abs(uni[:, 0].mean() - 650) < 10
 
 
+@pytest.mark.slow
 def test_resume_keeps_finished_runs(tmp_path):
     spec = SweepSpec(n=6, seed=1, sampling="lhs", base=BASE)
     full = run_sweep(spec, out_dir=tmp_path / "a", chunk=2, nthread=1)
@@ -70,6 +71,7 @@ def test_resume_keeps_finished_runs(tmp_path):
     assert len(other) == 2
 
 
+@pytest.mark.slow
 def test_dask_gives_the_same_numbers_as_local(tmp_path):
     distributed = pytest.importorskip("distributed")
     spec = SweepSpec(n=4, seed=2, sampling="uniform", base=BASE)
@@ -92,6 +94,7 @@ def test_dask_gives_the_same_numbers_as_local(tmp_path):
             assert a[key] == b[key]
 
 
+@pytest.mark.slow
 def test_unreachable_scheduler_is_a_clear_error():
     with pytest.raises(SchedulerError, match="cannot reach"):
         run_sweep(SweepSpec(n=1, base=BASE), scheduler="tcp://127.0.0.1:9")
@@ -108,6 +111,7 @@ def test_bad_spec_raises(kwargs, error):
         SweepSpec(base=BASE, **kwargs)
 
 
+@pytest.mark.slow
 def test_cli_sweep_json_and_files(tmp_path):
     proc = subprocess.run([sys.executable, "-m", "wmr_mj.cli", "sweep", "--n", "3", "--model", "nonholonomic",
                            "--duration", "10", "--out", str(tmp_path), "--json"],
@@ -139,7 +143,8 @@ def test_uncertainty_box_and_ranges_from_the_command_line():
 @pytest.mark.parametrize("argv", [["--n", "0"], ["--m1-range", "750", "550"], ["--range", "nope=1:2"],
                                   ["--uncertainty", "nope"],
                                   ["--range", "mu=0.03:0.01"], ["--sampling", "sobol"],
-                                  ["--scheduler", "tcp://127.0.0.1:9"], ["--range", "mu=abc"]])
+                                  pytest.param(["--scheduler", "tcp://127.0.0.1:9"], marks=pytest.mark.slow),
+                                  ["--range", "mu=abc"]])
 def test_cli_sweep_bad_input_exits_2(argv, tmp_path):
     proc = subprocess.run([sys.executable, "-m", "wmr_mj.cli", "sweep", "--duration", "10", "--out", str(tmp_path),
                            *argv],
@@ -149,6 +154,7 @@ def test_cli_sweep_bad_input_exits_2(argv, tmp_path):
     assert "Traceback" not in proc.stderr
 
 
+@pytest.mark.slow
 def test_cli_sweep_log_writes_replayable_mcap_per_run(tmp_path):
     from wmr_mj.logs.reader import load_log
 
@@ -165,6 +171,7 @@ def test_cli_sweep_log_writes_replayable_mcap_per_run(tmp_path):
         assert float(np.max(np.abs(log.signals["E"]))) == row["sup_E"]
 
 
+@pytest.mark.slow
 def test_certified_design_sweep_over_m1_is_certified_inside_for_every_run(tmp_path):
     """Issue 8: a sweep of the certified design over m1 550-750 kg has no run outside certified-inside."""
     from wmr_mj.analysis.verdicts import count_verdicts

@@ -55,6 +55,7 @@ def _saved(folder: Path) -> dict:
     return json.loads((folder / "summary.json").read_text())
 
 
+@pytest.mark.slow
 def test_the_folder_has_every_file_the_report_references(validated):
     folder, _, err = validated
     md, html = (folder / "index.md").read_text(), (folder / "index.html").read_text()
@@ -79,12 +80,14 @@ def test_the_folder_has_every_file_the_report_references(validated):
     assert "total wall time" in lines[-1]
 
 
+@pytest.mark.slow
 def test_json_equals_summary_json(validated):
     folder, out, _ = validated
     assert out == _saved(folder)
     assert out["settings"]["n"] == N and out["seed"] == 3 and out["versions"]["mujoco"]
 
 
+@pytest.mark.slow
 def test_verdict_counts_equal_those_recomputed_from_each_rungs_runs_csv(validated):
     folder, _, _ = validated
     saved = _saved(folder)
@@ -111,6 +114,7 @@ def test_verdict_counts_equal_those_recomputed_from_each_rungs_runs_csv(validate
     assert saved["certified_outside"] == 0, "a certified-outside run: a bug or a modelling gap"
 
 
+@pytest.mark.slow
 def test_the_ladder_has_four_rungs_changing_one_thing_each(validated):
     folder, _, _ = validated
     ladder = _saved(folder)["ladder"]
@@ -142,6 +146,7 @@ def test_ladder_changes_and_summarise_rung_units():
     assert (s["worst_sup_E"], s["worst_sup_E_m1"], s["worst_certificate_ratio"]) == (0.03, 700.0, 0.6)
 
 
+@pytest.mark.slow
 def test_the_search_beside_the_monte_carlo_worst_and_the_certificate(validated):
     from wmr_mj.logs.reader import load_log
 
@@ -185,6 +190,7 @@ def test_the_search_beside_the_monte_carlo_worst_and_the_certificate(validated):
     assert f"{cert['worst']['objective']:.4g}" in md and "Tightness" in md
 
 
+@pytest.mark.slow
 def test_a_rerun_resumes_and_prints_the_answer_first(validated):
     folder, _, _ = validated
     before = _saved(folder)
@@ -203,6 +209,7 @@ def test_a_rerun_resumes_and_prints_the_answer_first(validated):
     assert md.index("## (d)") < md.index("## (e) Identification") < md.index("## (f) Findings")
 
 
+@pytest.mark.slow
 def test_certified_outside_is_announced_loudly_before_the_answer(validated):
     folder, _, _ = validated
     summary = _saved(folder)

@@ -65,6 +65,7 @@ def _path_magenta(px: np.ndarray) -> int:
     return int(np.count_nonzero((r > 150) & (b > 110) & (r - g > 90) & (b - g > 60)))
 
 
+@pytest.mark.slow
 def test_mp4_has_one_frame_per_tick_at_the_asked_size(videos):
     res = videos["glass"]
     frames = _frames(res.path)
@@ -75,6 +76,7 @@ def test_mp4_has_one_frame_per_tick_at_the_asked_size(videos):
     assert set(res.seconds) >= {"load", "kinematics", "scene", "render", "overlay", "encode", "total"}
 
 
+@pytest.mark.slow
 def test_frame_shows_path_and_steering_unit_through_the_chassis(videos):
     glass, opaque = (_centre(_frames(videos[k].path)[10]) for k in ("glass", "opaque"))  # t = 1 s
     # Over the chassis, the steering needle is blue in both pictures; the steering unit (beam,

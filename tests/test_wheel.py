@@ -25,6 +25,8 @@ import pytest
 
 from wmr_mj.cli.app import COMMANDS
 
+pytestmark = pytest.mark.wheel  # builds the wheel: `make test-fast` leaves it out
+
 REPO = Path(__file__).resolve().parents[1]
 # what a build must not see: environments, build outputs, caches, run outputs
 _IGNORE_ANYWHERE = shutil.ignore_patterns(".git", ".venv", "build", "dist", "*.egg-info", "__pycache__",
