@@ -29,29 +29,36 @@ import json
 import math
 from collections.abc import Mapping
 from pathlib import Path
+from typing import Literal, get_args
 
 import numpy as np
 
 from controllers.base import SteeringController
 from wmr_mj.errors import ParameterError, UnknownNameError
-from wmr_mj.params import C80, PAPER_KD, PAPER_KP, C80Parameters
-from wmr_mj.plant.reduced import MODEL_NAMES, SteeringModel, smooth_sign, steering_model
+from wmr_mj.params import C80, COEFFICIENT_NAMES, PAPER_KD, PAPER_KP, C80Parameters
+from wmr_mj.plant.reduced import MODEL_NAMES, ModelName, SteeringModel, smooth_sign, steering_model
 
 __all__ = [
     "ComputedTorque",
     "PDController",
     "gains_from_omega_r",
     "model_from_source",
+    "ModelSource",
     "MODEL_SOURCES",
+    "FrictionSign",
     "FRICTION_SIGNS",
     "CONTROLLER_NAMES",
     "make_controller",
 ]
 
-MODEL_SOURCES = (*MODEL_NAMES, "identified", "explicit")
-FRICTION_SIGNS = ("measured", "reference", "none")
+#: Where the controller's model comes from: a reduced model on the parameters, the identified
+#: coefficients, or explicit ones.
+ModelSource = Literal[ModelName, "identified", "explicit"]
+MODEL_SOURCES: tuple[str, ...] = get_args(ModelSource)
+#: The sign the Coulomb compensation F^ sgn(.) uses: the measured alpha', the reference's, or none.
+FrictionSign = Literal["measured", "reference", "none"]
+FRICTION_SIGNS: tuple[str, ...] = get_args(FrictionSign)
 CONTROLLER_NAMES = ("computed-torque", "pd")
-_COEFFICIENT_KEYS = ("P", "C_V", "F", "K", "gyro")
 
 
 def _check_gain(name: str, value: float) -> float:
@@ -107,13 +114,13 @@ def model_from_source(
         if coefficients is None:
             raise ParameterError("model source 'explicit' needs coefficients P, C_V, F, K, gyro")
         values = coefficients
-    unknown = set(values) - set(_COEFFICIENT_KEYS) - {"V_A"}
+    unknown = set(values) - set(COEFFICIENT_NAMES) - {"V_A"}
     if source == "explicit" and unknown:
-        raise UnknownNameError("coefficient", sorted(unknown)[0], _COEFFICIENT_KEYS)
+        raise UnknownNameError("coefficient", sorted(unknown)[0], COEFFICIENT_NAMES)
     if "P" not in values:
         raise ParameterError(f"model source {source!r}: coefficient P is required")
     try:
-        coeffs = {k: float(values.get(k, 0.0)) for k in _COEFFICIENT_KEYS}
+        coeffs = {k: float(values.get(k, 0.0)) for k in COEFFICIENT_NAMES}
     except (TypeError, ValueError):
         raise ParameterError(f"model source {source!r}: coefficients must be numbers") from None
     return SteeringModel(**coeffs, V_A=float(values.get("V_A", params.V_A)), name=source)

@@ -19,6 +19,7 @@ __all__ = [
     "SchedulerError",
     "OutputPathError",
     "NotEnoughMemoryError",
+    "NoRenderBackendError",
 ]
 
 
@@ -71,3 +72,7 @@ class OutputPathError(WmrMjError):
 
 class NotEnoughMemoryError(WmrMjError):
     """A job would need more memory than the machine has available; refused before it starts."""
+
+
+class NoRenderBackendError(WmrMjError):
+    """No OpenGL backend (EGL, OSMesa) can render offscreen on this machine."""

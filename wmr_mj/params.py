@@ -30,7 +30,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass, fields
-from typing import Any
+from typing import Any, Literal, get_args
 
 from wmr_mj.errors import ParameterError, UnknownNameError
 
@@ -38,6 +38,9 @@ __all__ = [
     "C80Parameters",
     "C80",
     "Coefficients",
+    "COEFFICIENT_NAMES",
+    "CoefficientModel",
+    "COEFFICIENT_MODELS",
     "with_params",
     "parameter_names",
     "PARAMETER_SOURCES",
@@ -136,6 +139,16 @@ class Coefficients:
 
     def as_dict(self) -> dict[str, float]:
         return dataclasses.asdict(self)
+
+
+#: The reduced model's coefficients, in (2.13)'s order: the fields of :class:`Coefficients`, what
+#: identification fits and what an estimate names.
+COEFFICIENT_NAMES: tuple[str, ...] = tuple(f.name for f in dataclasses.fields(Coefficients))
+
+#: The models :meth:`C80Parameters.coefficients` derives coefficients for: the paper's (2.13) and
+#: the non-holonomic one (wmr_mj.plant.reduced adds 'paper-lagrange', a variant of the paper's).
+CoefficientModel = Literal["paper", "nonholonomic"]
+COEFFICIENT_MODELS: tuple[str, ...] = get_args(CoefficientModel)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -331,8 +344,8 @@ class C80Parameters:
             gyro = P / l1 (the chassis yaw acceleration V_A alpha'/(l1 cos^2)
             acting on the steering inertia).
         """
-        if model not in ("paper", "nonholonomic"):
-            raise UnknownNameError("model", model, ("paper", "nonholonomic"))
+        if model not in COEFFICIENT_MODELS:
+            raise UnknownNameError("model", model, COEFFICIENT_MODELS)
         ke = self.kinetic_energy_coefficients()
         r = self.R_a / self.k_i
         P = r * 2 * ke["D"] / self.i2

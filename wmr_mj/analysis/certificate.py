@@ -119,8 +119,11 @@ import itertools
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Literal, get_args
 
+from controllers.computed_torque import FRICTION_SIGNS
+from wmr_mj._util.checks import finite_number as _number
+from wmr_mj._util.checks import interval as _interval
 from wmr_mj.analysis.robustness import ParameterBox, _check_gains, damping_regime, exact_gammas
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import C80Parameters
@@ -128,8 +131,8 @@ from wmr_mj.reference.bounds import ReferenceBounds
 
 __all__ = [
     "friction_over_P_max",
+    "Verdict",
     "VERDICTS",
-    "FRICTION_MODES",
     "Assumption",
     "Certificate",
     "CertificateJudgement",
@@ -151,8 +154,9 @@ __all__ = [
     "CONTROL_PERIOD_FRACTION",
 ]
 
-VERDICTS = ("certified-inside", "certified-outside", "uncertified-inside", "uncertified-outside")
-FRICTION_MODES = ("measured", "reference", "none")
+#: A run's verdict against its certificate; only 'certified-inside' is a pass.
+Verdict = Literal["certified-inside", "certified-outside", "uncertified-inside", "uncertified-outside"]
+VERDICTS: tuple[str, ...] = get_args(Verdict)
 
 #: The plant's sin/cos^3 coefficient, V: |K| <= 0.02. Measured: MuJoCo identification
 #: K = -0.0052 +- 0.0016 V (model card, seed 0); Drake 0.018 V at 1e7 N/m contacts
@@ -431,8 +435,8 @@ def friction_term(mode: str, *, F: tuple[float, float], F_hat: float) -> float:
 
     'measured' max(F_max, F^); 'none' F_max; 'reference' F_max + F^ (module docstring).
     """
-    if mode not in FRICTION_MODES:
-        raise UnknownNameError("friction sign", str(mode), FRICTION_MODES)
+    if mode not in FRICTION_SIGNS:
+        raise UnknownNameError("friction sign", str(mode), FRICTION_SIGNS)
     F_max = float(F[1])
     if mode == "none":
         return F_max
@@ -489,33 +493,6 @@ def loop_crossover(kp: float, kd: float) -> tuple[float, float]:
         iq = 1.0 / q
         wc = math.sqrt(kp) * math.sqrt(0.5 * (iq + math.sqrt(iq * iq + 4.0)))
     return wc, math.atan2(kd, kp / wc)
-
-
-def _interval(name: str, value: Any, *, positive: bool = False) -> tuple[float, float]:
-    try:
-        lo, hi = (float(v) for v in value)
-    except (TypeError, ValueError):
-        raise ParameterError(f"{name} must be a pair (lo, hi) of numbers, got {value!r}") from None
-    if not (math.isfinite(lo) and math.isfinite(hi)) or hi < lo:
-        raise ParameterError(f"{name} = ({lo}, {hi}) is not accepted: finite lo <= hi is required")
-    if positive and lo <= 0:
-        raise ParameterError(f"{name} = ({lo}, {hi}) is not accepted: lo > 0 is required")
-    return lo, hi
-
-
-def _number(name: str, value: Any, *, minimum: float | None = None, strict: bool = False) -> float:
-    if isinstance(value, bool):
-        raise ParameterError(f"{name} must be a number, got {value!r}")
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ParameterError(f"{name} must be a number, got {value!r}") from None
-    if not math.isfinite(v):
-        raise ParameterError(f"{name} = {value!r} is not accepted: a finite number is required")
-    if minimum is not None and (v < minimum or (strict and v == minimum)):
-        need = ">" if strict else ">="
-        raise ParameterError(f"{name} = {value!r} is not accepted: a finite number {need} {minimum:g} is required")
-    return v
 
 
 # --------------------------------------------------------------------------- certify: inputs
@@ -632,7 +609,7 @@ class Compensation:
 
     Attributes:
         friction_sign: the sign it multiplies F^ by: 'measured' (sgn a'), 'reference' (sgn a0')
-            or 'none' (:data:`FRICTION_MODES`).
+            or 'none' (:data:`FRICTION_SIGNS`).
         friction_width: the sign's smoothing w [rad/s], >= 0 (recorded; the friction term covers
             any |s| <= 1).
         feedforward: False for a PD law without P^ a0'' (which has no compensation either).
@@ -647,8 +624,8 @@ class Compensation:
     feedforward: bool = True
 
     def __post_init__(self) -> None:
-        if self.friction_sign not in FRICTION_MODES:
-            raise UnknownNameError("friction sign", str(self.friction_sign), FRICTION_MODES)
+        if self.friction_sign not in FRICTION_SIGNS:
+            raise UnknownNameError("friction sign", str(self.friction_sign), FRICTION_SIGNS)
         object.__setattr__(self, "friction_width", _number("friction_width", self.friction_width, minimum=0.0))
         if not self.feedforward and self.friction_sign != "none":
             raise ParameterError("a law without feedforward (PD) has no Coulomb compensation: use friction_sign='none'")

@@ -90,6 +90,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, Literal
 
+from wmr_mj._util.checks import box_interval as _interval
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import M1_RANGE, PAPER_KD, PAPER_KP
 from wmr_mj.reference.bounds import PAPER_BOUNDS, ReferenceBounds
@@ -106,13 +107,15 @@ __all__ = [
     "gains_from_omega_r",
     "READINGS",
     "GAMMA_FORMS",
-    "COEFFICIENT_NAMES",
+    "BOX_COEFFICIENTS",
     "PAPER_CONDITION",
 ]
 
 READINGS = ("corrected", "printed", "printed-literal")
 GAMMA_FORMS = ("exact", "paper")
-COEFFICIENT_NAMES = ("P", "C_V", "F", "K")
+#: The coefficients a ParameterBox bounds, the uncertainty set of (4.2): the paper's model has no
+#: gyro term (wmr_mj.params.COEFFICIENT_NAMES has it too).
+BOX_COEFFICIENTS = ("P", "C_V", "F", "K")
 #: The left side of (4.23) the paper reports for its (5.1) example.
 PAPER_CONDITION = 0.2613
 
@@ -267,20 +270,6 @@ def impulse_responses(t: Any, kp: float, kd: float) -> tuple[Any, Any]:
 
 
 # --------------------------------------------------------------------------- box
-def _interval(name: str, value: Any, *, allow_degenerate: bool, what: str) -> tuple[float, float]:
-    try:
-        lo, hi = value
-        lo, hi = float(lo), float(hi)
-    except (TypeError, ValueError):
-        raise ParameterError(f"{what} {name} must be a pair (lo, hi) of numbers, got {value!r}") from None
-    if not (math.isfinite(lo) and math.isfinite(hi)):
-        raise ParameterError(f"{what} {name} = ({lo}, {hi}) is not finite; finite lo < hi is required")
-    if hi < lo or (hi == lo and not allow_degenerate):
-        need = "lo <= hi" if allow_degenerate else "lo < hi"
-        raise ParameterError(f"{what} {name} = ({lo}, {hi}) is empty or inverted; {need} is required")
-    return lo, hi
-
-
 @dataclass(frozen=True)
 class ParameterBox:
     """Intervals (lo, hi) of the plant coefficients of (2.12), the uncertainty set of (4.2).
@@ -295,7 +284,7 @@ class ParameterBox:
     K: tuple[float, float]
 
     def __post_init__(self) -> None:
-        for name in COEFFICIENT_NAMES:
+        for name in BOX_COEFFICIENTS:
             object.__setattr__(
                 self, name, _interval(name, getattr(self, name), allow_degenerate=True, what="box interval")
             )
@@ -349,24 +338,24 @@ class ParameterBox:
         axes = []
         for lo, hi in spans.values():
             axes.append(sorted({lo, hi, *(lo + (hi - lo) * k / (grid - 1) for k in range(grid))}))
-        lo_v = {name: math.inf for name in COEFFICIENT_NAMES}
-        hi_v = {name: -math.inf for name in COEFFICIENT_NAMES}
+        lo_v = {name: math.inf for name in BOX_COEFFICIENTS}
+        hi_v = {name: -math.inf for name in BOX_COEFFICIENTS}
         for point in itertools.product(*axes):
             changes = dict(zip(spans, point))
             p = with_params(params, m1_inertia=m1_inertia, **changes) if changes else params
             c = p.coefficients(model)
-            for name in COEFFICIENT_NAMES:
+            for name in BOX_COEFFICIENTS:
                 v = float(getattr(c, name))
                 lo_v[name] = min(lo_v[name], v)
                 hi_v[name] = max(hi_v[name], v)
-        return cls(**{name: (lo_v[name], hi_v[name]) for name in COEFFICIENT_NAMES})
+        return cls(**{name: (lo_v[name], hi_v[name]) for name in BOX_COEFFICIENTS})
 
     def width(self, name: str) -> float:
         lo, hi = getattr(self, name)
         return hi - lo
 
     def as_dict(self) -> dict[str, list[float]]:
-        return {n: list(getattr(self, n)) for n in COEFFICIENT_NAMES}
+        return {n: list(getattr(self, n)) for n in BOX_COEFFICIENTS}
 
 
 # --------------------------------------------------------------------------- result
@@ -488,14 +477,14 @@ def _normalise_estimate(estimate: Any) -> dict[str, float]:
         estimate = estimate.as_dict()
     if not isinstance(estimate, Mapping):
         raise ParameterError(
-            f"estimate must be a mapping {{name: value}} of {', '.join(COEFFICIENT_NAMES)}, got {estimate!r}"
+            f"estimate must be a mapping {{name: value}} of {', '.join(BOX_COEFFICIENTS)}, got {estimate!r}"
         )
     out: dict[str, float] = {}
     for name, value in estimate.items():
-        if name not in COEFFICIENT_NAMES:
+        if name not in BOX_COEFFICIENTS:
             if name == "gyro":  # Coefficients.as_dict() carries it; the analysis has no gyro term
                 continue
-            raise UnknownNameError("estimate name", name, COEFFICIENT_NAMES)
+            raise UnknownNameError("estimate name", name, BOX_COEFFICIENTS)
         try:
             v = float(value)
         except (TypeError, ValueError):

@@ -22,8 +22,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     from wmr_mj._util.files import check_output_path, write_json_atomic
     from wmr_mj.cli._common import print_json
-    from wmr_mj.params import C80, with_params
-    from wmr_mj.plant.identify import COEFFICIENT_NAMES, identify_plant
+    from wmr_mj.params import C80, COEFFICIENT_MODELS, COEFFICIENT_NAMES, with_params
+    from wmr_mj.plant.identify import identify_plant
 
     if args.out:  # before the identification, which takes a while
         check_output_path(args.out, kind="file", option="--out")
@@ -41,10 +41,10 @@ def run(args: argparse.Namespace) -> int:
           f"{result.diagnostics['samples']} samples, residual {result.diagnostics['residual_rms_V']:.3g} V rms")
     print(f"{'coef':5s} {'identified':>12s} {'+-':>8s} {'paper':>10s} {'diff':>8s} {'nonholon.':>10s} "
           f"{'diff':>8s}  unit")
-    rel = {name: result.relative_difference(name) for name in ("paper", "nonholonomic")}
+    rel = {name: result.relative_difference(name) for name in COEFFICIENT_MODELS}
     for k in COEFFICIENT_NAMES:
         cells = []
-        for name in ("paper", "nonholonomic"):
+        for name in COEFFICIENT_MODELS:
             r = rel[name][k]
             diff = "   n/a" if r is None else f"{100 * r:+7.1f}%"
             cells.append(f"{getattr(result.predicted[name], k):10.4g} {diff:>8s}")

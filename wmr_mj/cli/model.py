@@ -21,7 +21,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     from wmr_mj._util.resources import MODELS_IN_CHECKOUT
     from wmr_mj.cli._common import parse_assignments, print_json
-    from wmr_mj.params import C80, PARAMETER_SOURCES, with_params
+    from wmr_mj.params import C80, COEFFICIENT_NAMES, PARAMETER_SOURCES, with_params
     from wmr_mj.plant.mjcf import MODELS_DIR, robot_xml, scene_file_xml, write_model_files
 
     params = with_params(C80, **parse_assignments(args.param))
@@ -87,6 +87,6 @@ def run(args: argparse.Namespace) -> int:
     for name, value in params.as_dict().items():
         print(f"{name:22s} {value:12.6g}  {PARAMETER_SOURCES[name]}")
     print()
-    for key in ("P", "C_V", "F", "K", "gyro"):
+    for key in COEFFICIENT_NAMES:
         print(f"{key:5s} paper {getattr(paper, key):10.5g}   nonholonomic {getattr(nonholonomic, key):10.5g}")
     return 0

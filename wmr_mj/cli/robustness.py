@@ -17,7 +17,7 @@ import argparse
 import math
 
 from wmr_mj.cli._common import parse_assignments, parse_range, positive_float
-from wmr_mj.params import M1_NOMINAL, M1_RANGE, PAPER_KD, PAPER_KP
+from wmr_mj.params import COEFFICIENT_MODELS, M1_NOMINAL, M1_RANGE, PAPER_KD, PAPER_KP
 
 
 def _nonneg_float(text: str) -> float:
@@ -72,7 +72,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--model",
-        choices=("paper", "nonholonomic"),
+        choices=COEFFICIENT_MODELS,
         default=None,
         help="reduced model whose coefficients span --box derived (default paper)",
     )

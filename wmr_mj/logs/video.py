@@ -44,11 +44,10 @@ from typing import Any
 
 import numpy as np
 
-from wmr_mj.errors import ParameterError, WmrMjError
+from wmr_mj.errors import NoRenderBackendError, ParameterError, WmrMjError
 
 __all__ = [
     "BACKENDS",
-    "NoRenderBackendError",
     "VideoResult",
     "parse_size",
     "render_video",
@@ -84,10 +83,6 @@ _NEEDLE_RADIUS_M = 0.022
 # Child-process exit codes: the backend does not work (try the next) / a user error.
 _EXIT_NO_BACKEND = 3
 _EXIT_USER_ERROR = 2
-
-
-class NoRenderBackendError(WmrMjError):
-    """No OpenGL backend (EGL, OSMesa) can render offscreen on this machine."""
 
 
 @dataclasses.dataclass(frozen=True)

@@ -30,12 +30,10 @@ import mujoco
 import numpy as np
 
 from wmr_mj.errors import ParameterError
-from wmr_mj.params import C80, M1_NOMINAL, C80Parameters, Coefficients
+from wmr_mj.params import C80, COEFFICIENT_NAMES, M1_NOMINAL, C80Parameters, Coefficients
 from wmr_mj.plant.mjcf import Plant
 
-__all__ = ["IdentificationResult", "fit_steering_model", "excite_plant", "identify_plant", "COEFFICIENT_NAMES"]
-
-COEFFICIENT_NAMES = ("P", "C_V", "F", "K", "gyro")
+__all__ = ["IdentificationResult", "fit_steering_model", "excite_plant", "identify_plant"]
 
 
 def _regressors(alpha, alpha_dot, alpha_ddot, speed) -> np.ndarray:

@@ -49,6 +49,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Literal, get_args
 
 import mujoco
 import numpy as np
@@ -70,6 +71,7 @@ __all__ = [
     "MODELS_DIR",
     "TIMESTEP",
     "BEAM_PITCH_RATIO",
+    "SteeringFriction",
     "STEERING_FRICTION_MODELS",
     "STICTION_SOLREF",
     "STICTION_SOLIMP",
@@ -88,8 +90,10 @@ DRIVE_TIME_CONSTANT = 0.02
 # Significant digits of every number written into the MJCF (MjSpec.to_xml writes 6).
 SIGNIFICANT_DIGITS = 6
 
-#: Steering friction laws a plant can be built with (see the module docstring).
-STEERING_FRICTION_MODELS = ("stiction", "soft")
+#: Steering friction laws a plant can be built with (see the module docstring); the report
+#: measures each of them.
+SteeringFriction = Literal["stiction", "soft"]
+STEERING_FRICTION_MODELS: tuple[str, ...] = get_args(SteeringFriction)
 # "stiction": solver parameters of the steering joint's frictionloss constraint.
 # Below break-away a frictionloss constraint creeps at v = (1-d)/d * tau/J * d_w*timeconst/2
 # (MuJoCo's friction dynamics, modeling.rst "Friction"); MuJoCo's defaults (d = 0.9,

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import mujoco
 
-from wmr_mj.params import C80, M1_RANGE, PARAMETER_SOURCES, C80Parameters, with_params
+from wmr_mj.params import C80, COEFFICIENT_NAMES, M1_RANGE, PARAMETER_SOURCES, C80Parameters, with_params
 from wmr_mj.plant.friction import (
     HOLD_RATE,
     FrictionLaw,
@@ -136,7 +136,7 @@ def _coefficient_section(w, p: C80Parameters, paper, nh) -> None:
     w("| coefficient | paper model at m1 = 650 kg | over m1 = 550-750 kg | paper (5.1) | non-holonomic model | unit |")
     w("|---|---:|---|---|---:|---|")
     units = {"P": "V s²/rad", "C_V": "V s/rad", "F": "V", "K": "V", "gyro": "V s/m"}
-    for k in ("P", "C_V", "F", "K", "gyro"):
+    for k in COEFFICIENT_NAMES:
         a, b = getattr(paper_lo, k), getattr(paper_hi, k)
         interval = _PAPER_INTERVALS.get(k)
         w(f"| {k} | {_g(getattr(paper, k))} | ({_g(min(a, b))}, {_g(max(a, b))}) | "
@@ -218,7 +218,7 @@ def _identification_section(w, ident, paper, nh) -> None:
     w("")
     w("| coefficient | identified | ± (std. error) | paper model | non-holonomic model |")
     w("|---|---:|---:|---:|---:|")
-    for k in ("P", "C_V", "F", "K", "gyro"):
+    for k in COEFFICIENT_NAMES:
         w(f"| {k} | {_g(getattr(ident.identified, k))} | {_g(se[k], 2)} | {_g(getattr(paper, k))} "
           f"| {_g(getattr(nh, k))} |")
     w("")

@@ -26,7 +26,7 @@ Usage::
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from typing import Any, cast
+from typing import Any, Literal, cast, get_args
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -34,9 +34,11 @@ from numpy.typing import ArrayLike
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import C80Parameters, Coefficients
 
-__all__ = ["SteeringModel", "steering_model", "MODEL_NAMES", "smooth_sign"]
+__all__ = ["SteeringModel", "steering_model", "ModelName", "MODEL_NAMES", "smooth_sign"]
 
-MODEL_NAMES = ("paper", "paper-lagrange", "nonholonomic")
+#: The reduced models :func:`steering_model` builds.
+ModelName = Literal["paper", "paper-lagrange", "nonholonomic"]
+MODEL_NAMES: tuple[str, ...] = get_args(ModelName)
 
 
 def smooth_sign(x: ArrayLike, width: float) -> np.ndarray:

@@ -89,6 +89,8 @@ from numpy.typing import ArrayLike
 from scipy.integrate import quad, solve_ivp
 from scipy.optimize import brentq
 
+from wmr_mj._util.checks import positive_real as _positive
+from wmr_mj._util.checks import real as _number
 from wmr_mj.errors import InfeasiblePathError, ParameterError
 from wmr_mj.params import C80, C80Parameters
 from wmr_mj.reference.bounds import PAPER_BOUNDS, ReferenceBounds
@@ -120,22 +122,6 @@ _JOIN_TOL = 1e-9  # curvature mismatch accepted at a joint, 1/m
 
 # --------------------------------------------------------------------------
 # argument checks
-def _number(name: str, value: object) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise ParameterError(f"{name} must be a real number, got {value!r}")
-    x = float(value)
-    if not math.isfinite(x):
-        raise ParameterError(f"{name} = {value!r} is not accepted: it must be finite")
-    return x
-
-
-def _positive(name: str, value: object, unit: str = "") -> float:
-    x = _number(name, value)
-    if x <= 0.0:
-        raise ParameterError(f"{name} = {value!r}{unit} is not accepted: it must be finite and > 0")
-    return x
-
-
 def _terminal_event(fn: Callable[..., float], *, direction: int) -> Callable[..., float]:
     """``fn`` as a terminal event of ``solve_ivp``, which reads the two attributes off the function."""
     fn.terminal = True  # type: ignore[attr-defined]  # solve_ivp's event protocol: attributes on a function

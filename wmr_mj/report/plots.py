@@ -60,6 +60,7 @@ from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.patches import Patch, Polygon  # noqa: E402
 from matplotlib.ticker import MaxNLocator  # noqa: E402
 
+from wmr_mj.analysis.robustness import BOX_COEFFICIENTS  # noqa: E402
 from wmr_mj.params import M1_NOMINAL, PAPER_KD, PAPER_KP  # noqa: E402
 
 if TYPE_CHECKING:
@@ -770,8 +771,8 @@ def paper_example(*, duration: float = 35.0, friction_width: float = 1e-3, mujoc
     kp, kd = PAPER_KP, PAPER_KD
     result = analyse(box, kp=kp, kd=kd, bounds=ReferenceBounds())
     reference, settle_s = build_reference("paper-circle", C80, dt=1e-3, duration=float(duration))
-    lo = {n: getattr(box, n)[0] for n in ("P", "C_V", "F", "K")}
-    hi = {n: getattr(box, n)[1] for n in ("P", "C_V", "F", "K")}
+    lo = {n: getattr(box, n)[0] for n in BOX_COEFFICIENTS}
+    hi = {n: getattr(box, n)[1] for n in BOX_COEFFICIENTS}
     reduced = []
     for est, plant, name in ((lo, hi, "estimate at box min, plant at box max"),
                              (hi, lo, "estimate at box max, plant at box min")):

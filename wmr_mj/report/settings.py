@@ -14,7 +14,7 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from typing import Any
 
-from wmr_mj._util.checks import as_pair
+from wmr_mj._util.checks import as_pair, integer_at_least, positive_number
 from wmr_mj._util.progress import Stages
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import C80, M1_NOMINAL, M1_RANGE
@@ -27,7 +27,6 @@ __all__ = [
     "DEFAULT_DURATION",
     "DEFAULT_SEARCH_BUDGET",
     "FULL_BOX_FACTOR",
-    "FRICTION_LAWS",
     "LADDER_GROUPS",
     "ValidateSettings",
     "max_at",
@@ -44,24 +43,12 @@ DEFAULT_DURATION = 35.0
 #: Simulations of each m1-box search; the 5-parameter full-box search gets FULL_BOX_FACTOR times as many.
 DEFAULT_SEARCH_BUDGET = 30
 FULL_BOX_FACTOR = 2
-#: The steering joint's friction laws the report measures (wmr_mj.plant.mjcf.STEERING_FRICTION_MODELS).
-FRICTION_LAWS = ("stiction", "soft")
 #: What a ladder rung may change, in groups of RunConfig fields: each rung changes exactly one.
 LADDER_GROUPS = {"controller": ("controller",), "model source": ("model",),
                  "compensation": ("friction_sign", "friction_width"), "gains": ("kp", "kd")}
 _MIN_POPULATION = 5  # differential evolution's smallest generation (wmr_mj.sim.falsify.MIN_POPULATION)
 
 # --------------------------------------------------------------------------- settings
-def _check_number(name: str, value: Any) -> None:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
-        raise ParameterError(f"{name} = {value!r} is not accepted; a finite number > 0 is required")
-
-
-def _check_int(name: str, value: Any, minimum: int, what: str) -> None:
-    if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
-        raise ParameterError(f"{name} = {value!r} is not accepted; {what}")
-
-
 @dataclass(frozen=True, kw_only=True)
 class ValidateSettings:
     """What ``wmr-mj validate`` runs. Bad values raise ParameterError / UnknownNameError.
@@ -87,14 +74,15 @@ class ValidateSettings:
     def __post_init__(self) -> None:
         from wmr_mj.sim.sweep import SAMPLINGS
 
-        _check_int("n", self.n, 1, "the number of runs per rung must be an integer >= 1")
-        _check_int("seed", self.seed, 0, "an integer >= 0 is required")
+        integer_at_least("n", self.n, 1, "the number of runs per rung must be an integer >= 1")
+        integer_at_least("seed", self.seed, 0, "an integer >= 0 is required")
         if self.sampling not in SAMPLINGS:
             raise UnknownNameError("sampling", str(self.sampling), SAMPLINGS)
         for name in ("duration", "identify_duration", "nominal_m1"):
-            _check_number(name, getattr(self, name))
-        _check_int("nthread", self.nthread, 0, "an integer >= 0 (0: all CPUs) is required")
-        _check_int("search_budget", self.search_budget, 0, f"give 0 (no search) or an integer >= {_MIN_POPULATION}")
+            positive_number(name, getattr(self, name))
+        integer_at_least("nthread", self.nthread, 0, "an integer >= 0 (0: all CPUs) is required")
+        integer_at_least("search_budget", self.search_budget, 0,
+                         f"give 0 (no search) or an integer >= {_MIN_POPULATION}")
         if 0 < self.search_budget < _MIN_POPULATION:
             raise ParameterError(f"search_budget = {self.search_budget} is below one generation of differential "
                                  f"evolution; give 0 (no search) or an integer >= {_MIN_POPULATION}")

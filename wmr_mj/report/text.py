@@ -32,6 +32,10 @@ import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+from wmr_mj.analysis.certificate import VERDICTS
+from wmr_mj.params import COEFFICIENT_MODELS, COEFFICIENT_NAMES
+from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS
+
 __all__ = [
     "document",
     "answer_blocks",
@@ -208,8 +212,7 @@ def search_rows(summary: Mapping[str, Any]) -> list[list[str]]:
                     _params_text(w.get("params", {}), s.get("names", ())),
                     f"{_fmt(mc.get('worst_objective'), '.4g')} ({mc.get('n')} runs, rung {mc.get('rung')})"
                     if mc else "none (no sweep of this box)", bound,
-                    "/".join(str(v[k]) for k in ("certified-inside", "certified-outside", "uncertified-inside",
-                                                  "uncertified-outside")) + (" !!!" if v["certified-outside"] else "")])
+                    "/".join(str(v[k]) for k in VERDICTS) + (" !!!" if v["certified-outside"] else "")])
     return out
 
 
@@ -290,11 +293,9 @@ FRICTION_COLUMNS = ("plant law", "F (2.13) V", "break-away V", "creep at 0.5 F r
 
 def _friction_laws(summary: Mapping[str, Any]) -> list[tuple[str, Mapping[str, Any]]]:
     """The measured laws in the report's order (stiction first), whatever the mapping's order."""
-    from wmr_mj.report.settings import FRICTION_LAWS
-
     laws = summary["friction"]
-    return [(n, laws[n]) for n in FRICTION_LAWS if n in laws] + [(n, v) for n, v in laws.items()
-                                                                  if n not in FRICTION_LAWS]
+    return [(n, laws[n]) for n in STEERING_FRICTION_MODELS if n in laws] + [
+        (n, v) for n, v in laws.items() if n not in STEERING_FRICTION_MODELS]
 
 
 def friction_rows(summary: Mapping[str, Any]) -> list[list[str]]:
@@ -315,9 +316,9 @@ def identification_rows(summary: Mapping[str, Any]) -> list[list[str]]:
     ident = summary["identification"]
     se = ident.get("diagnostics", {}).get("std_error", {})
     out = []
-    for k in ("P", "C_V", "F", "K", "gyro"):
+    for k in COEFFICIENT_NAMES:
         row = [k, _fmt(ident["identified"][k], ".5g"), _fmt(se.get(k), ".2g")]
-        for model in ("paper", "nonholonomic"):
+        for model in COEFFICIENT_MODELS:
             r = ident["relative_difference"][model][k]
             row += [_fmt(ident["predicted"][model][k], ".4g"), "n/a" if r is None else f"{100 * r:+.1f}%"]
         row.append(UNITS[k])
@@ -635,8 +636,7 @@ def render_html(summary: Mapping[str, Any]) -> str:
 
 
 SUMMARY_CSV_COLUMNS = ("rung", "name", "design", "certificate_valid", "certificate_E_max", "certificate_Edot_max",
-                       "certificate_voltage_max", "unmet", "n", "certified-inside", "certified-outside",
-                       "uncertified-inside", "uncertified-outside", "paper_inside", "worst_sup_E",
+                       "certificate_voltage_max", "unmet", "n", *VERDICTS, "paper_inside", "worst_sup_E",
                        "worst_certificate_ratio", "worst_paper_ratio", "hit_stop", "growing", "runs_csv")
 
 
@@ -649,8 +649,7 @@ def summary_csv(summary: Mapping[str, Any]) -> str:
         c = r["certificate"]
         row = [r["index"], r["name"], r["design"], c["certified"], c.get("E_max"), c.get("Edot_max"),
                c.get("voltage_max"), " ".join(x.replace(" ", "_") for x in c["unmet"]), r["n"],
-               *(r["verdicts"][v] for v in ("certified-inside", "certified-outside", "uncertified-inside",
-                                            "uncertified-outside")),
+               *(r["verdicts"][v] for v in VERDICTS),
                r["paper_inside"], r["worst_sup_E"], r["worst_certificate_ratio"], r["worst_paper_ratio"],
                r["hit_stop"], r["growing"], r["runs_csv"]]
         w.writerow(["" if x is None else (repr(x) if isinstance(x, float) else x) for x in row])

@@ -45,7 +45,6 @@ from wmr_mj.report.settings import (
     DEFAULT_DURATION,
     DEFAULT_N,
     DEFAULT_SEARCH_BUDGET,
-    FRICTION_LAWS,
     FULL_BOX_FACTOR,
     LADDER_GROUPS,
     ValidateSettings,
@@ -62,7 +61,6 @@ __all__ = [
     "DEFAULT_DURATION",
     "DEFAULT_SEARCH_BUDGET",
     "FULL_BOX_FACTOR",
-    "FRICTION_LAWS",
     "LADDER_GROUPS",
     "ValidateSettings",
     "ladder_changes",
@@ -142,13 +140,14 @@ def identify_stage(settings: ValidateSettings, folder: Path, st: Stages) -> dict
 
 
 def friction_stage(settings: ValidateSettings, st: Stages) -> dict[str, dict[str, Any]]:
-    """The steering joint's measured friction law for each of :data:`FRICTION_LAWS`."""
+    """The steering joint's measured friction law for each of :data:`STEERING_FRICTION_MODELS`."""
     from wmr_mj.params import with_params
     from wmr_mj.plant.friction import measure_friction_law
+    from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS
 
     st.start("friction", "the steering joint's friction law (stiction, soft): constant voltages")
     plant = with_params(C80, m1=settings.nominal_m1)
-    laws = {name: measure_friction_law(plant, steering_friction=name).as_dict() for name in FRICTION_LAWS}
+    laws = {name: measure_friction_law(plant, steering_friction=name).as_dict() for name in STEERING_FRICTION_MODELS}
     st.done(", ".join(f"{name}: break-away {law['breakaway_voltage']:.3g} V, "
                       f"{'holds' if law['holds'] else 'creeps'} below it" for name, law in laws.items()))
     return laws

@@ -18,6 +18,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from controllers import ComputedTorque
+from wmr_mj._util.checks import finite_number, interval
 from wmr_mj.analysis.certificate import (
     GYRO_BAND,
     GYRO_MEASURED_RATIOS,
@@ -31,8 +32,6 @@ from wmr_mj.analysis.certificate import (
     PlantBox,
     PlantLimits,
     _hull,
-    _interval,
-    _number,
     certify,
     derived_box,
     friction_over_P_max,
@@ -40,7 +39,7 @@ from wmr_mj.analysis.certificate import (
 )
 from wmr_mj.analysis.robustness import ParameterBox
 from wmr_mj.errors import ParameterError
-from wmr_mj.params import C80, C80Parameters
+from wmr_mj.params import C80, COEFFICIENT_NAMES, C80Parameters
 from wmr_mj.plant.mjcf import TIMESTEP
 from wmr_mj.sim.config import controller_for, estimate_parameters, plant_parameters
 
@@ -63,7 +62,7 @@ def identified_spread(identified: Any) -> dict[str, tuple[float, float]]:
     values = data.get("identified", data)
     se = (data.get("diagnostics") or {}).get("std_error") or {}
     out = {}
-    for name in ("P", "C_V", "F", "K", "gyro"):
+    for name in COEFFICIENT_NAMES:
         if name in values:
             x, s = float(values[name]), 2.0 * abs(float(se.get(name, 0.0)))
             out[name] = (x - s, x + s)
@@ -85,8 +84,8 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
     ``controller_for`` on ``estimate_parameters(params)``). params: the base parameter set.
     """
     base = params
-    k_band = _number("k_band", k_band, minimum=0.0)
-    gyro_band = _interval("gyro_band", gyro_band, positive=True)
+    k_band = finite_number("k_band", k_band, minimum=0.0)
+    gyro_band = interval("gyro_band", gyro_band, positive=True)
     estimate_params = estimate_parameters(base)
     controller = controller_for(config, estimate_params)
     model = controller.model

@@ -220,9 +220,11 @@ def controller_for(config: RunConfig, params: C80Parameters) -> SteeringControll
 
 def estimate_of(controller: SteeringController) -> dict[str, float]:
     """The coefficients the controller's model-based part uses (K^ etc.); a PD has none but P^."""
+    from wmr_mj.analysis.robustness import BOX_COEFFICIENTS
+
     c = controller.model.coefficients.as_dict()
     if controller.name == "pd":
         return {"P": c["P"], "C_V": 0.0, "F": 0.0, "K": 0.0}
     if getattr(controller, "friction_sign", None) == "none":
         c["F"] = 0.0
-    return {k: c[k] for k in ("P", "C_V", "F", "K")}
+    return {k: c[k] for k in BOX_COEFFICIENTS}

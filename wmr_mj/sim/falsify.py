@@ -231,7 +231,7 @@ class FalsifySpec:
     population: int | None = None
 
     def __post_init__(self) -> None:
-        from wmr_mj.sim.sweep import _check_range
+        from wmr_mj._util.checks import positive_range as _check_range
 
         if self.objective not in OBJECTIVES:
             raise UnknownNameError("objective", self.objective, OBJECTIVES)

@@ -37,6 +37,7 @@ from typing import Any
 
 import numpy as np
 
+from wmr_mj._util.checks import positive_range
 from wmr_mj.errors import ParameterError, SchedulerError, UnknownNameError
 from wmr_mj.params import M1_RANGE, parameter_names
 from wmr_mj.sim.batch import run_batch
@@ -82,17 +83,6 @@ def flat_row(summary: Mapping[str, Any]) -> dict[str, Any]:
     return out
 
 
-def _check_range(name: str, lo: float, hi: float) -> tuple[float, float]:
-    lo, hi = float(lo), float(hi)
-    if not (math.isfinite(lo) and math.isfinite(hi)):
-        raise ParameterError(f"range of {name} = ({lo}, {hi}) must be finite")
-    if lo >= hi:
-        raise ParameterError(f"range of {name} = ({lo}, {hi}) is empty or inverted; give LO < HI")
-    if lo <= 0:
-        raise ParameterError(f"range of {name} = ({lo}, {hi}) must be > 0 (every C80 parameter is positive)")
-    return lo, hi
-
-
 @dataclass(frozen=True, kw_only=True)
 class SweepSpec:
     """n runs of ``base`` with the plant's m1 (and ``ranges``) drawn by ``sampling``."""
@@ -109,12 +99,12 @@ class SweepSpec:
             raise ParameterError(f"n = {self.n!r} is not accepted; the number of runs must be an integer >= 1")
         if self.sampling not in SAMPLINGS:
             raise UnknownNameError("sampling", self.sampling, SAMPLINGS)
-        _check_range("m1", *self.m1_range)
+        positive_range("m1", *self.m1_range)
         names = set(parameter_names()) - {"m1"}
         for name, (lo, hi) in self.ranges.items():
             if name not in names:
                 raise UnknownNameError("parameter", name, names)
-            _check_range(name, lo, hi)
+            positive_range(name, lo, hi)
         if self.sampling == "grid":
             d = 1 + len(self.ranges)
             k = round(self.n ** (1.0 / d))
