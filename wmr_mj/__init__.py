@@ -1,9 +1,29 @@
-"""wmr-mj: a MuJoCo validation testbed for computed-torque steering control of the C80 cart."""
+"""wmr-mj: a MuJoCo validation testbed for computed-torque steering control of the C80 cart.
+
+The top level is the library's public API, enough for a notebook::
+
+    import wmr_mj as wm
+
+    result = wm.run_closed_loop(wm.RunConfig(**wm.CERTIFIED.config_changes(), m1=700.0))
+    result.summary["verdict"]
+
+The parameter set and the errors are imported at once; everything else (the simulation, sweeps,
+the search, logs, the certificate) on first use (PEP 562), because ``controllers`` imports
+``wmr_mj.params`` and an eager import of ``wmr_mj.sim`` from here would be circular.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
 
 from wmr_mj.errors import (
     InfeasiblePathError,
     LogError,
     ModelFileError,
+    NoRenderBackendError,
+    NotEnoughMemoryError,
+    OutputPathError,
     ParameterError,
     SchedulerError,
     UnknownNameError,
@@ -13,12 +33,62 @@ from wmr_mj.params import C80, C80Parameters, Coefficients, parameter_names, wit
 
 from ._version import __version__ as __version__
 
+if TYPE_CHECKING:
+    from wmr_mj.logs.reader import load_log
+    from wmr_mj.logs.writer import RunLogger
+    from wmr_mj.sim.certify import certificate_for
+    from wmr_mj.sim.closed_loop import RunResult, run_closed_loop
+    from wmr_mj.sim.config import RunConfig, controller_for
+    from wmr_mj.sim.designs import CERTIFIED, PAPER, PRESETS, preset
+    from wmr_mj.sim.falsify import FalsifySpec, falsify
+    from wmr_mj.sim.sweep import SweepSpec, run_sweep
+
+#: name -> the module that defines it, imported on first access
+_LAZY: dict[str, str] = {
+    "RunConfig": "wmr_mj.sim.config",
+    "controller_for": "wmr_mj.sim.config",
+    "run_closed_loop": "wmr_mj.sim.closed_loop",
+    "RunResult": "wmr_mj.sim.closed_loop",
+    "certificate_for": "wmr_mj.sim.certify",
+    "SweepSpec": "wmr_mj.sim.sweep",
+    "run_sweep": "wmr_mj.sim.sweep",
+    "FalsifySpec": "wmr_mj.sim.falsify",
+    "falsify": "wmr_mj.sim.falsify",
+    "PAPER": "wmr_mj.sim.designs",
+    "CERTIFIED": "wmr_mj.sim.designs",
+    "PRESETS": "wmr_mj.sim.designs",
+    "preset": "wmr_mj.sim.designs",
+    "load_log": "wmr_mj.logs.reader",
+    "RunLogger": "wmr_mj.logs.writer",
+}
+
 __all__ = [
+    # parameters
     "C80",
     "C80Parameters",
     "Coefficients",
     "parameter_names",
     "with_params",
+    # one run, its controller and its certificate
+    "RunConfig",
+    "run_closed_loop",
+    "RunResult",
+    "controller_for",
+    "certificate_for",
+    # the design presets
+    "PAPER",
+    "CERTIFIED",
+    "PRESETS",
+    "preset",
+    # many runs and the search for the worst
+    "SweepSpec",
+    "run_sweep",
+    "FalsifySpec",
+    "falsify",
+    # logs
+    "RunLogger",
+    "load_log",
+    # errors
     "WmrMjError",
     "ParameterError",
     "UnknownNameError",
@@ -26,4 +96,20 @@ __all__ = [
     "InfeasiblePathError",
     "LogError",
     "SchedulerError",
+    "OutputPathError",
+    "NotEnoughMemoryError",
+    "NoRenderBackendError",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'wmr_mj' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value  # the next access skips this function
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

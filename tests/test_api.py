@@ -1,0 +1,47 @@
+"""The top level is the public API a notebook uses: every name in ``wmr_mj.__all__`` imports from it."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import pytest
+
+import wmr_mj
+
+
+@pytest.mark.parametrize("name", wmr_mj.__all__)
+def test_every_public_name_imports_from_the_top_level(name):
+    namespace: dict[str, object] = {}
+    exec(f"from wmr_mj import {name}", namespace)  # the statement a notebook writes
+    assert namespace[name] is getattr(wmr_mj, name)
+    assert name in dir(wmr_mj)
+
+
+def test_the_lazy_names_are_the_defining_modules_own():
+    from wmr_mj.sim.closed_loop import run_closed_loop
+    from wmr_mj.sim.designs import CERTIFIED
+
+    assert wmr_mj.run_closed_loop is run_closed_loop and wmr_mj.CERTIFIED is CERTIFIED
+
+
+def test_an_unknown_name_is_an_attribute_error():
+    with pytest.raises(AttributeError, match="no attribute 'nope'"):
+        wmr_mj.nope  # noqa: B018
+    with pytest.raises(ImportError):
+        exec("from wmr_mj import nope", {})
+
+
+@pytest.mark.parametrize("first", ["import controllers", "import wmr_mj.params", "pass"])
+def test_controllers_first_then_wmr_mj_in_a_fresh_interpreter(first):
+    code = f"{first}\nimport wmr_mj\nprint(wmr_mj.RunConfig.__name__, wmr_mj.controller_for.__module__)"
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.split() == ["RunConfig", "wmr_mj.sim.config"]
+
+
+def test_importing_wmr_mj_loads_no_simulation():
+    code = "import sys, wmr_mj; print(sorted(m for m in sys.modules if m.startswith(('wmr_mj.sim', 'wmr_mj.logs'))))"
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip() == "[]"
