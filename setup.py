@@ -16,11 +16,11 @@ from pathlib import Path
 from setuptools import Extension, setup
 from setuptools.command.build_py import build_py
 
-MODEL_FILES = ("c80.xml", "scene.xml", "README.md")
+MODEL_FILES = ("c80.xml", "scene.xml", "README.md", "c80.png", "CHANGELOG.md")
 
 
 class BuildPyWithModels(build_py):
-    """build_py that also copies models/{c80.xml,scene.xml,README.md} to wmr_mj/models/."""
+    """build_py that also copies the model folder (MODEL_FILES of models/) to wmr_mj/models/."""
 
     def run(self) -> None:
         super().run()

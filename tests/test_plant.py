@@ -303,3 +303,27 @@ def test_scene_xml_is_to_xml_without_the_sky_pixels(options):
 
     params = with_params(C80, m1=612.5)
     assert mjcf.scene_xml(params, **options) == mjcf.scene_spec(params, **options).to_xml()
+
+
+def test_the_model_folder_has_its_picture_changelog_and_one_compiler():
+    png = (MODELS_DIR / "c80.png").read_bytes()
+    assert png.startswith(b"\x89PNG\r\n\x1a\n") and 10_000 < len(png) < 300_000
+    assert 'src="c80.png"' in (MODELS_DIR / "README.md").read_text()
+    assert (MODELS_DIR / "CHANGELOG.md").read_text().startswith("# Changelog")
+    scene = (MODELS_DIR / "scene.xml").read_text()
+    assert "<compiler" not in scene and "<compiler" in (MODELS_DIR / "c80.xml").read_text()
+    assert "physics, not rendering" in scene
+
+
+@pytest.mark.slow
+def test_model_image_renders_the_home_keyframe_or_says_why(tmp_path):
+    from wmr_mj.errors import NoRenderBackendError
+    from wmr_mj.plant.image import IMAGE_SIZE, write_model_image
+
+    try:
+        path = write_model_image(tmp_path)
+    except NoRenderBackendError as exc:
+        pytest.skip(f"no offscreen OpenGL here: {exc}")
+    png = path.read_bytes()
+    assert png.startswith(b"\x89PNG") and int.from_bytes(png[16:20], "big") == IMAGE_SIZE[0]
+    assert len(png) < 300_000

@@ -43,7 +43,7 @@ def _IGNORE(folder: str, names: list[str]) -> set[str]:
     return ignored
 # files of the source that are package data (everything else in a package folder is a module or a cache)
 _DATA_GLOBS = ("wmr_mj/schemas/*", "wmr_mj/data/*", "wmr_mj/data/routes/*", "wmr_mj/py.typed", "controllers/py.typed")
-_MODEL_FILES = ("c80.xml", "scene.xml", "README.md")
+_MODEL_FILES = ("c80.xml", "scene.xml", "README.md", "c80.png", "CHANGELOG.md")
 
 
 def _run(cmd: list[str], *, cwd: Path, env: dict[str, str] | None = None, timeout: float = 120) -> str:

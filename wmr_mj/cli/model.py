@@ -1,4 +1,5 @@
-"""``wmr-mj model``: write or check models/c80.xml and models/scene.xml, or print a parameter table."""
+"""``wmr-mj model``: write or check models/c80.xml and models/scene.xml, render models/c80.png, write the model
+card, or print a parameter table."""
 
 from __future__ import annotations
 
@@ -7,12 +8,13 @@ import argparse
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("model", help="write/check the MJCF files generated from the C80 parameter set")
-    p.add_argument("action", choices=("write", "check", "params", "slip", "friction", "card"),
+    p.add_argument("action", choices=("write", "check", "params", "slip", "friction", "card", "image"),
                    help="write: regenerate models/*.xml; check: exit 1 if they differ from the parameter set; "
                         "params: print the parameter set with sources and the derived coefficients; "
                         "slip: measure the wheels' side slip on the 1 m circle; friction: measure the steering "
                         "joint's friction law (break-away, creep, sliding) for each friction model; "
-                        "card: write models/README.md")
+                        "card: write models/README.md; image: render models/c80.png (the scene at its home "
+                        "keyframe, offscreen: EGL or OSMesa)")
     p.add_argument("--param", action="append", metavar="NAME=VALUE", help="override a parameter (repeatable)")
     p.add_argument("--json", action="store_true", help="with 'params', 'slip' or 'friction': print one JSON object")
     p.set_defaults(func=run)
@@ -44,6 +46,15 @@ def run(args: argparse.Namespace) -> int:
 
         path = write_text_atomic(MODELS_DIR / "README.md", render_model_card(params))
         print(f"wrote {path}")
+        return 0
+    if args.action == "image":
+        from wmr_mj.plant.image import write_model_image
+
+        if args.param:
+            from wmr_mj.errors import ParameterError
+
+            raise ParameterError("model image renders the C80 parameter set of models/; it takes no --param")
+        print(f"wrote {write_model_image(MODELS_DIR)}")
         return 0
     if args.action == "friction":
         from wmr_mj.plant.friction import measure_friction_law

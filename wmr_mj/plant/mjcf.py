@@ -327,11 +327,20 @@ def robot_xml(params: C80Parameters = C80, *, steering_friction: str = "stiction
     return robot_spec(params, steering_friction=steering_friction, tyre_contact=tyre_contact).to_xml()
 
 
+#: The comment scene.xml carries above its floor.
+FLOOR_COMMENT = ("<!-- The floor's contact settings (friction = ground_friction, solref) are physics, not "
+                 "rendering: every wheel contact uses them (MuJoCo takes the larger friction of the two geoms "
+                 "and averages their solref). -->")
+
+
 def scene_file_xml(params: C80Parameters = C80) -> str:
     """``models/scene.xml``: includes c80.xml, adds floor and light.
 
     MjSpec has no include element, so the world-only spec's text gets the one
-    ``<include>`` line after its opening tag and comment.
+    ``<include>`` line after its opening tag and comment. MjSpec always writes a
+    ``<compiler>`` element; c80.xml has the one the model needs (angles in radians,
+    and the scene has none), so the scene's is left out, and the floor gets
+    :data:`FLOOR_COMMENT`.
     """
     spec = mujoco.MjSpec()
     spec.modelname = "c80 scene"
@@ -339,7 +348,12 @@ def scene_file_xml(params: C80Parameters = C80) -> str:
     spec.compiler.degree = False
     _add_world(spec, params)
     head, sep, tail = spec.to_xml().partition("-->\n")
-    return head + sep + '  <include file="c80.xml"/>\n' + tail
+    compiler = '  <compiler angle="radian"/>\n\n'
+    floor = '    <geom name="floor"'
+    if not tail.startswith(compiler) or tail.count(floor) != 1:
+        raise ModelFileError("MjSpec.to_xml wrote the scene in an unexpected form; update scene_file_xml")
+    tail = tail[len(compiler):].replace(floor, f"    {FLOOR_COMMENT}\n{floor}")
+    return head + sep + '  <include file="c80.xml"/>\n\n' + tail
 
 
 def scene_xml(params: C80Parameters = C80, *, steering_friction: str = "stiction", tyre_contact: str = "stiff") -> str:
