@@ -90,6 +90,7 @@ def test_objective_is_read_from_the_summary():
         objective_value(s, "sup-F")
 
 
+@pytest.mark.slow
 def test_the_reported_worst_run_reproduces_exactly():
     base = RunConfig(model="nonholonomic", path="lane-change", duration=3.0)
     spec = FalsifySpec(base=base, box={"m1": (550.0, 750.0), "mu": (0.01, 0.03)}, objective="sup-E", budget=10,
@@ -141,9 +142,9 @@ def test_cli_falsify_json_files_and_replayable_log(tmp_path):
     assert all((tmp_path / f"history.{ext}").stat().st_size > 1000 for ext in ("png", "svg"))
 
 
-@pytest.mark.parametrize("argv", [["--uncertainty", "nope"], ["--budget", "3"],
-                                  pytest.param(["--against", "moon"], marks=pytest.mark.slow),
-                                  pytest.param(["--range", "nope=1:2"], marks=pytest.mark.slow)])
+@pytest.mark.slow
+@pytest.mark.parametrize("argv", [["--uncertainty", "nope"], ["--budget", "3"], ["--against", "moon"],
+                                  ["--range", "nope=1:2"]])
 def test_cli_falsify_bad_input_exits_2(argv, tmp_path):
     proc = subprocess.run([sys.executable, "-m", "wmr_mj.cli", "falsify", "--duration", "3", "--path", "lane-change",
                            "--out", str(tmp_path), *argv], capture_output=True, text=True, timeout=120)

@@ -91,6 +91,7 @@ def test_unknown_friction_model_is_an_unknown_name(call):
         call()
 
 
+@pytest.mark.slow
 def test_run_config_validates_and_passes_the_friction_model():
     from wmr_mj.sim.closed_loop import run_closed_loop
     from wmr_mj.sim.config import RunConfig
@@ -118,6 +119,7 @@ def test_cli_friction_json(capsys):
     assert obj["stiction"]["creep_rates"]["0.9"] <= HOLD_RATE
 
 
+@pytest.mark.slow
 def test_cli_run_unknown_friction_model_is_one_line():
     proc = subprocess.run([sys.executable, "-m", "wmr_mj.cli", "run", "--duration", "1", "--no-log",
                            "--steering-friction", "viscous"], capture_output=True, text=True)

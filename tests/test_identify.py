@@ -93,6 +93,7 @@ def test_cli_json_keys_and_three_way_comparison():
     assert "paper" in text and "nonholon" in text and "identified" in text
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("argv", [["--m1", "-1"], ["--m1", "nan"], ["--duration", "0"], ["--param", "nope=1"]])
 def test_cli_bad_input_exits_2(argv):
     proc = subprocess.run([sys.executable, "-m", "wmr_mj.cli", "identify", *argv], capture_output=True, text=True)

@@ -138,6 +138,7 @@ def test_bad_input(straight):
         path_errors(object(), [0.0], [[0.0, 0.0]], [0.0])
 
 
+@pytest.mark.slow
 def test_replay_reports_the_path_of_c(tmp_path, capsys):
     """A real logged run (certified design, lane change, 6 s): `replay` prints C's path errors,
     --json carries them, --plot draws the path panels; they equal the errors computed directly."""

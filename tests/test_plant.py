@@ -251,6 +251,7 @@ def test_bad_parameters_raise(changes, error):
         with_params(C80, **changes)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("argv,needle", [
     (["model", "params", "--param", "m1=-5"], "m1"),
     (["model", "params", "--param", "m1=inf"], "m1"),

@@ -68,6 +68,7 @@ def test_verify_tampered_log_fails(logs, capsys):
     assert code == 1 and "MISMATCH: largest deviation" in out and "t = 0.6" in out
 
 
+@pytest.mark.slow
 def test_plot(logs, capsys):
     png = logs["dir"] / "fig" / "honest.png"
     code, out, _ = _run(capsys, logs["honest"], "--plot", png)
@@ -124,6 +125,7 @@ def test_bad_input_exit_2_one_line(logs, capsys, monkeypatch, case):
     assert "Traceback" not in err
 
 
+@pytest.mark.slow
 def test_bad_input_subprocess_no_traceback(logs):
     bad = logs["dir"] / "junk.mcap"
     bad.write_bytes(np.random.default_rng(0).bytes(4096))

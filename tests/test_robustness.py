@@ -389,6 +389,7 @@ def test_cli_bad_gain_is_argparse_error(capsys, argv):
     assert "Traceback" not in err and "is not accepted" in err
 
 
+@pytest.mark.slow
 def test_cli_exit_codes_subprocess():
     exe = REPO / ".venv" / "bin" / "wmr-mj"
     if not exe.exists():

@@ -121,6 +121,7 @@ def test_cli_run_json():
     assert proc.stderr == ""  # no progress bar when not on a terminal
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("argv", [["--kp", "0"], ["--kd", "-2"], ["--model", "oracle"], ["--controller", "mpc"],
                                   ["--m1", "-650"], ["--m1", "inf"], ["--m1-range", "700", "600"],
                                   ["--omega-r", "3", "--kp", "2"], ["--param", "l9=1"], ["--box", "huge"]])

@@ -140,11 +140,11 @@ def test_uncertainty_box_and_ranges_from_the_command_line():
     assert got == {**{k: v for k, v in full.items() if k != "m1"}, "mu": (0.015, 0.02), "l4": (0.2, 0.3)}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("argv", [["--n", "0"], ["--m1-range", "750", "550"], ["--range", "nope=1:2"],
                                   ["--uncertainty", "nope"],
                                   ["--range", "mu=0.03:0.01"], ["--sampling", "sobol"],
-                                  pytest.param(["--scheduler", "tcp://127.0.0.1:9"], marks=pytest.mark.slow),
-                                  ["--range", "mu=abc"]])
+                                  ["--scheduler", "tcp://127.0.0.1:9"], ["--range", "mu=abc"]])
 def test_cli_sweep_bad_input_exits_2(argv, tmp_path):
     proc = subprocess.run([sys.executable, "-m", "wmr_mj.cli", "sweep", "--duration", "10", "--out", str(tmp_path),
                            *argv],

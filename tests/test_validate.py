@@ -222,6 +222,7 @@ def test_certified_outside_is_announced_loudly_before_the_answer(validated):
     assert md.index("CERTIFIED-OUTSIDE") < md.index("## (a)")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("args", [("--n", "0"), ("--duration", "0"), ("--duration", "-3"), ("--sampling", "sobol"),
                                   ("--identify-duration", "nan"), ("--nthread", "-1"), ("--search-budget", "3"),
                                   ("--search-budget", "-1"), ("--seed", "-1")])
@@ -233,6 +234,7 @@ def test_bad_input_exits_2_with_one_line(args, tmp_path):
     assert not (tmp_path / "x").exists()
 
 
+@pytest.mark.slow
 def test_uncertainty_box_reaches_the_ladder_and_the_certificates():
     from wmr_mj.errors import UnknownNameError as _Unknown
     from wmr_mj.params import uncertainty_ranges

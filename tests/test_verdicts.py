@@ -27,6 +27,7 @@ def test_only_certified_inside_passes_and_counts_cover_all_four():
                       "uncertified-outside": 0}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("friction, growing", [("soft", True), ("stiction", False)])
 def test_soft_friction_creep_shows_as_drift(friction, growing):
     """The known finding: with MuJoCo's soft frictionloss the exact-sign compensation keeps the joint
