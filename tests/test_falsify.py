@@ -151,3 +151,22 @@ def test_cli_falsify_bad_input_exits_2(argv, tmp_path):
     assert proc.returncode == 2, proc.stderr
     assert len(proc.stderr.strip().splitlines()) == 1, proc.stderr
     assert "Traceback" not in proc.stderr
+
+
+def test_cli_falsify_refuses_a_too_short_duration_before_searching(tmp_path):
+    # the paper circle's lead-in and entry take longer than 8 s: once a scipy traceback from inside the search
+    proc = subprocess.run([sys.executable, "-m", "wmr_mj.cli", "falsify", "--preset", "certified", "--budget", "16",
+                           "--duration", "8", "--out", str(tmp_path / "f")], capture_output=True, text=True,
+                          timeout=120)
+    assert proc.returncode == 2, proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1 and "Traceback" not in proc.stderr, proc.stderr
+    assert "duration = 8" in proc.stderr and proc.stderr.startswith("wmr-mj: error: ")
+    assert not (tmp_path / "f" / "evaluations.csv").exists()
+
+
+def test_search_gives_back_a_user_error_raised_by_the_objective():
+    def refuse(points):
+        raise ParameterError("duration = 1 s is not accepted")
+
+    with pytest.raises(ParameterError, match="duration = 1 s"):
+        search_worst(refuse, BOX, budget=16, seed=0)

@@ -122,6 +122,27 @@ def test_cli_run_json():
 
 
 @pytest.mark.slow
+@pytest.mark.parametrize("argv,names", [
+    (["--control-period", "50"], ("control_period = 50", "longer than the run", "duration = 10")),
+    (["--control-period", "0.003"], ("control_period = 0.003", "whole multiple", "--duration 9.999")),
+    (["--duration", "10.0005"], ("physics step", "whole multiple", "--duration 10"))])
+def test_cli_run_refuses_a_period_that_does_not_fit_the_run(argv, names):
+    # --control-period 50 on a 10 s run once ran one control step (sup|E| = 0, judged inside)
+    proc = subprocess.run([sys.executable, "-m", "wmr_mj.cli", "run", "--no-log", "--duration", "10", *argv],
+                          capture_output=True, text=True)
+    assert proc.returncode == 2, proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1 and "Traceback" not in proc.stderr, proc.stderr
+    assert proc.stderr.startswith("wmr-mj: error: ") and all(n in proc.stderr for n in names), proc.stderr
+    assert proc.stdout == ""
+
+
+def test_config_refuses_a_period_longer_than_the_run():
+    with pytest.raises(ParameterError, match="longer than the run"):
+        RunConfig(duration=35.0, control_period=50.0)
+    assert RunConfig(duration=35.0, control_period=0.005).control_period == 0.005  # 7000 periods: fits
+
+
+@pytest.mark.slow
 @pytest.mark.parametrize("argv", [["--kp", "0"], ["--kd", "-2"], ["--model", "oracle"], ["--controller", "mpc"],
                                   ["--m1", "-650"], ["--m1", "inf"], ["--m1-range", "700", "600"],
                                   ["--omega-r", "3", "--kp", "2"], ["--param", "l9=1"], ["--box", "huge"]])

@@ -25,7 +25,7 @@ from controllers.computed_torque import CONTROLLER_NAMES, FRICTION_SIGNS, MODEL_
 from wmr_mj._util.checks import as_pair
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import C80, M1_NOMINAL, M1_RANGE, PAPER_KD, PAPER_KP, C80Parameters, parameter_names, with_params
-from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS, TYRE_CONTACT_MODELS
+from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS, TIMESTEP, TYRE_CONTACT_MODELS
 
 __all__ = [
     "PATH_NAMES",
@@ -89,6 +89,7 @@ class RunConfig:
                 raise ParameterError(f"{name} = {value!r} is not accepted; a finite number > 0 is required")
         if self.control_period is not None and (not math.isfinite(self.control_period) or self.control_period <= 0):
             raise ParameterError(f"control_period = {self.control_period!r} s must be finite and > 0")
+        _check_period_fits(self.control_period, self.duration)
         lo, hi = self.m1_range
         if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo < hi):
             raise ParameterError(f"m1_range = {self.m1_range!r} must be (lo, hi) with 0 < lo < hi")
@@ -128,6 +129,27 @@ def _check_path(config: RunConfig) -> None:
         if not is_route_spec(p):
             raise UnknownNameError("path", p, PATH_NAMES + route_names() + ("<route file .toml/.json>",))
         load_route(p)  # malformed: ParameterError naming the file and the segment
+
+
+def _check_period_fits(control_period: float | None, duration: float) -> None:
+    """A control period the run holds a whole number of times (at least once), else ParameterError.
+
+    A longer period would run one control step for the whole duration (sup|E| = 0: judged
+    inside), and one that does not divide it would silently change the run's length.
+    control_period None: the physics step.
+    """
+    period = TIMESTEP if control_period is None else control_period
+    what = (f"control_period = {period:g} s" if control_period is not None
+            else f"the physics step ({period:g} s, the default control period)")
+    if period > duration:
+        raise ParameterError(f"{what} is longer than the run (duration = {duration:g} s); give --control-period "
+                             f"<= --duration and a whole fraction of it (e.g. 0.001-0.1 s)")
+    n = round(duration / period)
+    if abs(n * period - duration) > 1e-9 * max(1.0, duration):
+        fix = f"give --duration {n * period:g}" + (" or a --control-period that divides it"
+                                                   if control_period is not None else "")
+        raise ParameterError(f"the run's duration = {duration:g} s is not a whole multiple of {what} "
+                             f"({duration / period:.6g} periods); {fix}")
 
 
 def plant_parameters(config: RunConfig, base: C80Parameters = C80) -> C80Parameters:

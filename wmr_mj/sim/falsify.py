@@ -35,6 +35,7 @@ NAME=VALUE ...`` give the same sup|E|; the same seed gives the same search.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import warnings
 from collections.abc import Callable, Mapping, Sequence
@@ -43,7 +44,7 @@ from typing import Any
 
 import numpy as np
 
-from wmr_mj.errors import ParameterError, UnknownNameError
+from wmr_mj.errors import ParameterError, UnknownNameError, WmrMjError
 from wmr_mj.params import parameter_names
 from wmr_mj.sim.config import RunConfig
 
@@ -60,6 +61,7 @@ __all__ = [
     "search_worst",
     "random_worst",
     "falsify",
+    "check_runnable",
     "worst_config",
 ]
 
@@ -163,6 +165,19 @@ def _streams(seed: int) -> list[np.random.Generator]:
     return [np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(3)]
 
 
+@contextlib.contextmanager
+def _user_errors_unwrapped():
+    """scipy wraps what the objective raises in a RuntimeError; give back a WmrMjError (bad input,
+    one line at the CLI) as itself."""
+    try:
+        yield
+    except RuntimeError as exc:
+        cause = exc.__cause__ or exc.__context__
+        if isinstance(cause, WmrMjError):
+            raise cause from None
+        raise
+
+
 def search_worst(evaluate: Callable[[np.ndarray], np.ndarray], bounds: np.ndarray, *, budget: int, seed: int = 0,
                  population: int | None = None) -> Trace:
     """Maximise ``evaluate`` over the box ``bounds`` (d, 2) with differential evolution.
@@ -197,7 +212,7 @@ def search_worst(evaluate: Callable[[np.ndarray], np.ndarray], bounds: np.ndarra
         generation.append(np.full(len(batch), len(generation)))
         return np.where(np.isnan(v), np.inf, -v)
 
-    with warnings.catch_warnings():
+    with warnings.catch_warnings(), _user_errors_unwrapped():
         warnings.simplefilter("ignore", RuntimeWarning)  # inf energies of undefined points
         differential_evolution(energies, bounds, maxiter=budget // population - 1, init=init, polish=False,
                                tol=0.0, atol=0.0, updating="deferred", vectorized=True, rng=evolve_rng)
@@ -395,6 +410,7 @@ def falsify(spec: FalsifySpec, *, chunk: int = 128, nthread: int = 0, scheduler:
         generations += 1
         return generations - 1
 
+    check_runnable(spec.base)  # a bad duration or path fails here, in one line, not inside the optimiser
     try:
         search_worst(evaluator("search", next_generation), spec.bounds, budget=spec.budget, seed=spec.seed,
                      population=spec.population_size)
@@ -406,6 +422,18 @@ def falsify(spec: FalsifySpec, *, chunk: int = 128, nthread: int = 0, scheduler:
     first = evaluations["search"][0].summary
     return FalsifyResult(spec=spec, search=evaluations["search"], random=evaluations["random"],
                          objective_source=objective_source(first, spec.objective))
+
+
+def check_runnable(base: RunConfig) -> None:
+    """Raise what the first batch would raise for ``base`` (a duration too short for the path,
+    a control period that does not fit), before any search starts: the reference every
+    evaluation shares depends on the base configuration only (path, duration, period)."""
+    from wmr_mj.plant.mjcf import TIMESTEP
+    from wmr_mj.sim.config import build_reference, estimate_parameters
+
+    period = TIMESTEP if base.control_period is None else base.control_period
+    n = int(round(base.duration / period))
+    build_reference(base.path, estimate_parameters(), dt=period, duration=n * period)
 
 
 def worst_config(result: FalsifyResult) -> RunConfig:
