@@ -449,3 +449,55 @@ def test_friction_over_P_bounds_every_plant_of_the_full_box():
     assert a.F / a.P == pytest.approx(b.F / b.P, rel=1e-12)
     # a parameter F/P is not monotone in gives no bound
     assert friction_over_P_max(C80, (550.0, 750.0), "payload", (("l4", (0.2, 0.3)),)) is None
+
+
+# -- the box says where it ends: a plant outside the declared box is not covered ----------------
+
+CERTIFIED_CFG = dict(model="nonholonomic", kp=100.0, kd=20.0, friction_width=0.01)
+
+
+@pytest.mark.parametrize("changes,name,value,limit,widen", [
+    (dict(m1=800.0), "m1", 800.0, 750.0, "--m1-range 550 800"),
+    (dict(m1=500.0), "m1", 500.0, 550.0, "--m1-range 500 750"),
+    (dict(plant_overrides={"mu": 0.03}, box_ranges={"mu": (0.0129, 0.0215)}), "mu", 0.03, 0.0215,
+     "--range mu=0.0129:0.03"),
+    (dict(plant_overrides={"l3": 0.15}), "l3", 0.15, 0.142, "--range l3=0.142:0.15"),
+])
+def test_a_plant_outside_the_box_fails_an_assumption_and_leaves_the_box_alone(circle, changes, name, value, limit,
+                                                                            widen):
+    inside = certificate_for(RunConfig(**CERTIFIED_CFG, **{k: v for k, v in changes.items() if k == "box_ranges"}),
+                             circle)
+    outside = certificate_for(RunConfig(**CERTIFIED_CFG, **changes), circle)
+    assert inside.certified and not outside.certified
+    assert outside.E_max == inside.E_max and outside.inputs["box"] == inside.inputs["box"]  # no hull with the plant
+    (failed,) = [a for a in outside.assumptions if not a.met]
+    assert failed.name == f"plant inside the box: {name}"
+    assert failed.value == pytest.approx(value) and failed.limit == pytest.approx(limit)
+    assert widen in failed.note
+    assert judge(outside, 0.0, 0.0)["verdict"] == "uncertified-inside"
+
+
+def test_a_plant_inside_the_box_has_the_assumptions_it_had(circle):
+    c = certificate_for(RunConfig(**CERTIFIED_CFG, m1=750.0, plant_overrides={"mu": 0.0129},
+                                  box_ranges={"mu": (0.0129, 0.0215)}), circle)
+    assert c.certified and not any(a.name.startswith("plant inside the box") for a in c.assumptions)
+    assert len(c.assumptions) == 8
+
+
+def test_cli_run_outside_the_box_is_uncertified(tmp_path):
+    import subprocess
+    import sys
+
+    def run(*argv):
+        proc = subprocess.run([sys.executable, "-m", "wmr_mj.cli", "run", "--preset", "certified", "--no-log",
+                               "--duration", "10", *argv], capture_output=True, text=True, timeout=120)
+        assert proc.returncode == 0, proc.stderr
+        return proc.stdout
+
+    out = run("--m1", "800")
+    assert "UNCERTIFIED-" in out and "plant inside the box: m1 (800 vs 750)" in out and "--m1-range 550 800" in out
+    s = json.loads(run("--m1", "800", "--json"))
+    assert s["verdict"].startswith("uncertified-")
+    assert s["certificate"]["E_max"] == pytest.approx(0.046334, rel=1e-4)  # the declared box's, not hulled
+    assert json.loads(run("--m1", "800", "--m1-range", "550", "800", "--json"))["verdict"] == "certified-inside"
+    assert json.loads(run("--m1", "750", "--json"))["verdict"] == "certified-inside"

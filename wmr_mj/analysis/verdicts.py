@@ -34,6 +34,7 @@ from wmr_mj.analysis.certificate import VERDICTS, Certificate, CertificateJudgem
 __all__ = [
     "VERDICTS",
     "PASS",
+    "OUTSIDE_THE_BOX",
     "DRIFT_WINDOW_S",
     "DRIFT_TOLERANCE",
     "Drift",
@@ -48,6 +49,8 @@ __all__ = [
 ]
 
 PASS = "certified-inside"
+#: Name (prefix) of the assumption a plant outside the certificate's box fails (wmr_mj.sim.certify).
+OUTSIDE_THE_BOX = "plant inside the box"
 #: Length of each of the two windows that compare |E| at the end of a run, s.
 DRIFT_WINDOW_S = 5.0
 #: |E| grows when the last window's max exceeds the previous window's by more than this, rad.
@@ -213,6 +216,9 @@ def format_verdict(summary: Mapping[str, Any]) -> list[str]:
     if unmet:
         lines.append("certificate NOT valid; assumptions not met: " + "; ".join(
             f"{a['name']} ({_num(a.get('value'), '.4g')} vs {_num(a.get('limit'), '.4g')})" for a in unmet))
+    for a in unmet:
+        if str(a.get("name", "")).startswith(OUTSIDE_THE_BOX):
+            lines.append(f"plant outside the box: {a.get('equation', '')} fails; {a.get('note', '')}")
     lines.append(f"certificate:   |E| <= {_num(cert.get('E_max'))} rad, |E'| <= {_num(cert.get('Edot_max'))} rad/s"
                  f", (4.23) = {_num(cert.get('condition'), '.4f')}, run "
                  f"{'inside' if cert.get('inside') else 'OUTSIDE'}")

@@ -38,12 +38,13 @@ from wmr_mj.analysis.certificate import (
     replace_inputs,
 )
 from wmr_mj.analysis.robustness import ParameterBox
+from wmr_mj.analysis.verdicts import OUTSIDE_THE_BOX
 from wmr_mj.errors import ParameterError
 from wmr_mj.params import C80, COEFFICIENT_NAMES, C80Parameters
 from wmr_mj.plant.mjcf import TIMESTEP
 from wmr_mj.sim.config import controller_for, estimate_parameters, plant_parameters
 
-__all__ = ["certificate_for", "identified_spread"]
+__all__ = ["certificate_for", "identified_spread", "box_spans", "outside_the_box"]
 
 
 def identified_spread(identified: Any) -> dict[str, tuple[float, float]]:
@@ -69,6 +70,47 @@ def identified_spread(identified: Any) -> dict[str, tuple[float, float]]:
     return out
 
 
+def box_spans(config: Any, base: C80Parameters = C80) -> dict[str, tuple[float, float]]:
+    """The box the certificate covers, per plant parameter that the run sets or ranges: m1 over
+    config.m1_range, each of config.box_ranges over its range, every other parameter the run
+    overrides (--param) at the base value only (the box does not range it)."""
+    spans = {"m1": (float(config.m1_range[0]), float(config.m1_range[1]))}
+    spans.update({k: (float(v[0]), float(v[1])) for k, v in config.box_ranges.items()})
+    for name in config.plant_overrides:
+        if name not in spans:
+            value = float(getattr(base, name))
+            spans[name] = (value, value)
+    return spans
+
+
+def _widen_hint(name: str, value: float, lo: float, hi: float) -> str:
+    new_lo, new_hi = min(lo, value), max(hi, value)
+    if name == "m1":
+        return f"--m1-range {new_lo:g} {new_hi:g}"
+    return f"--range {name}={new_lo!r}:{new_hi!r}"
+
+
+def outside_the_box(config: Any, plant: C80Parameters, base: C80Parameters = C80) -> tuple[Assumption, ...]:
+    """A failed assumption 'plant inside the box' per parameter of the run's plant that lies
+    outside the box the certificate covers (:func:`box_spans`); () when the plant is inside.
+
+    The certificate is computed over the declared box only: a run outside it is not covered.
+    (Listed only when failed, so the assumptions of a run inside the box are unchanged.)
+    """
+    out = []
+    for name, (lo, hi) in box_spans(config, base).items():
+        value = float(getattr(plant, name))
+        if lo <= value <= hi:
+            continue
+        limit = hi if value > hi else lo
+        span = f"{lo:g}-{hi:g}" if lo != hi else f"fixed at {lo:g} (not ranged)"
+        out.append(Assumption(
+            f"{OUTSIDE_THE_BOX}: {name}", f"{name} = {value:g} within the box's {name} {span}", False,
+            value, limit, f"the certificate covers the declared box only; to cover this plant, widen the box: "
+                          f"{_widen_hint(name, value, lo, hi)}", kind="checked"))
+    return tuple(out)
+
+
 def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
                     k_band: float = PLANT_K_BAND, gyro_band: tuple[float, float] = GYRO_BAND) -> Certificate:
     """The certificate of a :class:`wmr_mj.sim.closed_loop.RunConfig` run on ``reference``.
@@ -76,8 +118,11 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
     Plant box: P, C_V, F by the rule of ``simulate.analysis_box``: derived from ``params``
     over config.m1_range and config.box_ranges (both reduced models share P, C_V, F), and
     for config.box = 'paper' hulled with the (5.1) intervals (whose F does not cover the
-    simulated m1 range); always hulled with the run's own plant point (m1, --param
-    overrides); for model 'identified' also with its +-2 sigma. The plant's K is not the
+    simulated m1 range); for model 'identified' hulled with its +-2 sigma. The run's own plant
+    is not hulled in: a plant outside the declared box (m1 outside config.m1_range, a ranged
+    parameter outside its range, a --param override of a parameter the box does not range)
+    fails the assumption 'plant inside the box' (:func:`outside_the_box`), so the run is
+    uncertified. The plant's K is not the
     paper's (2.7) prediction (the plant has none): |K| <= k_band (:data:`PLANT_K_BAND`,
     measured). gyro: gyro_band x P/l1 over the box (:data:`GYRO_BAND`, measured), V_A
     over the box's range. Estimate: the controller as ``simulate`` builds it (the same
@@ -90,19 +135,18 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
     controller = controller_for(config, estimate_params)
     model = controller.model
     plant = plant_parameters(config, base)
-    point = plant.coefficients("nonholonomic")
 
     ranges = {k: (float(v[0]), float(v[1])) for k, v in config.box_ranges.items()}
     derived = derived_box(estimate_params, tuple(float(v) for v in config.m1_range), config.m1_inertia,
                            tuple(sorted(ranges.items())))
     box = ParameterBox.paper() if config.box == "paper" else derived
-    P = _hull(_hull(box.P, *derived.P), point.P)
-    C_V = _hull(_hull(box.C_V, *derived.C_V), point.C_V)
-    F = _hull(_hull(box.F, *derived.F), point.F)
+    P = _hull(box.P, *derived.P)
+    C_V = _hull(box.C_V, *derived.C_V)
+    F = _hull(box.F, *derived.F)
     K = (-k_band, k_band)
-    l1_lo, l1_hi = _hull(ranges.get("l1", (base.l1, base.l1)), plant.l1)
+    l1_lo, l1_hi = ranges.get("l1", (base.l1, base.l1))
     gyro = (gyro_band[0] * P[0] / l1_hi, gyro_band[1] * P[1] / l1_lo)
-    V_A = _hull(ranges.get("V_A", (base.V_A, base.V_A)), plant.V_A)
+    V_A = ranges.get("V_A", (base.V_A, base.V_A))
     notes = []
     if config.model == "identified":
         spread = identified_spread(config.identified)
@@ -113,11 +157,10 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
         gyro = _hull(gyro, *spread.get("gyro", gyro))
         notes.append("identified +-2 sigma hulled in")
     plant_box = ParameterBox(P=P, C_V=C_V, F=(max(F[0], 0.0), F[1]), K=K)
-    # F and P both scale with R_a: bound F/P over the same plants (the run's own point included)
+    # F and P both scale with R_a: bound F/P over the same plants
     ratio = friction_over_P_max(estimate_params, tuple(float(v) for v in config.m1_range), config.m1_inertia,
                                 tuple(sorted(ranges.items())))
     if ratio is not None:
-        ratio = max(ratio, point.F / point.P)
         if config.model == "identified" and "F" in spread and "P" in spread:
             ratio = max(ratio, spread["F"][1] / spread["P"][0])
         if config.box == "paper":
@@ -149,6 +192,7 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
                    g_used <= 1.0, g_used, 1.0,
                    "fraction of the band used by measurements: MuJoCo identify seeds 0-5 0.492-0.704 V s/m "
                    "(0.78-1.12 P/l1), Drake 0.621-0.644 (physics.md section 6)", kind="stated"),
+        *outside_the_box(config, plant, base),
     )
     cert = certify(plant=PlantBox(box=plant_box, gyro=gyro, V_A=V_A, friction_over_P=ratio),
                    estimate=estimate, gains=Gains(kp=config.kp, kd=config.kd),
