@@ -122,8 +122,40 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--log-every", type=positive_int, default=1, help="log signals every k-th control step (default 1)")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                    help="progress bar (default: only on a terminal)")
+    add_require_option(p)
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=run)
+
+
+def add_require_option(p: argparse.ArgumentParser) -> None:
+    from wmr_mj.analysis.requirements import PRESETS, SIGNALS
+
+    p.add_argument("--require", action="append", metavar="STL",
+                   help="a requirement in Signal Temporal Logic, monitored by rtamt on the run's signals "
+                        f"({', '.join(SIGNALS)}; time bounds in s), e.g. 'always[8,35](abs(E) <= 0.05)', or a "
+                        f"preset: {', '.join(PRESETS)} (the certificate's or the paper's |E|, |E'| bounds for the "
+                        "whole run); repeatable. Its robustness (> 0: held with that margin) is reported")
+
+
+def requirements_from_args(args: argparse.Namespace, period: float) -> list:
+    """The --require requirements, each checked (syntax, signal names, time bounds) before any run."""
+    from wmr_mj.analysis.requirements import parse_requirement
+
+    return [parse_requirement(text, period=period) for text in getattr(args, "require", None) or []]
+
+
+def format_requirements(results: list[dict]) -> list[str]:
+    """One line per requirement: formula, robustness, whether it holds."""
+    lines = []
+    for r in results:
+        rob = r["robustness"]
+        status = "no region" if rob is None else ("holds" if r["satisfied"] else "VIOLATED")
+        rob_text = "n/a" if rob is None else f"{rob:+.5g}"
+        name = r["formula"] if "requirement" not in r or r["formula"] == r["requirement"] else \
+            f"{r['requirement']} = {r['formula']}"
+        lines.append(f"requirement {name}: robustness {rob_text} ({status})"
+                     + (f"  [{r['note']}]" if r.get("note") else ""))
+    return lines
 
 
 def default_log_path(config) -> str:
@@ -186,6 +218,8 @@ def run(args: argparse.Namespace) -> int:
         path = args.out or default_log_path(args)
         check_output_path(path, kind="file", option="--out")
     config = config_from_args(args, m1=args.m1)
+    period = args.control_period or TIMESTEP
+    requirements = requirements_from_args(args, period)
     factory = None
     if path is not None:
         from wmr_mj.logs.writer import RunLogger
@@ -198,10 +232,18 @@ def run(args: argparse.Namespace) -> int:
     if result.law_note:
         print(f"wmr-mj: the Python law ran ({result.law_note}); the numbers are the same, the run slower",
               file=sys.stderr)
+    judged = None
+    if requirements:
+        from wmr_mj.analysis.requirements import evaluate_run
+
+        judged = [r.as_dict() for r in evaluate_run(requirements, result.rows, result.summary.to_dict(),
+                                                    period=period)]
     if args.json:
-        print_json({**result.summary.to_dict(), "log": path})
+        print_json({**result.summary.to_dict(), "log": path, **({"requirements": judged} if judged else {})})
     else:
         print(format_report(result.summary))
+        if judged:
+            print("\n".join(format_requirements(judged)))
         if path:
             print(f"log: {path}")
     if result.status == "interrupted":

@@ -1,0 +1,306 @@
+"""Requirements in Signal Temporal Logic, monitored by rtamt on a run's signals.
+
+A requirement is an STL formula over the run's signals (:data:`SIGNALS`), e.g.
+``always[8,35](abs(E) <= 0.05)``: from 8 s to 35 s the tracking error stays within
+0.05 rad. Its robustness is rtamt's quantitative semantics at t = 0 (discrete time, one
+sample per control step): > 0 satisfied with that margin, < 0 violated by that much
+(for ``always[a,b](abs(x) <= c)``, min over the window of c - |x|). Time bounds are in
+seconds and must be whole multiples of the control period.
+
+Presets (:data:`PRESETS`) name the regions the testbed judges runs by:
+
+- ``certificate``: the rectangle |E| <= E_max, |E'| <= Edot_max of the run's certificate,
+  for the whole run (the certificate's region (4.21) lies inside it);
+- ``paper``: the paper's claim, |E| <= E_max and |E'| <= Edot_max of its (4.21)-(4.23).
+
+The monitor is rtamt's offline discrete-time STL interpreter (parser, predicates, Boolean
+and temporal operators). Its bounded operators (always[a,b], eventually[a,b],
+historically[a,b], once[a,b]) take the min/max of a list slice per sample, O(n w): 12 s
+for always[8,35] over a 35 s run at 1 ms. :class:`_WindowedVisitor` overrides those four
+with the same semantics (the same padding at the ends of the trace) computed as a sliding
+min/max in O(n log w); a test holds them equal, to the bit, to rtamt's own on random
+signals.
+
+Usage::
+
+    from wmr_mj.analysis.requirements import parse_requirement, evaluate
+    req = parse_requirement("always[0,2](abs(x) <= 1)", period=1.0, signals=("x",))
+    result = evaluate(req, {"x": [0.1, -0.5, 0.3, 0.9]}, period=1.0)
+    result.robustness  # 0.5: min(1 - |x|) over samples 0..2
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from wmr_mj.errors import ParameterError, UnknownNameError
+
+__all__ = [
+    "SIGNALS",
+    "PRESETS",
+    "Requirement",
+    "RequirementResult",
+    "parse_requirement",
+    "evaluate",
+    "evaluate_run",
+    "preset_formula",
+    "number",
+]
+
+#: Signals a requirement may name (a run's rows: wmr_mj.sim.closed_loop.ROW_FIELDS), t in s.
+SIGNALS = ("t", "E", "E_dot", "alpha", "alpha_dot", "alpha0", "voltage")
+#: Named requirements, resolved against a run's bounds (see :func:`preset_formula`).
+PRESETS = {
+    "certificate": "the certificate's rectangle for the whole run: always((abs(E) <= E_max) and "
+                   "(abs(E_dot) <= Edot_max)) with the run's certificate",
+    "paper": "the paper's claim for the whole run: always((abs(E) <= E_max) and (abs(E_dot) <= Edot_max)) "
+             "with (4.21)-(4.23) as the paper bounds them",
+}
+
+
+def number(x: float) -> str:
+    """A float as rtamt's grammar reads it (no exponent), shortest digits that round-trip."""
+    return np.format_float_positional(float(x), unique=True, trim="-")
+
+
+def preset_formula(name: str, E_max: float | None, Edot_max: float | None) -> str | None:
+    """The formula of preset ``name`` for the bounds (None when there is no finite bound)."""
+    if name not in PRESETS:
+        raise UnknownNameError("requirement preset", name, PRESETS)
+    if E_max is None or Edot_max is None or not (math.isfinite(E_max) and math.isfinite(Edot_max)):
+        return None
+    return f"always((abs(E) <= {number(E_max)}) and (abs(E_dot) <= {number(Edot_max)}))"
+
+
+# -- rtamt with windowed operators in O(n log w) ---------------------------------------------
+
+def _sliding(y: np.ndarray, w: int, op) -> np.ndarray:
+    """out[k] = op(y[k:k+w]) for k in 0 .. len(y)-w (sparse table: windows of 1, 2, 4, ...)."""
+    m, p = y, 1
+    while 2 * p <= w:
+        m = op(m[:-p], m[p:])  # m[k] = op over y[k:k+2p]
+        p *= 2
+    count = len(y) - w + 1
+    return op(m[:count], m[w - p:w - p + count])
+
+
+def _window(sample: list[float], lo: int, hi: int, op, fill: float) -> list[float]:
+    """r[i] = op(sample[i+lo .. i+hi]) over the samples that exist, ``fill`` where none does."""
+    x = np.asarray(sample, dtype=float)
+    n = len(x)
+    front, back = max(0, -lo), max(0, hi)
+    y = np.concatenate([np.full(front, fill), x, np.full(back, fill)])
+    s = _sliding(y, hi - lo + 1, op)
+    return s[lo + front:lo + front + n].tolist()
+
+
+def _import_rtamt() -> None:
+    """Import rtamt quietly. Its ANTLR-generated parsers import ``typing.io`` (deprecated; gone
+    in Python 3.12): where it is missing, an alias module carries the one name they use."""
+    import sys
+    import types
+    import typing
+    import warnings
+
+    if "rtamt" in sys.modules:
+        return
+    try:
+        import typing.io  # noqa: F401
+    except ImportError:
+        alias = types.ModuleType("typing.io")
+        alias.TextIO = typing.TextIO
+        sys.modules["typing.io"] = alias
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)
+        import rtamt  # noqa: F401
+
+
+def _visitor_class():
+    _import_rtamt()
+    from rtamt.semantics.stl.discrete_time.offline.ast_visitor import StlDiscreteTimeOfflineAstVisitor
+
+    class _WindowedVisitor(StlDiscreteTimeOfflineAstVisitor):
+        """rtamt's offline discrete-time visitor; the bounded operators as sliding windows."""
+
+        def visitTimedAlways(self, node, *args, **kwargs):
+            sample = self.visit(node.children[0], *args, **kwargs)
+            begin, end = self.time_unit_transformer(node)
+            return _window(sample, begin, end, np.minimum, math.inf)
+
+        def visitTimedEventually(self, node, *args, **kwargs):
+            sample = self.visit(node.children[0], *args, **kwargs)
+            begin, end = self.time_unit_transformer(node)
+            return _window(sample, begin, end, np.maximum, -math.inf)
+
+        def visitTimedHistorically(self, node, *args, **kwargs):
+            sample = self.visit(node.children[0], *args, **kwargs)
+            begin, end = self.time_unit_transformer(node)
+            return _window(sample, -end, -begin, np.minimum, math.inf)
+
+        def visitTimedOnce(self, node, *args, **kwargs):
+            sample = self.visit(node.children[0], *args, **kwargs)
+            begin, end = self.time_unit_transformer(node)
+            return _window(sample, -end, -begin, np.maximum, -math.inf)
+
+    return _WindowedVisitor
+
+
+@contextlib.contextmanager
+def _quiet_rtamt():
+    """rtamt logs a warning on the root logger for an undeclared name before it raises."""
+    previous = logging.root.manager.disable
+    logging.disable(logging.WARNING)
+    try:
+        yield
+    finally:
+        logging.disable(previous)
+
+
+def _spec(formula: str, period: float, signals: Sequence[str], *, stock: bool = False):
+    """A parsed rtamt specification of ``formula`` (ParameterError / UnknownNameError on bad input).
+
+    stock: rtamt's own visitor, windowed operators included (tests compare the two)."""
+    _import_rtamt()
+    from rtamt.exception.exception import RTAMTException
+    from rtamt.explanation.stl.discrete_time.explainer import STLExplainer
+    from rtamt.semantics.abstract_discrete_time_offline_interpreter import discrete_time_offline_interpreter_factory
+    from rtamt.spec.abstract_specification import AbstractOfflineSpecification
+    from rtamt.syntax.ast.parser.stl.specification_parser import StlAst
+
+    if stock:
+        from rtamt.semantics.stl.discrete_time.offline.ast_visitor import StlDiscreteTimeOfflineAstVisitor as visitor
+    else:
+        visitor = _visitor_class()
+    spec = AbstractOfflineSpecification(StlAst(), discrete_time_offline_interpreter_factory(visitor)(),
+                                        explainer=STLExplainer())
+    for name in signals:
+        spec.declare_var(name, "float")
+    spec.set_sampling_period(int(round(period * 1e9)), "ns", 0.1)
+    spec.spec = formula
+    with _quiet_rtamt():
+        try:
+            spec.parse()
+        except KeyError as exc:
+            raise UnknownNameError("signal", str(exc.args[0]) if exc.args else "?", signals) from None
+        except RTAMTException as exc:
+            message = str(exc).replace("RTAMT Exception:", "").strip().split(" expecting ")[0]
+            raise ParameterError(f"requirement {formula!r} is not an STL formula rtamt reads ({message}); "
+                                 f"e.g. 'always[8,35](abs(E) <= 0.05)', signals: {', '.join(signals)}") from None
+        except Exception as exc:  # noqa: BLE001  (the parser's own errors: one line, the formula named)
+            raise ParameterError(f"requirement {formula!r} is not an STL formula rtamt reads "
+                                 f"({type(exc).__name__}: {exc}); signals: {', '.join(signals)}") from None
+    return spec
+
+
+def _robustness(spec, formula: str, signals: Mapping[str, Any], period: float) -> float:
+    from rtamt.exception.exception import RTAMTException
+
+    columns = {name: np.asarray(v, dtype=float).tolist() for name, v in signals.items()}
+    n = len(next(iter(columns.values()))) if columns else 0
+    if n < 2:
+        raise ParameterError(f"requirement {formula!r}: {n} sample(s) to monitor; rtamt needs at least 2")
+    dataset = {"time": (np.arange(n) * period).tolist(), **columns}
+    try:
+        with _quiet_rtamt():
+            out = spec.evaluate(dataset)
+    except RTAMTException as exc:
+        message = str(exc).replace("RTAMT Exception:", "").strip()
+        raise ParameterError(f"requirement {formula!r}: {message} ({period:g} s); give time bounds in s that are "
+                             f"whole multiples of it") from None
+    return float(out[0][1])
+
+
+# -- requirements -----------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Requirement:
+    """A requirement as given: a preset's name (:data:`PRESETS`) or an STL formula."""
+
+    text: str
+    signals: tuple[str, ...] = SIGNALS
+
+    @property
+    def preset(self) -> str | None:
+        return self.text if self.text in PRESETS else None
+
+
+@dataclass(frozen=True)
+class RequirementResult:
+    """One requirement judged on one run: the formula monitored (a preset resolved), its
+    robustness at t = 0 (None: a preset with no finite bound; inf: vacuous, every window past
+    the run's end) and whether it holds (robustness >= 0)."""
+
+    requirement: str
+    formula: str | None
+    robustness: float | None
+    satisfied: bool
+    note: str = ""
+
+    def as_dict(self) -> dict[str, Any]:
+        d = {"formula": self.formula if self.formula is not None else self.requirement,
+             "robustness": self.robustness, "satisfied": self.satisfied}
+        if self.formula != self.requirement:
+            d["requirement"] = self.requirement
+        if self.note:
+            d["note"] = self.note
+        return d
+
+
+def parse_requirement(text: str, *, period: float, signals: Sequence[str] = SIGNALS) -> Requirement:
+    """Check ``text`` (a preset or a formula over ``signals``) before any run: it parses, names
+    known signals only, and its time bounds are multiples of ``period`` (s)."""
+    if not isinstance(text, str) or not text.strip():
+        raise ParameterError(f"requirement {text!r} is empty; give an STL formula (e.g. 'always[8,35](abs(E) <= "
+                             f"0.05)') or a preset: {', '.join(PRESETS)}")
+    text = text.strip()
+    signals = tuple(signals)
+    if text not in PRESETS:
+        spec = _spec(text, period, signals)
+        _robustness(spec, text, dict.fromkeys(signals, np.zeros(2)), period)  # time bounds vs the period
+    return Requirement(text, signals)
+
+
+def evaluate(requirement: Requirement, signals: Mapping[str, Any], *, period: float,
+             bounds: Mapping[str, tuple[float | None, float | None]] | None = None) -> RequirementResult:
+    """Monitor ``requirement`` on ``signals`` (name -> samples, one per ``period`` s from t = 0).
+
+    bounds: {preset: (E_max, Edot_max)} for the presets (see :func:`evaluate_run`)."""
+    preset = requirement.preset
+    formula = requirement.text
+    if preset is not None:
+        E_max, Edot_max = (bounds or {}).get(preset, (None, None))
+        formula = preset_formula(preset, E_max, Edot_max)
+        if formula is None:
+            return RequirementResult(requirement.text, None, None, False,
+                                     note=f"no {preset} region for this run: nothing to satisfy")
+    missing = [s for s in requirement.signals if s not in signals]
+    if missing:
+        raise UnknownNameError("signal", missing[0], tuple(signals))
+    spec = _spec(formula, period, requirement.signals)
+    rob = _robustness(spec, formula, {s: signals[s] for s in requirement.signals}, period)
+    note = "vacuous: every window lies past the run's end" if math.isinf(rob) and rob > 0 else ""
+    return RequirementResult(requirement.text, formula, rob, bool(rob >= 0.0), note=note)
+
+
+def evaluate_run(requirements: Sequence[Requirement], rows: Mapping[str, Any], summary: Mapping[str, Any], *,
+                 period: float) -> list[RequirementResult]:
+    """Every requirement on a run's rows (wmr_mj.sim.closed_loop.RunResult.rows), the presets
+    resolved against its summary's certificate and paper region."""
+
+    def pair(region: Any) -> tuple[float | None, float | None]:
+        if not isinstance(region, Mapping):
+            return None, None
+        e, ed = region.get("E_max"), region.get("Edot_max")
+        return (None if e is None else float(e)), (None if ed is None else float(ed))
+
+    bounds = {"certificate": pair(summary.get("certificate")),
+              "paper": pair(summary.get("paper_region") or {"E_max": summary.get("E_max"),
+                                                            "Edot_max": summary.get("Edot_max")})}
+    return [evaluate(r, rows, period=period, bounds=bounds) for r in requirements]
