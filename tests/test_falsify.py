@@ -16,6 +16,7 @@ from wmr_mj.sim.closed_loop import run_closed_loop
 from wmr_mj.sim.config import RunConfig
 from wmr_mj.sim.falsify import (
     FalsifySpec,
+    covering_design,
     falsify,
     objective_source,
     objective_value,
@@ -43,7 +44,7 @@ def test_search_finds_the_known_worst_corner_and_beats_chance():
         calls.append(len(points))
         return bowl(points)
 
-    trace = search_worst(evaluate, BOX, budget=400, seed=3)
+    trace = search_worst(evaluate, BOX, budget=400, seed=3, method="de")
     best = trace.points[trace.best]
     assert np.all(np.abs(best - CORNER) <= 0.03 * (BOX[:, 1] - BOX[:, 0])), best
     # one call per generation, each with the whole population
@@ -54,10 +55,51 @@ def test_search_finds_the_known_worst_corner_and_beats_chance():
     assert trace.values.max() > chance.values.max()
 
 
-def test_the_same_seed_gives_the_same_search():
-    a = search_worst(bowl, BOX, budget=60, seed=7)
-    b = search_worst(bowl, BOX, budget=60, seed=7)
-    c = search_worst(bowl, BOX, budget=60, seed=8)
+def test_vertices_first_find_the_known_worst_corner_within_the_budget():
+    calls = []
+
+    def evaluate(points):
+        calls.append(len(points))
+        return bowl(points)
+
+    trace = search_worst(evaluate, BOX, budget=12, seed=0)
+    assert calls[0] == 8 and len(trace.values) <= 12  # all 2^3 vertices in one batch, then the polish
+    assert np.array_equal(trace.points[trace.best], CORNER)  # the corner itself, exactly
+    assert trace.best < 8
+    # a budget below 2^d: a fractional-factorial half of the vertices, then the polish climbs to the corner
+    trace = search_worst(bowl, BOX, budget=30, seed=0)
+    assert np.all(np.abs(trace.points[trace.best] - CORNER) <= 0.02 * (BOX[:, 1] - BOX[:, 0]))
+
+
+def test_the_polish_finds_an_interior_maximum_next_to_the_worst_vertex():
+    peak = np.array([720.0, 0.03, 0.75])  # on the face mu = max, inside in m1 and ground friction
+
+    def ridge(points):
+        unit = (points - BOX[:, 0]) / (BOX[:, 1] - BOX[:, 0])
+        target = (peak - BOX[:, 0]) / (BOX[:, 1] - BOX[:, 0])
+        return -np.sum((unit - target) ** 2, axis=1)
+
+    trace = search_worst(ridge, BOX, budget=60, seed=0)
+    assert trace.values.max() > -1e-4  # within 1% of each range of the peak
+    vertices_only = ridge(BOX[:, 0] + covering_design(3, 8) * (BOX[:, 1] - BOX[:, 0])).max()
+    assert trace.values.max() > vertices_only
+
+
+def test_covering_design_is_balanced_and_seeded():
+    full = covering_design(5, 32)
+    assert full.shape == (32, 5) and len({tuple(r) for r in full}) == 32
+    half = covering_design(5, 24)  # 16 = 2^(5-1) points: every column balanced, every pair of columns too
+    assert half.shape == (16, 5) and np.all(half.sum(axis=0) == 8)
+    assert np.all((2 * half - 1).T @ (2 * half - 1) == 16 * np.eye(5))
+    a, b = (covering_design(5, 8, np.random.default_rng(s)) for s in (0, 1))
+    assert a.shape == (8, 5) and not np.array_equal(a, b)
+
+
+@pytest.mark.parametrize("method", ["vertices-polish", "de"])
+def test_the_same_seed_gives_the_same_search(method):
+    a = search_worst(bowl, BOX, budget=60, seed=7, method=method)
+    b = search_worst(bowl, BOX, budget=60, seed=7, method=method)
+    c = search_worst(bowl, BOX, budget=60, seed=8, method=method)
     assert np.array_equal(a.points, b.points) and np.array_equal(a.values, b.values)
     assert not np.array_equal(a.points, c.points)
 
@@ -75,7 +117,7 @@ def test_undefined_values_are_never_the_worst():
 @pytest.mark.parametrize("budget,population", [(4, None), (10, 20), (10, 4)])
 def test_budget_below_a_population_is_refused(budget, population):
     with pytest.raises(ParameterError, match="budget|population"):
-        search_worst(bowl, BOX, budget=budget, population=population)
+        search_worst(bowl, BOX, budget=budget, population=population, method="de")
 
 
 def test_objective_is_read_from_the_summary():

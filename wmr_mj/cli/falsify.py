@@ -13,14 +13,23 @@ _OBJECTIVE_KINDS = ("ratio", "sup-E")
 def register(sub: argparse._SubParsersAction) -> None:
     from wmr_mj.cli.run import add_run_options
 
-    p = sub.add_parser("falsify", help="worst-case search over the uncertainty box (differential evolution on "
-                                       "mujoco.batch), beside the same budget spent at random")
+    p = sub.add_parser("falsify", help="worst-case search over the uncertainty box (its vertices, then a local "
+                                       "polish; or differential evolution) on mujoco.batch, beside the same "
+                                       "budget spent at random")
     add_run_options(p)
     p.add_argument("--range", action="append", metavar="NAME=LO:HI",
                    help="add a plant parameter to the box or replace its range (repeatable)")
     p.add_argument("--against", default="certificate",
                    help="the region of the ratio sup|E|/E_max: certificate (default) or paper (the paper's region)")
     p.add_argument("--objective", default="ratio", help="what is maximised: ratio (default, see --against) or sup-E")
+    p.add_argument("--method", default="vertices-polish",
+                   help="search: vertices-polish (default: the box's vertices, or a fractional-factorial covering "
+                        "of them when 2^d > budget, then scipy's Nelder-Mead from the worst) or de (differential "
+                        "evolution)")
+    p.add_argument("--require", metavar="STL",
+                   help="falsify an STL requirement (e.g. 'always(abs(E) <= 0.05)', signals as for wmr-mj run "
+                        "--require): maximise minus its robustness (> 0: falsified); runs serially, the batch keeps "
+                        "no signals")
     p.add_argument("--budget", type=positive_int, default=256,
                    help="simulations of the search (default 256); the random sample gets as many")
     p.add_argument("--population", type=int, default=None,
@@ -41,11 +50,15 @@ def _objective(args: argparse.Namespace) -> str:
         raise UnknownNameError("objective", args.objective, _OBJECTIVE_KINDS)
     if args.against not in _AGAINST:
         raise UnknownNameError("region", args.against, _AGAINST)
+    if args.require is not None:
+        return "requirement"
     return "sup-E" if args.objective == "sup-E" else args.against
 
 
 def reproduce_command(config, params: dict[str, float], args: argparse.Namespace) -> str:
     """A ``wmr-mj run`` line that repeats the worst run (parameters at full precision)."""
+    import shlex
+
     parts = ["wmr-mj run", f"--preset {args.preset}", f"--controller {config.controller}", f"--model {config.model}",
              f"--kp {config.kp!r}", f"--kd {config.kd!r}", f"--friction-sign {config.friction_sign}",
              f"--friction-width {config.friction_width!r}", f"--path {config.path}",
@@ -61,8 +74,11 @@ def reproduce_command(config, params: dict[str, float], args: argparse.Namespace
     for option in ("steering_friction", "tyre_contact"):
         if hasattr(config, option):
             parts.append(f"--{option.replace('_', '-')} {getattr(config, option)}")
+    if getattr(args, "require", None):
+        parts.append(f"--require {shlex.quote(args.require)}")
     parts += [f"--m1-inertia {config.m1_inertia}", f"--box {config.box}",
               f"--m1-range {config.m1_range[0]!r} {config.m1_range[1]!r}", f"--uncertainty {args.uncertainty}"]
+    parts += [f"--range {shlex.quote(item)}" for item in getattr(args, "range", None) or []]  # the same box
     return " ".join(parts)
 
 
@@ -75,15 +91,16 @@ def run(args: argparse.Namespace) -> int:
     from wmr_mj.cli.run import config_from_args
     from wmr_mj.logs.writer import run_logged
     from wmr_mj.report.plots import falsify_history, save_figure
-    from wmr_mj.sim.falsify import OBJECTIVE_LABELS, FalsifySpec, falsify, worst_config
+    from wmr_mj.sim.falsify import OBJECTIVE_LABELS, FalsifySpec, check_runnable, falsify, worst_config
 
     objective = _objective(args)
     args.uncertainty = args.uncertainty or "full"
     box = {"m1": tuple(args.m1_range), **box_ranges_from_args(args)}
-    out = check_output_path(args.out or f"logs/falsify-{time.strftime('%Y%m%d-%H%M%S')}", kind="dir", option="--out")
     base = config_from_args(args)
     spec = FalsifySpec(base=base, box=box, objective=objective, budget=args.budget, seed=args.seed,
-                       population=args.population)
+                       population=args.population, method=args.method, requirement=args.require)
+    check_runnable(base)  # a duration too short for the path: one line, before any output or search
+    out = check_output_path(args.out or f"logs/falsify-{time.strftime('%Y%m%d-%H%M%S')}", kind="dir", option="--out")
     with progress_bar(2 * spec.budget, desc="falsify", unit="runs") as bar:
         result = falsify(spec, chunk=args.chunk, nthread=args.nthread, scheduler=args.scheduler,
                          progress=counter_callback(bar),  # evaluations.csv after every generation: Ctrl-C keeps them
@@ -107,14 +124,28 @@ def run(args: argparse.Namespace) -> int:
         print_json(summary)
         return 0 if summary["reproduced"] else 1
     names = ", ".join(spec.names)
-    print(f"worst-case search over {len(spec.names)} parameter(s) ({names}; box {args.uncertainty}): differential "
-          f"evolution, {summary['population']} per generation x {summary['generations']} generations, seed {spec.seed}")
+    if spec.method == "de":
+        how = (f"differential evolution, {summary['population']} per generation x {summary['generations']} "
+               "generations")
+    else:
+        first = [e for e in result.search if e.generation == 0]
+        kind = ("all vertices" if len(first) == 2 ** len(spec.names)
+                else "a fractional-factorial covering of the vertices")
+        how = (f"{kind} ({len(first)} runs), then Nelder-Mead from the worst ({len(result.search) - len(first)} runs)")
+    print(f"worst-case search over {len(spec.names)} parameter(s) ({names}; box {args.uncertainty}): {how}, "
+          f"seed {spec.seed}")
     print(f"objective: {OBJECTIVE_LABELS[objective]}  [{result.objective_source}]")
     fmt = lambda x: "n/a" if x is None else f"{x:.6g}"  # noqa: E731
     print(f"search : worst objective {fmt(worst.objective)} in {len(result.search)} runs "
           f"(sup|E| = {worst.sup_E:.6g} rad, sup|E'| = {worst.sup_Edot:.6g} rad/s, {worst.verdict})")
     rw = result.random_worst
     print(f"random : worst objective {fmt(rw.objective)} in {len(result.random)} runs (Latin hypercube, same seed)")
+    if spec.objective == "requirement":
+        first = next((e.index + 1 for e in result.search if e.objective is not None and e.objective > 0), None)
+        first_r = next((e.index + 1 for e in result.random if e.objective is not None and e.objective > 0), None)
+        print(f"requirement {spec.requirement}: "
+              + (f"FALSIFIED, first at run {first} of the search" if first else "not falsified by the search")
+              + (f"; random: first at run {first_r}" if first_r else "; random: not falsified"))
     print("worst parameters: " + ", ".join(f"{k} = {v!r}" for k, v in worst.params.items()))
     print(f"reproduce: {summary['reproduce']}")
     if not summary["reproduced"]:

@@ -836,7 +836,8 @@ def falsify_history(result: FalsifyResult):
     from wmr_mj.sim.falsify import OBJECTIVE_LABELS
 
     fig, ax = new_figure(6.0, 3.6)
-    for evals, color, label in ((result.search, "C3", "differential evolution"),
+    search_label = "differential evolution" if result.spec.method == "de" else "vertices, then Nelder-Mead"
+    for evals, color, label in ((result.search, "C3", search_label),
                                 (result.random, "0.45", "random (Latin hypercube)")):
         x = np.arange(1, len(evals) + 1)
         y = np.array([np.nan if e.objective is None else e.objective for e in evals])

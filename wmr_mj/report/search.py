@@ -95,7 +95,7 @@ def _search_spec(plan: SearchPlan, settings: ValidateSettings):
     extra = {k: v for k, v in uncertainty_ranges(plan.box).items() if k != "m1"}
     base = settings.config(plan.design).replace(box_ranges=extra)
     return FalsifySpec(base=base, box={"m1": as_pair(settings.m1_range), **extra}, objective=plan.objective,
-                       budget=plan.budget, seed=settings.seed)
+                       budget=plan.budget, seed=settings.seed, method="de")
 
 
 def _fingerprint(spec) -> str:
@@ -126,7 +126,8 @@ def _evaluate_search(spec, *, nthread: int, progress: Callable[[float, int], Non
         generation[0] += 1
         return np.array(values)
 
-    search_worst(evaluate, spec.bounds, budget=spec.budget, seed=spec.seed, population=spec.population_size)
+    search_worst(evaluate, spec.bounds, budget=spec.budget, seed=spec.seed, population=spec.population_size,
+                 method=spec.method)
     return runs
 
 

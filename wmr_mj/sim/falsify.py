@@ -1,30 +1,43 @@
 """Worst-case search: the plant in the uncertainty box that the controller tracks worst.
 
 A robustness claim is only as credible as the worst case anyone looked for. Sweeps
-sample the box; ``falsify`` searches it, as falsification tools (S-TaLiRo, Breach) do:
-scipy's differential evolution maximises an objective of the closed-loop run over the
-ranged plant parameters, evaluating each generation as one batch
-(``wmr_mj.sim.sweep.run_configs``: ``mujoco.batch``, or Dask chunks), and the same number of
-simulations is spent on a seeded Latin-hypercube sample beside it, so the search can be
-judged against chance.
+sample the box; ``falsify`` searches it, as falsification tools (S-TaLiRo, Breach) do,
+maximising an objective of the closed-loop run over the ranged plant parameters, and the
+same number of simulations is spent on a seeded Latin-hypercube sample beside it, so the
+search can be judged against chance (``bench/bench_falsify.py`` does so over seeds).
+
+Methods (:data:`METHODS`):
+
+- ``vertices-polish`` (the default): the box's 2^d vertices first, as one batch, where the
+  budget allows them (else a fractional-factorial covering of them, :func:`covering_design`),
+  then scipy's Nelder-Mead with bounds from the worst point found, restarted from the
+  next-worst while budget is left. Robust-control worst cases sit at vertices more often than
+  not (the objective is monotone in most parameters: the heaviest chassis, the most friction,
+  the largest R_a); the polish finds an interior maximum next to the worst vertex or confirms it.
+  At a budget of 48 on the full box, differential evolution was beaten by random sampling in
+  3 of 6 seeds and never reached the worst vertex (0.3927 of E_max), which this finds in 27 runs.
+- ``de``: scipy's differential evolution, a generation per batch (``vectorized=True``).
+
+Each batch of points runs as one batch of simulations (``wmr_mj.sim.sweep.run_configs``:
+``mujoco.batch``, or Dask chunks); the polish asks for one point at a time.
 
 Objectives (:data:`OBJECTIVES`), read from a run's summary by :func:`objective_value`:
 
 - ``certificate``: sup|E| / E_max of the run's certificate (the default);
 - ``paper``: sup|E| / E_max of the paper's region;
-- ``sup-E``: sup|E| itself, rad.
-
-Why differential evolution: it is derivative-free and global, takes the box as bounds,
-evaluates a whole population per generation (``vectorized=True``), which is what makes
-a batch of simulations pay, and ships with scipy (CMA-ES would add a dependency and
-bound handling for the same job).
+- ``sup-E``: sup|E| itself, rad;
+- ``requirement``: minus the robustness of an STL requirement (``FalsifySpec.requirement``,
+  :mod:`wmr_mj.analysis.requirements`): > 0 falsified. These runs are serial
+  (``run_closed_loop``): the batch keeps no signals to monitor.
 
 Usage::
 
     from wmr_mj.sim.falsify import FalsifySpec, falsify
     from wmr_mj.params import uncertainty_ranges
     from wmr_mj.sim.closed_loop import RunConfig
-    spec = FalsifySpec(base=RunConfig(model="nonholonomic"), box=uncertainty_ranges("full"), budget=256)
+    box = uncertainty_ranges("full")  # the certificate covers the declared box: give the base the same ranges
+    base = RunConfig(model="nonholonomic", box_ranges={k: v for k, v in box.items() if k != "m1"})
+    spec = FalsifySpec(base=base, box=box, budget=256)
     result = falsify(spec)
     print(result.worst.params, result.worst.objective, result.random_worst.objective)
 
@@ -36,6 +49,7 @@ NAME=VALUE ...`` give the same sup|E|; the same seed gives the same search.
 from __future__ import annotations
 
 import contextlib
+import itertools
 import math
 import warnings
 from collections.abc import Callable, Mapping, Sequence
@@ -50,6 +64,8 @@ from wmr_mj.sim.config import RunConfig
 
 __all__ = [
     "OBJECTIVES",
+    "METHODS",
+    "covering_design",
     "OBJECTIVE_LABELS",
     "FalsifySpec",
     "FalsifyResult",
@@ -65,9 +81,11 @@ __all__ = [
     "worst_config",
 ]
 
-OBJECTIVES = ("certificate", "paper", "sup-E")
+OBJECTIVES = ("certificate", "paper", "sup-E", "requirement")
+#: Search methods: the box's vertices then a Nelder-Mead polish (default), or differential evolution.
+METHODS = ("vertices-polish", "de")
 OBJECTIVE_LABELS = {"certificate": "sup|E|/E_max of the certificate", "paper": "sup|E|/E_max of the paper's region",
-                    "sup-E": "sup|E| [rad]"}
+                    "sup-E": "sup|E| [rad]", "requirement": "-robustness of the requirement (> 0: falsified)"}
 MIN_POPULATION = 5  # scipy's differential evolution needs at least 5 members
 
 
@@ -87,6 +105,9 @@ def objective_value(summary: Mapping[str, Any], objective: str) -> float | None:
         raise UnknownNameError("objective", objective, OBJECTIVES)
     if objective == "sup-E":
         return float(summary["sup_E"])
+    if objective == "requirement":
+        (req,) = summary["requirements"]
+        return None if req["robustness"] is None else -float(req["robustness"])
     if objective == "paper":
         region = summary.get("paper_region")
         if isinstance(region, Mapping) and region.get("E_max") is not None:
@@ -102,6 +123,8 @@ def objective_source(summary: Mapping[str, Any], objective: str) -> str:
     """Which field of the summary :func:`objective_value` read, in words (for the report)."""
     if objective == "sup-E":
         return "sup_E"
+    if objective == "requirement":
+        return f"-robustness of {summary['requirements'][0]['formula']} (rtamt, serial runs)"
     if objective == "paper":
         region = summary.get("paper_region")
         if isinstance(region, Mapping) and region.get("E_max") is not None:
@@ -179,8 +202,132 @@ def _user_errors_unwrapped():
 
 
 def search_worst(evaluate: Callable[[np.ndarray], np.ndarray], bounds: np.ndarray, *, budget: int, seed: int = 0,
+                 population: int | None = None, method: str = "vertices-polish") -> Trace:
+    """Maximise ``evaluate`` over the box ``bounds`` (d, 2) with ``method`` (:data:`METHODS`).
+
+    evaluate(points (S, d)) -> values (S,), NaN where undefined, is called with a batch of
+    points at a time. At most ``budget`` points are evaluated. Seeded: the same seed gives
+    the same points. population: differential evolution's members per generation.
+    """
+    if method not in METHODS:
+        raise UnknownNameError("search method", method, METHODS)
+    if method == "de":
+        return _search_de(evaluate, bounds, budget=budget, seed=seed, population=population)
+    return _search_vertices_polish(evaluate, bounds, budget=budget, seed=seed)
+
+
+def covering_design(d: int, runs: int, rng: np.random.Generator | None = None) -> np.ndarray:
+    """Vertices of the unit box (runs, d) in {0, 1}: all 2^d when runs >= 2^d, else a two-level
+    fractional factorial 2^(d-p) of 2^k <= runs points (k base factors in full factorial, every
+    other factor the product of a subset of them, the largest subsets first: the highest
+    resolution this simple construction gives). rng: random sign flips of the columns (a
+    fold-over of the design), so that seeds cover different corners."""
+    if runs < 1:
+        raise ParameterError(f"runs = {runs!r}: a covering design needs at least one point")
+    k = min(d, int(math.floor(math.log2(runs))))
+    base = np.array(list(itertools.product((-1.0, 1.0), repeat=k))).reshape(2 ** k, k)
+    columns = [base[:, j] for j in range(k)]
+    subsets = [c for size in range(k, 1, -1) for c in itertools.combinations(range(k), size)]
+    for j in range(d - k):
+        if subsets:
+            sub = subsets[j % len(subsets)]
+            col = np.prod(base[:, list(sub)], axis=1) * (-1.0 if j >= len(subsets) else 1.0)
+        else:  # k <= 1: alternate the single base column
+            col = (base[:, 0] if k else np.ones(1)) * (-1.0 if j % 2 else 1.0)
+        columns.append(col)
+    design = np.column_stack(columns) if columns else np.zeros((1, 0))
+    if rng is not None and 2 ** d > runs:
+        design = design * rng.choice((-1.0, 1.0), size=d)
+    return (design + 1.0) / 2.0
+
+
+class _BudgetSpent(Exception):
+    """The local optimiser asked for more runs than the budget has left."""
+
+
+def _search_vertices_polish(evaluate: Callable[[np.ndarray], np.ndarray], bounds: np.ndarray, *, budget: int,
+                            seed: int = 0) -> Trace:
+    """The box's vertices first, then a bounded local search from the worst found.
+
+    1. Vertices, one batch: all 2^d corners where the budget allows them (2^d <= budget), else a
+       fractional-factorial covering design of at most half the budget (:func:`covering_design`,
+       seeded sign flips).
+    2. Polish: scipy's Nelder-Mead with bounds, in the unit box, from the worst point so far,
+       its initial simplex stepping inward from it by a seeded 5-20% of each range (evaluated
+       as one batch), then one run per call; when it converges with budget left it restarts from
+       the next-worst evaluated point. A point evaluated before is not run again.
+
+    Robust-control worst cases sit at vertices more often than not (the objective is monotone
+    in most parameters), which is why they come first; the polish finds an interior maximum
+    near the worst vertex, or confirms the vertex. Deterministic for a seed.
+    """
+    from scipy.optimize import minimize
+
+    bounds = np.asarray(bounds, dtype=float)
+    d = len(bounds)
+    _check_budget(budget, MIN_POPULATION)
+    rng = np.random.default_rng(np.random.SeedSequence(seed).spawn(4)[3])
+    lo, span = bounds[:, 0], bounds[:, 1] - bounds[:, 0]
+    points: list[np.ndarray] = []
+    values: list[np.ndarray] = []
+    generation: list[np.ndarray] = []
+    seen: dict[tuple[float, ...], float] = {}
+
+    def run(unit: np.ndarray) -> np.ndarray:
+        """Evaluate unit-box points (rows) not seen before, within the budget; values of all."""
+        unit = np.clip(np.atleast_2d(np.asarray(unit, dtype=float)), 0.0, 1.0)
+        keys = [tuple(u.tolist()) for u in unit]
+        new = list(dict.fromkeys(k for k in keys if k not in seen))
+        if sum(len(p) for p in points) + len(new) > budget:
+            raise _BudgetSpent
+        if new:
+            batch = lo + np.array(new) * span
+            v = np.asarray(evaluate(batch), dtype=float).reshape(-1)
+            if v.shape != (len(batch),):
+                raise ValueError(f"evaluate returned {v.shape} values for {len(batch)} points")
+            points.append(batch)
+            values.append(v)
+            generation.append(np.full(len(batch), len(generation)))
+            seen.update(zip(new, v.tolist()))
+        return np.array([seen[k] for k in keys])
+
+    def spent() -> int:
+        return sum(len(p) for p in points)
+
+    vertices = covering_design(d, budget if 2 ** d <= budget else max(1, budget // 2), rng)
+    run(vertices)
+    starts_used: list[np.ndarray] = []
+
+    def energy(x: np.ndarray) -> float:  # Nelder-Mead minimises
+        v = float(run(x)[0])
+        return 1e300 if math.isnan(v) else -v
+
+    while spent() < budget:
+        keys = sorted(seen, key=lambda k: -math.inf if math.isnan(seen[k]) else seen[k], reverse=True)
+        start = next((np.array(k) for k in keys
+                      if all(np.max(np.abs(np.array(k) - s)) > 1e-3 for s in starts_used)), None)
+        if start is None:
+            break
+        starts_used.append(start)
+        inward = np.where(start > 0.5, -1.0, 1.0)
+        steps = rng.uniform(0.05, 0.2, size=d) * inward
+        simplex = np.vstack([start, start + np.diag(steps)])
+        try:
+            run(simplex[1:][: budget - spent()])  # the initial simplex as one batch
+            if spent() >= budget:
+                break
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                minimize(energy, start, method="Nelder-Mead", bounds=[(0.0, 1.0)] * d,
+                         options={"initial_simplex": simplex, "maxfev": budget, "xatol": 1e-4, "fatol": 1e-7})
+        except _BudgetSpent:
+            break
+    return Trace(np.concatenate(points), np.concatenate(values), np.concatenate(generation))
+
+
+def _search_de(evaluate: Callable[[np.ndarray], np.ndarray], bounds: np.ndarray, *, budget: int, seed: int = 0,
                  population: int | None = None) -> Trace:
-    """Maximise ``evaluate`` over the box ``bounds`` (d, 2) with differential evolution.
+    """Maximise ``evaluate`` over the box ``bounds`` (d, 2) with scipy's differential evolution.
 
     evaluate(points (S, d)) -> values (S,), NaN where undefined, is called once per
     generation with the whole population. At most ``budget`` points are evaluated:
@@ -243,13 +390,21 @@ class FalsifySpec:
     objective: str = "certificate"
     budget: int = 256
     seed: int = 0
-    population: int | None = None
+    population: int | None = None  # differential evolution's members per generation
+    method: str = "vertices-polish"  # one of METHODS
+    requirement: str | None = None  # objective 'requirement': an STL formula (wmr_mj.analysis.requirements)
 
     def __post_init__(self) -> None:
         from wmr_mj._util.checks import positive_range as _check_range
 
         if self.objective not in OBJECTIVES:
             raise UnknownNameError("objective", self.objective, OBJECTIVES)
+        if self.method not in METHODS:
+            raise UnknownNameError("search method", self.method, METHODS)
+        if (self.objective == "requirement") != (self.requirement is not None):
+            raise ParameterError("the objective 'requirement' goes with a requirement (an STL formula), and only it")
+        if self.requirement is not None:
+            self.parsed_requirement  # noqa: B018  (refused here, before any run, when malformed)
         if not self.box:
             raise ParameterError("the box is empty; give at least one ranged parameter (e.g. --uncertainty m1)")
         names = parameter_names()
@@ -259,7 +414,15 @@ class FalsifySpec:
             _check_range(name, lo, hi)
         if isinstance(self.seed, bool) or not isinstance(self.seed, int):
             raise ParameterError(f"seed = {self.seed!r} is not accepted; give an integer")
-        _check_budget(self.budget, self.population_size)
+        _check_budget(self.budget, self.population_size if self.method == "de" else MIN_POPULATION)
+
+    @property
+    def parsed_requirement(self):
+        from wmr_mj.analysis.requirements import parse_requirement
+        from wmr_mj.plant.mjcf import TIMESTEP
+
+        period = TIMESTEP if self.base.control_period is None else self.base.control_period
+        return parse_requirement(self.requirement, period=period)
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -345,8 +508,11 @@ class FalsifyResult:
             "budget": self.spec.budget,
             "evaluations": len(self.search),
             "seed": self.spec.seed,
-            "population": self.spec.population_size,
+            "method": self.spec.method,
+            "population": self.spec.population_size if self.spec.method == "de" else None,
             "generations": self.generations,
+            "requirement": self.spec.requirement,
+            "falsified": (w.objective > 0.0) if self.spec.objective == "requirement" else None,
             "box": {k: [float(lo), float(hi)] for k, (lo, hi) in self.spec.box.items()},
             "worst": {"params": dict(w.params), "objective": w.objective, "sup_E": w.sup_E, "sup_Edot": w.sup_Edot,
                       "verdict": w.verdict, "generation": w.generation, "index": w.index},
@@ -383,8 +549,12 @@ def falsify(spec: FalsifySpec, *, chunk: int = 128, nthread: int = 0, scheduler:
                 if progress is not None:
                     progress(base_done + k, total)
 
-            reports = [s.to_dict() for s in  # the summaries' JSON, what a search writes and reads back
-                       run_configs(configs, chunk=chunk, nthread=nthread, client=client, progress=chunk_progress)]
+            if spec.objective == "requirement":
+                reports = _run_with_requirement(configs, spec, chunk_progress)
+            else:
+                reports = [s.to_dict() for s in  # the summaries' JSON, what a search writes and reads back
+                           run_configs(configs, chunk=chunk, nthread=nthread, client=client,
+                                       progress=chunk_progress)]
             done += len(reports)
             out = np.full(len(points), np.nan)
             generation = generation_of()
@@ -413,7 +583,7 @@ def falsify(spec: FalsifySpec, *, chunk: int = 128, nthread: int = 0, scheduler:
     check_runnable(spec.base)  # a bad duration or path fails here, in one line, not inside the optimiser
     try:
         search_worst(evaluator("search", next_generation), spec.bounds, budget=spec.budget, seed=spec.seed,
-                     population=spec.population_size)
+                     population=spec.population_size, method=spec.method)
         total = 2 * len(evaluations["search"])
         random_worst(evaluator("random", lambda: 0), spec.bounds, n=len(evaluations["search"]), seed=spec.seed)
     finally:
@@ -422,6 +592,26 @@ def falsify(spec: FalsifySpec, *, chunk: int = 128, nthread: int = 0, scheduler:
     first = evaluations["search"][0].summary
     return FalsifyResult(spec=spec, search=evaluations["search"], random=evaluations["random"],
                          objective_source=objective_source(first, spec.objective))
+
+
+def _run_with_requirement(configs: Sequence[RunConfig], spec: FalsifySpec,
+                          progress: Callable[[int, int], None]) -> list[dict[str, Any]]:
+    """Serial runs (the batch keeps no signals to monitor), each summary with its requirement judged."""
+    from wmr_mj.analysis.requirements import evaluate_run
+    from wmr_mj.plant.mjcf import TIMESTEP
+    from wmr_mj.sim.closed_loop import run_closed_loop
+
+    requirement = spec.parsed_requirement
+    period = TIMESTEP if spec.base.control_period is None else spec.base.control_period
+    reports = []
+    for k, config in enumerate(configs):
+        result = run_closed_loop(config, progress=False)
+        summary = result.summary.to_dict()
+        summary["requirements"] = [r.as_dict() for r in evaluate_run([requirement], result.rows, summary,
+                                                                     period=period)]
+        reports.append(summary)
+        progress(k + 1, len(configs))
+    return reports
 
 
 def check_runnable(base: RunConfig) -> None:
