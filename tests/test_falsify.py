@@ -212,3 +212,31 @@ def test_search_gives_back_a_user_error_raised_by_the_objective():
 
     with pytest.raises(ParameterError, match="duration = 1 s"):
         search_worst(refuse, BOX, budget=16, seed=0)
+
+
+def test_a_requirement_is_falsified_on_serial_runs():
+    base = RunConfig(model="nonholonomic", path="lane-change", duration=3.0, box_ranges={"mu": (0.01, 0.03)})
+    spec = FalsifySpec(base=base, box={"m1": (550.0, 750.0), "mu": (0.01, 0.03)}, objective="requirement",
+                       requirement="always(abs(E) <= 0.001)", budget=6, seed=0)
+    result = falsify(spec)
+    worst = result.worst
+    (req,) = worst.summary["requirements"]
+    assert worst.objective == -req["robustness"] > 0 and not req["satisfied"]  # falsified
+    assert req["robustness"] == pytest.approx(0.001 - worst.sup_E, abs=1e-15)  # min(0.001 - |E|)
+    assert result.as_dict()["falsified"] is True and result.as_dict()["method"] == "vertices-polish"
+    with pytest.raises(ParameterError, match="requirement"):
+        FalsifySpec(base=base, box={"m1": (550.0, 750.0)}, objective="requirement", budget=6)
+    with pytest.raises(UnknownNameError, match="signal"):
+        FalsifySpec(base=base, box={"m1": (550.0, 750.0)}, objective="requirement", requirement="always(Q < 1)",
+                    budget=6)
+
+
+@pytest.mark.parametrize("argv,names", [(["--require", "always(abs(Q) <= 1)"], ("'Q'", "E_dot")),
+                                        (["--method", "cmaes"], ("cmaes", "vertices-polish"))])
+def test_cli_falsify_bad_requirement_or_method_exits_2(argv, names, tmp_path):
+    proc = subprocess.run([sys.executable, "-m", "wmr_mj.cli", "falsify", "--duration", "3", "--path", "lane-change",
+                           "--out", str(tmp_path / "f"), *argv], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2, proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1 and "Traceback" not in proc.stderr, proc.stderr
+    assert all(n in proc.stderr for n in names), proc.stderr
+    assert not (tmp_path / "f").exists()
