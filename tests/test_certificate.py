@@ -474,7 +474,7 @@ def test_a_plant_outside_the_box_fails_an_assumption_and_leaves_the_box_alone(ci
     assert failed.name == f"plant inside the box: {name}"
     assert failed.value == pytest.approx(value) and failed.limit == pytest.approx(limit)
     assert widen in failed.note
-    assert judge(outside, 0.0, 0.0)["verdict"] == "uncertified-inside"
+    assert judge(outside, 0.0, 0.0).verdict == "uncertified-inside"
 
 
 def test_a_plant_inside_the_box_has_the_assumptions_it_had(circle):
