@@ -484,6 +484,7 @@ def test_a_plant_inside_the_box_has_the_assumptions_it_had(circle):
     assert len(c.assumptions) == 8
 
 
+@pytest.mark.slow
 def test_cli_run_outside_the_box_is_uncertified(tmp_path):
     import subprocess
     import sys

@@ -195,6 +195,7 @@ def test_cli_falsify_bad_input_exits_2(argv, tmp_path):
     assert "Traceback" not in proc.stderr
 
 
+@pytest.mark.slow
 def test_cli_falsify_refuses_a_too_short_duration_before_searching(tmp_path):
     # the paper circle's lead-in and entry take longer than 8 s: once a scipy traceback from inside the search
     proc = subprocess.run([sys.executable, "-m", "wmr_mj.cli", "falsify", "--preset", "certified", "--budget", "16",
@@ -214,6 +215,7 @@ def test_search_gives_back_a_user_error_raised_by_the_objective():
         search_worst(refuse, BOX, budget=16, seed=0)
 
 
+@pytest.mark.slow
 def test_a_requirement_is_falsified_on_serial_runs():
     base = RunConfig(model="nonholonomic", path="lane-change", duration=3.0, box_ranges={"mu": (0.01, 0.03)})
     spec = FalsifySpec(base=base, box={"m1": (550.0, 750.0), "mu": (0.01, 0.03)}, objective="requirement",
@@ -231,6 +233,7 @@ def test_a_requirement_is_falsified_on_serial_runs():
                     budget=6)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("argv,names", [(["--require", "always(abs(Q) <= 1)"], ("'Q'", "E_dot")),
                                         (["--method", "cmaes"], ("cmaes", "vertices-polish"))])
 def test_cli_falsify_bad_requirement_or_method_exits_2(argv, names, tmp_path):

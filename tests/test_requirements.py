@@ -94,6 +94,7 @@ def _cli(*argv, check=True):
                            "--duration", "10", *argv], capture_output=True, text=True, timeout=120)
 
 
+@pytest.mark.slow
 def test_cli_run_reports_each_requirement():
     proc = _cli("--json", "--require", "always(abs(E) <= 0.05)", "--require", "always[8,10](abs(E) <= 0.001)",
                 "--require", "certificate")
@@ -108,6 +109,7 @@ def test_cli_run_reports_each_requirement():
                                                    s["certificate"]["Edot_max"] - s["sup_Edot"]), abs=1e-15)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("formula,names", [("always(abs(Q) <= 1)", ("'Q'", "E_dot", "alpha0", "voltage")),
                                            ("always[0,2](abs(E) <=", ("always[0,2](abs(E) <=", "alpha_dot"))])
 def test_cli_run_bad_requirement_exits_2(formula, names):

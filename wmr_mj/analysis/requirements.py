@@ -104,6 +104,7 @@ def _window(sample: list[float], lo: int, hi: int, op, fill: float) -> list[floa
 def _import_rtamt() -> None:
     """Import rtamt quietly. Its ANTLR-generated parsers import ``typing.io`` (deprecated; gone
     in Python 3.12): where it is missing, an alias module carries the one name they use."""
+    import importlib
     import sys
     import types
     import typing
@@ -112,10 +113,10 @@ def _import_rtamt() -> None:
     if "rtamt" in sys.modules:
         return
     try:
-        import typing.io  # noqa: F401
+        importlib.import_module("typing.io")
     except ImportError:
         alias = types.ModuleType("typing.io")
-        alias.TextIO = typing.TextIO
+        alias.__dict__["TextIO"] = typing.TextIO
         sys.modules["typing.io"] = alias
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DeprecationWarning)
@@ -276,10 +277,11 @@ def evaluate(requirement: Requirement, signals: Mapping[str, Any], *, period: fl
     formula = requirement.text
     if preset is not None:
         E_max, Edot_max = (bounds or {}).get(preset, (None, None))
-        formula = preset_formula(preset, E_max, Edot_max)
-        if formula is None:
+        resolved = preset_formula(preset, E_max, Edot_max)
+        if resolved is None:
             return RequirementResult(requirement.text, None, None, False,
                                      note=f"no {preset} region for this run: nothing to satisfy")
+        formula = resolved
     missing = [s for s in requirement.signals if s not in signals]
     if missing:
         raise UnknownNameError("signal", missing[0], tuple(signals))

@@ -141,10 +141,10 @@ def run(args: argparse.Namespace) -> int:
     rw = result.random_worst
     print(f"random : worst objective {fmt(rw.objective)} in {len(result.random)} runs (Latin hypercube, same seed)")
     if spec.objective == "requirement":
-        first = next((e.index + 1 for e in result.search if e.objective is not None and e.objective > 0), None)
+        first_s = next((e.index + 1 for e in result.search if e.objective is not None and e.objective > 0), None)
         first_r = next((e.index + 1 for e in result.random if e.objective is not None and e.objective > 0), None)
         print(f"requirement {spec.requirement}: "
-              + (f"FALSIFIED, first at run {first} of the search" if first else "not falsified by the search")
+              + (f"FALSIFIED, first at run {first_s} of the search" if first_s else "not falsified by the search")
               + (f"; random: first at run {first_r}" if first_r else "; random: not falsified"))
     print("worst parameters: " + ", ".join(f"{k} = {v!r}" for k, v in worst.params.items()))
     print(f"reproduce: {summary['reproduce']}")

@@ -512,7 +512,8 @@ class FalsifyResult:
             "population": self.spec.population_size if self.spec.method == "de" else None,
             "generations": self.generations,
             "requirement": self.spec.requirement,
-            "falsified": (w.objective > 0.0) if self.spec.objective == "requirement" else None,
+            "falsified": (w.objective is not None and w.objective > 0.0) if self.spec.objective == "requirement"
+            else None,
             "box": {k: [float(lo), float(hi)] for k, (lo, hi) in self.spec.box.items()},
             "worst": {"params": dict(w.params), "objective": w.objective, "sup_E": w.sup_E, "sup_Edot": w.sup_Edot,
                       "verdict": w.verdict, "generation": w.generation, "index": w.index},
