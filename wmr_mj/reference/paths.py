@@ -787,12 +787,22 @@ def make_reference(
 ) -> Reference:
     """Convert C's ``path`` into the steering reference for ``params`` (l1, V_A).
 
-    dt: time step of the uniform grid (s). duration: stop there (s, <= the
-    path's time; default the whole path). initial_alpha: steering angle at
-    t = 0 (default the steady angle asin(l1 kappa(0)) of the path's initial
-    curvature). origin, heading: pose of A at t = 0 (m, rad). max_angle,
-    max_rate, max_accel: steering limits (defaults :func:`steering_limits`).
-    A path that violates a limit raises InfeasiblePathError.
+    Args:
+        path: the path of point C.
+        params: the parameter set (l1 [m], V_A [m/s] and the steering limits).
+        dt: time step of the uniform grid [s].
+        duration: stop there [s], at most the path's time; None: the whole path.
+        initial_alpha: steering angle at t = 0 [rad]; None: the steady angle asin(l1 kappa(0)) of the
+            path's initial curvature.
+        origin, heading: pose of A at t = 0 [m, m], [rad].
+        max_angle, max_rate, max_accel: steering limits [rad, rad/s, rad/s^2]; None: :func:`steering_limits`.
+
+    Returns:
+        The :class:`Reference` on the grid: alpha0 and its derivatives, s, theta, kappa, A_xy and C_xy.
+
+    Raises:
+        ParameterError: a bad argument.
+        InfeasiblePathError: the path violates a steering limit (the message says where, s and t).
     """
     if not isinstance(path, Path):
         raise ParameterError(f"path must be a wmr_mj.reference.paths.Path, got {type(path).__name__}")
@@ -800,63 +810,14 @@ def make_reference(
         raise ParameterError(f"params must be a C80Parameters, got {type(params).__name__}")
     h = _positive("dt", dt, " s")
     T_req = None if duration is None else _positive("duration", duration, " s")
-    lim = steering_limits(params)
-    amax = lim["max_angle"] if max_angle is None else _positive("max_angle", max_angle, " rad")
-    if amax >= 0.5 * math.pi:
-        raise ParameterError(f"max_angle = {amax} rad is not accepted: it must be below pi/2")
-    rmax = lim["max_rate"] if max_rate is None else _positive("max_rate", max_rate, " rad/s")
-    accmax = lim["max_accel"] if max_accel is None else _positive("max_accel", max_accel, " rad/s^2")
-    try:
-        ox, oy = (float(v) for v in origin)
-    except (TypeError, ValueError):
-        raise ParameterError(f"origin must be a pair of finite numbers (m), got {origin!r}") from None
-    if not (math.isfinite(ox) and math.isfinite(oy)):
-        raise ParameterError(f"origin must be a pair of finite numbers (m), got {origin!r}")
-    th0 = _number("heading", heading)
+    amax, rmax, accmax = _limits(params, max_angle, max_rate, max_accel)
+    ox, oy, th0 = _pose(origin, heading)
     l1, V_A = params.l1, params.V_A
-
-    k0 = path.start_curvature
-    if initial_alpha is None:
-        if abs(k0) * l1 >= 1.0:
-            raise InfeasiblePathError(
-                f"path infeasible {_where(0.0, 0.0)}: its initial radius {1.0 / abs(k0):.4g} m is below the "
-                f"wheelbase l1 = {l1:.4g} m; a steady start needs sin(alpha) = l1/R = {abs(k0) * l1:.4g} >= 1"
-            )
-        a0 = math.asin(l1 * k0)
-    else:
-        a0 = _number("initial_alpha", initial_alpha)
-        if abs(a0) >= amax:
-            raise ParameterError(f"initial_alpha = {a0} rad is not accepted: |initial_alpha| must be below "
-                                 f"max_angle = {amax} rad")
+    a0 = _initial_angle(path, l1, initial_alpha, amax)
 
     run = _integrate(path, l1, V_A, a0, max_angle=amax, max_rate=rmax, max_accel=accmax, t_stop=T_req)
-    T_path = run.t_end
-    if T_req is not None and not run.stopped and T_req > T_path * (1 + 1e-12):
-        raise ParameterError(
-            f"duration = {T_req} s is not accepted: the path takes {T_path:.6g} s; give duration <= that or None"
-        )
-    T = T_req if T_req is not None else T_path
-    n = int(math.floor(T / h + 1e-6)) + 1
-    if n < 2:
-        raise ParameterError(f"dt = {h} s is not accepted: it must be below the reference's duration {T:.6g} s")
-    t = np.arange(n) * h
-
-    s = np.empty(n)
-    z = np.empty((5, n))
-    k = np.empty(n)
-    dk = np.empty(n)
-    t_starts = np.array([p.t_steps[0] for p in run.pieces])
-    idx = np.clip(np.searchsorted(t_starts, t, side="right") - 1, 0, len(run.pieces) - 1)
-    for j, piece in enumerate(run.pieces):
-        m = idx == j
-        if not np.any(m):
-            continue
-        sl = _s_of_t(piece, t[m], V_A)
-        s[m] = piece.s0 + sl
-        z[:, m] = piece.sol(sl)
-        k[m] = piece.segment.curvature(sl)
-        dk[m] = piece.segment.curvature_rate(sl)
-
+    t = _grid(run, h, T_req)
+    s, z, k, dk = _sample(run, t, V_A)
     alpha, phi = z[0], z[2]
     ad, add = _alpha_dots(alpha, k, dk, l1, V_A)
     # C's path in the frame of its start, moved to the pose: C0 = A0 + l1 (cos th0, sin th0),
@@ -875,6 +836,81 @@ def make_reference(
     for v in arrays.values():
         v.setflags(write=False)
     return Reference(**arrays, l1=l1, V_A=V_A)
+
+
+def _limits(params: C80Parameters, max_angle: float | None, max_rate: float | None,
+            max_accel: float | None) -> tuple[float, float, float]:
+    """The steering limits (angle [rad], rate [rad/s], acceleration [rad/s^2]): given or the plant's."""
+    lim = steering_limits(params)
+    amax = lim["max_angle"] if max_angle is None else _positive("max_angle", max_angle, " rad")
+    if amax >= 0.5 * math.pi:
+        raise ParameterError(f"max_angle = {amax} rad is not accepted: it must be below pi/2")
+    rmax = lim["max_rate"] if max_rate is None else _positive("max_rate", max_rate, " rad/s")
+    accmax = lim["max_accel"] if max_accel is None else _positive("max_accel", max_accel, " rad/s^2")
+    return amax, rmax, accmax
+
+
+def _pose(origin: Sequence[float], heading: float) -> tuple[float, float, float]:
+    """A's starting pose (x [m], y [m], heading [rad]), checked."""
+    try:
+        ox, oy = (float(v) for v in origin)
+    except (TypeError, ValueError):
+        raise ParameterError(f"origin must be a pair of finite numbers (m), got {origin!r}") from None
+    if not (math.isfinite(ox) and math.isfinite(oy)):
+        raise ParameterError(f"origin must be a pair of finite numbers (m), got {origin!r}")
+    return ox, oy, _number("heading", heading)
+
+
+def _initial_angle(path: Path, l1: float, initial_alpha: float | None, amax: float) -> float:
+    """The steering angle at t = 0 [rad]: given, or the steady angle of the path's initial curvature."""
+    k0 = path.start_curvature
+    if initial_alpha is None:
+        if abs(k0) * l1 >= 1.0:
+            raise InfeasiblePathError(
+                f"path infeasible {_where(0.0, 0.0)}: its initial radius {1.0 / abs(k0):.4g} m is below the "
+                f"wheelbase l1 = {l1:.4g} m; a steady start needs sin(alpha) = l1/R = {abs(k0) * l1:.4g} >= 1"
+            )
+        return math.asin(l1 * k0)
+    a0 = _number("initial_alpha", initial_alpha)
+    if abs(a0) >= amax:
+        raise ParameterError(f"initial_alpha = {a0} rad is not accepted: |initial_alpha| must be below "
+                             f"max_angle = {amax} rad")
+    return a0
+
+
+def _grid(run: _Run, h: float, T_req: float | None) -> np.ndarray:
+    """The uniform time grid [s] of step h over the requested duration (or the whole path)."""
+    T_path = run.t_end
+    if T_req is not None and not run.stopped and T_req > T_path * (1 + 1e-12):
+        raise ParameterError(
+            f"duration = {T_req} s is not accepted: the path takes {T_path:.6g} s; give duration <= that or None"
+        )
+    T = T_req if T_req is not None else T_path
+    n = int(math.floor(T / h + 1e-6)) + 1
+    if n < 2:
+        raise ParameterError(f"dt = {h} s is not accepted: it must be below the reference's duration {T:.6g} s")
+    return np.arange(n) * h
+
+
+def _sample(run: _Run, t: np.ndarray, V_A: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(s [m], the integrated state z (5, n), kappa [1/m], dkappa/ds [1/m^2]) at the times t, piece by piece."""
+    n = len(t)
+    s = np.empty(n)
+    z = np.empty((5, n))
+    k = np.empty(n)
+    dk = np.empty(n)
+    t_starts = np.array([p.t_steps[0] for p in run.pieces])
+    idx = np.clip(np.searchsorted(t_starts, t, side="right") - 1, 0, len(run.pieces) - 1)
+    for j, piece in enumerate(run.pieces):
+        m = idx == j
+        if not np.any(m):
+            continue
+        sl = _s_of_t(piece, t[m], V_A)
+        s[m] = piece.s0 + sl
+        z[:, m] = piece.sol(sl)
+        k[m] = piece.segment.curvature(sl)
+        dk[m] = piece.segment.curvature_rate(sl)
+    return s, z, k, dk
 
 
 # --------------------------------------------------------------------------
