@@ -230,6 +230,16 @@ def _corner_geometry(k: float, b: float, delta: float) -> float:
 
 
 def _waypoints_route(w: _Where, head: dict, closed: bool) -> tuple[Path, tuple]:
+    """The route of [route] waypoints: straight legs, each corner rounded by transition-arc-transition."""
+    xy, radii, b = _read_waypoints(w, head, closed)
+    P, legs, length = _legs(w, xy, closed)
+    turn, tangent = _corners(w, P, legs, radii, b, closed)
+    straight = _straights(w, legs, length, tangent)
+    return _assemble(w, legs, straight, turn, radii, b, closed)
+
+
+def _read_waypoints(w: _Where, head: dict, closed: bool) -> tuple[list, list, float | None]:
+    """The waypoints [m], each corner's radius [m] (or None) and the transition length [m] (or None)."""
     pts = head.get("waypoints")
     if not isinstance(pts, list) or len(pts) < (3 if closed else 2):
         raise w.fail("waypoints", f"a list of at least {3 if closed else 2} [x, y] or [x, y, corner radius] "
@@ -248,6 +258,11 @@ def _waypoints_route(w: _Where, head: dict, closed: bool) -> tuple[Path, tuple]:
         radii.append(float(p[2]) if len(p) == 3 else default_R)
     if closed and np.hypot(xy[0][0] - xy[-1][0], xy[0][1] - xy[-1][1]) < 1e-9:
         xy, radii = xy[:-1], radii[:-1]  # the loop's closing point repeated
+    return xy, radii, b
+
+
+def _legs(w: _Where, xy: list, closed: bool) -> tuple[np.ndarray, list, np.ndarray]:
+    """The points (n, 2), the legs as (from, to) indices and their lengths [m]; consecutive points differ."""
     P = np.asarray(xy)
     n = len(P)
     legs = [(i, (i + 1) % n) for i in range(n if closed else n - 1)]
@@ -256,6 +271,13 @@ def _waypoints_route(w: _Where, head: dict, closed: bool) -> tuple[Path, tuple]:
     for (i, j), L in zip(legs, length):
         if L < 1e-9:
             raise w.fail(f"waypoint {j}", f"it repeats waypoint {i}: consecutive waypoints must differ")
+    return P, legs, length
+
+
+def _corners(w: _Where, P: np.ndarray, legs: list, radii: list, b: float | None, closed: bool) -> tuple[dict, dict]:
+    """Each corner's turn [rad] (signed) and the tangent length [m] its rounding takes from each leg."""
+    n = len(P)
+    vec = np.array([P[j] - P[i] for i, j in legs])
     heading = np.arctan2(vec[:, 1], vec[:, 0])
     corners = list(range(n)) if closed else list(range(1, n - 1))
     turn, tangent = {}, {}
@@ -279,6 +301,11 @@ def _waypoints_route(w: _Where, head: dict, closed: bool) -> tuple[Path, tuple]:
                                 f"of arc, not more than its two transitions of {b:.4g} m: use a larger radius or a "
                                 "shorter transition")
         turn[c], tangent[c] = d, _corner_geometry(1.0 / R, b, abs(d))
+    return turn, tangent
+
+
+def _straights(w: _Where, legs: list, length: np.ndarray, tangent: dict) -> list[float]:
+    """What is left of each leg [m] once its corners are rounded; a leg too short for them fails."""
     straight = []
     for (i, j), L in zip(legs, length):
         rest = L - tangent.get(i, 0.0) - tangent.get(j, 0.0)
@@ -287,6 +314,14 @@ def _waypoints_route(w: _Where, head: dict, closed: bool) -> tuple[Path, tuple]:
                          f"it is {L:.4g} m long, its corners need {L - rest:.4g} m: move the waypoints apart or use "
                          "smaller corner radii")
         straight.append(max(rest, 0.0))
+    return straight
+
+
+def _assemble(w: _Where, legs: list, straight: list, turn: dict, radii: list, b: float | None,
+              closed: bool) -> tuple[Path, tuple]:
+    """The segments in driving order (a closed loop starts and ends half-way along its first leg) and the
+    labelled parts (s from, s to, label)."""
+    n = len(radii)
     segs: list[Segment] = []
     parts: list[tuple[float, float, str]] = []
     s = 0.0
