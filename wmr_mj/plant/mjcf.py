@@ -202,7 +202,16 @@ def robot_spec(params: C80Parameters = C80, *, steering_friction: str = "stictio
                tyre_contact: str = "stiff") -> mujoco.MjSpec:
     """The C80 alone (no floor) as an MjSpec; every number comes from ``params``.
 
-    steering_friction: one of STEERING_FRICTION_MODELS; tyre_contact: one of TYRE_CONTACT_MODELS.
+    Args:
+        params: the parameter set.
+        steering_friction: one of STEERING_FRICTION_MODELS.
+        tyre_contact: one of TYRE_CONTACT_MODELS.
+
+    Returns:
+        The spec: chassis (unit a), drive unit (b), steering unit (c), actuators, sensors and the ``home`` key.
+
+    Raises:
+        UnknownNameError: an unknown friction or contact model.
     """
     _check_models(steering_friction, tyre_contact)
     p = params
@@ -216,7 +225,17 @@ def robot_spec(params: C80Parameters = C80, *, steering_friction: str = "stictio
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     spec.option.gravity = _r((0.0, 0.0, -p.g))
     _add_defaults(spec, p, steering_friction, tyre_contact)
+    chassis = _add_chassis(spec, p)
+    _add_drive_unit(spec, chassis, p)
+    _add_steering_unit(spec, chassis, p)
+    _add_actuators(spec, p)
+    _add_sensors(spec)
+    _add_home_key(spec, p)
+    return spec
 
+
+def _add_chassis(spec: mujoco.MjSpec, p: C80Parameters) -> mujoco.MjsBody:
+    """Unit a: the chassis on a free joint, with site A (the rear-axle midpoint)."""
     chassis = spec.worldbody.add_body(name="chassis", pos=_r((0.0, 0.0, p.r2)), childclass="c80")
     chassis.add_freejoint(name="chassis_free")
     zc = p.chassis_height / 2
@@ -225,8 +244,11 @@ def robot_spec(params: C80Parameters = C80, *, steering_friction: str = "stictio
                      size=_r((p.chassis_length / 2, p.chassis_width / 2, p.chassis_height / 2)),
                      rgba=[0.85, 0.55, 0.1, 0.6])
     chassis.add_site(name="A", pos=[0.0, 0.0, 0.0], size=_SITE_SIZE, rgba=[0.0, 0.0, 1.0, 1.0])
+    return chassis
 
-    # unit b: rear beam, differential and two driven wheels
+
+def _add_drive_unit(spec: mujoco.MjSpec, chassis: mujoco.MjsBody, p: C80Parameters) -> None:
+    """Unit b: rear beam, differential and two driven wheels."""
     drive = chassis.add_body(name="drive_unit", pos=[0.0, 0.0, 0.0])
     beam = p.rear_axle_yaw_inertia
     _inertial(drive, mass=p.rear_axle_mass, inertia=(beam, BEAM_PITCH_RATIO * beam, beam))
@@ -236,7 +258,9 @@ def robot_spec(params: C80Parameters = C80, *, steering_friction: str = "stictio
         _add_wheel(drive, spec, side, y=y, mass=p.rear_wheel_mass, radius=p.r2, width=p.rear_wheel_width,
                    spin=p.I_y2, diametral=p.I_z2)
 
-    # unit c: the steered front axle on the pivot O = C
+
+def _add_steering_unit(spec: mujoco.MjSpec, chassis: mujoco.MjsBody, p: C80Parameters) -> None:
+    """Unit c: the steered front axle on the pivot O = C, with site C."""
     steering = chassis.add_body(name="steering_unit", pos=_r((p.l1, 0.0, p.r3 - p.r2)))
     steering.add_joint(name="steer", default=spec.find_default("steer"),
                        range=_r((-p.steering_range, p.steering_range)),
@@ -250,6 +274,9 @@ def robot_spec(params: C80Parameters = C80, *, steering_friction: str = "stictio
         _add_wheel(steering, spec, side, y=y, mass=p.front_wheel_mass, radius=p.r3, width=p.front_wheel_width,
                    spin=p.I_y3, diametral=p.I_z3)
 
+
+def _add_actuators(spec: mujoco.MjSpec, p: C80Parameters) -> None:
+    """The open differential, the DC steering motor (2.9)-(2.11) and the drive's velocity servo."""
     # open differential: the drive acts on the mean rear-wheel angle, equal torque to each wheel
     differential = spec.add_tendon(name="differential")
     differential.wrap_joint("rear_left_spin", 0.5)
@@ -266,6 +293,9 @@ def robot_spec(params: C80Parameters = C80, *, steering_friction: str = "stictio
     servo.set_to_velocity(kv=round_sig(drive_kv))
     servo.gear = [round_sig(p.i1), 0.0, 0.0, 0.0, 0.0, 0.0]
 
+
+def _add_sensors(spec: mujoco.MjSpec) -> None:
+    """Steering angle, rate and torques; positions of A and C; the chassis's attitude; A's velocity."""
     sens, obj_t = mujoco.mjtSensor, mujoco.mjtObj
     for name, kind, objtype, obj in (
         ("steer_angle", sens.mjSENS_JOINTPOS, obj_t.mjOBJ_JOINT, "steer"),
@@ -279,14 +309,15 @@ def robot_spec(params: C80Parameters = C80, *, steering_friction: str = "stictio
     ):
         spec.add_sensor(name=name, type=kind, objtype=objtype, objname=obj)
 
-    # home: rolling straight ahead at V_A, drive commanding i1 V_A / r2.
+
+def _add_home_key(spec: mujoco.MjSpec, p: C80Parameters) -> None:
+    """The ``home`` key: rolling straight ahead at V_A, the drive commanding i1 V_A / r2."""
     # qpos order: free joint (7), rear_left, rear_right, steer, front_left, front_right
     w2, w3 = p.V_A / p.r2, p.V_A / p.r3
     spec.add_key(name="home",
                  qpos=_r((0.0, 0.0, p.r2, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)),
                  qvel=_r((p.V_A, 0.0, 0.0, 0.0, 0.0, 0.0, w2, w2, 0.0, w3, w3)),
                  ctrl=_r((0.0, p.i1 * w2)))
-    return spec
 
 
 def _add_world(spec: mujoco.MjSpec, params: C80Parameters, tyre_contact: str = "stiff") -> None:
