@@ -9,9 +9,10 @@ on with its number and whether it holds.
 
 Plant and controller (voltage form, X~ = X - X^ truth minus estimate)::
 
-    plant:  P a'' + C_V a' + f + K S(a) + Gam a'/cos^2(a) = u,   S(a) = sin(a)/cos^3(a)
+    plant:  P a'' + C_V a' + f + K S(a) + Gam a'/cos^2(a) = u + d_V,   S(a) = sin(a)/cos^3(a)
             f = F sgn(a') while sliding, f anywhere in [-F, F] at rest (stiction)
             Gam = gyro V_A  (the non-holonomic plant: gyro = P/l1; wmr_mj.plant.reduced)
+            d_V = R_a d/(k_i i2): a disturbance torque d [N m] on the steering joint, |d| <= d_max
     law:    u = P^ (a0'' + K_D E' + K_P E) + K^ S(a) + C_V^ a' + F^ s + Gam^ a'/cos^2(a)   (3.2)-(3.3)
             s: sgn(a') ('measured', exact or x/sqrt(x^2+w^2)), sgn(a0') ('reference'), 0 ('none')
 
@@ -19,18 +20,44 @@ With a'' = a0'' - E'' and a' = a0' - E' the error equation is (4.10) with::
 
     eta = (1 - P^/P)(K_D E' + K_P E)
           + P^-1 [P~ a0'' + (f - F^ s) + K~ S(a) + C~_V a0' + Gam~ a0'/cos^2(a) - (C~_V + Gam~/cos^2(a)) E']
+          - d_V/P
 
 so that, with alpha_max = max|a0| + E_max the largest reachable |a| (S and 1/cos^2 grow with |a|)::
 
     ||eta|| <= delta1 + delta2 ||E|| + delta3 ||E'||                                       (4.19)
     delta1 = max_P [ |P - P^| max|a0''| + phi + |K~| S(alpha_max) + |C~_V| max|a0'|
-                     + |Gam~| max|a0'| / cos^2(alpha_max) ] / P                           (4.18)
+                     + |Gam~| max|a0'| / cos^2(alpha_max) + d_V,max ] / P                 (4.18)
     delta2 = max_P |1 - P^/P| K_P                              (coefficient of ||E||, corrected (4.20))
     delta3 = max |(1 - P^/P) K_D - (C~_V + Gam~/c2)/P|  over P, C~_V, Gam~ corners, c2 in {cos^2(alpha_max), 1}
     condition = gamma1 delta2 + gamma2 delta3 < 1                                         (4.23)
     E_max = gamma1 delta1 / (1 - condition),   Edot_max = gamma2 delta1 / (1 - condition)  (4.21)
 
 (a PD controller has no feedforward: its a0'' term is |P - 0| max|a0''| / P = max|a0''|).
+
+Disturbance torque (``PlantBox.disturbance`` = d_V,max; 0 leaves every number as it was). The
+steering motor is MuJoCo's dcmotor (wmr_mj.plant.mjcf): at the joint it gives the torque
+i2 k_i (u - k_b i2 a')/R_a. A torque d on the same joint adds to it, so dividing the joint's
+equation J a'' + ... = i2 k_i u/R_a + ... + d by i2 k_i/R_a gives the voltage form (2.12) with
+u + d_V, d_V = R_a d/(k_i i2) (the factor that gives P = (R_a/k_i) 2D/i2 and F = (R_a/(k_i i2))
+tau_f, wmr_mj.params.C80Parameters.coefficients). In the error equation d_V enters as -d_V/P,
+beside the other P^-1 terms, so |d| <= d_max adds d_V,max/P to delta1 at every P corner, with
+d_V,max = d_max max(R_a)/min(k_i i2) over the box (:func:`wmr_mj.sim.certify.certificate_for`).
+delta2, delta3 and (4.23) do not change; E_max and Edot_max grow with delta1 (linearly, but for
+the fixed point on alpha_max). The supply assumption bounds the law's voltage, which d does not
+enter. Check (tests/test_disturbance.py): the PD loop u = P^ (K_D E' + K_P E) on a plant with
+F = K = 0 and a constant d settles, with a0 constant, at a'' = a' = 0, i.e. at
+P^ K_P E_ss + d_V = 0: E_ss = -d_V/(P^ K_P). For critical damping gamma1 = 1/K_P, so with
+P = P^ and nothing else uncertain the certificate's E_max = d_V/(P K_P) = |E_ss|: tight.
+
+Time-varying chassis mass (load steps and ramps, :mod:`wmr_mj.sim.signals`). Of the plant's
+coefficients only F (through the front axle's normal load Q) depends on m1: P (the steering
+unit's inertia 2D), C_V and gyro = P/l1 do not (K, of the paper's model only, is not in the
+plant: its band is stated). So m1(t) moves F(t) alone and no dP/dt a' term appears. Every bound
+above is pointwise in t: |eta(t)| <= delta1 + delta2 |E(t)| + delta3 |E'(t)| holds at each t as
+long as the plant's parameters at that t are in the box, and the L-infinity argument (4.17)-(4.21)
+uses nothing else. So a run whose m1 steps or ramps between values inside the box keeps the
+certificate of the box; an m1 outside it fails an assumption ("load inside the box"), as a
+disturbance beyond the declared d_max does ("disturbance within the bound").
 
 Friction term phi = sup |f - F^ s| over sliding and rest, by compensation mode:
 
@@ -216,7 +243,8 @@ class Certificate:
     alpha_max [rad]: max|a0| + E_max. voltage_max [V]: the law's |u| bound in the region.
     friction_term, gyro_term, K_term, P_term, C_V_term [rad/s^2]: the parts of delta1
     (each at P_min); gyro_Edot_term [1/s]: the gyro part of delta3; dead_band [rad]:
-    F_max/(P^ K_P).
+    F_max/(P^ K_P); disturbance_term [rad/s^2]: d_V,max/P_min, the disturbance's part of delta1
+    (written to the JSON only when not 0).
     """
 
     E_max: float
@@ -238,6 +266,7 @@ class Certificate:
     C_V_term: float = 0.0
     gyro_Edot_term: float = 0.0
     dead_band: float = 0.0
+    disturbance_term: float = 0.0
     kp: float = 0.0
     kd: float = 0.0
     friction_sign: str = "measured"
@@ -314,6 +343,8 @@ class Certificate:
                      "friction_term", "gyro_term", "K_term", "P_term", "C_V_term", "gyro_Edot_term",
                      "dead_band", "kp", "kd", "friction_width"):
             out[name] = _finite_or_none(getattr(self, name))
+        if self.disturbance_term:
+            out["disturbance_term"] = _finite_or_none(self.disturbance_term)
         out["friction_sign"] = self.friction_sign
         out["regime"] = damping_regime(self.kp, self.kd)
         out["iterations"] = int(self.iterations)
@@ -509,16 +540,19 @@ class PlantBox:
             both scale with R_a, so F/P does not move with it; see :func:`friction_over_P_max`).
             With it the friction level at each P is min(F_max, friction_over_P P) rather than
             F_max at every P; None: F and P independent, as the box alone says.
+        disturbance: d_V,max [V], the bound on a steering disturbance torque at the motor's voltage,
+            R_a d_max/(k_i i2) maximised over the box (module docstring); 0: none.
 
     Raises:
         ParameterError: a box that is not a ParameterBox, F < 0, a range that is not finite lo <= hi,
-            friction_over_P <= 0.
+            friction_over_P <= 0, disturbance < 0.
     """
 
     box: ParameterBox
     gyro: tuple[float, float]
     V_A: tuple[float, float]
     friction_over_P: float | None = None
+    disturbance: float = 0.0
 
     def __post_init__(self) -> None:
         if not isinstance(self.box, ParameterBox):
@@ -530,6 +564,7 @@ class PlantBox:
         if self.friction_over_P is not None:
             object.__setattr__(self, "friction_over_P",
                                _number("friction_over_P", self.friction_over_P, minimum=0.0, strict=True))
+        object.__setattr__(self, "disturbance", _number("disturbance", self.disturbance, minimum=0.0))
 
 
 @dataclass(frozen=True)
@@ -706,7 +741,7 @@ def certify(
         friction_term=max(bound.phi_at(p) / p for p in bound.P_corners), gyro_term=bound.dG * bound.a0d / c2 / P_lo,
         K_term=bound.dK * S / P_lo, P_term=max(abs(p - bound.P_ff) / p for p in bound.P_corners) * bound.a0dd,
         C_V_term=bound.dC * bound.a0d / P_lo, gyro_Edot_term=bound.dG / c2 / P_lo,
-        dead_band=plant.box.F[1] / (estimate.P * gains.kp),
+        dead_band=plant.box.F[1] / (estimate.P * gains.kp), disturbance_term=plant.disturbance / P_lo,
         kp=gains.kp, kd=gains.kd, friction_sign=compensation.friction_sign,
         friction_width=compensation.friction_width, reason=reason, iterations=iterations,
         inputs=_inputs_record(plant, estimate, compensation, a0, bound, limits, control_period, (E0, Ed0)),
@@ -809,6 +844,8 @@ class _Bound:
         """delta1, delta3 and (4.23) with the plant's angle up to ``alpha_max`` [rad]."""
         S, c2 = _S(alpha_max), math.cos(alpha_max) ** 2
         rest = self.dK * S + self.dC * self.a0d + self.dG * self.a0d / c2
+        if self.plant.disturbance:
+            rest = rest + self.plant.disturbance  # d_V,max: |d_V|/P beside the other terms (module docstring)
         delta1 = max((abs(p - self.P_ff) * self.a0dd + self.phi_at(p) + rest) / p for p in self.P_corners)
         delta3 = max(abs(self.mis[p] * self.kd - (c + g / cc) / p)
                      for p in self.P_corners for c in (self.dC_lo, self.dC_hi) for g in (self.dG_lo, self.dG_hi)
@@ -875,6 +912,7 @@ def _inputs_record(plant: PlantBox, estimate: Estimate, compensation: Compensati
         "reference": {"alpha0_max": a0, "alpha0_dot_max": bound.a0d, "alpha0_ddot_max": bound.a0dd},
         "steering_range": limits.steering_range, "voltage_limit": limits.voltage_limit,
         "control_period": control_period, "initial_error": list(initial_error), "friction_amplitude_phi": bound.phi,
+        **({"disturbance_V": plant.disturbance} if plant.disturbance else {}),
     }
 
 

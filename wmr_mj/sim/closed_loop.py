@@ -246,6 +246,7 @@ def run_on_reduced_model(
     friction_width: float = 0.0,
     rtol: float = 1e-10,
     atol: float = 1e-12,
+    disturbance: float | Callable[[float], float] = 0.0,
 ) -> dict[str, np.ndarray]:
     """The paper's view: the same controller on a reduced model as the plant, with scipy.
 
@@ -253,6 +254,9 @@ def run_on_reduced_model(
     :class:`wmr_mj.plant.reduced.SteeringModel`) with u from ``controller`` evaluated
     continuously (no sampling, no voltage limit), from zero error. The plant's
     Coulomb sign is x/sqrt(x^2+w^2) with w = friction_width (0: exact sign).
+    ``disturbance``: d_V [V] added to u in the plant (a number, or a function of t), the voltage
+    equivalent R_a d/(k_i i2) of a torque d on the steering joint
+    (:meth:`wmr_mj.params.C80Parameters.steering_torque_voltage`).
     Returns rows t, alpha, alpha_dot, alpha0, alpha0_dot, E, E_dot, voltage on the
     reference's grid.
     """
@@ -262,11 +266,14 @@ def run_on_reduced_model(
 
     T = float(reference.duration if duration is None else duration)
     law = controller.voltage_scalar
+    disturbed = callable(disturbance) or disturbance != 0.0
 
     def rhs(t, x):
         a, ad = float(x[0]), float(x[1])
         a0, a0d, a0dd = (float(v) for v in reference.at(t))
         u = law(a, ad, a0, a0d, a0dd)
+        if disturbed:
+            u = u + float(disturbance(t) if callable(disturbance) else disturbance)
         s = float(smooth_sign(ad, friction_width))
         return [ad, float(plant_model.acceleration(a, ad, u, friction_sign=s))]
 
