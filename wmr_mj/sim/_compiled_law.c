@@ -13,6 +13,10 @@
  * loop it replaced (tests/reference_loop.py); tests/test_compiled_law.py and tests/test_engine.py
  * check the bits.
  *
+ * A third numeric "wmr_mj_disturbance" (wmr_mj.sim.compiled_law.attach, optional) holds a torque
+ * on the steering joint per control step (N m); the callback writes it to qfrc_applied at every
+ * physics step, before the law (wmr_mj.sim.signals). Models without it are untouched.
+ *
  * userdata (7 per simulation), written at every control step for the statistics and the rows of a
  * single run (wmr_mj.sim.engine):
  *   alpha (rad), E = alpha0 - alpha (rad), E' = alpha0' - alpha' (rad/s), unsaturated law (V),
@@ -54,6 +58,9 @@ int wmr_mj_law_size(void) { return LAW_SIZE; }
 
 int wmr_mj_mujoco_version(void) { return mjVERSION_HEADER; }
 
+/* the index of the optional disturbance numeric: its presence tells Python this build applies it */
+int wmr_mj_disturbance_numeric(void) { return 2; }
+
 void wmr_mj_control(const mjModel* m, mjData* d) {
   if (m->nnumeric < 2 || m->nuserdata < 7 || m->numeric_size[0] != LAW_SIZE ||
       strcmp(m->names + m->name_numericadr[0], "wmr_mj_law") != 0) {
@@ -69,6 +76,14 @@ void wmr_mj_control(const mjModel* m, mjData* d) {
   }
   long long step = llround(d->time / m->opt.timestep);
   long long substeps = (long long)law[LAW_SUBSTEPS];
+  if (m->nnumeric >= 3 && substeps >= 1 && step >= 0 &&
+      strcmp(m->names + m->name_numericadr[2], "wmr_mj_disturbance") == 0) {
+    /* a disturbance torque on the steering joint, N m per control step, written at every physics step */
+    long long j = step / substeps;
+    if (j < m->numeric_size[2]) {
+      d->qfrc_applied[(int)law[LAW_DOF]] = m->numeric_data[m->numeric_adr[2] + j];
+    }
+  }
   if (substeps < 1 || step < 0 || step % substeps) {
     return;  /* the control of the period's first step holds (zero-order hold) */
   }

@@ -127,6 +127,12 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
     measured). gyro: gyro_band x P/l1 over the box (:data:`GYRO_BAND`, measured), V_A
     over the box's range. Estimate: the controller as ``simulate`` builds it (the same
     ``controller_for`` on ``estimate_parameters(params)``). params: the base parameter set.
+
+    Signals (config.signals, :mod:`wmr_mj.sim.signals`): the declared disturbance bound d_max
+    [N m] enters delta1 as d_V,max = d_max max(R_a)/min(k_i i2) over the box and the run's plant
+    (:func:`disturbance_voltage`); two assumptions are added, "disturbance within the bound"
+    (the signal's max|d| against d_max) and "load inside the box" (every m1 the run has against
+    the box's m1 range, the run's initial m1 included). A run without signals gets neither.
     """
     base = params
     k_band = finite_number("k_band", k_band, minimum=0.0)
@@ -194,7 +200,13 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
                    "(0.78-1.12 P/l1), Drake 0.621-0.644 (physics.md section 6)", kind="stated"),
         *outside_the_box(config, plant, base),
     )
-    cert = certify(plant=PlantBox(box=plant_box, gyro=gyro, V_A=V_A, friction_over_P=ratio),
+    signals = getattr(config, "signals", None)
+    d_V = 0.0
+    if signals is not None:
+        d_V = disturbance_voltage(signals.declared_d_max, plant, ranges)
+        stated = stated + _signal_assumptions(signals, plant.m1, _hull(tuple(float(v) for v in config.m1_range),
+                                                                          plant.m1))
+    cert = certify(plant=PlantBox(box=plant_box, gyro=gyro, V_A=V_A, friction_over_P=ratio, disturbance=d_V),
                    estimate=estimate, gains=Gains(kp=config.kp, kd=config.kd),
                    reference=reference.bounds(),
                    limits=PlantLimits(steering_range=plant.steering_range, voltage_limit=plant.voltage_limit),
@@ -204,6 +216,43 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
     inputs.update(model=config.model, controller=controller.name, box_rule=config.box,
                   m1_range=list(config.m1_range), box_ranges={k: list(v) for k, v in ranges.items()},
                   plant_m1=plant.m1, notes=notes, steering_friction=getattr(config, "steering_friction", None))
+    if signals is not None:
+        inputs.update(signals=signals.as_dict(), d_max=signals.declared_d_max)
     return replace_inputs(cert, inputs)
+
+
+def disturbance_voltage(d_max: float, plant: C80Parameters, ranges: Mapping[str, tuple[float, float]]) -> float:
+    """d_V,max [V] = d_max max(R_a)/min(k_i i2): a steering torque bound [N m] as a voltage, over the box.
+
+    R_a, k_i, i2 over their box ranges, hulled with the run's plant (``plant``); the factor of
+    :meth:`wmr_mj.params.C80Parameters.steering_torque_voltage`.
+    """
+    if not d_max:
+        return 0.0
+    R_a = _hull(ranges.get("R_a", (plant.R_a, plant.R_a)), plant.R_a)[1]
+    k_i = _hull(ranges.get("k_i", (plant.k_i, plant.k_i)), plant.k_i)[0]
+    i2 = _hull(ranges.get("i2", (plant.i2, plant.i2)), plant.i2)[0]
+    if k_i <= 0 or i2 <= 0:
+        raise ParameterError(f"k_i = {k_i:g}, i2 = {i2:g}: the disturbance bound needs k_i, i2 > 0 over the box")
+    return float(d_max) * R_a / (k_i * i2)
+
+
+def _signal_assumptions(signals: Any, m1: float, m1_box: tuple[float, float]) -> tuple[Assumption, ...]:
+    """The assumptions a run with signals adds: its disturbance within d_max, its loads inside the m1 box."""
+    d_max = signals.declared_d_max
+    d = signals.disturbance.bound if signals.disturbance is not None else 0.0
+    lo, hi = m1_box
+    values = signals.m1_values(m1)
+    # the value farthest outside the box (else the one nearest an edge), with that edge
+    worst = max(values, key=lambda v: max(lo - v, v - hi))
+    edge = lo if (lo - worst) > (worst - hi) else hi
+    inside = all(lo <= v <= hi for v in values)
+    return (
+        Assumption("disturbance within the bound", "max|d| <= d_max (declared; enters delta1 as R_a d_max/(k_i i2))",
+                   d <= d_max, d, d_max, "N m on the steering joint", kind="checked"),
+        Assumption("load inside the box", f"{lo:g} <= m1(t) <= {hi:g} kg at every load change",
+                   inside, worst, edge,
+                   "m1 values of the run: " + ", ".join(f"{v:g}" for v in values) + " kg", kind="checked"),
+    )
 
 

@@ -48,7 +48,7 @@ from wmr_mj.sim.config import (
     estimate_parameters,
     plant_parameters,
 )
-from wmr_mj.sim.engine import ROW_FIELDS, batch_model, plant_options, run_engine
+from wmr_mj.sim.engine import ROW_FIELDS, batch_model, load_fields, plant_options, run_engine
 from wmr_mj.sim.summary import RunSummary
 
 __all__ = ["RunResult", "run_closed_loop", "report", "run_on_reduced_model", "ROW_FIELDS"]
@@ -158,6 +158,27 @@ def _drift_of(E: np.ndarray, final_alpha_dot: float, period: float) -> Drift:
                  final_alpha_dot=final_alpha_dot)
 
 
+def _signal_inputs(config: RunConfig, params: C80Parameters, options: dict[str, Any], n: int, period: float):
+    """(disturbance torque per control step [N m] or None, [(control step, load fields)]) of config.signals.
+
+    A load change at time t is applied at the first control step at or after t.
+    """
+    signals = getattr(config, "signals", None)
+    if signals is None:
+        return None, []
+    from wmr_mj.params import with_params
+
+    disturbance = None
+    if signals.disturbance is not None:
+        disturbance = signals.disturbance.samples(np.arange(n) * period)
+    loads = []
+    for t, m1 in signals.load_steps(params.m1):
+        k = int(np.ceil(t / period - 1e-9))
+        if k < n:
+            loads.append((k, load_fields(with_params(params, m1_inertia=config.m1_inertia, m1=m1), **options)))
+    return disturbance, loads
+
+
 def run_closed_loop(
     config: RunConfig = RunConfig(),
     *,
@@ -209,11 +230,13 @@ def run_closed_loop(
                                 bounds={"E_max": certificate.E_max, "Edot_max": certificate.Edot_max},
                                 reference_path=np.asarray(reference.C_xy)[::max(1, len(reference.C_xy) // 2000)])
 
+    disturbance, loads = _signal_inputs(config, params, options, n, period)
     bar = progress_bar(n, desc="run", unit="step", unit_scale=True, enabled=progress)
     try:
         run = run_engine(params=params, controller=controller, options=options, model=plain,
                          reference=(a0_all, a0d_all, a0dd_all), n=n, substeps=substeps, period=period, law=law,
-                         on_block=None if logger is None else logger.write_block, on_progress=bar.update)
+                         on_block=None if logger is None else logger.write_block, on_progress=bar.update,
+                         disturbance=disturbance, loads=loads)
     finally:
         bar.close()
     done, k, status, wall = run.rows, run.steps, run.status, run.wall_s

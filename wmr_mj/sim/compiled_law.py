@@ -58,7 +58,7 @@ LAW_FIELDS = ("kind", "P", "K_P", "K_D", "C_V", "F", "K", "gyro_V", "friction_wi
 #: userdata of a model with the law, written at every control step (heading: at every physics step,
 #: where the law names the chassis body).
 USERDATA_FIELDS = ("alpha", "E", "E_dot", "voltage_cmd", "alpha_dot", "voltage", "heading")
-LAW_NUMERIC, REFERENCE_NUMERIC = "wmr_mj_law", "wmr_mj_reference"
+LAW_NUMERIC, REFERENCE_NUMERIC, DISTURBANCE_NUMERIC = "wmr_mj_law", "wmr_mj_reference", "wmr_mj_disturbance"
 _ENV = "WMR_MJ_COMPILED_LAW"
 _install_lock = threading.Lock()
 
@@ -74,7 +74,7 @@ def _library() -> tuple[ctypes.CDLL | None, str | None]:
     built_for, running = int(lib.wmr_mj_mujoco_version()), int(mujoco.mj_version())
     if built_for != running:
         return None, f"wmr_mj.sim._compiled_law was built for MuJoCo {built_for}, this is {running}; reinstall wmr-mj"
-    if int(lib.wmr_mj_law_size()) != len(LAW_FIELDS):
+    if int(lib.wmr_mj_law_size()) != len(LAW_FIELDS) or not hasattr(lib, "wmr_mj_disturbance_numeric"):
         return None, "wmr_mj.sim._compiled_law does not match wmr_mj.sim.compiled_law (LAW_FIELDS); reinstall wmr-mj"
     return lib, None
 
@@ -143,10 +143,13 @@ def law_vector(controller: Any, *, voltage_limit: float, substeps: int, nstep: i
     return np.array([float(values[name]) for name in LAW_FIELDS])
 
 
-def attach(spec: mujoco.MjSpec, law: np.ndarray, reference: Sequence[np.ndarray]) -> None:
+def attach(spec: mujoco.MjSpec, law: np.ndarray, reference: Sequence[np.ndarray],
+           disturbance: np.ndarray | None = None) -> None:
     """Give the model of ``spec`` the law: the numerics the callback reads, and its userdata.
 
-    ``reference`` is (alpha0, alpha0', alpha0'') on the control grid, nstep samples each.
+    ``reference`` is (alpha0, alpha0', alpha0'') on the control grid, nstep samples each;
+    ``disturbance``, where given, a torque on the steering joint per control step [N m] (nstep
+    samples), the third numeric, which the callback writes to qfrc_applied at every physics step.
     """
     if len(spec.numerics):
         raise ParameterError("attach needs a spec without numerics: the law must be the model's first numeric")
@@ -161,4 +164,9 @@ def attach(spec: mujoco.MjSpec, law: np.ndarray, reference: Sequence[np.ndarray]
         raise ParameterError(f"reference must be three rows of at least {nstep} samples")
     spec.add_numeric(name=LAW_NUMERIC, data=law.tolist())
     spec.add_numeric(name=REFERENCE_NUMERIC, data=rows.ravel().tolist())
+    if disturbance is not None:
+        torque = np.asarray(disturbance, dtype=float)[:nstep]
+        if torque.shape != (nstep,) or not np.all(np.isfinite(torque)):
+            raise ParameterError(f"disturbance must be {nstep} finite samples")
+        spec.add_numeric(name=DISTURBANCE_NUMERIC, data=torque.tolist())
     spec.nuserdata = len(USERDATA_FIELDS)

@@ -68,6 +68,9 @@ class RunConfig:
     seed: int = 0  # recorded; a single run draws nothing at random
     steering_friction: str = "stiction"  # plant's steering friction law: one of STEERING_FRICTION_MODELS
     tyre_contact: str = "stiff"  # plant's tyre-floor contact law: one of TYRE_CONTACT_MODELS
+    # a steering disturbance torque and chassis load changes (wmr_mj.sim.signals.Signals, or its JSON
+    # form, a mapping or a .json file); None: none (as_dict then has no "signals" key)
+    signals: Any = None
 
     def __post_init__(self) -> None:
         if self.controller not in CONTROLLER_NAMES:
@@ -93,6 +96,9 @@ class RunConfig:
         lo, hi = self.m1_range
         if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo < hi):
             raise ParameterError(f"m1_range = {self.m1_range!r} must be (lo, hi) with 0 < lo < hi")
+        from wmr_mj.sim.signals import signals_from
+
+        object.__setattr__(self, "signals", signals_from(self.signals))
         names = parameter_names()
         for name in self.plant_overrides:
             if name not in names:
@@ -100,6 +106,10 @@ class RunConfig:
 
     def as_dict(self) -> dict[str, Any]:
         d = dataclasses.asdict(self)
+        if self.signals is None:
+            del d["signals"]  # a run without signals keeps the keys it always had
+        else:
+            d["signals"] = self.signals.as_dict()
         d["plant_overrides"] = dict(self.plant_overrides)
         d["m1_range"] = list(self.m1_range)
         d["box_ranges"] = {k: list(v) for k, v in self.box_ranges.items()}

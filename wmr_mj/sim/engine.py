@@ -17,6 +17,13 @@
   from its first state with the Python law, which, as ``mj_step`` does, goes on after a warning;
   the rest of the run keeps the Python law.
 
+Signals (:mod:`wmr_mj.sim.signals`): a disturbance torque on the steering joint, one value per
+control step, is written to qfrc_applied at every physics step (by the compiled law's callback from
+a third numeric of the model, or by the Python stepper before its mj_step calls); a load change
+sets the chassis's model fields (:data:`LOAD_FIELDS`, as the model compiled for the new m1 has
+them) at its control step, then mj_setConst, the block being stepped in parts around it. A run
+without signals steps exactly as before.
+
 Each block is handed to ``on_block`` (the MCAP logger) as arrays: the rows plus qpos, qvel, ctrl
 at every control step's start and the positions of sites A and C.
 
@@ -26,9 +33,10 @@ not), shared with ``wmr_mj.sim.batch``; :func:`batch_law_backend` chooses the la
 
 from __future__ import annotations
 
+import copy
 import math
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -40,7 +48,7 @@ from wmr_mj.params import C80Parameters
 from wmr_mj.sim import compiled_law
 
 __all__ = ["run_engine", "EngineRun", "batch_model", "batch_law_backend", "LAW_BACKENDS", "plant_options",
-           "ROW_FIELDS"]
+           "ROW_FIELDS", "LOAD_FIELDS", "load_fields"]
 
 # scalar fields recorded for every control step (see wmr_mj.sim.closed_loop.RunResult.rows)
 ROW_FIELDS = ("t", "alpha", "alpha_dot", "alpha0", "alpha0_dot", "alpha0_ddot", "E", "E_dot",
@@ -53,20 +61,33 @@ LAW_BACKENDS = ("auto", "compiled", "numpy")
 
 _PLANT_OPTIONS = ("steering_friction", "tyre_contact")  # RunConfig fields that choose the plant's laws
 
+#: The model fields a change of the chassis mass m1 sets (mass and inertia of the bodies, and the
+#: steering's Coulomb friction through the front axle's load); mj_setConst derives the rest. The
+#: drive servo's gain, which the model scales with the mass, is left as it was (a payload change
+#: does not retune it).
+LOAD_FIELDS = ("body_mass", "body_inertia", "body_ipos", "body_iquat", "dof_frictionloss")
+
+
+def load_fields(params: C80Parameters, **plant_options: Any) -> dict[str, np.ndarray]:
+    """:data:`LOAD_FIELDS` of the plant of ``params`` (give it the changed m1, as with_params makes it)."""
+    model = batch_model(params, **plant_options)
+    return {name: getattr(model, name).copy() for name in LOAD_FIELDS}
+
 
 def plant_options(config: Any) -> dict[str, Any]:
     """The plant-law keywords the config carries (compile_model and Plant take them)."""
     return {name: getattr(config, name) for name in _PLANT_OPTIONS if hasattr(config, name)}
 
 
-def batch_model(params: C80Parameters, *, law: tuple[np.ndarray, Sequence[np.ndarray]] | None = None,
+def batch_model(params: C80Parameters, *, law: tuple[Any, ...] | None = None,
                 **plant_options: Any) -> mujoco.MjModel:
     """The plant of ``compile_model(params, ...)`` without its sky texture, for the engine and the batch.
 
     Generating the 512x3072 sky gradient is 95% of compiling the scene (11.6 of 12 ms
     measured); a texture touches no physics, and a test checks that every other model
-    field equals the serial run's. ``law`` = (law vector, reference rows) attaches the
-    compiled law (:func:`wmr_mj.sim.compiled_law.attach`: two numerics and userdata, no physics).
+    field equals the serial run's. ``law`` = (law vector, reference rows[, disturbance]) attaches the
+    compiled law (:func:`wmr_mj.sim.compiled_law.attach`: two numerics and userdata, no physics; a
+    third numeric with the disturbance torque).
     """
     from wmr_mj.plant import mjcf as plant
 
@@ -185,6 +206,12 @@ class _CompiledStepper:
     def warnings(self) -> int:
         return int(self.batch.warning[0, :, 1].sum())  # (nsim, mjNWARNING, (lastinfo, number))
 
+    def set_fields(self, fields: Mapping[str, np.ndarray]) -> None:
+        """A load change: the model's fields for the batch's simulation, then mj_setConst."""
+        for name, value in fields.items():
+            self.batch.expand(name)[0] = value
+        self.batch.set_const()
+
     def state(self) -> np.ndarray:
         return self.batch.state[0].copy()  # mjSTATE_INTEGRATION of the model with the law
 
@@ -214,12 +241,25 @@ class _PythonStepper:
     """The same closed loop with the Python law, one mj_step at a time (no compiled law, or after a warning)."""
 
     def __init__(self, model: mujoco.MjModel, where: _Plant, substeps: int, log: bool, law: Callable[..., float],
-                 reference: tuple[np.ndarray, np.ndarray, np.ndarray], voltage_limit: float) -> None:
+                 reference: tuple[np.ndarray, np.ndarray, np.ndarray], voltage_limit: float,
+                 disturbance: np.ndarray | None = None, fields: Mapping[str, np.ndarray] | None = None) -> None:
         self.model, self.where, self.substeps, self.log = model, where, substeps, log
-        self.data = mujoco.MjData(model)
-        mujoco.mj_resetDataKeyframe(model, self.data, where.keyframe)
-        mujoco.mj_forward(model, self.data)
+        if fields:
+            self.set_fields(fields)  # on its own copy of the model
+        self.data = mujoco.MjData(self.model)
+        mujoco.mj_resetDataKeyframe(self.model, self.data, where.keyframe)
+        mujoco.mj_forward(self.model, self.data)
         self.law, self.reference, self.limit = law, reference, voltage_limit
+        self.disturbance = disturbance
+        self._own = bool(fields)
+
+    def set_fields(self, fields: Mapping[str, np.ndarray]) -> None:
+        """A load change: the fields in this stepper's own copy of the model, then mj_setConst."""
+        if not getattr(self, "_own", False):
+            self.model, self._own = copy.copy(self.model), True
+        for name, value in fields.items():
+            getattr(self.model, name)[...] = value
+        mujoco.mj_setConst(self.model, mujoco.MjData(self.model))  # scratch data: the run's state stays
 
     def warnings(self) -> int:
         return int(sum(w.number for w in self.data.warning))
@@ -240,8 +280,12 @@ class _PythonStepper:
         xquat, site_xpos, act_force, qfrc_act = d.xquat, d.site_xpos, d.actuator_force, d.qfrc_actuator
         limit, law, substeps, log, step = self.limit, self.law, self.substeps, self.log, mujoco.mj_step
         a0_all, a0d_all, a0dd_all = (r[k0:k0 + count].tolist() for r in self.reference)
+        dist = None if self.disturbance is None else self.disturbance[k0:k0 + count].tolist()
+        qfrc_applied = d.qfrc_applied
         quat = np.empty((count, 4))
         for j in range(count):
+            if dist is not None:
+                qfrc_applied[dv] = dist[j]  # held over the control step's physics steps, as the callback does
             a = float(qpos[qa])
             ad = float(qvel[dv])
             u_cmd = law(a, ad, a0_all[j], a0d_all[j], a0dd_all[j])
@@ -272,7 +316,9 @@ class _PythonStepper:
 def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any],
                reference: tuple[np.ndarray, np.ndarray, np.ndarray], n: int, substeps: int, period: float,
                law: str = "auto", on_block: Callable[[dict[str, np.ndarray]], None] | None = None,
-               on_progress: Callable[[int], None] | None = None, model: mujoco.MjModel | None = None) -> EngineRun:
+               on_progress: Callable[[int], None] | None = None, model: mujoco.MjModel | None = None,
+               disturbance: np.ndarray | None = None,
+               loads: Sequence[tuple[int, Mapping[str, np.ndarray]]] = ()) -> EngineRun:
     """Run ``n`` control steps of ``controller`` on the plant of ``params``; rows of every control step.
 
     ``reference`` = (alpha0, alpha0', alpha0'') on the control grid (at least n samples);
@@ -281,7 +327,9 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
     and C); ``on_progress(steps)`` the control steps of each block. KeyboardInterrupt (Ctrl-C,
     SIGTERM made one) ends the run as "interrupted" with the blocks simulated so far; a block
     committed but not yet handed to ``on_block`` is handed over before returning. ``model``:
-    ``batch_model(params, **options)`` where the caller has it already.
+    ``batch_model(params, **options)`` where the caller has it already. ``disturbance``: a torque on
+    the steering joint [N m] per control step (at least n samples); ``loads``: (control step, model
+    fields) of each load change (:func:`load_fields`), in step order.
     """
     backend, note = _backend(controller, law)
     plain = batch_model(params, **options) if model is None else model
@@ -290,10 +338,16 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
     a0_all, a0d_all, a0dd_all = (np.asarray(r, dtype=np.float64) for r in reference)
     if len(a0_all) < n:
         raise ParameterError(f"reference shorter than the run: {len(a0_all)} < {n} samples")
+    if disturbance is not None:
+        disturbance = np.asarray(disturbance, dtype=np.float64)
+        if len(disturbance) < n:
+            raise ParameterError(f"disturbance shorter than the run: {len(disturbance)} < {n} samples")
+    loads = sorted(((int(k), dict(f)) for k, f in loads), key=lambda kf: kf[0])
+    in_effect: dict[str, np.ndarray] = {}  # the load fields set so far (a Python stepper made later starts with them)
 
-    def python_stepper() -> _PythonStepper:
+    def python_stepper(fields: Mapping[str, np.ndarray] | None = None) -> _PythonStepper:
         return _PythonStepper(plain, where, substeps, log, controller.voltage_scalar, (a0_all, a0d_all, a0dd_all),
-                              params.voltage_limit)
+                              params.voltage_limit, disturbance, fields)
 
     lawful = None
     stepper: _CompiledStepper | _PythonStepper
@@ -303,7 +357,8 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
                                          qpos_adr=where.qpos, dof_adr=where.dof, actuator=where.actuator,
                                          chassis=where.chassis)
         assert vector is not None  # the backend is 'compiled' only where compiled_law.supports(controller)
-        lawful = batch_model(params, law=(vector, (a0_all, a0d_all, a0dd_all)), **options)
+        carried = (vector, (a0_all, a0d_all, a0dd_all)) + (() if disturbance is None else (disturbance[:n],))
+        lawful = batch_model(params, law=carried, **options)
         stepper = _CompiledStepper(lawful, where, substeps, log)
     else:
         stepper = python_stepper()
@@ -329,6 +384,27 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
         sent = upto  # first: an interrupt raised as the block is written must not send it twice
         on_block(block)
 
+    def step_block(st: _CompiledStepper | _PythonStepper, b: _Block, k0: int, cnt: int) -> None:
+        """Step one block; with load changes in it, in parts, each change set at its control step."""
+        due = [(kc, f) for kc, f in loads if k0 <= kc < k0 + cnt]
+        if not due:
+            st.step(b, k0, cnt)
+            return
+        edges = sorted({k0, *(kc for kc, _ in due), k0 + cnt})
+        for s0, s1 in zip(edges, edges[1:]):
+            for kc, f in due:
+                if kc == s0:
+                    st.set_fields(f)
+                    in_effect.update(f)
+            part = _Block(s1 - s0, plain, log)
+            st.step(part, s0, s1 - s0)
+            sl = slice(s0 - k0, s1 - k0)
+            for name in ("alpha", "alpha_dot", "voltage_cmd", "voltage", "force", "torque", "heading"):
+                getattr(b, name)[sl] = getattr(part, name)
+            if log:
+                for name in ("qpos", "qvel", "ctrl", "sites"):
+                    getattr(b, name)[sl] = getattr(part, name)
+
     k0 = cnt = 0
     wall0, cpu0 = time.perf_counter(), time.thread_time()
     try:
@@ -338,16 +414,18 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
             if b is None:
                 b = blocks[cnt] = _Block(cnt, plain, log)
             if isinstance(stepper, _CompiledStepper):
-                before, start = stepper.warnings(), stepper.state()
-                stepper.step(b, k0, cnt)
+                before, start, fields_before = stepper.warnings(), stepper.state(), dict(in_effect)
+                step_block(stepper, b, k0, cnt)
                 if stepper.warnings() != before:  # rollout stopped the simulation: this block again, stepwise
-                    python = python_stepper()
+                    python = python_stepper(fields_before)
                     python.set_state(lawful, start)
                     warned, stepper, used = before, python, "python"
                     note = "MuJoCo warned; the run went on from that block with the Python law"
-                    stepper.step(b, k0, cnt)
+                    in_effect.clear()
+                    in_effect.update(fields_before)
+                    step_block(stepper, b, k0, cnt)
             else:
-                stepper.step(b, k0, cnt)
+                step_block(stepper, b, k0, cnt)
             sl = slice(k0, k0 + cnt)
             rows["t"][sl] = np.arange(k0, k0 + cnt) * period
             rows["alpha"][sl] = b.alpha

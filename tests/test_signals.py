@@ -1,0 +1,126 @@
+"""Signals on the plant during a run (wmr_mj.sim.signals): data, the engine's two steppers, the verdict."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from wmr_mj.errors import ParameterError
+from wmr_mj.sim.closed_loop import run_closed_loop
+from wmr_mj.sim.config import RunConfig
+from wmr_mj.sim.designs import CERTIFIED
+from wmr_mj.sim.signals import Disturbance, LoadChange, Signals, signals_from
+
+SIGNALS = {"disturbance": {"kind": "noise", "amplitude": 0.8, "t1": 0.5, "bandwidth": 3.0, "seed": 7},
+           "d_max": 1.0,
+           "loads": [{"kind": "step", "t": 1.0, "m1": 560.0},
+                     {"kind": "ramp", "t1": 1.5, "t2": 2.0, "m1": 740.0, "every": 0.1}]}
+
+
+def _config(**changes):
+    return RunConfig(**{**CERTIFIED.config_changes(), "duration": 2.5, "path": "lane-change", **changes})
+
+
+def test_signals_round_trip_through_json():
+    s = signals_from(SIGNALS)
+    assert isinstance(s, Signals)
+    again = signals_from(json.dumps(s.as_dict()))
+    assert again == s and again.as_dict() == s.as_dict()
+    assert s.as_dict() == {**SIGNALS, "disturbance": {**SIGNALS["disturbance"]}}
+    assert signals_from({}) is None and signals_from(None) is None
+    assert s.load_steps(650.0)[0] == (1.0, 560.0) and s.load_steps(650.0)[-1] == (2.0, 740.0)
+    assert s.m1_values(650.0)[:2] == [650.0, 560.0]
+
+
+def test_disturbance_kinds():
+    t = np.arange(0, 3.0, 1e-3)
+    step = Disturbance("step", -1.5, t1=1.0).samples(t)
+    assert np.all(step[t < 1.0] == 0.0) and np.all(step[t >= 1.0] == -1.5)
+    pulse = Disturbance("pulse", 2.0, t1=1.0, t2=1.2).samples(t)
+    assert np.count_nonzero(pulse) == 200
+    assert np.all(Disturbance("constant", 0.3).samples(t) == 0.3)
+    noise = Disturbance("noise", 0.8, bandwidth=5.0, seed=3)
+    a, b = noise.samples(t), noise.samples(t)
+    assert np.array_equal(a, b) and np.max(np.abs(a)) <= 0.8 and np.max(np.abs(a)) > 0.5
+    # the same seed gives the same values on a longer run: the prefix does not depend on the duration
+    assert np.array_equal(noise.samples(np.arange(0, 6.0, 1e-3))[:t.size], a)
+    assert not np.array_equal(Disturbance("noise", 0.8, bandwidth=5.0, seed=4).samples(t), a)
+
+
+@pytest.mark.parametrize("bad, word", [
+    ({"disturbance": {"kind": "sine", "amplitude": 1}}, "kind"),
+    ({"disturbance": {"kind": "pulse", "amplitude": 1, "t1": 1}}, "t2"),
+    ({"disturbance": {"kind": "noise", "amplitude": 1, "bandwidth": 2}}, "seed"),
+    ({"disturbance": {"kind": "step", "amplitude": "big"}}, "amplitude"),
+    ({"disturbance": {"kind": "step", "amplitude": 1, "t1": 2, "t2": 1}}, "t2"),
+    ({"loads": [{"kind": "step", "t": 1, "m1": -5}]}, "m1"),
+    ({"loads": [{"kind": "step", "t": 2, "m1": 600}, {"kind": "step", "t": 1, "m1": 700}]}, "order"),
+    ({"load": []}, "unknown key"),
+    ({"d_max": -1}, "d_max"),
+    ("{not json", "JSON"),
+    ("/nonexistent/signals.json", "not readable"),
+])
+def test_bad_signals_raise_one_line(bad, word):
+    with pytest.raises(ParameterError) as info:
+        _config(signals=bad)
+    assert word in str(info.value) and "\n" not in str(info.value)
+
+
+def test_runs_without_signals_keep_their_config_keys():
+    assert "signals" not in RunConfig().as_dict()
+    assert "signals" not in RunConfig(signals={}).as_dict()
+    assert RunConfig(signals=SIGNALS).as_dict()["signals"] == signals_from(SIGNALS).as_dict()
+
+
+def test_signals_run_alike_on_both_steppers_and_reproduce_from_their_report():
+    config = _config(signals=SIGNALS)
+    compiled = run_closed_loop(config)
+    python = run_closed_loop(config, law="numpy")
+    assert compiled.law == "compiled" and python.law == "python"
+    for key in compiled.rows:
+        assert np.array_equal(compiled.rows[key], python.rows[key]), key
+    plain = run_closed_loop(_config())
+    assert not np.array_equal(plain.rows["E"], compiled.rows["E"])  # the signals act
+    again = run_closed_loop(RunConfig(**{**config.as_dict(), "m1_range": tuple(config.m1_range)}))
+    assert all(np.array_equal(again.rows[k], compiled.rows[k]) for k in compiled.rows)
+
+
+def test_load_change_matches_a_run_started_at_that_mass_before_it():
+    """Before its time a load change changes nothing; after it the plant is the other mass's."""
+    changed = run_closed_loop(_config(signals={"loads": [{"kind": "step", "t": 1.0, "m1": 740.0}]}))
+    plain = run_closed_loop(_config())
+    k = 1000
+    assert np.array_equal(changed.rows["E"][:k], plain.rows["E"][:k])
+    assert not np.array_equal(changed.rows["E"][k:], plain.rows["E"][k:])
+
+
+def test_constant_disturbance_shifts_the_steady_error_by_the_closed_form():
+    """On MuJoCo: +1 N m shifts the certified design's late error by about -d_V/(P^ K_P) (stiction aside)."""
+    from wmr_mj import C80
+
+    base = _config(duration=20.0, path="paper-circle")
+    plain = run_closed_loop(base)
+    pushed = run_closed_loop(base.replace(signals={"disturbance": {"kind": "constant", "amplitude": 1.0}}))
+    shift = pushed.rows["E"][-1] - plain.rows["E"][-1]
+    P_hat = C80.coefficients("nonholonomic").P
+    expected = -C80.steering_torque_voltage(1.0) / (P_hat * base.kp)
+    assert shift == pytest.approx(expected, rel=0.05)
+    assert pushed.summary.verdict == "certified-inside"
+    assert pushed.summary.certificate.certificate.disturbance_term > 0
+
+
+def test_signal_beyond_the_declared_bound_or_box_is_uncertified():
+    s = run_closed_loop(_config(signals={"disturbance": {"kind": "step", "amplitude": 1.0, "t1": 1.0},
+                                         "d_max": 0.5, "loads": [{"kind": "step", "t": 2.0, "m1": 800.0}]})).summary
+    assert s.verdict.startswith("uncertified")
+    unmet = {a.name: a for a in s.certificate.assumptions if not a.met}
+    assert set(unmet) == {"disturbance within the bound", "load inside the box"}
+    assert (unmet["disturbance within the bound"].value, unmet["disturbance within the bound"].limit) == (1.0, 0.5)
+    assert (unmet["load inside the box"].value, unmet["load inside the box"].limit) == (800.0, 750.0)
+
+
+def test_load_change_record():
+    ramp = LoadChange("ramp", 700.0, t1=1.0, t2=1.25, every=0.1)
+    assert ramp.steps(600.0) == [(1.0 + 0.25 / 3, 600.0 + 100.0 / 3), (1.0 + 0.5 / 3, 600.0 + 200.0 / 3), (1.25, 700.0)]
