@@ -124,3 +124,48 @@ def test_signal_beyond_the_declared_bound_or_box_is_uncertified():
 def test_load_change_record():
     ramp = LoadChange("ramp", 700.0, t1=1.0, t2=1.25, every=0.1)
     assert ramp.steps(600.0) == [(1.0 + 0.25 / 3, 600.0 + 100.0 / 3), (1.0 + 0.5 / 3, 600.0 + 200.0 / 3), (1.25, 700.0)]
+
+
+# ---------------------------------------------------------------------------- the command line
+def _cli_json(capsys, argv):
+    from wmr_mj.cli.app import main
+
+    assert main(argv) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+RUN = ["run", "--preset", "certified", "--path", "lane-change", "--duration", "3", "--no-log", "--json"]
+
+
+def test_cli_reports_every_signal_parameter_and_reproduces_the_run_to_the_bit(capsys, tmp_path):
+    first = _cli_json(capsys, [*RUN, "--disturbance", "kind=noise,amplitude=0.9,bandwidth=4,seed=11,t1=0.5",
+                               "--load", "t=1,m1=720", "--load", "kind=ramp,t1=1.5,t2=2,m1=600", "--d-max", "1.2"])
+    assert first["signals"] == {"disturbance": {"kind": "noise", "amplitude": 0.9, "t1": 0.5, "bandwidth": 4.0,
+                                                "seed": 11},
+                                "d_max": 1.2,
+                                "loads": [{"kind": "step", "t": 1.0, "m1": 720.0},
+                                          {"kind": "ramp", "t1": 1.5, "t2": 2.0, "every": 0.1, "m1": 600.0}]}
+    assert first["certificate"]["inputs"]["signals"] == first["signals"]
+    assert first["certificate"]["disturbance_term"] > 0
+    path = tmp_path / "worst.json"
+    path.write_text(json.dumps(first["signals"]))
+    for given in (str(path), json.dumps(first["signals"])):
+        again = _cli_json(capsys, [*RUN, "--signals", given])
+        for key in ("sup_E", "sup_Edot", "final_alpha", "verdict", "certificate"):
+            assert again[key] == first[key], key  # JSON floats are written exactly: equal to the bit
+
+
+@pytest.mark.parametrize("argv, word", [
+    (["--disturbance", "kind=step"], "amplitude"),
+    (["--disturbance", "kind=noise,amplitude=1,bandwidth=x,seed=1"], "not a number"),
+    (["--load", "t=1"], "m1"),
+    (["--signals", "{\"loads\": 3}"], "list"),
+    (["--signals", "{\"disturbance\": {\"kind\": \"step\", \"amplitude\": 1}}", "--disturbance",
+      "kind=step,amplitude=1"], "not both"),
+])
+def test_cli_bad_signals_are_one_line_exit_2(capsys, argv, word):
+    from wmr_mj.cli.app import main
+
+    assert main([*RUN, *argv]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("wmr-mj: error: ") and word in err[0], err

@@ -124,6 +124,18 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="progress bar (default: only on a terminal)")
     add_require_option(p)
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    g = p.add_argument_group("signals on the plant during the run (wmr_mj/sim/signals.py); reported under "
+                             "'signals' in --json, which --signals takes back to reproduce the run to the bit")
+    g.add_argument("--signals", metavar="FILE|JSON",
+                   help="a .json file or JSON text: {\"disturbance\": {...}, \"d_max\": N m, \"loads\": [...]}")
+    g.add_argument("--disturbance", metavar="KEY=VALUE,...",
+                   help="torque on the steering joint, N m: kind=constant|step|pulse|noise,amplitude=A "
+                        "[,t1=S][,t2=S][,bandwidth=HZ,seed=N for noise], e.g. kind=step,amplitude=1,t1=5")
+    g.add_argument("--load", action="append", metavar="KEY=VALUE,...",
+                   help="chassis mass change (repeatable, in time order): t=S,m1=KG (a step) or "
+                        "kind=ramp,t1=S,t2=S,m1=KG[,every=S]")
+    g.add_argument("--d-max", type=float, default=None, metavar="NM",
+                   help="disturbance bound the certificate declares, N m (default: the disturbance's amplitude)")
     p.set_defaults(func=run)
 
 
@@ -156,6 +168,48 @@ def format_requirements(results: list[dict]) -> list[str]:
         lines.append(f"requirement {name}: robustness {rob_text} ({status})"
                      + (f"  [{r['note']}]" if r.get("note") else ""))
     return lines
+
+
+def _key_values(option: str, text: str) -> dict:
+    """'k=v,k=v' -> {k: v}, numbers as numbers (seed an integer), kind as text."""
+    from wmr_mj.errors import ParameterError
+
+    out: dict = {}
+    for item in text.split(","):
+        key, sep, value = item.partition("=")
+        key, value = key.strip(), value.strip()
+        if not sep or not key or not value:
+            raise ParameterError(f"{option} {text!r}: expected KEY=VALUE pairs separated by commas")
+        if key == "kind":
+            out[key] = value
+            continue
+        try:
+            out[key] = int(value) if key == "seed" else float(value)
+        except ValueError:
+            raise ParameterError(f"{option} {text!r}: {key} = {value!r} is not a number") from None
+    return out
+
+
+def signals_from_args(args: argparse.Namespace):
+    """The run's Signals from --signals, --disturbance, --load, --d-max (None without any)."""
+    from wmr_mj.errors import ParameterError
+    from wmr_mj.sim.signals import signals_from
+
+    data: dict = {}
+    if getattr(args, "signals", None):
+        s = signals_from(args.signals)
+        data = {} if s is None else s.as_dict()
+    if getattr(args, "disturbance", None):
+        if "disturbance" in data:
+            raise ParameterError("give the disturbance by --signals or by --disturbance, not both")
+        data["disturbance"] = _key_values("--disturbance", args.disturbance)
+    if getattr(args, "load", None):
+        if "loads" in data:
+            raise ParameterError("give the loads by --signals or by --load, not both")
+        data["loads"] = [{"kind": "step", **_key_values("--load", text)} for text in args.load]
+    if getattr(args, "d_max", None) is not None:
+        data["d_max"] = args.d_max
+    return signals_from(data) if data else None
 
 
 def default_log_path(config) -> str:
@@ -217,7 +271,8 @@ def run(args: argparse.Namespace) -> int:
     if not args.no_log:
         path = args.out or default_log_path(args)
         check_output_path(path, kind="file", option="--out")
-    config = config_from_args(args, m1=args.m1)
+    signals = signals_from_args(args)
+    config = config_from_args(args, m1=args.m1, **({} if signals is None else {"signals": signals}))
     period = args.control_period or TIMESTEP
     requirements = requirements_from_args(args, period)
     factory = None
@@ -238,12 +293,20 @@ def run(args: argparse.Namespace) -> int:
 
         judged = [r.as_dict() for r in evaluate_run(requirements, result.rows, result.summary.to_dict(),
                                                     period=period)]
+    report = {**result.summary.to_dict(), "log": path, **({"requirements": judged} if judged else {})}
+    if config.signals is not None:
+        report["signals"] = config.signals.as_dict()  # every parameter: --signals takes it back
     if args.json:
-        print_json({**result.summary.to_dict(), "log": path, **({"requirements": judged} if judged else {})})
+        print_json(report)
     else:
         print(format_report(result.summary))
         if judged:
             print("\n".join(format_requirements(judged)))
+        if config.signals is not None:
+            import json
+
+            print(f"signals: {json.dumps(report['signals'], separators=(',', ':'))}")
+            print(f"reproduce: add --signals '{json.dumps(report['signals'], separators=(',', ':'))}'")
         if path:
             print(f"log: {path}")
     if result.status == "interrupted":
