@@ -169,3 +169,24 @@ def test_cli_bad_signals_are_one_line_exit_2(capsys, argv, word):
     assert main([*RUN, *argv]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("wmr-mj: error: ") and word in err[0], err
+
+
+def test_replay_verify_reapplies_the_signals(tmp_path):
+    import functools
+
+    from wmr_mj.logs.reader import load_log
+    from wmr_mj.logs.replay import verify
+    from wmr_mj.logs.writer import RunLogger
+
+    out = tmp_path / "signals.mcap"
+    run_closed_loop(_config(signals=SIGNALS), logger_factory=functools.partial(RunLogger, str(out)))
+    log = load_log(str(out))
+    assert log.config["signals"] == signals_from(SIGNALS).as_dict()
+    assert verify(log)["identical"]
+
+
+def test_batches_refuse_signals():
+    from wmr_mj.sim.batch import run_batch
+
+    with pytest.raises(ParameterError, match="signals"):
+        run_batch([_config(signals=SIGNALS)])

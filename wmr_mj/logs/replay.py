@@ -202,10 +202,37 @@ def summarize(log: RunLog, settle_s: float | None = None) -> dict[str, Any]:
     return out
 
 
+def _signals_of(log: RunLog, n: int, substeps: int) -> tuple[np.ndarray | None, dict[int, dict[str, np.ndarray]]]:
+    """(disturbance torque per control step or None, {control step: load fields}) of a logged run's signals."""
+    config = log.config
+    if not config.get("signals"):
+        return None, {}
+    from wmr_mj.params import C80Parameters, with_params
+    from wmr_mj.sim.engine import load_fields
+    from wmr_mj.sim.signals import signals_from
+
+    signals = signals_from(config["signals"])
+    if signals is None:
+        return None, {}
+    period = log.timestep * substeps
+    dist = None if signals.disturbance is None else signals.disturbance.samples(np.arange(n) * period)
+    params = C80Parameters(**log.parameters)
+    options = {k: v for k, v in config.items() if k in ("steering_friction", "tyre_contact")}
+    loads: dict[int, dict[str, np.ndarray]] = {}
+    for t, m1 in signals.load_steps(params.m1):
+        k = int(np.ceil(t / period - 1e-9))
+        if k < n:
+            changed = with_params(params, m1_inertia=config.get("m1_inertia", "payload"), m1=m1)
+            loads[k] = load_fields(changed, **options)
+    return dist, loads
+
+
 def verify(log: RunLog) -> dict[str, Any]:
     """Re-simulate from the attached MJCF and initial state with the logged ctrl; compare qpos and
     qvel at every control step. {"identical": bool, "rows", "mj_steps", and where it first and
-    most differs}."""
+    most differs}. A run with signals (config "signals", :mod:`wmr_mj.sim.signals`) gets them again:
+    its disturbance torque on the steering joint at every control step, its load changes' model
+    fields (then mj_setConst) at theirs."""
     import mujoco
 
     try:
@@ -228,9 +255,17 @@ def verify(log: RunLog) -> dict[str, Any]:
         raise LogError(f"{log.path}: /sim/state sizes (nq, nv, nu) do not match the attached model")
     mujoco.mj_setState(m, d, s0, spec)
     sub = log.control_substeps
+    dist, loads = _signals_of(log, n, sub)
+    dof = int(m.jnt_dofadr[m.joint("steer").id])
     sim_q, sim_v = np.empty_like(qpos), np.empty_like(qvel)
     step = mujoco.mj_step
     for k in range(n):  # the runner's loop: record, apply the row's ctrl, step
+        for name, value in loads.get(k, {}).items():
+            getattr(m, name)[...] = value
+        if k in loads:
+            mujoco.mj_setConst(m, mujoco.MjData(m))
+        if dist is not None:
+            d.qfrc_applied[dof] = dist[k]
         sim_q[k] = d.qpos
         sim_v[k] = d.qvel
         d.ctrl[:] = ctrl[k]

@@ -277,6 +277,9 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
     if not configs:
         return []
     first = configs[0]
+    if any(getattr(c, "signals", None) is not None for c in configs):
+        raise ParameterError("run_batch does not apply signals (a disturbance or load changes): run such configs "
+                             "one at a time with run_closed_loop (wmr-mj run --signals)")
     shared = first.replace(m1=M1_NOMINAL, plant_overrides={})
     for c in configs[1:]:
         if c.replace(m1=M1_NOMINAL, plant_overrides={}) != shared:
