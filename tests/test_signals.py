@@ -190,3 +190,27 @@ def test_batches_refuse_signals():
 
     with pytest.raises(ParameterError, match="signals"):
         run_batch([_config(signals=SIGNALS)])
+
+
+def test_worst_signal_found_by_a_search_reproduces_to_the_bit(capsys):
+    """A search over the disturbance and m1; the reported worst signal, given back to `wmr-mj run`, is the same run."""
+    from wmr_mj.sim.signal_search import config_for, search_signals
+    from wmr_mj.sim.signals import Disturbance
+
+    base = _config()
+    # 7.2 N m of Coulomb friction hold the steering: pulses up to 12 N m break it away
+    template = Signals(disturbance=Disturbance("pulse", 1.0, t1=0.5, t2=1.0), d_max=12.0,
+                       loads=(LoadChange("step", 700.0, t=1.5),))
+    cfg = config_for(base, template, ["disturbance.t1", "load0.m1", "R_a"], [0.8, 600.0, 1.1])
+    assert cfg.signals.disturbance.t2 == pytest.approx(1.3) and cfg.signals.loads[0].m1 == 600.0
+    assert cfg.plant_overrides == {"R_a": 1.1}
+    found = search_signals(base, template, {"m1": (550.0, 750.0), "disturbance.amplitude": (-12.0, 12.0),
+                                            "disturbance.t1": (0.2, 2.0)}, budget=12, seed=1)
+    assert len(found.evaluations) == 12 and found.worst.verdict == "certified-inside"
+    assert found.worst_objective > 0.05  # the pulse moves the steering
+    assert found.worst_objective == max(v for _, v, _ in found.evaluations)
+    reported = found.worst_config.as_dict()["signals"]
+    summary = _cli_json(capsys, [*RUN[:-1], "--json", "--duration", "2.5", "--m1", repr(found.worst_config.m1),
+                                 "--signals", json.dumps(reported)])
+    assert summary["sup_E"] == found.worst.sup_E and summary["sup_Edot"] == found.worst.sup_Edot
+    assert summary["certificate"]["E_ratio"] == found.worst_objective
