@@ -256,6 +256,10 @@ def certificate_parser() -> argparse.ArgumentParser:
     if "--range" not in taken:
         p.add_argument("--range", action="append", metavar="NAME=LO:HI",
                        help="another ranged plant parameter of the box (repeatable), e.g. R_a=1.0:1.3")
+    if "--d-max" not in taken:
+        p.add_argument("--d-max", type=float, default=None, metavar="NM",
+                       help="a steering disturbance torque bound, N m: its term R_a d_max/(k_i i2)/P enters delta1 "
+                       "(wmr-mj run --disturbance)")
     if "--uncertainty" not in taken:
         p.add_argument("--uncertainty", choices=UNCERTAINTY_NAMES, default=None,
                        help="a named uncertainty box of wmr_mj.params: m1 (the paper's 550-750 kg) or full "
@@ -314,7 +318,9 @@ def _certificate_table(cert, config, paper) -> str:
         ("gamma1, gamma2 (4.14)", f"{cert.gamma1:.4g}, {cert.gamma2:.4g}"),
         ("delta1 (4.18) [rad/s^2]", f"{fmt(cert.delta1)} = friction {cert.friction_term:.4g} "
                                     f"+ K~ {cert.K_term:.3g} + gyro {cert.gyro_term:.3g} + P~ {cert.P_term:.3g} "
-                                    f"+ C_V~ {cert.C_V_term:.3g} (at P_min)"),
+                                    f"+ C_V~ {cert.C_V_term:.3g}"
+                                    + (f" + disturbance {cert.disturbance_term:.4g}" if cert.disturbance_term else "")
+                                    + " (at P_min)"),
         ("delta2, delta3", f"{fmt(cert.delta2)} (of ||E||), {fmt(cert.delta3)} "
                            f"(of ||E'||; gyro {cert.gyro_Edot_term:.3g})"),
         ("condition (4.23)", fmt(cert.condition)),
@@ -363,7 +369,8 @@ def run_certificate(args: argparse.Namespace) -> int:
 
     m1_range, ranges = _box_ranges(inner)
     inner.m1_range = m1_range
-    config = config_from_args(inner, m1=inner.m1)
+    extra = {} if inner.d_max is None else {"signals": {"d_max": inner.d_max}}
+    config = config_from_args(inner, m1=inner.m1, **extra)
     config = config.replace(m1_range=m1_range, box_ranges=ranges)
     period = config.control_period or TIMESTEP
     n = int(round(config.duration / period))

@@ -89,7 +89,7 @@ def _why_no_certificate(cert: Mapping[str, Any]) -> str:
         margin = cert["steering_range"] - cert["alpha0_max"]
     terms = ", ".join(f"{name} {_fmt(cert.get(key), '.3g')}" for name, key in
                       (("K~ term", "K_term"), ("friction", "friction_term"), ("gyro", "gyro_term"),
-                       ("P~", "P_term"), ("C_V~", "C_V_term")) if cert.get(key))
+                       ("P~", "P_term"), ("C_V~", "C_V_term"), ("disturbance", "disturbance_term")) if cert.get(key))
     reason = cert.get("reason") or "an assumption fails"
     text = (f"{reason[:1].upper() + reason[1:]}. Not met: {_unmet_text(cert)}. "
             f"delta1 = {_fmt(cert.get('delta1'), '.3g')} rad/s^2 ({terms}), gamma1 = {_fmt(cert.get('gamma1'), '.3g')} "
