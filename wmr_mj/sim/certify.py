@@ -189,7 +189,7 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
     g_lo, g_hi = GYRO_MEASURED_RATIOS
     g_used = max((1.0 - g_lo) / (1.0 - gyro_band[0]) if gyro_band[0] < 1.0 else math.inf,
                  (g_hi - 1.0) / (gyro_band[1] - 1.0) if gyro_band[1] > 1.0 else math.inf)
-    stated = (
+    stated: tuple[Assumption, ...] = (
         Assumption("plant K band", f"|K_plant| <= {k_band:g} V (non-holonomic plant: K = 0)",
                    k_seen <= k_band, k_seen, k_band,
                    "MuJoCo identify K = -0.0052 +- 0.0016 V; Drake 0.018 V at 1e7 N/m (physics.md section 6)",
@@ -204,8 +204,8 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
     d_V = 0.0
     if signals is not None:
         d_V = disturbance_voltage(signals.declared_d_max, plant, ranges)
-        stated = stated + _signal_assumptions(signals, plant.m1, _hull(tuple(float(v) for v in config.m1_range),
-                                                                          plant.m1))
+        m1_box = _hull((float(config.m1_range[0]), float(config.m1_range[1])), plant.m1)
+        stated = stated + _signal_assumptions(signals, plant.m1, m1_box)
     cert = certify(plant=PlantBox(box=plant_box, gyro=gyro, V_A=V_A, friction_over_P=ratio, disturbance=d_V),
                    estimate=estimate, gains=Gains(kp=config.kp, kd=config.kd),
                    reference=reference.bounds(),

@@ -120,7 +120,7 @@ def search_signals(base: RunConfig, template: Signals, ranges: Mapping[str, tupl
         cfg = config_for(base, template, names, x)
         s = run_closed_loop(cfg).summary
         value = _objective(s, objective)
-        evaluations.append((tuple(float(v) for v in x), value, s.verdict))
+        evaluations.append((tuple(float(v) for v in x), value, str(s.verdict)))
         if value > best["value"]:
             best.update(value=value, x=tuple(float(v) for v in x), config=cfg, summary=s)
         return -value if math.isfinite(value) else -1e300

@@ -117,11 +117,12 @@ class Disturbance:
             on &= t < self.t2
         if self.kind != "noise":
             return np.where(on, self.amplitude, 0.0)
-        h = 0.5 / float(self.bandwidth)  # knot spacing, s
+        assert self.bandwidth is not None and self.seed is not None  # checked for noise at construction
+        h = 0.5 / self.bandwidth  # knot spacing, s
         x = t / h
         j = np.floor(x).astype(np.int64)
         count = int(j.max()) + 2 if j.size else 2
-        knots = self.amplitude * np.random.default_rng(int(self.seed)).uniform(-1.0, 1.0, size=count)
+        knots = self.amplitude * np.random.default_rng(self.seed).uniform(-1.0, 1.0, size=count)
         w = 0.5 * (1.0 - np.cos(math.pi * (x - j)))
         return np.where(on, knots[j] * (1.0 - w) + knots[j + 1] * w, 0.0)
 
