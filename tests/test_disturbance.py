@@ -93,3 +93,23 @@ def test_no_disturbance_leaves_the_certificate_as_it_was():
     assert "disturbance_term" not in a.as_dict() and "disturbance_V" not in a.as_dict()["inputs"]
     assert b.delta1 > a.delta1 and b.E_max > a.E_max
     assert math.isclose(b.delta1 - a.delta1, 1e-3 / 0.385, rel_tol=1e-9)
+
+
+def test_disturbance_term_over_an_R_a_box_is_d_max_over_the_steering_inertia():
+    """d_V/P = d/(2D): R_a cancels, so over R_a 1.0-1.3 the term stays d_max/(2D), not d_V(1.3)/P(1.0)."""
+    from wmr_mj.sim.certify import certificate_for
+    from wmr_mj.sim.config import RunConfig, build_reference
+    from wmr_mj.sim.designs import CERTIFIED
+
+    base = RunConfig(**CERTIFIED.config_changes(), box_ranges={"R_a": (1.0, 1.3)})
+    reference = build_reference(base.path, C80, dt=1e-3, duration=35.0)[0]
+    plain = certificate_for(base, reference)
+    cert = certificate_for(base.replace(signals={"d_max": 1.0}), reference)
+    two_D = 2.0 * C80.kinetic_energy_coefficients()["D"]
+    assert cert.disturbance_term == pytest.approx(1.0 / two_D, rel=1e-12)
+    d_V_max = 1.3 / (C80.k_i * C80.i2)
+    assert cert.inputs["disturbance_V"] == pytest.approx(d_V_max, rel=1e-12)
+    assert cert.disturbance_term < d_V_max / plain.inputs["box"]["P"][0]
+    assert cert.delta1 > plain.delta1 and cert.certified
+    # without signals the certificate is the one it always was: no new keys
+    assert "disturbance_term" not in plain.as_dict() and "disturbance_V" not in plain.as_dict()["inputs"]

@@ -42,6 +42,10 @@ u + d_V, d_V = R_a d/(k_i i2) (the factor that gives P = (R_a/k_i) 2D/i2 and F =
 tau_f, wmr_mj.params.C80Parameters.coefficients). In the error equation d_V enters as -d_V/P,
 beside the other P^-1 terms, so |d| <= d_max adds d_V,max/P to delta1 at every P corner, with
 d_V,max = d_max max(R_a)/min(k_i i2) over the box (:func:`wmr_mj.sim.certify.certificate_for`).
+d_V and P move together as F and P do: d_V/P = d/(2D), which R_a, k_i, i2 leave alone, so with
+r_d >= d_max/(2D) over the box (``PlantBox.disturbance_over_P``) the term at P is
+min(d_V,max, r_d P)/P, and d_V,max/r_d joins the P corners (between corners each term stays of
+the form A + B/P, monotone).
 delta2, delta3 and (4.23) do not change; E_max and Edot_max grow with delta1 (linearly, but for
 the fixed point on alpha_max). The supply assumption bounds the law's voltage, which d does not
 enter. Check (tests/test_disturbance.py): the PD loop u = P^ (K_D E' + K_P E) on a plant with
@@ -542,6 +546,9 @@ class PlantBox:
             F_max at every P; None: F and P independent, as the box alone says.
         disturbance: d_V,max [V], the bound on a steering disturbance torque at the motor's voltage,
             R_a d_max/(k_i i2) maximised over the box (module docstring); 0: none.
+        disturbance_over_P: an upper bound on d_V/P = d_max/(2D) over the plants of the box
+            [rad/s^2] (R_a cancels, as in F/P); the term at each P is then min(d_V,max, r_d P)/P.
+            None: d_V,max/P at every P.
 
     Raises:
         ParameterError: a box that is not a ParameterBox, F < 0, a range that is not finite lo <= hi,
@@ -553,6 +560,7 @@ class PlantBox:
     V_A: tuple[float, float]
     friction_over_P: float | None = None
     disturbance: float = 0.0
+    disturbance_over_P: float | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.box, ParameterBox):
@@ -565,6 +573,9 @@ class PlantBox:
             object.__setattr__(self, "friction_over_P",
                                _number("friction_over_P", self.friction_over_P, minimum=0.0, strict=True))
         object.__setattr__(self, "disturbance", _number("disturbance", self.disturbance, minimum=0.0))
+        if self.disturbance_over_P is not None:
+            object.__setattr__(self, "disturbance_over_P",
+                               _number("disturbance_over_P", self.disturbance_over_P, minimum=0.0, strict=True))
 
 
 @dataclass(frozen=True)
@@ -741,7 +752,8 @@ def certify(
         friction_term=max(bound.phi_at(p) / p for p in bound.P_corners), gyro_term=bound.dG * bound.a0d / c2 / P_lo,
         K_term=bound.dK * S / P_lo, P_term=max(abs(p - bound.P_ff) / p for p in bound.P_corners) * bound.a0dd,
         C_V_term=bound.dC * bound.a0d / P_lo, gyro_Edot_term=bound.dG / c2 / P_lo,
-        dead_band=plant.box.F[1] / (estimate.P * gains.kp), disturbance_term=plant.disturbance / P_lo,
+        dead_band=plant.box.F[1] / (estimate.P * gains.kp),
+        disturbance_term=max(bound.dist_at(p) / p for p in bound.P_corners) if plant.disturbance else 0.0,
         kp=gains.kp, kd=gains.kd, friction_sign=compensation.friction_sign,
         friction_width=compensation.friction_width, reason=reason, iterations=iterations,
         inputs=_inputs_record(plant, estimate, compensation, a0, bound, limits, control_period, (E0, Ed0)),
@@ -813,6 +825,9 @@ class _Bound:
         if friction_over_P is not None:
             breaks = (box.F[1] / friction_over_P, F_hat / friction_over_P)
             P_corners = sorted({*P_corners, *(b for b in breaks if P_lo < b < P_hi)})
+        if plant.disturbance and plant.disturbance_over_P is not None:
+            b = plant.disturbance / plant.disturbance_over_P
+            P_corners = sorted({*P_corners, *([b] if P_lo < b < P_hi else [])})
         dC_lo, dC_hi = box.C_V[0] - estimate.C_V, box.C_V[1] - estimate.C_V
         Gam = [g * v for g in plant.gyro for v in plant.V_A]
         Gam_hat = estimate.gyro * estimate.V_A
@@ -835,6 +850,11 @@ class _Bound:
         F_p = F[1] if r is None else min(F[1], r * p)
         return friction_term(self.friction_sign, F=(F[0], F_p), F_hat=self.estimate.F)
 
+    def dist_at(self, p: float) -> float:
+        """sup |d_V| [V] for the plants with this P (module docstring)."""
+        d, r = self.plant.disturbance, self.plant.disturbance_over_P
+        return d if r is None else min(d, r * p)
+
     @property
     def phi(self) -> float:
         """sup |f - F^ s| [V] over the box."""
@@ -844,9 +864,11 @@ class _Bound:
         """delta1, delta3 and (4.23) with the plant's angle up to ``alpha_max`` [rad]."""
         S, c2 = _S(alpha_max), math.cos(alpha_max) ** 2
         rest = self.dK * S + self.dC * self.a0d + self.dG * self.a0d / c2
-        if self.plant.disturbance:
-            rest = rest + self.plant.disturbance  # d_V,max: |d_V|/P beside the other terms (module docstring)
-        delta1 = max((abs(p - self.P_ff) * self.a0dd + self.phi_at(p) + rest) / p for p in self.P_corners)
+        if self.plant.disturbance:  # |d_V|/P beside the other terms (module docstring)
+            delta1 = max((abs(p - self.P_ff) * self.a0dd + self.phi_at(p) + rest + self.dist_at(p)) / p
+                         for p in self.P_corners)
+        else:
+            delta1 = max((abs(p - self.P_ff) * self.a0dd + self.phi_at(p) + rest) / p for p in self.P_corners)
         delta3 = max(abs(self.mis[p] * self.kd - (c + g / cc) / p)
                      for p in self.P_corners for c in (self.dC_lo, self.dC_hi) for g in (self.dG_lo, self.dG_hi)
                      for cc in (c2, 1.0))
@@ -912,7 +934,8 @@ def _inputs_record(plant: PlantBox, estimate: Estimate, compensation: Compensati
         "reference": {"alpha0_max": a0, "alpha0_dot_max": bound.a0d, "alpha0_ddot_max": bound.a0dd},
         "steering_range": limits.steering_range, "voltage_limit": limits.voltage_limit,
         "control_period": control_period, "initial_error": list(initial_error), "friction_amplitude_phi": bound.phi,
-        **({"disturbance_V": plant.disturbance} if plant.disturbance else {}),
+        **({"disturbance_V": plant.disturbance, "disturbance_over_P": plant.disturbance_over_P}
+           if plant.disturbance else {}),
     }
 
 

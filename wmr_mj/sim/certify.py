@@ -13,6 +13,7 @@ Usage::
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Mapping
 from typing import Any
@@ -201,12 +202,17 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
         *outside_the_box(config, plant, base),
     )
     signals = getattr(config, "signals", None)
-    d_V = 0.0
+    d_V, d_over_P = 0.0, None
     if signals is not None:
         d_V = disturbance_voltage(signals.declared_d_max, plant, ranges)
+        if d_V and config.box != "paper":  # (5.1)'s printed P interval comes with no inertia behind it
+            d_over_P = disturbance_over_P_max(signals.declared_d_max, estimate_params, plant,
+                                              tuple(float(v) for v in config.m1_range), config.m1_inertia,
+                                              tuple(sorted(ranges.items())))
         m1_box = _hull((float(config.m1_range[0]), float(config.m1_range[1])), plant.m1)
         stated = stated + _signal_assumptions(signals, plant.m1, m1_box)
-    cert = certify(plant=PlantBox(box=plant_box, gyro=gyro, V_A=V_A, friction_over_P=ratio, disturbance=d_V),
+    cert = certify(plant=PlantBox(box=plant_box, gyro=gyro, V_A=V_A, friction_over_P=ratio, disturbance=d_V,
+                                  disturbance_over_P=d_over_P),
                    estimate=estimate, gains=Gains(kp=config.kp, kd=config.kd),
                    reference=reference.bounds(),
                    limits=PlantLimits(steering_range=plant.steering_range, voltage_limit=plant.voltage_limit),
@@ -235,6 +241,27 @@ def disturbance_voltage(d_max: float, plant: C80Parameters, ranges: Mapping[str,
     if k_i <= 0 or i2 <= 0:
         raise ParameterError(f"k_i = {k_i:g}, i2 = {i2:g}: the disturbance bound needs k_i, i2 > 0 over the box")
     return float(d_max) * R_a / (k_i * i2)
+
+
+def disturbance_over_P_max(d_max: float, params: C80Parameters, plant: C80Parameters, m1_range: tuple[float, float],
+                           m1_inertia: str, ranges: tuple[tuple[str, tuple[float, float]], ...]) -> float | None:
+    """max d_V/P [rad/s^2] = d_max/min(2D) over the box's plants and the run's ``plant``.
+
+    d_V/P = (R_a d/(k_i i2)) / ((R_a/k_i) 2D/i2) = d/(2D): R_a, k_i, i2 cancel and 2D, the steering's
+    inertia, does not depend on m1 or any other parameter but the geometry and masses of
+    :data:`wmr_mj.analysis.certificate._F_OVER_P_NOT_MONOTONE`; with one of those ranged, None.
+    """
+    from wmr_mj.analysis.certificate import _F_OVER_P_NOT_MONOTONE
+    from wmr_mj.params import with_params
+
+    if any(name in _F_OVER_P_NOT_MONOTONE for name, _ in ranges):
+        return None
+    axes = [("m1", m1_range), *ranges]
+    worst = plant.steering_torque_voltage(d_max) / plant.coefficients("nonholonomic").P
+    for corner in itertools.product(*(span for _, span in axes)):
+        p = with_params(params, m1_inertia=m1_inertia, **dict(zip((n for n, _ in axes), corner)))
+        worst = max(worst, p.steering_torque_voltage(d_max) / p.coefficients("nonholonomic").P)
+    return worst
 
 
 def _signal_assumptions(signals: Any, m1: float, m1_box: tuple[float, float]) -> tuple[Assumption, ...]:
