@@ -244,18 +244,18 @@ class _PythonStepper:
                  reference: tuple[np.ndarray, np.ndarray, np.ndarray], voltage_limit: float,
                  disturbance: np.ndarray | None = None, fields: Mapping[str, np.ndarray] | None = None) -> None:
         self.model, self.where, self.substeps, self.log = model, where, substeps, log
+        self._own = False  # whether self.model is this stepper's own copy (made at the first load change)
         if fields:
-            self.set_fields(fields)  # on its own copy of the model
+            self.set_fields(fields)
         self.data = mujoco.MjData(self.model)
         mujoco.mj_resetDataKeyframe(self.model, self.data, where.keyframe)
         mujoco.mj_forward(self.model, self.data)
         self.law, self.reference, self.limit = law, reference, voltage_limit
         self.disturbance = disturbance
-        self._own = bool(fields)
 
     def set_fields(self, fields: Mapping[str, np.ndarray]) -> None:
         """A load change: the fields in this stepper's own copy of the model, then mj_setConst."""
-        if not getattr(self, "_own", False):
+        if not self._own:
             self.model, self._own = copy.copy(self.model), True
         for name, value in fields.items():
             getattr(self.model, name)[...] = value
