@@ -74,8 +74,9 @@ def test_runs_without_signals_keep_their_config_keys():
     assert RunConfig(signals=SIGNALS).as_dict()["signals"] == signals_from(SIGNALS).as_dict()
 
 
-def test_signals_run_alike_on_both_steppers_and_reproduce_from_their_report():
-    config = _config(signals=SIGNALS)
+@pytest.mark.parametrize("period", [None, 0.005])
+def test_signals_run_alike_on_both_steppers_and_reproduce_from_their_report(period):
+    config = _config(signals=SIGNALS, control_period=period)
     compiled = run_closed_loop(config)
     python = run_closed_loop(config, law="numpy")
     assert compiled.law == "compiled" and python.law == "python"
