@@ -137,14 +137,6 @@ class Coefficients:
     K: float  # V, coefficient of sin/cos^3
     gyro: float  # V s/m, coefficient of V_A alpha'/cos^2
 
-    def steering_torque_voltage(self, torque: float) -> float:
-        """The voltage [V] equivalent to a torque [N m] on the steering joint: R_a torque/(k_i i2).
-
-        The dcmotor gives the joint i2 k_i (u - k_b i2 a')/R_a, so a joint torque d enters the
-        voltage form (2.12) as u + R_a d/(k_i i2), the factor of P and F in :meth:`coefficients`.
-        """
-        return self.R_a * float(torque) / (self.k_i * self.i2)
-
     def as_dict(self) -> dict[str, float]:
         return dataclasses.asdict(self)
 

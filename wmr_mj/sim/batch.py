@@ -306,7 +306,7 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
                        hint="run fewer at once (a smaller chunk) or the NumPy law (WMR_MJ_COMPILED_LAW=0)")
         compiled_law.install()
         # law_vector is None only for a law supports() refuses, and then the backend is not 'compiled'
-        models = [batch_model(p, law=(compiled_law.law_vector(controller, voltage_limit=p.voltage_limit,  # type: ignore[arg-type]
+        models = [batch_model(p, law=(compiled_law.law_vector(controller, voltage_limit=p.voltage_limit,
                                                               substeps=substeps, nstep=n, **where), rows),
                               **options) for p in plants]
     else:

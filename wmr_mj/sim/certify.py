@@ -205,11 +205,11 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
     d_V, d_over_P = 0.0, None
     if signals is not None:
         d_V = disturbance_voltage(signals.declared_d_max, plant, ranges)
+        m1_range = (float(config.m1_range[0]), float(config.m1_range[1]))
         if d_V and config.box != "paper":  # (5.1)'s printed P interval comes with no inertia behind it
-            d_over_P = disturbance_over_P_max(signals.declared_d_max, estimate_params, plant,
-                                              tuple(float(v) for v in config.m1_range), config.m1_inertia,
-                                              tuple(sorted(ranges.items())))
-        m1_box = _hull((float(config.m1_range[0]), float(config.m1_range[1])), plant.m1)
+            d_over_P = disturbance_over_P_max(signals.declared_d_max, estimate_params, plant, m1_range,
+                                              config.m1_inertia, tuple(sorted(ranges.items())))
+        m1_box = _hull(m1_range, plant.m1)
         stated = stated + _signal_assumptions(signals, plant.m1, m1_box)
     cert = certify(plant=PlantBox(box=plant_box, gyro=gyro, V_A=V_A, friction_over_P=ratio, disturbance=d_V,
                                   disturbance_over_P=d_over_P),
