@@ -41,6 +41,8 @@ if TYPE_CHECKING:
     from wmr_mj.sim.config import RunConfig, controller_for
     from wmr_mj.sim.designs import CERTIFIED, PAPER, PRESETS, preset
     from wmr_mj.sim.falsify import FalsifySpec, falsify
+    from wmr_mj.sim.signal_search import search_signals
+    from wmr_mj.sim.signals import Disturbance, LoadChange, Signals
     from wmr_mj.sim.sweep import SweepSpec, run_sweep
 
 #: name -> the module that defines it, imported on first access
@@ -59,6 +61,10 @@ _LAZY: dict[str, str] = {
     "PRESETS": "wmr_mj.sim.designs",
     "preset": "wmr_mj.sim.designs",
     "load_log": "wmr_mj.logs.reader",
+    "Signals": "wmr_mj.sim.signals",
+    "Disturbance": "wmr_mj.sim.signals",
+    "LoadChange": "wmr_mj.sim.signals",
+    "search_signals": "wmr_mj.sim.signal_search",
     "RunLogger": "wmr_mj.logs.writer",
 }
 
@@ -75,6 +81,10 @@ __all__ = [
     "RunResult",
     "controller_for",
     "certificate_for",
+    # what acts on the plant during a run: a steering disturbance, load changes
+    "Signals",
+    "Disturbance",
+    "LoadChange",
     # the design presets
     "PAPER",
     "CERTIFIED",
@@ -85,6 +95,7 @@ __all__ = [
     "run_sweep",
     "FalsifySpec",
     "falsify",
+    "search_signals",
     # logs
     "RunLogger",
     "load_log",
