@@ -131,9 +131,10 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
 
     Signals (config.signals, :mod:`wmr_mj.sim.signals`): the declared disturbance bound d_max
     [N m] enters delta1 as d_V,max = d_max max(R_a)/min(k_i i2) over the box and the run's plant
-    (:func:`disturbance_voltage`); two assumptions are added, "disturbance within the bound"
-    (the signal's max|d| against d_max) and "load inside the box" (every m1 the run has against
-    the box's m1 range, the run's initial m1 included). A run without signals gets neither.
+    (:func:`disturbance_voltage`); the assumption "disturbance within the bound" (the signal's
+    max|d| against d_max) is added, and with load changes "load inside the box" (every m1 they
+    set against the box's m1 range; the initial m1 is the plant's, checked as every run's by
+    :func:`outside_the_box`). A run without signals gets neither.
     """
     base = params
     k_band = finite_number("k_band", k_band, minimum=0.0)
@@ -209,8 +210,7 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
         if d_V and config.box != "paper":  # (5.1)'s printed P interval comes with no inertia behind it
             d_over_P = disturbance_over_P_max(signals.declared_d_max, estimate_params, plant, m1_range,
                                               config.m1_inertia, tuple(sorted(ranges.items())))
-        m1_box = _hull(m1_range, plant.m1)
-        stated = stated + _signal_assumptions(signals, plant.m1, m1_box)
+        stated = stated + _signal_assumptions(signals, plant.m1, m1_range)
     cert = certify(plant=PlantBox(box=plant_box, gyro=gyro, V_A=V_A, friction_over_P=ratio, disturbance=d_V,
                                   disturbance_over_P=d_over_P),
                    estimate=estimate, gains=Gains(kp=config.kp, kd=config.kd),
@@ -265,21 +265,22 @@ def disturbance_over_P_max(d_max: float, params: C80Parameters, plant: C80Parame
 
 
 def _signal_assumptions(signals: Any, m1: float, m1_box: tuple[float, float]) -> tuple[Assumption, ...]:
-    """The assumptions a run with signals adds: its disturbance within d_max, its loads inside the m1 box."""
+    """The assumptions a run with signals adds: its disturbance within d_max; with load changes, every
+    m1 they set inside the box's m1 range (the initial m1, the plant's, is :func:`outside_the_box`'s)."""
     d_max = signals.declared_d_max
     d = signals.disturbance.bound if signals.disturbance is not None else 0.0
-    lo, hi = m1_box
-    values = signals.m1_values(m1)
-    # the value farthest outside the box (else the one nearest an edge), with that edge
-    worst = max(values, key=lambda v: max(lo - v, v - hi))
-    edge = lo if (lo - worst) > (worst - hi) else hi
-    inside = all(lo <= v <= hi for v in values)
-    return (
-        Assumption("disturbance within the bound", "max|d| <= d_max (declared; enters delta1 as R_a d_max/(k_i i2))",
-                   d <= d_max, d, d_max, "N m on the steering joint", kind="checked"),
-        Assumption("load inside the box", f"{lo:g} <= m1(t) <= {hi:g} kg at every load change",
-                   inside, worst, edge,
-                   "m1 values of the run: " + ", ".join(f"{v:g}" for v in values) + " kg", kind="checked"),
-    )
+    out = [Assumption("disturbance within the bound", "max|d| <= d_max (declared; enters delta1 as R_a d_max/(k_i i2))",
+                      d <= d_max, d, d_max, "N m on the steering joint", kind="checked")]
+    values = [v for _, v in signals.load_steps(m1)]
+    if values:
+        lo, hi = m1_box
+        # the value farthest outside the box (else the one nearest an edge), with that edge
+        worst = max(values, key=lambda v: max(lo - v, v - hi))
+        edge = lo if (lo - worst) > (worst - hi) else hi
+        out.append(Assumption("load inside the box", f"{lo:g} <= m1 <= {hi:g} kg at every load change",
+                              all(lo <= v <= hi for v in values), worst, edge,
+                              f"m1 from {m1:g} kg, then " + ", ".join(f"{v:g}" for v in values) + " kg",
+                              kind="checked"))
+    return tuple(out)
 
 
