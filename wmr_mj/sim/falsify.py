@@ -162,6 +162,31 @@ class Trace:
         return int(np.argmax(finite)) if finite.size and np.isfinite(finite).any() else -1
 
 
+class _Recorder:
+    """Calls evaluate(points (S, d)) -> values (S,), checks the shape, and keeps every batch in order
+    (a batch is a generation) for the search's :class:`Trace`."""
+
+    def __init__(self, evaluate: Callable[[np.ndarray], np.ndarray]) -> None:
+        self._evaluate = evaluate
+        self._points: list[np.ndarray] = []
+        self._values: list[np.ndarray] = []
+        self._generation: list[np.ndarray] = []
+        self.spent = 0  # points evaluated so far
+
+    def __call__(self, batch: np.ndarray) -> np.ndarray:
+        v = np.asarray(self._evaluate(batch), dtype=float).reshape(-1)
+        if v.shape != (len(batch),):
+            raise ValueError(f"evaluate returned {v.shape} values for {len(batch)} points")
+        self._generation.append(np.full(len(batch), len(self._points)))
+        self._points.append(batch)
+        self._values.append(v)
+        self.spent += len(batch)
+        return v
+
+    def trace(self) -> Trace:
+        return Trace(np.concatenate(self._points), np.concatenate(self._values), np.concatenate(self._generation))
+
+
 def population_size(budget: int, d: int) -> int:
     """Members per generation: 10 per parameter, but at most an eighth of the budget (so
     that at least 8 generations run), and never below scipy's minimum of 5."""
@@ -268,9 +293,7 @@ def _search_vertices_polish(evaluate: Callable[[np.ndarray], np.ndarray], bounds
     _check_budget(budget, MIN_POPULATION)
     rng = np.random.default_rng(np.random.SeedSequence(seed).spawn(4)[3])
     lo, span = bounds[:, 0], bounds[:, 1] - bounds[:, 0]
-    points: list[np.ndarray] = []
-    values: list[np.ndarray] = []
-    generation: list[np.ndarray] = []
+    rec = _Recorder(evaluate)
     seen: dict[tuple[float, ...], float] = {}
 
     def run(unit: np.ndarray) -> np.ndarray:
@@ -278,21 +301,15 @@ def _search_vertices_polish(evaluate: Callable[[np.ndarray], np.ndarray], bounds
         unit = np.clip(np.atleast_2d(np.asarray(unit, dtype=float)), 0.0, 1.0)
         keys = [tuple(u.tolist()) for u in unit]
         new = list(dict.fromkeys(k for k in keys if k not in seen))
-        if sum(len(p) for p in points) + len(new) > budget:
+        if rec.spent + len(new) > budget:
             raise _BudgetSpent
         if new:
-            batch = lo + np.array(new) * span
-            v = np.asarray(evaluate(batch), dtype=float).reshape(-1)
-            if v.shape != (len(batch),):
-                raise ValueError(f"evaluate returned {v.shape} values for {len(batch)} points")
-            points.append(batch)
-            values.append(v)
-            generation.append(np.full(len(batch), len(generation)))
+            v = rec(lo + np.array(new) * span)
             seen.update(zip(new, v.tolist()))
         return np.array([seen[k] for k in keys])
 
     def spent() -> int:
-        return sum(len(p) for p in points)
+        return rec.spent
 
     vertices = covering_design(d, budget if 2 ** d <= budget else max(1, budget // 2), rng)
     run(vertices)
@@ -322,7 +339,7 @@ def _search_vertices_polish(evaluate: Callable[[np.ndarray], np.ndarray], bounds
                          options={"initial_simplex": simplex, "maxfev": budget, "xatol": 1e-4, "fatol": 1e-7})
         except _BudgetSpent:
             break
-    return Trace(np.concatenate(points), np.concatenate(values), np.concatenate(generation))
+    return rec.trace()
 
 
 def _search_de(evaluate: Callable[[np.ndarray], np.ndarray], bounds: np.ndarray, *, budget: int, seed: int = 0,
@@ -345,25 +362,17 @@ def _search_de(evaluate: Callable[[np.ndarray], np.ndarray], bounds: np.ndarray,
     _check_budget(budget, population)
     init_rng, evolve_rng, _ = _streams(seed)
     init = _unit_to_box(latin_hypercube(population, d, init_rng), bounds)
-    points: list[np.ndarray] = []
-    values: list[np.ndarray] = []
-    generation: list[np.ndarray] = []
+    rec = _Recorder(evaluate)
 
     def energies(x: np.ndarray) -> np.ndarray:  # x: (d, S); DE minimises
-        batch = np.array(x.T, dtype=float)
-        v = np.asarray(evaluate(batch), dtype=float).reshape(-1)
-        if v.shape != (len(batch),):
-            raise ValueError(f"evaluate returned {v.shape} values for {len(batch)} points")
-        points.append(batch)
-        values.append(v)
-        generation.append(np.full(len(batch), len(generation)))
+        v = rec(np.array(x.T, dtype=float))
         return np.where(np.isnan(v), np.inf, -v)
 
     with warnings.catch_warnings(), _user_errors_unwrapped():
         warnings.simplefilter("ignore", RuntimeWarning)  # inf energies of undefined points
         differential_evolution(energies, bounds, maxiter=budget // population - 1, init=init, polish=False,
                                tol=0.0, atol=0.0, updating="deferred", vectorized=True, rng=evolve_rng)
-    return Trace(np.concatenate(points), np.concatenate(values), np.concatenate(generation))
+    return rec.trace()
 
 
 def random_worst(evaluate: Callable[[np.ndarray], np.ndarray], bounds: np.ndarray, *, n: int,
