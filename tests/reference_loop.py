@@ -23,7 +23,16 @@ from wmr_mj.errors import ParameterError
 from wmr_mj.params import C80, C80Parameters
 from wmr_mj.plant.mjcf import Plant
 from wmr_mj.sim.certify import certificate_for
-from wmr_mj.sim.closed_loop import ROW_FIELDS, RunResult, _drift_of, _substeps, _sup, report
+from wmr_mj.sim.closed_loop import (
+    ROW_FIELDS,
+    RunResult,
+    _drift_of,
+    _substeps,
+    _sup,
+    judge_path,
+    path_sample_index,
+    report,
+)
 from wmr_mj.sim.config import (
     RunConfig,
     analysis_for,
@@ -70,6 +79,7 @@ def reference_run(
     full = logger_factory is not None
     block_len = max(1, int(round(1.0 / period)))  # one simulated second per block
     rows = {k: np.empty(n) for k in ROW_FIELDS}
+    r_C = np.empty((n, 2))  # C's xy at every control step (the path errors)
     if full:  # per logged row: qpos, qvel, ctrl in one mj_getState call, and the site positions
         log_spec = int(mujoco.mjtState.mjSTATE_QPOS | mujoco.mjtState.mjSTATE_QVEL | mujoco.mjtState.mjSTATE_CTRL)
         log_state = np.empty((block_len, mujoco.mj_stateSize(m, log_spec)))
@@ -150,6 +160,7 @@ def reference_run(
             r_tau[k] = qfrc_act[dv]
             q = xquat[chassis]
             r_h[k] = math.atan2(2.0 * (q[0] * q[3] + q[1] * q[2]), 1.0 - 2.0 * (q[2] * q[2] + q[3] * q[3]))
+            r_C[k] = site_xpos[site_C, :2]
             if full:
                 site_rows[j][...] = site_xpos
             if left_range_at is None and abs(a) >= range_limit:
@@ -168,12 +179,15 @@ def reference_run(
     if k == 0:
         raise KeyboardInterrupt  # nothing simulated: nothing to report
     after = done["t"] >= settle_s
+    at = path_sample_index(k, period)
     summary = report(config, analysis=analysis, params=params, settle_s=settle_s, sup_E=_sup(done["E"]),
                      sup_Edot=_sup(done["E_dot"]), sup_E_settled=_sup(done["E"][after]),
                      sup_Edot_settled=_sup(done["E_dot"][after]), saturated_fraction=saturated / k,
                      left_range_at=left_range_at, final_alpha=done["alpha"][-1], control_steps=k,
                      steps=k * substeps, wall_s=wall, status=status, certificate=certificate,
-                     drift=_drift_of(done["E"], done["alpha0_dot"][-1] - done["E_dot"][-1], period))
+                     drift=_drift_of(done["E"], done["alpha0_dot"][-1] - done["E_dot"][-1], period),
+                     path=judge_path(reference, done["t"][at], r_C[:k][at], done["heading"][at], settle_s=settle_s,
+                                     certificate=certificate, steering_range=params.steering_range))
     summary = dataclasses.replace(summary, mujoco_warnings=int(sum(w.number for w in d.warning)),
                                   analysis=analysis.as_dict(), controller_config=controller.describe())
     if logger is not None:

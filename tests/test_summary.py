@@ -17,6 +17,8 @@ RUN_KEYS = {"E_max", "E_ratio", "Edot_max", "Edot_ratio", "analysis", "certifica
             "left_steering_range", "left_steering_range_at_s", "m1", "model", "mujoco_warnings", "paper_region",
             "path", "realtime_factor", "saturated_fraction", "settle_s", "stable", "status", "steps", "sup_E",
             "sup_E_settled", "sup_Edot", "sup_Edot_settled", "verdict", "wall_s"}
+# added with C's path errors (wmr_mj.analysis.path_error, path_bound)
+PATH_KEYS = {"path_error", "path_bound", "path_verdict"}
 CERTIFICATE_KEYS = {"C_V_term", "E_max", "E_ratio", "Edot_max", "Edot_ratio", "K_term", "P_term", "alpha_max",
                     "assumptions", "certified", "condition", "dead_band", "delta1", "delta2", "delta3",
                     "friction_sign", "friction_term", "friction_width", "gamma1", "gamma2", "gyro_Edot_term",
@@ -32,7 +34,7 @@ def summary():
 
 def test_the_json_keeps_every_key(summary):
     d = summary.to_dict()
-    assert set(d) == RUN_KEYS
+    assert set(d) == RUN_KEYS | PATH_KEYS  # the path keys are new: every key before is kept
     assert set(d["certificate"]) == CERTIFICATE_KEYS
     assert set(d["paper_region"]) == {"E_max", "Edot_max", "condition", "inside"}
     assert set(d["drift"]) == {"final_alpha_dot", "growing", "E_last_window", "E_prev_window", "window_s",

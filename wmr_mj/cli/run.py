@@ -248,6 +248,13 @@ def format_report(s: RunSummary) -> str:
         f"{ratio(s.Edot_ratio):>8s}",
         f"voltage saturated {100 * s.saturated_fraction:.1f}% of the time",
     ]
+    if s.path_error is not None:
+        pe = s.path_error
+        lines.append(f"path of C: cross-track max {pe.cross_track_max:.4g} m, rms {pe.cross_track_rms:.4g} m; "
+                     f"along-track at the end {pe.along_track_final:+.4g} m; heading error max "
+                     f"{pe.heading_error_max:.4g} rad")
+    if s.path_verdict is not None:
+        lines.append(f"path verdict: {s.path_verdict.verdict} ({s.path_verdict.text})")
     if s.left_steering_range:
         lines.append(f"the steering reached its stop (+-range) at t = {s.left_steering_range_at_s:.3f} s")
     if s.status != "completed":

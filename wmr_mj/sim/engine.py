@@ -137,6 +137,7 @@ class EngineRun:
     law_note: str | None  # why the Python law ran, None with the compiled law
     wall_s: float  # the block loop's wall time: stepping, recording, rows, hand-over (models built before)
     cpu_s: float  # the block loop's CPU time on the calling thread (the batch of one steps on it)
+    C_xy: np.ndarray | None = None  # (steps, 2) xy of site C [m] per control step, as the log's C_pos
 
 
 class _Plant:
@@ -170,6 +171,7 @@ class _Block:
         self.qvel = np.empty((rows, m.nv))
         self.ctrl = np.empty((rows, m.nu))
         self.sites = np.empty((rows, m.nsite, 3))
+        self.C_xy = np.empty((count, 2))  # always: the run's path errors (wmr_mj.analysis.path_error)
 
 
 def _heading(quat: np.ndarray) -> np.ndarray:
@@ -195,9 +197,9 @@ class _CompiledStepper:
         self.model, self.where, self.substeps, self.log = model, where, substeps, log
         self.batch = Batch(model, nsim=1, nthread=1)
         self.batch.reset(keyframe=where.keyframe)
-        self.record = ["userdata", "actuator_force", "qfrc_actuator"]
+        self.record = ["userdata", "actuator_force", "qfrc_actuator", "site_xpos"]  # sites: C's path, always
         if log:
-            self.record += ["qpos", "qvel", "ctrl", "site_xpos"]
+            self.record += ["qpos", "qvel", "ctrl"]
             # the state at the next control step's start (the rollout records the state after each step)
             self._qpos, self._qvel = self.batch.qpos[0].copy(), self.batch.qvel[0].copy()
         self._out: dict[int, dict[Any, np.ndarray]] = {}  # record buffers per block length, reused
@@ -229,11 +231,13 @@ class _CompiledStepper:
         block.heading[:] = ud[:, f["heading"]]  # written at every substep: the last one's
         block.force[:] = end["actuator_force"][:, w.actuator]
         block.torque[:] = end["qfrc_actuator"][:, w.dof]
+        sites = end["site_xpos"].reshape(count, -1, 3)
+        block.C_xy[:] = sites[:, w.site_C, :2]
         if self.log:
             block.qpos[0], block.qpos[1:] = self._qpos, end["qpos"][:-1]
             block.qvel[0], block.qvel[1:] = self._qvel, end["qvel"][:-1]
             block.ctrl[:] = end["ctrl"]
-            block.sites[:] = end["site_xpos"].reshape(count, -1, 3)
+            block.sites[:] = sites
             self._qpos, self._qvel = end["qpos"][-1].copy(), end["qvel"][-1].copy()
 
 
@@ -276,7 +280,7 @@ class _PythonStepper:
     def step(self, block: _Block, k0: int, count: int) -> None:
         m, d, w = self.model, self.data, self.where
         qpos, qvel, ctrl = d.qpos, d.qvel, d.ctrl
-        qa, dv, act, chassis = w.qpos, w.dof, w.actuator, w.chassis
+        qa, dv, act, chassis, site_C = w.qpos, w.dof, w.actuator, w.chassis, w.site_C
         xquat, site_xpos, act_force, qfrc_act = d.xquat, d.site_xpos, d.actuator_force, d.qfrc_actuator
         limit, law, substeps, log, step = self.limit, self.law, self.substeps, self.log, mujoco.mj_step
         a0_all, a0d_all, a0dd_all = (r[k0:k0 + count].tolist() for r in self.reference)
@@ -307,6 +311,7 @@ class _PythonStepper:
             block.force[j] = act_force[act]
             block.torque[j] = qfrc_act[dv]
             quat[j] = xquat[chassis]
+            block.C_xy[j] = site_xpos[site_C, :2]
             if log:
                 block.ctrl[j] = ctrl
                 block.sites[j] = site_xpos
@@ -364,6 +369,7 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
         stepper = python_stepper()
     used = "compiled" if backend == "compiled" else "python"
     rows = {key: np.empty(n) for key in ROW_FIELDS}
+    C_xy = np.empty((n, 2))
     block_len = max(1, int(round(1.0 / period)))  # one simulated second per block
     blocks: dict[int, _Block] = {}
     k_i = params.k_i
@@ -440,6 +446,7 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
             np.divide(b.force, k_i, out=rows["current"][sl])
             rows["steer_torque"][sl] = b.torque
             rows["heading"][sl] = b.heading
+            C_xy[sl] = b.C_xy
             k = k0 + cnt
             hand_over(k)
             if on_progress is not None:
@@ -451,4 +458,4 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
     wall, cpu = time.perf_counter() - wall0, time.thread_time() - cpu0
     done = {key: v[:k] for key, v in rows.items()}
     return EngineRun(rows=done, steps=k, status=status, warnings=warned + stepper.warnings(), law=used,
-                     law_note=note, wall_s=wall, cpu_s=cpu)
+                     law_note=note, wall_s=wall, cpu_s=cpu, C_xy=C_xy[:k])

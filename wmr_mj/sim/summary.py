@@ -22,6 +22,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from wmr_mj.analysis.certificate import Assumption, CertificateJudgement
+from wmr_mj.analysis.path_bound import PathBound, PathVerdict
+from wmr_mj.analysis.path_error import PathErrors
 from wmr_mj.analysis.verdicts import Drift, PaperRegion
 
 __all__ = ["RunSummary", "PaperRegion", "Drift", "CertificateJudgement", "Assumption", "BatchFigures"]
@@ -85,6 +87,11 @@ class RunSummary:
         analysis: the paper's region as ``RobustnessResult.as_dict()`` (the serial runner).
         controller_config: the controller's ``describe()`` (the serial runner).
         batch: what a batch adds (``run_batch``).
+        path_error: C's Cartesian errors against its desired path (cross-track, along-track,
+            heading: sup, RMS, final; ``wmr_mj.analysis.path_error``); None when not measured.
+        path_bound: what the certificate's E_max implies for C's path (``wmr_mj.analysis.path_bound``).
+        path_verdict: the run's cross-track against ``path_bound``: 'within-bound', 'beyond-bound'
+            or 'no-guarantee'.
     """
 
     status: str
@@ -115,6 +122,9 @@ class RunSummary:
     analysis: Mapping[str, Any] | None = None
     controller_config: Mapping[str, Any] | None = None
     batch: BatchFigures | None = None
+    path_error: PathErrors | None = None
+    path_bound: PathBound | None = None
+    path_verdict: PathVerdict | None = None
 
     # the paper's claim, read through paper_region (the JSON also writes these at the top level)
     @property
@@ -164,7 +174,8 @@ class RunSummary:
 
         inf stays inf (the JSON writers write null); the keys of the verdict (verdict,
         certificate, paper_region, drift) appear only with a certificate, those the runners
-        add (mujoco_warnings, analysis, controller_config, the batch's) only when set.
+        add (mujoco_warnings, analysis, controller_config, the batch's, path_error, path_bound,
+        path_verdict) only when set.
         """
         out: dict[str, Any] = {
             "status": self.status,
@@ -209,4 +220,10 @@ class RunSummary:
             out["controller_config"] = dict(self.controller_config)
         if self.batch is not None:
             out.update(self.batch.to_dict())
+        if self.path_error is not None:
+            out["path_error"] = self.path_error.to_dict()
+        if self.path_bound is not None:
+            out["path_bound"] = self.path_bound.to_dict()
+        if self.path_verdict is not None:
+            out["path_verdict"] = self.path_verdict.to_dict()
         return out
