@@ -92,6 +92,10 @@ def run(args: argparse.Namespace) -> int:
           f"worst sup|E|/E_max = {fmt(runs.paper_E_ratio.value)}, "
           f"worst sup|E'|/Edot_max = {fmt(runs.paper_Edot_ratio.value)}; "
           f"{runs.hit_stop} runs hit the steering stop")
+    if runs.path_verdicts is not None:
+        print(f"path of C: worst sup|cross-track| = {runs.path_cross_track.value:.4g} m "
+              f"(m1 = {runs.path_cross_track.m1:g} kg); path verdicts: "
+              + ", ".join(f"{v} {c}" for v, c in runs.path_verdicts.items()))
     law = f", {' and '.join(runs.batch_law)} law" if runs.batch_law else ""
     print(f"{runs.steps} steps in {wall:.1f} s ({summary['steps_per_s']:.3g} steps/s{law})")
     print(f"table: {out / 'runs.csv'}\nplot:  {plot_path}")

@@ -133,7 +133,7 @@ def paper_design_lines(summary: Mapping[str, Any]) -> list[str]:
 
 # --------------------------------------------------------------------------- (b) the ladder
 LADDER_COLUMNS = ("rung", "design", "change", "certificate", "cert-in", "CERT-OUT", "uncert-in", "uncert-out",
-                  "paper in", "worst sup|E| rad", "sup|E|/E_max", "stop", "growing")
+                  "paper in", "worst sup|E| rad", "sup|E|/E_max", "stop", "growing", "cross-track m")
 
 
 def ladder_rows(summary: Mapping[str, Any]) -> list[list[str]]:
@@ -145,7 +145,7 @@ def ladder_rows(summary: Mapping[str, Any]) -> list[list[str]]:
                     f"{v['certified-outside']}/{n}" + (" !!!" if v["certified-outside"] else ""),
                     f"{v['uncertified-inside']}/{n}", f"{v['uncertified-outside']}/{n}", f"{r['paper_inside']}/{n}",
                     _fmt(r["worst_sup_E"]), _fmt(r["worst_certificate_ratio"], ".3f"), f"{r['hit_stop']}/{n}",
-                    f"{r['growing']}/{n}"])
+                    f"{r['growing']}/{n}", _fmt(r.get("worst_path_cross_track"), ".3g")])
     return out
 
 
@@ -637,7 +637,8 @@ def render_html(summary: Mapping[str, Any]) -> str:
 
 SUMMARY_CSV_COLUMNS = ("rung", "name", "design", "certificate_valid", "certificate_E_max", "certificate_Edot_max",
                        "certificate_voltage_max", "unmet", "n", *VERDICTS, "paper_inside", "worst_sup_E",
-                       "worst_certificate_ratio", "worst_paper_ratio", "hit_stop", "growing", "runs_csv")
+                       "worst_certificate_ratio", "worst_paper_ratio", "hit_stop", "growing", "runs_csv",
+                       "worst_path_cross_track")
 
 
 def summary_csv(summary: Mapping[str, Any]) -> str:
@@ -651,6 +652,6 @@ def summary_csv(summary: Mapping[str, Any]) -> str:
                c.get("voltage_max"), " ".join(x.replace(" ", "_") for x in c["unmet"]), r["n"],
                *(r["verdicts"][v] for v in VERDICTS),
                r["paper_inside"], r["worst_sup_E"], r["worst_certificate_ratio"], r["worst_paper_ratio"],
-               r["hit_stop"], r["growing"], r["runs_csv"]]
+               r["hit_stop"], r["growing"], r["runs_csv"], r.get("worst_path_cross_track")]
         w.writerow(["" if x is None else (repr(x) if isinstance(x, float) else x) for x in row])
     return buf.getvalue()

@@ -46,7 +46,7 @@ from wmr_mj.errors import ParameterError
 from wmr_mj.params import C80, M1_NOMINAL, C80Parameters
 from wmr_mj.sim import compiled_law
 from wmr_mj.sim.certify import certificate_for
-from wmr_mj.sim.closed_loop import _substeps, report, run_closed_loop
+from wmr_mj.sim.closed_loop import _substeps, judge_path, path_sample_index, report, run_closed_loop
 from wmr_mj.sim.config import (
     RunConfig,
     analysis_for,
@@ -103,6 +103,9 @@ class _BatchStats:
     drift_prev: np.ndarray = field(init=False)  # max |E| over the window before the last (wmr_mj.analysis.verdicts)
     drift_last: np.ndarray = field(init=False)  # max |E| over the last window
     final_alpha_dot: np.ndarray = field(init=False)  # alpha0' - E' of the last control step
+    path_samples: int = 0  # control steps at which C is sampled (closed_loop.path_sample_index)
+    C_xy: np.ndarray = field(init=False)  # (nsim, path_samples, 2) C's xy there [m]
+    heading: np.ndarray = field(init=False)  # (nsim, path_samples) the chassis heading there [rad]
     cpu_s: list[float] = field(default_factory=list)  # CPU time of each group's thread
 
     def __post_init__(self) -> None:
@@ -113,6 +116,8 @@ class _BatchStats:
         self.left_at, self.final_alpha, self.final_alpha_after_step = (np.full(n, np.nan) for _ in range(3))
         self.drift_prev, self.drift_last = np.zeros(n), np.zeros(n)
         self.final_alpha_dot = np.full(n, np.nan)
+        self.C_xy = np.full((n, self.path_samples, 2), np.nan)
+        self.heading = np.full((n, self.path_samples), np.nan)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -134,6 +139,9 @@ class _Loop:
     keyframe: int
     voltage_limit: np.ndarray  # (nsim,)
     range_limit: np.ndarray  # (nsim,)
+    path_at: np.ndarray  # control steps at which C's xy and the heading are kept (closed_loop.path_sample_index)
+    chassis: int  # the chassis body (its heading)
+    site_C: int  # site C (its xy)
 
 
 def _run_group(loop: _Loop, models: Sequence[mujoco.MjModel], idx: np.ndarray, threads: int, law,
@@ -154,7 +162,10 @@ def _run_group(loop: _Loop, models: Sequence[mujoco.MjModel], idx: np.ndarray, t
     alpha_now = batch.bind("qpos")[:, loop.qpos_adr]  # views of the state rows: no copy
     alpha_dot_now = batch.bind("qvel")[:, loop.dof_adr]
     ctrl_now = batch.bind("ctrl")[:, loop.actuator]
+    C_now = batch.bind("site_xpos")[:, loop.site_C, :2]  # after a step: of the state it started from
+    quat_now = batch.bind("xquat")[:, loop.chassis]
     block = loop.block
+    C_buf, q_buf = np.empty((block, g, 2)), np.empty((block, g, 4))
     bufs = a_buf, E_buf, Ed_buf, u_buf = tuple(np.empty((block, g)) for _ in range(4))
     rows = [list(buf) for buf in bufs]  # row views made once, not at every step
     clipped = np.empty(g)
@@ -166,7 +177,7 @@ def _run_group(loop: _Loop, models: Sequence[mujoco.MjModel], idx: np.ndarray, t
         count = min(block, loop.n - k0)
         reference = (loop.alpha0[k0:k0 + count].tolist(), loop.alpha0_dot[k0:k0 + count].tolist(),
                      loop.alpha0_ddot[k0:k0 + count].tolist())
-        for alpha, E, E_dot, u, a0, a0d, a0dd in zip(*rows, *reference):
+        for j, (alpha, E, E_dot, u, a0, a0d, a0dd) in enumerate(zip(*rows, *reference)):
             alpha[:] = alpha_now  # recorded: the state row changes with the step
             law(alpha, alpha_dot_now, a0, a0d, a0dd, E, E_dot, u)
             # the voltage limit; a NaN passes through to MuJoCo, which then warns (BADCTRL), and
@@ -174,6 +185,9 @@ def _run_group(loop: _Loop, models: Sequence[mujoco.MjModel], idx: np.ndarray, t
             maximum(u, lo, out=clipped)
             minimum(clipped, hi, out=ctrl_now)
             step(nstep=nstep)
+            C_buf[j] = C_now
+            q_buf[j] = quat_now
+        _path_stats(loop, stats, idx, k0, count, C_buf, q_buf)
         _block_stats(loop, stats, idx, k0, count, a_buf, E_buf, Ed_buf, u_buf, lo, hi, range_limit)
         if _stopped(loop, k0 + count, stop, progress):
             return
@@ -217,19 +231,44 @@ def _run_group_compiled(loop: _Loop, models: Sequence[mujoco.MjModel], idx: np.n
     lo, hi = -loop.voltage_limit[idx], loop.voltage_limit[idx]
     range_limit = loop.range_limit[idx]
     substeps = loop.substeps
+    heading_field = compiled_law.USERDATA_FIELDS.index("heading")
     records: dict[int, dict[str, np.ndarray]] = {}  # one output buffer per block length, reused
     for k0 in range(0, loop.n, loop.block):
         count = min(loop.block, loop.n - k0)
-        if count not in records:
-            records[count] = {"userdata": np.empty((g, count * substeps, len(compiled_law.USERDATA_FIELDS)))}
-        out = records[count]
+        out = records.setdefault(count, {})
         # the record after each physics step; a control step's values hold over its substeps
-        userdata = batch.rollout(count * substeps, record=("userdata",), out=out)["userdata"][:, ::substeps]
+        rec = batch.rollout(count * substeps, record=("userdata", "site_xpos"), out=out)
+        out.update(rec)
+        userdata = rec["userdata"][:, ::substeps]
         a_buf, E_buf, Ed_buf, u_buf = (userdata[:, :, j].T for j in range(4))  # (count, g) views
+        # C and the heading after each control step's last substep, as the single run records them
+        end = slice(substeps - 1, None, substeps)
+        sites = rec["site_xpos"][:, end].reshape(g, count, -1, 3)
+        _path_stats(loop, stats, idx, k0, count, sites[:, :, loop.site_C, :2].transpose(1, 0, 2),
+                    heading=rec["userdata"][:, end, heading_field].T)
         _block_stats(loop, stats, idx, k0, count, a_buf, E_buf, Ed_buf, u_buf, lo, hi, range_limit)
         if _stopped(loop, k0 + count, stop, progress):
             return
     _final_stats(loop, stats, idx, batch, a_buf[count - 1], Ed_buf[count - 1], alpha_now)
+
+
+def _path_stats(loop: _Loop, stats: _BatchStats, idx: np.ndarray, k0: int, rows: int, C_buf: np.ndarray,
+                quat: np.ndarray | None = None, heading: np.ndarray | None = None) -> None:
+    """Keep C's xy and the heading (or the chassis quaternion's yaw) of control steps k0 .. k0+rows-1
+    that are path samples; (rows, g, ...) buffers."""
+    from wmr_mj.sim.engine import _heading
+
+    lo, hi = np.searchsorted(loop.path_at, [k0, k0 + rows])
+    if lo == hi:
+        return
+    local = loop.path_at[lo:hi] - k0
+    stats.C_xy[idx, lo:hi] = C_buf[local].transpose(1, 0, 2)
+    if heading is None:
+        q = quat[local].reshape(-1, 4)
+        heading = _heading(q).reshape(len(local), -1)
+        stats.heading[idx, lo:hi] = heading.T
+    else:
+        stats.heading[idx, lo:hi] = heading[local].T
 
 
 def _block_stats(loop: _Loop, stats: _BatchStats, idx: np.ndarray, k0: int, rows: int, a_buf, E_buf, Ed_buf,
@@ -299,7 +338,8 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
     rows = (np.asarray(reference.alpha0), np.asarray(reference.alpha0_dot), np.asarray(reference.alpha0_ddot))
     steer = model.joint("steer").id
     where = dict(qpos_adr=int(model.jnt_qposadr[steer]), dof_adr=int(model.jnt_dofadr[steer]),
-                 actuator=model.actuator("steering_motor").id)  # the same in every simulation's model
+                 actuator=model.actuator("steering_motor").id,
+                 chassis=model.body("chassis").id)  # the same in every simulation's model; the law writes the heading
     if backend == "compiled":
         # each model carries the reference (3 float64 per control step), for the callback
         require_memory(nsim * n * 3 * 8, what=f"a batch of {nsim} runs of {n} control steps with the compiled law",
@@ -312,12 +352,16 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
     else:
         models = [model] + [batch_model(p, **options) for p in plants[1:]]
     analysis = analysis_for(first, reference, estimate, estimate=estimate_of(controller))
+    path_at = path_sample_index(n, period)
+    require_memory(nsim * len(path_at) * 3 * 8, what=f"C's path samples of a batch of {nsim} runs",
+                   hint="run fewer at once (a smaller chunk)")
     loop = _Loop(alpha0=rows[0], alpha0_dot=rows[1], alpha0_ddot=rows[2], n=n, substeps=substeps, period=period,
                  settle_k=int(math.ceil(settle_s / period - 1e-9)), drift_k=drift_window_steps(n, period),
                  block=min(n, 1000), **where, keyframe=model.key("home").id,
                  voltage_limit=np.array([p.voltage_limit for p in plants]),
-                 range_limit=np.array([p.steering_range for p in plants]) - 1e-3)
-    stats = _BatchStats(nsim)
+                 range_limit=np.array([p.steering_range for p in plants]) - 1e-3,
+                 path_at=path_at, site_C=model.site("C").id)
+    stats = _BatchStats(nsim, path_samples=len(path_at))
     threads = thread_count(nthread, nsim)
     # the compiled law holds no GIL: one batch on every thread
     groups = [(np.arange(nsim), threads)] if backend == "compiled" else batch_groups(nsim, threads)
@@ -358,14 +402,17 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
     wall = time.perf_counter() - wall0
     reports = []
     for i, (c, p) in enumerate(zip(configs, plants)):
+        certificate = certificate_for(c, reference, params=base)
         r = report(c, analysis=analysis, params=p, settle_s=settle_s, sup_E=stats.sup_E[i], sup_Edot=stats.sup_Ed[i],
                    sup_E_settled=stats.sup_E_s[i], sup_Edot_settled=stats.sup_Ed_s[i],
                    saturated_fraction=stats.saturated[i] / n,
                    left_range_at=None if np.isnan(stats.left_at[i]) else float(stats.left_at[i]),
                    final_alpha=stats.final_alpha[i], control_steps=n, steps=n * substeps, wall_s=wall / nsim,
-                   status="completed", certificate=certificate_for(c, reference, params=base),
+                   status="completed", certificate=certificate,
                    drift=drift(prev_window=float(stats.drift_prev[i]), last_window=float(stats.drift_last[i]),
-                               final_alpha_dot=float(stats.final_alpha_dot[i])))
+                               final_alpha_dot=float(stats.final_alpha_dot[i])),
+                   path=judge_path(reference, path_at * period, stats.C_xy[i], stats.heading[i], settle_s=settle_s,
+                                   certificate=certificate, steering_range=p.steering_range))
         if stats.law_nan[i] if backend == "numpy" else stats.warnings[i]:
             # NumPy law: NaN from the law, where the serial loop applies 0 V and MuJoCo would zero
             # every control of the step (BADCTRL); compiled law (which applies 0 V as the serial

@@ -65,22 +65,40 @@ SAMPLINGS = ("uniform", "lhs", "grid")
 RESULT_COLUMNS = ("run", "m1", "verdict", "cert_valid", "cert_E_max", "cert_Edot_max", "cert_E_ratio",
                   "cert_Edot_ratio", "cert_inside", "sup_E", "sup_Edot", "sup_E_settled", "sup_Edot_settled",
                   "E_max", "Edot_max", "E_ratio", "Edot_ratio", "inside", "saturated_fraction",
-                  "left_steering_range", "final_alpha", "final_alpha_dot", "drift_growing")
-#: runs.csv columns taken from a run summary's nested certificate and drift (see flat_row)
+                  "left_steering_range", "final_alpha", "final_alpha_dot", "drift_growing",
+                  # C's path (wmr_mj.analysis.path_error, path_bound): [m], [m], [rad], verdict, [m]
+                  "path_cross_track_max", "path_along_track_final", "path_heading_error_max", "path_verdict",
+                  "path_cross_track_bound")
+#: runs.csv columns taken from a run summary's nested certificate, drift and path (see flat_row)
 _FLAT = {"cert_valid": ("certificate", "certified"), "cert_E_max": ("certificate", "E_max"),
          "cert_Edot_max": ("certificate", "Edot_max"), "cert_E_ratio": ("certificate", "E_ratio"),
          "cert_Edot_ratio": ("certificate", "Edot_ratio"), "cert_inside": ("certificate", "inside"),
-         "final_alpha_dot": ("drift", "final_alpha_dot"), "drift_growing": ("drift", "growing")}
+         "final_alpha_dot": ("drift", "final_alpha_dot"), "drift_growing": ("drift", "growing"),
+         "path_cross_track_max": ("path_error", "cross_track_max"),
+         "path_along_track_final": ("path_error", "along_track_final"),
+         "path_heading_error_max": ("path_error", "heading_error_max"),
+         "path_verdict": ("path_verdict", "verdict"), "path_cross_track_bound": ("path_verdict", "cross_track_bound")}
 
 
 def flat_row(summary: Mapping[str, Any]) -> dict[str, Any]:
-    """A run summary with the runs.csv columns of its certificate and drift added at the top level
-    (cert_valid, cert_E_max, cert_E_ratio, ..., final_alpha_dot, drift_growing)."""
+    """A run summary with the runs.csv columns of its certificate, drift and path added at the top level
+    (cert_valid, cert_E_max, cert_E_ratio, ..., final_alpha_dot, drift_growing, path_cross_track_max, ...)."""
     out = dict(summary)
     for col, (outer, inner) in _FLAT.items():
-        if col not in out:
+        # path_verdict: the summary's is the whole judgement (a mapping); the column is its word
+        if col not in out or isinstance(out[col], Mapping):
             out[col] = (summary.get(outer) or {}).get(inner)
     return out
+
+
+def _count_path_verdicts(rows: Sequence[Mapping[str, Any]]) -> dict[str, int] | None:
+    """The count of each path verdict in ``rows`` (zeros included); None when no row has one."""
+    from wmr_mj.analysis.path_bound import PATH_VERDICTS
+
+    seen = [str(r["path_verdict"]) for r in rows if r.get("path_verdict")]
+    if not seen:
+        return None
+    return {v: seen.count(v) for v in (*PATH_VERDICTS, *sorted(set(seen) - set(PATH_VERDICTS)))}
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -425,6 +443,8 @@ class SweepSummary:
         m1_max: the largest m1 [kg].
         steps: physics steps of the runs simulated by this call (resumed runs have none).
         batch_law: how this call's batches evaluated the law (``wmr_mj.sim.batch.LAW_BACKENDS``).
+        path_cross_track: the worst sup|cross-track| of C [m] (None for rows without it).
+        path_verdicts: the count of each path verdict ('within-bound', 'beyond-bound', 'no-guarantee').
     """
 
     n: int
@@ -447,6 +467,8 @@ class SweepSummary:
     m1_max: float
     steps: int
     batch_law: tuple[str, ...]
+    path_cross_track: Worst = Worst(None, None)
+    path_verdicts: Mapping[str, int] | None = None
 
     @classmethod
     def of(cls, rows: Sequence[Mapping[str, Any]]) -> SweepSummary:
@@ -481,6 +503,8 @@ class SweepSummary:
             m1_max=max(float(r["m1"]) for r in rows),
             steps=sum(int(r["steps"]) for r in rows if r.get("steps") is not None),
             batch_law=tuple(sorted({r["batch_law"] for r in rows if r.get("batch_law")})),
+            path_cross_track=Worst(*max_at(rows, "path_cross_track_max")),
+            path_verdicts=_count_path_verdicts(rows),
         )
 
     @property
@@ -519,6 +543,10 @@ class SweepSummary:
             "steps_per_s": self.steps / wall_s if wall_s > 0 and math.isfinite(wall_s) else None,
             # how the runs of this call evaluated the law (wmr_mj.sim.batch.LAW_BACKENDS; resumed runs: none)
             "batch_law": list(self.batch_law),
+            # C's path (wmr_mj.analysis.path_error): the worst sup|cross-track| [m] and the path verdicts
+            "worst_path_cross_track": self.path_cross_track.value,
+            "worst_path_cross_track_m1": self.path_cross_track.m1,
+            "path_verdicts": None if self.path_verdicts is None else dict(self.path_verdicts),
         }
 
     def rung_dict(self) -> dict[str, Any]:
@@ -538,4 +566,7 @@ class SweepSummary:
             "growing": self.growing,
             "mean_saturated_fraction": self.mean_saturated_fraction,
             "m1_min": self.m1_min, "m1_max": self.m1_max,
+            "worst_path_cross_track": self.path_cross_track.value,
+            "worst_path_cross_track_m1": self.path_cross_track.m1,
+            "path_verdicts": None if self.path_verdicts is None else dict(self.path_verdicts),
         }
