@@ -42,7 +42,7 @@ from numpy.typing import ArrayLike
 
 from wmr_mj.errors import ParameterError
 
-__all__ = ["PathErrors", "PathErrorSeries", "path_error_series", "path_errors", "wrap_angle"]
+__all__ = ["PathErrors", "PathErrorSeries", "PathProjector", "path_error_series", "path_errors", "wrap_angle"]
 
 #: spacing of the polyline the projection searches [m]; a sagitta correction from the
 #: reference's curvature removes the chord's offset (kappa ds^2 / 8: 2 um at 1/m)
@@ -289,3 +289,23 @@ def path_errors(reference: Any, t: ArrayLike, C_xy: ArrayLike, heading: ArrayLik
     :func:`path_error_series` for the per-sample values and ``window``.
     """
     return summarize_series(path_error_series(reference, t, C_xy, heading, window=window), settle_s)
+
+
+class PathProjector:
+    """C's desired path, built once, for projecting one position at a time (an outer loop's feedback).
+
+    ``project(xy, s_prev)`` searches ``window`` m of arc length around ``s_prev`` as
+    :func:`path_error_series` does (moving on past the window's edge) and returns (s [m], the
+    signed cross-track [m], > 0 left, the desired chassis heading theta at s [rad]).
+    """
+
+    def __init__(self, reference: Any, *, window: float = WINDOW, spacing: float = POLYLINE_SPACING) -> None:
+        rs = _as_reference_arrays(reference)[1]
+        self.window = float(window)
+        extend = max(4.0 * self.window, float(rs[-1] - rs[0]))
+        self._gs, self._gxy, self._gth, self._gk, _, _ = _geometry(reference, float(spacing), extend)
+
+    def project(self, xy: ArrayLike, s_prev: float) -> tuple[float, float, float]:
+        X = np.asarray(xy, dtype=float).reshape(1, 2)
+        s, d = _project(self._gs, self._gxy, self._gk, X, float(s_prev), self.window)
+        return float(s[0]), float(d[0]), float(np.interp(s[0], self._gs, self._gth))

@@ -79,6 +79,8 @@ def reproduce_command(config, params: dict[str, float], args: argparse.Namespace
     parts += [f"--m1-inertia {config.m1_inertia}", f"--box {config.box}",
               f"--m1-range {config.m1_range[0]!r} {config.m1_range[1]!r}", f"--uncertainty {args.uncertainty}"]
     parts += [f"--range {shlex.quote(item)}" for item in getattr(args, "range", None) or []]  # the same box
+    if getattr(config, "correction", False):
+        parts.append("--correction")
     return " ".join(parts)
 
 

@@ -60,6 +60,10 @@ def add_run_options(p: argparse.ArgumentParser) -> None:
                                                      "over --m1-range) or paper (5.1)")
     p.add_argument("--m1-range", nargs=2, type=positive_float, metavar=("LO", "HI"), default=M1_RANGE,
                    help="m1 range of the analysis box, kg (default 550 750)")
+    p.add_argument("--correction", action="store_true",
+                   help="Cartesian correction: an outer loop at C (Stanley-like, from C's cross-track and heading "
+                        "errors) corrects alpha0 within declared rate and acceleration limits, which the "
+                        "certificate then assumes (wmr_mj/sim/correction.py)")
     from wmr_mj.params import UNCERTAINTY_NAMES
 
     p.add_argument("--uncertainty", default=None,
@@ -103,7 +107,8 @@ def config_from_args(args: argparse.Namespace, **extra):
                      plant_overrides=parse_assignments(args.param), m1_inertia=args.m1_inertia,
                      identified=identified, coefficients=coefficients, box=args.box,
                      m1_range=tuple(args.m1_range), steering_friction=args.steering_friction,
-                     tyre_contact=args.tyre_contact, box_ranges=box_ranges_from_args(args), **extra)
+                     tyre_contact=args.tyre_contact, box_ranges=box_ranges_from_args(args),
+                     correction=bool(getattr(args, "correction", False)), **extra)
 
 
 def register(sub: argparse._SubParsersAction) -> None:

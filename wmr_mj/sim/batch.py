@@ -323,6 +323,8 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
     for c in configs[1:]:
         if c.replace(m1=M1_NOMINAL, plant_overrides={}) != shared:
             raise ParameterError("run_batch needs configs that differ only in m1 and plant_overrides")
+    if first.correction:
+        return _run_one_by_one(configs, base=base, progress=progress, law=law)
     estimate = estimate_parameters(base)
     controller = controller_for(first, estimate)
     backend = batch_law_backend(controller, law)
@@ -430,6 +432,29 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
             law=backend))
         reports.append(r)
     return reports
+
+
+def _run_one_by_one(configs: Sequence[RunConfig], *, base: C80Parameters, progress: Callable[[int, int], None] | None,
+                    law: str) -> list[RunSummary]:
+    """Runs with the Cartesian correction (``wmr_mj.sim.correction``), one after the other on the engine.
+
+    The correction's outer loop rewrites each simulation's reference from its own state between
+    blocks; the batch's loops share one reference, so these runs are single runs (their
+    summaries are run_closed_loop's, as the batch's are). ``batch.final_alpha_after_step`` is
+    NaN: a single run does not keep the state after its last step.
+    """
+    reports = []
+    wall0, cpu0 = time.perf_counter(), time.thread_time()
+    for i, c in enumerate(configs):
+        r = run_closed_loop(c, progress=False, base=base, law=law)
+        reports.append((r.summary, r.law))
+        if progress is not None:
+            progress(i + 1, len(configs))
+    wall, cpu = time.perf_counter() - wall0, time.thread_time() - cpu0
+    steps = sum(s.steps for s, _ in reports)
+    return [dataclasses.replace(s, analysis=None, controller_config=None, batch=BatchFigures(
+        final_alpha_after_step=math.nan, wall_s=wall, steps_per_s=steps / wall if wall > 0 else None, cpu_s=cpu,
+        law="compiled" if used == "compiled" else "numpy")) for s, used in reports]
 
 
 # -- sweeps: chunks, resume, Dask ---------------------------------------------------------

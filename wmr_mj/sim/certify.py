@@ -211,10 +211,17 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
             d_over_P = disturbance_over_P_max(signals.declared_d_max, estimate_params, plant, m1_range,
                                               config.m1_inertia, tuple(sorted(ranges.items())))
         stated = stated + _signal_assumptions(signals, plant.m1, m1_range)
+    bounds = reference.bounds()
+    if getattr(config, "correction", False):
+        # the corrected alpha0 = alpha0 + delta, delta within the correction's declared limits
+        from wmr_mj.sim.correction import corrected_bounds, correction_assumptions
+
+        bounds = corrected_bounds(bounds)
+        stated = stated + correction_assumptions()
     cert = certify(plant=PlantBox(box=plant_box, gyro=gyro, V_A=V_A, friction_over_P=ratio, disturbance=d_V,
                                   disturbance_over_P=d_over_P),
                    estimate=estimate, gains=Gains(kp=config.kp, kd=config.kd),
-                   reference=reference.bounds(),
+                   reference=bounds,
                    limits=PlantLimits(steering_range=plant.steering_range, voltage_limit=plant.voltage_limit),
                    compensation=Compensation(friction_sign=sign, friction_width=width, feedforward=not pd),
                    control_period=period, initial_error=initial, stated=stated)

@@ -174,14 +174,15 @@ def path_sample_index(k: int, period: float) -> np.ndarray:
 
 
 def judge_path(reference, t: np.ndarray, C_xy: np.ndarray, heading: np.ndarray, *, settle_s: float,
-               certificate=None, steering_range: float | None = None) -> PathJudgement | None:
+               certificate=None, steering_range: float | None = None, corrected: bool = False) -> PathJudgement | None:
     """C's Cartesian errors over a run, judged against what its certificate implies for the path.
 
     reference: the run's Reference; t, C_xy (m, 2), heading: C's samples (the control steps of
     :func:`path_sample_index`, from the engine's rows and ``EngineRun.C_xy``, or the batch's);
     the bound from the certificate's E_max when it is valid (else no bound), judged from
     ``settle_s`` on (from the start where the reference ends before it). None when no sample
-    is finite (a diverged run): nothing to project.
+    is finite (a diverged run): nothing to project. ``corrected``: the run had the Cartesian
+    correction (position feedback at C); the bound and verdict say that no bound is proven for it.
     """
     from wmr_mj.analysis.path_bound import path_bound, path_verdict
     from wmr_mj.analysis.path_error import path_errors
@@ -196,7 +197,13 @@ def judge_path(reference, t: np.ndarray, C_xy: np.ndarray, heading: np.ndarray, 
         bound = path_bound(reference, E_max, settle_s=settle_s, max_angle=steering_range)
     except WmrMjError:  # the reference ends before settle_s
         bound = path_bound(reference, E_max, max_angle=steering_range)
-    return PathJudgement(errors=errors, bound=bound, verdict=path_verdict(errors, bound))
+    verdict = path_verdict(errors, bound)
+    if corrected:
+        note = ("; with the Cartesian correction C's position is fed back, but no bound on C's path is proven "
+                "for that loop (the certificate covers the inner loop on the corrected alpha0)")
+        bound = dataclasses.replace(bound, reason=bound.reason + note)
+        verdict = dataclasses.replace(verdict, text=verdict.text + note)
+    return PathJudgement(errors=errors, bound=bound, verdict=verdict)
 
 
 def _sup(x: np.ndarray) -> float:
@@ -289,9 +296,14 @@ def run_closed_loop(
                                 reference_path=np.asarray(reference.C_xy)[::max(1, len(reference.C_xy) // 2000)])
 
     disturbance, loads = _signal_inputs(config, params, options, n, period)
+    outer = None
+    if config.correction:
+        from wmr_mj.sim.correction import CartesianCorrection
+
+        outer = CartesianCorrection(reference, period=period)
     bar = progress_bar(n, desc="run", unit="step", unit_scale=True, enabled=progress)
     try:
-        run = run_engine(params=params, controller=controller, options=options, model=plain,
+        run = run_engine(correction=outer, params=params, controller=controller, options=options, model=plain,
                          reference=(a0_all, a0d_all, a0dd_all), n=n, substeps=substeps, period=period, law=law,
                          on_block=None if logger is None else logger.write_block, on_progress=bar.update,
                          disturbance=disturbance, loads=loads)
@@ -312,7 +324,10 @@ def run_closed_loop(
                      steps=k * substeps, wall_s=wall, status=status, certificate=certificate,
                      drift=_drift_of(done["E"], done["alpha0_dot"][-1] - done["E_dot"][-1], period),
                      path=judge_path(reference, done["t"][at], run.C_xy[at], done["heading"][at], settle_s=settle_s,
-                                     certificate=certificate, steering_range=params.steering_range))
+                                     certificate=certificate, steering_range=params.steering_range,
+                                     corrected=config.correction))
+    if outer is not None:
+        summary = dataclasses.replace(summary, correction=outer.describe(done))
     summary = dataclasses.replace(summary, mujoco_warnings=run.warnings,
                                   analysis=analysis.as_dict(), controller_config=controller.describe())
     if logger is not None:

@@ -71,6 +71,8 @@ class RunConfig:
     # a steering disturbance torque and chassis load changes (wmr_mj.sim.signals.Signals, or its JSON
     # form, a mapping or a .json file); None: none (as_dict then has no "signals" key)
     signals: Any = None
+    # the Cartesian correction at C (wmr_mj.sim.correction): an outer loop that corrects alpha0
+    correction: bool = False
 
     def __post_init__(self) -> None:
         if self.controller not in CONTROLLER_NAMES:
@@ -80,6 +82,8 @@ class RunConfig:
         if self.friction_sign not in FRICTION_SIGNS:
             raise UnknownNameError("friction sign", self.friction_sign, FRICTION_SIGNS)
         _check_path(self)
+        if not isinstance(self.correction, bool):
+            raise ParameterError(f"correction = {self.correction!r} is not accepted: True or False")
         if self.box not in ("derived", "paper"):
             raise UnknownNameError("box", self.box, ("derived", "paper"))
         if self.steering_friction not in STEERING_FRICTION_MODELS:
@@ -110,6 +114,8 @@ class RunConfig:
             del d["signals"]  # a run without signals keeps the keys it always had
         else:
             d["signals"] = self.signals.as_dict()
+        if not self.correction:
+            del d["correction"]  # the configs written before the correction existed, unchanged
         d["plant_overrides"] = dict(self.plant_overrides)
         d["m1_range"] = list(self.m1_range)
         d["box_ranges"] = {k: list(v) for k, v in self.box_ranges.items()}

@@ -191,11 +191,13 @@ class _CompiledStepper:
     actuator's force and qfrc_actuator (computed after the callback), and for a log the state.
     """
 
-    def __init__(self, model: mujoco.MjModel, where: _Plant, substeps: int, log: bool) -> None:
+    def __init__(self, model: mujoco.MjModel, where: _Plant, substeps: int, log: bool, own_model: bool = False) -> None:
         from mujoco.batch import Batch
 
         self.model, self.where, self.substeps, self.log = model, where, substeps, log
         self.batch = Batch(model, nsim=1, nthread=1)
+        if own_model:  # the simulation runs on ``model`` itself: edits of its reference numeric reach the law
+            self.batch.set_models([model])
         self.batch.reset(keyframe=where.keyframe)
         self.record = ["userdata", "actuator_force", "qfrc_actuator", "site_xpos"]  # sites: C's path, always
         if log:
@@ -323,7 +325,8 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
                law: str = "auto", on_block: Callable[[dict[str, np.ndarray]], None] | None = None,
                on_progress: Callable[[int], None] | None = None, model: mujoco.MjModel | None = None,
                disturbance: np.ndarray | None = None,
-               loads: Sequence[tuple[int, Mapping[str, np.ndarray]]] = ()) -> EngineRun:
+               loads: Sequence[tuple[int, Mapping[str, np.ndarray]]] = (),
+               correction: Any = None) -> EngineRun:
     """Run ``n`` control steps of ``controller`` on the plant of ``params``; rows of every control step.
 
     ``reference`` = (alpha0, alpha0', alpha0'') on the control grid (at least n samples);
@@ -334,15 +337,21 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
     committed but not yet handed to ``on_block`` is handed over before returning. ``model``:
     ``batch_model(params, **options)`` where the caller has it already. ``disturbance``: a torque on
     the steering joint [N m] per control step (at least n samples); ``loads``: (control step, model
-    fields) of each load change (:func:`load_fields`), in step order.
+    fields) of each load change (:func:`load_fields`), in step order. ``correction``: a
+    :class:`wmr_mj.sim.correction.CartesianCorrection`, whose outer loop rewrites the next
+    block's reference (alpha0 + delta, ...) before each block of its period, from C's position
+    and the heading of the control step before; the rows' alpha0 are then the corrected ones.
     """
     backend, note = _backend(controller, law)
     plain = batch_model(params, **options) if model is None else model
     where = _Plant(plain)
     log = on_block is not None
-    a0_all, a0d_all, a0dd_all = (np.asarray(r, dtype=np.float64) for r in reference)
+    a0_all, a0d_all, a0dd_all = (np.array(r, dtype=np.float64) if correction is not None
+                                 else np.asarray(r, dtype=np.float64) for r in reference)
     if len(a0_all) < n:
         raise ParameterError(f"reference shorter than the run: {len(a0_all)} < {n} samples")
+    if correction is not None and (disturbance is not None or loads):
+        raise ParameterError("the Cartesian correction does not run with disturbance or load signals yet")
     if disturbance is not None:
         disturbance = np.asarray(disturbance, dtype=np.float64)
         if len(disturbance) < n:
@@ -364,13 +373,17 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
         assert vector is not None  # the backend is 'compiled' only where compiled_law.supports(controller)
         carried = (vector, (a0_all, a0d_all, a0dd_all)) + (() if disturbance is None else (disturbance[:n],))
         lawful = batch_model(params, law=carried, **options)
-        stepper = _CompiledStepper(lawful, where, substeps, log)
+        stepper = _CompiledStepper(lawful, where, substeps, log, own_model=correction is not None)
+        ref_numeric = lawful.numeric(compiled_law.REFERENCE_NUMERIC)
+        ref_adr = int(lawful.numeric_adr[ref_numeric.id])
     else:
         stepper = python_stepper()
     used = "compiled" if backend == "compiled" else "python"
     rows = {key: np.empty(n) for key in ROW_FIELDS}
     C_xy = np.empty((n, 2))
     block_len = max(1, int(round(1.0 / period)))  # one simulated second per block
+    if correction is not None:
+        block_len = correction.block_steps  # the outer loop's period
     blocks: dict[int, _Block] = {}
     k_i = params.k_i
     warned = 0  # warnings counted by a stepper left behind
@@ -419,6 +432,17 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
             b = blocks.get(cnt)
             if b is None:
                 b = blocks[cnt] = _Block(cnt, plain, log)
+            if correction is not None:
+                if k0:
+                    correction.measure(rows["t"][k0 - 1], C_xy[k0 - 1], rows["heading"][k0 - 1])
+                d, dd, ddd = correction.block(cnt)
+                sl = slice(k0, k0 + cnt)
+                a0_all[sl] += d
+                a0d_all[sl] += dd
+                a0dd_all[sl] += ddd
+                if lawful is not None:  # the compiled law reads its reference from the model
+                    lawful.numeric_data[ref_adr + 3 * k0:ref_adr + 3 * (k0 + cnt)] = np.stack(
+                        [a0_all[sl], a0d_all[sl], a0dd_all[sl]], axis=1).ravel()
             if isinstance(stepper, _CompiledStepper):
                 before, start, fields_before = stepper.warnings(), stepper.state(), dict(in_effect)
                 step_block(stepper, b, k0, cnt)

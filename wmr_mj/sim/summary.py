@@ -92,6 +92,8 @@ class RunSummary:
         path_bound: what the certificate's E_max implies for C's path (``wmr_mj.analysis.path_bound``).
         path_verdict: the run's cross-track against ``path_bound``: 'within-bound', 'beyond-bound'
             or 'no-guarantee'.
+        correction: the Cartesian correction's gains, limits and the largest values it used
+            (``wmr_mj.sim.correction``); None when the run had none.
     """
 
     status: str
@@ -125,6 +127,7 @@ class RunSummary:
     path_error: PathErrors | None = None
     path_bound: PathBound | None = None
     path_verdict: PathVerdict | None = None
+    correction: Mapping[str, Any] | None = None
 
     # the paper's claim, read through paper_region (the JSON also writes these at the top level)
     @property
@@ -226,4 +229,6 @@ class RunSummary:
             out["path_bound"] = self.path_bound.to_dict()
         if self.path_verdict is not None:
             out["path_verdict"] = self.path_verdict.to_dict()
+        if self.correction is not None:
+            out["correction"] = dict(self.correction)
         return out
