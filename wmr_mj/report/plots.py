@@ -262,11 +262,19 @@ def plot_alpha0_accel(ax, reference, *, bound: float | None = None) -> None:
     ax.set_xlim(0.0, float(reference.t[-1]))
 
 
-def figure_paths(reference, *, title: str | None = None) -> Figure:
+def figure_paths(reference, *, title: str | None = None,
+                 actual: Sequence[tuple[str, np.ndarray]] = ()) -> Figure:
+    """Fig. 4; ``actual``: (label, C's xy (n, 2) [m]) of runs, the paths C travelled, drawn over it."""
     fig, ax = new_figure(5.0, 5.0)
     plot_paths(ax, reference)
+    for (label, xy), color in zip(actual, ("#d35400", "#1e8449", "#7d3c98", "#f0b000")):
+        xy = np.asarray(xy, dtype=float)
+        ax.plot(xy[:, 0], xy[:, 1], color=color, lw=1.1, alpha=0.9, label=f"C travelled: {label}")
     _legend_below(fig, ax, ncols=2)
-    ax.set_title(title or rf"Fig. 4  Desired trajectory: C on the circle, $V_A$ = {reference.V_A:g} m/s")
+    default = rf"Fig. 4  Desired trajectory: C on the circle, $V_A$ = {reference.V_A:g} m/s"
+    if actual:
+        default = "Fig. 4  C's desired path and the paths C travelled (MuJoCo plant)"
+    ax.set_title(title or default)
     return fig
 
 
@@ -745,6 +753,7 @@ class PaperExample:
     reduced: list[tuple[str, dict[str, np.ndarray]]] = field(default_factory=list)
     mujoco_rows: dict[str, np.ndarray] | None = None
     mujoco_summary: RunSummary | None = None
+    actual_paths: list[tuple[str, np.ndarray]] = field(default_factory=list)  # (label, C's xy) for Fig. 4
 
 
 def paper_example(*, duration: float = 35.0, friction_width: float = 1e-3, mujoco: bool = True) -> PaperExample:
@@ -786,6 +795,13 @@ def paper_example(*, duration: float = 35.0, friction_width: float = 1e-3, mujoc
         run = run_closed_loop(RunConfig(model="paper", duration=float(duration), kp=kp, kd=kd), progress=False)
         ex.mujoco_rows = run.rows
         ex.mujoco_summary = run.summary
+        from wmr_mj.sim.designs import CERTIFIED
+
+        certified = run_closed_loop(RunConfig(**CERTIFIED.config_changes(), duration=float(duration)), progress=False)
+        for label, r in (("the paper's design", run), ("the certified design", certified)):
+            if r.C_xy is not None and r.summary.path_error is not None:
+                ex.actual_paths.append((f"{label}, cross-track max {r.summary.path_error.cross_track_max:.3g} m",
+                                        r.C_xy))
     return ex
 
 
@@ -810,7 +826,7 @@ def paper_figures(example: PaperExample) -> dict[str, Figure]:
     ref = example.reference
     r = example.result
     figs = {
-        "fig4_trajectory": figure_paths(ref),
+        "fig4_trajectory": figure_paths(ref, actual=example.actual_paths),
         "fig5_alpha0": figure_alpha0(ref),
         "fig6_alpha0_rates": figure_alpha0_rates(ref, rate_bound=PAPER_BOUNDS.alpha_dot_max,
                                                  accel_bound=PAPER_BOUNDS.alpha_ddot_max),

@@ -138,7 +138,8 @@ LADDER_COLUMNS = ("rung", "design", "change", "certificate", "cert-in", "CERT-OU
 
 def ladder_rows(summary: Mapping[str, Any]) -> list[list[str]]:
     out = []
-    for r in summary["ladder"]:
+    extra = [summary["correction_rung"]] if summary.get("correction_rung") else []
+    for r in [*summary["ladder"], *extra]:
         v, n = r["verdicts"], r["n"]
         out.append([str(r["index"]), r["label"], r["change"] or "-", _cert_cell(r["certificate"]),
                     f"{v['certified-inside']}/{n}",
@@ -646,7 +647,8 @@ def summary_csv(summary: Mapping[str, Any]) -> str:
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(SUMMARY_CSV_COLUMNS)
-    for r in summary["ladder"]:
+    extra = [summary["correction_rung"]] if summary.get("correction_rung") else []
+    for r in [*summary["ladder"], *extra]:
         c = r["certificate"]
         row = [r["index"], r["name"], r["design"], c["certified"], c.get("E_max"), c.get("Edot_max"),
                c.get("voltage_max"), " ".join(x.replace(" ", "_") for x in c["unmet"]), r["n"],

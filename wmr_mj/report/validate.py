@@ -188,6 +188,18 @@ def ladder_stage(settings: ValidateSettings, folder: Path, st: Stages) -> list[d
     return rungs
 
 
+def correction_stage(settings: ValidateSettings, folder: Path, st: Stages) -> dict[str, Any]:
+    """The rung after the ladder: the certified design with the Cartesian correction at C
+    (:data:`wmr_mj.sim.designs.CORRECTION_RUNG`; summary.json's ``correction_rung``)."""
+    from wmr_mj.sim.designs import CERTIFIED, CORRECTION_RUNG
+
+    rung = run_rung(settings, len(LADDER) + 1, CORRECTION_RUNG, folder, st, paper_circle_reference(settings),
+                    CERTIFIED)
+    rung.update(changed=["correction"], change="Cartesian correction at C (outer loop on alpha0, "
+                                              "wmr_mj/sim/correction.py)")
+    return rung
+
+
 # --------------------------------------------------------------------------- stage 5: nominal runs
 def nominal_stage(settings: ValidateSettings, st: Stages) -> dict[str, Any]:
     """The paper's and the certified design at the nominal m1: {name: RunResult}."""
@@ -263,6 +275,7 @@ def run_validate(settings: ValidateSettings, out_dir: str | os.PathLike, *, log:
     identification = identify_stage(settings, folder, st)
     friction = friction_stage(settings, st)
     rungs = ladder_stage(settings, folder, st)
+    corrected = correction_stage(settings, folder, st)
     searches = search_stage(settings, folder, st, rungs)
     nominal = nominal_stage(settings, st)
     figures, fig7 = figures_stage(settings, folder, st, rungs, searches, nominal)
@@ -272,7 +285,8 @@ def run_validate(settings: ValidateSettings, out_dir: str | os.PathLike, *, log:
         "seed": settings.seed, "ladder": rungs, "certified_rule": _certified_rule(), "searches": searches,
         "nominal": {name: _nominal_summary(run) for name, run in nominal.items()}, "friction": friction,
         "identification": identification, "paper_example": fig7, "figures": figures,
-        "certified_outside": sum(r["certified_outside"] for r in rungs)
+        "correction_rung": corrected,
+        "certified_outside": sum(r["certified_outside"] for r in rungs) + corrected["certified_outside"]
         + sum(s["verdicts"]["certified-outside"] for s in searches),
         "versions": software_versions(),
     }

@@ -69,6 +69,7 @@ class RunResult:
     law: str = "compiled"  # the law that ran: "compiled" (C, MuJoCo's control callback) or "python"
     law_note: str | None = None  # why the Python law ran
     cpu_s: float | None = None  # CPU time of the run's loop on its thread (wall_s is in the summary)
+    C_xy: np.ndarray | None = None  # (control steps, 2) xy of point C [m], as the log's C_pos
 
 
 def _substeps(config: RunConfig, timestep: float) -> int:
@@ -333,6 +334,7 @@ def run_closed_loop(
     if logger is not None:
         logger.close(summary.to_dict(), status=status)
     return RunResult(config=config, rows=done, summary=summary, status=status, law=run.law, law_note=run.law_note,
+                     C_xy=run.C_xy,
                      cpu_s=run.cpu_s)
 
 

@@ -52,6 +52,7 @@ __all__ = [
     "PRESETS",
     "PRESET_NAMES",
     "LADDER",
+    "CORRECTION_RUNG",
     "ERROR_SPEC",
     "OMEGA_R_GRID",
     "certified_omega_r",
@@ -77,11 +78,15 @@ class Design:
     kd: float = PAPER_KD  # 1/s
     friction_sign: str = "measured"
     friction_width: float = 0.0  # rad/s; 0: exact sign
+    correction: bool = False  # the Cartesian correction at C (wmr_mj.sim.correction)
 
     def config_changes(self) -> dict[str, Any]:
-        """The RunConfig fields this design sets."""
-        return {"controller": self.controller, "model": self.model, "kp": self.kp, "kd": self.kd,
-                "friction_sign": self.friction_sign, "friction_width": self.friction_width}
+        """The RunConfig fields this design sets (``correction`` only where it is on)."""
+        out = {"controller": self.controller, "model": self.model, "kp": self.kp, "kd": self.kd,
+               "friction_sign": self.friction_sign, "friction_width": self.friction_width}
+        if self.correction:
+            out["correction"] = True
+        return out
 
     def describe(self) -> str:
         sign = "exact sign" if self.friction_width == 0 else f"sign smoothed w = {self.friction_width:g} rad/s"
@@ -89,7 +94,8 @@ class Design:
             sign = "sign of alpha0'"
         elif self.friction_sign == "none":
             sign = "no compensation"
-        return f"{self.model} model, K_P = {self.kp:g}, K_D = {self.kd:g}, {sign}"
+        return f"{self.model} model, K_P = {self.kp:g}, K_D = {self.kd:g}, {sign}" + (
+            ", Cartesian correction" if self.correction else "")
 
 
 PAPER = Design(name="paper", label="the paper's design")
@@ -106,6 +112,12 @@ LADDER: tuple[Design, ...] = (
     Design(name="gains", label="+ gains omega_r = 20 (= certified)", model=CERTIFIED.model, kp=CERTIFIED.kp,
            kd=CERTIFIED.kd, friction_sign=CERTIFIED.friction_sign, friction_width=CERTIFIED.friction_width),
 )
+
+#: validate's rung after the ladder: the certified design with the Cartesian correction at C
+#: (not in LADDER, whose last rung is the certified design)
+CORRECTION_RUNG = Design(name="correction", label="+ Cartesian correction", model=CERTIFIED.model, kp=CERTIFIED.kp,
+                         kd=CERTIFIED.kd, friction_sign=CERTIFIED.friction_sign,
+                         friction_width=CERTIFIED.friction_width, correction=True)
 
 
 def preset(name: str) -> Design:
