@@ -264,6 +264,8 @@ def _path_stats(loop: _Loop, stats: _BatchStats, idx: np.ndarray, k0: int, rows:
     local = loop.path_at[lo:hi] - k0
     stats.C_xy[idx, lo:hi] = C_buf[local].transpose(1, 0, 2)
     if heading is None:
+        if quat is None:
+            raise ParameterError("_path_stats needs the heading or the chassis quaternions")
         q = quat[local].reshape(-1, 4)
         heading = _heading(q).reshape(len(local), -1)
         stats.heading[idx, lo:hi] = heading.T

@@ -87,6 +87,8 @@ def corrected_bounds(bounds: ReferenceBounds, gains: CorrectionGains = DEFAULT_G
 
     sin(a)/cos^3(a) rises with |a| on [0, pi/2), so its max at max|alpha0| + delta_max bounds it.
     """
+    if bounds.alpha_max is None:
+        raise ParameterError("the correction needs the reference's max|alpha0| (ReferenceBounds.alpha_max)")
     a = bounds.alpha_max + gains.delta_max
     if a >= 0.5 * math.pi:
         raise ParameterError(f"max|alpha0| + delta_max = {a:.4g} rad reaches pi/2")

@@ -37,7 +37,7 @@ import copy
 import math
 import time
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import mujoco
@@ -137,7 +137,7 @@ class EngineRun:
     law_note: str | None  # why the Python law ran, None with the compiled law
     wall_s: float  # the block loop's wall time: stepping, recording, rows, hand-over (models built before)
     cpu_s: float  # the block loop's CPU time on the calling thread (the batch of one steps on it)
-    C_xy: np.ndarray | None = None  # (steps, 2) xy of site C [m] per control step, as the log's C_pos
+    C_xy: np.ndarray = field(default_factory=lambda: np.empty((0, 2)))  # (steps, 2) xy of site C [m], as C_pos
 
 
 class _Plant:
