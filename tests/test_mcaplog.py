@@ -203,7 +203,8 @@ def test_official_mcap_reader_and_schemas(logged):
         reader = make_reader(f)
         summ = reader.get_summary()
         topics = {c.topic: c for c in summ.channels.values()}
-        assert set(topics) == {"/signals", "/sim/state", "/steering", "/motor", "/pose", "/bounds", "/tf", "/scene"}
+        assert set(topics) == {"/signals", "/sim/state", "/steering", "/motor", "/pose", "/path", "/bounds", "/tf",
+                               "/scene"}
         schemas = {t: summ.schemas[c.schema_id] for t, c in topics.items()}
         assert schemas["/tf"].name == "foxglove_msgs/msg/FrameTransforms" and schemas["/tf"].encoding == "ros2msg"
         assert schemas["/scene"].name == "foxglove.SceneUpdate" and schemas["/scene"].encoding == "jsonschema"
@@ -215,7 +216,7 @@ def test_official_mcap_reader_and_schemas(logged):
             counts[ch.topic] = counts.get(ch.topic, 0) + 1
         # 1.2 s at 1 kHz, flushed every simulated second: 2 packed messages; 100 Hz plot rows; /tf at 50 Hz
         assert counts["/sim/state"] == counts["/signals"] == 2
-        assert counts["/steering"] == counts["/motor"] == 120
+        assert counts["/steering"] == counts["/motor"] == counts["/path"] == 120
         assert counts["/pose"] == 60 and counts["/tf"] == 59  # the NaN pose row (700) is left out of /tf
         assert counts["/scene"] == 1 and counts["/bounds"] == 3  # one per flush, one at the end
         assert summ.statistics.message_count == sum(counts.values())

@@ -305,6 +305,13 @@ class PathProjector:
         extend = max(4.0 * self.window, float(rs[-1] - rs[0]))
         self._gs, self._gxy, self._gth, self._gk, _, _ = _geometry(reference, float(spacing), extend)
 
+    def project_many(self, xy: ArrayLike, s_prev: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Points (n, 2) in order, each searched from the one before (the first from ``s_prev``):
+        (s, cross-track, desired heading) arrays."""
+        X = np.asarray(xy, dtype=float).reshape(-1, 2)
+        s, d = _project(self._gs, self._gxy, self._gk, X, float(s_prev), self.window)
+        return s, d, np.interp(s, self._gs, self._gth)
+
     def project(self, xy: ArrayLike, s_prev: float) -> tuple[float, float, float]:
         X = np.asarray(xy, dtype=float).reshape(1, 2)
         s, d = _project(self._gs, self._gxy, self._gk, X, float(s_prev), self.window)

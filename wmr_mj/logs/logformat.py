@@ -16,6 +16,8 @@ topic           schema (encoding)                  messages    rate             
 /steering       wmr_mj/msg/Steering                cdr         plot rate (100 Hz) one row: t alpha ... e e_dot
 /motor          wmr_mj/msg/Motor                   cdr         plot rate          one row: t voltage_cmd voltage ...
 /pose           wmr_mj/msg/Pose2                   cdr         tf rate            one row: t a_x a_y c_x c_y heading
+/path           wmr_mj/msg/PathError               cdr         plot rate          one row: t cross_track along_track
+                                                                                  heading_error (C against its path)
 /bounds         wmr_mj/msg/Bounds                  cdr         one per block      +-E_max, +-Edot_max, +-voltage limit
 /tf             foxglove_msgs/msg/FrameTransforms  cdr         tf rate (50 Hz)    world -> chassis -> ... -> wheels
 /scene          foxglove.SceneUpdate (jsonschema)  json        once, at t = 0     the vehicle's shapes, desired path
@@ -61,6 +63,7 @@ __all__ = [
     "TF_TOPIC",
     "SCENE_TOPIC",
     "BLOCK_KEYS",
+    "OPTIONAL_BLOCK_KEYS",
     "channel_layouts",
     "schema_text",
     "foxglove_schema",
@@ -80,7 +83,7 @@ CDR_LE_HEADER = b"\x00\x01\x00\x00"  # encapsulation: plain CDR, little endian
 
 SIGNALS_TOPIC = "/signals"
 STATE_TOPIC = "/sim/state"
-PLOT_TOPICS = ("/steering", "/motor", "/pose")
+PLOT_TOPICS = ("/steering", "/motor", "/pose", "/path")
 BOUNDS_TOPIC = "/bounds"
 TF_TOPIC = "/tf"
 SCENE_TOPIC = "/scene"
@@ -91,6 +94,8 @@ BLOCK_KEYS = (
     "voltage_cmd", "voltage", "current", "steer_torque", "A_pos", "C_pos", "heading",
     "qpos", "qvel", "ctrl",
 )  # fmt: skip
+#: What the runner may add to a block: C's path errors (NaN where absent), for the /path channel.
+OPTIONAL_BLOCK_KEYS = ("path_cross_track", "path_along_track", "path_heading_error")
 
 _PRIMITIVES = {
     "float64": "<f8", "float32": "<f4", "int8": "i1", "uint8": "u1", "int16": "<i2", "uint16": "<u2",

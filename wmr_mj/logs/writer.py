@@ -403,6 +403,12 @@ class RunLogger:
                     raise ParameterError(f"block[{k!r}] has shape {a.shape}; {want} is expected")
                 a = a.reshape(want)
             clean[k] = np.array(a) if self._background else a  # the runner may reuse its buffers
+        for k in lf.OPTIONAL_BLOCK_KEYS:  # C's path errors: NaN where the runner gave none
+            given = block.get(k)
+            a = np.full(n, np.nan) if given is None else np.array(given, np.float64).ravel()
+            if a.shape != (n,):
+                raise ParameterError(f"block[{k!r}] has shape {a.shape}; {(n,)} is expected")
+            clean[k] = a
         self._pending.append(clean)
         self._pending_rows += n
         if self._pending_rows * self.dt_row >= self.flush_period_s - 0.5 * self.dt_row:
@@ -411,7 +417,8 @@ class RunLogger:
     def _take_pending(self) -> dict[str, np.ndarray]:
         self._taken_rows += self._pending_rows
         blocks, self._pending, self._pending_rows = self._pending, [], 0
-        return blocks[0] if len(blocks) == 1 else {k: np.concatenate([b[k] for b in blocks]) for k in lf.BLOCK_KEYS}
+        keys = (*lf.BLOCK_KEYS, *lf.OPTIONAL_BLOCK_KEYS)
+        return blocks[0] if len(blocks) == 1 else {k: np.concatenate([b[k] for b in blocks]) for k in keys}
 
     def flush(self) -> None:
         """Write the pending rows as two complete chunks and flush them to the file.

@@ -164,6 +164,36 @@ class PathJudgement:
     verdict: PathVerdict
 
 
+class _PathRows:
+    """C's path errors added to each logged block (the log's /path channel), at the rows the
+    logger plots (every ``every``-th control step), projected with continuity across blocks."""
+
+    def __init__(self, reference, period: float, every: int, write: Callable[..., Any]) -> None:
+        from wmr_mj.analysis.path_error import PathProjector
+
+        self.projector = PathProjector(reference)
+        self.rt, self.rs = np.asarray(reference.t, float), np.asarray(reference.s, float)
+        self.s_prev = float(self.rs[0])
+        self.period, self.every, self.write = period, max(1, int(every)), write
+
+    def __call__(self, block) -> None:
+        from wmr_mj.analysis.path_error import wrap_angle
+
+        t = np.asarray(block["t"], float)
+        n = t.size
+        out = {key: np.full(n, np.nan) for key in ("path_cross_track", "path_along_track", "path_heading_error")}
+        k = np.rint(t / self.period)
+        X, h = np.asarray(block["C_pos"], float).reshape(n, 2), np.asarray(block["heading"], float)
+        sel = np.flatnonzero((k % self.every == 0) & np.isfinite(X).all(axis=1) & np.isfinite(h) & np.isfinite(t))
+        if sel.size:
+            s, d, theta = self.projector.project_many(X[sel], self.s_prev)
+            self.s_prev = float(s[-1])
+            out["path_cross_track"][sel] = d
+            out["path_along_track"][sel] = s - np.interp(t[sel], self.rt, self.rs)
+            out["path_heading_error"][sel] = wrap_angle(h[sel] - theta)
+        self.write({**block, **out})
+
+
 def path_sample_index(k: int, period: float) -> np.ndarray:
     """The control steps (of ``k``) at which a run's path errors are judged: every ``PATH_SAMPLE_S``
     and the last one."""
@@ -302,11 +332,14 @@ def run_closed_loop(
         from wmr_mj.sim.correction import CartesianCorrection
 
         outer = CartesianCorrection(reference, period=period)
+    on_block = None  # the log's blocks, with C's path errors for its /path channel
+    if logger is not None:
+        on_block = _PathRows(reference, period, getattr(logger, "plot_every", 1), logger.write_block)
     bar = progress_bar(n, desc="run", unit="step", unit_scale=True, enabled=progress)
     try:
         run = run_engine(correction=outer, params=params, controller=controller, options=options, model=plain,
                          reference=(a0_all, a0d_all, a0dd_all), n=n, substeps=substeps, period=period, law=law,
-                         on_block=None if logger is None else logger.write_block, on_progress=bar.update,
+                         on_block=on_block, on_progress=bar.update,
                          disturbance=disturbance, loads=loads)
     finally:
         bar.close()
