@@ -11,7 +11,7 @@ picture shows what the controller acts on:
   reached (blue, alpha) and the one asked for (green, alpha0); the angle between them is
   the servo error E = alpha0 - alpha (paper, section 3, before (3.4));
 - an overlay: t, alpha, alpha0, E against its bound E_max (the region (4.21) closed by
-  (4.23)), a strip of E(t) with the band +-E_max, and the run's verdict.
+  (4.23)), a strip of E(t) with the band +-E_max, the run's verdict and C's cross-track (the log's /path channel).
 
 The frames are encoded by imageio's ffmpeg writer (H.264, the ``video`` extra). MuJoCo
 picks its OpenGL backend when it is first imported, so :func:`render_video` renders in
@@ -413,6 +413,15 @@ def _frame_signals(log: Any, t_frames: np.ndarray) -> dict[str, np.ndarray]:
         ok = v is not None and t.size and len(v) == t.size
         out[key] = np.asarray(v, float)[rows] if ok else np.full(t_frames.size, np.nan)
     out["t_all"], out["E_all"] = t, np.asarray(sig.get("E", np.full(t.size, np.nan)), float)
+    out["cross_track"] = np.full(t_frames.size, np.nan)  # C's cross-track from the /path channel, where the log has it
+    try:
+        path = log.channel("/path")
+        tp, ct = np.asarray(path["t"], float), np.asarray(path["cross_track"], float)
+    except Exception:  # noqa: BLE001  (a log written before the channel existed, or a stand-in log)
+        tp = np.empty(0)
+    if tp.size:
+        rows = np.clip(np.searchsorted(tp, t_frames + 1e-9, side="right") - 1, 0, tp.size - 1)
+        out["cross_track"] = ct[rows]
     return out
 
 
@@ -588,7 +597,9 @@ class _Overlay:
         col = self.col
         y = 3
         d.text((6, y), f"t = {t:5.2f} s", font=self.font, fill=(240, 240, 240))
-        d.text((col, y), "desired path of C", font=self.font, fill=_rgb255(PATH_RGBA))
+        ct = float(self.sig["cross_track"][k]) if "cross_track" in self.sig else math.nan
+        label = "desired path of C" + (f", C off it {ct:+.3f} m" if math.isfinite(ct) else "")
+        d.text((col, y), label, font=self.font, fill=_rgb255(PATH_RGBA))
         y += self.line
         d.text((6, y), f"steering alpha = {a:+.3f} rad", font=self.font, fill=_rgb255(STEER_RGBA, lift=80))
         d.text((col, y), f"asked alpha0 = {a0:+.3f} rad", font=self.font, fill=_rgb255(DESIRED_RGBA))
