@@ -218,7 +218,8 @@ def test_official_mcap_reader_and_schemas(logged):
         assert counts["/sim/state"] == counts["/signals"] == 2
         assert counts["/steering"] == counts["/motor"] == counts["/path"] == 120
         assert counts["/pose"] == 60 and counts["/tf"] == 59  # the NaN pose row (700) is left out of /tf
-        assert counts["/scene"] == 1 and counts["/bounds"] == 3  # one per flush, one at the end
+        # /scene: the vehicle and the desired path at t = 0, then C's travelled path once per written block
+        assert counts["/scene"] == 3 and counts["/bounds"] == 3  # one per flush, one at the end
         assert summ.statistics.message_count == sum(counts.values())
         assert {m.name for m in reader.iter_metadata()} == {"wmr_mj", "versions", "config", "summary"}
         assert {a.name for a in reader.iter_attachments()} >= {"c80.xml", "parameters.json", "initial_state.npy"}
@@ -280,9 +281,14 @@ def test_scene_validates_and_shows_the_axles(logged):
     jsonschema = pytest.importorskip("jsonschema")
     path, _ = logged
     scene = load_log(path).messages("/scene")
-    assert len(scene) == 1 and scene[0][0] == 0
+    assert len(scene) == 3 and scene[0][0] == 0  # the vehicle, then the travelled path per written block
     msg = scene[0][1]
-    jsonschema.validate(msg, foxglove_schema("foxglove.SceneUpdate"))
+    for _, m in scene:
+        jsonschema.validate(m, foxglove_schema("foxglove.SceneUpdate"))
+    travelled = [m["entities"][0] for _, m in scene[1:]]
+    assert [e["id"] for e in travelled] == ["travelled_path/0", "travelled_path/1"]
+    first, second = (e["lines"][0]["points"] for e in travelled)
+    assert first[-1] == second[0]  # the pieces join: each starts where the one before ended
     ents = {e["id"]: e for e in msg["entities"]}
     bodies = {"body:chassis", "body:steering_unit", "body:front_left_wheel", "body:rear_right_wheel"}
     assert bodies | {"reference_path"} <= set(ents)

@@ -242,6 +242,25 @@ def _box_edges(half: np.ndarray) -> list[dict[str, float]]:
     return [{"x": float(p[0]), "y": float(p[1]), "z": float(p[2])} for p in pts]
 
 
+def travelled_update(points: np.ndarray, stamp_ns: int, piece: int) -> dict[str, Any]:
+    """foxglove.SceneUpdate of one piece of the path C travelled ((N, 2) world xy, starting at the
+    previous piece's last point), as the entity ``travelled_path/<piece>``: the pieces add up on
+    the 3D panel as the run plays (each message holds only its block's points)."""
+    xy = np.asarray(points, float).reshape(-1, 2)
+    stamp = {"sec": int(stamp_ns // 1_000_000_000), "nsec": int(stamp_ns % 1_000_000_000)}
+    ent = {
+        "timestamp": stamp, "frame_id": "world", "id": f"travelled_path/{piece}", "lifetime": {"sec": 0, "nsec": 0},
+        "frame_locked": False, "metadata": [], "arrows": [], "cubes": [], "spheres": [], "cylinders": [],
+        "lines": [{
+            "type": 0, "pose": _pose([0, 0, 0], [1, 0, 0, 0]), "thickness": 3.0, "scale_invariant": True,
+            "points": [{"x": float(x), "y": float(y), "z": 0.003} for x, y in xy],
+            "color": {"r": 0.1, "g": 0.55, "b": 0.25, "a": 1.0}, "colors": [], "indices": [],
+        }],
+        "triangles": [], "texts": [], "models": [],
+    }  # fmt: skip
+    return {"deletions": [], "entities": [ent]}
+
+
 def scene_update(model: Any, frame_names: list[str], reference_path: np.ndarray | None, *,
                  translucent: tuple[str, ...] = ("chassis",), max_group: int = 2) -> dict[str, Any]:
     """foxglove.SceneUpdate: one frame-locked entity per body with visible geoms, plus the path.

@@ -50,7 +50,14 @@ from mcap.records import MessageIndex
 from wmr_mj._util.files import json_safe, software_versions
 from wmr_mj.errors import LogError, OutputPathError, ParameterError
 from wmr_mj.logs import logformat as lf
-from wmr_mj.logs.foxglove import TF_SCHEMA_NAME, FrameTree, TfEncoder, scene_update, tf_schema_text
+from wmr_mj.logs.foxglove import (
+    TF_SCHEMA_NAME,
+    FrameTree,
+    TfEncoder,
+    scene_update,
+    tf_schema_text,
+    travelled_update,
+)
 
 if TYPE_CHECKING:
     from wmr_mj.sim.config import RunConfig
@@ -261,6 +268,8 @@ class RunLogger:
         self._bounds = self._bound_values(bounds or {}, parameters)
         self._closed = False
         self._rows = 0
+        self._travelled_last = np.empty((0, 2))  # C's last xy drawn in the scene's travelled path
+        self._travelled_pieces = 0
         self._last_t = 0.0
         self._pending: list[dict[str, np.ndarray]] = []
         self._pending_rows = 0
@@ -479,6 +488,15 @@ class RunLogger:
             self._add_many(topic, lt[sel], lf.encode_rows(topic, b, sel))
         keep, payloads = self._tf.encode(lt[tf], b["qpos"][tf])
         self._add_many(lf.TF_TOPIC, lt[tf][keep], payloads)
+        # the path C travelled, on the 3D panel: one piece per written block, joined to the one before
+        C = b["C_pos"][tf]
+        piece = np.concatenate([self._travelled_last, C[np.all(np.isfinite(C), axis=1)]])
+        if len(piece) >= 2:
+            scene = travelled_update(piece, int(lt[-1]), self._travelled_pieces)
+            self._add(lf.SCENE_TOPIC, int(lt[-1]), json.dumps(scene, separators=(",", ":")).encode())
+            self._travelled_pieces += 1
+        if len(piece):
+            self._travelled_last = piece[-1:]
         if self._bounds_given:
             self._add_bounds(int(lt[0]))
         self._rows += n
