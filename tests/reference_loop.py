@@ -25,6 +25,7 @@ from wmr_mj.plant.mjcf import Plant
 from wmr_mj.sim.certify import certificate_for
 from wmr_mj.sim.closed_loop import (
     ROW_FIELDS,
+    RunMeasures,
     RunResult,
     _drift_of,
     _substeps,
@@ -180,11 +181,11 @@ def reference_run(
         raise KeyboardInterrupt  # nothing simulated: nothing to report
     after = done["t"] >= settle_s
     at = path_sample_index(k, period)
-    summary = report(config, analysis=analysis, params=params, settle_s=settle_s, sup_E=_sup(done["E"]),
-                     sup_Edot=_sup(done["E_dot"]), sup_E_settled=_sup(done["E"][after]),
-                     sup_Edot_settled=_sup(done["E_dot"][after]), saturated_fraction=saturated / k,
-                     left_range_at=left_range_at, final_alpha=done["alpha"][-1], control_steps=k,
-                     steps=k * substeps, wall_s=wall, status=status, certificate=certificate,
+    measured = RunMeasures(status=status, settle_s=settle_s, sup_E=_sup(done["E"]), sup_Edot=_sup(done["E_dot"]),
+                           sup_E_settled=_sup(done["E"][after]), sup_Edot_settled=_sup(done["E_dot"][after]),
+                           saturated_fraction=saturated / k, left_range_at=left_range_at,
+                           final_alpha=done["alpha"][-1], control_steps=k, steps=k * substeps, wall_s=wall)
+    summary = report(config, measured, analysis=analysis, params=params, certificate=certificate,
                      drift=_drift_of(done["E"], done["alpha0_dot"][-1] - done["E_dot"][-1], period),
                      path=judge_path(reference, done["t"][at], r_C[:k][at], done["heading"][at], settle_s=settle_s,
                                      certificate=certificate, steering_range=params.steering_range))

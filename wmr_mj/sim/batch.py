@@ -21,7 +21,7 @@ How a batch runs at the speed of open-loop ``mujoco.rollout`` (bench/bench_sweep
 Usage::
 
     from wmr_mj.sim.batch import run_batch
-    from wmr_mj.sim.closed_loop import RunConfig
+    from wmr_mj.sim.config import RunConfig
     base = RunConfig(model="nonholonomic", duration=20.0)
     reports = run_batch([base.replace(m1=m) for m in (550.0, 650.0, 750.0)], nthread=2)
     [r.sup_E for r in reports]           # each a RunSummary, as run_closed_loop(config).summary
@@ -46,7 +46,7 @@ from wmr_mj.errors import ParameterError
 from wmr_mj.params import C80, M1_NOMINAL, C80Parameters
 from wmr_mj.sim import compiled_law
 from wmr_mj.sim.certify import certificate_for
-from wmr_mj.sim.closed_loop import _substeps, judge_path, path_sample_index, report, run_closed_loop
+from wmr_mj.sim.closed_loop import RunMeasures, _substeps, judge_path, path_sample_index, report, run_closed_loop
 from wmr_mj.sim.config import (
     RunConfig,
     analysis_for,
@@ -407,12 +407,13 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
     reports = []
     for i, (c, p) in enumerate(zip(configs, plants)):
         certificate = certificate_for(c, reference, params=base)
-        r = report(c, analysis=analysis, params=p, settle_s=settle_s, sup_E=stats.sup_E[i], sup_Edot=stats.sup_Ed[i],
-                   sup_E_settled=stats.sup_E_s[i], sup_Edot_settled=stats.sup_Ed_s[i],
-                   saturated_fraction=stats.saturated[i] / n,
-                   left_range_at=None if np.isnan(stats.left_at[i]) else float(stats.left_at[i]),
-                   final_alpha=stats.final_alpha[i], control_steps=n, steps=n * substeps, wall_s=wall / nsim,
-                   status="completed", certificate=certificate,
+        measured = RunMeasures(status="completed", settle_s=settle_s, sup_E=stats.sup_E[i], sup_Edot=stats.sup_Ed[i],
+                               sup_E_settled=stats.sup_E_s[i], sup_Edot_settled=stats.sup_Ed_s[i],
+                               saturated_fraction=stats.saturated[i] / n,
+                               left_range_at=None if np.isnan(stats.left_at[i]) else float(stats.left_at[i]),
+                               final_alpha=stats.final_alpha[i], control_steps=n, steps=n * substeps,
+                               wall_s=wall / nsim)
+        r = report(c, measured, analysis=analysis, params=p, certificate=certificate,
                    drift=drift(prev_window=float(stats.drift_prev[i]), last_window=float(stats.drift_last[i]),
                                final_alpha_dot=float(stats.final_alpha_dot[i])),
                    path=judge_path(reference, path_at * period, stats.C_xy[i], stats.heading[i], settle_s=settle_s,

@@ -53,7 +53,7 @@ from wmr_mj.sim.config import (
 from wmr_mj.sim.engine import ROW_FIELDS, batch_model, load_fields, plant_options, run_engine
 from wmr_mj.sim.summary import RunSummary
 
-__all__ = ["RunResult", "run_closed_loop", "report", "run_on_reduced_model", "ROW_FIELDS", "judge_path",
+__all__ = ["RunResult", "RunMeasures", "run_closed_loop", "report", "run_on_reduced_model", "ROW_FIELDS", "judge_path",
            "path_sample_index", "PathJudgement", "PATH_SAMPLE_S"]
 
 
@@ -82,10 +82,26 @@ def _substeps(config: RunConfig, timestep: float) -> int:
     return n
 
 
-def report(config: RunConfig, *, analysis, params: C80Parameters, settle_s: float, sup_E: float, sup_Edot: float,
-           sup_E_settled: float, sup_Edot_settled: float, saturated_fraction: float, left_range_at: float | None,
-           final_alpha: float, control_steps: int, steps: int, wall_s: float, status: str,
-           certificate=None, drift: Drift | None = None, path: PathJudgement | None = None) -> RunSummary:
+@dataclass(frozen=True, kw_only=True)
+class RunMeasures:
+    """What a run measured, before it is judged: the inputs of :func:`report` that come from its steps."""
+
+    status: str  # 'completed' or 'interrupted'
+    settle_s: float  # end of the entry transient [s]
+    sup_E: float  # sup |E| over the run [rad]
+    sup_Edot: float  # sup |E'| over the run [rad/s]
+    sup_E_settled: float  # sup |E| after settle_s [rad]
+    sup_Edot_settled: float  # sup |E'| after settle_s [rad/s]
+    saturated_fraction: float  # fraction of control steps whose voltage was limited [-]
+    left_range_at: float | None  # when the steering first reached its stop [s]; None if never
+    final_alpha: float  # alpha at the last control step [rad]
+    control_steps: int  # control steps simulated
+    steps: int  # physics steps simulated
+    wall_s: float  # wall time [s]
+
+
+def report(config: RunConfig, measured: RunMeasures, *, analysis, params: C80Parameters, certificate=None,
+           drift: Drift | None = None, path: PathJudgement | None = None) -> RunSummary:
     """The run's report: sup errors (whole run and after the entry transient) against the region.
 
     Shared by the single run and the batched sweep so both report alike.
@@ -94,16 +110,8 @@ def report(config: RunConfig, *, analysis, params: C80Parameters, settle_s: floa
         config: the run's configuration.
         analysis: the paper's region (``RobustnessResult``): the summary's E_max, Edot_max, inside,
             E_ratio, Edot_ratio are the paper's claim.
+        measured: what the run measured (:class:`RunMeasures`, units there).
         params: the plant's parameters (its m1 [kg]).
-        settle_s: end of the entry transient [s].
-        sup_E, sup_Edot: sup |E| [rad], sup |E'| [rad/s] over the run.
-        sup_E_settled, sup_Edot_settled: the same after ``settle_s``.
-        saturated_fraction: fraction of control steps whose voltage was limited [-].
-        left_range_at: when the steering first reached its stop [s]; None if never.
-        final_alpha: alpha at the last control step [rad].
-        control_steps, steps: control and physics steps simulated.
-        wall_s: wall time [s].
-        status: 'completed' or 'interrupted'.
         certificate: the run's :class:`wmr_mj.analysis.certificate.Certificate`; with it and the
             end-of-run ``drift`` (:func:`wmr_mj.analysis.verdicts.drift`) the separated verdict is
             added (:func:`wmr_mj.analysis.verdicts.judge_run`).
@@ -112,14 +120,16 @@ def report(config: RunConfig, *, analysis, params: C80Parameters, settle_s: floa
     Returns:
         RunSummary: ``to_dict()`` writes the JSON interface.
     """
-    sup_E, sup_Edot = float(sup_E), float(sup_Edot)
+    m = measured
+    sup_E, sup_Edot = float(m.sup_E), float(m.sup_Edot)
+    steps, wall_s = m.steps, m.wall_s
     from wmr_mj.analysis.verdicts import judge_run, paper_region
 
     judged = None
     if certificate is not None:
         judged = judge_run(certificate=certificate, analysis=analysis, sup_E=sup_E, sup_Edot=sup_Edot, drift=drift)
     return RunSummary(
-        status=status,
+        status=m.status,
         controller=config.controller,
         model=config.model,
         m1=float(params.m1),
@@ -128,18 +138,18 @@ def report(config: RunConfig, *, analysis, params: C80Parameters, settle_s: floa
         path=config.path,
         duration=steps * TIMESTEP,
         steps=int(steps),
-        control_steps=int(control_steps),
+        control_steps=int(m.control_steps),
         wall_s=float(wall_s),
         realtime_factor=float(steps * TIMESTEP / wall_s) if wall_s > 0 else None,
         sup_E=sup_E,
         sup_Edot=sup_Edot,
-        settle_s=float(settle_s),
-        sup_E_settled=float(sup_E_settled),
-        sup_Edot_settled=float(sup_Edot_settled),
+        settle_s=float(m.settle_s),
+        sup_E_settled=float(m.sup_E_settled),
+        sup_Edot_settled=float(m.sup_Edot_settled),
         stable=bool(analysis.stable),
-        saturated_fraction=float(saturated_fraction),
-        left_steering_range_at_s=left_range_at,
-        final_alpha=float(final_alpha),
+        saturated_fraction=float(m.saturated_fraction),
+        left_steering_range_at_s=m.left_range_at,
+        final_alpha=float(m.final_alpha),
         paper_region=paper_region(analysis, sup_E, sup_Edot) if judged is None else judged.paper_region,
         certificate=None if judged is None else judged.certificate,
         drift=None if judged is None else judged.drift,
@@ -351,11 +361,11 @@ def run_closed_loop(
     saturated = int(np.count_nonzero(done["voltage"] != done["voltage_cmd"]))  # NaN included: 0 V applied
     hit = np.flatnonzero(np.abs(done["alpha"]) >= params.steering_range - 1e-3)
     left_range_at = int(hit[0]) * period if hit.size else None
-    summary = report(config, analysis=analysis, params=params, settle_s=settle_s, sup_E=_sup(done["E"]),
-                     sup_Edot=_sup(done["E_dot"]), sup_E_settled=_sup(done["E"][after]),
-                     sup_Edot_settled=_sup(done["E_dot"][after]), saturated_fraction=saturated / k,
-                     left_range_at=left_range_at, final_alpha=done["alpha"][-1], control_steps=k,
-                     steps=k * substeps, wall_s=wall, status=status, certificate=certificate,
+    measured = RunMeasures(status=status, settle_s=settle_s, sup_E=_sup(done["E"]), sup_Edot=_sup(done["E_dot"]),
+                           sup_E_settled=_sup(done["E"][after]), sup_Edot_settled=_sup(done["E_dot"][after]),
+                           saturated_fraction=saturated / k, left_range_at=left_range_at,
+                           final_alpha=done["alpha"][-1], control_steps=k, steps=k * substeps, wall_s=wall)
+    summary = report(config, measured, analysis=analysis, params=params, certificate=certificate,
                      drift=_drift_of(done["E"], done["alpha0_dot"][-1] - done["E_dot"][-1], period),
                      path=judge_path(reference, done["t"][at], run.C_xy[at], done["heading"][at], settle_s=settle_s,
                                      certificate=certificate, steering_range=params.steering_range,
