@@ -251,3 +251,21 @@ def test_uncertainty_box_reaches_the_ladder_and_the_certificates():
         ValidateSettings(uncertainty="everything")
     proc = _cli("validate", "--uncertainty", "everything")
     assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1
+
+
+def test_validate_runs_every_rung_on_the_path_it_is_given():
+    from wmr_mj import C80
+    from wmr_mj.errors import WmrMjError
+    from wmr_mj.report.settings import ValidateSettings, reference_of
+    from wmr_mj.sim.config import build_reference
+    from wmr_mj.sim.designs import CERTIFIED
+
+    settings = ValidateSettings(path="agv-loop", duration=40.0)
+    assert settings.config(CERTIFIED).path == "agv-loop" and settings.as_dict()["path"] == "agv-loop"
+    route = build_reference("agv-loop", C80, dt=1e-3, duration=40.0)[0]
+    circle = build_reference("paper-circle", C80, dt=1e-3, duration=40.0)[0]
+    assert (reference_of(settings).alpha0 == route.alpha0).all()
+    assert (route.alpha0 != circle.alpha0).any()
+    assert (reference_of(ValidateSettings(duration=40.0)).alpha0 == circle.alpha0).all()  # the default
+    with pytest.raises(WmrMjError, match="nowhere.toml"):
+        ValidateSettings(path="nowhere.toml")

@@ -45,6 +45,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--uncertainty", default="m1",
                    help="uncertainty box the ladder samples and its certificates cover: m1 (the paper's, default) or "
                         "full (m1, steering and tyre friction, R_a, V_A; see wmr_mj/params.py)")
+    p.add_argument("--path", default="paper-circle", metavar="NAME|FILE",
+                   help="path of C every run follows: a named path (paper-circle, the default), a packaged route "
+                        "(agv-loop) or a route file, as for wmr-mj run")
     p.add_argument("--nthread", type=_nonneg_int, default=0, help="simulation threads (default 0: all CPUs)")
     p.add_argument("--out", metavar="DIR",
                    help="report folder (default logs/validate-<timestamp>/; an existing folder resumes its sweeps)")
@@ -67,7 +70,7 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     settings = ValidateSettings(n=args.n, seed=args.seed, sampling=args.sampling, duration=args.duration,
                                 identify_duration=args.identify_duration, search_budget=args.search_budget,
-                                nthread=args.nthread, uncertainty=args.uncertainty)
+                                nthread=args.nthread, uncertainty=args.uncertainty, path=args.path)
     out = check_output_path(args.out or default_folder("validate"), kind="dir", option="--out")
     summary = run_validate(settings, out)
     pointer = write_pointer(out)

@@ -44,7 +44,7 @@ from wmr_mj.report.settings import (
     certificate_summary,
     loud,
     max_at,
-    paper_circle_reference,
+    reference_of,
     stage_progress,
 )
 from wmr_mj.sim.designs import CERTIFIED, LADDER, PAPER, Design
@@ -236,5 +236,5 @@ def _num(x: Any) -> str:
 def search_stage(settings: ValidateSettings, folder: Path, st: Stages, rungs: Sequence[Mapping[str, Any]]
                  ) -> list[dict[str, Any]]:
     """Every search of :func:`search_plans`, in order ([] when the search is disabled)."""
-    reference = paper_circle_reference(settings)
+    reference = reference_of(settings)
     return [run_search(plan, settings, folder, st, rungs, reference) for plan in search_plans(settings)]

@@ -31,7 +31,7 @@ __all__ = [
     "ValidateSettings",
     "max_at",
     "certificate_summary",
-    "paper_circle_reference",
+    "reference_of",
     "stage_progress",
     "loud",
 ]
@@ -70,6 +70,7 @@ class ValidateSettings:
     m1_range: tuple[float, float] = M1_RANGE
     nominal_m1: float = M1_NOMINAL
     uncertainty: str = "m1"
+    path: str = "paper-circle"
 
     def __post_init__(self) -> None:
         from wmr_mj.sim.sweep import SAMPLINGS
@@ -93,6 +94,7 @@ class ValidateSettings:
 
         if self.uncertainty not in UNCERTAINTY_NAMES:
             raise UnknownNameError("uncertainty box name", str(self.uncertainty), UNCERTAINTY_NAMES)
+        RunConfig(path=self.path)  # a named path or a route file: refused here as a run would refuse it
 
     @property
     def ranges(self) -> dict[str, tuple[float, float]]:
@@ -103,7 +105,7 @@ class ValidateSettings:
 
     def config(self, design: Design) -> RunConfig:
         """The run of ``design`` these settings sweep (m1 at nominal; the sweep draws it)."""
-        return RunConfig(**design.config_changes(), duration=self.duration, m1=self.nominal_m1,
+        return RunConfig(**design.config_changes(), duration=self.duration, m1=self.nominal_m1, path=self.path,
                          m1_range=as_pair(self.m1_range), box_ranges=self.ranges, seed=self.seed)
 
     def as_dict(self) -> dict[str, Any]:
@@ -125,9 +127,10 @@ def certificate_summary(cert: Any) -> dict[str, Any]:
     return d
 
 
-def paper_circle_reference(settings: ValidateSettings):
-    """The paper circle's reference for runs of ``settings.duration`` on the 1 ms grid."""
-    return build_reference("paper-circle", C80, dt=1e-3, duration=settings.duration)[0]
+def reference_of(settings: ValidateSettings):
+    """The reference of ``settings.path`` (the paper circle by default) for runs of ``settings.duration``
+    on the 1 ms grid."""
+    return build_reference(settings.path, C80, dt=1e-3, duration=settings.duration)[0]
 
 
 

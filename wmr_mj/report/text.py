@@ -464,13 +464,19 @@ def answer_blocks(summary: Mapping[str, Any], *, brief: bool = False) -> list[Bl
     ]
 
 
+def _path_words(settings: Mapping[str, Any]) -> str:
+    """The runs' path of C in words: 'the paper circle' (also for reports written before --path)."""
+    path = settings.get("path", "paper-circle")
+    return "the paper circle" if path == "paper-circle" else f"the path {path}"
+
+
 def _settings_line(summary: Mapping[str, Any]) -> str:
     s = summary["settings"]
     box = s.get("uncertainty", "m1")
     search = (f"search budget {s['search_budget']} runs per {box}-box search" if s["search_budget"] else "no search")
     others = "" if box == "m1" else " and the rest of the full uncertainty box (wmr_mj/params.py)"
     return (f"{s['n']} runs per rung, {s['sampling']} sampling of m1 over {s['m1_range'][0]:g}-{s['m1_range'][1]:g} "
-            f"kg{others}, seed {s['seed']}, {s['duration']:g} s per run on the paper circle; {search}; identification "
+            f"kg{others}, seed {s['seed']}, {s['duration']:g} s per run on {_path_words(s)}; {search}; identification "
             f"{s['identify_duration']:g} s at m1 = {s['nominal_m1']:g} kg")
 
 

@@ -50,7 +50,7 @@ from wmr_mj.report.settings import (
     ValidateSettings,
     certificate_summary,
     loud,
-    paper_circle_reference,
+    reference_of,
     stage_progress,
 )
 from wmr_mj.sim.config import RunConfig
@@ -181,7 +181,7 @@ def run_rung(settings: ValidateSettings, k: int, design: Design, folder: Path, s
 
 def ladder_stage(settings: ValidateSettings, folder: Path, st: Stages) -> list[dict[str, Any]]:
     """Every rung of :data:`LADDER`, in order (see :func:`run_rung`)."""
-    reference = paper_circle_reference(settings)
+    reference = reference_of(settings)
     rungs = []
     for k, design in enumerate(LADDER, start=1):
         rungs.append(run_rung(settings, k, design, folder, st, reference, LADDER[k - 2] if k > 1 else None))
@@ -193,7 +193,7 @@ def correction_stage(settings: ValidateSettings, folder: Path, st: Stages) -> di
     (:data:`wmr_mj.sim.designs.CORRECTION_RUNG`; summary.json's ``correction_rung``)."""
     from wmr_mj.sim.designs import CERTIFIED, CORRECTION_RUNG
 
-    rung = run_rung(settings, len(LADDER) + 1, CORRECTION_RUNG, folder, st, paper_circle_reference(settings),
+    rung = run_rung(settings, len(LADDER) + 1, CORRECTION_RUNG, folder, st, reference_of(settings),
                     CERTIFIED)
     rung.update(changed=["correction"], change="Cartesian correction at C (outer loop on alpha0, "
                                               "wmr_mj/sim/correction.py)")
