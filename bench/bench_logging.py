@@ -32,7 +32,7 @@ import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 
 from wmr_mj.logs.reader import load_log  # noqa: E402
-from wmr_mj.logs.writer import COMPRESSIONS, RunLogger  # noqa: E402
+from wmr_mj.logs.writer import COMPRESSIONS, LogHeader, LogOptions, RunLogger  # noqa: E402
 from wmr_mj.sim.closed_loop import run_closed_loop
 from wmr_mj.sim.config import RunConfig
 
@@ -44,7 +44,7 @@ DEFAULT_COMPRESSION = "lz4"
 class NullLogger:
     """Takes the runner's blocks and drops them: what the runner's logging path costs alone."""
 
-    def __init__(self, **_: object) -> None:
+    def __init__(self, header: object) -> None:
         pass
 
     def write_block(self, block: dict) -> None:
@@ -56,10 +56,11 @@ class NullLogger:
 
 def bench_run(seconds: float, folder: Path, repeats: int, compressions: list[str]) -> dict[str, float]:
     cfg = RunConfig(duration=seconds)
-    variants: dict[str, object] = {"unlogged": None, "null": lambda **kw: NullLogger(**kw)}
+    variants: dict[str, object] = {"unlogged": None, "null": NullLogger}
     for c in compressions:
         # as `wmr-mj run` writes: a writer thread compresses and writes each second while the next steps
-        variants[c] = lambda c=c, **kw: RunLogger(folder / f"run-{c}.mcap", compression=c, background=True, **kw)
+        variants[c] = lambda header, c=c: RunLogger(folder / f"run-{c}.mcap", header,
+                                                    options=LogOptions(compression=c, background=True))
     run_closed_loop(cfg, progress=False)  # warm up (imports, caches)
     wall: dict[str, list[float]] = {k: [] for k in variants}
     cpu: dict[str, list[float]] = {k: [] for k in variants}
@@ -129,9 +130,10 @@ def bench_write(seconds: float, path: Path, repeats: int, compression: str) -> d
     rows = sum(len(b["t"]) for b in blocks)
     times = []
     for _ in range(repeats):
-        log = RunLogger(path, mjcf_xml=xml, config={"bench": True, "seed": 0}, parameters={"voltage_limit": 24.0},
-                        initial_state=s0, timestep=m.opt.timestep, control_substeps=1, model=m,
-                        bounds={"E_max": 0.1, "Edot_max": 0.2}, compression=compression)  # fmt: skip
+        header = LogHeader(mjcf_xml=xml, config={"bench": True, "seed": 0}, parameters={"voltage_limit": 24.0},
+                           initial_state=s0, timestep=m.opt.timestep, control_substeps=1, model=m,
+                           bounds={"E_max": 0.1, "Edot_max": 0.2})
+        log = RunLogger(path, header, options=LogOptions(compression=compression))
         t0 = time.perf_counter()
         for b in blocks:
             log.write_block(b)

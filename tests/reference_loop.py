@@ -43,6 +43,7 @@ from wmr_mj.sim.config import (
     estimate_parameters,
     plant_parameters,
 )
+from wmr_mj.sim.log_header import LogHeader
 
 
 def reference_run(
@@ -54,9 +55,8 @@ def reference_run(
 ) -> RunResult:
     """Run ``config`` on the MuJoCo plant; optionally stream rows to an MCAP logger.
 
-    logger_factory(mjcf_xml=..., config=..., parameters=..., initial_state=..., timestep=...,
-    control_substeps=..., reference_path=..., bounds={"E_max", "Edot_max"}, model=the compiled
-    plant) returns a ``wmr_mj.logs.writer.RunLogger``; it
+    logger_factory(header) takes the run's ``wmr_mj.sim.log_header.LogHeader`` and returns a
+    ``wmr_mj.logs.writer.RunLogger``; it
     receives a block of rows every simulated second and is closed with the summary,
     also when the run is interrupted (KeyboardInterrupt or SIGTERM).
     """
@@ -90,10 +90,11 @@ def reference_run(
     if full:
         state = np.empty(mujoco.mj_stateSize(m, mujoco.mjtState.mjSTATE_INTEGRATION))
         mujoco.mj_getState(m, d, state, mujoco.mjtState.mjSTATE_INTEGRATION)
-        logger = logger_factory(mjcf_xml=plant.xml, config=config.as_dict(), parameters=params.as_dict(),
-                                initial_state=state, timestep=dt, control_substeps=substeps,
-                                bounds={"E_max": certificate.E_max, "Edot_max": certificate.Edot_max}, model=m,
-                                reference_path=np.asarray(reference.C_xy)[::max(1, len(reference.C_xy) // 2000)])
+        logger = logger_factory(LogHeader(
+            mjcf_xml=plant.xml, config=config.as_dict(), parameters=params.as_dict(),
+            initial_state=state, timestep=dt, control_substeps=substeps,
+            bounds={"E_max": certificate.E_max, "Edot_max": certificate.Edot_max}, model=m,
+            reference_path=np.asarray(reference.C_xy)[::max(1, len(reference.C_xy) // 2000)]))
 
     qpos, qvel, ctrl = d.qpos, d.qvel, d.ctrl
     qa, dv, act = plant.steer_qpos, plant.steer_dof, plant.steer_actuator

@@ -62,11 +62,12 @@ def test_the_steering_stop_is_detected_as_in_the_serial_loop():
 
 def test_a_logged_run_writes_the_serial_loops_log(tmp_path):
     from wmr_mj.logs.reader import load_log
-    from wmr_mj.logs.writer import RunLogger
+    from wmr_mj.logs.writer import LogOptions, RunLogger
 
     cfg = RunConfig(duration=12.5)  # a last block shorter than a second
-    new = run_closed_loop(cfg, logger_factory=functools.partial(RunLogger, tmp_path / "new.mcap", background=True),
-                          progress=False)  # as wmr-mj run logs: a writer thread
+    background = LogOptions(background=True)  # as wmr-mj run logs: a writer thread
+    new = run_closed_loop(cfg, logger_factory=functools.partial(RunLogger, tmp_path / "new.mcap", options=background),
+                          progress=False)
     old = reference_run(cfg, logger_factory=functools.partial(RunLogger, tmp_path / "old.mcap"), progress=False)
     assert new.law == "compiled"
     assert_identical(new, old)
@@ -104,7 +105,7 @@ def test_a_block_with_a_warning_is_stepped_again_with_the_python_law(monkeypatch
 @pytest.mark.parametrize("background", [False, True])
 def test_an_interrupted_logged_run_leaves_a_finished_log_of_its_rows(tmp_path, background):
     from wmr_mj.logs.reader import load_log
-    from wmr_mj.logs.writer import RunLogger
+    from wmr_mj.logs.writer import LogOptions, RunLogger
 
     path = tmp_path / "run.mcap"
 
@@ -115,7 +116,8 @@ def test_an_interrupted_logged_run_leaves_a_finished_log_of_its_rows(tmp_path, b
                 raise KeyboardInterrupt
 
     result = run_closed_loop(RunConfig(duration=12.0), progress=False,
-                             logger_factory=lambda **kw: StopAfter(path, background=background, **kw))
+                             logger_factory=lambda header: StopAfter(path, header,
+                                                                           options=LogOptions(background=background)))
     assert result.status == "interrupted" and len(result.rows["t"]) == 3000
     log = load_log(path)
     assert log.status == "interrupted" and not log.truncated and log.rows == 3000

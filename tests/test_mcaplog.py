@@ -9,6 +9,7 @@ MuJoCo's kinematics.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import os
@@ -27,7 +28,7 @@ from wmr_mj.errors import LogError, ParameterError
 from wmr_mj.logs import logformat
 from wmr_mj.logs.logformat import foxglove_schema
 from wmr_mj.logs.reader import load_log
-from wmr_mj.logs.writer import RunLogger, terminate_as_interrupt
+from wmr_mj.logs.writer import LogHeader, LogOptions, RunLogger, terminate_as_interrupt
 
 TEST_MJCF = """
 <mujoco model="c80_test">
@@ -81,7 +82,7 @@ CONFIG = {"seed": 7, "controller": "test", "settle_s": 0.5, "E_max": 0.5, "Edot_
 
 
 def synthetic_run(path, seconds=1.0, *, block_rows=1000, log_every=1, substeps=1, nan_at=None,
-                  tamper_at=None, summary=None, **kw):  # fmt: skip
+                  tamper_at=None, summary=None, bounds=None, **options):  # fmt: skip
     """Simulate TEST_MJCF under a simple steering law and log it; returns the rows logged."""
     m = mujoco.MjModel.from_xml_string(TEST_MJCF)
     d = mujoco.MjData(m)
@@ -94,9 +95,10 @@ def synthetic_run(path, seconds=1.0, *, block_rows=1000, log_every=1, substeps=1
     ab = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "drive_unit")
     n = int(round(seconds / (m.opt.timestep * substeps)))
     ref = np.column_stack([np.linspace(0, 2, 50), 0.2 * np.sin(np.linspace(0, 3, 50))])
-    log = RunLogger(path, mjcf_xml=TEST_MJCF, config=CONFIG, parameters={"m1": 650.0, "voltage_limit": 20.0},
-                    initial_state=s0, timestep=m.opt.timestep, control_substeps=substeps, reference_path=ref,
-                    log_every=log_every, **kw)  # fmt: skip
+    header = LogHeader(mjcf_xml=TEST_MJCF, config=CONFIG, parameters={"m1": 650.0, "voltage_limit": 20.0},
+                       initial_state=s0, timestep=m.opt.timestep, control_substeps=substeps, reference_path=ref,
+                       bounds=bounds)
+    log = RunLogger(path, header, options=LogOptions(log_every=log_every, **options))
     rows = {k: [] for k in ROW_KEYS}
     out = {k: [] for k in ROW_KEYS}
     for k in range(n):
@@ -382,8 +384,8 @@ def test_each_block_is_on_disk(tmp_path):
     s0 = np.empty(mujoco.mj_stateSize(m, mujoco.mjtState.mjSTATE_INTEGRATION))
     mujoco.mj_getState(m, d, s0, mujoco.mjtState.mjSTATE_INTEGRATION)
     path = tmp_path / "open.mcap"
-    log = RunLogger(path, mjcf_xml=TEST_MJCF, config={}, parameters={}, initial_state=s0, timestep=0.001,
-                    control_substeps=1)
+    log = RunLogger(path, LogHeader(mjcf_xml=TEST_MJCF, config={}, parameters={}, initial_state=s0, timestep=0.001,
+                                    control_substeps=1))
     for b in range(3):
         log.write_block(_block(m, 1000, b))
         partial = load_log(path)
@@ -411,12 +413,13 @@ def test_bad_blocks_and_options_are_refused(tmp_path):
     m = mujoco.MjModel.from_xml_string(TEST_MJCF)
     s0 = np.empty(mujoco.mj_stateSize(m, mujoco.mjtState.mjSTATE_INTEGRATION))
     mujoco.mj_getState(m, mujoco.MjData(m), s0, mujoco.mjtState.mjSTATE_INTEGRATION)
-    kw = dict(mjcf_xml=TEST_MJCF, config={}, parameters={}, initial_state=s0, timestep=0.001, control_substeps=1)
+    header = LogHeader(mjcf_xml=TEST_MJCF, config={}, parameters={}, initial_state=s0, timestep=0.001,
+                       control_substeps=1)
     with pytest.raises(ParameterError, match="compression 'gzip'"):
-        RunLogger(tmp_path / "x.mcap", compression="gzip", **kw)
+        RunLogger(tmp_path / "x.mcap", header, options=LogOptions(compression="gzip"))
     with pytest.raises(ParameterError, match="initial_state"):
-        RunLogger(tmp_path / "x.mcap", **{**kw, "initial_state": s0[:-1]})
-    with RunLogger(tmp_path / "x.mcap", **kw) as log:
+        RunLogger(tmp_path / "x.mcap", dataclasses.replace(header, initial_state=s0[:-1]))
+    with RunLogger(tmp_path / "x.mcap", header) as log:
         blk = _block(m, 10, 0)
         with pytest.raises(ParameterError, match="lacks qvel"):
             log.write_block({k: v for k, v in blk.items() if k != "qvel"})
@@ -431,8 +434,9 @@ def test_unwritable_log_path_is_one_clear_error(tmp_path):
     m = mujoco.MjModel.from_xml_string(TEST_MJCF)
     s0 = np.zeros(mujoco.mj_stateSize(m, mujoco.mjtState.mjSTATE_INTEGRATION))
     with pytest.raises(OutputPathError, match="cannot be written"):
-        RunLogger(tmp_path / "file" / "run.mcap", mjcf_xml=TEST_MJCF, config={}, parameters={}, initial_state=s0,
-                  timestep=0.001, control_substeps=1, model=m)  # fmt: skip
+        RunLogger(tmp_path / "file" / "run.mcap", LogHeader(mjcf_xml=TEST_MJCF, config={}, parameters={},
+                                                             initial_state=s0, timestep=0.001, control_substeps=1,
+                                                             model=m))
 
 
 def test_context_manager_closes_on_error(tmp_path):
@@ -441,8 +445,8 @@ def test_context_manager_closes_on_error(tmp_path):
     mujoco.mj_getState(m, mujoco.MjData(m), s0, mujoco.mjtState.mjSTATE_INTEGRATION)
     path = tmp_path / "err.mcap"
     with pytest.raises(ZeroDivisionError):
-        with RunLogger(path, mjcf_xml=TEST_MJCF, config={}, parameters={}, initial_state=s0, timestep=0.001,
-                       control_substeps=1) as log:  # fmt: skip
+        with RunLogger(path, LogHeader(mjcf_xml=TEST_MJCF, config={}, parameters={}, initial_state=s0,
+                                       timestep=0.001, control_substeps=1)) as log:
             log.write_block(_block(m, 200, 0))
             raise ZeroDivisionError("division by zero")
     log2 = load_log(path)
@@ -574,13 +578,14 @@ _LOOP = textwrap.dedent(
     import numpy as np, mujoco
     sys.path.insert(0, {tests!r})
     from test_mcaplog import TEST_MJCF, _block
-    from wmr_mj.logs.writer import RunLogger, terminate_as_interrupt
+    from wmr_mj.logs.writer import LogHeader, RunLogger, terminate_as_interrupt
     m = mujoco.MjModel.from_xml_string(TEST_MJCF)
     s0 = np.empty(mujoco.mj_stateSize(m, mujoco.mjtState.mjSTATE_INTEGRATION))
     mujoco.mj_getState(m, mujoco.MjData(m), s0, mujoco.mjtState.mjSTATE_INTEGRATION)
     try:
-        with terminate_as_interrupt(), RunLogger({path!r}, mjcf_xml=TEST_MJCF, config={{"seed": 1}}, parameters={{}},
-                                                 initial_state=s0, timestep=0.001, control_substeps=1, model=m) as log:
+        header = LogHeader(mjcf_xml=TEST_MJCF, config={{"seed": 1}}, parameters={{}}, initial_state=s0,
+                           timestep=0.001, control_substeps=1, model=m)
+        with terminate_as_interrupt(), RunLogger({path!r}, header) as log:
             b = 0
             while True:
                 log.write_block(_block(m, 1000, b))
@@ -665,8 +670,8 @@ def test_bulk_messages_are_the_messages_added_one_by_one(tmp_path):
     files = {}
     for bulk in (True, False):
         path = files[bulk] = tmp_path / f"bulk-{bulk}.mcap"
-        log = RunLogger(path, mjcf_xml=TEST_MJCF, config={}, parameters={}, initial_state=s0, timestep=0.001,
-                        control_substeps=1, bounds={"E_max": 0.1, "Edot_max": 0.2})
+        log = RunLogger(path, LogHeader(mjcf_xml=TEST_MJCF, config={}, parameters={}, initial_state=s0,
+                                        timestep=0.001, control_substeps=1, bounds={"E_max": 0.1, "Edot_max": 0.2}))
         assert log._bulk is not None  # the fast path runs with this mcap
         if not bulk:
             log._bulk = None
@@ -708,8 +713,9 @@ def test_a_background_writer_writes_the_same_file_a_second_behind_at_most(tmp_pa
     files = {}
     for background in (False, True):
         path = files[background] = tmp_path / f"bg-{background}.mcap"
-        log = RunLogger(path, mjcf_xml=TEST_MJCF, config={}, parameters={}, initial_state=s0, timestep=0.001,
-                        control_substeps=1, bounds={"E_max": 0.1, "Edot_max": 0.2}, background=background)
+        log = RunLogger(path, LogHeader(mjcf_xml=TEST_MJCF, config={}, parameters={}, initial_state=s0,
+                                        timestep=0.001, control_substeps=1, bounds={"E_max": 0.1, "Edot_max": 0.2}),
+                        options=LogOptions(background=background))
         buffer = _block(m, 1000, 0)
         for b in range(4):
             block = _block(m, 1000, b)

@@ -153,7 +153,7 @@ def test_replay_reports_the_path_of_c(tmp_path, capsys):
 
     path = tmp_path / "run.mcap"
     config = RunConfig(**CERTIFIED.config_changes(), path="lane-change", duration=6.0)
-    run_closed_loop(config, logger_factory=lambda **kw: RunLogger(path, **kw), progress=False)
+    run_closed_loop(config, logger_factory=lambda header: RunLogger(path, header), progress=False)
     assert main(["replay", str(path), "--json"]) == 0
     rep = json.loads(capsys.readouterr().out)
     pe = rep["path_errors"]

@@ -162,7 +162,7 @@ def test_real_run_replays_bit_for_bit(tmp_path, capsys):
             if self.rows >= 3000:
                 raise KeyboardInterrupt
 
-    result = run_closed_loop(RunConfig(duration=12.0), logger_factory=lambda **kw: StopAfter(path, **kw),
+    result = run_closed_loop(RunConfig(duration=12.0), logger_factory=lambda header: StopAfter(path, header),
                              progress=False)
     assert result.status == "interrupted"
     log = load_log(path)

@@ -35,12 +35,13 @@ from ._version import __version__ as __version__
 
 if TYPE_CHECKING:
     from wmr_mj.logs.reader import load_log
-    from wmr_mj.logs.writer import RunLogger
+    from wmr_mj.logs.writer import LogOptions, RunLogger
     from wmr_mj.sim.certify import certificate_for
     from wmr_mj.sim.closed_loop import RunResult, run_closed_loop
     from wmr_mj.sim.config import RunConfig, controller_for
     from wmr_mj.sim.designs import CERTIFIED, PAPER, PRESETS, preset
     from wmr_mj.sim.falsify import FalsifySpec, falsify
+    from wmr_mj.sim.log_header import LogHeader
     from wmr_mj.sim.signal_search import search_signals
     from wmr_mj.sim.signals import Disturbance, LoadChange, Signals
     from wmr_mj.sim.sweep import SweepSpec, run_sweep
@@ -66,6 +67,8 @@ _LAZY: dict[str, str] = {
     "LoadChange": "wmr_mj.sim.signals",
     "search_signals": "wmr_mj.sim.signal_search",
     "RunLogger": "wmr_mj.logs.writer",
+    "LogHeader": "wmr_mj.sim.log_header",
+    "LogOptions": "wmr_mj.logs.writer",
 }
 
 __all__ = [
@@ -98,6 +101,8 @@ __all__ = [
     "search_signals",
     # logs
     "RunLogger",
+    "LogHeader",
+    "LogOptions",
     "load_log",
     # errors
     "WmrMjError",

@@ -289,9 +289,9 @@ def run(args: argparse.Namespace) -> int:
     requirements = requirements_from_args(args, period)
     factory = None
     if path is not None:
-        from wmr_mj.logs.writer import RunLogger
+        from wmr_mj.logs.writer import LogOptions, RunLogger
 
-        factory = functools.partial(RunLogger, path, log_every=args.log_every, background=True)
+        factory = functools.partial(RunLogger, path, options=LogOptions(log_every=args.log_every, background=True))
     from wmr_mj.logs.writer import terminate_as_interrupt
 
     with terminate_as_interrupt():

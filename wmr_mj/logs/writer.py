@@ -19,9 +19,11 @@ loss with ``fsync=True``) the file holds every flushed block; mcap's stream read
 
 Usage::
 
-    with terminate_as_interrupt(), RunLogger("logs/run.mcap", mjcf_xml=xml, config=cfg,
-            parameters=params, initial_state=s0, timestep=m.opt.timestep,
-            control_substeps=1, bounds={"E_max": 0.02, "Edot_max": 0.1}) as log:
+    header = LogHeader(mjcf_xml=xml, config=cfg, parameters=params, initial_state=s0,
+                       timestep=m.opt.timestep, control_substeps=1,
+                       bounds={"E_max": 0.02, "Edot_max": 0.1})
+    with terminate_as_interrupt(), RunLogger("logs/run.mcap", header,
+                                             options=LogOptions(compression="zstd")) as log:
         for block in blocks:            # dict of (N, ...) float64 arrays, see logformat.BLOCK_KEYS
             log.write_block(block)
         log.close({"sup_E": 0.01})
@@ -40,6 +42,7 @@ import statistics
 import threading
 import time
 from collections.abc import Iterator, Mapping
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -58,12 +61,14 @@ from wmr_mj.logs.foxglove import (
     tf_schema_text,
     travelled_update,
 )
+from wmr_mj.sim.log_header import LogHeader
 
 if TYPE_CHECKING:
     from wmr_mj.sim.config import RunConfig
     from wmr_mj.sim.summary import RunSummary
 
-__all__ = ["RunLogger", "run_logged", "terminate_as_interrupt", "measure_logging_overhead", "COMPRESSIONS", "STATUSES"]
+__all__ = ["RunLogger", "LogHeader", "LogOptions", "run_logged", "terminate_as_interrupt", "measure_logging_overhead",
+           "COMPRESSIONS", "STATUSES"]
 
 STATUSES = ("completed", "interrupted", "error")
 COMPRESSIONS = ("lz4", "zstd", "none")
@@ -192,50 +197,57 @@ class _BulkMessages:
         self._finalize()
 
 
+@dataclass(frozen=True)
+class LogOptions:
+    """How a log is written (not what the run is: that is :class:`LogHeader`).
+
+    Attributes:
+        log_every: /signals keeps every k-th row (/sim/state keeps all), an integer >= 1.
+        plot_rate_hz: rate of the Foxglove plot channels /steering, /motor, /pose [Hz].
+        tf_rate_hz: rate of /tf (3D panel) [Hz].
+        flush_period_s: simulated time per flush [s].
+        compression: "lz4" (default: about 20 % smaller files than "none" for 2 % more run
+            time), "zstd" (about 25 % smaller again, for some 6 % more run time;
+            bench/bench_logging.py measures them) or "none".
+        fsync: make each flush durable against power loss, not only against the process being
+            killed.
+        background: a writer thread encodes, compresses and writes each flushed second while the
+            runner simulates the next (NumPy, lz4 and the file write release the GIL, as
+            ``mujoco.batch`` does): ``write_block`` then returns once every second before the one
+            it hands over is on disk, so a hard kill loses at most the second in flight; ``close``
+            and ``flush`` wait for it.
+    """
+
+    log_every: int = 1  # rows per /signals row
+    plot_rate_hz: float = 100.0  # [Hz]
+    tf_rate_hz: float = 50.0  # [Hz]
+    flush_period_s: float = 1.0  # simulated [s]
+    compression: str = "lz4"  # one of COMPRESSIONS
+    fsync: bool = False
+    background: bool = False
+
 
 class RunLogger:
     """Write one run to an MCAP file (see the module docstring).
 
-    Args (keyword-only after ``path``): the runner contract (``mjcf_xml``, ``config``,
-    ``parameters``, ``initial_state`` = mjSTATE_INTEGRATION at t = 0, ``timestep`` [s],
-    ``control_substeps``, ``reference_path`` (M, 2) world xy of C); ``bounds``: E_max [rad],
-    Edot_max [rad/s] for /bounds (else taken from the summary at close); ``log_every``: /signals
-    keeps every k-th row (/sim/state keeps all); ``plot_rate_hz``, ``tf_rate_hz``: rates of the
-    Foxglove channels; ``flush_period_s``: simulated time per flush; ``model``: the compiled
-    ``mjcf_xml``, to skip compiling it again; ``compression``: "lz4" (default: about 20 % smaller
-    files than "none" for 2 % more run time), "zstd" (about 25 % smaller again, for some 6 % more
-    run time; bench/bench_logging.py measures them) or "none"; ``fsync``: make each flush durable
-    against power loss, not only against the process being killed; ``background``: a writer thread
-    encodes, compresses and writes each flushed second while the runner simulates the next
-    (NumPy, lz4 and the file write release the GIL, as ``mujoco.batch`` does): ``write_block``
-    then returns once every second before the one it hands over is on disk, so a hard kill loses
-    at most the second in flight; ``close`` and ``flush`` wait for it.
+    Args:
+        path: the .mcap file to write (its folder is made).
+        header: what the runner tells the log (:class:`LogHeader`: MJCF, config, parameters,
+            initial state, timestep, control substeps, reference path, bounds, compiled model).
+        options: how the log is written (:class:`LogOptions`: /signals decimation, Foxglove
+            rates, flush period, compression, fsync, background writer thread).
     """
 
-    def __init__(
-        self,
-        path: str | os.PathLike,
-        *,
-        mjcf_xml: str,
-        config: Mapping[str, Any] | Any,
-        parameters: Mapping[str, Any],
-        initial_state: np.ndarray,
-        timestep: float,
-        control_substeps: int,
-        reference_path: np.ndarray | None = None,
-        bounds: Mapping[str, float] | None = None,
-        log_every: int = 1,
-        plot_rate_hz: float = 100.0,
-        tf_rate_hz: float = 50.0,
-        flush_period_s: float = 1.0,
-        model: Any = None,
-        compression: str = "lz4",
-        fsync: bool = False,
-        background: bool = False,
-    ):
+    def __init__(self, path: str | os.PathLike, header: LogHeader, *, options: LogOptions = LogOptions()):
         import mujoco
         from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
 
+        mjcf_xml, config, parameters = header.mjcf_xml, header.config, header.parameters
+        initial_state, timestep, control_substeps = header.initial_state, header.timestep, header.control_substeps
+        reference_path, bounds, model = header.reference_path, header.bounds, header.model
+        log_every, plot_rate_hz, tf_rate_hz = options.log_every, options.plot_rate_hz, options.tf_rate_hz
+        flush_period_s, compression = options.flush_period_s, options.compression
+        fsync, background = options.fsync, options.background
         if compression not in COMPRESSIONS:
             raise ParameterError(f"compression {compression!r} is not one of {', '.join(COMPRESSIONS)}")
         for name, value in (("log_every", log_every), ("control_substeps", control_substeps)):

@@ -51,6 +51,7 @@ from wmr_mj.sim.config import (
     plant_parameters,
 )
 from wmr_mj.sim.engine import ROW_FIELDS, batch_model, load_fields, plant_options, run_engine
+from wmr_mj.sim.log_header import LogHeader
 from wmr_mj.sim.summary import RunSummary
 
 __all__ = ["RunResult", "RunMeasures", "run_closed_loop", "report", "run_on_reduced_model", "ROW_FIELDS", "judge_path",
@@ -299,9 +300,9 @@ def run_closed_loop(
     can run, else the Python law (``RunResult.law``, ``RunResult.law_note`` say which and why);
     ``law`` ("auto", "compiled", "numpy") chooses as ``run_batch`` does.
 
-    logger_factory(mjcf_xml=..., config=..., parameters=..., initial_state=..., timestep=...,
-    control_substeps=..., reference_path=..., bounds={"E_max", "Edot_max"}, model=the compiled
-    plant) returns a ``wmr_mj.logs.writer.RunLogger``; it
+    logger_factory(header) takes the run's :class:`~wmr_mj.sim.log_header.LogHeader` (MJCF,
+    config, parameters, initial state, timestep, control substeps, reference path, bounds
+    E_max/Edot_max, the compiled plant) and returns a ``wmr_mj.logs.writer.RunLogger``; it
     receives a block of rows every simulated second and is closed with the summary,
     also when the run is interrupted (KeyboardInterrupt or SIGTERM).
     """
@@ -330,11 +331,11 @@ def run_closed_loop(
         state = np.empty(mujoco.mj_stateSize(m, mujoco.mjtState.mjSTATE_INTEGRATION))
         mujoco.mj_getState(m, d, state, mujoco.mjtState.mjSTATE_INTEGRATION)
         # the log carries the scene's MJCF as the plant compiles it, sky included
-        logger = logger_factory(mjcf_xml=scene_xml(params, **options), config=config.as_dict(),
-                                parameters=params.as_dict(), initial_state=state, timestep=dt,
-                                control_substeps=substeps, model=m,
-                                bounds={"E_max": certificate.E_max, "Edot_max": certificate.Edot_max},
-                                reference_path=np.asarray(reference.C_xy)[::max(1, len(reference.C_xy) // 2000)])
+        logger = logger_factory(LogHeader(
+            mjcf_xml=scene_xml(params, **options), config=config.as_dict(), parameters=params.as_dict(),
+            initial_state=state, timestep=dt, control_substeps=substeps, model=m,
+            bounds={"E_max": certificate.E_max, "Edot_max": certificate.Edot_max},
+            reference_path=np.asarray(reference.C_xy)[::max(1, len(reference.C_xy) // 2000)]))
 
     disturbance, loads = _signal_inputs(config, params, options, n, period)
     outer = None
