@@ -245,6 +245,7 @@ class RunLogger:
         mjcf_xml, config, parameters = header.mjcf_xml, header.config, header.parameters
         initial_state, timestep, control_substeps = header.initial_state, header.timestep, header.control_substeps
         reference_path, bounds, model = header.reference_path, header.bounds, header.model
+        self._path_errors = header.path_errors
         log_every, plot_rate_hz, tf_rate_hz = options.log_every, options.plot_rate_hz, options.tf_rate_hz
         flush_period_s, compression = options.flush_period_s, options.compression
         fsync, background = options.fsync, options.background
@@ -461,6 +462,8 @@ class RunLogger:
             self._write_and_flush(self._take_pending())
 
     def _write_and_flush(self, rows: Mapping[str, np.ndarray]) -> None:
+        if self._path_errors is not None:  # C's path errors for /path, here: on the writer's thread if any
+            rows = {**rows, **self._path_errors(rows, self.plot_every)}
         self._write_rows(rows)
         self._w.flush()
         if self._fsync:

@@ -24,7 +24,7 @@ the two bit-identical.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -176,33 +176,35 @@ class PathJudgement:
 
 
 class _PathRows:
-    """C's path errors added to each logged block (the log's /path channel), at the rows the
-    logger plots (every ``every``-th control step), projected with continuity across blocks."""
+    """C's path errors of logged rows (the log's /path channel, ``LogHeader.path_errors``), at the rows
+    the logger plots (every ``every``-th control step), projected with continuity across calls; the
+    log's writer calls it, on its own thread when it has one, so the run does not wait for it."""
 
-    def __init__(self, reference, period: float, every: int, write: Callable[..., Any]) -> None:
+    def __init__(self, reference, period: float) -> None:
         from wmr_mj.analysis.path_error import PathProjector
 
         self.projector = PathProjector(reference)
         self.rt, self.rs = np.asarray(reference.t, float), np.asarray(reference.s, float)
         self.s_prev = float(self.rs[0])
-        self.period, self.every, self.write = period, max(1, int(every)), write
+        self.period = period
 
-    def __call__(self, block) -> None:
+    def __call__(self, block: Mapping[str, np.ndarray], every: int) -> dict[str, np.ndarray]:
         from wmr_mj.analysis.path_error import wrap_angle
 
+        every = max(1, int(every))
         t = np.asarray(block["t"], float)
         n = t.size
         out = {key: np.full(n, np.nan) for key in ("path_cross_track", "path_along_track", "path_heading_error")}
         k = np.rint(t / self.period)
         X, h = np.asarray(block["C_pos"], float).reshape(n, 2), np.asarray(block["heading"], float)
-        sel = np.flatnonzero((k % self.every == 0) & np.isfinite(X).all(axis=1) & np.isfinite(h) & np.isfinite(t))
+        sel = np.flatnonzero((k % every == 0) & np.isfinite(X).all(axis=1) & np.isfinite(h) & np.isfinite(t))
         if sel.size:
             s, d, theta = self.projector.project_many(X[sel], self.s_prev)
             self.s_prev = float(s[-1])
             out["path_cross_track"][sel] = d
             out["path_along_track"][sel] = s - np.interp(t[sel], self.rt, self.rs)
             out["path_heading_error"][sel] = wrap_angle(h[sel] - theta)
-        self.write({**block, **out})
+        return out
 
 
 def path_sample_index(k: int, period: float) -> np.ndarray:
@@ -335,7 +337,8 @@ def run_closed_loop(
             mjcf_xml=scene_xml(params, **options), config=config.as_dict(), parameters=params.as_dict(),
             initial_state=state, timestep=dt, control_substeps=substeps, model=m,
             bounds={"E_max": certificate.E_max, "Edot_max": certificate.Edot_max},
-            reference_path=np.asarray(reference.C_xy)[::max(1, len(reference.C_xy) // 2000)]))
+            reference_path=np.asarray(reference.C_xy)[::max(1, len(reference.C_xy) // 2000)],
+            path_errors=_PathRows(reference, period)))
 
     disturbance, loads = _signal_inputs(config, params, options, n, period)
     outer = None
@@ -343,9 +346,7 @@ def run_closed_loop(
         from wmr_mj.sim.correction import CartesianCorrection
 
         outer = CartesianCorrection(reference, period=period)
-    on_block = None  # the log's blocks, with C's path errors for its /path channel
-    if logger is not None:
-        on_block = _PathRows(reference, period, getattr(logger, "plot_every", 1), logger.write_block)
+    on_block = None if logger is None else logger.write_block
     bar = progress_bar(n, desc="run", unit="step", unit_scale=True, enabled=progress)
     try:
         run = run_engine(correction=outer, params=params, controller=controller, options=options, model=plain,

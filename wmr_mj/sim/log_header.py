@@ -40,6 +40,11 @@ class LogHeader:
         bounds: E_max [rad], Edot_max [rad/s] drawn on /bounds; None: taken from the summary at close.
         model: the compiled ``mjcf_xml`` (``mujoco.MjModel``), to skip compiling it again; None
             compiles it.
+        path_errors: path_errors(rows, every) -> the log's /path columns (path_cross_track [m],
+            path_along_track [m], path_heading_error [rad], NaN between plotted rows) of the rows'
+            C_pos, heading and t, every ``every``-th control step; called once per written chunk of
+            rows, in order (it keeps the projection's continuity), on the writer's thread when it
+            has one; None: the rows' own columns (NaN where the runner gave none).
     """
 
     mjcf_xml: str
@@ -51,3 +56,4 @@ class LogHeader:
     reference_path: np.ndarray | None = None  # (M, 2) world xy of C [m]
     bounds: Mapping[str, float] | None = None  # E_max [rad], Edot_max [rad/s]
     model: Any = None  # mujoco.MjModel compiled from mjcf_xml, or None
+    path_errors: Any = None  # Callable[[Mapping[str, np.ndarray], int], Mapping[str, np.ndarray]] | None
