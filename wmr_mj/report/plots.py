@@ -81,6 +81,7 @@ __all__ = [
     "plot_alpha0_rate",
     "plot_alpha0_accel",
     "plot_region",
+    "RegionStyle",
     "plot_error_trajectory",
     "plot_region_points",
     "plot_time_history",
@@ -306,14 +307,30 @@ def _region_extent(result) -> tuple[float, float]:
     return float(v[:, 0].max()), float(v[:, 1].max())
 
 
+@dataclass(frozen=True)
+class RegionStyle:
+    """How :func:`plot_region` draws: labels, the points' colour map and colorbar, the (4.21) lines.
+
+    region_label: the polygon's legend entry (default: the region's bounds). value_label: the
+    colorbar's label. point_label: the points' legend entry. lines: also draw the two lines of (4.21).
+    """
+
+    region_label: str | None = None
+    value_label: str = "plant m1 [kg]"
+    cmap: str = "viridis"
+    lines: bool = True
+    colorbar: bool = True
+    point_label: str | None = None
+
+
 def plot_region(ax, result, *, points=None, values=None, trajectory=None, label: str | None = None,
-                region_label: str | None = None, value_label: str = "plant m1 [kg]", cmap: str = "viridis",
-                lines: bool = True, colorbar: bool = True, point_label: str | None = None) -> dict[str, Any]:
+                style: RegionStyle = RegionStyle()) -> dict[str, Any]:
     """The region (4.21)-(4.23) of ``result`` (a RobustnessResult) in the (||E||, ||E'||) plane.
 
     points: (N, 2) array of (sup|E|, sup|E'|) (one per run), coloured by ``values`` (e.g. m1)
-    with a colorbar labelled ``value_label``. trajectory: (|E(t)|, |E'(t)|) arrays drawn as a
-    line labelled ``label``. lines: also draw the two lines of (4.21). Returns the artists
+    with a colorbar labelled ``style.value_label``. trajectory: (|E(t)|, |E'(t)|) arrays drawn as a
+    line labelled ``label``. ``style`` (:class:`RegionStyle`): labels, colour map, colorbar and
+    whether the lines of (4.21) are drawn. Returns the artists
     {'region': Polygon or None, 'scatter': ..., 'trajectory': ..., 'colorbar': ...}.
     The polygon's vertices are exactly ``result.vertices`` (gid :data:`REGION_GID`).
     """
@@ -322,13 +339,13 @@ def plot_region(ax, result, *, points=None, values=None, trajectory=None, label:
     if verts:
         poly = Polygon(np.asarray(verts, dtype=float), closed=True, facecolor=_COLORS["region"], alpha=0.45,
                        edgecolor="#1b4f72", lw=1.0, zorder=1,
-                       label=region_label or (f"region (4.21)-(4.23): ||E|| <= {result.E_max:.3g} rad, "
+                       label=style.region_label or (f"region (4.21)-(4.23): ||E|| <= {result.E_max:.3g} rad, "
                                               f"||E'|| <= {result.Edot_max:.3g} rad/s"))
         poly.set_gid(REGION_GID)
         ax.add_patch(poly)
         out["region"] = poly
         ax.plot([result.E_max], [result.Edot_max], "s", ms=3.5, color="#1b4f72", zorder=2)
-        if lines:
+        if style.lines:
             _draw_4_21_lines(ax, result)
     else:
         ax.text(0.03, 0.97, f"(4.23) fails: condition = {result.condition:.3g} >= 1;\nno bounded region",
@@ -339,10 +356,10 @@ def plot_region(ax, result, *, points=None, values=None, trajectory=None, label:
         out["trajectory"] = plot_error_trajectory(ax, E, Ed, label=label or "error trajectory")
     if points is not None:
         pts = np.asarray(points, dtype=float).reshape(-1, 2)
-        s = Series(label=point_label or "runs: (sup|E|, sup|E'|)", E=pts[:, 0], E_dot=pts[:, 1], kind="points",
+        s = Series(label=style.point_label or "runs: (sup|E|, sup|E'|)", E=pts[:, 0], E_dot=pts[:, 1], kind="points",
                    values=None if values is None else np.asarray(values, dtype=float))
-        out["scatter"], out["colorbar"] = plot_region_points(ax, s, value_label=value_label, colorbar=colorbar,
-                                                             cmap=cmap)
+        out["scatter"], out["colorbar"] = plot_region_points(ax, s, value_label=style.value_label,
+                                                             colorbar=style.colorbar, cmap=style.cmap)
     ax.set_xlabel(r"$\|E\|$ = sup$|E|$ [rad]")
     ax.set_ylabel(r"$\|\dot E\|$ = sup$|\dot E|$ [rad/s]")
     return out
@@ -394,7 +411,7 @@ class Series:
 
 def _draw_series(ax, result, series: Sequence[Series], *, value_label: str, colorbar: bool,
                  region_label: str | None) -> dict[str, Any]:
-    arts = plot_region(ax, result, region_label=region_label)
+    arts = plot_region(ax, result, style=RegionStyle(region_label=region_label))
     for s in series:
         if s.kind == "points":
             plot_region_points(ax, s, value_label=value_label, colorbar=colorbar)
