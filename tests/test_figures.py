@@ -15,13 +15,13 @@ import pytest  # noqa: E402
 
 from wmr_mj.analysis.robustness import ParameterBox, analyse  # noqa: E402
 from wmr_mj.cli.app import main  # noqa: E402
+from wmr_mj.report.paper_example import paper_example  # noqa: E402
 from wmr_mj.report.plots import (  # noqa: E402
     PAPER_FIGURE_NAMES,
     REGION_GID,
     Series,
     figure_region,
     new_figure,
-    paper_example,
     paper_figures,
     plot_region,
 )

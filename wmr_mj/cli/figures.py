@@ -30,7 +30,8 @@ def default_folder(prefix: str) -> str:
 
 def run(args: argparse.Namespace) -> int:
     from wmr_mj._util.files import check_output_path
-    from wmr_mj.report.plots import paper_example, paper_figures, write_figures
+    from wmr_mj.report.paper_example import paper_example
+    from wmr_mj.report.plots import paper_figures, write_figures
 
     out = check_output_path(args.out or default_folder("figures"), kind="dir", option="--out")
     example = paper_example(duration=args.duration)

@@ -91,6 +91,7 @@ def figures_stage(settings: ValidateSettings, folder: Path, st: Stages, rungs: S
                   ) -> tuple[dict[str, list[str]], dict[str, Any]]:
     """Write every figure (PNG + SVG) into figures/: ({stem: [relative paths]}, Fig. 7's numbers)."""
     from wmr_mj.report import plots
+    from wmr_mj.report.paper_example import paper_example
 
     st.start("figures", "figures (PNG + SVG)")
     figs: dict[str, Any] = {"ladder": plots.figure_ladder(
@@ -101,7 +102,7 @@ def figures_stage(settings: ValidateSettings, folder: Path, st: Stages, rungs: S
     figs.update(_history_figures(nominal))
     if searches:
         figs["search_history"] = _search_figure(searches, rungs)
-    example = plots.paper_example(duration=settings.duration, mujoco=False)
+    example = paper_example(duration=settings.duration, mujoco=False)
     example.mujoco_rows, example.mujoco_summary = nominal["paper"].rows, nominal["paper"].summary
     figs.update(plots.paper_figures(example))
     paths = {stem: [p.relative_to(folder).as_posix() for p in plots.save_figure(fig, folder / "figures" / stem)]

@@ -29,7 +29,8 @@ The validation's figures (``wmr-mj validate``)::
 
 The paper's figures::
 
-    from wmr_mj.report.plots import paper_example, paper_figures, write_figures
+    from wmr_mj.report.paper_example import paper_example   # computes (runs the simulations)
+    from wmr_mj.report.plots import paper_figures, write_figures  # only draws
     example = paper_example()                 # reference, (5.1) analysis, reduced + MuJoCo runs
     paths = write_figures(paper_figures(example), "logs/figures")
 
@@ -46,7 +47,7 @@ from __future__ import annotations
 import io
 import math
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -60,12 +61,12 @@ from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.patches import Patch, Polygon  # noqa: E402
 from matplotlib.ticker import MaxNLocator  # noqa: E402
 
-from wmr_mj.analysis.robustness import BOX_COEFFICIENTS  # noqa: E402
-from wmr_mj.params import M1_NOMINAL, PAPER_KD, PAPER_KP  # noqa: E402
+from wmr_mj.params import M1_NOMINAL  # noqa: E402
 
 if TYPE_CHECKING:
     from matplotlib.typing import RcKeyType
 
+    from wmr_mj.report.paper_example import PaperExample
     from wmr_mj.sim.falsify import FalsifyResult
     from wmr_mj.sim.summary import RunSummary
 
@@ -80,6 +81,7 @@ __all__ = [
     "plot_alpha0_rate",
     "plot_alpha0_accel",
     "plot_region",
+    "RegionStyle",
     "plot_error_trajectory",
     "plot_region_points",
     "plot_time_history",
@@ -89,8 +91,6 @@ __all__ = [
     "figure_alpha0_rates",
     "figure_region",
     "figure_time_history",
-    "PaperExample",
-    "paper_example",
     "paper_figures",
     "PAPER_FIGURE_NAMES",
     "REGION_GID",
@@ -307,14 +307,30 @@ def _region_extent(result) -> tuple[float, float]:
     return float(v[:, 0].max()), float(v[:, 1].max())
 
 
+@dataclass(frozen=True)
+class RegionStyle:
+    """How :func:`plot_region` draws: labels, the points' colour map and colorbar, the (4.21) lines.
+
+    region_label: the polygon's legend entry (default: the region's bounds). value_label: the
+    colorbar's label. point_label: the points' legend entry. lines: also draw the two lines of (4.21).
+    """
+
+    region_label: str | None = None
+    value_label: str = "plant m1 [kg]"
+    cmap: str = "viridis"
+    lines: bool = True
+    colorbar: bool = True
+    point_label: str | None = None
+
+
 def plot_region(ax, result, *, points=None, values=None, trajectory=None, label: str | None = None,
-                region_label: str | None = None, value_label: str = "plant m1 [kg]", cmap: str = "viridis",
-                lines: bool = True, colorbar: bool = True, point_label: str | None = None) -> dict[str, Any]:
+                style: RegionStyle = RegionStyle()) -> dict[str, Any]:
     """The region (4.21)-(4.23) of ``result`` (a RobustnessResult) in the (||E||, ||E'||) plane.
 
     points: (N, 2) array of (sup|E|, sup|E'|) (one per run), coloured by ``values`` (e.g. m1)
-    with a colorbar labelled ``value_label``. trajectory: (|E(t)|, |E'(t)|) arrays drawn as a
-    line labelled ``label``. lines: also draw the two lines of (4.21). Returns the artists
+    with a colorbar labelled ``style.value_label``. trajectory: (|E(t)|, |E'(t)|) arrays drawn as a
+    line labelled ``label``. ``style`` (:class:`RegionStyle`): labels, colour map, colorbar and
+    whether the lines of (4.21) are drawn. Returns the artists
     {'region': Polygon or None, 'scatter': ..., 'trajectory': ..., 'colorbar': ...}.
     The polygon's vertices are exactly ``result.vertices`` (gid :data:`REGION_GID`).
     """
@@ -323,13 +339,13 @@ def plot_region(ax, result, *, points=None, values=None, trajectory=None, label:
     if verts:
         poly = Polygon(np.asarray(verts, dtype=float), closed=True, facecolor=_COLORS["region"], alpha=0.45,
                        edgecolor="#1b4f72", lw=1.0, zorder=1,
-                       label=region_label or (f"region (4.21)-(4.23): ||E|| <= {result.E_max:.3g} rad, "
+                       label=style.region_label or (f"region (4.21)-(4.23): ||E|| <= {result.E_max:.3g} rad, "
                                               f"||E'|| <= {result.Edot_max:.3g} rad/s"))
         poly.set_gid(REGION_GID)
         ax.add_patch(poly)
         out["region"] = poly
         ax.plot([result.E_max], [result.Edot_max], "s", ms=3.5, color="#1b4f72", zorder=2)
-        if lines:
+        if style.lines:
             _draw_4_21_lines(ax, result)
     else:
         ax.text(0.03, 0.97, f"(4.23) fails: condition = {result.condition:.3g} >= 1;\nno bounded region",
@@ -340,10 +356,10 @@ def plot_region(ax, result, *, points=None, values=None, trajectory=None, label:
         out["trajectory"] = plot_error_trajectory(ax, E, Ed, label=label or "error trajectory")
     if points is not None:
         pts = np.asarray(points, dtype=float).reshape(-1, 2)
-        s = Series(label=point_label or "runs: (sup|E|, sup|E'|)", E=pts[:, 0], E_dot=pts[:, 1], kind="points",
+        s = Series(label=style.point_label or "runs: (sup|E|, sup|E'|)", E=pts[:, 0], E_dot=pts[:, 1], kind="points",
                    values=None if values is None else np.asarray(values, dtype=float))
-        out["scatter"], out["colorbar"] = plot_region_points(ax, s, value_label=value_label, colorbar=colorbar,
-                                                             cmap=cmap)
+        out["scatter"], out["colorbar"] = plot_region_points(ax, s, value_label=style.value_label,
+                                                             colorbar=style.colorbar, cmap=style.cmap)
     ax.set_xlabel(r"$\|E\|$ = sup$|E|$ [rad]")
     ax.set_ylabel(r"$\|\dot E\|$ = sup$|\dot E|$ [rad/s]")
     return out
@@ -395,7 +411,7 @@ class Series:
 
 def _draw_series(ax, result, series: Sequence[Series], *, value_label: str, colorbar: bool,
                  region_label: str | None) -> dict[str, Any]:
-    arts = plot_region(ax, result, region_label=region_label)
+    arts = plot_region(ax, result, style=RegionStyle(region_label=region_label))
     for s in series:
         if s.kind == "points":
             plot_region_points(ax, s, value_label=value_label, colorbar=colorbar)
@@ -743,68 +759,6 @@ def figure_search_history(histories: Sequence[SearchHistory], *, title: str | No
 
 
 # --------------------------------------------------------------------------- the paper's example
-@dataclass
-class PaperExample:
-    """Data of the paper's Figs. 4-7 (see :func:`paper_example`)."""
-
-    reference: Any
-    settle_s: float
-    result: Any  # RobustnessResult of (5.1)
-    reduced: list[tuple[str, dict[str, np.ndarray]]] = field(default_factory=list)
-    mujoco_rows: dict[str, np.ndarray] | None = None
-    mujoco_summary: RunSummary | None = None
-    actual_paths: list[tuple[str, np.ndarray]] = field(default_factory=list)  # (label, C's xy) for Fig. 4
-
-
-def paper_example(*, duration: float = 35.0, friction_width: float = 1e-3, mujoco: bool = True) -> PaperExample:
-    """Reference of the paper circle, the (5.1) analysis and the error trajectories of Fig. 7.
-
-    (a) the computed-torque law on the reduced paper model as the plant: estimate at
-    the box's lower corner and plant at its upper corner, and the reverse; the
-    Coulomb sign smoothed as x/sqrt(x^2 + w^2), w = ``friction_width``, identically in
-    law and plant (so the mismatch is (F - F^) s, as the analysis assumes).
-    (b) ``run_closed_loop(RunConfig(model='paper'))`` on the MuJoCo plant.
-    """
-    from controllers import ComputedTorque
-    from wmr_mj.analysis.robustness import ParameterBox, analyse
-    from wmr_mj.errors import ParameterError
-    from wmr_mj.params import C80
-    from wmr_mj.plant.reduced import SteeringModel
-    from wmr_mj.reference.bounds import ReferenceBounds
-    from wmr_mj.sim.closed_loop import run_closed_loop, run_on_reduced_model
-    from wmr_mj.sim.config import RunConfig, build_reference
-
-    if not (isinstance(duration, (int, float)) and math.isfinite(duration) and duration > 0):
-        raise ParameterError(f"duration = {duration!r} s is not accepted; a finite number > 0 is required")
-    box = ParameterBox.paper()
-    kp, kd = PAPER_KP, PAPER_KD
-    result = analyse(box, kp=kp, kd=kd, bounds=ReferenceBounds())
-    reference, settle_s = build_reference("paper-circle", C80, dt=1e-3, duration=float(duration))
-    lo = {n: getattr(box, n)[0] for n in BOX_COEFFICIENTS}
-    hi = {n: getattr(box, n)[1] for n in BOX_COEFFICIENTS}
-    reduced = []
-    for est, plant, name in ((lo, hi, "estimate at box min, plant at box max"),
-                             (hi, lo, "estimate at box max, plant at box min")):
-        law = ComputedTorque(SteeringModel(**est, gyro=0.0, V_A=C80.V_A, name="estimate"), kp=kp, kd=kd,
-                             friction_width=friction_width)
-        rows = run_on_reduced_model(law, SteeringModel(**plant, gyro=0.0, V_A=C80.V_A, name="plant"), reference,
-                                    friction_width=friction_width)
-        reduced.append((name, rows))
-    ex = PaperExample(reference=reference, settle_s=settle_s, result=result, reduced=reduced)
-    if mujoco:
-        run = run_closed_loop(RunConfig(model="paper", duration=float(duration), kp=kp, kd=kd), progress=False)
-        ex.mujoco_rows = run.rows
-        ex.mujoco_summary = run.summary
-        from wmr_mj.sim.designs import CERTIFIED
-
-        certified = run_closed_loop(RunConfig(**CERTIFIED.config_changes(), duration=float(duration)), progress=False)
-        for label, r in (("the paper's design", run), ("the certified design", certified)):
-            if r.C_xy is not None and r.summary.path_error is not None:
-                ex.actual_paths.append((f"{label}, cross-track max {r.summary.path_error.cross_track_max:.3g} m",
-                                        r.C_xy))
-    return ex
-
-
 def fig7_series(example: PaperExample) -> list[Series]:
     series = []
     styles = [(_COLORS["reduced"], "-"), (_COLORS["reduced2"], "--")]

@@ -36,6 +36,7 @@ import threading
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import mujoco
 import numpy as np
@@ -318,13 +319,7 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
     if not configs:
         return []
     first = configs[0]
-    if any(getattr(c, "signals", None) is not None for c in configs):
-        raise ParameterError("run_batch does not apply signals (a disturbance or load changes): run such configs "
-                             "one at a time with run_closed_loop (wmr-mj run --signals)")
-    shared = first.replace(m1=M1_NOMINAL, plant_overrides={})
-    for c in configs[1:]:
-        if c.replace(m1=M1_NOMINAL, plant_overrides={}) != shared:
-            raise ParameterError("run_batch needs configs that differ only in m1 and plant_overrides")
+    _check_batchable(configs)
     if first.correction:
         return _run_one_by_one(configs, base=base, progress=progress, law=law)
     estimate = estimate_parameters(base)
@@ -344,17 +339,7 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
     where = dict(qpos_adr=int(model.jnt_qposadr[steer]), dof_adr=int(model.jnt_dofadr[steer]),
                  actuator=model.actuator("steering_motor").id,
                  chassis=model.body("chassis").id)  # the same in every simulation's model; the law writes the heading
-    if backend == "compiled":
-        # each model carries the reference (3 float64 per control step), for the callback
-        require_memory(nsim * n * 3 * 8, what=f"a batch of {nsim} runs of {n} control steps with the compiled law",
-                       hint="run fewer at once (a smaller chunk) or the NumPy law (WMR_MJ_COMPILED_LAW=0)")
-        compiled_law.install()
-        # law_vector is None only for a law supports() refuses, and then the backend is not 'compiled'
-        models = [batch_model(p, law=(compiled_law.law_vector(controller, voltage_limit=p.voltage_limit,
-                                                              substeps=substeps, nstep=n, **where), rows),
-                              **options) for p in plants]
-    else:
-        models = [model] + [batch_model(p, **options) for p in plants[1:]]
+    models = _simulation_models(backend, controller, plants, options, model, (substeps, n), rows, where)
     analysis = analysis_for(first, reference, estimate, estimate=estimate_of(controller))
     path_at = path_sample_index(n, period)
     require_memory(nsim * len(path_at) * 3 * 8, what=f"C's path samples of a batch of {nsim} runs",
@@ -386,6 +371,9 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
             errors.append(exc)
             stop.set()
 
+    # The groups' threads run here in one piece: each group's block loop (_run_group*) is the hot
+    # loop, one Batch.rollout call per block and no Python per step; this only starts, joins and
+    # stops them.
     wall0 = time.perf_counter()
     workers = [threading.Thread(target=work, args=(idx, threads, None), daemon=True) for idx, threads in groups[1:]]
     for w in workers:
@@ -404,6 +392,60 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
     if errors:
         raise errors[0]
     wall = time.perf_counter() - wall0
+    return _summaries(configs, plants, stats, _BatchRun(base=base, reference=reference, settle_s=settle_s,
+                                                       analysis=analysis, loop=loop, backend=backend, wall=wall))
+
+
+def _check_batchable(configs: Sequence[RunConfig]) -> None:
+    """Configs :func:`run_batch` runs together: no signals, differing only in m1 and plant_overrides."""
+    if any(getattr(c, "signals", None) is not None for c in configs):
+        raise ParameterError("run_batch does not apply signals (a disturbance or load changes): run such configs "
+                             "one at a time with run_closed_loop (wmr-mj run --signals)")
+    shared = configs[0].replace(m1=M1_NOMINAL, plant_overrides={})
+    for c in configs[1:]:
+        if c.replace(m1=M1_NOMINAL, plant_overrides={}) != shared:
+            raise ParameterError("run_batch needs configs that differ only in m1 and plant_overrides")
+
+
+def _simulation_models(backend: str, controller: Any, plants: Sequence[C80Parameters], options: dict[str, Any],
+                       model: mujoco.MjModel, grid: tuple[int, int], rows: tuple[np.ndarray, ...],
+                       where: dict[str, int]) -> list[mujoco.MjModel]:
+    """One model per simulation (``model`` is the first plant's, without the law); with the compiled
+    law each carries the law and the reference. grid: (substeps, n)."""
+    substeps, n = grid
+    nsim = len(plants)
+    if backend == "compiled":
+        # each model carries the reference (3 float64 per control step), for the callback
+        require_memory(nsim * n * 3 * 8, what=f"a batch of {nsim} runs of {n} control steps with the compiled law",
+                       hint="run fewer at once (a smaller chunk) or the NumPy law (WMR_MJ_COMPILED_LAW=0)")
+        compiled_law.install()
+        # law_vector is None only for a law supports() refuses, and then the backend is not 'compiled'
+        return [batch_model(p, law=(compiled_law.law_vector(controller, voltage_limit=p.voltage_limit,
+                                                            substeps=substeps, nstep=n, **where), rows),
+                            **options) for p in plants]
+    return [model] + [batch_model(p, **options) for p in plants[1:]]
+
+
+@dataclass(frozen=True)
+class _BatchRun:
+    """What :func:`_summaries` needs of a finished batch besides its statistics."""
+
+    base: C80Parameters
+    reference: Any
+    settle_s: float
+    analysis: Any
+    loop: _Loop
+    backend: str
+    wall: float
+
+
+def _summaries(configs: Sequence[RunConfig], plants: Sequence[C80Parameters], stats: _BatchStats,
+               run: _BatchRun) -> list[RunSummary]:
+    """Each simulation's :class:`RunSummary` from the batch's statistics (a serial re-run where the
+    batch's law gave NaN or MuJoCo warned), with the batch-level figures."""
+    base, reference, settle_s, analysis = run.base, run.reference, run.settle_s, run.analysis
+    n, substeps, period, path_at = run.loop.n, run.loop.substeps, run.loop.period, run.loop.path_at
+    backend, wall, nsim = run.backend, run.wall, len(configs)
     reports = []
     for i, (c, p) in enumerate(zip(configs, plants)):
         certificate = certificate_for(c, reference, params=base)

@@ -13,6 +13,7 @@ Usage::
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 from collections.abc import Mapping
@@ -141,12 +142,43 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
     gyro_band = interval("gyro_band", gyro_band, positive=True)
     estimate_params = estimate_parameters(base)
     controller = controller_for(config, estimate_params)
-    model = controller.model
     plant = plant_parameters(config, base)
-
     ranges = {k: (float(v[0]), float(v[1])) for k, v in config.box_ranges.items()}
+    plant_box, notes = _plant_box(config, base, estimate_params, ranges, k_band, gyro_band)
+    estimate, compensation = _estimate(controller)
+    period = config.control_period if config.control_period is not None else TIMESTEP
+    initial = (float(reference.alpha0[0]), float(reference.alpha0_dot[0]))  # the plant starts at alpha = alpha' = 0
+    stated = _stated_assumptions(k_band, gyro_band) + tuple(outside_the_box(config, plant, base))
+    signals = getattr(config, "signals", None)
+    if signals is not None:
+        plant_box, extra = _signal_terms(config, signals, plant_box, estimate_params, plant, ranges)
+        stated = stated + extra
+    bounds = reference.bounds()
+    if getattr(config, "correction", False):
+        # the corrected alpha0 = alpha0 + delta, delta within the correction's declared limits
+        from wmr_mj.sim.correction import corrected_bounds, correction_assumptions
+
+        bounds = corrected_bounds(bounds)
+        stated = stated + correction_assumptions()
+    cert = certify(plant=plant_box, estimate=estimate, gains=Gains(kp=config.kp, kd=config.kd),
+                   reference=bounds,
+                   limits=PlantLimits(steering_range=plant.steering_range, voltage_limit=plant.voltage_limit),
+                   compensation=compensation, control_period=period, initial_error=initial, stated=stated)
+    inputs = dict(cert.inputs)
+    inputs.update(model=config.model, controller=controller.name, box_rule=config.box,
+                  m1_range=list(config.m1_range), box_ranges={k: list(v) for k, v in ranges.items()},
+                  plant_m1=plant.m1, notes=notes, steering_friction=getattr(config, "steering_friction", None))
+    if signals is not None:
+        inputs.update(signals=signals.as_dict(), d_max=signals.declared_d_max)
+    return replace_inputs(cert, inputs)
+
+
+def _plant_box(config: Any, base: C80Parameters, estimate_params: C80Parameters,
+               ranges: Mapping[str, tuple[float, float]], k_band: float,
+               gyro_band: tuple[float, float]) -> tuple[PlantBox, list[str]]:
+    """The plant box of :func:`certificate_for` (no disturbance yet) and its notes."""
     derived = derived_box(estimate_params, tuple(float(v) for v in config.m1_range), config.m1_inertia,
-                           tuple(sorted(ranges.items())))
+                          tuple(sorted(ranges.items())))
     box = ParameterBox.paper() if config.box == "paper" else derived
     P = _hull(box.P, *derived.P)
     C_V = _hull(box.C_V, *derived.C_V)
@@ -156,6 +188,7 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
     gyro = (gyro_band[0] * P[0] / l1_hi, gyro_band[1] * P[1] / l1_lo)
     V_A = ranges.get("V_A", (base.V_A, base.V_A))
     notes = []
+    spread: dict[str, Any] = {}
     if config.model == "identified":
         spread = identified_spread(config.identified)
         P = _hull(P, *spread.get("P", P))
@@ -173,25 +206,32 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
             ratio = max(ratio, spread["F"][1] / spread["P"][0])
         if config.box == "paper":
             ratio = None  # (5.1)'s printed intervals come with no such relation
+    return PlantBox(box=plant_box, gyro=gyro, V_A=V_A, friction_over_P=ratio, disturbance=0.0,
+                    disturbance_over_P=None), notes
 
+
+def _estimate(controller: Any) -> tuple[Estimate, Compensation]:
+    """The controller's model as the analysis' estimate, and its friction compensation."""
     pd = controller.name == "pd"
     if isinstance(controller, ComputedTorque):
         sign, width = controller.friction_sign, controller.friction_width
     else:  # a PD (controller_for builds no other): no compensation
         sign, width = "none", 0.0
+    model = controller.model
     c = model.coefficients
     # a PD law has no model but P^ (its gain scale); F^ is the compensation's amplitude
     estimate = Estimate(P=c.P, C_V=0.0, F=0.0, K=0.0, gyro=0.0, V_A=model.V_A) if pd else Estimate(
         P=c.P, C_V=c.C_V, F=0.0 if sign == "none" else c.F, K=c.K, gyro=c.gyro, V_A=model.V_A)
+    return estimate, Compensation(friction_sign=sign, friction_width=width, feedforward=not pd)
 
-    period = config.control_period if config.control_period is not None else TIMESTEP
-    initial = (float(reference.alpha0[0]), float(reference.alpha0_dot[0]))  # the plant starts at alpha = alpha' = 0
 
+def _stated_assumptions(k_band: float, gyro_band: tuple[float, float]) -> tuple[Assumption, ...]:
+    """The measured plant K and gyro bands, each against the data behind it."""
     k_seen = max(abs(v) for v in PLANT_K_MEASURED)
     g_lo, g_hi = GYRO_MEASURED_RATIOS
     g_used = max((1.0 - g_lo) / (1.0 - gyro_band[0]) if gyro_band[0] < 1.0 else math.inf,
                  (g_hi - 1.0) / (gyro_band[1] - 1.0) if gyro_band[1] > 1.0 else math.inf)
-    stated: tuple[Assumption, ...] = (
+    return (
         Assumption("plant K band", f"|K_plant| <= {k_band:g} V (non-holonomic plant: K = 0)",
                    k_seen <= k_band, k_seen, k_band,
                    "MuJoCo identify K = -0.0052 +- 0.0016 V; Drake 0.018 V at 1e7 N/m (physics.md section 6)",
@@ -200,38 +240,21 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
                    g_used <= 1.0, g_used, 1.0,
                    "fraction of the band used by measurements: MuJoCo identify seeds 0-5 0.492-0.704 V s/m "
                    "(0.78-1.12 P/l1), Drake 0.621-0.644 (physics.md section 6)", kind="stated"),
-        *outside_the_box(config, plant, base),
     )
-    signals = getattr(config, "signals", None)
-    d_V, d_over_P = 0.0, None
-    if signals is not None:
-        d_V = disturbance_voltage(signals.declared_d_max, plant, ranges)
-        m1_range = (float(config.m1_range[0]), float(config.m1_range[1]))
-        if d_V and config.box != "paper":  # (5.1)'s printed P interval comes with no inertia behind it
-            d_over_P = disturbance_over_P_max(signals.declared_d_max, estimate_params, plant, m1_range,
-                                              config.m1_inertia, tuple(sorted(ranges.items())))
-        stated = stated + _signal_assumptions(signals, plant.m1, m1_range)
-    bounds = reference.bounds()
-    if getattr(config, "correction", False):
-        # the corrected alpha0 = alpha0 + delta, delta within the correction's declared limits
-        from wmr_mj.sim.correction import corrected_bounds, correction_assumptions
 
-        bounds = corrected_bounds(bounds)
-        stated = stated + correction_assumptions()
-    cert = certify(plant=PlantBox(box=plant_box, gyro=gyro, V_A=V_A, friction_over_P=ratio, disturbance=d_V,
-                                  disturbance_over_P=d_over_P),
-                   estimate=estimate, gains=Gains(kp=config.kp, kd=config.kd),
-                   reference=bounds,
-                   limits=PlantLimits(steering_range=plant.steering_range, voltage_limit=plant.voltage_limit),
-                   compensation=Compensation(friction_sign=sign, friction_width=width, feedforward=not pd),
-                   control_period=period, initial_error=initial, stated=stated)
-    inputs = dict(cert.inputs)
-    inputs.update(model=config.model, controller=controller.name, box_rule=config.box,
-                  m1_range=list(config.m1_range), box_ranges={k: list(v) for k, v in ranges.items()},
-                  plant_m1=plant.m1, notes=notes, steering_friction=getattr(config, "steering_friction", None))
-    if signals is not None:
-        inputs.update(signals=signals.as_dict(), d_max=signals.declared_d_max)
-    return replace_inputs(cert, inputs)
+
+def _signal_terms(config: Any, signals: Any, plant_box: PlantBox, estimate_params: C80Parameters,
+                  plant: C80Parameters, ranges: Mapping[str, tuple[float, float]]
+                  ) -> tuple[PlantBox, tuple[Assumption, ...]]:
+    """The plant box with the declared disturbance bound in it, and the signals' box-membership assumptions."""
+    d_V = disturbance_voltage(signals.declared_d_max, plant, ranges)
+    d_over_P = None
+    m1_range = (float(config.m1_range[0]), float(config.m1_range[1]))
+    if d_V and config.box != "paper":  # (5.1)'s printed P interval comes with no inertia behind it
+        d_over_P = disturbance_over_P_max(signals.declared_d_max, estimate_params, plant, m1_range,
+                                          config.m1_inertia, tuple(sorted(ranges.items())))
+    boxed = dataclasses.replace(plant_box, disturbance=d_V, disturbance_over_P=d_over_P)
+    return boxed, tuple(_signal_assumptions(signals, plant.m1, m1_range))
 
 
 def disturbance_voltage(d_max: float, plant: C80Parameters, ranges: Mapping[str, tuple[float, float]]) -> float:

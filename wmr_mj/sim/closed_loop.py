@@ -50,7 +50,7 @@ from wmr_mj.sim.config import (
     estimate_parameters,
     plant_parameters,
 )
-from wmr_mj.sim.engine import ROW_FIELDS, batch_model, load_fields, plant_options, run_engine
+from wmr_mj.sim.engine import ROW_FIELDS, Schedule, batch_model, load_fields, plant_options, run_engine
 from wmr_mj.sim.log_header import LogHeader
 from wmr_mj.sim.summary import RunSummary
 
@@ -349,10 +349,10 @@ def run_closed_loop(
     on_block = None if logger is None else logger.write_block
     bar = progress_bar(n, desc="run", unit="step", unit_scale=True, enabled=progress)
     try:
-        run = run_engine(correction=outer, params=params, controller=controller, options=options, model=plain,
-                         reference=(a0_all, a0d_all, a0dd_all), n=n, substeps=substeps, period=period, law=law,
-                         on_block=on_block, on_progress=bar.update,
-                         disturbance=disturbance, loads=loads)
+        schedule = Schedule(reference=(a0_all, a0d_all, a0dd_all), n=n, substeps=substeps, period=period,
+                            disturbance=disturbance, loads=loads, correction=outer)
+        run = run_engine(params=params, controller=controller, options=options, model=plain, schedule=schedule,
+                         law=law, on_block=on_block, on_progress=bar.update)
     finally:
         bar.close()
     done, k, status, wall = run.rows, run.steps, run.status, run.wall_s

@@ -47,7 +47,7 @@ from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import C80Parameters
 from wmr_mj.sim import compiled_law
 
-__all__ = ["run_engine", "EngineRun", "batch_model", "batch_law_backend", "LAW_BACKENDS", "plant_options",
+__all__ = ["run_engine", "Schedule", "EngineRun", "batch_model", "batch_law_backend", "LAW_BACKENDS", "plant_options",
            "ROW_FIELDS", "LOAD_FIELDS", "load_fields"]
 
 # scalar fields recorded for every control step (see wmr_mj.sim.closed_loop.RunResult.rows)
@@ -320,43 +320,47 @@ class _PythonStepper:
         block.heading[:] = _heading(quat)
 
 
-def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any],
-               reference: tuple[np.ndarray, np.ndarray, np.ndarray], n: int, substeps: int, period: float,
-               law: str = "auto", on_block: Callable[[dict[str, np.ndarray]], None] | None = None,
-               on_progress: Callable[[int], None] | None = None, model: mujoco.MjModel | None = None,
-               disturbance: np.ndarray | None = None,
-               loads: Sequence[tuple[int, Mapping[str, np.ndarray]]] = (),
-               correction: Any = None) -> EngineRun:
-    """Run ``n`` control steps of ``controller`` on the plant of ``params``; rows of every control step.
+@dataclass(frozen=True)
+class Schedule:
+    """What a run of :func:`run_engine` follows, control step by control step.
 
-    ``reference`` = (alpha0, alpha0', alpha0'') on the control grid (at least n samples);
-    ``on_block(block)``, where given, receives the rows of every simulated second with qpos,
-    qvel, ctrl (at each control step's start, ctrl as applied), A_pos and C_pos (xy of sites A
-    and C); ``on_progress(steps)`` the control steps of each block. KeyboardInterrupt (Ctrl-C,
-    SIGTERM made one) ends the run as "interrupted" with the blocks simulated so far; a block
-    committed but not yet handed to ``on_block`` is handed over before returning. ``model``:
-    ``batch_model(params, **options)`` where the caller has it already. ``disturbance``: a torque on
+    ``reference`` = (alpha0, alpha0', alpha0'') on the control grid (at least n samples); ``n``
+    control steps of ``substeps`` physics steps, ``period`` [s] each. ``disturbance``: a torque on
     the steering joint [N m] per control step (at least n samples); ``loads``: (control step, model
     fields) of each load change (:func:`load_fields`), in step order. ``correction``: a
     :class:`wmr_mj.sim.correction.CartesianCorrection`, whose outer loop rewrites the next
     block's reference (alpha0 + delta, ...) before each block of its period, from C's position
     and the heading of the control step before; the rows' alpha0 are then the corrected ones.
     """
+
+    reference: tuple[np.ndarray, np.ndarray, np.ndarray]
+    n: int
+    substeps: int
+    period: float
+    disturbance: np.ndarray | None = None
+    loads: Sequence[tuple[int, Mapping[str, np.ndarray]]] = ()
+    correction: Any = None
+
+
+def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any], schedule: Schedule,
+               law: str = "auto", on_block: Callable[[dict[str, np.ndarray]], None] | None = None,
+               on_progress: Callable[[int], None] | None = None, model: mujoco.MjModel | None = None) -> EngineRun:
+    """Run ``schedule.n`` control steps of ``controller`` on the plant of ``params``; rows of every control step.
+
+    ``schedule`` (:class:`Schedule`): the reference, the control grid, the signals and the
+    correction. ``on_block(block)``, where given, receives the rows of every simulated second with qpos,
+    qvel, ctrl (at each control step's start, ctrl as applied), A_pos and C_pos (xy of sites A
+    and C); ``on_progress(steps)`` the control steps of each block. KeyboardInterrupt (Ctrl-C,
+    SIGTERM made one) ends the run as "interrupted" with the blocks simulated so far; a block
+    committed but not yet handed to ``on_block`` is handed over before returning. ``model``:
+    ``batch_model(params, **options)`` where the caller has it already.
+    """
+    n, substeps, period, correction = schedule.n, schedule.substeps, schedule.period, schedule.correction
     backend, note = _backend(controller, law)
     plain = batch_model(params, **options) if model is None else model
     where = _Plant(plain)
     log = on_block is not None
-    a0_all, a0d_all, a0dd_all = (np.array(r, dtype=np.float64) if correction is not None
-                                 else np.asarray(r, dtype=np.float64) for r in reference)
-    if len(a0_all) < n:
-        raise ParameterError(f"reference shorter than the run: {len(a0_all)} < {n} samples")
-    if correction is not None and (disturbance is not None or loads):
-        raise ParameterError("the Cartesian correction does not run with disturbance or load signals yet")
-    if disturbance is not None:
-        disturbance = np.asarray(disturbance, dtype=np.float64)
-        if len(disturbance) < n:
-            raise ParameterError(f"disturbance shorter than the run: {len(disturbance)} < {n} samples")
-    loads = sorted(((int(k), dict(f)) for k, f in loads), key=lambda kf: kf[0])
+    (a0_all, a0d_all, a0dd_all), disturbance, loads = _checked_inputs(schedule)
     in_effect: dict[str, np.ndarray] = {}  # the load fields set so far (a Python stepper made later starts with them)
 
     def python_stepper(fields: Mapping[str, np.ndarray] | None = None) -> _PythonStepper:
@@ -364,18 +368,11 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
                               params.voltage_limit, disturbance, fields)
 
     lawful = None
+    ref_adr = 0
     stepper: _CompiledStepper | _PythonStepper
     if backend == "compiled":
-        compiled_law.install()
-        vector = compiled_law.law_vector(controller, voltage_limit=params.voltage_limit, substeps=substeps, nstep=n,
-                                         qpos_adr=where.qpos, dof_adr=where.dof, actuator=where.actuator,
-                                         chassis=where.chassis)
-        assert vector is not None  # the backend is 'compiled' only where compiled_law.supports(controller)
-        carried = (vector, (a0_all, a0d_all, a0dd_all)) + (() if disturbance is None else (disturbance[:n],))
-        lawful = batch_model(params, law=carried, **options)
-        stepper = _CompiledStepper(lawful, where, substeps, log, own_model=correction is not None)
-        ref_numeric = lawful.numeric(compiled_law.REFERENCE_NUMERIC)
-        ref_adr = int(lawful.numeric_adr[ref_numeric.id])
+        stepper, lawful, ref_adr = _compiled_stepper(params, controller, options, where, schedule,
+                                                     (a0_all, a0d_all, a0dd_all), disturbance, log)
     else:
         stepper = python_stepper()
     used = "compiled" if backend == "compiled" else "python"
@@ -426,6 +423,10 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
 
     k0 = cnt = 0
     wall0, cpu0 = time.perf_counter(), time.thread_time()
+    # The block loop stays in one piece: it is the hot loop (one rollout call, or one Python
+    # stepper call, per block of control steps and no Python per physics step), and its state
+    # (the stepper, which may fall back to the Python law, the reference the correction rewrites,
+    # the rows handed over so far) is shared by every part of it.
     try:
         for k0 in range(0, n, block_len):
             cnt = min(block_len, n - k0)
@@ -456,21 +457,7 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
                     step_block(stepper, b, k0, cnt)
             else:
                 step_block(stepper, b, k0, cnt)
-            sl = slice(k0, k0 + cnt)
-            rows["t"][sl] = np.arange(k0, k0 + cnt) * period
-            rows["alpha"][sl] = b.alpha
-            rows["alpha_dot"][sl] = b.alpha_dot
-            rows["alpha0"][sl] = a0_all[sl]
-            rows["alpha0_dot"][sl] = a0d_all[sl]
-            rows["alpha0_ddot"][sl] = a0dd_all[sl]
-            np.subtract(a0_all[sl], b.alpha, out=rows["E"][sl])
-            np.subtract(a0d_all[sl], b.alpha_dot, out=rows["E_dot"][sl])
-            rows["voltage_cmd"][sl] = b.voltage_cmd
-            rows["voltage"][sl] = b.voltage
-            np.divide(b.force, k_i, out=rows["current"][sl])
-            rows["steer_torque"][sl] = b.torque
-            rows["heading"][sl] = b.heading
-            C_xy[sl] = b.C_xy
+            _record_block(rows, C_xy, b, k0, period, (a0_all, a0d_all, a0dd_all), k_i)
             k = k0 + cnt
             hand_over(k)
             if on_progress is not None:
@@ -483,3 +470,62 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
     done = {key: v[:k] for key, v in rows.items()}
     return EngineRun(rows=done, steps=k, status=status, warnings=warned + stepper.warnings(), law=used,
                      law_note=note, wall_s=wall, cpu_s=cpu, C_xy=C_xy[:k])
+
+
+def _checked_inputs(schedule: Schedule) -> tuple[tuple[np.ndarray, np.ndarray, np.ndarray], np.ndarray | None,
+                                                 list[tuple[int, dict[str, np.ndarray]]]]:
+    """The schedule's reference (a copy where the correction rewrites it), disturbance and load
+    changes (sorted by step), each checked against the run's length."""
+    n, correction = schedule.n, schedule.correction
+    a0_all, a0d_all, a0dd_all = (np.array(r, dtype=np.float64) if correction is not None
+                                 else np.asarray(r, dtype=np.float64) for r in schedule.reference)
+    if len(a0_all) < n:
+        raise ParameterError(f"reference shorter than the run: {len(a0_all)} < {n} samples")
+    disturbance, loads = schedule.disturbance, schedule.loads
+    if correction is not None and (disturbance is not None or loads):
+        raise ParameterError("the Cartesian correction does not run with disturbance or load signals yet")
+    if disturbance is not None:
+        disturbance = np.asarray(disturbance, dtype=np.float64)
+        if len(disturbance) < n:
+            raise ParameterError(f"disturbance shorter than the run: {len(disturbance)} < {n} samples")
+    ordered = sorted(((int(k), dict(f)) for k, f in loads), key=lambda kf: kf[0])
+    return (a0_all, a0d_all, a0dd_all), disturbance, ordered
+
+
+def _compiled_stepper(params: C80Parameters, controller: Any, options: dict[str, Any], where: _Plant,
+                      schedule: Schedule, reference: tuple[np.ndarray, np.ndarray, np.ndarray],
+                      disturbance: np.ndarray | None, log: bool) -> tuple[_CompiledStepper, mujoco.MjModel, int]:
+    """The compiled law's stepper, its model (which carries the reference) and the reference's address in it."""
+    n, substeps = schedule.n, schedule.substeps
+    compiled_law.install()
+    vector = compiled_law.law_vector(controller, voltage_limit=params.voltage_limit, substeps=substeps, nstep=n,
+                                     qpos_adr=where.qpos, dof_adr=where.dof, actuator=where.actuator,
+                                     chassis=where.chassis)
+    assert vector is not None  # the backend is 'compiled' only where compiled_law.supports(controller)
+    carried = (vector, reference) + (() if disturbance is None else (disturbance[:n],))
+    lawful = batch_model(params, law=carried, **options)
+    stepper = _CompiledStepper(lawful, where, substeps, log, own_model=schedule.correction is not None)
+    ref_numeric = lawful.numeric(compiled_law.REFERENCE_NUMERIC)
+    return stepper, lawful, int(lawful.numeric_adr[ref_numeric.id])
+
+
+def _record_block(rows: dict[str, np.ndarray], C_xy: np.ndarray, b: _Block, k0: int, period: float,
+                  reference: tuple[np.ndarray, np.ndarray, np.ndarray], k_i: float) -> None:
+    """The rows of one stepped block (control steps k0 .. k0 + len(b)), and C's xy."""
+    a0_all, a0d_all, a0dd_all = reference
+    cnt = len(b.alpha)
+    sl = slice(k0, k0 + cnt)
+    rows["t"][sl] = np.arange(k0, k0 + cnt) * period
+    rows["alpha"][sl] = b.alpha
+    rows["alpha_dot"][sl] = b.alpha_dot
+    rows["alpha0"][sl] = a0_all[sl]
+    rows["alpha0_dot"][sl] = a0d_all[sl]
+    rows["alpha0_ddot"][sl] = a0dd_all[sl]
+    np.subtract(a0_all[sl], b.alpha, out=rows["E"][sl])
+    np.subtract(a0d_all[sl], b.alpha_dot, out=rows["E_dot"][sl])
+    rows["voltage_cmd"][sl] = b.voltage_cmd
+    rows["voltage"][sl] = b.voltage
+    np.divide(b.force, k_i, out=rows["current"][sl])
+    rows["steer_torque"][sl] = b.torque
+    rows["heading"][sl] = b.heading
+    C_xy[sl] = b.C_xy
