@@ -87,7 +87,7 @@ class OpenLoop:
 
     def same_as(self, reports: list[dict]) -> bool:
         """Whether the open loop ended where the closed loop did, to the bit (the same physics)."""
-        return bool(np.array_equal(self.final_alpha, [r["final_alpha_after_step"] for r in reports]))
+        return bool(np.array_equal(self.final_alpha, [r.batch.final_alpha_after_step for r in reports]))
 
 
 def _median_ratio(num: list[float], den: list[float]) -> str:
@@ -140,12 +140,12 @@ def main() -> None:
                 open_loop[nsim].append(ol.steps_per_s(pool))
                 for law in laws:
                     reports = run_batch(configs, nthread=args.nthread, law=law)
-                    closed[law][nsim].append(reports[0]["batch_steps_per_s"])
+                    closed[law][nsim].append(reports[0].batch.steps_per_s)
                     same[law, nsim] = ol.same_as(reports)
                 if not args.no_cpu:  # CPU seconds of one thread's share: what a shared machine cannot blur
                     rollout_rate = one.steps_per_s(caller, clock=time.thread_time)
                     for law in laws:
-                        closed_cpu = run_batch(configs[:len(one.models)], nthread=1, law=law)[0]["batch_cpu_s"]
+                        closed_cpu = run_batch(configs[:len(one.models)], nthread=1, law=law)[0].batch.cpu_s
                         cpu[law][nsim].append(len(one.models) * one.nstep / closed_cpu / rollout_rate)
             if sweep_ol is not None:
                 sweep_open.append(sweep_ol.steps_per_s(pool))
