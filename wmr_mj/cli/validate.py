@@ -24,7 +24,7 @@ _nonneg_int = int_at_least(0)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    from wmr_mj.report.validate import DEFAULT_DURATION, DEFAULT_N, DEFAULT_SEARCH_BUDGET, FULL_BOX_FACTOR
+    from wmr_mj.report.settings import DEFAULT_DURATION, DEFAULT_N, DEFAULT_SEARCH_BUDGET, FULL_BOX_FACTOR
     from wmr_mj.sim.sweep import SAMPLINGS
 
     p = sub.add_parser("validate", help="headline report: the paper's design, the ladder to the certified design, "

@@ -42,10 +42,6 @@ from wmr_mj._util.files import software_versions
 from wmr_mj._util.progress import Stages
 from wmr_mj.params import C80
 from wmr_mj.report.settings import (
-    DEFAULT_DURATION,
-    DEFAULT_N,
-    DEFAULT_SEARCH_BUDGET,
-    FULL_BOX_FACTOR,
     LADDER_GROUPS,
     ValidateSettings,
     certificate_summary,
@@ -57,12 +53,7 @@ from wmr_mj.sim.config import RunConfig
 from wmr_mj.sim.designs import CERTIFIED, LADDER, PAPER, Design
 
 __all__ = [
-    "DEFAULT_N",
-    "DEFAULT_DURATION",
-    "DEFAULT_SEARCH_BUDGET",
-    "FULL_BOX_FACTOR",
-    "LADDER_GROUPS",
-    "ValidateSettings",
+    "ValidateSettings",  # defined in wmr_mj.report.settings, with the defaults; here beside run_validate
     "ladder_changes",
     "summarise_rung",
     "certificate_summary",
