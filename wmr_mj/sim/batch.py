@@ -29,6 +29,7 @@ Usage::
 
 from __future__ import annotations
 
+import concurrent.futures
 import dataclasses
 import math
 import os
@@ -47,7 +48,15 @@ from wmr_mj.errors import ParameterError
 from wmr_mj.params import C80, M1_NOMINAL, C80Parameters
 from wmr_mj.sim import compiled_law
 from wmr_mj.sim.certify import certificate_for
-from wmr_mj.sim.closed_loop import RunMeasures, _substeps, judge_path, path_sample_index, report, run_closed_loop
+from wmr_mj.sim.closed_loop import (
+    PathJudgement,
+    RunMeasures,
+    _substeps,
+    judge_path,
+    path_sample_index,
+    report,
+    run_closed_loop,
+)
 from wmr_mj.sim.config import (
     RunConfig,
     analysis_for,
@@ -393,7 +402,8 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
         raise errors[0]
     wall = time.perf_counter() - wall0
     return _summaries(configs, plants, stats, _BatchRun(base=base, reference=reference, settle_s=settle_s,
-                                                       analysis=analysis, loop=loop, backend=backend, wall=wall))
+                                                       analysis=analysis, loop=loop, backend=backend, wall=wall,
+                                                       threads=threads))
 
 
 def _check_batchable(configs: Sequence[RunConfig]) -> None:
@@ -437,6 +447,7 @@ class _BatchRun:
     loop: _Loop
     backend: str
     wall: float
+    threads: int  # the batch's threads, which also judge C's paths
 
 
 def _summaries(configs: Sequence[RunConfig], plants: Sequence[C80Parameters], stats: _BatchStats,
@@ -446,9 +457,18 @@ def _summaries(configs: Sequence[RunConfig], plants: Sequence[C80Parameters], st
     base, reference, settle_s, analysis = run.base, run.reference, run.settle_s, run.analysis
     n, substeps, period, path_at = run.loop.n, run.loop.substeps, run.loop.period, run.loop.path_at
     backend, wall, nsim = run.backend, run.wall, len(configs)
+    certificates = [certificate_for(c, reference, params=base) for c in configs]
+
+    def path_of(i: int) -> PathJudgement | None:
+        return judge_path(reference, path_at * period, stats.C_xy[i], stats.heading[i], settle_s=settle_s,
+                          certificate=certificates[i], steering_range=plants[i].steering_range)
+
+    # C's projections are NumPy work that releases the GIL: judged on the batch's threads, each run alone
+    with concurrent.futures.ThreadPoolExecutor(max(1, min(run.threads, nsim))) as pool:
+        paths = list(pool.map(path_of, range(nsim)))
     reports = []
     for i, (c, p) in enumerate(zip(configs, plants)):
-        certificate = certificate_for(c, reference, params=base)
+        certificate = certificates[i]
         measured = RunMeasures(status="completed", settle_s=settle_s, sup_E=stats.sup_E[i], sup_Edot=stats.sup_Ed[i],
                                sup_E_settled=stats.sup_E_s[i], sup_Edot_settled=stats.sup_Ed_s[i],
                                saturated_fraction=stats.saturated[i] / n,
@@ -458,8 +478,7 @@ def _summaries(configs: Sequence[RunConfig], plants: Sequence[C80Parameters], st
         r = report(c, measured, analysis=analysis, params=p, certificate=certificate,
                    drift=drift(prev_window=float(stats.drift_prev[i]), last_window=float(stats.drift_last[i]),
                                final_alpha_dot=float(stats.final_alpha_dot[i])),
-                   path=judge_path(reference, path_at * period, stats.C_xy[i], stats.heading[i], settle_s=settle_s,
-                                   certificate=certificate, steering_range=p.steering_range))
+                   path=paths[i])
         if stats.law_nan[i] if backend == "numpy" else stats.warnings[i]:
             # NumPy law: NaN from the law, where the serial loop applies 0 V and MuJoCo would zero
             # every control of the step (BADCTRL); compiled law (which applies 0 V as the serial
