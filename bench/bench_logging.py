@@ -61,6 +61,15 @@ def bench_run(seconds: float, folder: Path, repeats: int, compressions: list[str
         # as `wmr-mj run` writes: a writer thread compresses and writes each second while the next steps
         variants[c] = lambda header, c=c: RunLogger(folder / f"run-{c}.mcap", header,
                                                     options=LogOptions(compression=c, background=True))
+
+    def library_writer(header: object) -> RunLogger:
+        # the same log written with the official mcap Writer.add_message for every message, beside the
+        # writer's NumPy bulk path (which builds the same records from mcap's internals)
+        log = RunLogger(folder / "run-lz4-library.mcap", header, options=LogOptions(compression="lz4", background=True))
+        log._bulk = None
+        return log
+
+    variants["lz4-library"] = library_writer
     run_closed_loop(cfg, progress=False)  # warm up (imports, caches)
     wall: dict[str, list[float]] = {k: [] for k in variants}
     cpu: dict[str, list[float]] = {k: [] for k in variants}
@@ -85,7 +94,7 @@ def bench_run(seconds: float, folder: Path, repeats: int, compressions: list[str
             if name != "unlogged":
                 out[f"{kind}{name}_s"] = med[name]
                 out[f"{kind}{name}_ratio"] = med[name] / med["unlogged"]
-    for c in compressions:
+    for c in [*compressions, "lz4-library"]:
         out[f"{c}_file_mb"] = (folder / f"run-{c}.mcap").stat().st_size / 1e6
     return out
 
@@ -176,11 +185,12 @@ def main() -> None:
     print(f"closed-loop run, paper circle, {args.seconds:g} s at 1 kHz; medians over {args.repeats} alternated repeats")
     print("                       wall clock                 CPU time of this process")
     print(f"run     unlogged       {res['unlogged_s']:.3f} s                    {res['cpu_unlogged_s']:.3f} s")
-    for name in ["null"] + compressions:
-        what = "null logger" if name == "null" else f"logged {name}"
+    for name in ["null", *compressions, "lz4-library"]:
+        what = {"null": "null logger", "lz4-library": "lz4, mcap's"}.get(name, f"logged {name}")
         print(f"run     {what:14s} {res[f'{name}_s']:.3f} s = {res[f'{name}_ratio']:.2f}x"
               f"             {res[f'cpu_{name}_s']:.3f} s = {res[f'cpu_{name}_ratio']:.2f}x"
-              + (f"   file {res[f'{name}_file_mb']:.1f} MB" if name != "null" else "   (the runner's copies only)"))
+              + (f"   file {res[f'{name}_file_mb']:.1f} MB" if name != "null" else "   (the runner's copies only)")
+              + ("   (Writer.add_message per message)" if name == "lz4-library" else ""))
     print(f"logged/unlogged ({d}) = {res[f'{d}_ratio']:.2f} wall, {res[f'cpu_{d}_ratio']:.2f} CPU (medians);"
           f"  target <= {RATIO_TARGET}")
     for kind, what in (("", "wall"), ("cpu_", "CPU ")):
