@@ -186,32 +186,56 @@ def test_replay_verify_reapplies_the_signals(tmp_path):
     assert verify(log)["identical"]
 
 
-def test_batches_refuse_signals():
-    from wmr_mj.sim.batch import run_batch
+def test_batches_run_signal_configs_one_by_one_bit_identical_to_single_runs():
+    """Configs with signals (or their own path) share no batch: run_batch runs them one by one on
+    threads, each summary run_closed_loop's own."""
+    from wmr_mj.sim.batch import run_batch, shares_one_batch
 
-    with pytest.raises(ParameterError, match="signals"):
-        run_batch([_config(signals=SIGNALS)])
+    configs = [_config(signals=SIGNALS), _config(m1=700.0), _config(path="figure-eight", m1=600.0)]
+    assert not shares_one_batch(configs) and shares_one_batch([_config(m1=700.0), _config(m1=600.0)])
+    out = run_batch(configs, nthread=2)
+    for config, summary in zip(configs, out):
+        single = run_closed_loop(config, progress=False).summary
+        assert (summary.sup_E, summary.sup_Edot, summary.verdict) == (single.sup_E, single.sup_Edot, single.verdict)
+        assert summary.certificate == single.certificate
 
 
-def test_worst_signal_found_by_a_search_reproduces_to_the_bit(capsys):
-    """A search over the disturbance and m1; the reported worst signal, given back to `wmr-mj run`, is the same run."""
-    from wmr_mj.sim.signal_search import config_for, search_signals
-    from wmr_mj.sim.signals import Disturbance
+def test_search_space_maps_signal_axes_and_refuses_unknown_ones():
+    from wmr_mj.sim.search_space import config_for
 
-    base = _config()
-    # 7.2 N m of Coulomb friction hold the steering: pulses up to 12 N m break it away
     template = Signals(disturbance=Disturbance("pulse", 1.0, t1=0.5, t2=1.0), d_max=12.0,
                        loads=(LoadChange("step", 700.0, t=1.5),))
-    cfg = config_for(base, template, ["disturbance.t1", "load0.m1", "R_a"], [0.8, 600.0, 1.1])
+    base = _config(signals=template)
+    cfg = config_for(base, ["disturbance.t1", "load0.m1", "R_a"], [0.8, 600.0, 1.1])
     assert cfg.signals.disturbance.t2 == pytest.approx(1.3) and cfg.signals.loads[0].m1 == 600.0
-    assert cfg.plant_overrides == {"R_a": 1.1}
-    found = search_signals(base, template, {"m1": (550.0, 750.0), "disturbance.amplitude": (-12.0, 12.0),
-                                            "disturbance.t1": (0.2, 2.0)}, budget=12, seed=1)
-    assert len(found.evaluations) == 12 and found.worst.verdict == "certified-inside"
-    assert found.worst_objective > 0.05  # the pulse moves the steering
-    assert found.worst_objective == max(v for _, v, _ in found.evaluations)
-    reported = found.worst_config.as_dict()["signals"]
-    summary = _cli_json(capsys, [*RUN[:-1], "--json", "--duration", "2.5", "--m1", repr(found.worst_config.m1),
-                                 "--signals", json.dumps(reported)])
-    assert summary["sup_E"] == found.worst.sup_E and summary["sup_Edot"] == found.worst.sup_Edot
-    assert summary["certificate"]["E_ratio"] == found.worst_objective
+    assert cfg.plant_overrides == {"R_a": 1.1} and cfg.signals.d_max == 12.0
+    for names, word in ((["disturbance.width"], "amplitude, t1"), (["load1.m1"], "1 load change"),
+                        (["load0.mass"], "t, t1, t2, m1"), (["wind"], "accepted: m1")):
+        with pytest.raises(ParameterError, match=word):
+            config_for(base, names, [1.0])
+    with pytest.raises(ParameterError, match="no disturbance"):
+        config_for(_config(), ["disturbance.amplitude"], [1.0])
+
+
+def test_worst_signal_found_by_falsify_reproduces_to_the_bit(capsys, tmp_path):
+    """falsify over m1 and a pulse's amplitude and start: the worst is found at a vertex, the box's
+    largest |amplitude| is the declared d_max, and the reported signal given back to `wmr-mj run`
+    is the same run, bit for bit."""
+    from wmr_mj.cli.app import main
+
+    argv = ["falsify", "--preset", "certified", "--uncertainty", "m1", "--path", "lane-change", "--duration", "2.5",
+            "--budget", "10", "--disturbance", "kind=pulse,amplitude=1,t1=0.5,t2=1.0",
+            "--range", "disturbance.amplitude=-12:12", "--range", "disturbance.t1=0.2:2.0",
+            "--out", str(tmp_path / "f"), "--json"]
+    assert main(argv) == 0
+    found = json.loads(capsys.readouterr().out)
+    assert found["evaluations"] == 10 and found["reproduced"] is True
+    worst = found["worst"]
+    assert worst["signals"]["d_max"] == 12.0 and abs(worst["signals"]["disturbance"]["amplitude"]) == 12.0
+    assert worst["objective"] > 0.05  # a 12 N m pulse breaks the 7.2 N m of Coulomb friction away
+    assert json.loads((tmp_path / "f" / "worst-signals.json").read_text()) == worst["signals"]
+    summary = _cli_json(capsys, [*RUN[:-1], "--json", "--duration", "2.5", "--path", "lane-change",
+                                 "--m1", repr(worst["params"]["m1"]),
+                                 "--signals", str(tmp_path / "f" / "worst-signals.json")])
+    assert summary["sup_E"] == worst["sup_E"] and summary["sup_Edot"] == worst["sup_Edot"]
+    assert summary["certificate"]["E_ratio"] == worst["objective"]

@@ -189,3 +189,34 @@ def test_certified_design_sweep_over_m1_is_certified_inside_for_every_run(tmp_pa
     assert [r["verdict"] for r in saved] == [r["verdict"] for r in rows]
     assert [r["cert_E_ratio"] for r in saved] == [r["cert_E_ratio"] for r in rows]
 
+
+
+def test_cli_sweep_reports_each_requirement_and_the_signals(tmp_path, capsys):
+    """sweep --require: each run's robustness (runs.csv) is `wmr-mj run --require`'s for that plant,
+    bit for bit, and the summary's least robustness is the least of the rows; --disturbance applies
+    to every run and is reported with every parameter."""
+    from wmr_mj.cli.app import main
+
+    common = ["--preset", "certified", "--path", "lane-change", "--duration", "3",
+              "--disturbance", "kind=step,amplitude=2,t1=1"]
+    requirements = ["always[1,3](abs(E) <= 0.01)", "certificate"]
+    argv = ["sweep", *common, "--n", "3", "--out", str(tmp_path / "s"), "--json"]
+    for text in requirements:
+        argv += ["--require", text]
+    assert main(argv) == 0
+    summary = json.loads(capsys.readouterr().out)
+    rows = read_results(tmp_path / "s" / "runs.csv")
+    assert summary["signals"]["disturbance"] == {"kind": "step", "amplitude": 2.0, "t1": 1.0}
+    for i, (text, judged) in enumerate(zip(requirements, summary["requirements"])):
+        column = f"requirement_{i + 1}_robustness"
+        values = [r[column] for r in rows]
+        assert judged["requirement"] == text and judged["column"] == column
+        assert judged["min_robustness"] == min(values)
+        assert judged["satisfied"] + judged["violated"] == 3 and judged["satisfied"] == sum(v >= 0 for v in values)
+    row = rows[int(summary["requirements"][0]["run"])]
+    assert main(["run", *common, "--m1", repr(row["m1"]), "--no-log", "--json",
+                 *[x for text in requirements for x in ("--require", text)]]) == 0
+    single = json.loads(capsys.readouterr().out)
+    assert [r["robustness"] for r in single["requirements"]] == [row["requirement_1_robustness"],
+                                                                 row["requirement_2_robustness"]]
+    assert single["sup_E"] == row["sup_E"]

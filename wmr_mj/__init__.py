@@ -42,7 +42,6 @@ if TYPE_CHECKING:
     from wmr_mj.sim.designs import CERTIFIED, PAPER, PRESETS, preset
     from wmr_mj.sim.falsify import FalsifySpec, falsify
     from wmr_mj.sim.log_header import LogHeader
-    from wmr_mj.sim.signal_search import search_signals
     from wmr_mj.sim.signals import Disturbance, LoadChange, Signals
     from wmr_mj.sim.sweep import SweepSpec, run_sweep
 
@@ -65,7 +64,6 @@ _LAZY: dict[str, str] = {
     "Signals": "wmr_mj.sim.signals",
     "Disturbance": "wmr_mj.sim.signals",
     "LoadChange": "wmr_mj.sim.signals",
-    "search_signals": "wmr_mj.sim.signal_search",
     "RunLogger": "wmr_mj.logs.writer",
     "LogHeader": "wmr_mj.sim.log_header",
     "LogOptions": "wmr_mj.logs.writer",
@@ -98,7 +96,6 @@ __all__ = [
     "run_sweep",
     "FalsifySpec",
     "falsify",
-    "search_signals",
     # logs
     "RunLogger",
     "LogHeader",

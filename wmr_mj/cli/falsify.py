@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import json
 
 from wmr_mj.cli._common import positive_int
 
@@ -11,14 +12,16 @@ _OBJECTIVE_KINDS = ("ratio", "sup-E")
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    from wmr_mj.cli.run import add_run_options
+    from wmr_mj.cli.run import add_run_options, add_signal_options
 
     p = sub.add_parser("falsify", help="worst-case search over the uncertainty box (its vertices, then a local "
                                        "polish; or differential evolution) on mujoco.batch, beside the same "
                                        "budget spent at random")
     add_run_options(p)
     p.add_argument("--range", action="append", metavar="NAME=LO:HI",
-                   help="add a plant parameter to the box or replace its range (repeatable)")
+                   help="add a plant parameter to the box or replace its range (repeatable); with --disturbance "
+                        "or --load, also their parameters: disturbance.amplitude, disturbance.t1, ..., load0.m1, "
+                        "load0.t, ..., d_max (a ranged amplitude without --d-max declares the box's largest)")
     p.add_argument("--against", default="certificate",
                    help="the region of the ratio sup|E|/E_max: certificate (default) or paper (the paper's region)")
     p.add_argument("--objective", default="ratio", help="what is maximised: ratio (default, see --against) or sup-E")
@@ -28,8 +31,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "evolution)")
     p.add_argument("--require", metavar="STL",
                    help="falsify an STL requirement (e.g. 'always(abs(E) <= 0.05)', signals as for wmr-mj run "
-                        "--require): maximise minus its robustness (> 0: falsified); runs serially, the batch keeps "
-                        "no signals")
+                        "--require): maximise minus its robustness (> 0: falsified); runs one by one, the batch "
+                        "keeps no per-step signals")
     p.add_argument("--budget", type=positive_int, default=256,
                    help="simulations of the search (default 256); the random sample gets as many")
     p.add_argument("--population", type=int, default=None,
@@ -40,6 +43,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--scheduler", metavar="ADDRESS", help="run the batches on a Dask cluster (e.g. tcp://127.0.0.1:8786)")
     p.add_argument("--out", metavar="DIR", help="output folder (default logs/falsify-<time>)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_signal_options(p)
     p.set_defaults(func=run)
 
 
@@ -55,8 +59,10 @@ def _objective(args: argparse.Namespace) -> str:
     return "sup-E" if args.objective == "sup-E" else args.against
 
 
-def reproduce_command(config, params: dict[str, float], args: argparse.Namespace) -> str:
-    """A ``wmr-mj run`` line that repeats the worst run (parameters at full precision)."""
+def reproduce_command(config, params: dict[str, float], args: argparse.Namespace, *,
+                      signals_file: str | None = None) -> str:
+    """A ``wmr-mj run`` line that repeats the worst run (parameters at full precision; its signals,
+    when it has some, from ``signals_file``, where they were written with every parameter)."""
     import shlex
 
     parts = ["wmr-mj run", f"--preset {args.preset}", f"--controller {config.controller}", f"--model {config.model}",
@@ -81,6 +87,8 @@ def reproduce_command(config, params: dict[str, float], args: argparse.Namespace
     parts += [f"--range {shlex.quote(item)}" for item in getattr(args, "range", None) or []]  # the same box
     if getattr(config, "correction", False):
         parts.append("--correction")
+    if config.signals is not None:
+        parts.append(f"--signals {shlex.quote(signals_file or json.dumps(config.signals.as_dict()))}")
     return " ".join(parts)
 
 
@@ -89,15 +97,20 @@ def run(args: argparse.Namespace) -> int:
 
     from wmr_mj._util.files import check_output_path, write_json_atomic, write_text_atomic
     from wmr_mj._util.progress import counter_callback, progress_bar
-    from wmr_mj.cli._common import box_ranges_from_args, print_json
+    from wmr_mj.cli._common import box_ranges_from_args, parse_range, print_json
     from wmr_mj.cli.run import config_from_args
     from wmr_mj.logs.writer import run_logged
     from wmr_mj.report.plots import falsify_history, save_figure
     from wmr_mj.sim.falsify import OBJECTIVE_LABELS, FalsifySpec, check_runnable, falsify, worst_config
+    from wmr_mj.sim.search_space import signal_axis
 
     objective = _objective(args)
     args.uncertainty = args.uncertainty or "full"
-    box = {"m1": tuple(args.m1_range), **box_ranges_from_args(args)}
+    # the signals' axes are searched, not certified over: the certificate's box is the plant's
+    given = args.range or []
+    signal_ranges = dict(parse_range(item) for item in given if signal_axis(parse_range(item)[0]))
+    args.range = [item for item in given if not signal_axis(parse_range(item)[0])]
+    box = {"m1": tuple(args.m1_range), **box_ranges_from_args(args), **signal_ranges}
     base = config_from_args(args)
     spec = FalsifySpec(base=base, box=box, objective=objective, budget=args.budget, seed=args.seed,
                        population=args.population, method=args.method, requirement=args.require)
@@ -112,9 +125,15 @@ def run(args: argparse.Namespace) -> int:
     logged = run_logged(config, str(log_path))
     worst = result.worst
     summary = result.as_dict(log=str(log_path))
+    signals_file = None
+    if config.signals is not None:  # the worst run's signals, every parameter: --signals takes them back
+        signals_file = str(out / "worst-signals.json")
+        write_json_atomic(signals_file, config.signals.as_dict())
+        summary["worst"]["signals"] = config.signals.as_dict()
+        summary["signals_file"] = signals_file
     summary.update({
         "reproduced": logged.sup_E == worst.sup_E,  # the serial re-run gives the batch's bits
-        "reproduce": reproduce_command(config, worst.params, args),
+        "reproduce": reproduce_command(config, worst.params, args, signals_file=signals_file),
         "uncertainty": args.uncertainty,
         "folder": str(out),
         "table": str(out / "evaluations.csv"),
@@ -149,6 +168,8 @@ def run(args: argparse.Namespace) -> int:
               + (f"FALSIFIED, first at run {first_s} of the search" if first_s else "not falsified by the search")
               + (f"; random: first at run {first_r}" if first_r else "; random: not falsified"))
     print("worst parameters: " + ", ".join(f"{k} = {v!r}" for k, v in worst.params.items()))
+    if signals_file is not None:
+        print(f"worst signals: {json.dumps(summary['worst']['signals'], separators=(',', ':'))}")
     print(f"reproduce: {summary['reproduce']}")
     if not summary["reproduced"]:
         print(f"WARNING: the serial re-run gave sup|E| = {logged.sup_E!r}, the search {worst.sup_E!r}",

@@ -101,6 +101,9 @@ def config_from_args(args: argparse.Namespace, **extra):
 
         identified = identify_plant(C80, duration=30.0, seed=0).as_dict()
     coefficients = parse_assignments(args.coef) if args.coef else None
+    signals = signals_from_args(args)
+    if signals is not None:
+        extra.setdefault("signals", signals)
     return RunConfig(controller=controller, model=model, duration=args.duration,
                      control_period=args.control_period, kp=kp, kd=kd, friction_sign=friction_sign,
                      friction_width=friction_width, path=args.path,
@@ -129,6 +132,12 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="progress bar (default: only on a terminal)")
     add_require_option(p)
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_signal_options(p)
+    p.set_defaults(func=run)
+
+
+def add_signal_options(p: argparse.ArgumentParser) -> None:
+    """--signals, --disturbance, --load, --d-max (``run``, ``sweep``, ``falsify``; see signals_from_args)."""
     g = p.add_argument_group("signals on the plant during the run (wmr_mj/sim/signals.py); reported under "
                              "'signals' in --json, which --signals takes back to reproduce the run to the bit")
     g.add_argument("--signals", metavar="FILE|JSON",
@@ -141,7 +150,6 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "kind=ramp,t1=S,t2=S,m1=KG[,every=S]")
     g.add_argument("--d-max", type=float, default=None, metavar="NM",
                    help="disturbance bound the certificate declares, N m (default: the disturbance's amplitude)")
-    p.set_defaults(func=run)
 
 
 def add_require_option(p: argparse.ArgumentParser) -> None:
@@ -283,8 +291,7 @@ def run(args: argparse.Namespace) -> int:
     if not args.no_log:
         path = args.out or default_log_path(args)
         check_output_path(path, kind="file", option="--out")
-    signals = signals_from_args(args)
-    config = config_from_args(args, m1=args.m1, **({} if signals is None else {"signals": signals}))
+    config = config_from_args(args, m1=args.m1)
     period = args.control_period or TIMESTEP
     requirements = requirements_from_args(args, period)
     factory = None

@@ -13,7 +13,7 @@ if TYPE_CHECKING:
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    from wmr_mj.cli.run import add_run_options
+    from wmr_mj.cli.run import add_require_option, add_run_options, add_signal_options
 
     p = sub.add_parser("sweep",
                        help="Monte-Carlo over m1 (and --uncertainty/--range) on mujoco.batch: per-run "
@@ -31,6 +31,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--log", action="store_true",
                    help="also write an MCAP log per run (re-run one by one; bit-identical)")
     p.add_argument("--json", action="store_true", help="print one summary JSON object")
+    add_require_option(p)
+    add_signal_options(p)
     p.set_defaults(func=run)
 
 
@@ -41,8 +43,9 @@ def run(args: argparse.Namespace) -> int:
     from wmr_mj._util.files import check_output_path, write_json_atomic
     from wmr_mj._util.progress import counter_callback, progress_bar
     from wmr_mj.cli._common import box_ranges_from_args, print_json
-    from wmr_mj.cli.run import config_from_args
+    from wmr_mj.cli.run import config_from_args, requirements_from_args
     from wmr_mj.errors import ParameterError
+    from wmr_mj.plant.mjcf import TIMESTEP
     from wmr_mj.sim.sweep import SweepSpec, SweepSummary, run_sweep
 
     if args.n < 1:
@@ -50,18 +53,21 @@ def run(args: argparse.Namespace) -> int:
     ranges = box_ranges_from_args(args)  # --uncertainty (default m1), then --range
     out = check_output_path(args.out or f"logs/sweep-{time.strftime('%Y%m%d-%H%M%S')}", kind="dir", option="--out")
     base = config_from_args(args)
+    requirements = tuple(r.text for r in requirements_from_args(args, args.control_period or TIMESTEP))
     spec = SweepSpec(n=args.n, seed=args.seed, sampling=args.sampling, m1_range=tuple(args.m1_range),
-                     ranges=ranges, base=base)
+                     ranges=ranges, base=base, requirements=requirements)
     t0 = time.perf_counter()
     with progress_bar(spec.n, desc="sweep", unit="runs", fractional=True) as bar:
         results = run_sweep(spec, out_dir=out, chunk=args.chunk, nthread=args.nthread, scheduler=args.scheduler,
                             progress=counter_callback(bar))
     wall = time.perf_counter() - t0
-    runs = SweepSummary.of(results)  # the one aggregator of sweep and validate
+    runs = SweepSummary.of(results, spec.requirements)  # the one aggregator of sweep and validate
     summary = runs.sweep_dict(wall)
     summary.update({"folder": str(out), "model": base.model, "controller": base.controller, "seed": args.seed,
                     "sampling": args.sampling,
                     "ranges": {"m1": list(args.m1_range), **{k: list(v) for k, v in ranges.items()}}})
+    if base.signals is not None:
+        summary["signals"] = base.signals.as_dict()  # every run's, with every parameter
     plot_path = _plot(results, runs, out / "region")
     summary["plot"] = str(plot_path)
     if args.log:
@@ -96,6 +102,11 @@ def run(args: argparse.Namespace) -> int:
         print(f"path of C: worst sup|cross-track| = {runs.path_cross_track.value:.4g} m "
               f"(m1 = {runs.path_cross_track.m1:g} kg); path verdicts: "
               + ", ".join(f"{v} {c}" for v, c in runs.path_verdicts.items()))
+    for req in runs.requirements:
+        least = ("n/a" if req.min_robustness is None
+                 else f"{req.min_robustness:+.5g} (run {req.run}, m1 = {req.m1:g} kg)")
+        print(f"requirement {req.requirement}: {req.satisfied} hold, {req.violated} violated"
+              + (f", {req.undefined} without a region" if req.undefined else "") + f"; least robustness {least}")
     law = f", {' and '.join(runs.batch_law)} law" if runs.batch_law else ""
     print(f"{runs.steps} steps in {wall:.1f} s ({summary['steps_per_s']:.3g} steps/s{law})")
     print(f"table: {out / 'runs.csv'}\nplot:  {plot_path}")

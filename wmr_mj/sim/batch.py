@@ -46,6 +46,7 @@ from wmr_mj._util.memory import require_memory
 from wmr_mj.analysis.verdicts import drift, drift_window_steps
 from wmr_mj.errors import ParameterError
 from wmr_mj.params import C80, M1_NOMINAL, C80Parameters
+from wmr_mj.plant.mjcf import TIMESTEP
 from wmr_mj.sim import compiled_law
 from wmr_mj.sim.certify import certificate_for
 from wmr_mj.sim.closed_loop import (
@@ -70,7 +71,8 @@ from wmr_mj.sim.engine import LAW_BACKENDS, batch_law_backend, batch_model
 from wmr_mj.sim.engine import plant_options as _plant_options
 from wmr_mj.sim.summary import BatchFigures, RunSummary
 
-__all__ = ["run_batch", "batch_model", "batch_law_backend", "LAW_BACKENDS", "thread_count", "batch_groups"]
+__all__ = ["run_batch", "shares_one_batch", "batch_model", "batch_law_backend", "LAW_BACKENDS", "thread_count",
+           "batch_groups"]
 
 def thread_count(nthread: int, nsim: int) -> int:
     """Threads for nsim simulations: nthread, or every core this process may use when 0."""
@@ -310,27 +312,37 @@ def _block_stats(loop: _Loop, stats: _BatchStats, idx: np.ndarray, k0: int, rows
 
 
 def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parameters = C80,
-              progress: Callable[[int, int], None] | None = None, law: str = "auto") -> list[RunSummary]:
-    """Run closed-loop configs that differ only in their plant parameters, all at once.
+              progress: Callable[[int, int], None] | None = None, law: str = "auto",
+              requirements: Sequence[str] = ()) -> list[RunSummary]:
+    """Run closed-loop configs, all at once where they share one batch.
 
-    ``law`` (:data:`LAW_BACKENDS`, :func:`batch_law_backend`): 'compiled' runs one
+    Configs that differ only in their plant parameters (m1, plant_overrides) and have no
+    signals and no Cartesian correction share one batch (:func:`shares_one_batch`). ``law``
+    (:data:`LAW_BACKENDS`, :func:`batch_law_backend`): 'compiled' runs one
     ``mujoco.batch.Batch`` of every simulation on ``nthread`` threads (0: every core) with
     the law in MuJoCo's control callback, a block of steps per ``Batch.rollout`` call;
     'numpy' splits the simulations into groups (:func:`batch_groups`), each a ``Batch`` on
     its own Python thread with its own vectorised law (``controller.batch_law``), so that
     the law of one group runs while the others step; 'auto' (the default) takes the
-    compiled law where it can run. Each simulation has its own compiled model. Returns
-    per-run :class:`RunSummary` records, each bit-identical to ``run_closed_loop`` of the same
-    config, whichever the law. Their ``batch.cpu_s`` is the CPU time of the group threads (a
-    figure for benchmarks on a shared machine; batch-internal threads excluded), ``batch.law``
-    the law that ran.
+    compiled law where it can run. Each simulation has its own compiled model.
+
+    Configs that cannot share a batch (each its own reference, signals or correction) and runs
+    with ``requirements`` (STL formulas or presets, :mod:`wmr_mj.analysis.requirements`, whose
+    monitor needs every control step's signals, which a batch does not keep) run one by one on
+    the engine (``run_closed_loop``), ``nthread`` at a time on threads (each engine call
+    releases the GIL while MuJoCo steps).
+
+    Returns per-run :class:`RunSummary` records, each bit-identical to ``run_closed_loop`` of
+    the same config, whichever the law. Their ``batch.cpu_s`` is the CPU time of the group
+    threads (a figure for benchmarks on a shared machine; batch-internal threads excluded),
+    ``batch.law`` the law that ran; ``requirements`` holds each requirement judged.
     """
     if not configs:
         return []
     first = configs[0]
-    _check_batchable(configs)
-    if first.correction:
-        return _run_one_by_one(configs, base=base, progress=progress, law=law)
+    if requirements or not shares_one_batch(configs):
+        return _run_one_by_one(configs, base=base, progress=progress, law=law, nthread=nthread,
+                               requirements=tuple(requirements))
     estimate = estimate_parameters(base)
     controller = controller_for(first, estimate)
     backend = batch_law_backend(controller, law)
@@ -406,15 +418,13 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
                                                        threads=threads))
 
 
-def _check_batchable(configs: Sequence[RunConfig]) -> None:
-    """Configs :func:`run_batch` runs together: no signals, differing only in m1 and plant_overrides."""
-    if any(getattr(c, "signals", None) is not None for c in configs):
-        raise ParameterError("run_batch does not apply signals (a disturbance or load changes): run such configs "
-                             "one at a time with run_closed_loop (wmr-mj run --signals)")
+def shares_one_batch(configs: Sequence[RunConfig]) -> bool:
+    """Whether ``configs`` run as one batch: no signals, no correction, and nothing but m1 and
+    plant_overrides differs (the batch's simulations share one reference and one law)."""
+    if any(c.signals is not None or c.correction for c in configs):
+        return False
     shared = configs[0].replace(m1=M1_NOMINAL, plant_overrides={})
-    for c in configs[1:]:
-        if c.replace(m1=M1_NOMINAL, plant_overrides={}) != shared:
-            raise ParameterError("run_batch needs configs that differ only in m1 and plant_overrides")
+    return all(c.replace(m1=M1_NOMINAL, plant_overrides={}) == shared for c in configs[1:])
 
 
 def _simulation_models(backend: str, controller: Any, plants: Sequence[C80Parameters], options: dict[str, Any],
@@ -499,26 +509,65 @@ def _summaries(configs: Sequence[RunConfig], plants: Sequence[C80Parameters], st
 
 
 def _run_one_by_one(configs: Sequence[RunConfig], *, base: C80Parameters, progress: Callable[[int, int], None] | None,
-                    law: str) -> list[RunSummary]:
-    """Runs with the Cartesian correction (``wmr_mj.sim.correction``), one after the other on the engine.
+                    law: str, nthread: int = 1, requirements: tuple[str, ...] = ()) -> list[RunSummary]:
+    """Runs that do not share a batch, each a single run on the engine, ``nthread`` at a time.
 
-    The correction's outer loop rewrites each simulation's reference from its own state between
-    blocks; the batch's loops share one reference, so these runs are single runs (their
-    summaries are run_closed_loop's, as the batch's are). ``batch.final_alpha_after_step`` is
-    NaN: a single run does not keep the state after its last step.
+    A run with the Cartesian correction (``wmr_mj.sim.correction``) rewrites its own reference
+    from its state between blocks; a run with signals, or on its own path, has inputs of its
+    own; and a requirement's monitor needs every control step's signals: the batch's loops
+    share one reference and keep statistics only. Each summary is run_closed_loop's (the
+    requirements judged on its rows); ``batch.final_alpha_after_step`` is NaN: a single run
+    does not keep the state after its last step. ``batch.wall_s`` is the wall time of them
+    all, ``batch.cpu_s`` the sum of the threads' CPU time.
     """
-    reports = []
-    wall0, cpu0 = time.perf_counter(), time.thread_time()
-    for i, c in enumerate(configs):
-        r = run_closed_loop(c, progress=False, base=base, law=law)
-        reports.append((r.summary, r.law))
-        if progress is not None:
-            progress(i + 1, len(configs))
-    wall, cpu = time.perf_counter() - wall0, time.thread_time() - cpu0
-    steps = sum(s.steps for s, _ in reports)
+    from wmr_mj.analysis.requirements import evaluate_run, parse_requirement
+
+    def period_of(config: RunConfig) -> float:
+        return TIMESTEP if config.control_period is None else config.control_period
+
+    # parsed here, on the calling thread: a bad formula fails before any run, and rtamt is imported
+    # once (its modules deadlock when two threads import them at once)
+    parsed = {p: [parse_requirement(text, period=p) for text in requirements] for p in {period_of(c) for c in configs}}
+    monitor = threading.Lock()  # rtamt is pure Python and toggles process-wide logging: one run at a time
+
+    def one(config: RunConfig) -> tuple[RunSummary, str, float]:
+        cpu0 = time.thread_time()
+        result = run_closed_loop(config, progress=False, base=base, law=law)
+        summary = result.summary
+        if requirements:
+            period = period_of(config)
+            with monitor:
+                judged = evaluate_run(parsed[period], result.rows, summary.to_dict(), period=period)
+            summary = dataclasses.replace(summary, requirements=tuple(judged))
+        return summary, result.law, time.thread_time() - cpu0
+
+    threads = thread_count(nthread, len(configs))
+    wall0 = time.perf_counter()
+    done: list[tuple[RunSummary, str, float]] = []
+    if threads == 1:
+        for c in configs:
+            done.append(one(c))
+            if progress is not None:
+                progress(len(done), len(configs))
+    else:
+        with concurrent.futures.ThreadPoolExecutor(threads) as pool:
+            futures = [pool.submit(one, c) for c in configs]
+            try:
+                for k, fut in enumerate(concurrent.futures.as_completed(futures)):
+                    fut.result()  # the first failure, raised here
+                    if progress is not None:
+                        progress(k + 1, len(configs))
+            except BaseException:
+                for fut in futures:
+                    fut.cancel()
+                raise
+            done = [fut.result() for fut in futures]
+    wall = time.perf_counter() - wall0
+    cpu = sum(c for _, _, c in done)
+    steps = sum(s.steps for s, _, _ in done)
     return [dataclasses.replace(s, analysis=None, controller_config=None, batch=BatchFigures(
         final_alpha_after_step=math.nan, wall_s=wall, steps_per_s=steps / wall if wall > 0 else None, cpu_s=cpu,
-        law="compiled" if used == "compiled" else "numpy")) for s, used in reports]
+        law="compiled" if used == "compiled" else "numpy")) for s, used, _ in done]
 
 
 # -- sweeps: chunks, resume, Dask ---------------------------------------------------------

@@ -27,8 +27,14 @@ Objectives (:data:`OBJECTIVES`), read from a run's summary by :func:`objective_v
 - ``paper``: sup|E| / E_max of the paper's region;
 - ``sup-E``: sup|E| itself, rad;
 - ``requirement``: minus the robustness of an STL requirement (``FalsifySpec.requirement``,
-  :mod:`wmr_mj.analysis.requirements`): > 0 falsified. These runs are serial
-  (``run_closed_loop``): the batch keeps no signals to monitor.
+  :mod:`wmr_mj.analysis.requirements`): > 0 falsified. These runs go one by one on the engine,
+  ``nthread`` at a time (the batch keeps no per-step signals to monitor).
+
+The box (``FalsifySpec.box``) ranges plant parameters and, where the base config has signals
+(:mod:`wmr_mj.sim.signals`), their parameters: ``disturbance.amplitude``, ``disturbance.t1``,
+``load0.m1``, ... (:mod:`wmr_mj.sim.search_space`). A ranged disturbance amplitude with no
+declared ``d_max`` declares the box's largest |amplitude|, one certificate for the whole search.
+Runs with signals do not share a batch: they run one by one, ``nthread`` at a time.
 
 Usage::
 
@@ -49,6 +55,7 @@ NAME=VALUE ...`` give the same sup|E|; the same seed gives the same search.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import itertools
 import math
 import warnings
@@ -124,7 +131,7 @@ def objective_source(summary: Mapping[str, Any], objective: str) -> str:
     if objective == "sup-E":
         return "sup_E"
     if objective == "requirement":
-        return f"-robustness of {summary['requirements'][0]['formula']} (rtamt, serial runs)"
+        return f"-robustness of {summary['requirements'][0]['formula']} (rtamt, runs one by one)"
     if objective == "paper":
         region = summary.get("paper_region")
         if isinstance(region, Mapping) and region.get("E_max") is not None:
@@ -414,13 +421,26 @@ class FalsifySpec:
             raise ParameterError("the objective 'requirement' goes with a requirement (an STL formula), and only it")
         if self.requirement is not None:
             self.parsed_requirement  # noqa: B018  (refused here, before any run, when malformed)
+        from wmr_mj.sim.search_space import config_for, signal_axis
+
         if not self.box:
             raise ParameterError("the box is empty; give at least one ranged parameter (e.g. --uncertainty m1)")
         names = parameter_names()
         for name, (lo, hi) in self.box.items():
+            if signal_axis(name):
+                if not (math.isfinite(lo) and math.isfinite(hi) and lo <= hi):
+                    raise ParameterError(f"range of {name} = {lo!r}:{hi!r} is not accepted: finite LO <= HI")
+                continue
             if name not in names:
                 raise UnknownNameError("parameter", name, names)
             _check_range(name, lo, hi)
+        amplitude = self.box.get("disturbance.amplitude")
+        signals = self.base.signals
+        if amplitude is not None and signals is not None and signals.d_max is None:
+            # the certificate declares one bound for the whole search: the largest amplitude of the box
+            declared = dataclasses.replace(signals, d_max=max(abs(float(amplitude[0])), abs(float(amplitude[1]))))
+            object.__setattr__(self, "base", self.base.replace(signals=declared))
+        config_for(self.base, self.names, [lo for lo, _ in self.box.values()])  # a bad axis fails before any run
         if isinstance(self.seed, bool) or not isinstance(self.seed, int):
             raise ParameterError(f"seed = {self.seed!r} is not accepted; give an integer")
         _check_budget(self.budget, self.population_size if self.method == "de" else MIN_POPULATION)
@@ -446,10 +466,11 @@ class FalsifySpec:
         return population_size(self.budget, len(self.box)) if self.population is None else self.population
 
     def config(self, point: Sequence[float]) -> RunConfig:
-        """The run at ``point`` (values in ``names`` order): m1 and the plant overrides set."""
-        values = {name: float(v) for name, v in zip(self.names, point)}
-        m1 = values.pop("m1", self.base.m1)
-        return self.base.replace(m1=m1, plant_overrides={**self.base.plant_overrides, **values})
+        """The run at ``point`` (values in ``names`` order): m1, the plant overrides and the signals'
+        parameters set (:func:`wmr_mj.sim.search_space.config_for`)."""
+        from wmr_mj.sim.search_space import config_for
+
+        return config_for(self.base, self.names, point)
 
 
 @dataclass(frozen=True)
@@ -559,12 +580,10 @@ def falsify(spec: FalsifySpec, *, chunk: int = 128, nthread: int = 0, scheduler:
                 if progress is not None:
                     progress(base_done + k, total)
 
-            if spec.objective == "requirement":
-                reports = _run_with_requirement(configs, spec, chunk_progress)
-            else:
-                reports = [s.to_dict() for s in  # the summaries' JSON, what a search writes and reads back
-                           run_configs(configs, chunk=chunk, nthread=nthread, client=client,
-                                       progress=chunk_progress)]
+            requirements = () if spec.requirement is None else (spec.requirement,)
+            reports = [s.to_dict() for s in  # the summaries' JSON, what a search writes and reads back
+                       run_configs(configs, chunk=chunk, nthread=nthread, client=client, progress=chunk_progress,
+                                   requirements=requirements)]
             done += len(reports)
             out = np.full(len(points), np.nan)
             generation = generation_of()
@@ -602,26 +621,6 @@ def falsify(spec: FalsifySpec, *, chunk: int = 128, nthread: int = 0, scheduler:
     first = evaluations["search"][0].summary
     return FalsifyResult(spec=spec, search=evaluations["search"], random=evaluations["random"],
                          objective_source=objective_source(first, spec.objective))
-
-
-def _run_with_requirement(configs: Sequence[RunConfig], spec: FalsifySpec,
-                          progress: Callable[[int, int], None]) -> list[dict[str, Any]]:
-    """Serial runs (the batch keeps no signals to monitor), each summary with its requirement judged."""
-    from wmr_mj.analysis.requirements import evaluate_run
-    from wmr_mj.plant.mjcf import TIMESTEP
-    from wmr_mj.sim.closed_loop import run_closed_loop
-
-    requirement = spec.parsed_requirement
-    period = TIMESTEP if spec.base.control_period is None else spec.base.control_period
-    reports = []
-    for k, config in enumerate(configs):
-        result = run_closed_loop(config, progress=False)
-        summary = result.summary.to_dict()
-        summary["requirements"] = [r.as_dict() for r in evaluate_run([requirement], result.rows, summary,
-                                                                     period=period)]
-        reports.append(summary)
-        progress(k + 1, len(configs))
-    return reports
 
 
 def check_runnable(base: RunConfig) -> None:

@@ -24,6 +24,7 @@ from typing import Any
 from wmr_mj.analysis.certificate import Assumption, CertificateJudgement
 from wmr_mj.analysis.path_bound import PathBound, PathVerdict
 from wmr_mj.analysis.path_error import PathErrors
+from wmr_mj.analysis.requirements import RequirementResult
 from wmr_mj.analysis.verdicts import Drift, PaperRegion
 
 __all__ = ["RunSummary", "PaperRegion", "Drift", "CertificateJudgement", "Assumption", "BatchFigures"]
@@ -94,6 +95,8 @@ class RunSummary:
             or 'no-guarantee'.
         correction: the Cartesian correction's gains, limits and the largest values it used
             (``wmr_mj.sim.correction``); None when the run had none.
+        requirements: each STL requirement judged on the run (``wmr_mj.analysis.requirements``:
+            formula, robustness, satisfied); None when none was asked for.
     """
 
     status: str
@@ -128,6 +131,7 @@ class RunSummary:
     path_bound: PathBound | None = None
     path_verdict: PathVerdict | None = None
     correction: Mapping[str, Any] | None = None
+    requirements: tuple[RequirementResult, ...] | None = None
 
     # the paper's claim, read through paper_region (the JSON also writes these at the top level)
     @property
@@ -231,4 +235,6 @@ class RunSummary:
             out["path_verdict"] = self.path_verdict.to_dict()
         if self.correction is not None:
             out["correction"] = dict(self.correction)
+        if self.requirements is not None:
+            out["requirements"] = [r.as_dict() for r in self.requirements]
         return out

@@ -59,6 +59,8 @@ __all__ = [
     "SweepSummary",
     "config_from_dict",
     "connect",
+    "requirement_column",
+    "RequirementSweep",
 ]
 
 SAMPLINGS = ("uniform", "lhs", "grid")
@@ -80,14 +82,21 @@ _FLAT = {"cert_valid": ("certificate", "certified"), "cert_E_max": ("certificate
          "path_verdict": ("path_verdict", "verdict"), "path_cross_track_bound": ("path_verdict", "cross_track_bound")}
 
 
+def requirement_column(index: int) -> str:
+    """runs.csv's column of the robustness of requirement ``index`` (0-based): requirement_1_robustness, ..."""
+    return f"requirement_{index + 1}_robustness"
+
+
 def flat_row(summary: Mapping[str, Any]) -> dict[str, Any]:
-    """A run summary with the runs.csv columns of its certificate, drift and path added at the top level
-    (cert_valid, cert_E_max, cert_E_ratio, ..., final_alpha_dot, drift_growing, path_cross_track_max, ...)."""
+    """A run summary with the runs.csv columns of its certificate, drift, path and requirements added at
+    the top level (cert_valid, cert_E_max, ..., path_cross_track_max, ..., requirement_1_robustness, ...)."""
     out = dict(summary)
     for col, (outer, inner) in _FLAT.items():
         # path_verdict: the summary's is the whole judgement (a mapping); the column is its word
         if col not in out or isinstance(out[col], Mapping):
             out[col] = (summary.get(outer) or {}).get(inner)
+    for i, judged in enumerate(summary.get("requirements") or ()):
+        out.setdefault(requirement_column(i), judged.get("robustness"))
     return out
 
 
@@ -111,8 +120,12 @@ class SweepSpec:
     m1_range: tuple[float, float] = M1_RANGE
     ranges: Mapping[str, tuple[float, float]] = field(default_factory=dict)
     base: RunConfig = field(default_factory=RunConfig)
+    # STL requirements (formulas or presets, wmr_mj.analysis.requirements) judged on every run: such
+    # sweeps run one by one on the engine (the batch keeps no per-step signals to monitor)
+    requirements: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "requirements", tuple(self.requirements))
         if not isinstance(self.n, int) or self.n < 1:
             raise ParameterError(f"n = {self.n!r} is not accepted; the number of runs must be an integer >= 1")
         if self.sampling not in SAMPLINGS:
@@ -140,10 +153,17 @@ class SweepSpec:
     def base_for_box(self) -> RunConfig:
         return self.base.replace(m1_range=tuple(self.m1_range), box_ranges=dict(self.ranges))
 
+    @property
+    def requirement_columns(self) -> tuple[str, ...]:
+        """runs.csv's robustness column of each requirement, in order."""
+        return tuple(requirement_column(i) for i in range(len(self.requirements)))
+
     def fingerprint(self) -> str:
         """Identifies the sweep, so that resuming never mixes two different sweeps."""
         obj = {"n": self.n, "seed": self.seed, "sampling": self.sampling, "m1_range": list(self.m1_range),
                "ranges": {k: list(v) for k, v in self.ranges.items()}, "base": self.base.as_dict()}
+        if self.requirements:  # a sweep without requirements keeps the fingerprint it always had
+            obj["requirements"] = list(self.requirements)
         return hashlib.sha256(json.dumps(obj, sort_keys=True, default=str).encode()).hexdigest()[:16]
 
 
@@ -200,7 +220,8 @@ def _run_chunk(spec_json: str, indices: list[int], nthread: int,
     samples = draw_samples(spec)
     configs = _run_configs(spec, samples[indices])
     rows = []
-    for i, summary in zip(indices, run_batch(configs, nthread=nthread, progress=progress)):
+    for i, summary in zip(indices, run_batch(configs, nthread=nthread, progress=progress,
+                                             requirements=spec.requirements)):
         r = summary.to_dict()
         r["run"] = int(i)
         for name, value in zip(spec.names[1:], samples[i][1:]):
@@ -211,14 +232,18 @@ def _run_chunk(spec_json: str, indices: list[int], nthread: int,
 
 def spec_to_json(spec: SweepSpec) -> str:
     base = spec.base.as_dict()
-    return json.dumps({"n": spec.n, "seed": spec.seed, "sampling": spec.sampling, "m1_range": list(spec.m1_range),
-                       "ranges": {k: list(v) for k, v in spec.ranges.items()}, "base": base}, sort_keys=True)
+    obj = {"n": spec.n, "seed": spec.seed, "sampling": spec.sampling, "m1_range": list(spec.m1_range),
+           "ranges": {k: list(v) for k, v in spec.ranges.items()}, "base": base}
+    if spec.requirements:
+        obj["requirements"] = list(spec.requirements)
+    return json.dumps(obj, sort_keys=True)
 
 
 def spec_from_json(text: str) -> SweepSpec:
     obj = json.loads(text)
     return SweepSpec(n=obj["n"], seed=obj["seed"], sampling=obj["sampling"], m1_range=tuple(obj["m1_range"]),
-                     ranges={k: tuple(v) for k, v in obj["ranges"].items()}, base=config_from_dict(obj["base"]))
+                     ranges={k: tuple(v) for k, v in obj["ranges"].items()}, base=config_from_dict(obj["base"]),
+                     requirements=tuple(obj.get("requirements", ())))
 
 
 def config_from_dict(obj: Mapping[str, Any]) -> RunConfig:
@@ -229,40 +254,44 @@ def config_from_dict(obj: Mapping[str, Any]) -> RunConfig:
     return RunConfig(**d)
 
 
-def _run_config_chunk(config_dicts: list[dict[str, Any]], nthread: int) -> list[RunSummary]:
+def _run_config_chunk(config_dicts: list[dict[str, Any]], nthread: int,
+                      requirements: Sequence[str] = ()) -> list[RunSummary]:
     """Summaries of configs given as ``as_dict()`` (a Dask task: plain data in, frozen records out)."""
-    return run_batch([config_from_dict(d) for d in config_dicts], nthread=nthread)
+    return run_batch([config_from_dict(d) for d in config_dicts], nthread=nthread, requirements=requirements)
 
 
 def run_configs(configs: Sequence[RunConfig], *, chunk: int = 128, nthread: int = 0, client: Any = None,
-                progress: Callable[[int, int], None] | None = None) -> list[RunSummary]:
-    """Summaries of ``configs`` (differing only in plant parameters), in order.
+                progress: Callable[[int, int], None] | None = None,
+                requirements: Sequence[str] = ()) -> list[RunSummary]:
+    """Summaries of ``configs``, in order (``requirements``: STL formulas judged on every run).
 
-    Locally: batches of at most ``chunk`` simulations (``run_batch``). With a Dask
-    ``client`` (see :func:`connect`): one task per chunk, the same numbers.
-    progress(done, total) is called as chunks finish.
+    Locally: ``run_batch`` calls of at most ``chunk`` simulations (one batch where they share
+    one, else one by one on ``nthread`` threads). With a Dask ``client`` (see :func:`connect`):
+    one task per chunk, the same numbers. progress(done, total) is called as chunks finish.
     """
     if chunk < 1:
         raise ParameterError(f"chunk = {chunk} must be >= 1")
+    requirements = tuple(requirements)
     parts = [list(configs[i:i + chunk]) for i in range(0, len(configs), chunk)]
     reports: list[RunSummary] = []
     if client is not None:
-        futures = [client.submit(_run_config_chunk, [c.as_dict() for c in part], 1, pure=False) for part in parts]
+        futures = [client.submit(_run_config_chunk, [c.as_dict() for c in part], 1, requirements, pure=False)
+                   for part in parts]
         for fut in futures:
             reports.extend(fut.result())
             if progress is not None:
                 progress(len(reports), len(configs))
         return reports
     for part in parts:
-        reports.extend(run_batch(part, nthread=nthread))
+        reports.extend(run_batch(part, nthread=nthread, requirements=requirements))
         if progress is not None:
             progress(len(reports), len(configs))
     return reports
 
 
-def _csv_text(rows: list[dict[str, Any]], extra: Sequence[str]) -> str:
+def _csv_text(rows: list[dict[str, Any]], extra: Sequence[str], tail: Sequence[str] = ()) -> str:
     buf = io.StringIO()
-    cols = list(RESULT_COLUMNS[:2]) + list(extra) + list(RESULT_COLUMNS[2:])
+    cols = list(RESULT_COLUMNS[:2]) + list(extra) + list(RESULT_COLUMNS[2:]) + list(tail)
     w = csv.DictWriter(buf, fieldnames=cols, extrasaction="ignore", lineterminator="\n")
     w.writeheader()
     for r in sorted(rows, key=lambda r: r["run"]):
@@ -362,7 +391,7 @@ def run_sweep(spec: SweepSpec, *, out_dir: str | os.PathLike | None = None, chun
         for r in reports:
             done[r["run"]] = flat_row(r)
         if out is not None:
-            write_text_atomic(out / "runs.csv", _csv_text(list(done.values()), extra))
+            write_text_atomic(out / "runs.csv", _csv_text(list(done.values()), extra, spec.requirement_columns))
         if progress is not None:
             progress(len(done), spec.n)
 
@@ -413,6 +442,46 @@ class Worst:
 
     value: float | None
     m1: float | None
+
+
+@dataclass(frozen=True)
+class RequirementSweep:
+    """One STL requirement over a sweep's runs (``wmr-mj sweep --require``).
+
+    Attributes:
+        requirement: the formula or preset as given.
+        min_robustness: the least robustness over the runs (< 0: violated by that much); None when
+            no run has one (a preset whose region no run has).
+        run: the run of that robustness (the first of equals); None with it.
+        m1: that run's m1 [kg]; None with it.
+        satisfied: runs with robustness >= 0.
+        violated: runs with robustness < 0.
+        undefined: runs without a robustness.
+    """
+
+    requirement: str
+    min_robustness: float | None
+    run: int | None
+    m1: float | None
+    satisfied: int
+    violated: int
+    undefined: int
+
+    @classmethod
+    def of(cls, rows: Sequence[Mapping[str, Any]], index: int, requirement: str) -> RequirementSweep:
+        column = requirement_column(index)
+        values = [(float(r[column]), r) for r in rows if r.get(column) is not None]
+        least = min(values, key=lambda vr: vr[0], default=None)
+        return cls(requirement=requirement, min_robustness=None if least is None else least[0],
+                   run=None if least is None else int(least[1]["run"]),
+                   m1=None if least is None else float(least[1]["m1"]),
+                   satisfied=sum(v >= 0.0 for v, _ in values), violated=sum(v < 0.0 for v, _ in values),
+                   undefined=len(rows) - len(values))
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"requirement": self.requirement, "min_robustness": self.min_robustness,
+                "run": self.run, "m1": self.m1, "satisfied": self.satisfied, "violated": self.violated,
+                "undefined": self.undefined}
 
 
 @dataclass(frozen=True)
@@ -469,10 +538,12 @@ class SweepSummary:
     batch_law: tuple[str, ...]
     path_cross_track: Worst = Worst(None, None)
     path_verdicts: Mapping[str, int] | None = None
+    requirements: tuple[RequirementSweep, ...] = ()
 
     @classmethod
-    def of(cls, rows: Sequence[Mapping[str, Any]]) -> SweepSummary:
-        """Summarise ``rows`` (runs.csv columns: :data:`RESULT_COLUMNS`).
+    def of(cls, rows: Sequence[Mapping[str, Any]], requirements: Sequence[str] = ()) -> SweepSummary:
+        """Summarise ``rows`` (runs.csv columns: :data:`RESULT_COLUMNS`; ``requirements``: the sweep's,
+        whose robustness columns the rows carry, :func:`requirement_column`).
 
         Raises:
             ParameterError: no rows.
@@ -505,6 +576,7 @@ class SweepSummary:
             batch_law=tuple(sorted({r["batch_law"] for r in rows if r.get("batch_law")})),
             path_cross_track=Worst(*max_at(rows, "path_cross_track_max")),
             path_verdicts=_count_path_verdicts(rows),
+            requirements=tuple(RequirementSweep.of(rows, i, text) for i, text in enumerate(requirements)),
         )
 
     @property
@@ -547,6 +619,8 @@ class SweepSummary:
             "worst_path_cross_track": self.path_cross_track.value,
             "worst_path_cross_track_m1": self.path_cross_track.m1,
             "path_verdicts": None if self.path_verdicts is None else dict(self.path_verdicts),
+            **({"requirements": [{**r.to_dict(), "column": requirement_column(i)}
+                                 for i, r in enumerate(self.requirements)]} if self.requirements else {}),
         }
 
     def rung_dict(self) -> dict[str, Any]:
