@@ -190,9 +190,17 @@ def test_knot_path_lasts_the_duration_and_survives_its_route_text(hold):
 def test_knot_space_axes_ranges_and_paths():
     space = KnotSpace(knots=3, hold_range=(0.5, 4.0))
     assert space.names == ("path.k1", "path.k2", "path.k3", "path.hold")
-    km = kappa_max(PAPER, C80)
-    assert space.ranges(PAPER, C80) == {"path.k1": (-km, km), "path.k2": (-km, km), "path.k3": (-km, km),
-                                        "path.hold": (0.5, 4.0)}
+    km = kappa_max(PAPER, C80) * (1.0 - 1e-6)  # the ramps' safety margin
+    ranges = space.ranges(PAPER, C80)
+    assert ranges == {"path.k1": (-km, km), "path.k2": (-km, km), "path.k3": (-km, km), "path.hold": (0.5, 4.0)}
+    # a path held at the range's edge stays within every declared bound after integration (one held at
+    # kappa_max itself measured sin/cos^3 2e-11 over 1.24)
+    corner = {"path.k1": ranges["path.k1"][1], "path.k2": ranges["path.k2"][0], "path.k3": ranges["path.k3"][1],
+              "path.hold": 2.0}
+    measured = make_reference(space.path(corner, bounds=PAPER, params=C80, duration=25.0), C80, dt=1e-3,
+                              duration=25.0).bounds()
+    assert measured.sin_cos3_max <= PAPER.sin_cos3_max and measured.alpha_max <= PAPER.angle_max
+    assert measured.alpha_dot_max <= PAPER.alpha_dot_max and measured.alpha_ddot_max <= PAPER.alpha_ddot_max
     values = {"path.k1": 0.2, "path.k2": -0.4, "path.k3": 0.9, "path.hold": 1.5}
     assert space.path(values, bounds=PAPER, params=C80, duration=12.0) == knot_path(
         [0.2, -0.4, 0.9], hold_s=1.5, bounds=PAPER, params=C80, duration=12.0)

@@ -22,6 +22,11 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="add a plant parameter to the box or replace its range (repeatable); with --disturbance "
                         "or --load, also their parameters: disturbance.amplitude, disturbance.t1, ..., load0.m1, "
                         "load0.t, ..., d_max (a ranged amplitude without --d-max declares the box's largest)")
+    p.add_argument("--path-knots", type=int, default=0, metavar="N",
+                   help="search C's path too: N curvature knots (path.k1..path.kN, each within +-kappa_max of the "
+                        "declared reference bounds) and the hold time at each (path.hold, 0-3 s), every path "
+                        "feasible for those bounds (wmr_mj/reference/knots.py); declares --reference-bounds paper "
+                        "unless given (default 0: the --path given)")
     p.add_argument("--against", default="certificate",
                    help="the region of the ratio sup|E|/E_max: certificate (default) or paper (the paper's region)")
     p.add_argument("--objective", default="ratio", help="what is maximised: ratio (default, see --against) or sup-E")
@@ -60,14 +65,15 @@ def _objective(args: argparse.Namespace) -> str:
 
 
 def reproduce_command(config, params: dict[str, float], args: argparse.Namespace, *,
-                      signals_file: str | None = None) -> str:
+                      signals_file: str | None = None, path_file: str | None = None) -> str:
     """A ``wmr-mj run`` line that repeats the worst run (parameters at full precision; its signals,
-    when it has some, from ``signals_file``, where they were written with every parameter)."""
+    when it has some, from ``signals_file``, and its searched path from ``path_file``, where they
+    were written exactly)."""
     import shlex
 
     parts = ["wmr-mj run", f"--preset {args.preset}", f"--controller {config.controller}", f"--model {config.model}",
              f"--kp {config.kp!r}", f"--kd {config.kd!r}", f"--friction-sign {config.friction_sign}",
-             f"--friction-width {config.friction_width!r}", f"--path {config.path}",
+             f"--friction-width {config.friction_width!r}", f"--path {shlex.quote(path_file or config.path)}",
              f"--duration {config.duration!r}", f"--m1 {config.m1!r}"]
     if args.identified:
         parts.append(f"--identified {args.identified}")
@@ -89,6 +95,9 @@ def reproduce_command(config, params: dict[str, float], args: argparse.Namespace
         parts.append("--correction")
     if config.signals is not None:
         parts.append(f"--signals {shlex.quote(signals_file or json.dumps(config.signals.as_dict()))}")
+    if config.reference_bounds is not None:
+        bounds = ",".join(f"{k}={v!r}" for k, v in config.reference_bounds.as_dict().items())
+        parts.append(f"--reference-bounds {bounds}")
     return " ".join(parts)
 
 
@@ -99,18 +108,34 @@ def run(args: argparse.Namespace) -> int:
     from wmr_mj._util.progress import counter_callback, progress_bar
     from wmr_mj.cli._common import box_ranges_from_args, parse_range, print_json
     from wmr_mj.cli.run import config_from_args
+    from wmr_mj.errors import ParameterError
     from wmr_mj.logs.writer import run_logged
     from wmr_mj.report.plots import falsify_history, save_figure
     from wmr_mj.sim.falsify import OBJECTIVE_LABELS, FalsifySpec, check_runnable, falsify, worst_config
-    from wmr_mj.sim.search_space import signal_axis
+    from wmr_mj.sim.search_space import path_axis, signal_axis
 
     objective = _objective(args)
     args.uncertainty = args.uncertainty or "full"
-    # the signals' axes are searched, not certified over: the certificate's box is the plant's
+    # the signals' and the path's axes are searched, not certified over: the certificate's box is the plant's
     given = args.range or []
-    signal_ranges = dict(parse_range(item) for item in given if signal_axis(parse_range(item)[0]))
-    args.range = [item for item in given if not signal_axis(parse_range(item)[0])]
-    box = {"m1": tuple(args.m1_range), **box_ranges_from_args(args), **signal_ranges}
+
+    def searched_only(item: str) -> bool:
+        name = parse_range(item)[0]
+        return signal_axis(name) or path_axis(name)
+
+    searched = dict(parse_range(item) for item in given if searched_only(item))
+    args.range = [item for item in given if not searched_only(item)]
+    if args.path_knots < 0:
+        raise ParameterError(f"--path-knots {args.path_knots} is not accepted: a number of knots >= 0")
+    if (args.path_knots or any(path_axis(n) for n in searched)) and args.reference_bounds is None:
+        args.reference_bounds = "paper"  # every searched path within the bounds its certificate declares
+    if args.path_knots:
+        from wmr_mj.reference.bounds import reference_bounds_from
+        from wmr_mj.reference.knots import KnotSpace
+
+        space = KnotSpace(args.path_knots, hold_range=(0.0, 3.0))
+        searched = {**space.ranges(reference_bounds_from(args.reference_bounds) or "paper"), **searched}
+    box = {"m1": tuple(args.m1_range), **box_ranges_from_args(args), **searched}
     base = config_from_args(args)
     spec = FalsifySpec(base=base, box=box, objective=objective, budget=args.budget, seed=args.seed,
                        population=args.population, method=args.method, requirement=args.require)
@@ -125,15 +150,20 @@ def run(args: argparse.Namespace) -> int:
     logged = run_logged(config, str(log_path))
     worst = result.worst
     summary = result.as_dict(log=str(log_path))
-    signals_file = None
+    signals_file = path_file = None
     if config.signals is not None:  # the worst run's signals, every parameter: --signals takes them back
         signals_file = str(out / "worst-signals.json")
         write_json_atomic(signals_file, config.signals.as_dict())
         summary["worst"]["signals"] = config.signals.as_dict()
         summary["signals_file"] = signals_file
+    if config.path != base.path:  # a searched path: its canonical route, which --path takes back exactly
+        path_file = str(out / "worst-path.json")
+        write_text_atomic(path_file, config.path + "\n")
+        summary["path_file"] = path_file
     summary.update({
         "reproduced": logged.sup_E == worst.sup_E,  # the serial re-run gives the batch's bits
-        "reproduce": reproduce_command(config, worst.params, args, signals_file=signals_file),
+        "reproduce": reproduce_command(config, worst.params, args, signals_file=signals_file, path_file=path_file),
+        "reference_bounds": None if base.reference_bounds is None else base.reference_bounds.as_dict(),
         "uncertainty": args.uncertainty,
         "folder": str(out),
         "table": str(out / "evaluations.csv"),
@@ -170,6 +200,13 @@ def run(args: argparse.Namespace) -> int:
     print("worst parameters: " + ", ".join(f"{k} = {v!r}" for k, v in worst.params.items()))
     if signals_file is not None:
         print(f"worst signals: {json.dumps(summary['worst']['signals'], separators=(',', ':'))}")
+    if path_file is not None:
+        print(f"worst path: {path_file} (a knot path within the declared reference bounds)")
+    if base.reference_bounds is not None:
+        b = base.reference_bounds
+        print(f"reference bounds declared: |alpha0'| <= {b.alpha_dot_max:g} rad/s, |alpha0''| <= "
+              f"{b.alpha_ddot_max:g} rad/s^2, |alpha0| <= {b.angle_max:.6g} rad (the certificate holds for every "
+              "reference within them)")
     print(f"reproduce: {summary['reproduce']}")
     if not summary["reproduced"]:
         print(f"WARNING: the serial re-run gave sup|E| = {logged.sup_E!r}, the search {worst.sup_E!r}",

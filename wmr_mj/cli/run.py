@@ -60,6 +60,11 @@ def add_run_options(p: argparse.ArgumentParser) -> None:
                                                      "over --m1-range) or paper (5.1)")
     p.add_argument("--m1-range", nargs=2, type=positive_float, metavar=("LO", "HI"), default=M1_RANGE,
                    help="m1 range of the analysis box, kg (default 550 750)")
+    p.add_argument("--reference-bounds", metavar="paper|KEY=VALUE,...", default=None,
+                   help="declared bounds on the reference alpha0: 'paper' ((5.1): alpha0' 0.23 rad/s, alpha0'' 0.4 "
+                        "rad/s^2, sin/cos^3 1.24) or alpha_dot_max=..,alpha_ddot_max=..,alpha_max=.. (others: the "
+                        "paper's). The certificate then covers every reference within them, and the run's own "
+                        "reference is checked against them (default: the certificate is for this path alone)")
     p.add_argument("--correction", action="store_true",
                    help="Cartesian correction: an outer loop at C (Stanley-like, from C's cross-track and heading "
                         "errors) corrects alpha0 within declared rate and acceleration limits, which the "
@@ -111,7 +116,8 @@ def config_from_args(args: argparse.Namespace, **extra):
                      identified=identified, coefficients=coefficients, box=args.box,
                      m1_range=tuple(args.m1_range), steering_friction=args.steering_friction,
                      tyre_contact=args.tyre_contact, box_ranges=box_ranges_from_args(args),
-                     correction=bool(getattr(args, "correction", False)), **extra)
+                     correction=bool(getattr(args, "correction", False)),
+                     reference_bounds=getattr(args, "reference_bounds", None), **extra)
 
 
 def register(sub: argparse._SubParsersAction) -> None:

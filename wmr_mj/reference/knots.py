@@ -280,8 +280,10 @@ class KnotSpace:
 
     def ranges(self, bounds: ReferenceBounds | Mapping[str, float] | str,
                params: C80Parameters = C80) -> dict[str, tuple[float, float]]:
-        """{axis: (lo, hi)}: each curvature in [-kappa_max, kappa_max] [1/m], the hold in hold_range [s]."""
-        k = kappa_max(bounds, params)
+        """{axis: (lo, hi)}: each curvature in [-kappa_max, kappa_max] [1/m] less the ramps' relative safety
+        margin (a path held at kappa_max exactly measured 2e-11 over the angle bound after integration), the
+        hold in hold_range [s]."""
+        k = kappa_max(bounds, params) * (1.0 - _SAFETY)
         out = {name: (-k, k) for name in self.names[:-1]}
         out["path.hold"] = self.hold_range
         return out

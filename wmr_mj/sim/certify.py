@@ -44,9 +44,9 @@ from wmr_mj.analysis.verdicts import OUTSIDE_THE_BOX
 from wmr_mj.errors import ParameterError
 from wmr_mj.params import C80, COEFFICIENT_NAMES, C80Parameters
 from wmr_mj.plant.mjcf import TIMESTEP
-from wmr_mj.sim.config import controller_for, estimate_parameters, plant_parameters
+from wmr_mj.sim.config import controller_for, estimate_parameters, plant_parameters, reference_bounds_of
 
-__all__ = ["certificate_for", "identified_spread", "box_spans", "outside_the_box"]
+__all__ = ["certificate_for", "identified_spread", "box_spans", "outside_the_box", "reference_within"]
 
 
 def identified_spread(identified: Any) -> dict[str, tuple[float, float]]:
@@ -113,6 +113,27 @@ def outside_the_box(config: Any, plant: C80Parameters, base: C80Parameters = C80
     return tuple(out)
 
 
+def reference_within(measured: Any, declared: Any) -> Assumption:
+    """The assumption "reference within the declared bounds": the run's reference (``measured``,
+    its grid's maxima) against the declared :class:`~wmr_mj.reference.bounds.ReferenceBounds`.
+
+    Value and limit are the largest ratio measured/declared over max|alpha0'|, max|alpha0''|,
+    max sin/cos^3 and max|alpha0|, against 1 (a declared bound of 0 with a measured one above
+    it: inf).
+    """
+    pairs = (("max|alpha0'|", measured.alpha_dot_max, declared.alpha_dot_max),
+             ("max|alpha0''|", measured.alpha_ddot_max, declared.alpha_ddot_max),
+             ("max sin/cos^3", measured.sin_cos3_max, declared.sin_cos3_max),
+             ("max|alpha0|", measured.angle_max, declared.angle_max))
+    ratios = [(m / d if d > 0 else (math.inf if m > 0 else 0.0), name, m, d) for name, m, d in pairs]
+    worst, name, m, d = max(ratios)
+    return Assumption("reference within the declared bounds",
+                      "max|alpha0'|, max|alpha0''|, max sin/cos^3, max|alpha0| of the run's reference <= declared",
+                      worst <= 1.0, worst, 1.0,
+                      f"largest ratio {name}: {m:.6g} against {d:.6g} declared; the certificate covers every "
+                      "reference within the declared bounds", kind="checked")
+
+
 def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
                     k_band: float = PLANT_K_BAND, gyro_band: tuple[float, float] = GYRO_BAND) -> Certificate:
     """The certificate of a :class:`wmr_mj.sim.closed_loop.RunConfig` run on ``reference``.
@@ -129,6 +150,10 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
     measured). gyro: gyro_band x P/l1 over the box (:data:`GYRO_BAND`, measured), V_A
     over the box's range. Estimate: the controller as ``simulate`` builds it (the same
     ``controller_for`` on ``estimate_parameters(params)``). params: the base parameter set.
+
+    Reference: the declared bounds (config.reference_bounds) where given, with the assumption
+    "reference within the declared bounds" (:func:`reference_within`) checked on ``reference``;
+    else ``reference.bounds()``, the run's own (a certificate for that reference alone).
 
     Signals (config.signals, :mod:`wmr_mj.sim.signals`): the declared disturbance bound d_max
     [N m] enters delta1 as d_V,max = d_max max(R_a)/min(k_i i2) over the box and the run's plant
@@ -153,7 +178,9 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
     if signals is not None:
         plant_box, extra = _signal_terms(config, signals, plant_box, estimate_params, plant, ranges)
         stated = stated + extra
-    bounds = reference.bounds()
+    bounds = reference_bounds_of(config, reference)
+    if config.reference_bounds is not None:
+        stated = stated + (reference_within(reference.bounds(), config.reference_bounds),)
     if getattr(config, "correction", False):
         # the corrected alpha0 = alpha0 + delta, delta within the correction's declared limits
         from wmr_mj.sim.correction import corrected_bounds, correction_assumptions

@@ -37,6 +37,7 @@ __all__ = [
     "build_reference",
     "analysis_box",
     "analysis_for",
+    "reference_bounds_of",
 ]
 
 PATH_NAMES = ("paper-circle", "lane-change", "figure-eight")
@@ -73,6 +74,10 @@ class RunConfig:
     signals: Any = None
     # the Cartesian correction at C (wmr_mj.sim.correction): an outer loop that corrects alpha0
     correction: bool = False
+    # declared bounds on the reference alpha0 (wmr_mj.reference.bounds.ReferenceBounds, 'paper', a
+    # mapping or 'key=value,...'): the certificate and the paper's region are computed for every
+    # reference within them, and the run's own is checked against them; None: the run's own bounds
+    reference_bounds: Any = None
 
     def __post_init__(self) -> None:
         if self.controller not in CONTROLLER_NAMES:
@@ -103,6 +108,9 @@ class RunConfig:
         from wmr_mj.sim.signals import signals_from
 
         object.__setattr__(self, "signals", signals_from(self.signals))
+        from wmr_mj.reference.bounds import reference_bounds_from
+
+        object.__setattr__(self, "reference_bounds", reference_bounds_from(self.reference_bounds))
         names = parameter_names()
         for name in self.plant_overrides:
             if name not in names:
@@ -116,6 +124,10 @@ class RunConfig:
             d["signals"] = self.signals.as_dict()
         if not self.correction:
             del d["correction"]  # the configs written before the correction existed, unchanged
+        if self.reference_bounds is None:
+            del d["reference_bounds"]  # likewise
+        else:
+            d["reference_bounds"] = self.reference_bounds.as_dict()
         d["plant_overrides"] = dict(self.plant_overrides)
         d["m1_range"] = list(self.m1_range)
         d["box_ranges"] = {k: list(v) for k, v in self.box_ranges.items()}
@@ -236,11 +248,17 @@ def analysis_for(config: RunConfig, reference, params: C80Parameters = C80, *, e
     from wmr_mj.reference.bounds import ReferenceBounds
 
     box = analysis_box(config, params)
-    b = reference.bounds()
+    b = reference_bounds_of(config, reference)
     bounds = ReferenceBounds(alpha_ddot_max=max(b.alpha_ddot_max, 1e-12), alpha_dot_max=max(b.alpha_dot_max, 1e-12),
                              sin_cos3_max=max(b.sin_cos3_max, 1e-12))
     return analyse(box, kp=config.kp, kd=config.kd, bounds=bounds, estimate=estimate)
 
+
+
+def reference_bounds_of(config: RunConfig, reference):
+    """The reference bounds the run's analyses are computed for: the declared ones
+    (``config.reference_bounds``), else the run's own reference's (``reference.bounds()``)."""
+    return reference.bounds() if config.reference_bounds is None else config.reference_bounds
 
 
 def controller_for(config: RunConfig, params: C80Parameters) -> SteeringController:

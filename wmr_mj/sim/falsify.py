@@ -421,13 +421,13 @@ class FalsifySpec:
             raise ParameterError("the objective 'requirement' goes with a requirement (an STL formula), and only it")
         if self.requirement is not None:
             self.parsed_requirement  # noqa: B018  (refused here, before any run, when malformed)
-        from wmr_mj.sim.search_space import config_for, signal_axis
+        from wmr_mj.sim.search_space import config_for, path_axis, signal_axis
 
         if not self.box:
             raise ParameterError("the box is empty; give at least one ranged parameter (e.g. --uncertainty m1)")
         names = parameter_names()
         for name, (lo, hi) in self.box.items():
-            if signal_axis(name):
+            if signal_axis(name) or path_axis(name):
                 if not (math.isfinite(lo) and math.isfinite(hi) and lo <= hi):
                     raise ParameterError(f"range of {name} = {lo!r}:{hi!r} is not accepted: finite LO <= HI")
                 continue

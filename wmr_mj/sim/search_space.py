@@ -1,4 +1,4 @@
-"""The axes a worst-case search may range: plant parameters, signal parameters, and C's path.
+"""The axes a worst-case search may range: plant parameters, signal parameters and C's path.
 
 :func:`config_for` maps a point (one value per axis name) to a :class:`wmr_mj.sim.config.RunConfig`.
 Each name is
@@ -8,8 +8,13 @@ Each name is
   (t, t1, t2, m1, every of the i-th load change): the signals of the template (the base
   config's ``signals``, :mod:`wmr_mj.sim.signals`);
 
-so a search over plants and signals at once is a box over these names (``wmr-mj falsify
---range disturbance.amplitude=-1.5:1.5``). The config of a point carries its signals with every
+- ``path.k<i>`` (curvature of knot i [1/m]) and ``path.hold`` (s): C's path, a knot path
+  (:mod:`wmr_mj.reference.knots`) feasible for the base's declared reference bounds
+  (``RunConfig.reference_bounds``, which a path axis requires); knots not ranged are 0 (straight),
+  the hold not ranged is :data:`DEFAULT_HOLD_S`;
+
+so a search over plants, signals and paths at once is a box over these names (``wmr-mj falsify
+--range disturbance.amplitude=-1.5:1.5 --path-knots 3``). The config of a point carries its signals with every
 parameter, so its ``as_dict()["signals"]`` is the ``--signals`` that reproduces the run::
 
     from wmr_mj.sim.search_space import config_for
@@ -30,11 +35,20 @@ from wmr_mj.params import parameter_names
 from wmr_mj.sim.config import RunConfig
 from wmr_mj.sim.signals import Signals
 
-__all__ = ["config_for", "signal_axis", "DISTURBANCE_FIELDS", "LOAD_FIELDS"]
+__all__ = ["config_for", "signal_axis", "path_axis", "DISTURBANCE_FIELDS", "LOAD_FIELDS", "DEFAULT_HOLD_S"]
 
 #: The fields of a disturbance and of a load change that a search may range.
 DISTURBANCE_FIELDS = ("amplitude", "t1", "t2", "bandwidth", "seed")
 LOAD_FIELDS = ("t", "t1", "t2", "m1", "every")
+
+
+#: The hold time [s] of a knot path whose ``path.hold`` is not ranged.
+DEFAULT_HOLD_S = 2.0
+
+
+def path_axis(name: str) -> bool:
+    """Whether ``name`` is a path axis (path.k<i>, path.hold)."""
+    return name == "path.hold" or (name.startswith("path.k") and name[6:].isdigit() and int(name[6:]) >= 1)
 
 
 def signal_axis(name: str) -> bool:
@@ -57,9 +71,12 @@ def config_for(base: RunConfig, names: Sequence[str], x: Sequence[float]) -> Run
     d_changes: dict[str, Any] = {}
     loads = [dict() for _ in template.loads]  # type: list[dict[str, Any]]
     m1, overrides, d_max = base.m1, dict(base.plant_overrides), template.d_max
+    knots: dict[str, float] = {}
     for name, value in zip(names, x):
         v = float(value)
-        if name == "m1":
+        if path_axis(name):
+            knots[name] = v
+        elif name == "m1":
             m1 = v
         elif name == "d_max":
             d_max = v
@@ -92,4 +109,24 @@ def config_for(base: RunConfig, names: Sequence[str], x: Sequence[float]) -> Run
         dist = dataclasses.replace(dist, **d_changes)
     new_loads = tuple(dataclasses.replace(ld, **ch) for ld, ch in zip(template.loads, loads))
     signals = Signals(disturbance=dist, loads=new_loads, d_max=d_max)
-    return base.replace(m1=m1, plant_overrides=overrides, signals=None if signals.empty else signals)
+    changes: dict[str, Any] = {}
+    if knots:
+        changes["path"] = _knot_route(base, knots)
+    return base.replace(m1=m1, plant_overrides=overrides, signals=None if signals.empty else signals, **changes)
+
+
+def _knot_route(base: RunConfig, values: dict[str, float]) -> str:
+    """The canonical route text of the knot path at ``values`` (path.k<i>, path.hold)."""
+    from wmr_mj.reference.knots import knot_path
+    from wmr_mj.reference.route import route_from_path
+    from wmr_mj.sim.config import estimate_parameters
+
+    if base.reference_bounds is None:
+        raise ParameterError("searching C's path (path.k<i>, path.hold) needs declared reference bounds, for which "
+                             "the certificate holds and within which every searched path stays: give "
+                             "--reference-bounds paper (or alpha_dot_max=..,alpha_ddot_max=..,alpha_max=..)")
+    count = max((int(n[6:]) for n in values if n != "path.hold"), default=0)
+    curvatures = [values.get(f"path.k{i + 1}", 0.0) for i in range(count)]
+    path = knot_path(curvatures, hold_s=values.get("path.hold", DEFAULT_HOLD_S), bounds=base.reference_bounds,
+                     params=estimate_parameters(), duration=base.duration)
+    return route_from_path(path, name="knots").text
