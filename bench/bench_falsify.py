@@ -1,11 +1,19 @@
 """Worst-case search against random sampling at equal budget, ARCH-COMP style (falsification).
 
-    .venv/bin/python bench/bench_falsify.py [--trials 10] [--budgets 48,96] [--duration 20]
-                                            [--method vertices-polish] [--threshold 0.05] [--nthread 2]
+    .venv/bin/python bench/bench_falsify.py [--space box|paths|signals] [--trials 10] [--budgets 48,96]
+                                            [--duration 20] [--method vertices-polish] [--threshold 0.05]
+                                            [--nthread 2]
 
-The certified design over the full uncertainty box (m1, mu, ground_friction, R_a, V_A), objective
-sup|E|/E_max of its certificate (``wmr-mj falsify``'s default). For each budget and each of
-``--trials`` seeds, side by side:
+The certified design, objective sup|E|/E_max of its certificate (``wmr-mj falsify``'s default),
+over one of three search spaces (``--space``):
+
+  box:     the full uncertainty box (m1, mu, ground_friction, R_a, V_A) on the paper circle;
+  paths:   m1 and C's path: 3 curvature knots and the hold time (``falsify --path-knots 3``),
+           the certificate for the paper's declared reference bounds (5.1);
+  signals: m1, R_a and a 1 s steering-torque pulse: amplitude -1.5..1.5 N m (d_max 1.5) and its
+           start 2..15 s (``falsify --disturbance kind=pulse,... --range disturbance.amplitude=...``).
+
+For each budget and each of ``--trials`` seeds, side by side:
 
   search: ``wmr_mj.sim.falsify.search_worst`` with ``--method`` (default: the box's vertices,
           then Nelder-Mead from the worst);
@@ -80,6 +88,29 @@ def median_or_dash(xs: list[int | None]) -> str:
     return f"{statistics.median(got):g}" if got else "-"
 
 
+def make_spec(space: str, duration: float, budget: int, method: str) -> FalsifySpec:
+    """The search of ``--space`` (module docstring)."""
+    if space == "box":
+        ranges = {k: v for k, v in uncertainty_ranges("full").items() if k != "m1"}
+        base = RunConfig(**CERTIFIED.config_changes(), duration=duration, box_ranges=ranges)
+        return FalsifySpec(base=base, box={"m1": M1_RANGE, **ranges}, objective="certificate", budget=budget,
+                           method=method)
+    if space == "paths":
+        from wmr_mj.reference.bounds import reference_bounds_from
+        from wmr_mj.reference.knots import KnotSpace
+
+        bounds = reference_bounds_from("paper")
+        base = RunConfig(**CERTIFIED.config_changes(), duration=duration, reference_bounds=bounds)
+        return FalsifySpec(base=base, box={"m1": M1_RANGE, **KnotSpace(3, hold_range=(0.0, 3.0)).ranges(bounds)},
+                           objective="certificate", budget=budget, method=method)
+    ranges = {"R_a": uncertainty_ranges("full")["R_a"]}
+    signals = {"disturbance": {"kind": "pulse", "amplitude": 1.0, "t1": 5.0, "t2": 6.0}, "d_max": 1.5}
+    base = RunConfig(**CERTIFIED.config_changes(), duration=duration, box_ranges=ranges, signals=signals)
+    return FalsifySpec(base=base, box={"m1": M1_RANGE, **ranges, "disturbance.amplitude": (-1.5, 1.5),
+                                       "disturbance.t1": (2.0, 15.0)},
+                       objective="certificate", budget=budget, method=method)
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--trials", type=int, default=10, help="seeds per budget (default 10)")
@@ -89,13 +120,11 @@ def main() -> int:
     ap.add_argument("--threshold", type=float, default=0.05,
                     help="the requirement always(abs(E) <= THRESHOLD) rad to falsify (default 0.05)")
     ap.add_argument("--nthread", type=int, default=2, help="threads of each batch (default 2)")
+    ap.add_argument("--space", default="box", choices=("box", "paths", "signals"),
+                    help="what is searched (default box: the full uncertainty box)")
     args = ap.parse_args()
     budgets = [int(b) for b in args.budgets.split(",")]
-
-    ranges = {k: v for k, v in uncertainty_ranges("full").items() if k != "m1"}
-    base = RunConfig(**CERTIFIED.config_changes(), duration=args.duration, box_ranges=ranges)
-    spec = FalsifySpec(base=base, box={"m1": M1_RANGE, **ranges}, objective="certificate", budget=max(budgets),
-                       method=args.method)
+    spec = make_spec(args.space, args.duration, max(budgets), args.method)
     bounds = spec.bounds
     evaluate = CachedEvaluator(spec, args.nthread)
     t0 = time.perf_counter()
@@ -103,7 +132,8 @@ def main() -> int:
     corner_values = evaluate(corners)
     corner_worst = float(np.nanmax(corner_values))
     corner_at = corners[int(np.nanargmax(corner_values))]
-    print(f"bench_falsify: certified design, full box ({', '.join(spec.names)}), {args.duration:g} s per run, "
+    print(f"bench_falsify: certified design, space {args.space} ({', '.join(spec.names)}), "
+          f"{args.duration:g} s per run, "
           f"objective sup|E|/E_max of the certificate; search = {args.method}, random = Latin hypercube; "
           f"{args.trials} seeds per budget")
     print(f"the box's {len(corners)} vertices: worst objective {corner_worst:.6g} at "

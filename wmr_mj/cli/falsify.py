@@ -32,8 +32,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--objective", default="ratio", help="what is maximised: ratio (default, see --against) or sup-E")
     p.add_argument("--method", default="vertices-polish",
                    help="search: vertices-polish (default: the box's vertices, or a fractional-factorial covering "
-                        "of them when 2^d > budget, then scipy's Nelder-Mead from the worst) or de (differential "
-                        "evolution)")
+                        "of them when 2^d > budget, then scipy's Nelder-Mead from the worst), lhs-polish (a Latin "
+                        "hypercube of half the budget, then the same polish: for interior worst cases, e.g. over C's "
+                        "path) or de (differential evolution)")
     p.add_argument("--require", metavar="STL",
                    help="falsify an STL requirement (e.g. 'always(abs(E) <= 0.05)', signals as for wmr-mj run "
                         "--require): maximise minus its robustness (> 0: falsified); runs one by one, the batch "
@@ -180,8 +181,8 @@ def run(args: argparse.Namespace) -> int:
                "generations")
     else:
         first = [e for e in result.search if e.generation == 0]
-        kind = ("all vertices" if len(first) == 2 ** len(spec.names)
-                else "a fractional-factorial covering of the vertices")
+        kind = ("a Latin hypercube" if spec.method == "lhs-polish" else "all vertices"
+                if len(first) == 2 ** len(spec.names) else "a fractional-factorial covering of the vertices")
         how = (f"{kind} ({len(first)} runs), then Nelder-Mead from the worst ({len(result.search) - len(first)} runs)")
     print(f"worst-case search over {len(spec.names)} parameter(s) ({names}; box {args.uncertainty}): {how}, "
           f"seed {spec.seed}")
