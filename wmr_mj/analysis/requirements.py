@@ -34,6 +34,7 @@ from __future__ import annotations
 import contextlib
 import logging
 import math
+import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -54,14 +55,18 @@ __all__ = [
     "number",
 ]
 
-#: Signals a requirement may name (a run's rows: wmr_mj.sim.closed_loop.ROW_FIELDS), t in s.
-SIGNALS = ("t", "E", "E_dot", "alpha", "alpha_dot", "alpha0", "voltage")
+#: Signals a requirement may name (a run's rows: wmr_mj.sim.closed_loop.ROW_FIELDS), t in s; cross_track
+#: is C's signed distance from its desired path [m] at every control step (computed when a formula names it).
+SIGNALS = ("t", "E", "E_dot", "alpha", "alpha_dot", "alpha0", "voltage", "cross_track")
 #: Named requirements, resolved against a run's bounds (see :func:`preset_formula`).
 PRESETS = {
     "certificate": "the certificate's rectangle for the whole run: always((abs(E) <= E_max) and "
                    "(abs(E_dot) <= Edot_max)) with the run's certificate",
     "paper": "the paper's claim for the whole run: always((abs(E) <= E_max) and (abs(E_dot) <= Edot_max)) "
              "with (4.21)-(4.23) as the paper bounds them",
+    "cross-track": "C on its path: always[settle_s, end](abs(cross_track) <= bound) with the steady-state "
+                   "cross-track bound the certificate implies (wmr_mj.analysis.path_bound), from the run's "
+                   "settling time; none where the path has no Cartesian guarantee",
 }
 
 
@@ -74,6 +79,8 @@ def preset_formula(name: str, E_max: float | None, Edot_max: float | None) -> st
     """The formula of preset ``name`` for the bounds (None when there is no finite bound)."""
     if name not in PRESETS:
         raise UnknownNameError("requirement preset", name, PRESETS)
+    if name == "cross-track":  # E_max carries the cross-track bound [m]; the window is evaluate()'s
+        return None if E_max is None or not math.isfinite(E_max) else f"always(abs(cross_track) <= {number(E_max)})"
     if E_max is None or Edot_max is None or not (math.isfinite(E_max) and math.isfinite(Edot_max)):
         return None
     return f"always((abs(E) <= {number(E_max)}) and (abs(E_dot) <= {number(Edot_max)}))"
@@ -231,6 +238,12 @@ class Requirement:
     def preset(self) -> str | None:
         return self.text if self.text in PRESETS else None
 
+    def names(self, signal: str) -> bool:
+        """Whether the requirement reads ``signal`` (a preset: the signals of its formula)."""
+        if self.preset is not None:
+            return signal == "cross_track" if self.preset == "cross-track" else signal in ("E", "E_dot")
+        return re.search(rf"(?<![A-Za-z0-9_]){re.escape(signal)}(?![A-Za-z0-9_])", self.text) is not None
+
 
 @dataclass(frozen=True)
 class RequirementResult:
@@ -282,11 +295,21 @@ def evaluate(requirement: Requirement, signals: Mapping[str, Any], *, period: fl
             return RequirementResult(requirement.text, None, None, False,
                                      note=f"no {preset} region for this run: nothing to satisfy")
         formula = resolved
-    missing = [s for s in requirement.signals if s not in signals]
+        window = (bounds or {}).get("cross-track window")
+        if preset == "cross-track" and window is not None and window[0]:
+            # the bound holds in steady state: from the path verdict's settling time, on the control grid
+            n = len(next(iter(signals.values()))) if signals else 0
+            start = math.ceil(float(window[0]) / period - 1e-9)
+            if start < n - 1:
+                formula = formula.replace("always(", f"always[{number(start * period)},{number((n - 1) * period)}](", 1)
+    missing = [s for s in requirement.signals if s not in signals and requirement.names(s)]
     if missing:
         raise UnknownNameError("signal", missing[0], tuple(signals))
+    n = len(next(iter(signals.values()))) if signals else 0
+    # a signal the formula does not read is declared but never evaluated: zeros stand in for it
+    columns = {s: signals[s] if s in signals else np.zeros(n) for s in requirement.signals}
     spec = _spec(formula, period, requirement.signals)
-    rob = _robustness(spec, formula, {s: signals[s] for s in requirement.signals}, period)
+    rob = _robustness(spec, formula, columns, period)
     note = "vacuous: every window lies past the run's end" if math.isinf(rob) and rob > 0 else ""
     return RequirementResult(requirement.text, formula, rob, bool(rob >= 0.0), note=note)
 
@@ -302,7 +325,11 @@ def evaluate_run(requirements: Sequence[Requirement], rows: Mapping[str, Any], s
         e, ed = region.get("E_max"), region.get("Edot_max")
         return (None if e is None else float(e)), (None if ed is None else float(ed))
 
+    verdict = summary.get("path_verdict")
+    cross = verdict.get("cross_track_bound") if isinstance(verdict, Mapping) else None
     bounds = {"certificate": pair(summary.get("certificate")),
               "paper": pair(summary.get("paper_region") or {"E_max": summary.get("E_max"),
-                                                            "Edot_max": summary.get("Edot_max")})}
+                                                            "Edot_max": summary.get("Edot_max")}),
+              "cross-track": (None if cross is None else float(cross), None),
+              "cross-track window": (summary.get("settle_s"), None)}
     return [evaluate(r, rows, period=period, bounds=bounds) for r in requirements]

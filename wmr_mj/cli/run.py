@@ -315,8 +315,10 @@ def run(args: argparse.Namespace) -> int:
     judged = None
     if requirements:
         from wmr_mj.analysis.requirements import evaluate_run
+        from wmr_mj.sim.closed_loop import requirement_rows
 
-        judged = [r.as_dict() for r in evaluate_run(requirements, result.rows, result.summary.to_dict(),
+        judged = [r.as_dict() for r in evaluate_run(requirements, requirement_rows(result, requirements),
+                                                    result.summary.to_dict(),
                                                     period=period)]
     report = {**result.summary.to_dict(), "log": path, **({"requirements": judged} if judged else {})}
     if config.signals is not None:

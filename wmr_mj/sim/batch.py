@@ -56,6 +56,7 @@ from wmr_mj.sim.closed_loop import (
     judge_path,
     path_sample_index,
     report,
+    requirement_rows,
     run_closed_loop,
 )
 from wmr_mj.sim.config import (
@@ -537,7 +538,8 @@ def _run_one_by_one(configs: Sequence[RunConfig], *, base: C80Parameters, progre
         if requirements:
             period = period_of(config)
             with monitor:
-                judged = evaluate_run(parsed[period], result.rows, summary.to_dict(), period=period)
+                rows = requirement_rows(result, parsed[period], base=base)
+                judged = evaluate_run(parsed[period], rows, summary.to_dict(), period=period)
             summary = dataclasses.replace(summary, requirements=tuple(judged))
         return summary, result.law, time.thread_time() - cpu0
 

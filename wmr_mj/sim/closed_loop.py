@@ -24,7 +24,7 @@ the two bit-identical.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -71,6 +71,22 @@ class RunResult:
     law_note: str | None = None  # why the Python law ran
     cpu_s: float | None = None  # CPU time of the run's loop on its thread (wall_s is in the summary)
     C_xy: np.ndarray | None = None  # (control steps, 2) xy of point C [m], as the log's C_pos
+
+
+def requirement_rows(result: RunResult, requirements: Sequence[Any], *, base: C80Parameters = C80
+                     ) -> Mapping[str, np.ndarray]:
+    """The run's rows as a requirement monitor reads them (``wmr_mj.analysis.requirements.SIGNALS``):
+    ``result.rows``, with ``cross_track`` (C's signed distance from its path at every control step [m],
+    projected as the log's /path channel is) added when a requirement reads it."""
+    if not any(r.names("cross_track") for r in requirements) or result.C_xy is None:
+        return result.rows
+    config = result.config
+    period = _substeps(config, TIMESTEP) * TIMESTEP
+    n = len(result.rows["t"])
+    reference, _ = build_reference(config.path, estimate_parameters(base), dt=period,
+                                   duration=int(round(config.duration / period)) * period)
+    block = {"t": result.rows["t"], "C_pos": result.C_xy[:n], "heading": result.rows["heading"]}
+    return {**result.rows, "cross_track": _PathRows(reference, period)(block, 1)["path_cross_track"]}
 
 
 def _substeps(config: RunConfig, timestep: float) -> int:
