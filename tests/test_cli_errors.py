@@ -142,3 +142,20 @@ def test_a_gl_backend_that_cannot_load_is_one_line():
     assert proc.returncode == 2
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and "MUJOCO_GL='osmesa'" in lines[0] and "Traceback" not in proc.stderr
+
+
+@pytest.mark.parametrize("argv, names", [
+    (["run", "--no-log", "--reference-bounds", "alpha_dot=0.2"], "alpha_dot_max"),
+    (["run", "--no-log", "--reference-bounds", "alpha_dot_max=fast"], "alpha_dot_max"),
+    (["falsify", "--path-knots", "-1", "--budget", "8"], "--path-knots"),
+    (["falsify", "--budget", "8", "--disturbance", "kind=step,amplitude=1", "--range", "disturbance.width=0:1"],
+     "amplitude, t1"),
+    (["falsify", "--budget", "8", "--range", "disturbance.amplitude=-1:1"], "no disturbance"),
+    (["falsify", "--budget", "8", "--disturbance", "kind=step,amplitude=1", "--range", "load0.m1=600:700"],
+     "0 load change"),
+    (["sweep", "--n", "1", "--require", "always(abs(Q) <= 1)"], "valid signals"),
+], ids=["bounds-key", "bounds-value", "knots", "signal-field", "no-disturbance", "no-load", "sweep-require"])
+def test_bad_search_spaces_and_bounds_are_one_line_exit_2(tmp_path, capsys, argv, names):
+    code = main([*argv, "--duration", "10", *(["--out", str(tmp_path / "o")] if argv[0] != "run" else [])])
+    line = _one_error_line(capsys)
+    assert code == 2 and names in line, line
