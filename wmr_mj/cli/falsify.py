@@ -118,26 +118,20 @@ def run(args: argparse.Namespace) -> int:
     objective = _objective(args)
     args.uncertainty = args.uncertainty or "full"
     # the signals' and the path's axes are searched, not certified over: the certificate's box is the plant's
-    given = args.range or []
-
-    def searched_only(item: str) -> bool:
-        name = parse_range(item)[0]
-        return signal_axis(name) or path_axis(name)
-
-    searched = dict(parse_range(item) for item in given if searched_only(item))
-    args.range = [item for item in given if not searched_only(item)]
+    parsed = [(item, parse_range(item)) for item in args.range or []]
+    searched = dict(span for _, span in parsed if signal_axis(span[0]) or path_axis(span[0]))
+    args.range = [item for item, (name, _) in parsed if name not in searched]
     if args.path_knots < 0:
         raise ParameterError(f"--path-knots {args.path_knots} is not accepted: a number of knots >= 0")
     if (args.path_knots or any(path_axis(n) for n in searched)) and args.reference_bounds is None:
         args.reference_bounds = "paper"  # every searched path within the bounds its certificate declares
+    base = config_from_args(args)
     if args.path_knots:
-        from wmr_mj.reference.bounds import reference_bounds_from
         from wmr_mj.reference.knots import KnotSpace
 
         space = KnotSpace(args.path_knots, hold_range=(0.0, 3.0))
-        searched = {**space.ranges(reference_bounds_from(args.reference_bounds) or "paper"), **searched}
+        searched = {**space.ranges(base.reference_bounds), **searched}
     box = {"m1": tuple(args.m1_range), **box_ranges_from_args(args), **searched}
-    base = config_from_args(args)
     spec = FalsifySpec(base=base, box=box, objective=objective, budget=args.budget, seed=args.seed,
                        population=args.population, method=args.method, requirement=args.require)
     check_runnable(base)  # a duration too short for the path: one line, before any output or search
