@@ -36,7 +36,15 @@ import numpy as np
 from controllers.base import SteeringController
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import C80, COEFFICIENT_NAMES, PAPER_KD, PAPER_KP, C80Parameters
-from wmr_mj.plant.reduced import MODEL_NAMES, ModelName, SteeringModel, smooth_sign, steering_model
+from wmr_mj.plant.reduced import (
+    FRICTION_SIGNS,
+    MODEL_NAMES,
+    FrictionSign,
+    ModelName,
+    SteeringModel,
+    smooth_sign,
+    steering_model,
+)
 
 __all__ = [
     "ComputedTorque",
@@ -55,9 +63,6 @@ __all__ = [
 #: coefficients, or explicit ones.
 ModelSource = Literal[ModelName, "identified", "explicit"]
 MODEL_SOURCES: tuple[str, ...] = get_args(ModelSource)
-#: The sign the Coulomb compensation F^ sgn(.) uses: the measured alpha', the reference's, or none.
-FrictionSign = Literal["measured", "reference", "none"]
-FRICTION_SIGNS: tuple[str, ...] = get_args(FrictionSign)
 CONTROLLER_NAMES = ("computed-torque", "pd")
 
 

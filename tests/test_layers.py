@@ -8,9 +8,9 @@ rank  modules                                     what
 ====  ==========================================  =====================================================
 0     wmr_mj.errors, params, _version, _util      errors, the parameter set, files, memory, progress
 1     wmr_mj.plant                                MJCF model, derivation, reduced models, friction, identification
-2     controllers                                 the steering laws (top-level package)
-3     wmr_mj.reference                            paths of C and alpha0(t)
-4     wmr_mj.analysis                             the paper's section 4, the certificate, verdicts
+2     wmr_mj.reference                            paths of C and alpha0(t)
+3     wmr_mj.analysis                             the paper's section 4, the certificate, verdicts
+4     controllers                                 steering laws and path trackers, each with its claim
 5     wmr_mj.sim                                  closed loop, batch, sweep, falsify, designs
 6     wmr_mj.logs                                 MCAP format, writer, reader, replay, video
 7     wmr_mj.report                               validate, text, HTML, figures
@@ -28,9 +28,9 @@ ROOT = Path(__file__).resolve().parents[1]
 LAYERS: tuple[tuple[str, ...], ...] = (
     ("wmr_mj.errors", "wmr_mj.params", "wmr_mj._version", "wmr_mj._util"),
     ("wmr_mj.plant",),
-    ("controllers",),
     ("wmr_mj.reference",),
     ("wmr_mj.analysis",),
+    ("controllers",),
     ("wmr_mj.sim",),
     ("wmr_mj.logs",),
     ("wmr_mj.report",),
@@ -90,7 +90,7 @@ def test_rank_of_known_modules():
     assert rank("wmr_mj.plant.mjcf") == 1
     assert rank("wmr_mj.params") == 0
     assert rank("wmr_mj") == len(LAYERS) - 1
-    assert rank("controllers.computed_torque") == 2
+    assert rank("controllers.computed_torque") == 4
     assert rank("numpy") is None
 
 

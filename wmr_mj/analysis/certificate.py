@@ -152,12 +152,12 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal, get_args
 
-from controllers.computed_torque import FRICTION_SIGNS
 from wmr_mj._util.checks import finite_number as _number
 from wmr_mj._util.checks import interval as _interval
 from wmr_mj.analysis.robustness import ParameterBox, _check_gains, damping_regime, exact_gammas
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import C80Parameters
+from wmr_mj.plant.reduced import FRICTION_SIGNS
 from wmr_mj.reference.bounds import ReferenceBounds
 
 __all__ = [

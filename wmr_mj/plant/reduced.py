@@ -34,7 +34,13 @@ from numpy.typing import ArrayLike
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import C80Parameters, Coefficients
 
-__all__ = ["SteeringModel", "steering_model", "ModelName", "MODEL_NAMES", "smooth_sign"]
+__all__ = ["SteeringModel", "steering_model", "ModelName", "MODEL_NAMES", "smooth_sign", "FrictionSign",
+           "FRICTION_SIGNS"]
+
+#: The sign a Coulomb compensation F^ sgn(.) uses: the measured alpha', the reference's, or none (a
+#: law's choice; the certificate's friction term depends on it, so it is named here, below both).
+FrictionSign = Literal["measured", "reference", "none"]
+FRICTION_SIGNS: tuple[str, ...] = get_args(FrictionSign)
 
 #: The reduced models :func:`steering_model` builds.
 ModelName = Literal["paper", "paper-lagrange", "nonholonomic"]
