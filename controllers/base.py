@@ -1,36 +1,54 @@
-"""The steering-controller interface.
+"""The steering-law interface: steering state, reference and time in, armature voltage out.
 
-A controller maps the steering state and the reference to an armature voltage,
-vectorised over a leading batch axis so that one call controls many
-simulations::
+A steering law is a :class:`SteeringController`. The testbed calls it once per control period
+with the steering state and the reference, and applies the voltage it returns (clipped to the
+supply by :func:`saturate`; NaN applies 0 V)::
 
-    u = controller.voltage(alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot)   # arrays (B,) -> (B,)
+    law.reset(control_period=0.001)                      # before every run: clear any state
+    u = law.step(t, alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot)   # floats, V
 
-``voltage_scalar`` is the same law on Python floats, for the single-run loop
-where NumPy's per-call overhead would dominate, and ``batch_law(n)`` the same
-law for the batched loop of ``wmr_mj.sim.sweep``: a callable that writes into
-buffers it owns, so that a control step allocates nothing (tests keep all three
-bit-identical)::
+A stateless law writes only :meth:`voltage_scalar` (floats) or :meth:`voltage` (arrays, a
+leading batch axis): each is derived from the other, and :meth:`step` calls
+:meth:`voltage_scalar`. A law with state (an adaptive law's estimates, an integrator) overrides
+:meth:`reset` and :meth:`step`. :meth:`batch_law` is the vectorised form a batch of runs may use
+(the default derives it from :meth:`voltage`; a stateful law that has no batch form runs its
+simulations one by one on the engine).
 
-    law = controller.batch_law(n)
-    u = law(alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot, E, E_dot, u_out)
+A law may state a claim (:meth:`claim`): a bound on |E| and |E'| with its assumptions
+(:mod:`wmr_mj.analysis.claim`), which every run of it is judged against. Without one the run
+is judged by its requirements only (``--require``), never as a pass.
 
-The motor's voltage limit is applied outside the law by :func:`saturate`.
+A law of one's own, in a file of one's own (``wmr-mj run --controller my_law.py:MyLaw
+--controller-param k=2``)::
+
+    from controllers import SteeringController
+
+    class MyPD(SteeringController):
+        name = "my-pd"
+        def __init__(self, kp=50.0, kd=15.0):
+            self.kp, self.kd = kp, kd
+        def voltage_scalar(self, alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot):
+            return 0.1 * (self.kp * (alpha0 - alpha) + self.kd * (alpha0_dot - alpha_dot))
+
+The built-in computed-torque and PD laws also run compiled in MuJoCo's control callback
+(:mod:`wmr_mj.sim.compiled_law`); any other law runs in Python in the same engine, and the run
+says so.
 """
 
 from __future__ import annotations
 
-import abc
-from collections.abc import Callable
-from typing import TYPE_CHECKING
+from collections.abc import Callable, Mapping
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 if TYPE_CHECKING:
+    from wmr_mj.analysis.certificate import Certificate
+    from wmr_mj.analysis.claim import ClaimContext
     from wmr_mj.plant.reduced import SteeringModel
 
-__all__ = ["SteeringController", "BatchLaw", "saturate"]
+__all__ = ["SteeringController", "BatchLaw", "saturate", "BuildContext", "law_methods_missing"]
 
 #: law(alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot, E, E_dot, u) -> u: alpha, alpha_dot (n,) arrays
 #: (rad, rad/s; strided views are fine); the reference as floats; E = alpha0 - alpha and
@@ -39,30 +57,72 @@ __all__ = ["SteeringController", "BatchLaw", "saturate"]
 BatchLaw = Callable[[np.ndarray, np.ndarray, float, float, float, np.ndarray, np.ndarray, np.ndarray], np.ndarray]
 
 
-class SteeringController(abc.ABC):
-    """Steering state and reference in (rad, rad/s, rad/s^2), armature voltage out (V)."""
+class BuildContext:
+    """What the testbed knows when it builds a law from a name and parameters (``from_context``).
+
+    Attributes:
+        model: the reduced model of the run's model source on the estimate (P^, C_V^, F^, K^, gyro^).
+        estimate: the controller's belief, the nominal parameter set (:class:`wmr_mj.params.C80Parameters`).
+        voltage_limit: the supply [V].
+        kp, kd: the run's K_P [1/s^2], K_D [1/s] (a law with a PD servo of its own may take them).
+    """
+
+    def __init__(self, *, model: SteeringModel, estimate: Any, voltage_limit: float, kp: float, kd: float) -> None:
+        self.model, self.estimate, self.voltage_limit, self.kp, self.kd = model, estimate, voltage_limit, kp, kd
+
+
+class SteeringController:
+    """Steering state and reference in (rad, rad/s, rad/s^2), armature voltage out (V).
+
+    Override :meth:`voltage_scalar` or :meth:`voltage` (at least one); :meth:`reset` and
+    :meth:`step` for a law with state; :meth:`claim` to state a guarantee; ``name`` to be named
+    as yourself in every output.
+    """
 
     name: str = "controller"
-    #: the reduced model the law stands on (its estimate P^, C_V^, F^, K^); the certificate reads it
-    model: SteeringModel
+    #: the reduced model the law stands on (its estimate P^, C_V^, F^, K^), where it has one
+    model: SteeringModel | None = None
 
-    @abc.abstractmethod
-    def voltage(
-        self,
-        alpha: ArrayLike,
-        alpha_dot: ArrayLike,
-        alpha0: ArrayLike,
-        alpha0_dot: ArrayLike,
-        alpha0_ddot: ArrayLike,
-    ) -> np.ndarray:
-        """Unsaturated armature voltage for each simulation of the batch, V."""
+    @classmethod
+    def from_context(cls, context: BuildContext, **params: Any) -> SteeringController:
+        """The law built by name (``--controller NAME --controller-param k=v``): ``cls(**params)``.
 
-    def voltage_scalar(
-        self, alpha: float, alpha_dot: float, alpha0: float, alpha0_dot: float, alpha0_ddot: float
-    ) -> float:
-        """The same law on floats (override for speed)."""
+        A law that stands on the run's model (its P^ etc.) overrides this to take ``context.model``.
+        """
+        return cls(**params)
+
+    def voltage(self, alpha: ArrayLike, alpha_dot: ArrayLike, alpha0: ArrayLike, alpha0_dot: ArrayLike,
+                alpha0_ddot: ArrayLike) -> np.ndarray:
+        """Unsaturated armature voltage [V] for each simulation of a batch (arrays (B,) -> (B,))."""
+        if type(self).voltage_scalar is SteeringController.voltage_scalar:
+            raise TypeError(f"{type(self).__name__} defines neither voltage nor voltage_scalar")
+        a, ad, a0, a0d, a0dd = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in
+                                                    (alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot)))
+        return np.array([self.voltage_scalar(*map(float, row)) for row in zip(a.ravel(), ad.ravel(), a0.ravel(),
+                                                                              a0d.ravel(), a0dd.ravel())],
+                        dtype=float).reshape(a.shape)
+
+    def voltage_scalar(self, alpha: float, alpha_dot: float, alpha0: float, alpha0_dot: float,
+                       alpha0_ddot: float) -> float:
+        """The same law on floats [V] (override for speed)."""
+        if type(self).voltage is SteeringController.voltage:
+            raise TypeError(f"{type(self).__name__} defines neither voltage nor voltage_scalar")
         return float(self.voltage(np.array([alpha]), np.array([alpha_dot]), np.array([alpha0]),
                                   np.array([alpha0_dot]), np.array([alpha0_ddot]))[0])
+
+    def reset(self, *, control_period: float) -> None:
+        """Before each run: clear the law's state; ``control_period`` [s] is the time between steps."""
+
+    def step(self, t: float, alpha: float, alpha_dot: float, alpha0: float, alpha0_dot: float,
+             alpha0_ddot: float) -> float:
+        """One control step at time ``t`` [s]: the voltage to apply [V]; a law with state updates it here."""
+        return self.voltage_scalar(alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot)
+
+    @property
+    def stateful(self) -> bool:
+        """Whether the law keeps state between steps (it overrides :meth:`step` or :meth:`reset`)."""
+        cls = type(self)
+        return cls.step is not SteeringController.step or cls.reset is not SteeringController.reset
 
     def batch_law(self, n: int) -> BatchLaw:
         """The law for a batch of ``n`` simulations, writing into the caller's buffers.
@@ -79,9 +139,24 @@ class SteeringController(abc.ABC):
 
         return law
 
+    def claim(self, context: ClaimContext) -> Certificate | None:
+        """The law's guarantee for the run of ``context`` (:mod:`wmr_mj.analysis.claim`); None: it claims nothing."""
+        return None
+
     def describe(self) -> dict:
-        """JSON-able description for logs and reports."""
+        """JSON-able description for logs and reports (``controller`` is the law's name)."""
         return {"controller": self.name}
+
+
+def law_methods_missing(cls: Any) -> str | None:
+    """Why ``cls`` cannot run as a steering law (one line), or None where it can."""
+    if not (isinstance(cls, type) and issubclass(cls, SteeringController)):
+        return (f"{getattr(cls, '__name__', cls)!r} is not a steering law: subclass controllers.SteeringController "
+                "and define voltage_scalar (or voltage, or step)")
+    if (cls.voltage_scalar is SteeringController.voltage_scalar and cls.voltage is SteeringController.voltage
+            and cls.step is SteeringController.step):
+        return f"{cls.__name__} defines none of voltage_scalar, voltage, step: a steering law needs one"
+    return None
 
 
 def saturate(u: ArrayLike, limit: float) -> tuple[np.ndarray, np.ndarray]:
@@ -89,3 +164,8 @@ def saturate(u: ArrayLike, limit: float) -> tuple[np.ndarray, np.ndarray]:
     u = np.asarray(u, dtype=float)
     clipped = np.clip(u, -limit, limit)
     return clipped, clipped != u
+
+
+def describe_params(params: Mapping[str, Any]) -> dict[str, Any]:
+    """Parameters as JSON-able values (numbers and strings kept, anything else as its repr)."""
+    return {str(k): (v if isinstance(v, (int, float, str, bool)) or v is None else repr(v)) for k, v in params.items()}

@@ -34,6 +34,8 @@ from typing import Literal, get_args
 import numpy as np
 
 from controllers.base import SteeringController
+from wmr_mj.analysis.certificate import Certificate, Compensation, Estimate, Gains, certify
+from wmr_mj.analysis.claim import ClaimContext
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import C80, COEFFICIENT_NAMES, PAPER_KD, PAPER_KP, C80Parameters
 from wmr_mj.plant.reduced import (
@@ -272,6 +274,24 @@ class ComputedTorque(SteeringController):
 
         return law
 
+    def paper_estimate(self) -> dict[str, float]:
+        """The coefficients the paper's analysis takes as this law's estimate: P^, C_V^, F^ (0 with
+        friction_sign 'none'), K^."""
+        c = self.model.coefficients.as_dict()
+        if self.friction_sign == "none":
+            c["F"] = 0.0
+        return {k: c[k] for k in ("P", "C_V", "F", "K")}
+
+    def claim(self, context: ClaimContext) -> Certificate:
+        """The section-4 analysis redone for this law on the run's plant box
+        (:func:`wmr_mj.analysis.certificate.certify`)."""
+        c = self.model.coefficients
+        sign = self.friction_sign
+        estimate = Estimate(P=c.P, C_V=c.C_V, F=0.0 if sign == "none" else c.F, K=c.K, gyro=c.gyro,
+                            V_A=self.model.V_A)
+        return _section4(context, estimate, Compensation(friction_sign=sign, friction_width=self.friction_width),
+                         kp=self.kp, kd=self.kd)
+
     def describe(self) -> dict:
         return {"controller": self.name, "model": self.model.name, "kp": self.kp, "kd": self.kd,
                 "friction_sign": self.friction_sign, "friction_width": self.friction_width,
@@ -319,9 +339,28 @@ class PDController(SteeringController):
 
         return law
 
+    def paper_estimate(self) -> dict[str, float]:
+        """A PD law has no model-based part but P^ (its gain scale)."""
+        return {"P": self.model.coefficients.P, "C_V": 0.0, "F": 0.0, "K": 0.0}
+
+    def claim(self, context: ClaimContext) -> Certificate:
+        """The section-4 analysis for a law without feedforward or compensation."""
+        c = self.model.coefficients
+        estimate = Estimate(P=c.P, C_V=0.0, F=0.0, K=0.0, gyro=0.0, V_A=self.model.V_A)
+        return _section4(context, estimate, Compensation(friction_sign="none", friction_width=0.0, feedforward=False),
+                         kp=self.kp, kd=self.kd)
+
     def describe(self) -> dict:
         return {"controller": self.name, "model": self.model.name, "kp": self.kp, "kd": self.kd,
                 "estimate": {"P": self._P}}
+
+
+def _section4(context: ClaimContext, estimate: Estimate, compensation: Compensation, *, kp: float,
+              kd: float) -> Certificate:
+    """:func:`wmr_mj.analysis.certificate.certify` on the run's context."""
+    return certify(plant=context.plant, estimate=estimate, gains=Gains(kp=kp, kd=kd), reference=context.reference,
+                   limits=context.limits, compensation=compensation, control_period=context.control_period,
+                   initial_error=context.initial_error, stated=context.stated)
 
 
 def make_controller(name: str, model: SteeringModel, *, kp: float = PAPER_KP, kd: float = PAPER_KD,

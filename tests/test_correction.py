@@ -1,4 +1,4 @@
-"""The Cartesian correction (wmr_mj.sim.correction): limits, the certificate's assumptions, both laws alike."""
+"""The Cartesian correction (controllers.tracking.StanleyAtC): limits, the certificate's assumptions, both laws alike."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ from wmr_mj.errors import ParameterError
 from wmr_mj.reference.bounds import ReferenceBounds
 from wmr_mj.sim.closed_loop import run_closed_loop
 from wmr_mj.sim.config import RunConfig
-from wmr_mj.sim.correction import DEFAULT_GAINS, CartesianCorrection, CorrectionGains, corrected_bounds
+from controllers.tracking import DEFAULT_GAINS, TRACKER_BOUNDS_ASSUMPTION, CorrectionGains, StanleyAtC, corrected_bounds
 from wmr_mj.sim.designs import CERTIFIED
 
 BASE = RunConfig(**CERTIFIED.config_changes()).replace(path="lane-change", duration=12.0)
@@ -22,9 +22,10 @@ def test_the_filter_keeps_rate_and_acceleration_within_the_limits():
     from wmr_mj.sim.config import build_reference, estimate_parameters
 
     ref, _ = build_reference("lane-change", estimate_parameters(C80), dt=0.001, duration=12.0)
-    c = CartesianCorrection(ref, period=0.001)
+    c = StanleyAtC()
+    c.reset(ref, control_period=0.001)
     c.command = 0.1  # a step to the largest correction
-    d, dd, ddd = (np.concatenate(x) for x in zip(*(c.block(50) for _ in range(200))))
+    d, dd, ddd = (np.concatenate(x) for x in zip(*(c.corrections(50) for _ in range(200))))
     g = DEFAULT_GAINS
     assert np.max(np.abs(d)) <= g.delta_max + 1e-12
     assert np.max(np.abs(dd)) <= g.rate_max + 1e-12
@@ -58,8 +59,10 @@ def test_a_corrected_run_names_its_assumptions_and_keeps_its_limits():
     plain = run_closed_loop(BASE, progress=False).summary
     s = new.summary
     names = [a.name for a in s.certificate.assumptions]
-    for name in ("correction limits", "correction measurement", "correction path", "correction start"):
+    for name in (TRACKER_BOUNDS_ASSUMPTION, "correction measurement", "correction path", "correction start"):
         assert name in names
+    measured = next(a for a in s.certificate.assumptions if a.name == TRACKER_BOUNDS_ASSUMPTION)
+    assert measured.kind == "checked" and measured.met and 0.0 < measured.value <= 1.0  # measured on the run
     for used, limit in (("delta_max_used", "delta_max"), ("rate_max_used", "rate_max"), ("acc_max_used", "acc_max")):
         assert s.correction[used] <= s.correction[limit] + 1e-12
     assert s.certificate.E_max >= plain.certificate.E_max  # the corrected reference's wider bounds

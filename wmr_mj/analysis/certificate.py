@@ -278,6 +278,11 @@ class Certificate:
     reason: str = ""
     iterations: int = 0
     inputs: Mapping[str, Any] = field(default_factory=dict, compare=False, hash=False)
+    #: the region's shape: 'small-gain' (4.21) from gamma and delta, or 'box' (|E| <= E_max and
+    #: |E'| <= Edot_max, a claim of another law: :mod:`wmr_mj.analysis.claim`)
+    region: str = "small-gain"
+    #: whose claim it is (the controller's name; '' for the section-4 analysis of the run's law)
+    claimant: str = ""
 
     @property
     def certified(self) -> bool:
@@ -294,6 +299,9 @@ class Certificate:
         """The region's polygon in the (||E||, ||E'||) plane; () when not valid."""
         if not self.valid:
             return ()
+        if self.region == "box":
+            Ed = self.Edot_max if math.isfinite(self.Edot_max) else 0.0
+            return ((0.0, 0.0), (self.E_max, 0.0), (self.E_max, Ed), (0.0, Ed))
         g1, g2, d1 = self.gamma1, self.gamma2, self.delta1
         return ((0.0, 0.0), (g1 * d1 / (1.0 - g1 * self.delta2), 0.0), (self.E_max, self.Edot_max),
                 (0.0, g2 * d1 / (1.0 - g2 * self.delta3)))
@@ -307,6 +315,8 @@ class Certificate:
         if not self.valid:
             return math.inf
         x, y = float(sup_E), float(sup_Edot)
+        if self.region == "box":  # Edot_max = inf: the claim bounds |E| alone
+            return max(x / self.E_max if self.E_max > 0 else math.inf, y / self.Edot_max)
         eta = self.delta1 + self.delta2 * x + self.delta3 * y
         return max(x / (self.gamma1 * eta), y / (self.gamma2 * eta))
 
@@ -354,6 +364,10 @@ class Certificate:
         out["iterations"] = int(self.iterations)
         out["vertices"] = [list(v) for v in self.vertices]
         out["inputs"] = _clean_inputs(self.inputs)
+        if self.region != "small-gain":  # the section-4 certificate's keys, as they have always been
+            out["region"] = self.region
+        if self.claimant:
+            out["claimant"] = self.claimant
         return out
 
 

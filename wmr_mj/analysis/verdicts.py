@@ -34,6 +34,8 @@ from wmr_mj.analysis.certificate import VERDICTS, Certificate, CertificateJudgem
 __all__ = [
     "VERDICTS",
     "PASS",
+    "NO_CLAIM",
+    "FAILED",
     "OUTSIDE_THE_BOX",
     "DRIFT_WINDOW_S",
     "DRIFT_TOLERANCE",
@@ -49,6 +51,10 @@ __all__ = [
 ]
 
 PASS = "certified-inside"
+#: The verdict of a run whose controller states no claim: judged by its requirements only, never a pass.
+NO_CLAIM = "no-claim"
+#: The verdict of a run whose law (or tracker) failed mid-run (raised, returned NaN or not one voltage).
+FAILED = "failed"
 #: Name (prefix) of the assumption a plant outside the certificate's box fails (wmr_mj.sim.certify).
 OUTSIDE_THE_BOX = "plant inside the box"
 #: Length of each of the two windows that compare |E| at the end of a run, s.
@@ -201,6 +207,11 @@ def format_verdict(summary: Mapping[str, Any]) -> list[str]:
     verdict = summary.get("verdict")
     if verdict is None:
         return ["no certificate in this summary (written before verdicts existed)"]
+    if verdict == FAILED:
+        return [f"verdict: FAILED -- not a pass: {summary.get('failure', 'the controller failed')}"]
+    if verdict == NO_CLAIM:
+        return [f"verdict: NO-CLAIM -- not a pass: controller {summary.get('controller')!r} states no claim; "
+                "the run is judged by its requirements only (--require)"]
     cert = summary.get("certificate") or {}
     paper = summary.get("paper_region") or {}
     dr = summary.get("drift") or {}

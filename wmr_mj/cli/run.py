@@ -68,7 +68,7 @@ def add_run_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--correction", action="store_true",
                    help="Cartesian correction: an outer loop at C (Stanley-like, from C's cross-track and heading "
                         "errors) corrects alpha0 within declared rate and acceleration limits, which the "
-                        "certificate then assumes (wmr_mj/sim/correction.py)")
+                        "certificate then assumes (controllers/tracking.py)")
     from wmr_mj.params import UNCERTAINTY_NAMES
 
     p.add_argument("--uncertainty", default=None,

@@ -187,7 +187,7 @@ def correction_stage(settings: ValidateSettings, folder: Path, st: Stages) -> di
     rung = run_rung(settings, len(LADDER) + 1, CORRECTION_RUNG, folder, st, reference_of(settings),
                     CERTIFIED)
     rung.update(changed=["correction"], change="Cartesian correction at C (outer loop on alpha0, "
-                                              "wmr_mj/sim/correction.py)")
+                                              "controllers/tracking.py)")
     return rung
 
 

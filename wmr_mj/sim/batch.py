@@ -66,6 +66,7 @@ from wmr_mj.sim.config import (
     controller_for,
     estimate_of,
     estimate_parameters,
+    has_tracker,
     plant_parameters,
 )
 from wmr_mj.sim.engine import LAW_BACKENDS, batch_law_backend, batch_model
@@ -318,7 +319,7 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
     """Run closed-loop configs, all at once where they share one batch.
 
     Configs that differ only in their plant parameters (m1, plant_overrides) and have no
-    signals and no Cartesian correction share one batch (:func:`shares_one_batch`). ``law``
+    signals and no path tracker share one batch (:func:`shares_one_batch`). ``law``
     (:data:`LAW_BACKENDS`, :func:`batch_law_backend`): 'compiled' runs one
     ``mujoco.batch.Batch`` of every simulation on ``nthread`` threads (0: every core) with
     the law in MuJoCo's control callback, a block of steps per ``Batch.rollout`` call;
@@ -327,7 +328,7 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
     the law of one group runs while the others step; 'auto' (the default) takes the
     compiled law where it can run. Each simulation has its own compiled model.
 
-    Configs that cannot share a batch (each its own reference, signals or correction) and runs
+    Configs that cannot share a batch (each its own reference, signals or tracker; a law with state) and runs
     with ``requirements`` (STL formulas or presets, :mod:`wmr_mj.analysis.requirements`, whose
     monitor needs every control step's signals, which a batch does not keep) run one by one on
     the engine (``run_closed_loop``), ``nthread`` at a time on threads (each engine call
@@ -346,6 +347,8 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
                                requirements=tuple(requirements))
     estimate = estimate_parameters(base)
     controller = controller_for(first, estimate)
+    if controller.stateful:  # a law with state (or time) has no batch form: each run on the engine
+        return _run_one_by_one(configs, base=base, progress=progress, law=law, nthread=nthread)
     backend = batch_law_backend(controller, law)
     plants = [plant_parameters(c, base) for c in configs]
     options = _plant_options(first)
@@ -420,9 +423,9 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
 
 
 def shares_one_batch(configs: Sequence[RunConfig]) -> bool:
-    """Whether ``configs`` run as one batch: no signals, no correction, and nothing but m1 and
+    """Whether ``configs`` run as one batch: no signals, no tracker, and nothing but m1 and
     plant_overrides differs (the batch's simulations share one reference and one law)."""
-    if any(c.signals is not None or c.correction for c in configs):
+    if any(c.signals is not None or has_tracker(c) for c in configs):
         return False
     shared = configs[0].replace(m1=M1_NOMINAL, plant_overrides={})
     return all(c.replace(m1=M1_NOMINAL, plant_overrides={}) == shared for c in configs[1:])
@@ -487,6 +490,7 @@ def _summaries(configs: Sequence[RunConfig], plants: Sequence[C80Parameters], st
                                final_alpha=stats.final_alpha[i], control_steps=n, steps=n * substeps,
                                wall_s=wall / nsim)
         r = report(c, measured, analysis=analysis, params=p, certificate=certificate,
+                   claims_nothing=certificate is None,
                    drift=drift(prev_window=float(stats.drift_prev[i]), last_window=float(stats.drift_last[i]),
                                final_alpha_dot=float(stats.final_alpha_dot[i])),
                    path=paths[i])
@@ -513,7 +517,7 @@ def _run_one_by_one(configs: Sequence[RunConfig], *, base: C80Parameters, progre
                     law: str, nthread: int = 1, requirements: tuple[str, ...] = ()) -> list[RunSummary]:
     """Runs that do not share a batch, each a single run on the engine, ``nthread`` at a time.
 
-    A run with the Cartesian correction (``wmr_mj.sim.correction``) rewrites its own reference
+    A run with a path tracker (``controllers.tracking``) rewrites its own reference
     from its state between blocks; a run with signals, or on its own path, has inputs of its
     own; and a requirement's monitor needs every control step's signals: the batch's loops
     share one reference and keep statistics only. Each summary is run_closed_loop's (the

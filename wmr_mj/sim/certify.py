@@ -19,7 +19,6 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
-from controllers import ComputedTorque
 from wmr_mj._util.checks import finite_number, interval
 from wmr_mj.analysis.certificate import (
     GYRO_BAND,
@@ -28,23 +27,26 @@ from wmr_mj.analysis.certificate import (
     PLANT_K_MEASURED,
     Assumption,
     Certificate,
-    Compensation,
-    Estimate,
-    Gains,
     PlantBox,
     PlantLimits,
     _hull,
-    certify,
     derived_box,
     friction_over_P_max,
     replace_inputs,
 )
+from wmr_mj.analysis.claim import ClaimContext
 from wmr_mj.analysis.robustness import ParameterBox
 from wmr_mj.analysis.verdicts import OUTSIDE_THE_BOX
 from wmr_mj.errors import ParameterError
 from wmr_mj.params import C80, COEFFICIENT_NAMES, C80Parameters
 from wmr_mj.plant.mjcf import TIMESTEP
-from wmr_mj.sim.config import controller_for, estimate_parameters, plant_parameters, reference_bounds_of
+from wmr_mj.sim.config import (
+    controller_for,
+    estimate_parameters,
+    plant_parameters,
+    reference_bounds_of,
+    tracker_for,
+)
 
 __all__ = ["certificate_for", "identified_spread", "box_spans", "outside_the_box", "reference_within"]
 
@@ -135,7 +137,7 @@ def reference_within(measured: Any, declared: Any) -> Assumption:
 
 
 def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
-                    k_band: float = PLANT_K_BAND, gyro_band: tuple[float, float] = GYRO_BAND) -> Certificate:
+                    k_band: float = PLANT_K_BAND, gyro_band: tuple[float, float] = GYRO_BAND) -> Certificate | None:
     """The certificate of a :class:`wmr_mj.sim.closed_loop.RunConfig` run on ``reference``.
 
     Plant box: P, C_V, F by the rule of ``simulate.analysis_box``: derived from ``params``
@@ -170,7 +172,6 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
     plant = plant_parameters(config, base)
     ranges = {k: (float(v[0]), float(v[1])) for k, v in config.box_ranges.items()}
     plant_box, notes = _plant_box(config, base, estimate_params, ranges, k_band, gyro_band)
-    estimate, compensation = _estimate(controller)
     period = config.control_period if config.control_period is not None else TIMESTEP
     initial = (float(reference.alpha0[0]), float(reference.alpha0_dot[0]))  # the plant starts at alpha = alpha' = 0
     stated = _stated_assumptions(k_band, gyro_band) + tuple(outside_the_box(config, plant, base))
@@ -181,16 +182,21 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
     bounds = reference_bounds_of(config, reference)
     if config.reference_bounds is not None:
         stated = stated + (reference_within(reference.bounds(), config.reference_bounds),)
-    if getattr(config, "correction", False):
-        # the corrected alpha0 = alpha0 + delta, delta within the correction's declared limits
-        from wmr_mj.sim.correction import corrected_bounds, correction_assumptions
-
-        bounds = corrected_bounds(bounds)
-        stated = stated + correction_assumptions()
-    cert = certify(plant=plant_box, estimate=estimate, gains=Gains(kp=config.kp, kd=config.kd),
-                   reference=bounds,
-                   limits=PlantLimits(steering_range=plant.steering_range, voltage_limit=plant.voltage_limit),
-                   compensation=compensation, control_period=period, initial_error=initial, stated=stated)
+    tracker = tracker_for(config, estimate_params)
+    if tracker is not None:
+        # the reference the law receives is the tracker's: the claim is computed for the bounds it
+        # declares, which every run measures (controllers.tracking.within_declared)
+        bounds = tracker.declared_bounds(bounds)
+        stated = stated + tracker.stated_assumptions()
+    context = ClaimContext(plant=plant_box, reference=bounds,
+                           limits=PlantLimits(steering_range=plant.steering_range, voltage_limit=plant.voltage_limit),
+                           control_period=period, initial_error=initial, stated=stated, estimate=estimate_params)
+    cert = controller.claim(context)
+    if cert is None:
+        return None
+    if not isinstance(cert, Certificate):
+        raise ParameterError(f"controller {controller.name!r}: claim() returned {type(cert).__name__}, not a "
+                             "Certificate (see wmr_mj.analysis.claim.box_claim) or None")
     inputs = dict(cert.inputs)
     inputs.update(model=config.model, controller=controller.name, box_rule=config.box,
                   m1_range=list(config.m1_range), box_ranges={k: list(v) for k, v in ranges.items()},
@@ -235,21 +241,6 @@ def _plant_box(config: Any, base: C80Parameters, estimate_params: C80Parameters,
             ratio = None  # (5.1)'s printed intervals come with no such relation
     return PlantBox(box=plant_box, gyro=gyro, V_A=V_A, friction_over_P=ratio, disturbance=0.0,
                     disturbance_over_P=None), notes
-
-
-def _estimate(controller: Any) -> tuple[Estimate, Compensation]:
-    """The controller's model as the analysis' estimate, and its friction compensation."""
-    pd = controller.name == "pd"
-    if isinstance(controller, ComputedTorque):
-        sign, width = controller.friction_sign, controller.friction_width
-    else:  # a PD (controller_for builds no other): no compensation
-        sign, width = "none", 0.0
-    model = controller.model
-    c = model.coefficients
-    # a PD law has no model but P^ (its gain scale); F^ is the compensation's amplitude
-    estimate = Estimate(P=c.P, C_V=0.0, F=0.0, K=0.0, gyro=0.0, V_A=model.V_A) if pd else Estimate(
-        P=c.P, C_V=c.C_V, F=0.0 if sign == "none" else c.F, K=c.K, gyro=c.gyro, V_A=model.V_A)
-    return estimate, Compensation(friction_sign=sign, friction_width=width, feedforward=not pd)
 
 
 def _stated_assumptions(k_band: float, gyro_band: tuple[float, float]) -> tuple[Assumption, ...]:

@@ -24,6 +24,7 @@ the two bit-identical.
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -32,8 +33,10 @@ import mujoco
 import numpy as np
 
 from controllers import SteeringController
+from controllers.tracking import within_declared
 from wmr_mj._util.memory import require_run_memory
 from wmr_mj._util.progress import progress_bar
+from wmr_mj.analysis.claim import with_measured
 from wmr_mj.analysis.path_bound import PathBound, PathVerdict
 from wmr_mj.analysis.path_error import PathErrors
 from wmr_mj.analysis.verdicts import Drift
@@ -46,11 +49,22 @@ from wmr_mj.sim.config import (
     analysis_for,
     build_reference,
     controller_for,
+    controller_name,
     estimate_of,
     estimate_parameters,
     plant_parameters,
+    reference_bounds_of,
+    tracker_for,
 )
-from wmr_mj.sim.engine import ROW_FIELDS, Schedule, batch_model, load_fields, plant_options, run_engine
+from wmr_mj.sim.engine import (
+    ROW_FIELDS,
+    ControllerFailure,
+    Schedule,
+    batch_model,
+    load_fields,
+    plant_options,
+    run_engine,
+)
 from wmr_mj.sim.log_header import LogHeader
 from wmr_mj.sim.summary import RunSummary
 
@@ -118,7 +132,7 @@ class RunMeasures:
 
 
 def report(config: RunConfig, measured: RunMeasures, *, analysis, params: C80Parameters, certificate=None,
-           drift: Drift | None = None, path: PathJudgement | None = None) -> RunSummary:
+           drift: Drift | None = None, path: PathJudgement | None = None, claims_nothing: bool = False) -> RunSummary:
     """The run's report: sup errors (whole run and after the entry transient) against the region.
 
     Shared by the single run and the batched sweep so both report alike.
@@ -133,6 +147,8 @@ def report(config: RunConfig, measured: RunMeasures, *, analysis, params: C80Par
             end-of-run ``drift`` (:func:`wmr_mj.analysis.verdicts.drift`) the separated verdict is
             added (:func:`wmr_mj.analysis.verdicts.judge_run`).
         path: C's path errors, bound and verdict (:func:`judge_path`); None: not measured.
+        claims_nothing: the controller states no claim (``certificate_for`` gave None): the verdict
+            is 'no-claim', never a pass.
 
     Returns:
         RunSummary: ``to_dict()`` writes the JSON interface.
@@ -147,7 +163,7 @@ def report(config: RunConfig, measured: RunMeasures, *, analysis, params: C80Par
         judged = judge_run(certificate=certificate, analysis=analysis, sup_E=sup_E, sup_Edot=sup_Edot, drift=drift)
     return RunSummary(
         status=m.status,
-        controller=config.controller,
+        controller=controller_name(config),
         model=config.model,
         m1=float(params.m1),
         kp=config.kp,
@@ -169,7 +185,8 @@ def report(config: RunConfig, measured: RunMeasures, *, analysis, params: C80Par
         final_alpha=float(m.final_alpha),
         paper_region=paper_region(analysis, sup_E, sup_Edot) if judged is None else judged.paper_region,
         certificate=None if judged is None else judged.certificate,
-        drift=None if judged is None else judged.drift,
+        drift=drift if judged is None else judged.drift,
+        claimed=certificate is not None or not claims_nothing,
         path_error=None if path is None else path.errors,
         path_bound=None if path is None else path.bound,
         path_verdict=None if path is None else path.verdict,
@@ -352,28 +369,33 @@ def run_closed_loop(
         logger = logger_factory(LogHeader(
             mjcf_xml=scene_xml(params, **options), config=config.as_dict(), parameters=params.as_dict(),
             initial_state=state, timestep=dt, control_substeps=substeps, model=m,
-            bounds={"E_max": certificate.E_max, "Edot_max": certificate.Edot_max},
+            bounds=({"E_max": certificate.E_max, "Edot_max": certificate.Edot_max} if certificate is not None
+                    else {"E_max": math.inf, "Edot_max": math.inf}),
             reference_path=np.asarray(reference.C_xy)[::max(1, len(reference.C_xy) // 2000)],
             path_errors=_PathRows(reference, period)))
 
     disturbance, loads = _signal_inputs(config, params, options, n, period)
-    outer = None
-    if config.correction:
-        from wmr_mj.sim.correction import CartesianCorrection
-
-        outer = CartesianCorrection(reference, period=period)
+    outer = tracker_for(config, estimate)
     on_block = None if logger is None else logger.write_block
     bar = progress_bar(n, desc="run", unit="step", unit_scale=True, enabled=progress)
     try:
         schedule = Schedule(reference=(a0_all, a0d_all, a0dd_all), n=n, substeps=substeps, period=period,
-                            disturbance=disturbance, loads=loads, correction=outer)
+                            disturbance=disturbance, loads=loads, tracker=outer, path_reference=reference)
         run = run_engine(params=params, controller=controller, options=options, model=plain, schedule=schedule,
                          law=law, on_block=on_block, on_progress=bar.update)
     finally:
         bar.close()
     done, k, status, wall = run.rows, run.steps, run.status, run.wall_s
     if k == 0:
+        if run.failure is not None:
+            if logger is not None:
+                logger.close({"status": "failed", "failure": run.failure}, status="failed")
+            raise ControllerFailure(run.failure)  # nothing simulated: nothing to judge
         raise KeyboardInterrupt  # nothing simulated: nothing to report
+    if outer is not None and certificate is not None:
+        # the tracker's declared bounds, measured on the reference the law received
+        certificate = with_measured(certificate, within_declared(done, outer.declared_bounds(
+            reference_bounds_of(config, reference)), tracker=outer.name))
     after = done["t"] >= settle_s
     at = path_sample_index(k, period)
     saturated = int(np.count_nonzero(done["voltage"] != done["voltage_cmd"]))  # NaN included: 0 V applied
@@ -383,14 +405,15 @@ def run_closed_loop(
                            sup_E_settled=_sup(done["E"][after]), sup_Edot_settled=_sup(done["E_dot"][after]),
                            saturated_fraction=saturated / k, left_range_at=left_range_at,
                            final_alpha=done["alpha"][-1], control_steps=k, steps=k * substeps, wall_s=wall)
-    summary = report(config, measured, analysis=analysis, params=params, certificate=certificate,
+    summary = report(config, measured, analysis=analysis, params=params,
+                     certificate=None if run.failure is not None else certificate, claims_nothing=certificate is None,
                      drift=_drift_of(done["E"], done["alpha0_dot"][-1] - done["E_dot"][-1], period),
                      path=judge_path(reference, done["t"][at], run.C_xy[at], done["heading"][at], settle_s=settle_s,
                                      certificate=certificate, steering_range=params.steering_range,
-                                     corrected=config.correction))
+                                     corrected=outer is not None))
     if outer is not None:
         summary = dataclasses.replace(summary, correction=outer.describe(done))
-    summary = dataclasses.replace(summary, mujoco_warnings=run.warnings,
+    summary = dataclasses.replace(summary, mujoco_warnings=run.warnings, failure=run.failure,
                                   analysis=analysis.as_dict(), controller_config=controller.describe())
     if logger is not None:
         logger.close(summary.to_dict(), status=status)

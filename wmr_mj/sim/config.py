@@ -33,6 +33,10 @@ __all__ = [
     "plant_parameters",
     "estimate_parameters",
     "controller_for",
+    "tracker_for",
+    "has_tracker",
+    "plugin_source",
+    "controller_name",
     "estimate_of",
     "build_reference",
     "analysis_box",
@@ -47,7 +51,11 @@ PATH_NAMES = ("paper-circle", "lane-change", "figure-eight")
 class RunConfig:
     """Everything that defines a closed-loop run (JSON-able via ``as_dict``)."""
 
-    controller: str = "computed-torque"
+    # the steering law: a name (controllers.registry.controller_names(): computed-torque, pd, sliding-mode,
+    # adaptive-computed-torque, an installed entry point), "FILE.py:Class" or "module:Class" (a plug-in, built
+    # with controller_params), or a SteeringController object or a factory of one (a library user's own)
+    controller: Any = "computed-torque"
+    controller_params: Mapping[str, Any] = field(default_factory=dict)  # NAME: value for a plug-in's constructor
     model: str = "paper"  # model source of the controller's estimate
     m1: float = M1_NOMINAL  # plant chassis mass, kg
     duration: float = 35.0  # s
@@ -72,16 +80,21 @@ class RunConfig:
     # a steering disturbance torque and chassis load changes (wmr_mj.sim.signals.Signals, or its JSON
     # form, a mapping or a .json file); None: none (as_dict then has no "signals" key)
     signals: Any = None
-    # the Cartesian correction at C (wmr_mj.sim.correction): an outer loop that corrects alpha0
+    # the Cartesian correction at C (controllers.tracking.StanleyAtC): an outer loop that corrects alpha0;
+    # the same as tracker="stanley-at-C"
     correction: bool = False
+    # a path tracker (the outer loop on C that writes alpha0): a name (controllers.registry.tracker_names()),
+    # "FILE.py:Class", "module:Class", or a PathTracker object or factory; None: the path's own alpha0
+    tracker: Any = None
+    tracker_params: Mapping[str, Any] = field(default_factory=dict)
     # declared bounds on the reference alpha0 (wmr_mj.reference.bounds.ReferenceBounds, 'paper', a
     # mapping or 'key=value,...'): the certificate and the paper's region are computed for every
     # reference within them, and the run's own is checked against them; None: the run's own bounds
     reference_bounds: Any = None
 
     def __post_init__(self) -> None:
-        if self.controller not in CONTROLLER_NAMES:
-            raise UnknownNameError("controller", self.controller, CONTROLLER_NAMES)
+        _check_plugin(self, "controller")
+        _check_plugin(self, "tracker")
         if self.model not in MODEL_SOURCES:
             raise UnknownNameError("model source", self.model, MODEL_SOURCES)
         if self.friction_sign not in FRICTION_SIGNS:
@@ -124,6 +137,20 @@ class RunConfig:
             d["signals"] = self.signals.as_dict()
         if not self.correction:
             del d["correction"]  # the configs written before the correction existed, unchanged
+        # likewise the plug-in keys, only where a plug-in runs
+        for kind in ("controller", "tracker"):
+            given = getattr(self, kind)
+            if not getattr(self, f"{kind}_params"):
+                del d[f"{kind}_params"]
+            else:
+                d[f"{kind}_params"] = dict(getattr(self, f"{kind}_params"))
+            source = plugin_source(self, kind)
+            if source is not None:
+                d[f"{kind}_plugin"] = source.as_dict()
+                if not isinstance(given, str):
+                    d[kind] = source.name  # an object: its name (the plugin record says where it came from)
+        if self.tracker is None:
+            del d["tracker"]
         if self.reference_bounds is None:
             del d["reference_bounds"]  # likewise
         else:
@@ -137,6 +164,71 @@ class RunConfig:
 
     def replace(self, **changes: Any) -> RunConfig:
         return dataclasses.replace(self, **changes)
+
+
+def _check_plugin(config: RunConfig, kind: str) -> None:
+    """A controller (or tracker) that can be built: a name resolves (a plug-in's file and class are found,
+    else one line naming them), an object is a law (or tracker), parameters only where a plug-in takes them."""
+    from controllers.base import SteeringController
+    from controllers.registry import resolve
+    from controllers.tracking import PathTracker
+
+    given, params = getattr(config, kind), getattr(config, f"{kind}_params")
+    if not isinstance(params, Mapping):
+        raise ParameterError(f"{kind}_params = {params!r} is not accepted: a mapping NAME -> value")
+    object.__setattr__(config, f"{kind}_params", dict(params))
+    base = SteeringController if kind == "controller" else PathTracker
+    if kind == "tracker" and given is None:
+        if params:
+            raise ParameterError("tracker_params given without a tracker")
+        return
+    if kind == "tracker" and config.correction and given != "stanley-at-C":
+        raise ParameterError(f"correction=True is the tracker stanley-at-C; it cannot run beside tracker {given!r}")
+    if isinstance(given, str):
+        if kind == "controller" and given in CONTROLLER_NAMES:
+            if params:
+                raise ParameterError(f"controller {given!r} takes its settings as RunConfig fields (kp, kd, model, "
+                                     f"friction_sign, friction_width), not controller_params {sorted(params)}")
+            return
+        resolve(given, params, kind=kind)  # a missing file, class or method: one line, before any run
+        return
+    if isinstance(given, base):
+        if params:
+            raise ParameterError(f"{kind}_params are for a {kind} given by name; this {kind} is an object")
+        return
+    if callable(given):
+        return  # a factory: called (and checked) where the run builds its parts
+    raise ParameterError(f"{kind} = {given!r} is not accepted: a name, FILE.py:Class, module:Class, a "
+                         f"{base.__name__} or a factory of one")
+
+
+def plugin_source(config: RunConfig, kind: str = "controller"):
+    """Where the run's controller (or tracker) comes from (:class:`controllers.registry.PluginSource`),
+    as its log records it; None for the computed-torque and PD laws built from the config's fields and
+    for no tracker."""
+    from controllers.registry import PluginSource, resolve, source_hash
+
+    given = getattr(config, kind)
+    if given is None or (kind == "controller" and isinstance(given, str) and given in CONTROLLER_NAMES):
+        return None
+    if isinstance(given, str):
+        return resolve(given, getattr(config, f"{kind}_params"), kind=kind)[1]
+    cls = given if isinstance(given, type) else type(given)
+    describe = getattr(given, "describe", None)
+    params = {}
+    if not isinstance(given, type) and callable(describe):
+        params = {k: v for k, v in describe().items() if k not in (kind, "law")}
+    from controllers.base import describe_params
+
+    return PluginSource(spec=f"{cls.__module__}:{cls.__qualname__}", name=str(getattr(given, "name", cls.__name__)),
+                        origin="instance", import_path=f"{cls.__module__}:{cls.__qualname__}",
+                        params=describe_params(params), source_sha256=source_hash(cls))
+
+
+def controller_name(config: RunConfig) -> str:
+    """What every output calls the run's steering law: a built-in's name, a plug-in's ``name``."""
+    source = plugin_source(config, "controller")
+    return str(config.controller) if source is None else source.name
 
 
 def _check_path(config: RunConfig) -> None:
@@ -262,25 +354,76 @@ def reference_bounds_of(config: RunConfig, reference):
 
 
 def controller_for(config: RunConfig, params: C80Parameters) -> SteeringController:
-    """The controller ``config`` runs, built on ``params`` (the controller's belief, see
-    :func:`estimate_parameters`).
+    """A fresh instance of the controller ``config`` runs, built on ``params`` (the controller's belief,
+    see :func:`estimate_parameters`): the computed-torque and PD laws from the config's fields, a plug-in
+    from its name and ``controller_params`` (``from_context``), an object as a deep copy (a run never
+    shares a law's state with another), a factory by calling it.
 
     Raises:
         UnknownNameError: an unknown controller or model source.
+        ParameterError: a plug-in that cannot be built (a parameter it does not take, a factory that
+            returns no SteeringController).
     """
+    import copy
+
+    from controllers.base import BuildContext
+    from controllers.registry import build, resolve
+
+    given = config.controller
     model = model_from_source(config.model, params=params, identified=config.identified,
                               coefficients=config.coefficients)
-    return make_controller(config.controller, model, kp=config.kp, kd=config.kd,
-                           friction_sign=config.friction_sign, friction_width=config.friction_width)
+    if isinstance(given, str) and given in CONTROLLER_NAMES:
+        return make_controller(given, model, kp=config.kp, kd=config.kd,
+                               friction_sign=config.friction_sign, friction_width=config.friction_width)
+    if isinstance(given, SteeringController):
+        return copy.deepcopy(given)
+    context = BuildContext(model=model, estimate=params, voltage_limit=params.voltage_limit, kp=config.kp,
+                           kd=config.kd)
+    if isinstance(given, str):
+        cls, _ = resolve(given, config.controller_params, kind="controller")
+        law = build(cls, config.controller_params, context, spec=given)
+    else:
+        law = given()
+    if not isinstance(law, SteeringController):
+        raise ParameterError(f"controller {given!r} built {type(law).__name__}, not a controllers.SteeringController")
+    return law
 
 
-def estimate_of(controller: SteeringController) -> dict[str, float]:
-    """The coefficients the controller's model-based part uses (K^ etc.); a PD has none but P^."""
-    from wmr_mj.analysis.robustness import BOX_COEFFICIENTS
+def tracker_for(config: RunConfig, params: C80Parameters):
+    """A fresh instance of the run's path tracker (:class:`controllers.tracking.PathTracker`), None without one."""
+    import copy
 
-    c = controller.model.coefficients.as_dict()
-    if controller.name == "pd":
-        return {"P": c["P"], "C_V": 0.0, "F": 0.0, "K": 0.0}
-    if getattr(controller, "friction_sign", None) == "none":
-        c["F"] = 0.0
-    return {k: c[k] for k in BOX_COEFFICIENTS}
+    from controllers.base import BuildContext
+    from controllers.registry import build, resolve
+    from controllers.tracking import PathTracker
+
+    given = "stanley-at-C" if config.tracker is None and config.correction else config.tracker
+    if given is None:
+        return None
+    if isinstance(given, PathTracker):
+        return copy.deepcopy(given)
+    if isinstance(given, str):
+        cls, _ = resolve(given, config.tracker_params, kind="tracker")
+        model = model_from_source(config.model, params=params, identified=config.identified,
+                                  coefficients=config.coefficients)
+        context = BuildContext(model=model, estimate=params, voltage_limit=params.voltage_limit, kp=config.kp,
+                               kd=config.kd)
+        tracker = build(cls, config.tracker_params, context, spec=given, kind="tracker")
+    else:
+        tracker = given()
+    if not isinstance(tracker, PathTracker):
+        raise ParameterError(f"tracker {given!r} built {type(tracker).__name__}, not a controllers.PathTracker")
+    return tracker
+
+
+def has_tracker(config: RunConfig) -> bool:
+    """Whether the run has an outer loop on C (a tracker, or the correction)."""
+    return config.tracker is not None or bool(config.correction)
+
+
+def estimate_of(controller: SteeringController) -> dict[str, float] | None:
+    """The coefficients the paper's analysis takes as the law's estimate (P^, C_V^, F^, K^), where the law
+    is the paper's family (:meth:`~controllers.computed_torque.ComputedTorque.paper_estimate`); None: the
+    paper's (4.2), the estimate anywhere in the box."""
+    method = getattr(controller, "paper_estimate", None)
+    return method() if callable(method) else None

@@ -78,7 +78,7 @@ class Design:
     kd: float = PAPER_KD  # 1/s
     friction_sign: str = "measured"
     friction_width: float = 0.0  # rad/s; 0: exact sign
-    correction: bool = False  # the Cartesian correction at C (wmr_mj.sim.correction)
+    correction: bool = False  # the Cartesian correction at C (controllers.tracking.StanleyAtC)
 
     def config_changes(self) -> dict[str, Any]:
         """The RunConfig fields this design sets (``correction`` only where it is on)."""

@@ -43,12 +43,12 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from wmr_mj.errors import ParameterError, UnknownNameError
+from wmr_mj.errors import ParameterError, UnknownNameError, WmrMjError
 from wmr_mj.params import C80Parameters
 from wmr_mj.sim import compiled_law
 
 __all__ = ["run_engine", "Schedule", "EngineRun", "batch_model", "batch_law_backend", "LAW_BACKENDS", "plant_options",
-           "ROW_FIELDS", "LOAD_FIELDS", "load_fields"]
+           "ROW_FIELDS", "LOAD_FIELDS", "load_fields", "ControllerFailure"]
 
 # scalar fields recorded for every control step (see wmr_mj.sim.closed_loop.RunResult.rows)
 ROW_FIELDS = ("t", "alpha", "alpha_dot", "alpha0", "alpha0_dot", "alpha0_ddot", "E", "E_dot",
@@ -138,6 +138,7 @@ class EngineRun:
     wall_s: float  # the block loop's wall time: stepping, recording, rows, hand-over (models built before)
     cpu_s: float  # the block loop's CPU time on the calling thread (the batch of one steps on it)
     C_xy: np.ndarray = field(default_factory=lambda: np.empty((0, 2)))  # (steps, 2) xy of site C [m], as C_pos
+    failure: str | None = None  # status 'failed': why (the law or tracker raised, returned NaN or a bad shape)
 
 
 class _Plant:
@@ -243,13 +244,44 @@ class _CompiledStepper:
             self._qpos, self._qvel = end["qpos"][-1].copy(), end["qvel"][-1].copy()
 
 
+class ControllerFailure(WmrMjError):
+    """A law (or tracker) of the user's raised, returned NaN or returned something that is not one voltage:
+    the run stops there, as 'failed', with this message."""
+
+
+def _checked_call(law: Callable[..., Any], t: float, *state: float) -> float:
+    """``law(t, *state)`` as one finite float, else :class:`ControllerFailure` naming the law, the time and why."""
+    name = getattr(getattr(law, "__self__", None), "name", getattr(law, "__qualname__", "the law"))
+    try:
+        out = law(t, *state)
+    except Exception as exc:  # noqa: BLE001  (the user's law: its message, naming it and the time)
+        raise ControllerFailure(f"controller {name!r} raised {type(exc).__name__} at t = {t:.6g} s: {exc}") from None
+    try:
+        u = float(out)
+    except (TypeError, ValueError):
+        shape = getattr(out, "shape", None)
+        raise ControllerFailure(f"controller {name!r} returned {type(out).__name__}"
+                                f"{'' if shape is None else f' of shape {shape}'} at t = {t:.6g} s; one voltage "
+                                "(a float, V) is required") from None
+    if not math.isfinite(u):
+        raise ControllerFailure(f"controller {name!r} returned {u} V at t = {t:.6g} s (a finite voltage is required)")
+    return u
+
+
 class _PythonStepper:
-    """The same closed loop with the Python law, one mj_step at a time (no compiled law, or after a warning)."""
+    """The same closed loop with the Python law, one mj_step at a time (no compiled law, or after a warning).
+
+    ``law(t, alpha, alpha', alpha0, alpha0', alpha0'')`` is the controller's ``step``; ``strict``: a law the
+    testbed does not compile (a plug-in) fails the run on an exception, a NaN or a value that is not one
+    voltage (:class:`ControllerFailure`); the built-in laws apply 0 V for a NaN, as the compiled law does.
+    """
 
     def __init__(self, model: mujoco.MjModel, where: _Plant, substeps: int, log: bool, law: Callable[..., float],
                  reference: tuple[np.ndarray, np.ndarray, np.ndarray], voltage_limit: float,
-                 disturbance: np.ndarray | None = None, fields: Mapping[str, np.ndarray] | None = None) -> None:
+                 disturbance: np.ndarray | None = None, fields: Mapping[str, np.ndarray] | None = None, *,
+                 period: float = 1.0, strict: bool = False) -> None:
         self.model, self.where, self.substeps, self.log = model, where, substeps, log
+        self.period, self.strict = period, strict
         self._own = False  # whether self.model is this stepper's own copy (made at the first load change)
         if fields:
             self.set_fields(fields)
@@ -289,12 +321,16 @@ class _PythonStepper:
         dist = None if self.disturbance is None else self.disturbance[k0:k0 + count].tolist()
         qfrc_applied = d.qfrc_applied
         quat = np.empty((count, 4))
+        period, strict = self.period, self.strict
         for j in range(count):
             if dist is not None:
                 qfrc_applied[dv] = dist[j]  # held over the control step's physics steps, as the callback does
             a = float(qpos[qa])
             ad = float(qvel[dv])
-            u_cmd = law(a, ad, a0_all[j], a0d_all[j], a0dd_all[j])
+            if strict:
+                u_cmd = _checked_call(law, (k0 + j) * period, a, ad, a0_all[j], a0d_all[j], a0dd_all[j])
+            else:
+                u_cmd = law((k0 + j) * period, a, ad, a0_all[j], a0d_all[j], a0dd_all[j])
             if u_cmd != u_cmd:  # NaN from a diverged law: apply nothing, keep the record
                 u = 0.0
             else:
@@ -327,10 +363,10 @@ class Schedule:
     ``reference`` = (alpha0, alpha0', alpha0'') on the control grid (at least n samples); ``n``
     control steps of ``substeps`` physics steps, ``period`` [s] each. ``disturbance``: a torque on
     the steering joint [N m] per control step (at least n samples); ``loads``: (control step, model
-    fields) of each load change (:func:`load_fields`), in step order. ``correction``: a
-    :class:`wmr_mj.sim.correction.CartesianCorrection`, whose outer loop rewrites the next
-    block's reference (alpha0 + delta, ...) before each block of its period, from C's position
-    and the heading of the control step before; the rows' alpha0 are then the corrected ones.
+    fields) of each load change (:func:`load_fields`), in step order. ``tracker``: a
+    :class:`controllers.tracking.PathTracker` (reset with ``path_reference``), whose outer loop writes the
+    next block's reference before each block of its period, from C's position, the heading and C's
+    speed of the control step before; the rows' alpha0 are then the tracker's.
     """
 
     reference: tuple[np.ndarray, np.ndarray, np.ndarray]
@@ -339,7 +375,8 @@ class Schedule:
     period: float
     disturbance: np.ndarray | None = None
     loads: Sequence[tuple[int, Mapping[str, np.ndarray]]] = ()
-    correction: Any = None
+    tracker: Any = None  # a controllers.tracking.PathTracker
+    path_reference: Any = None  # the path's Reference, which the tracker is reset with
 
 
 def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any], schedule: Schedule,
@@ -348,14 +385,14 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
     """Run ``schedule.n`` control steps of ``controller`` on the plant of ``params``; rows of every control step.
 
     ``schedule`` (:class:`Schedule`): the reference, the control grid, the signals and the
-    correction. ``on_block(block)``, where given, receives the rows of every simulated second with qpos,
+    tracker. ``on_block(block)``, where given, receives the rows of every simulated second with qpos,
     qvel, ctrl (at each control step's start, ctrl as applied), A_pos and C_pos (xy of sites A
     and C); ``on_progress(steps)`` the control steps of each block. KeyboardInterrupt (Ctrl-C,
     SIGTERM made one) ends the run as "interrupted" with the blocks simulated so far; a block
     committed but not yet handed to ``on_block`` is handed over before returning. ``model``:
     ``batch_model(params, **options)`` where the caller has it already.
     """
-    n, substeps, period, correction = schedule.n, schedule.substeps, schedule.period, schedule.correction
+    n, substeps, period, tracker = schedule.n, schedule.substeps, schedule.period, schedule.tracker
     backend, note = _backend(controller, law)
     plain = batch_model(params, **options) if model is None else model
     where = _Plant(plain)
@@ -363,9 +400,14 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
     (a0_all, a0d_all, a0dd_all), disturbance, loads = _checked_inputs(schedule)
     in_effect: dict[str, np.ndarray] = {}  # the load fields set so far (a Python stepper made later starts with them)
 
+    strict = not compiled_law.supports(controller)
+    controller.reset(control_period=period)
+    if tracker is not None:
+        tracker.reset(schedule.path_reference, control_period=period)
+
     def python_stepper(fields: Mapping[str, np.ndarray] | None = None) -> _PythonStepper:
-        return _PythonStepper(plain, where, substeps, log, controller.voltage_scalar, (a0_all, a0d_all, a0dd_all),
-                              params.voltage_limit, disturbance, fields)
+        return _PythonStepper(plain, where, substeps, log, controller.step, (a0_all, a0d_all, a0dd_all),
+                              params.voltage_limit, disturbance, fields, period=period, strict=strict)
 
     lawful = None
     ref_adr = 0
@@ -379,12 +421,13 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
     rows = {key: np.empty(n) for key in ROW_FIELDS}
     C_xy = np.empty((n, 2))
     block_len = max(1, int(round(1.0 / period)))  # one simulated second per block
-    if correction is not None:
-        block_len = correction.block_steps  # the outer loop's period
+    if tracker is not None:
+        block_len = tracker.block_steps  # the outer loop's period
     blocks: dict[int, _Block] = {}
     k_i = params.k_i
     warned = 0  # warnings counted by a stepper left behind
     status = "completed"
+    failure: str | None = None
     k = sent = 0
 
     def hand_over(upto: int) -> None:
@@ -425,7 +468,7 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
     wall0, cpu0 = time.perf_counter(), time.thread_time()
     # The block loop stays in one piece: it is the hot loop (one rollout call, or one Python
     # stepper call, per block of control steps and no Python per physics step), and its state
-    # (the stepper, which may fall back to the Python law, the reference the correction rewrites,
+    # (the stepper, which may fall back to the Python law, the reference the tracker rewrites,
     # the rows handed over so far) is shared by every part of it.
     try:
         for k0 in range(0, n, block_len):
@@ -433,14 +476,13 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
             b = blocks.get(cnt)
             if b is None:
                 b = blocks[cnt] = _Block(cnt, plain, log)
-            if correction is not None:
+            if tracker is not None:
                 if k0:
-                    correction.measure(rows["t"][k0 - 1], C_xy[k0 - 1], rows["heading"][k0 - 1])
-                d, dd, ddd = correction.block(cnt)
+                    # C's speed over the control step before (NaN until two samples exist)
+                    speed = (math.hypot(*(C_xy[k0 - 1] - C_xy[k0 - 2])) / period) if k0 >= 2 else math.nan
+                    tracker.measure(rows["t"][k0 - 1], C_xy[k0 - 1], rows["heading"][k0 - 1], speed)
                 sl = slice(k0, k0 + cnt)
-                a0_all[sl] += d
-                a0d_all[sl] += dd
-                a0dd_all[sl] += ddd
+                a0_all[sl], a0d_all[sl], a0dd_all[sl] = _tracker_block(tracker, k0, cnt)
                 if lawful is not None:  # the compiled law reads its reference from the model
                     lawful.numeric_data[ref_adr + 3 * k0:ref_adr + 3 * (k0 + cnt)] = np.stack(
                         [a0_all[sl], a0d_all[sl], a0dd_all[sl]], axis=1).ravel()
@@ -464,26 +506,46 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
                 on_progress(cnt)
     except KeyboardInterrupt:
         status = "interrupted"
+    except ControllerFailure as exc:  # the run stops at the failing block; what was simulated stays
+        status, failure = "failed", str(exc)
     if k:
         hand_over(k)  # a block interrupted between its rows and its hand-over
     wall, cpu = time.perf_counter() - wall0, time.thread_time() - cpu0
     done = {key: v[:k] for key, v in rows.items()}
     return EngineRun(rows=done, steps=k, status=status, warnings=warned + stepper.warnings(), law=used,
-                     law_note=note, wall_s=wall, cpu_s=cpu, C_xy=C_xy[:k])
+                     law_note=note, wall_s=wall, cpu_s=cpu, C_xy=C_xy[:k], failure=failure)
+
+
+def _tracker_block(tracker: Any, k0: int, cnt: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The tracker's reference for control steps k0 .. k0 + cnt, checked: three finite arrays of cnt values."""
+    try:
+        out = tracker.block(k0, cnt)
+        a0, a0d, a0dd = (np.asarray(x, dtype=np.float64) for x in out)
+    except (TypeError, ValueError) as exc:
+        raise ControllerFailure(f"tracker {getattr(tracker, 'name', type(tracker).__name__)!r}: block() must "
+                                f"return (alpha0, alpha0', alpha0'') of {cnt} values each ({exc})") from None
+    except Exception as exc:  # noqa: BLE001  (the user's tracker: its message, naming it)
+        raise ControllerFailure(f"tracker {getattr(tracker, 'name', type(tracker).__name__)!r} raised "
+                                f"{type(exc).__name__}: {exc}") from None
+    for x in (a0, a0d, a0dd):
+        if x.shape != (cnt,) or not np.all(np.isfinite(x)):
+            raise ControllerFailure(f"tracker {getattr(tracker, 'name', type(tracker).__name__)!r}: block() must "
+                                    f"return three arrays of {cnt} finite values, got shape {x.shape}")
+    return a0, a0d, a0dd
 
 
 def _checked_inputs(schedule: Schedule) -> tuple[tuple[np.ndarray, np.ndarray, np.ndarray], np.ndarray | None,
                                                  list[tuple[int, dict[str, np.ndarray]]]]:
-    """The schedule's reference (a copy where the correction rewrites it), disturbance and load
+    """The schedule's reference (a copy where the tracker rewrites it), disturbance and load
     changes (sorted by step), each checked against the run's length."""
-    n, correction = schedule.n, schedule.correction
-    a0_all, a0d_all, a0dd_all = (np.array(r, dtype=np.float64) if correction is not None
+    n, tracker = schedule.n, schedule.tracker
+    a0_all, a0d_all, a0dd_all = (np.array(r, dtype=np.float64) if tracker is not None
                                  else np.asarray(r, dtype=np.float64) for r in schedule.reference)
     if len(a0_all) < n:
         raise ParameterError(f"reference shorter than the run: {len(a0_all)} < {n} samples")
     disturbance, loads = schedule.disturbance, schedule.loads
-    if correction is not None and (disturbance is not None or loads):
-        raise ParameterError("the Cartesian correction does not run with disturbance or load signals yet")
+    if tracker is not None and (disturbance is not None or loads):
+        raise ParameterError("a path tracker (or --correction) does not run with disturbance or load signals yet")
     if disturbance is not None:
         disturbance = np.asarray(disturbance, dtype=np.float64)
         if len(disturbance) < n:
@@ -504,7 +566,7 @@ def _compiled_stepper(params: C80Parameters, controller: Any, options: dict[str,
     assert vector is not None  # the backend is 'compiled' only where compiled_law.supports(controller)
     carried = (vector, reference) + (() if disturbance is None else (disturbance[:n],))
     lawful = batch_model(params, law=carried, **options)
-    stepper = _CompiledStepper(lawful, where, substeps, log, own_model=schedule.correction is not None)
+    stepper = _CompiledStepper(lawful, where, substeps, log, own_model=schedule.tracker is not None)
     ref_numeric = lawful.numeric(compiled_law.REFERENCE_NUMERIC)
     return stepper, lawful, int(lawful.numeric_adr[ref_numeric.id])
 

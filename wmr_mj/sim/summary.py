@@ -25,7 +25,7 @@ from wmr_mj.analysis.certificate import Assumption, CertificateJudgement
 from wmr_mj.analysis.path_bound import PathBound, PathVerdict
 from wmr_mj.analysis.path_error import PathErrors
 from wmr_mj.analysis.requirements import RequirementResult
-from wmr_mj.analysis.verdicts import Drift, PaperRegion
+from wmr_mj.analysis.verdicts import FAILED, NO_CLAIM, Drift, PaperRegion
 
 __all__ = ["RunSummary", "PaperRegion", "Drift", "CertificateJudgement", "Assumption", "BatchFigures"]
 
@@ -94,7 +94,7 @@ class RunSummary:
         path_verdict: the run's cross-track against ``path_bound``: 'within-bound', 'beyond-bound'
             or 'no-guarantee'.
         correction: the Cartesian correction's gains, limits and the largest values it used
-            (``wmr_mj.sim.correction``); None when the run had none.
+            (``controllers.tracking``); None when the run had none.
         requirements: each STL requirement judged on the run (``wmr_mj.analysis.requirements``:
             formula, robustness, satisfied); None when none was asked for.
     """
@@ -132,6 +132,8 @@ class RunSummary:
     path_verdict: PathVerdict | None = None
     correction: Mapping[str, Any] | None = None
     requirements: tuple[RequirementResult, ...] | None = None
+    failure: str | None = None  # status 'failed': why the law (or tracker) failed; the run has no verdict but this
+    claimed: bool = True  # False: the controller states no claim (judged by its requirements only, never a pass)
 
     # the paper's claim, read through paper_region (the JSON also writes these at the top level)
     @property
@@ -173,7 +175,13 @@ class RunSummary:
 
     @property
     def verdict(self) -> str | None:
-        """The separated verdict (``wmr_mj.analysis.verdicts``); None without a certificate."""
+        """The separated verdict (``wmr_mj.analysis.verdicts``): 'failed' for a run whose law failed
+        (:attr:`failure`), 'no-claim' for a controller that states no claim, else the certificate's;
+        None without a certificate (a summary of a caller that judged none)."""
+        if self.failure is not None:
+            return FAILED
+        if not self.claimed:
+            return NO_CLAIM
         return None if self.certificate is None else self.certificate.verdict
 
     def to_dict(self) -> dict[str, Any]:
@@ -219,6 +227,12 @@ class RunSummary:
             out["certificate"] = self.certificate.to_dict()
             out["paper_region"] = self.paper_region.to_dict()
             out["drift"] = {} if self.drift is None else self.drift.to_dict()
+        elif self.failure is not None or not self.claimed:
+            out["verdict"] = self.verdict
+            out["paper_region"] = self.paper_region.to_dict()
+            out["drift"] = {} if self.drift is None else self.drift.to_dict()
+        if self.failure is not None:
+            out["failure"] = self.failure
         if self.mujoco_warnings is not None:
             out["mujoco_warnings"] = self.mujoco_warnings
         if self.analysis is not None:

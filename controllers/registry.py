@@ -1,0 +1,267 @@
+"""Finding a steering law or a path tracker by name: built-ins, files, modules and installed plug-ins.
+
+A controller (or tracker) is named by one string:
+
+- a built-in name (:data:`BUILTIN_CONTROLLERS`, :data:`BUILTIN_TRACKERS`);
+- ``FILE.py:Class``: a class in a Python file of one's own (relative to the working folder);
+- ``module:Class`` or ``package.module:Class``: a class of an importable module;
+- the name of an entry point that an installed package registers in the group
+  ``wmr_mj.controllers`` (or ``wmr_mj.trackers``)::
+
+      [project.entry-points."wmr_mj.controllers"]
+      my-smc = "my_package.smc:SlidingMode"
+
+with its parameters as NAME=VALUE strings (``--controller-param``): a value is read as JSON where
+it parses (numbers, true/false, lists), else kept as a string. :func:`resolve` returns the class
+and a :class:`PluginSource`: what the log records to find it again (the import path, the
+parameters, the SHA-256 of the file that defines it), so that ``replay --verify`` re-imports it
+and refuses a source that has changed.
+
+Usage::
+
+    from controllers.registry import resolve, parse_params
+    cls, source = resolve("examples/my_law.py:MyPD", parse_params(["kp=40"]), kind="controller")
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib
+import importlib.util
+import inspect
+import json
+import sys
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from importlib.metadata import entry_points
+from pathlib import Path
+from typing import Any
+
+from wmr_mj.errors import ParameterError, UnknownNameError
+
+__all__ = ["PluginSource", "resolve", "parse_params", "BUILTIN_CONTROLLERS", "BUILTIN_TRACKERS", "ENTRY_POINT_GROUPS",
+           "controller_names", "tracker_names", "source_hash", "is_builtin"]
+
+#: built-in steering laws: name -> "module:Class"
+BUILTIN_CONTROLLERS: dict[str, str] = {
+    "computed-torque": "controllers.computed_torque:ComputedTorque",
+    "pd": "controllers.computed_torque:PDController",
+    "sliding-mode": "controllers.sliding_mode:SlidingMode",
+    "adaptive-computed-torque": "controllers.adaptive:AdaptiveComputedTorque",
+}
+#: built-in path trackers: name -> "module:Class"
+BUILTIN_TRACKERS: dict[str, str] = {
+    "stanley-at-C": "controllers.tracking:StanleyAtC",
+    "pure-pursuit": "controllers.pure_pursuit:PurePursuit",
+}
+ENTRY_POINT_GROUPS = {"controller": "wmr_mj.controllers", "tracker": "wmr_mj.trackers"}
+
+
+@dataclass(frozen=True)
+class PluginSource:
+    """Where a law or tracker came from, as its log records it.
+
+    Attributes:
+        spec: the name as given (a built-in name, ``FILE.py:Class``, ``module:Class``, an entry point).
+        name: the class's ``name`` (what every output calls it).
+        origin: 'builtin', 'file', 'module', 'entry-point' or 'instance' (given as an object).
+        import_path: ``module:Class``, or ``/absolute/file.py:Class`` for a file.
+        params: the parameters it was built with (JSON-able).
+        source_sha256: SHA-256 of the file that defines the class (None where there is no file).
+    """
+
+    spec: str
+    name: str
+    origin: str
+    import_path: str
+    params: Mapping[str, Any] = field(default_factory=dict)
+    source_sha256: str | None = None
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"spec": self.spec, "name": self.name, "origin": self.origin, "import_path": self.import_path,
+                "params": dict(self.params), "source_sha256": self.source_sha256}
+
+
+def controller_names() -> tuple[str, ...]:
+    """Every steering law reachable by name: the built-ins, then installed entry points."""
+    return tuple(BUILTIN_CONTROLLERS) + _entry_point_names("controller")
+
+
+def tracker_names() -> tuple[str, ...]:
+    """Every path tracker reachable by name: the built-ins, then installed entry points."""
+    return tuple(BUILTIN_TRACKERS) + _entry_point_names("tracker")
+
+
+def is_builtin(spec: Any, kind: str = "controller") -> bool:
+    return isinstance(spec, str) and spec in (BUILTIN_CONTROLLERS if kind == "controller" else BUILTIN_TRACKERS)
+
+
+def _entry_point_names(kind: str) -> tuple[str, ...]:
+    return tuple(sorted(ep.name for ep in entry_points(group=ENTRY_POINT_GROUPS[kind])))
+
+
+def parse_params(items: Iterable[str] | Mapping[str, Any] | None, *, option: str = "--controller-param"
+                 ) -> dict[str, Any]:
+    """NAME=VALUE strings as a mapping (a value that parses as JSON is read as JSON, else kept as text).
+
+    Raises:
+        ParameterError: an item without '=' or with an empty name, or a name given twice.
+    """
+    if items is None:
+        return {}
+    if isinstance(items, Mapping):
+        return dict(items)
+    out: dict[str, Any] = {}
+    for item in items:
+        name, sep, text = str(item).partition("=")
+        name = name.strip()
+        if not sep or not name or not name.isidentifier():
+            raise ParameterError(f"{option} {item!r} is not accepted: NAME=VALUE with NAME a Python identifier, "
+                                 "e.g. k=2.5")
+        if name in out:
+            raise ParameterError(f"{option}: {name!r} is given twice")
+        try:
+            out[name] = json.loads(text)
+        except ValueError:
+            out[name] = text
+    return out
+
+
+def source_hash(cls: type) -> str | None:
+    """SHA-256 of the file that defines ``cls``; None where it has none (built in C, made in a REPL)."""
+    try:
+        path = inspect.getsourcefile(cls)
+    except TypeError:
+        return None
+    if path is None or not Path(path).is_file():
+        return None
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def _from_file(path_text: str, class_name: str, kind: str) -> tuple[type, str]:
+    path = Path(path_text).expanduser()
+    if not path.is_file():
+        raise ParameterError(f"{kind} file {path_text!r} does not exist; give FILE.py:Class with FILE.py a Python file")
+    path = path.resolve()
+    module_name = "wmr_mj_plugin_" + hashlib.sha256(str(path).encode()).hexdigest()[:12]
+    module = sys.modules.get(module_name)
+    if module is None or getattr(module, "__file__", None) != str(path):
+        spec = importlib.util.spec_from_file_location(module_name, path)
+        if spec is None or spec.loader is None:
+            raise ParameterError(f"{kind} file {path_text!r} cannot be imported as Python")
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[module_name] = module  # dataclasses and pickling look the module up by name
+        try:
+            spec.loader.exec_module(module)
+        except Exception as exc:  # noqa: BLE001  (any error of the user's file: one line, naming it)
+            del sys.modules[module_name]
+            raise ParameterError(f"{kind} file {path_text!r} fails to import: {type(exc).__name__}: {exc}") from None
+    cls = getattr(module, class_name, None)
+    if cls is None:
+        found = sorted(n for n, v in vars(module).items() if isinstance(v, type) and v.__module__ == module_name)
+        raise ParameterError(f"{kind} file {path_text!r} has no class {class_name!r}; classes there: "
+                             f"{', '.join(found) or 'none'}")
+    return cls, f"{path}:{class_name}"
+
+
+def _from_module(module_name: str, class_name: str, kind: str) -> tuple[type, str]:
+    try:
+        module = importlib.import_module(module_name)
+    except ImportError as exc:
+        raise ParameterError(f"{kind} module {module_name!r} cannot be imported ({exc}); give module:Class of an "
+                             "installed module, or FILE.py:Class") from None
+    except Exception as exc:  # noqa: BLE001
+        raise ParameterError(f"{kind} module {module_name!r} fails to import: {type(exc).__name__}: {exc}") from None
+    obj: Any = module
+    for part in class_name.split("."):
+        obj = getattr(obj, part, None)
+        if obj is None:
+            raise ParameterError(f"{kind} module {module_name!r} has no {class_name!r}")
+    return obj, f"{module_name}:{class_name}"
+
+
+def _class_of(spec: str, kind: str) -> tuple[type, str, str]:
+    """(class, origin, import path) of a name."""
+    builtins = BUILTIN_CONTROLLERS if kind == "controller" else BUILTIN_TRACKERS
+    if spec in builtins:
+        module_name, class_name = builtins[spec].split(":")
+        cls, path = _from_module(module_name, class_name, kind)
+        return cls, "builtin", path
+    if ":" in spec:
+        where, _, class_name = spec.rpartition(":")
+        if not class_name.replace(".", "_").isidentifier() or not where:
+            raise ParameterError(f"{kind} {spec!r} is not accepted: FILE.py:Class or module:Class")
+        if where.endswith(".py") or "/" in where or "\\" in where:
+            cls, path = _from_file(where, class_name, kind)
+            return cls, "file", path
+        cls, path = _from_module(where, class_name, kind)
+        return cls, "module", path
+    for ep in entry_points(group=ENTRY_POINT_GROUPS[kind]):
+        if ep.name == spec:
+            try:
+                cls = ep.load()
+            except Exception as exc:  # noqa: BLE001
+                raise ParameterError(f"{kind} entry point {spec!r} ({ep.value}) fails to load: {exc}") from None
+            return cls, "entry-point", ep.value
+    names = controller_names() if kind == "controller" else tracker_names()
+    if spec.endswith(".py"):
+        raise ParameterError(f"{kind} {spec!r} is not accepted: name the class too, FILE.py:Class")
+    raise UnknownNameError(kind, spec, names + ("FILE.py:Class", "module:Class"))
+
+
+def resolve(spec: str, params: Mapping[str, Any] | None = None, *, kind: str = "controller"
+            ) -> tuple[type, PluginSource]:
+    """The class named by ``spec`` and where it came from (the module docstring lists the forms).
+
+    kind: 'controller' (a :class:`controllers.base.SteeringController`) or 'tracker' (a
+    :class:`controllers.tracking.PathTracker`); the class is checked to be one, with the method a
+    law needs (:func:`controllers.base.law_methods_missing`).
+
+    Raises:
+        UnknownNameError: a name that is neither built in, nor a file or module path, nor an entry point.
+        ParameterError: a missing file, a file or module that fails to import, a missing class, a
+            class that is not a law (or tracker).
+    """
+    from controllers.base import law_methods_missing
+    from controllers.tracking import PathTracker
+
+    if not isinstance(spec, str) or not spec.strip():
+        raise ParameterError(f"{kind} {spec!r} is not accepted: a name, FILE.py:Class or module:Class")
+    cls, origin, import_path = _class_of(spec.strip(), kind)
+    if kind == "controller":
+        why = law_methods_missing(cls)
+    else:
+        why = (None if isinstance(cls, type) and issubclass(cls, PathTracker) else
+               f"{getattr(cls, '__name__', cls)!r} is not a path tracker: subclass controllers.PathTracker")
+    if why is not None:
+        raise ParameterError(f"{kind} {spec!r}: {why}")
+    from controllers.base import describe_params
+
+    source = PluginSource(spec=spec.strip(), name=str(getattr(cls, "name", cls.__name__)), origin=origin,
+                          import_path=import_path, params=describe_params(params or {}),
+                          source_sha256=source_hash(cls))
+    return cls, source
+
+
+def build(cls: type, params: Mapping[str, Any], context: Any, *, spec: str, kind: str = "controller") -> Any:
+    """``cls.from_context(context, **params)``, a bad parameter named in one line.
+
+    Raises:
+        ParameterError: a parameter the class does not take, or a value it refuses.
+    """
+    try:
+        return cls.from_context(context, **dict(params))
+    except TypeError as exc:
+        accepted = _accepted(cls)
+        raise ParameterError(f"{kind} {spec!r} does not take these parameters ({exc}); accepted: "
+                             f"{', '.join(accepted) or 'none'}") from None
+    except (ValueError, ArithmeticError) as exc:
+        raise ParameterError(f"{kind} {spec!r}: a parameter is refused: {exc}") from None
+
+
+def _accepted(cls: type) -> list[str]:
+    try:
+        sig = inspect.signature(cls.__init__)
+    except (TypeError, ValueError):
+        return []
+    return [n for n, p in sig.parameters.items() if n != "self" and p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)]

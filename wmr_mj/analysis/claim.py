@@ -1,0 +1,133 @@
+"""A controller's claim: what a steering law promises about |E| and |E'|, and what the run gives it to work with.
+
+Every controller may state a claim: a bound on the tracking error with the assumptions it rests
+on (:meth:`controllers.base.SteeringController.claim`). The testbed hands it a
+:class:`ClaimContext` (the plant box the run declares, the bounds of the reference the law will
+receive, the plant's limits, the control period, the initial error, and the assumptions the run
+itself brings: plant inside the box, signals within their bounds, reference within the declared
+bounds, a tracker within its declared limits) and judges the run against what comes back, a
+:class:`~wmr_mj.analysis.certificate.Certificate`, exactly as it judges the computed-torque law's
+section-4 certificate:
+
+* ``certified-inside``: every assumption holds and (sup|E|, sup|E'|) lies in the claimed region;
+* ``certified-outside``: the assumptions hold and the run is outside (the claim is wrong for this
+  plant, or the plant is not what the claim assumes: printed loudly);
+* ``uncertified-*``: an assumption fails; never a pass;
+* no claim at all (the law states none): the run has no verdict, only its requirements
+  (``--require``); it is never a pass.
+
+The computed-torque and PD laws claim the section-4 certificate
+(:func:`wmr_mj.analysis.certificate.certify`). A law with a simpler guarantee, such as a
+sliding-mode law's boundary layer |E| <= phi/lambda, states it with :func:`box_claim`: the region
+|E| <= E_max, |E'| <= Edot_max, with its own assumptions beside the run's.
+
+Usage::
+
+    from wmr_mj.analysis.claim import box_claim, run_assumptions
+    def claim(self, context):
+        E_max = self.phi / self.lam
+        return box_claim(claimant=self.name, E_max=E_max, Edot_max=2 * self.phi, context=context,
+                         alpha_max=context.reference.alpha_max + E_max, voltage_max=..., own=(...))
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+from wmr_mj.analysis.certificate import Assumption, Certificate, PlantBox, PlantLimits
+from wmr_mj.errors import ParameterError
+from wmr_mj.params import C80Parameters
+from wmr_mj.reference.bounds import ReferenceBounds
+
+__all__ = ["ClaimContext", "box_claim", "run_assumptions", "with_measured"]
+
+
+@dataclass(frozen=True, kw_only=True)
+class ClaimContext:
+    """What a run gives a controller's claim (:meth:`controllers.base.SteeringController.claim`).
+
+    Attributes:
+        plant: the plants the run declares (P [V s^2/rad], C_V [V s/rad], F [V], K [V] ranges,
+            gyro [V s/m], V_A [m/s], the disturbance bound d_V,max [V]): the box the claim must cover.
+        reference: bounds of the reference the law receives (max|alpha0| [rad], max|alpha0'|
+            [rad/s], max|alpha0''| [rad/s^2], max sin/cos^3): the declared ones where the run
+            declares them, widened by a tracker's declared limits where one runs.
+        limits: the plant's steering stops [rad] and supply [V].
+        control_period: the law's period [s].
+        initial_error: (E(0) [rad], E'(0) [rad/s]) of the run.
+        stated: the assumptions the run brings (each checked against the run, or stated with its
+            source); a claim appends them to its own.
+        estimate: the controller's belief, the nominal parameter set.
+    """
+
+    plant: PlantBox
+    reference: ReferenceBounds
+    limits: PlantLimits
+    control_period: float
+    initial_error: tuple[float, float]
+    stated: tuple[Assumption, ...] = ()
+    estimate: C80Parameters
+    notes: Mapping[str, Any] = field(default_factory=dict)
+
+
+def run_assumptions(*, alpha_max: float, voltage_max: float, context: ClaimContext,
+                    initial_tolerance: float = 1e-9) -> tuple[Assumption, ...]:
+    """The assumptions every claim of a bounded |E| shares, checked: the reachable angle below pi/2
+    (``alpha_max`` = max|alpha0| + E_max [rad]), inside the steering stops, the law's voltage within
+    the supply (``voltage_max`` [V], the claim's bound on |u|), zero initial error (within
+    ``initial_tolerance``, the reference's rounding at t = 0)."""
+    limits = context.limits
+    E0, Ed0 = context.initial_error
+    init = max(abs(E0), abs(Ed0))
+    return (
+        Assumption("reachable angle", "alpha_max = max|alpha0| + E_max < pi/2", alpha_max < 0.5 * math.pi,
+                   alpha_max, 0.5 * math.pi, ""),
+        Assumption("inside the steering stops", "max|alpha0| + E_max < steering_range",
+                   alpha_max < limits.steering_range, alpha_max, limits.steering_range,
+                   "the stop's torque is not in the model"),
+        Assumption("within the supply", "the law's |u| bound <= voltage_limit", voltage_max <= limits.voltage_limit,
+                   voltage_max, limits.voltage_limit, "the analysis has no saturation"),
+        Assumption("zero initial error", "E(0) = E'(0) = 0", init <= initial_tolerance, init, initial_tolerance,
+                   f"E(0) = {E0:g} rad, E'(0) = {Ed0:g} rad/s"),
+    )
+
+
+def box_claim(*, claimant: str, E_max: float, Edot_max: float = math.inf, context: ClaimContext, alpha_max: float,
+              voltage_max: float, own: Sequence[Assumption] = (), reason: str = "",
+              inputs: Mapping[str, Any] | None = None) -> Certificate:
+    """A claim |E| <= E_max [rad] and |E'| <= Edot_max [rad/s] (inf: |E| alone) as a certificate.
+
+    Its assumptions: :func:`run_assumptions` (reachable angle, stops, supply, initial error), then
+    the claim's ``own`` (e.g. a gain above an uncertainty bound), then the run's
+    (``context.stated``). ``valid`` is False (E_max inf) where E_max is not a finite number >= 0 or
+    the reachable angle reaches pi/2.
+
+    Raises:
+        ParameterError: an assumption that is not an :class:`Assumption`.
+    """
+    for a in own:
+        if not isinstance(a, Assumption):
+            raise ParameterError(f"a claim's assumptions must be Assumption records, got {type(a).__name__}")
+    E_max, Edot_max = float(E_max), float(Edot_max)
+    valid = math.isfinite(E_max) and E_max >= 0.0 and not math.isnan(Edot_max) and alpha_max < 0.5 * math.pi
+    if not valid:
+        E_max, Edot_max = math.inf, math.inf
+        reason = reason or "no finite bound"
+    assumptions = (*run_assumptions(alpha_max=alpha_max, voltage_max=voltage_max, context=context), *own,
+                   *context.stated)
+    nan = math.nan
+    return Certificate(E_max=E_max, Edot_max=Edot_max, condition=nan, valid=valid, assumptions=assumptions,
+                       gamma1=nan, gamma2=nan, delta1=nan, delta2=nan, delta3=nan, alpha_max=alpha_max,
+                       voltage_max=voltage_max, friction_term=nan, gyro_term=nan, reason=reason,
+                       inputs=dict(inputs or {}), region="box", claimant=claimant, friction_sign="none")
+
+
+def with_measured(cert: Certificate, assumption: Assumption) -> Certificate:
+    """``cert`` with ``assumption``, measured on the run, in place of the one of the same name (else appended)."""
+    import dataclasses
+
+    kept = tuple(a for a in cert.assumptions if a.name != assumption.name)
+    return dataclasses.replace(cert, assumptions=(*kept, assumption))
