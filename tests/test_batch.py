@@ -85,13 +85,14 @@ def test_batch_model_is_the_serial_model_but_for_the_sky():
 
 
 
-def test_a_nan_voltage_applies_nothing_as_in_the_serial_run(monkeypatch):
-    from controllers import ComputedTorque
-    from wmr_mj.sim import batch
-    from wmr_mj.sim import closed_loop as simulate
+def test_a_nan_voltage_from_a_plug_in_fails_its_run_in_the_batch_as_in_the_serial_run():
+    from controllers import ComputedTorque, model_from_source
+    from wmr_mj.params import C80
 
     class NanWhileTurning(ComputedTorque):
-        """The law of the paper, but NaN while the reference turns fast (a diverged law)."""
+        """The law of the paper, but NaN while the reference turns fast (a law with a bug)."""
+
+        name = "nan-while-turning"
 
         def voltage_scalar(self, alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot):
             return math.nan if alpha0_dot > 0.002 else super().voltage_scalar(alpha, alpha_dot, alpha0, alpha0_dot,
@@ -108,22 +109,17 @@ def test_a_nan_voltage_applies_nothing_as_in_the_serial_run(monkeypatch):
 
             return nan_law
 
-    def controller(config, params):
-        c = original(config, params)
-        return NanWhileTurning(c.model, kp=c.kp, kd=c.kd)
-
-    from wmr_mj.sim import certify
-
-    original = simulate.controller_for
-    for module in (simulate, batch, certify):  # every module that builds the run's controller
-        monkeypatch.setattr(module, "controller_for", controller)
-    configs = [BASE.replace(path="lane-change", duration=4.0, m1=m) for m in (560.0, 720.0)]
+    law = NanWhileTurning(model_from_source(BASE.model, params=C80), kp=BASE.kp, kd=BASE.kd)
+    configs = [BASE.replace(controller=law, path="lane-change", duration=4.0, m1=m) for m in (560.0, 720.0)]
     for cfg, b in zip(configs, run_batch(configs, nthread=1)):
         s, b = run_closed_loop(cfg, progress=False).summary.to_dict(), b.to_dict()
-        assert s["saturated_fraction"] > 0  # the NaN steps happened (counted as saturated)
-        for key in KEYS:
+        # the batch's NaN step sends the run to the serial engine, which stops it there, naming the law
+        assert s["status"] == b["status"] == "failed" and s["verdict"] == "failed"
+        assert "nan-while-turning" in s["failure"] and "nan" in s["failure"].lower()
+        assert s["controller"] == "nan-while-turning"
+        assert 0 < s["control_steps"] < 4000  # stopped at the first NaN, with what ran before it
+        for key in ("sup_E", "sup_Edot", "final_alpha", "failure", "control_steps"):
             assert s[key] == b[key], key
-
 
 
 def test_paper_model_batch_matches_serial_including_steering_stop():
