@@ -395,3 +395,24 @@ def test_pose_and_duration_options() -> None:
 def test_bad_arguments(call, name: str) -> None:
     with pytest.raises(ParameterError, match=name):
         call()
+
+
+def test_too_short_a_duration_names_the_minimum_the_paper_circle_needs():
+    """The message states C's time over the lead-in and entry, computed here by hand: on the line alpha = 0
+    and C moves at V_A; on the ramp alpha(s) = asin(l1/R) S7(s/L) and dt/ds = cos(alpha)/V_A (C outruns A)."""
+    from scipy.integrate import quad
+
+    lead, L, R = 0.4, 1.5, 1.0
+    a1 = math.asin(L1 / R)
+    ramp = quad(lambda s: math.cos(a1 * (35 * (s / L) ** 4 - 84 * (s / L) ** 5 + 70 * (s / L) ** 6
+                                         - 20 * (s / L) ** 7)), 0.0, L, epsabs=1e-13, epsrel=1e-12)[0]
+    t_min = (lead + ramp) / VA
+    with pytest.raises(ParameterError) as info:
+        paper_circle(C80, radius=R, lead_in=lead, transition=L, duration=2.0)
+    msg = str(info.value)
+    assert "\n" not in msg and "duration = 2.0 s" in msg
+    took, least = (float(x) for x in re.search(r"take (\d+\.\d+) s; .*at least (\d+\.\d+) s", msg).groups())
+    # the message rounds to 1 ms (nearest, then up); the path's own integration (DOP853) is far finer
+    assert abs(took - t_min) <= 0.5e-3 + 1e-9
+    assert t_min <= least < t_min + 1e-3 + 1e-9
+    paper_circle(C80, radius=R, lead_in=lead, transition=L, duration=least)  # the minimum it names is accepted
