@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -182,3 +183,21 @@ def test_replay_without_a_path_says_why(tmp_path, capsys):
     synthetic_run(path, 0.2, block_rows=100)
     assert main(["replay", str(path)]) == 0
     assert "path of C  n/a: the log's configuration names no path" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("far", [(0.1, 1e200), (0.1, -1e200), (1e200, 0.0), (1e160, 1e160), (1e300, -1e300)])
+def test_a_diverged_position_projects_without_a_warning(straight, far):
+    """A point whose squared distance from the path overflows (beyond ~1.3e154 m): once kappa * inf
+    (NaN on a line) warned 'invalid value encountered in multiply'; now its cross-track is +-inf by its
+    side (+inf on the path's line, ahead), the samples beside it projected as they always were."""
+    from wmr_mj.analysis.path_error import PathProjector
+
+    X = np.array([straight.C_xy[10], far, straight.C_xy[20]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        s, d, _ = PathProjector(straight).project_many(X, 0.0)
+        series = path_error_series(straight, np.array([0.0, 1.0, 2.0]), X, np.zeros(3))
+    side = 1.0 if far[1] >= 0.0 else -1.0  # the line runs along +x from the origin: left is +y
+    assert d[1] == side * math.inf and series.cross_track[1] == side * math.inf
+    # on the path; on a line the chords are the path: rounding of metres only
+    assert np.all(np.isfinite(s)) and abs(d[0]) < 1e-9
