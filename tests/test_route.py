@@ -93,6 +93,7 @@ def test_route_runs_closed_loop_and_config_stays_json(tmp_path):
 def test_waypoints_and_the_packaged_agv_loop():
     assert "agv-loop" in route_names()
     r = load_route("agv-loop")
+    # a sum of closed-form turns of the segments: rounding (measured 9e-16)
     assert r.closed and r.path.heading_change == pytest.approx(2 * math.pi, abs=1e-9)
     radii = sorted({round(abs(1 / s.start_curvature), 6) for s in r.path.segments if s.kind == "arc"})
     assert len(radii) >= 4 and min(radii) >= 1.0
