@@ -27,6 +27,7 @@ def test_the_filter_keeps_rate_and_acceleration_within_the_limits():
     c.command = 0.1  # a step to the largest correction
     d, dd, ddd = (np.concatenate(x) for x in zip(*(c.corrections(50) for _ in range(200))))
     g = DEFAULT_GAINS
+    # the filter clips each to its limit: 1e-12 (rad, rad/s, rad/s^2 of order 0.1-10) is rounding only
     assert np.max(np.abs(d)) <= g.delta_max + 1e-12
     assert np.max(np.abs(dd)) <= g.rate_max + 1e-12
     assert np.max(np.abs(ddd)) <= g.acc_max + 1e-12
@@ -64,7 +65,7 @@ def test_a_corrected_run_names_its_assumptions_and_keeps_its_limits():
     measured = next(a for a in s.certificate.assumptions if a.name == TRACKER_BOUNDS_ASSUMPTION)
     assert measured.kind == "checked" and measured.met and 0.0 < measured.value <= 1.0  # measured on the run
     for used, limit in (("delta_max_used", "delta_max"), ("rate_max_used", "rate_max"), ("acc_max_used", "acc_max")):
-        assert s.correction[used] <= s.correction[limit] + 1e-12
+        assert s.correction[used] <= s.correction[limit] + 1e-12  # clipped to the limit: rounding
     assert s.certificate.E_max >= plain.certificate.E_max  # the corrected reference's wider bounds
     assert s.path_error.cross_track_max < plain.path_error.cross_track_max  # the correction's purpose
     assert "Cartesian correction" in s.path_verdict.text

@@ -439,7 +439,7 @@ def _simulate(p, V_of_t, T=4.0, n_eval=81):
     a0, ad0, _ = _alpha_ref(0.0)
     z0, zd0 = sim.initial_state(a0, ad0, V_of_t(0.0)[0])
     G, _ = sim.constraints(z0, zd0)
-    assert np.abs(G @ zd0).max() < 1e-12  # consistent initial velocities
+    assert np.abs(G @ zd0).max() < 1e-12  # consistent initial velocities (a linear solve: rounding)
 
     def rhs(t, y):
         z, zd = y[:sim.n], y[sim.n:]

@@ -72,6 +72,8 @@ def test_foxglove_reader_decodes_every_channel(tmp_path, compression):
             p, q = world[tr["parent"]]
             x, y, z, w = tr["rotation"]
             world[tr["child"]] = (p + qrot(q, np.array(tr["translation"])), qmul(q, np.array([w, x, y, z])))
+        # the logged transforms composed again against mj_kinematics of the same qpos: rounding of a
+        # chain of products of m-scale poses, no simulation in it
         for b in range(1, m.nbody):
             p, q = world[mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b)]
             assert np.allclose(p, d.xpos[b], atol=1e-12) and abs(abs(np.dot(q, d.xquat[b])) - 1) < 1e-12

@@ -78,6 +78,7 @@ def test_measured_breakaway_brackets_the_friction_voltage():
     soft = measure_friction_law(C80, steering_friction="soft", rounds=1)
     # the least voltage tried, 2F/9, already moves the joint: the bracket starts at 0
     assert not soft.holds() and soft.breakaway_voltage == pytest.approx(2 * F / 9)
+    # both ends are voltages of the tried grid: a difference of V-scale numbers, rounding only
     assert soft.breakaway_voltage - soft.breakaway_resolution == pytest.approx(0.0, abs=1e-12)
 
 

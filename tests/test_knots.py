@@ -27,6 +27,9 @@ SLOW = reference_bounds_from("alpha_dot_max=0.3,alpha_ddot_max=0.05,alpha_max=0.
 
 
 def within(measured: ReferenceBounds, declared: ReferenceBounds) -> None:
+    # the measured bounds come from the reference's alpha(s), integrated at rtol 1e-10 (paths._RTOL):
+    # 1e-9 relative is 10 times that. Measured: alpha on the angle bound 1e-12 to 1e-11 below it,
+    # the rates ~1e-6 below (ramp_length takes the peaks 1e-6 high)
     assert measured.alpha_dot_max <= declared.alpha_dot_max * (1 + 1e-9)
     assert measured.alpha_ddot_max <= declared.alpha_ddot_max * (1 + 1e-9)
     assert measured.alpha_max is not None and measured.alpha_max <= declared.angle_max * (1 + 1e-9)
@@ -103,7 +106,7 @@ def test_ramp_length_edge_cases():
     assert ramp_length(0.4, 0.4, bounds=PAPER, V_A=VA) == 0.0
     # symmetric: steering back is as long as steering out
     assert ramp_length(0.0, 0.5, bounds=PAPER, V_A=VA) == pytest.approx(
-        ramp_length(0.5, 0.0, bounds=PAPER, V_A=VA), rel=1e-9)
+        ramp_length(0.5, 0.0, bounds=PAPER, V_A=VA), rel=1e-9)  # mirrored peaks: rounding (6e-16 measured)
     # paper_circle's entry, found from the peaks of its own integration: the same ramp, 1e-6 longer here
     entry = paper_circle(C80, duration=10.0).segments[1]
     assert entry.kind == "ramp"

@@ -272,6 +272,7 @@ def test_tf_matches_mujoco_kinematics(logged):
         d.qpos[:] = rows["qpos"][k]
         mujoco.mj_kinematics(m, d)
         world = _compose(tf.transforms)
+        # composed transforms against mj_kinematics of the same qpos: rounding of m-scale products
         for b in range(1, m.nbody):
             p, q = world[mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b)]
             assert np.allclose(p, d.xpos[b], atol=1e-12)

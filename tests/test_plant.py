@@ -203,6 +203,8 @@ def test_dcmotor_torque_is_equation_2_9():
         mujoco.mj_forward(m, d)
         rate = d.qvel[plant.steer_dof]
         expected = C80.i2 * C80.k_i * (u - C80.k_b * C80.i2 * rate) / C80.R_a
+        # MuJoCo's actuator force at the state it stepped to, against (2.9) at that same state: the
+        # arithmetic of its gain and bias terms, rounding only (no integration error enters)
         assert plant.steer_torque() == pytest.approx(expected, rel=1e-9)
         assert plant.motor_current() == pytest.approx((u - C80.k_b * C80.i2 * rate) / C80.R_a, rel=1e-9)
 

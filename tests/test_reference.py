@@ -106,6 +106,8 @@ def at_s(ref: Reference, s: float, values: np.ndarray) -> np.ndarray:
 def test_steady_circle_angle_and_radius(radius: float) -> None:
     ref = make_reference(circle(radius, turns=1.25), C80)
     expected = math.asin(L1 / radius)
+    # the integration starts at the steady angle, an equilibrium of alpha' = kappa - sin(alpha)/l1:
+    # measured <= 1.1e-16; 1e-9 is 10 times the integration's rtol 1e-10 (paths._RTOL)
     assert np.max(np.abs(ref.alpha0 - expected)) < 1e-9
     assert np.max(np.abs(ref.alpha0_dot)) < 1e-9
     assert np.max(np.abs(ref.alpha0_ddot)) < 1e-9
@@ -164,6 +166,8 @@ def test_paper_circle_bounds(paper_ref: Reference) -> None:
     assert b.alpha_dot_max == pytest.approx(PAPER_BOUNDS.alpha_dot_max, rel=0.03)
     assert b.alpha_ddot_max <= PAPER_BOUNDS.alpha_ddot_max
     assert 1.23 <= b.sin_cos3_max <= 1.25
+    # alpha settles on the circle's steady angle (a stable equilibrium) within the integration's
+    # rtol 1e-10 (measured 2e-16); 1e-9 is 10 times that. The duration is grid arithmetic: rounding
     assert b.alpha_max == pytest.approx(math.asin(L1), abs=1e-9)
     assert paper_ref.duration == pytest.approx(35.0, abs=1e-9)
     assert len(paper_ref) == 35001
@@ -176,8 +180,11 @@ def test_paper_circle_blend_entry(blend_ref: Reference) -> None:
     b = blend_ref.bounds()
     # the acceleration bound binds; a monotone curvature cannot give more than V_A/R
     assert b.alpha_ddot_max == pytest.approx(0.4, rel=1e-3)
+    # the blend's length is found by brentq (xtol 1e-9 m on ~1.5 m): that moves the peak by < 1e-9
+    # relative; the sampled peak lies below (measured 4.1e-7 below)
     assert b.alpha_ddot_max <= 0.4 + 1e-9
     assert b.alpha_dot_max < VA / 1.0
+    # the path's own curvature function, evaluated: rounding; the duration is grid arithmetic
     assert np.all(np.diff(blend_ref.kappa) >= -1e-12) and blend_ref.kappa.max() <= 1.0 + 1e-12
     assert blend_ref.duration == pytest.approx(35.0, abs=1e-9)
 
@@ -316,6 +323,9 @@ def test_at_interpolates(paper_ref: Reference) -> None:
     fine = make_reference(paper_circle(C80), C80, dt=5e-4)
     t_mid = fine.t[1:-1:2][:69000]
     a, ad, add = paper_ref.at(t_mid)
+    # one integration (dense output over s) sampled on two grids: the difference is at()'s cubic
+    # Hermite error, O(dt^4): measured 9e-15 rad (alpha0) and 1.5e-12 rad/s (alpha0'); 1e-10 is the
+    # integration's rtol
     assert np.max(np.abs(a - fine.alpha0[1:-1:2][:69000])) < 1e-10
     assert np.max(np.abs(ad - fine.alpha0_dot[1:-1:2][:69000])) < 1e-8
     assert np.max(np.abs(add - fine.alpha0_ddot[1:-1:2][:69000])) < 1e-4
@@ -348,6 +358,7 @@ def test_pose_and_duration_options() -> None:
     )
     assert base.duration == pytest.approx(10.0)
     rot = np.array([[math.cos(0.5), -math.sin(0.5)], [math.sin(0.5), math.cos(0.5)]])
+    # the pose is applied to the same integrated positions: rounding (measured 9e-16 m, 2e-16 rad)
     assert np.allclose(moved.A_xy, base.A_xy @ rot.T + [1.0, -2.0], atol=1e-9)
     assert np.allclose(moved.theta, base.theta + 0.5, atol=1e-12)
     assert np.array_equal(moved.alpha0, base.alpha0)
@@ -395,3 +406,24 @@ def test_pose_and_duration_options() -> None:
 def test_bad_arguments(call, name: str) -> None:
     with pytest.raises(ParameterError, match=name):
         call()
+
+
+def test_too_short_a_duration_names_the_minimum_the_paper_circle_needs():
+    """The message states C's time over the lead-in and entry, computed here by hand: on the line alpha = 0
+    and C moves at V_A; on the ramp alpha(s) = asin(l1/R) S7(s/L) and dt/ds = cos(alpha)/V_A (C outruns A)."""
+    from scipy.integrate import quad
+
+    lead, L, R = 0.4, 1.5, 1.0
+    a1 = math.asin(L1 / R)
+    ramp = quad(lambda s: math.cos(a1 * (35 * (s / L) ** 4 - 84 * (s / L) ** 5 + 70 * (s / L) ** 6
+                                         - 20 * (s / L) ** 7)), 0.0, L, epsabs=1e-13, epsrel=1e-12)[0]
+    t_min = (lead + ramp) / VA
+    with pytest.raises(ParameterError) as info:
+        paper_circle(C80, radius=R, lead_in=lead, transition=L, duration=2.0)
+    msg = str(info.value)
+    assert "\n" not in msg and "duration = 2.0 s" in msg
+    took, least = (float(x) for x in re.search(r"take (\d+\.\d+) s; .*at least (\d+\.\d+) s", msg).groups())
+    # the message rounds to 1 ms (nearest, then up); the path's own integration (DOP853) is far finer
+    assert abs(took - t_min) <= 0.5e-3 + 1e-9
+    assert t_min <= least < t_min + 1e-3 + 1e-9
+    paper_circle(C80, radius=R, lead_in=lead, transition=L, duration=least)  # the minimum it names is accepted

@@ -93,6 +93,8 @@ def test_exact_gammas_match_scipy_impulse(kp, kd):
     assert g2 == pytest.approx(integrate.trapezoid(np.abs(g), t), rel=2e-4)
     # the module's own h, g agree with scipy's
     hm, gm = impulse_responses(t[:2000], kp, kd)
+    # scipy's impulse is a matrix exponential, not a stepped integration: both are closed forms up to
+    # rounding (measured <= 1.9e-14 on responses ~0.1-0.3)
     np.testing.assert_allclose(hm, h[:2000], atol=1e-9)
     np.testing.assert_allclose(gm, g[:2000], atol=1e-9)
 

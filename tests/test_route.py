@@ -93,6 +93,7 @@ def test_route_runs_closed_loop_and_config_stays_json(tmp_path):
 def test_waypoints_and_the_packaged_agv_loop():
     assert "agv-loop" in route_names()
     r = load_route("agv-loop")
+    # a sum of closed-form turns of the segments: rounding (measured 9e-16)
     assert r.closed and r.path.heading_change == pytest.approx(2 * math.pi, abs=1e-9)
     radii = sorted({round(abs(1 / s.start_curvature), 6) for s in r.path.segments if s.kind == "arc"})
     assert len(radii) >= 4 and min(radii) >= 1.0
@@ -159,3 +160,42 @@ def test_bad_route_in_the_library(tmp_path):
         build_reference(str(f), C80, dt=1e-3, duration=20.0)
     with pytest.raises(Exception, match="unknown path 'nowhere'"):
         RunConfig(path="nowhere")
+
+
+def _run_json(capsys, *argv) -> dict:
+    capsys.readouterr()
+    assert main(["run", *argv, "--no-log", "--json"]) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+def test_a_route_longer_than_the_run_is_reported_unfinished(capsys):
+    """An 8.1 m straight route (its length: the distance between its two waypoints) and 35 s at
+    V_A = 0.2 m/s: on a straight alpha = 0 and C moves at V_A, so the reference covers 7.0 m."""
+    straight = json.dumps({"route": {"waypoints": [[0, 0], [8.1, 0]]}})
+    s = _run_json(capsys, "--path", straight, "--duration", "35")
+    # the reference's t(s) is integrated at rtol 1e-10 (paths._RTOL); 1e-9 relative is 10x that
+    assert s["route_length_m"] == pytest.approx(8.1, rel=1e-9)
+    assert s["route_driven_m"] == pytest.approx(C80.V_A * 35.0, rel=1e-9) and C80.V_A == 0.2
+    assert s["route_finished"] is False
+    assert main(["run", "--path", straight, "--duration", "35", "--no-log"]) == 0
+    text = capsys.readouterr().out
+    assert "route not finished: its reference covers 7 m of the route's 8.1 m in 35 s" in text
+
+
+def test_the_packaged_loop_run_short_is_unfinished_and_a_named_path_has_no_route_keys(capsys):
+    s = _run_json(capsys, "--path", "agv-loop", "--duration", "5")
+    lap = load_route("agv-loop").path.length
+    # one lap, not the laps the reference repeats; its corners cut the waypoints' 52 m polygon
+    assert s["route_length_m"] == lap and 40.0 < lap < 52.0
+    # it starts mid-way along its first straight leg: C at V_A for 5 s (tolerance as above)
+    assert s["route_driven_m"] == pytest.approx(C80.V_A * 5.0, rel=1e-9) and s["route_finished"] is False
+    named = _run_json(capsys, "--path", "lane-change", "--duration", "1")
+    assert not any(k.startswith("route_") for k in named)
+
+
+def test_route_progress_finishes_at_the_route_end():
+    from wmr_mj.reference.route import FINISHED_TOL_M, RouteProgress, route_progress
+
+    assert RouteProgress(length_m=8.1, driven_m=8.1 - 0.5 * FINISHED_TOL_M).finished
+    assert not RouteProgress(length_m=8.1, driven_m=8.1 - 2 * FINISHED_TOL_M).finished
+    assert route_progress("paper-circle", None, 35.0) is None

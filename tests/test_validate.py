@@ -22,7 +22,7 @@ import pytest  # noqa: E402
 
 from wmr_mj.analysis.verdicts import VERDICTS  # noqa: E402
 from wmr_mj.report.text import format_headline, render_markdown  # noqa: E402
-from wmr_mj.report.validate import ladder_changes, summarise_rung  # noqa: E402
+from wmr_mj.report.validate import ladder_changes, summarise_rung, write_pointer  # noqa: E402
 from wmr_mj.sim.designs import CERTIFIED, LADDER, PAPER  # noqa: E402
 
 N = 3
@@ -72,7 +72,8 @@ def test_the_folder_has_every_file_the_report_references(validated):
     for name in ("summary.json", "summary.csv", "identified.json"):
         assert name in linked
     assert html.lstrip().startswith("<!DOCTYPE html>") and html.rstrip().endswith("</html>")
-    assert Path((folder.parent / "validate-latest").read_text().strip()) == folder.resolve()
+    latest = folder.parent / "validate-latest"
+    assert latest.is_symlink() and not os.path.isabs(os.readlink(latest)) and latest.resolve() == folder.resolve()
     lines = err.strip().splitlines()  # one line per stage (stderr is not a terminal), then the total
     assert all(line.startswith("validate: ") for line in lines)
     assert sum(": rung " in line for line in lines) == len(LADDER) + 1  # and the correction rung
@@ -269,3 +270,37 @@ def test_validate_runs_every_rung_on_the_path_it_is_given():
     assert (reference_of(ValidateSettings(duration=40.0)).alpha0 == circle.alpha0).all()  # the default
     with pytest.raises(WmrMjError, match="nowhere.toml"):
         ValidateSettings(path="nowhere.toml")
+
+
+def _report(parent: Path, name: str, n: int) -> Path:
+    folder = parent / name
+    (folder / "figures").mkdir(parents=True)
+    (folder / "summary.json").write_text(json.dumps({"n": n}))
+    (folder / "figures" / "ladder.svg").write_text("<svg/>")
+    return folder
+
+
+def test_validate_latest_is_a_relative_symlink_replaced_atomically(tmp_path):
+    (tmp_path / "validate-latest").write_text(str(tmp_path / "elsewhere") + "\n")  # an old text pointer
+    for n in (1, 2):
+        folder = _report(tmp_path, f"validate-{n}", n)
+        link = write_pointer(folder)
+        assert link == tmp_path / "validate-latest" and link.is_symlink()
+        assert os.readlink(link) == f"validate-{n}"  # relative: the logs folder may move
+        assert json.loads((link / "summary.json").read_text()) == {"n": n}
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["validate-1", "validate-2", "validate-latest"]
+
+
+def test_validate_latest_is_a_copy_where_symlinks_are_unavailable(tmp_path, monkeypatch):
+    first = _report(tmp_path, "validate-1", 1)
+    write_pointer(first)  # a link from a machine with symlinks
+    monkeypatch.setattr(os, "symlink", lambda *a, **k: (_ for _ in ()).throw(OSError("symlinks unavailable")))
+    for n in (2, 3):  # the copy replaces the link, then a copy from before
+        link = write_pointer(_report(tmp_path, f"validate-{n}", n))
+        assert link.is_dir() and not link.is_symlink()
+        assert json.loads((link / "summary.json").read_text()) == {"n": n}
+        assert (link / "figures" / "ladder.svg").read_text() == "<svg/>"
+    assert json.loads((first / "summary.json").read_text()) == {"n": 1}  # the linked report was not touched
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["validate-1", "validate-2", "validate-3", "validate-latest"]
+    monkeypatch.undo()
+    assert write_pointer(tmp_path / "validate-1").is_symlink()  # and back to a link over the copy

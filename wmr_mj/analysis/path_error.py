@@ -22,6 +22,10 @@ heading theta).
 
 Each with its sup (largest magnitude), RMS and final value, in :class:`PathErrors`.
 
+A position so far from the path (beyond ~1.3e154 m, only a diverged run's) that its squared
+distance overflows gets cross-track +-inf by its side (+inf on the chord's line), without a warning
+(up to |C| ~ 1e300 m; nearer the float maximum the search's own sums overflow).
+
 Usage::
 
     from wmr_mj.analysis.path_error import path_errors
@@ -203,12 +207,17 @@ def _project(gs: np.ndarray, gxy: np.ndarray, gk: np.ndarray, X: np.ndarray, s_s
         uj = uj[:m]
         rows = rows[:m]
         cross = Db[j[:m], 0] * rel[rows, j[:m], 1] - Db[j[:m], 1] * rel[rows, j[:m], 0]
-        d = np.sign(cross) * np.sqrt(dist2[rows, j[:m]])
+        # a point beyond ~1.3e154 m of the path (only a diverged run's) has a squared distance that
+        # overflows to inf: its cross-track is +-inf by its side (+inf on the chord's line), and it
+        # keeps the clipped chord parameter (no arc correction: kappa * inf would be NaN on a line)
+        far = np.isinf(dist2[rows, j[:m]])
+        d = np.where(far, np.copysign(np.inf, cross),
+                     np.sign(cross) * np.sqrt(np.where(far, 0.0, dist2[rows, j[:m]])))
         # the polyline is the curve's chords; the curve lies kappa L^2 u (1-u) / 2 to their right
         d += 0.5 * kmid[seg] * seg_len[seg] ** 2 * uj * (1.0 - uj)
         # and a point d to the left of an arc of curvature kappa projects on the chord at a
         # tangential distance scaled by 1 - kappa d from the arc's: undo that about the midpoint
-        scale = 1.0 - kmid[seg] * d
+        scale = np.where(far, -1.0, 1.0 - kmid[seg] * np.where(far, 0.0, d))
         u_arc = 0.5 + (u_raw[rows, j[:m]] - 0.5) / np.where(scale > 0.0, scale, 1.0)
         uj = np.where(scale > 0.0, np.clip(u_arc, 0.0, 1.0), uj)
         out_s[b:b + m] = gs[seg] + uj * seg_len[seg]

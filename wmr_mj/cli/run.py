@@ -274,6 +274,9 @@ def format_report(s: RunSummary) -> str:
                      f"{pe.heading_error_max:.4g} rad")
     if s.path_verdict is not None:
         lines.append(f"path verdict: {s.path_verdict.verdict} ({s.path_verdict.text})")
+    if s.route is not None and not s.route.finished:
+        lines.append(f"route not finished: its reference covers {s.route.driven_m:.4g} m of the route's "
+                     f"{s.route.length_m:.4g} m in {s.duration:g} s")
     if s.left_steering_range:
         lines.append(f"the steering reached its stop (+-range) at t = {s.left_steering_range_at_s:.3f} s")
     if s.status != "completed":

@@ -998,7 +998,10 @@ def paper_circle(
     guess = head + circle(R, length=(T * V_A / math.cos(a_ss)) * 1.05 + 1.0)
     run = _integrate(guess, l1, V_A, 0.0, max_angle=0.5 * math.pi - 1e-6, t_stop=T)
     if not run.stopped or run.s_end <= head.length:
+        # C's time over the lead-in and entry alone: the circle starts only after it
+        t_head = _integrate(head, l1, V_A, 0.0, max_angle=0.5 * math.pi - 1e-6).t_end
         raise ParameterError(
-            f"duration = {T} s is not accepted: the lead-in and entry alone take longer; give a longer duration"
+            f"duration = {T} s is not accepted: the lead-in and entry alone take {t_head:.3f} s; "
+            f"give a longer duration (at least {math.ceil(t_head * 1e3) / 1e3:.3f} s)"
         )
     return head + circle(R, length=run.s_end - head.length)

@@ -69,7 +69,7 @@ from wmr_mj.params import C80Parameters
 from wmr_mj.reference.paths import Path, Reference, Segment, SegmentKind, _s5_int, make_reference
 
 __all__ = ["Route", "ROUTES_DIR", "route_names", "load_route", "parse_route", "route_from_path",
-           "is_route_spec", "route_reference"]
+           "is_route_spec", "route_reference", "RouteProgress", "route_progress"]
 
 #: Routes shipped with the package, selectable by name (the file's stem).
 ROUTES_DIR = DATA_DIR / "routes"
@@ -482,3 +482,38 @@ def route_reference(route: Route, params: C80Parameters, *, dt: float, duration:
         raise InfeasiblePathError(f"route {route.source}: {where}: {msg}") from None
     except ParameterError as exc:
         raise ParameterError(f"route {route.source}: {exc}") from None
+
+
+#: a route counts as finished when its reference comes this near its end [m]: 1 um, far above the
+#: reference's own integration error (t(s) with rtol 1e-10) and far below any route's features
+FINISHED_TOL_M = 1e-6
+
+
+@dataclass(frozen=True)
+class RouteProgress:
+    """How far a run's reference goes along its route, so that a route longer than the run is not
+    left unfinished silently. ``length_m``: the route's length [m] (one lap of a closed route);
+    ``driven_m``: the arc length of C's reference over the run's duration [m]; ``finished``: it
+    covers the route (a closed route: at least one lap)."""
+
+    length_m: float
+    driven_m: float
+
+    @property
+    def finished(self) -> bool:
+        return self.driven_m >= self.length_m - FINISHED_TOL_M
+
+    def to_dict(self) -> dict[str, Any]:
+        """The summary keys route_length_m, route_driven_m, route_finished."""
+        return {"route_length_m": self.length_m, "route_driven_m": self.driven_m, "route_finished": self.finished}
+
+
+def route_progress(spec: str, reference: Any, duration: float) -> RouteProgress | None:
+    """The :class:`RouteProgress` of a run of ``duration`` s on the route ``spec`` with ``reference``
+    (built by ``route_reference``); None when ``spec`` names no route (a named path, built to fill
+    the duration)."""
+    if not isinstance(spec, str) or not is_route_spec(spec):
+        return None
+    s = np.asarray(reference.s, float)
+    driven = float(np.interp(float(duration), np.asarray(reference.t, float), s)) - float(s[0])
+    return RouteProgress(length_m=float(load_route(spec).path.length), driven_m=driven)

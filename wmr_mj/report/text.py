@@ -19,7 +19,7 @@ Usage::
 
     import json
     from wmr_mj.report.text import format_headline, render_markdown
-    summary = json.load(open("logs/validate-latest-folder/summary.json"))
+    summary = json.load(open("logs/validate-latest/summary.json"))
     print(format_headline(summary))
 """
 

@@ -227,11 +227,38 @@ def write_report(summary: dict[str, Any], folder: Path) -> None:
 
 
 def write_pointer(folder: str | os.PathLike) -> Path:
-    """Write ``<parent>/validate-latest``: a text file holding the folder's absolute path."""
-    from wmr_mj._util.files import write_text_atomic
+    """Point ``<parent>/validate-latest`` at the report ``folder``: a relative symlink, replaced
+    atomically (a temporary link, then ``os.replace``). Where symlinks are unavailable (``os.symlink``
+    raises OSError) it is a folder holding a copy of the report instead. Either way
+    ``validate-latest/summary.json`` reads the latest report."""
+    import shutil
 
     folder = Path(folder)
-    return write_text_atomic(folder.parent / "validate-latest", str(folder.resolve()) + "\n")
+    link = folder.parent / "validate-latest"
+    tmp = folder.parent / f".validate-latest.{os.getpid()}.tmp"
+    _remove(tmp)
+    try:
+        os.symlink(os.path.relpath(folder.resolve(), link.parent.resolve()), tmp, target_is_directory=True)
+    except OSError:  # no symlinks here (Windows without the privilege, some file systems): a copy
+        shutil.copytree(folder, tmp, symlinks=True)
+    old = folder.parent / f".validate-latest.{os.getpid()}.old"
+    if link.is_dir() and not link.is_symlink():  # a copy from before: os.replace cannot replace a folder
+        _remove(old)
+        os.replace(link, old)
+    elif tmp.is_dir() and not tmp.is_symlink() and (link.is_symlink() or link.exists()):
+        link.unlink()  # a folder cannot replace a link or a file (nor the text pointer of old versions)
+    os.replace(tmp, link)
+    _remove(old)
+    return link
+
+
+def _remove(path: Path) -> None:
+    import shutil
+
+    if path.is_symlink() or path.is_file():
+        path.unlink()
+    elif path.is_dir():
+        shutil.rmtree(path)
 
 
 def _certified_rule() -> dict[str, Any]:

@@ -415,6 +415,9 @@ def run_closed_loop(
         summary = dataclasses.replace(summary, correction=outer.describe(done))
     summary = dataclasses.replace(summary, mujoco_warnings=run.warnings, failure=run.failure,
                                   analysis=analysis.as_dict(), controller_config=controller.describe())
+    from wmr_mj.reference.route import route_progress
+
+    summary = dataclasses.replace(summary, route=route_progress(config.path, reference, summary.duration))
     if logger is not None:
         logger.close(summary.to_dict(), status=status)
     return RunResult(config=config, rows=done, summary=summary, status=status, law=run.law, law_note=run.law_note,

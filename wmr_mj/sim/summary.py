@@ -26,6 +26,7 @@ from wmr_mj.analysis.path_bound import PathBound, PathVerdict
 from wmr_mj.analysis.path_error import PathErrors
 from wmr_mj.analysis.requirements import RequirementResult
 from wmr_mj.analysis.verdicts import FAILED, NO_CLAIM, Drift, PaperRegion
+from wmr_mj.reference.route import RouteProgress
 
 __all__ = ["RunSummary", "PaperRegion", "Drift", "CertificateJudgement", "Assumption", "BatchFigures"]
 
@@ -97,6 +98,8 @@ class RunSummary:
             (``controllers.tracking``); None when the run had none.
         requirements: each STL requirement judged on the run (``wmr_mj.analysis.requirements``:
             formula, robustness, satisfied); None when none was asked for.
+        route: the route's length, the distance its reference covers in the run and whether that
+            finishes it (``wmr_mj.reference.route.RouteProgress``); None when the path is no route.
     """
 
     status: str
@@ -132,6 +135,7 @@ class RunSummary:
     path_verdict: PathVerdict | None = None
     correction: Mapping[str, Any] | None = None
     requirements: tuple[RequirementResult, ...] | None = None
+    route: RouteProgress | None = None
     failure: str | None = None  # status 'failed': why the law (or tracker) failed; the run has no verdict but this
     claimed: bool = True  # False: the controller states no claim (judged by its requirements only, never a pass)
 
@@ -251,4 +255,6 @@ class RunSummary:
             out["correction"] = dict(self.correction)
         if self.requirements is not None:
             out["requirements"] = [r.as_dict() for r in self.requirements]
+        if self.route is not None:
+            out.update(self.route.to_dict())
         return out
