@@ -137,6 +137,7 @@ class ComputedTorque(SteeringController):
     """u = P^ (alpha0'' + K_D E' + K_P E) + K^(alpha) + G^(alpha'), (3.2)-(3.3)."""
 
     name = "computed-torque"
+    model: SteeringModel
 
     def __init__(
         self,
@@ -306,6 +307,7 @@ class PDController(SteeringController):
     """
 
     name = "pd"
+    model: SteeringModel
 
     def __init__(self, model: SteeringModel, *, kp: float = PAPER_KP, kd: float = PAPER_KD):
         self.model = model

@@ -250,7 +250,7 @@ def build(cls: type, params: Mapping[str, Any], context: Any, *, spec: str, kind
         ParameterError: a parameter the class does not take, or a value it refuses.
     """
     try:
-        return cls.from_context(context, **dict(params))
+        return cls.from_context(context, **dict(params))  # type: ignore[attr-defined]
     except TypeError as exc:
         accepted = _accepted(cls)
         raise ParameterError(f"{kind} {spec!r} does not take these parameters ({exc}); accepted: "
@@ -261,7 +261,7 @@ def build(cls: type, params: Mapping[str, Any], context: Any, *, spec: str, kind
 
 def _accepted(cls: type) -> list[str]:
     try:
-        sig = inspect.signature(cls.__init__)
+        sig = inspect.signature(cls)
     except (TypeError, ValueError):
         return []
-    return [n for n, p in sig.parameters.items() if n != "self" and p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)]
+    return [n for n, p in sig.parameters.items() if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)]

@@ -1,4 +1,4 @@
-"""The Cartesian correction (controllers.tracking.StanleyAtC): limits, the certificate's assumptions, both laws alike."""
+"""The Cartesian correction (controllers.tracking.StanleyAtC): limits, assumptions, both laws alike."""
 
 from __future__ import annotations
 
@@ -7,11 +7,11 @@ import math
 import numpy as np
 import pytest
 
+from controllers.tracking import DEFAULT_GAINS, TRACKER_BOUNDS_ASSUMPTION, CorrectionGains, StanleyAtC, corrected_bounds
 from wmr_mj.errors import ParameterError
 from wmr_mj.reference.bounds import ReferenceBounds
 from wmr_mj.sim.closed_loop import run_closed_loop
 from wmr_mj.sim.config import RunConfig
-from controllers.tracking import DEFAULT_GAINS, TRACKER_BOUNDS_ASSUMPTION, CorrectionGains, StanleyAtC, corrected_bounds
 from wmr_mj.sim.designs import CERTIFIED
 
 BASE = RunConfig(**CERTIFIED.config_changes()).replace(path="lane-change", duration=12.0)

@@ -377,6 +377,12 @@ def run_certificate(args: argparse.Namespace) -> int:
     estimate = estimate_parameters(C80)
     reference, _ = build_reference(config.path, estimate, dt=period, duration=n * period)
     cert = certificate_for(config, reference, params=C80)
+    if cert is None:
+        from wmr_mj.errors import ParameterError
+        from wmr_mj.sim.config import controller_name
+
+        raise ParameterError(f"controller {controller_name(config)!r} states no claim: there is no certificate to "
+                             "print; judge its runs by requirements (wmr-mj run --require ...)")
     paper = analysis_for(config, reference, estimate, estimate=estimate_of(controller_for(config, estimate)))
     if as_json:
         out = cert.as_dict()

@@ -15,7 +15,8 @@ if TYPE_CHECKING:
 
 def add_run_options(p: argparse.ArgumentParser) -> None:
     """Options shared by ``run`` and ``sweep`` (the closed-loop configuration)."""
-    from controllers.computed_torque import CONTROLLER_NAMES, FRICTION_SIGNS, MODEL_SOURCES
+    from controllers.computed_torque import FRICTION_SIGNS, MODEL_SOURCES
+    from controllers.registry import controller_names, tracker_names
     from wmr_mj.params import M1_RANGE
     from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS, TYRE_CONTACT_MODELS
     from wmr_mj.sim.config import PATH_NAMES
@@ -24,7 +25,19 @@ def add_run_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--preset", default="paper",
                    help=f"controller design: one of {', '.join(PRESET_NAMES)} (default paper: paper model, K_P = 6, "
                         "K_D = 9, exact sign; certified: see wmr_mj/sim/designs.py); explicit options override it")
-    p.add_argument("--controller", default=None, help=f"one of {', '.join(CONTROLLER_NAMES)} (default: the preset's)")
+    p.add_argument("--controller", default=None, metavar="NAME|FILE.py:Class|module:Class",
+                   help=f"the steering law: one of {', '.join(controller_names())}, a class in a file of your own "
+                        "(FILE.py:Class), or of an importable module (module:Class) (default: the preset's; see "
+                        "controllers/base.py)")
+    p.add_argument("--controller-param", action="append", metavar="NAME=VALUE", default=None,
+                   help="a parameter of a --controller given by name or file (repeatable; VALUE read as JSON where "
+                        "it parses, e.g. lam=5, else as text)")
+    p.add_argument("--tracker", default=None, metavar="NAME|FILE.py:Class|module:Class",
+                   help=f"a path tracker, the outer loop on C that writes alpha0: one of {', '.join(tracker_names())}, "
+                        "FILE.py:Class or module:Class (default: none, the path's own alpha0; see "
+                        "controllers/tracking.py)")
+    p.add_argument("--tracker-param", action="append", metavar="NAME=VALUE", default=None,
+                   help="a parameter of the --tracker (repeatable)")
     p.add_argument("--model", default=None,
                    help=f"model source of the estimate: one of {', '.join(MODEL_SOURCES)} (default: the preset's)")
     p.add_argument("--identified", metavar="PATH",
@@ -109,7 +122,15 @@ def config_from_args(args: argparse.Namespace, **extra):
     signals = signals_from_args(args)
     if signals is not None:
         extra.setdefault("signals", signals)
-    return RunConfig(controller=controller, model=model, duration=args.duration,
+    from controllers.registry import parse_params
+
+    controller_params = parse_params(getattr(args, "controller_param", None))
+    tracker = getattr(args, "tracker", None)
+    tracker_params = parse_params(getattr(args, "tracker_param", None), option="--tracker-param")
+    if bool(getattr(args, "correction", False)) and tracker not in (None, "stanley-at-C"):
+        raise ParameterError(f"--correction is the tracker stanley-at-C; give it or --tracker {tracker}, not both")
+    return RunConfig(controller=controller, controller_params=controller_params, tracker=tracker,
+                     tracker_params=tracker_params, model=model, duration=args.duration,
                      control_period=args.control_period, kp=kp, kd=kd, friction_sign=friction_sign,
                      friction_width=friction_width, path=args.path,
                      plant_overrides=parse_assignments(args.param), m1_inertia=args.m1_inertia,
@@ -254,10 +275,17 @@ def format_report(s: RunSummary) -> str:
     cert_E_ratio, cert_Edot_ratio = (None, None) if cert is None else (cert.E_ratio, cert.Edot_ratio)
 
     after = f"after {s.settle_s:.1f} s"
+    if s.paper_law:
+        who = f"controller {s.controller} ({s.model} model), plant m1 = {s.m1:g} kg, K_P = {s.kp:g}, K_D = {s.kd:g}"
+    else:
+        params = ", ".join(f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}"
+                           for k, v in (s.controller_config or {}).items()
+                           if k != "controller" and not isinstance(v, (dict, list)))
+        who = (f"controller {s.controller} ({params or 'no parameters'}), plant m1 = {s.m1:g} kg (the paper's "
+               "region is for its own law: shown, not judged)")
+    rate = "" if s.realtime_factor is None else f" ({s.realtime_factor:.0f}x real time)"
     lines = [
-        f"controller {s.controller} ({s.model} model), plant m1 = {s.m1:g} kg, K_P = {s.kp:g}, "
-        f"K_D = {s.kd:g}, {s.duration:g} s, {s.steps} steps in {s.wall_s:.2f} s "
-        f"({s.realtime_factor:.0f}x real time)",
+        f"{who}, {s.duration:g} s, {s.steps} steps in {s.wall_s:.2f} s{rate}",
         *format_verdict(s.to_dict()),
         f"{'':22s} {'whole run':>12s} {after:>12s} {'certificate':>12s} {'ratio':>8s} {'paper':>12s} {'ratio':>8s}",
         f"{'sup|E|   [rad]':22s} {s.sup_E:12.5g} {s.sup_E_settled:12.5g} {num(cert_E_max):>12s} "
@@ -313,8 +341,16 @@ def run(args: argparse.Namespace) -> int:
     with terminate_as_interrupt():
         result = run_closed_loop(config, logger_factory=factory, progress=args.progress)
     if result.law_note:
-        print(f"wmr-mj: the Python law ran ({result.law_note}); the numbers are the same, the run slower",
-              file=sys.stderr)
+        from wmr_mj.sim.config import plugin_source
+
+        if plugin_source(config) is None:
+            print(f"wmr-mj: the Python law ran ({result.law_note}); the numbers are the same, the run slower",
+                  file=sys.stderr)
+        else:
+            print(f"wmr-mj: controller {result.summary.controller!r} runs in Python in the engine, one call per "
+                  f"control step ({result.law_note})", file=sys.stderr)
+    if result.summary.failure is not None:
+        print(f"wmr-mj: the run failed: {result.summary.failure}", file=sys.stderr)
     judged = None
     if requirements:
         from wmr_mj.analysis.requirements import evaluate_run

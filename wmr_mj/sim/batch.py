@@ -419,7 +419,8 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
     wall = time.perf_counter() - wall0
     return _summaries(configs, plants, stats, _BatchRun(base=base, reference=reference, settle_s=settle_s,
                                                        analysis=analysis, loop=loop, backend=backend, wall=wall,
-                                                       threads=threads))
+                                                       threads=threads,
+                                                       paper_law=estimate_of(controller) is not None))
 
 
 def shares_one_batch(configs: Sequence[RunConfig]) -> bool:
@@ -462,6 +463,7 @@ class _BatchRun:
     backend: str
     wall: float
     threads: int  # the batch's threads, which also judge C's paths
+    paper_law: bool = True  # the law is the paper's family (its region applies)
 
 
 def _summaries(configs: Sequence[RunConfig], plants: Sequence[C80Parameters], stats: _BatchStats,
@@ -502,7 +504,7 @@ def _summaries(configs: Sequence[RunConfig], plants: Sequence[C80Parameters], st
             serial = run_closed_loop(c, progress=False, base=base).summary
             r = dataclasses.replace(serial, analysis=None, controller_config=None)  # report's fields and the warnings
         else:
-            r = dataclasses.replace(r, mujoco_warnings=int(stats.warnings[i]))
+            r = dataclasses.replace(r, mujoco_warnings=int(stats.warnings[i]), paper_law=run.paper_law)
         r = dataclasses.replace(r, batch=BatchFigures(
             final_alpha_after_step=float(stats.final_alpha_after_step[i]),  # the serial run reports the last row
             # batch-level figures for benchmarks

@@ -414,6 +414,7 @@ def run_closed_loop(
     if outer is not None:
         summary = dataclasses.replace(summary, correction=outer.describe(done))
     summary = dataclasses.replace(summary, mujoco_warnings=run.warnings, failure=run.failure,
+                                  paper_law=estimate_of(controller) is not None,
                                   analysis=analysis.as_dict(), controller_config=controller.describe())
     from wmr_mj.reference.route import route_progress
 

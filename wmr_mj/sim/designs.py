@@ -140,6 +140,6 @@ def certified_omega_r(*, error_spec: float = ERROR_SPEC, grid: tuple[float, ...]
         config = RunConfig(model=CERTIFIED.model, kp=w * w / 4.0, kd=w, friction_sign=CERTIFIED.friction_sign,
                            friction_width=CERTIFIED.friction_width)
         cert = certificate_for(config, reference)
-        if cert.certified and cert.E_max <= error_spec:
+        if cert is not None and cert.certified and cert.E_max <= error_spec:
             return w
     return None

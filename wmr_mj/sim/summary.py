@@ -138,6 +138,7 @@ class RunSummary:
     route: RouteProgress | None = None
     failure: str | None = None  # status 'failed': why the law (or tracker) failed; the run has no verdict but this
     claimed: bool = True  # False: the controller states no claim (judged by its requirements only, never a pass)
+    paper_law: bool = True  # False: the law is not the paper's family, so the paper's region says nothing of it
 
     # the paper's claim, read through paper_region (the JSON also writes these at the top level)
     @property
@@ -237,6 +238,8 @@ class RunSummary:
             out["drift"] = {} if self.drift is None else self.drift.to_dict()
         if self.failure is not None:
             out["failure"] = self.failure
+        if not self.paper_law:
+            out["paper_claim_applies"] = False  # the paper's region is for its computed-torque family only
         if self.mujoco_warnings is not None:
             out["mujoco_warnings"] = self.mujoco_warnings
         if self.analysis is not None:
