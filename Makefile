@@ -5,13 +5,13 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test test-fast lint venv bench clean foxglove-reader
+.PHONY: demo test test-fast lint venv bench clean foxglove-reader docs
 
 # the editable install builds the compiled law (wmr_mj/sim/_compiled_law.c) in place: rebuild when it changes
 $(STAMP): pyproject.toml setup.py wmr_mj/sim/_compiled_law.c
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
-	$(PY) -m pip install -q -e '.[test,dask,video]'
+	$(PY) -m pip install -q -e '.[test,dask,video,docs]'
 	touch $(STAMP)
 
 venv: $(STAMP)
@@ -38,6 +38,10 @@ test: lint $(FOXGLOVE_READER)
 test-fast: $(STAMP)
 	$(PY) -m pytest -m "not slow and not wheel and not npm"
 
+# the documentation site into site/ (docs/, mkdocs.yml); --strict: a warning is an error
+docs: $(STAMP)
+	NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs build --strict -d site
+
 bench: $(STAMP)
 	$(PY) bench/bench_run.py
 	$(PY) bench/bench_logging.py --end-to-end
@@ -45,4 +49,4 @@ bench: $(STAMP)
 	$(PY) bench/bench_video.py
 
 clean:
-	rm -rf $(VENV) build dist *.egg-info .ruff_cache wmr_mj/sim/_compiled_law.*.so
+	rm -rf $(VENV) build dist site *.egg-info .ruff_cache wmr_mj/sim/_compiled_law.*.so
