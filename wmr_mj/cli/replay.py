@@ -10,7 +10,10 @@ and prints.
   ``--json`` prints it as one JSON object;
 - ``--plot PATH.png``: E and E' over time, the armature voltage, and the (|E|, |E'|) plane;
 - ``--verify``: rebuild the model from the attached MJCF, set the initial state, re-apply the
-  logged ctrl and compare qpos/qvel at every control step: exit 0 when bit-identical, 1 otherwise;
+  logged ctrl and compare qpos/qvel at every control step; then re-run the logged configuration with
+  its controller imported again (a plug-in by its recorded path, its source's SHA-256 checked) and
+  compare the voltages it applies with the logged ones: exit 0 when both are bit-identical, 1 otherwise
+  (with one line saying why a controller could not be re-run);
 - ``--video PATH.mp4``: the run rendered offscreen by :mod:`wmr_mj.logs.video` (MuJoCo's Renderer on EGL
   or OSMesa, imageio's ffmpeg writer): the steering seen through the chassis, E against E_max.
 """
@@ -48,7 +51,15 @@ def register(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from wmr_mj.logs.reader import load_log
-    from wmr_mj.logs.replay import format_summary, format_verify, plot, summarize, verify
+    from wmr_mj.logs.replay import (
+        format_summary,
+        format_verify,
+        format_verify_controller,
+        plot,
+        summarize,
+        verify,
+        verify_controller,
+    )
 
     log = load_log(args.log)
     rep = summarize(log, args.settle)
@@ -63,7 +74,8 @@ def run(args: argparse.Namespace) -> int:
         rep.update(video=video.path, video_backend=video.backend, video_seconds=video.seconds)
     if args.verify:
         rep["verify"] = verify(log)
-        status = 0 if rep["verify"]["identical"] else 1
+        rep["verify_controller"] = verify_controller(log)
+        status = 0 if rep["verify"]["identical"] and rep["verify_controller"]["identical"] else 1
     if args.json:
         print_json(rep)
         return status
@@ -74,5 +86,6 @@ def run(args: argparse.Namespace) -> int:
         print(f"video      {args.video} ({rep['video_backend']})")
     if args.verify:
         print(format_verify(rep["verify"]))
+        print(format_verify_controller(rep["verify_controller"]))
     return status
 

@@ -37,6 +37,7 @@ __all__ = [
     "has_tracker",
     "plugin_source",
     "controller_name",
+    "config_from_dict",
     "estimate_of",
     "build_reference",
     "analysis_box",
@@ -427,3 +428,46 @@ def estimate_of(controller: SteeringController) -> dict[str, float] | None:
     paper's (4.2), the estimate anywhere in the box."""
     method = getattr(controller, "paper_estimate", None)
     return method() if callable(method) else None
+
+
+def config_from_dict(obj: Mapping[str, Any]) -> RunConfig:
+    """The RunConfig of ``RunConfig.as_dict()`` (after a JSON round trip: lists back to tuples).
+
+    A plug-in (``controller_plugin``, ``tracker_plugin``) is found again by its name, else by the
+    absolute import path the record holds (a file named relative to another folder), and its source
+    must be the one recorded.
+
+    Raises:
+        ParameterError: a plug-in given as an object (it cannot be rebuilt from JSON), one whose file
+            or module is gone, or whose source has changed since the record was written (its SHA-256).
+    """
+    d = dict(obj)
+    d["m1_range"] = tuple(d["m1_range"])
+    d["box_ranges"] = {k: tuple(v) for k, v in d.get("box_ranges", {}).items()}
+    for kind in ("controller", "tracker"):
+        record = d.pop(f"{kind}_plugin", None)
+        if record is not None:
+            d[kind] = _plugin_again(kind, record)
+    return RunConfig(**d)
+
+
+def _plugin_again(kind: str, record: Mapping[str, Any]) -> str:
+    """The name a recorded plug-in is found by now, its source checked against the record."""
+    from controllers.registry import resolve
+
+    if record.get("origin") == "instance":
+        raise ParameterError(f"the {kind} {record.get('name')!r} was given as an object "
+                             f"({record.get('import_path')}); it cannot be rebuilt from the record: give it by "
+                             "name, FILE.py:Class or module:Class to make runs that can be replayed and resumed")
+    spec = str(record.get("spec"))
+    if record.get("origin") == "file":
+        where = spec.rpartition(":")[0]
+        if not os.path.isfile(where):
+            spec = str(record.get("import_path"))  # the absolute path it was imported from
+    params = record.get("params") or {}
+    _, now = resolve(spec, params, kind=kind)
+    if record.get("source_sha256") and now.source_sha256 != record["source_sha256"]:
+        raise ParameterError(f"the {kind} {record.get('name')!r} ({now.import_path}) has changed since it ran: its "
+                             f"source's SHA-256 is {str(now.source_sha256)[:12]}..., the record's "
+                             f"{str(record['source_sha256'])[:12]}...; restore that source to reproduce the run")
+    return spec

@@ -41,7 +41,7 @@ from wmr_mj._util.checks import positive_range
 from wmr_mj.errors import ParameterError, SchedulerError, UnknownNameError
 from wmr_mj.params import M1_RANGE, parameter_names
 from wmr_mj.sim.batch import run_batch
-from wmr_mj.sim.config import RunConfig
+from wmr_mj.sim.config import RunConfig, config_from_dict
 from wmr_mj.sim.summary import RunSummary
 
 __all__ = [
@@ -244,14 +244,6 @@ def spec_from_json(text: str) -> SweepSpec:
     return SweepSpec(n=obj["n"], seed=obj["seed"], sampling=obj["sampling"], m1_range=tuple(obj["m1_range"]),
                      ranges={k: tuple(v) for k, v in obj["ranges"].items()}, base=config_from_dict(obj["base"]),
                      requirements=tuple(obj.get("requirements", ())))
-
-
-def config_from_dict(obj: Mapping[str, Any]) -> RunConfig:
-    """The RunConfig of ``RunConfig.as_dict()`` (after a JSON round trip: lists back to tuples)."""
-    d = dict(obj)
-    d["m1_range"] = tuple(d["m1_range"])
-    d["box_ranges"] = {k: tuple(v) for k, v in d.get("box_ranges", {}).items()}
-    return RunConfig(**d)
 
 
 def _run_config_chunk(config_dicts: list[dict[str, Any]], nthread: int,
