@@ -685,7 +685,7 @@ figure{display:inline-block;margin:.5em;vertical-align:top;max-width:48%}figure 
 border:1px solid #ddd}figcaption{font-size:.85em;color:#555}code{background:#f4f4f4;padding:0 .2em}
 .small{font-size:.85em;color:#555}.answer{margin:0 0 .4em}.answer p{margin:.15em 0}
 .answer .question{font-size:1.2em;font-weight:bold}figure.lead{display:block;max-width:none;margin:.3em 0 1em}
-figure.lead img{max-height:560px;max-width:100%;width:auto}
+figure.lead img{max-height:520px;max-width:100%;width:auto}
 .loud{background:#fde2e2;border:2px solid #e00000;padding:.6em;font-weight:bold}"""
 
 
