@@ -2,8 +2,10 @@
 
 :func:`document` lays the report out once, as a list of blocks (headings, paragraphs,
 lists, tables, figures); :func:`render_markdown`, :func:`render_html` and
-:func:`format_headline` (stdout: the answer, sections (a)-(d)) render those blocks. The
-order is the answer's:
+:func:`format_headline` (stdout: the verdict, then sections (a)-(d)) render those blocks. Each
+opens with :func:`verdict_lines`, five lines: the question, the answer for the paper's design,
+why, the answer for the certified design, where the report is; in index.html Fig. 4 (the desired
+path and the paths C travelled under both designs) follows directly. Then, in order:
 
 (a) the paper's design against the paper's claim and against its own certificate;
 (b) the ladder from the paper's design to the certified one, verdict counts per rung;
@@ -12,8 +14,9 @@ order is the answer's:
 (d) the plant's measured friction law; (e) identification; (f) findings (computed
 sentences); figures; files; software.
 
-A ``certified-outside`` run (a bug or a modelling gap) is announced in a banner above
-everything else wherever it appears. ``uncertified-*`` runs are never counted as a pass.
+A ``certified-outside`` run (a bug or a modelling gap) is announced in a banner directly under
+the verdict, above the details, wherever it appears (the verdict's certified-design line names
+its own). ``uncertified-*`` runs are never counted as a pass.
 
 Usage::
 
