@@ -166,7 +166,7 @@ def _certified_verdict(summary: Mapping[str, Any]) -> str:
             f"worst sup|E| = {_fmt(rung['worst_sup_E'], '.3g')} rad = "
             f"{_fmt(rung['worst_certificate_ratio'], '.3f')} of its certificate")
     if rung["certified_outside"]:
-        text += f"; !!! {rung['certified_outside']}/{n} CERTIFIED-OUTSIDE: a bug or a modelling gap !!!"
+        return text + f"; !!! {rung['certified_outside']}/{n} CERTIFIED-OUTSIDE: a bug or a modelling gap !!!"
     return text + "."
 
 
@@ -507,16 +507,16 @@ def banner(summary: Mapping[str, Any]) -> list[Block]:
                      "assumptions all hold. This is a bug or a modelling gap: report it. !!!")]
 
 
-def answer_blocks(summary: Mapping[str, Any], *, brief: bool = False) -> list[Block]:
-    """Sections (a)-(d): what the report opens with; ``brief`` (stdout): the rule in one
-    sentence and the assumptions without their equations."""
+def answer_blocks(summary: Mapping[str, Any], *, brief: bool = False, with_banner: bool = True) -> list[Block]:
+    """Sections (a)-(d), after the certified-outside banner (``with_banner``); ``brief``
+    (stdout): the rule in one sentence and the assumptions without their equations."""
     rung = summary["ladder"][-1]
     assumptions = assumption_rows(rung["certificate"])
     header: tuple[str, ...] = ASSUMPTION_COLUMNS
     if brief:
         header, assumptions = tuple(c for c in header if c != "equation"), [r[:1] + r[2:] for r in assumptions]
     return [
-        *banner(summary),
+        *(banner(summary) if with_banner else []),
         ("h2", "(a) The paper's design"),
         ("ul", paper_design_lines(summary)),
         ("h2", "(b) The ladder: from the paper's design to the certified one, one change per rung"),
@@ -601,10 +601,11 @@ def document(summary: Mapping[str, Any]) -> list[Block]:
     lead = [("lead", fig4_caption(summary), "fig4_trajectory")] if "fig4_trajectory" in summary["figures"] else []
     return [
         ("answer", verdict_lines(summary)),
+        *banner(summary),
         *lead,
         ("h1", "wmr-mj validate: does the paper's steering controller keep its promise on the MuJoCo C80?"),
         ("p", f"{summary['created']} - {_settings_line(summary)}."),
-        *answer_blocks(summary),
+        *answer_blocks(summary, with_banner=False),
         ("h2", f"(e) Identification (m1 = {ident['m1']:g} kg, {ident['duration']:g} s excitation)"),
         ("table", IDENT_COLUMNS, identification_rows(summary)),
         ("p", "diff = (identified - predicted) / |predicted|."),
@@ -630,8 +631,10 @@ def _text_table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> list[st
 
 def format_headline(summary: Mapping[str, Any]) -> str:
     """The answer as text (what ``wmr-mj validate`` prints on stdout)."""
-    out = [*verdict_lines(summary), "", f"wmr-mj validate - {_settings_line(summary)}"]
-    for block in answer_blocks(summary, brief=True):
+    out = [*verdict_lines(summary)]
+    out += [line for b in banner(summary) for line in ("", b[1])]
+    out += ["", f"wmr-mj validate - {_settings_line(summary)}"]
+    for block in answer_blocks(summary, brief=True, with_banner=False):
         kind = block[0]
         if kind == "loud":
             out += ["", block[1], ""]
