@@ -34,9 +34,9 @@ foxglove-reader: $(FOXGLOVE_READER)
 test: lint $(FOXGLOVE_READER)
 	$(PY) -m pytest
 
-# the quick loop while editing: no lint, no test marked slow, wheel or npm (431 tests, 40 s of CPU)
+# the quick loop while editing: no lint, no test marked slow, wheel, npm or browser (431 tests, 40 s of CPU)
 test-fast: $(STAMP)
-	$(PY) -m pytest -m "not slow and not wheel and not npm"
+	$(PY) -m pytest -m "not slow and not wheel and not npm and not browser"
 
 # the documentation site into site/ (docs/, mkdocs.yml); --strict: a warning is an error
 docs: $(STAMP)

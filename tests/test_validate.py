@@ -191,18 +191,75 @@ def test_the_search_beside_the_monte_carlo_worst_and_the_certificate(validated):
     assert f"{cert['worst']['objective']:.4g}" in md and "Tightness" in md
 
 
-@pytest.mark.slow
-def test_a_rerun_resumes_and_prints_the_answer_first(validated):
+@pytest.fixture(scope="module")
+def rerun(validated):
+    """The same command again into the same folder, without --json: (before, proc, after)."""
     folder, _, _ = validated
     before = _saved(folder)
     proc = _cli(*ARGS, "--out", str(folder))
     assert proc.returncode == 0, proc.stderr
-    after = _saved(folder)
+    return before, proc, _saved(folder)
+
+
+def _numbers(text: str) -> list[float]:
+    return [float(x) for x in re.findall(r"(?<![\w.])-?\d+(?:\.\d+)?(?:e[-+]?\d+)?", text)]
+
+
+def _expected_verdict_numbers(summary: dict) -> list[list[float]]:
+    """The numbers each line of the verdict must carry, in order, computed here from summary.json."""
+    first, last = summary["ladder"][0], summary["ladder"][-1]
+    n, s = first["n"], summary["settings"]
+    radius = summary["path"]["circle_radius"]
+    g3 = lambda x: float(f"{x:.3g}")  # noqa: E731
+    c1, c4 = first["certificate"], last["certificate"]
+    return [
+        [*s["m1_range"], n, s["duration"]],
+        [*_numbers(first["design"]), n - first["paper_inside"], n, g3(radius), g3(first["worst_path_cross_track"]),
+         first["hit_stop"], n, g3(first["worst_sup_E"]), g3(first["worst_paper_ratio"]),
+         g3(first["paper_region"]["E_max"])],
+        [*(_numbers(", ".join(c1["unmet"]))), len(c4["assumptions"]), g3(c4["E_max"]), g3(c4["voltage_max"])],
+        [last["index"], *_numbers(last["design"]), g3(last["worst_path_cross_track"]), g3(radius), last["passes"],
+         last["n"], g3(c4["E_max"]), g3(last["worst_sup_E"]), float(f"{last['worst_certificate_ratio']:.3f}")],
+        _numbers(summary["folder"]),
+    ]
+
+
+@pytest.mark.slow
+def test_the_five_line_verdict_is_printed_first_with_the_summarys_numbers(rerun, validated):
+    folder, _, _ = validated
+    _, proc, summary = rerun
+    out = proc.stdout.splitlines()
+    verdict, rest = out[:5], out[5:]
+    assert verdict[0].startswith("Question: does the paper's robustness region hold for the C80 under m1 in ")
+    assert verdict[1].startswith("The paper's design (") and verdict[3].startswith("The certified design (rung 4")
+    assert verdict[2].startswith("Why: ") and verdict[4].startswith(f"Report: {folder}/index.html")
+    assert rest[0] == "" and rest[1].startswith("wmr-mj validate - ")
+    first, last = summary["ladder"][0], summary["ladder"][-1]
+    assert (" No. " in verdict[1]) is (first["paper_inside"] < first["n"])
+    assert f"{last['passes']}/{last['n']} runs certified-inside" in verdict[3]
+    assert summary["path"]["name"] == "paper-circle" and summary["path"]["circle_radius"] == pytest.approx(1.0)
+    for line, expected in zip(verdict, _expected_verdict_numbers(summary)):
+        assert _numbers(line) == pytest.approx(expected, rel=1e-12), line
+    # the same five lines open index.md and index.html (in the document's order, before any table)
+    md = (folder / "index.md").read_text().splitlines()
+    assert [line.rstrip() for line in md[:5]] == verdict
+    html_text = (folder / "index.html").read_text()
+    import html as _html
+
+    at = [html_text.index(f">{_html.escape(line)}</p>") for line in verdict]
+    assert at == sorted(at) and at[-1] < html_text.index("fig4_trajectory.png") < html_text.index("<table")
+
+
+@pytest.mark.slow
+def test_a_rerun_resumes_and_prints_the_answer_first(rerun, validated):
+    folder, _, _ = validated
+    before, proc, after = rerun
     assert [r["verdicts"] for r in after["ladder"]] == [r["verdicts"] for r in before["ladder"]]
     assert [s["worst"] for s in after["searches"]] == [s["worst"] for s in before["searches"]]
     assert proc.stderr.count("read back from search-") == 3
     out = proc.stdout.splitlines()
-    assert out[0].startswith("wmr-mj validate") and out[2] == "(a) The paper's design:"
+    assert out[0].startswith("Question: ") and out[6].startswith("wmr-mj validate")
+    assert out[8] == "(a) The paper's design:"
     heads = [line for line in out if re.match(r"^\([a-d]\) ", line)]
     assert [h[:3] for h in heads] == ["(a)", "(b)", "(c)", "(d)"]
     md = (folder / "index.md").read_text()

@@ -7,8 +7,9 @@
 - ``history_paper``, ``history_certified``: the nominal runs' E, E', voltage against the
   certificate's bounds, or the paper's claim where there is no certificate;
 - ``search_history``: each search's runs, its running worst, the Monte-Carlo worst;
-- the paper's Figs. 4-7 (:func:`wmr_mj.report.plots.paper_figures`), Fig. 7 with the paper's design
-  on the MuJoCo plant at m1 = 650 kg.
+- the paper's Figs. 4-7 (:func:`wmr_mj.report.plots.paper_figures`): Fig. 4 with the paths C
+  travelled in the nominal runs (the paper's and the certified design, :func:`travelled_paths`),
+  Fig. 7 with the paper's design on the MuJoCo plant at m1 = 650 kg.
 
 Usage::
 
@@ -27,7 +28,7 @@ from wmr_mj._util.progress import Stages
 from wmr_mj.params import C80
 from wmr_mj.report.settings import ValidateSettings
 
-__all__ = ["figures_stage"]
+__all__ = ["figures_stage", "travelled_paths"]
 
 
 def _rung_figure(rung: Mapping[str, Any], folder: Path):
@@ -86,6 +87,20 @@ def _search_figure(searches: Sequence[Mapping[str, Any]], rungs: Sequence[Mappin
     return plots.figure_search_history(histories, title="worst-case search (differential evolution)")
 
 
+def travelled_paths(nominal: Mapping[str, Any]) -> list[tuple[str, np.ndarray]]:
+    """(label, C's xy) of the nominal runs for Fig. 4: the paths C travelled under the paper's
+    and the certified design, each labelled with its largest cross-track error."""
+    words = {"paper": "the paper's design", "certified": "the certified design"}
+    out = []
+    for name, run in nominal.items():
+        if run.C_xy is None:
+            continue
+        s = run.summary
+        cross = "" if s.path_error is None else f", cross-track max {s.path_error.cross_track_max:.3g} m"
+        out.append((f"{words.get(name, name)}{cross}", np.asarray(run.C_xy)))
+    return out
+
+
 def figures_stage(settings: ValidateSettings, folder: Path, st: Stages, rungs: Sequence[Mapping[str, Any]],
                   searches: Sequence[Mapping[str, Any]], nominal: Mapping[str, Any]
                   ) -> tuple[dict[str, list[str]], dict[str, Any]]:
@@ -104,6 +119,7 @@ def figures_stage(settings: ValidateSettings, folder: Path, st: Stages, rungs: S
         figs["search_history"] = _search_figure(searches, rungs)
     example = paper_example(duration=settings.duration, mujoco=False)
     example.mujoco_rows, example.mujoco_summary = nominal["paper"].rows, nominal["paper"].summary
+    example.actual_paths = travelled_paths(nominal)
     figs.update(plots.paper_figures(example))
     paths = {stem: [p.relative_to(folder).as_posix() for p in plots.save_figure(fig, folder / "figures" / stem)]
              for stem, fig in figs.items()}

@@ -269,7 +269,8 @@ def figure_paths(reference, *, title: str | None = None,
     plot_paths(ax, reference)
     for (label, xy), color in zip(actual, ("#d35400", "#1e8449", "#7d3c98", "#f0b000")):
         xy = np.asarray(xy, dtype=float)
-        ax.plot(xy[:, 0], xy[:, 1], color=color, lw=1.1, alpha=0.9, label=f"C travelled: {label}")
+        # wide and under the desired path (zorder 1.5 < 2), so a path that follows it shows as a halo around it
+        ax.plot(xy[:, 0], xy[:, 1], color=color, lw=2.6, alpha=0.75, zorder=1.5, label=f"C travelled: {label}")
     _legend_below(fig, ax, ncols=2)
     default = rf"Fig. 4  Desired trajectory: C on the circle, $V_A$ = {reference.V_A:g} m/s"
     if actual:

@@ -2,8 +2,10 @@
 
 :func:`document` lays the report out once, as a list of blocks (headings, paragraphs,
 lists, tables, figures); :func:`render_markdown`, :func:`render_html` and
-:func:`format_headline` (stdout: the answer, sections (a)-(d)) render those blocks. The
-order is the answer's:
+:func:`format_headline` (stdout: the verdict, then sections (a)-(d)) render those blocks. Each
+opens with :func:`verdict_lines`, five lines: the question, the answer for the paper's design,
+why, the answer for the certified design, where the report is; in index.html Fig. 4 (the desired
+path and the paths C travelled under both designs) follows directly. Then, in order:
 
 (a) the paper's design against the paper's claim and against its own certificate;
 (b) the ladder from the paper's design to the certified one, verdict counts per rung;
@@ -12,8 +14,9 @@ order is the answer's:
 (d) the plant's measured friction law; (e) identification; (f) findings (computed
 sentences); figures; files; software.
 
-A ``certified-outside`` run (a bug or a modelling gap) is announced in a banner above
-everything else wherever it appears. ``uncertified-*`` runs are never counted as a pass.
+A ``certified-outside`` run (a bug or a modelling gap) is announced in a banner directly under
+the verdict, above the details, wherever it appears (the verdict's certified-design line names
+its own). ``uncertified-*`` runs are never counted as a pass.
 
 Usage::
 
@@ -39,6 +42,7 @@ from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS
 __all__ = [
     "document",
     "answer_blocks",
+    "verdict_lines",
     "format_headline",
     "render_markdown",
     "render_html",
@@ -49,6 +53,7 @@ __all__ = [
 ]
 
 #: A block of the document: ("h1" | "h2" | "h3" | "p" | "loud", text), ("ul", [text]),
+#: ("answer", [five lines]), ("lead", caption, stem) (the figure under the answer),
 #: ("table", header, rows), ("figures", [(caption, stem)]) or ("files", [(path, what)]).
 Block = tuple
 
@@ -108,6 +113,74 @@ def _cert_cell(cert: Mapping[str, Any]) -> str:
     if cert.get("valid"):
         return f"|E| <= {_fmt(cert['E_max'])} rad, NOT met: {', '.join(cert['unmet'])}"
     return "none: " + ", ".join(cert.get("unmet", []))
+
+
+# --------------------------------------------------------------------------- the verdict: five lines
+def _path_text(summary: Mapping[str, Any]) -> str:
+    """'its 1 m circle' on the paper circle (radius from the run's reference), else 'its path'."""
+    radius = (summary.get("path") or {}).get("circle_radius")
+    return f"its {_fmt(radius, '.3g')} m circle" if radius else "its path"
+
+
+def _paper_verdict(summary: Mapping[str, Any]) -> str:
+    rung = summary["ladder"][0]
+    n, inside, pr = rung["n"], rung["paper_inside"], rung["paper_region"]
+    answer = "Yes" if inside == n else "No"
+    ratio = rung["worst_paper_ratio"]
+    parts = [f"{n - inside}/{n} runs leave the paper's region" if inside < n else f"{n}/{n} runs stay inside it"]
+    cross = rung.get("worst_path_cross_track")
+    if cross is not None:
+        parts.append(f"C leaves {_path_text(summary)} by up to {_fmt(cross, '.3g')} m")
+    parts.append(f"{rung['hit_stop']}/{n} runs reach the steering stop")
+    parts.append(f"worst sup|E| = {_fmt(rung['worst_sup_E'], '.3g')} rad, {_fmt(ratio, '.3g')} times the paper's "
+                 f"E_max = {_fmt(pr['E_max'], '.3g')} rad")
+    return f"The paper's design ({rung['design']}): {answer}. " + "; ".join(parts) + "."
+
+
+def _why_verdict(summary: Mapping[str, Any]) -> str:
+    first, last = summary["ladder"][0]["certificate"], summary["ladder"][-1]["certificate"]
+    if first.get("certified"):
+        head = (f"Why: redone for the plant actually simulated, the paper's analysis certifies the paper's design "
+                f"only to |E| <= {_fmt(first.get('E_max'), '.3g')} rad")
+    else:
+        head = ("Why: redone for the plant actually simulated, the paper's analysis gives the paper's design no "
+                f"certificate (not met: {', '.join(first.get('unmet') or []) or 'none'})")
+    if last.get("certified"):
+        tail = (f"the certified design's certificate meets all {len(last.get('assumptions', []))} of its assumptions "
+                f"(|E| <= {_fmt(last.get('E_max'), '.3g')} rad, at most {_fmt(last.get('voltage_max'), '.3g')} V)")
+    else:
+        tail = f"the certified design's certificate fails too (not met: {', '.join(last.get('unmet') or [])})"
+    return f"{head}; {tail}."
+
+
+def _certified_verdict(summary: Mapping[str, Any]) -> str:
+    rung = summary["ladder"][-1]
+    n, cert, passes = rung["n"], rung["certificate"], rung["passes"]
+    head = f"The certified design (rung {rung['index']}: {rung['design']})"
+    cross = rung.get("worst_path_cross_track")
+    keeps = f" keeps C within {_fmt(cross, '.3g')} m of {_path_text(summary)}" if cross is not None else ""
+    if not cert.get("certified"):
+        return (f"{head}{keeps}, but has NO certificate here: {passes}/{n} runs certified-inside; worst sup|E| = "
+                f"{_fmt(rung['worst_sup_E'], '.3g')} rad.")
+    text = (f"{head}{keeps}: {passes}/{n} runs certified-inside (|E| <= {_fmt(cert.get('E_max'), '.3g')} rad); "
+            f"worst sup|E| = {_fmt(rung['worst_sup_E'], '.3g')} rad = "
+            f"{_fmt(rung['worst_certificate_ratio'], '.3f')} of its certificate")
+    if rung["certified_outside"]:
+        return text + f"; !!! {rung['certified_outside']}/{n} CERTIFIED-OUTSIDE: a bug or a modelling gap !!!"
+    return text + "."
+
+
+def verdict_lines(summary: Mapping[str, Any]) -> list[str]:
+    """The five-line verdict that opens stdout, index.md and index.html: the question, the answer
+    for the paper's design, why, the answer for the certified design, where the report is. Every
+    number from ``summary`` (rung 1 and the last rung of the ladder, the settings, the folder)."""
+    s = summary["settings"]
+    lo, hi = s["m1_range"]
+    question = (f"Question: does the paper's robustness region hold for the C80 under m1 in {lo:g}-{hi:g} kg? "
+                f"({summary['ladder'][0]['n']} MuJoCo runs per design on {_path_words(s)}, {s['duration']:g} s each)")
+    report = (f"Report: {summary['folder']}/index.html (also index.md, summary.json); the details follow: (a) the "
+              "paper's design, (b) the ladder between the designs, (c) the certified design, (d) the friction law.")
+    return [question, _paper_verdict(summary), _why_verdict(summary), _certified_verdict(summary), report]
 
 
 # --------------------------------------------------------------------------- (a) the paper's design
@@ -434,16 +507,16 @@ def banner(summary: Mapping[str, Any]) -> list[Block]:
                      "assumptions all hold. This is a bug or a modelling gap: report it. !!!")]
 
 
-def answer_blocks(summary: Mapping[str, Any], *, brief: bool = False) -> list[Block]:
-    """Sections (a)-(d): what the report opens with; ``brief`` (stdout): the rule in one
-    sentence and the assumptions without their equations."""
+def answer_blocks(summary: Mapping[str, Any], *, brief: bool = False, with_banner: bool = True) -> list[Block]:
+    """Sections (a)-(d), after the certified-outside banner (``with_banner``); ``brief``
+    (stdout): the rule in one sentence and the assumptions without their equations."""
     rung = summary["ladder"][-1]
     assumptions = assumption_rows(rung["certificate"])
     header: tuple[str, ...] = ASSUMPTION_COLUMNS
     if brief:
         header, assumptions = tuple(c for c in header if c != "equation"), [r[:1] + r[2:] for r in assumptions]
     return [
-        *banner(summary),
+        *(banner(summary) if with_banner else []),
         ("h2", "(a) The paper's design"),
         ("ul", paper_design_lines(summary)),
         ("h2", "(b) The ladder: from the paper's design to the certified one, one change per rung"),
@@ -480,13 +553,19 @@ def _settings_line(summary: Mapping[str, Any]) -> str:
             f"{s['identify_duration']:g} s at m1 = {s['nominal_m1']:g} kg")
 
 
+def fig4_caption(summary: Mapping[str, Any]) -> str:
+    """The caption of Fig. 4 under the answer."""
+    return (f"Fig. 4: C's desired path and the paths C travelled under the paper's design and the certified design "
+            f"(MuJoCo plant, m1 = {summary['settings']['nominal_m1']:g} kg)")
+
 FIGURE_GROUPS = (
     ("The ladder", [("verdict counts per rung", "ladder")]),
     ("Every run of each rung by verdict, with the certificate's region and the paper's claim", None),
     ("Nominal runs (m1 = 650 kg)", [("the paper's design: E, E', voltage", "history_paper"),
                                     ("the certified design: E, E', voltage", "history_certified")]),
     ("Worst-case search", [("each run's objective, the running worst, the Monte-Carlo worst", "search_history")]),
-    ("The paper's figures", [("Fig. 4 desired trajectory", "fig4_trajectory"), ("Fig. 5 alpha0(t)", "fig5_alpha0"),
+    ("The paper's figures", [("Fig. 4 desired path and the paths C travelled", "fig4_trajectory"),
+                             ("Fig. 5 alpha0(t)", "fig5_alpha0"),
                              ("Fig. 6 alpha0'(t), alpha0''(t)", "fig6_alpha0_rates"),
                              ("Fig. 7 region of the (5.1) example, the paper's view and the MuJoCo plant",
                               "fig7_region")]),
@@ -519,10 +598,14 @@ def _files(summary: Mapping[str, Any]) -> list[tuple[str, str]]:
 def document(summary: Mapping[str, Any]) -> list[Block]:
     """The whole report as blocks, the answer first."""
     ident = summary["identification"]
+    lead = [("lead", fig4_caption(summary), "fig4_trajectory")] if "fig4_trajectory" in summary["figures"] else []
     return [
+        ("answer", verdict_lines(summary)),
+        *banner(summary),
+        *lead,
         ("h1", "wmr-mj validate: does the paper's steering controller keep its promise on the MuJoCo C80?"),
         ("p", f"{summary['created']} - {_settings_line(summary)}."),
-        *answer_blocks(summary),
+        *answer_blocks(summary, with_banner=False),
         ("h2", f"(e) Identification (m1 = {ident['m1']:g} kg, {ident['duration']:g} s excitation)"),
         ("table", IDENT_COLUMNS, identification_rows(summary)),
         ("p", "diff = (identified - predicted) / |predicted|."),
@@ -548,8 +631,10 @@ def _text_table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> list[st
 
 def format_headline(summary: Mapping[str, Any]) -> str:
     """The answer as text (what ``wmr-mj validate`` prints on stdout)."""
-    out = [f"wmr-mj validate - {_settings_line(summary)}"]
-    for block in answer_blocks(summary, brief=True):
+    out = [*verdict_lines(summary)]
+    out += [line for b in banner(summary) for line in ("", b[1])]
+    out += ["", f"wmr-mj validate - {_settings_line(summary)}"]
+    for block in answer_blocks(summary, brief=True, with_banner=False):
         kind = block[0]
         if kind == "loud":
             out += ["", block[1], ""]
@@ -582,14 +667,16 @@ def render_markdown(summary: Mapping[str, Any]) -> str:
             out += [{"h1": "#", "h2": "##", "h3": "###"}[kind] + " " + block[1], ""]
         elif kind == "p":
             out += [block[1], ""]
+        elif kind == "answer":  # the five lines, one per line (Markdown hard breaks)
+            out += [line + "  " for line in block[1][:-1]] + [block[1][-1], ""]
         elif kind == "loud":
             out += [f"> **{block[1]}**", ""]
         elif kind == "ul":
             out += [*(f"- {line}" for line in block[1]), ""]
         elif kind == "table":
             out += [_md_table(block[1], block[2]), ""]
-        elif kind == "figures":
-            for caption, stem in block[1]:
+        elif kind in ("figures", "lead"):
+            for caption, stem in (block[1] if kind == "figures" else [block[1:]]):
                 out += [f"[![{caption}]({_fig_path(summary, stem, 'png')})]({_fig_path(summary, stem, 'svg')})", "",
                         f"*{caption}*", ""]
         elif kind == "files":
@@ -602,7 +689,10 @@ margin:2em auto;padding:0 1em;color:#222;line-height:1.4}table{border-collapse:c
 font-size:.9em}th,td{border:1px solid #ccc;padding:.25em .5em;text-align:left}th{background:#f2f4f7}
 figure{display:inline-block;margin:.5em;vertical-align:top;max-width:48%}figure img{max-width:100%;
 border:1px solid #ddd}figcaption{font-size:.85em;color:#555}code{background:#f4f4f4;padding:0 .2em}
-.small{font-size:.85em;color:#555}.loud{background:#fde2e2;border:2px solid #e00000;padding:.6em;font-weight:bold}"""
+.small{font-size:.85em;color:#555}.answer{margin:0 0 .4em}.answer p{margin:.15em 0}
+.answer .question{font-size:1.2em;font-weight:bold}figure.lead{display:block;max-width:none;margin:.3em 0 1em}
+figure.lead img{max-height:520px;max-width:100%;width:auto}
+.loud{background:#fde2e2;border:2px solid #e00000;padding:.6em;font-weight:bold}"""
 
 
 def _html_table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
@@ -620,10 +710,19 @@ def _html_block(block: Block, summary: Mapping[str, Any]) -> str:
         return f"<p>{e(block[1])}</p>"
     if kind == "loud":
         return f"<p class='loud'>{e(block[1])}</p>"
+    if kind == "answer":
+        first, *rest = block[1]
+        return ("<section id='answer' class='answer'>" + f"<p class='question'>{e(first)}</p>"
+                + "".join(f"<p>{e(line)}</p>" for line in rest) + "</section>")
     if kind == "ul":
         return "<ul>" + "".join(f"<li>{e(line)}</li>" for line in block[1]) + "</ul>"
     if kind == "table":
         return _html_table(block[1], block[2])
+    if kind == "lead":
+        caption, stem = block[1], block[2]
+        return (f"<figure class='lead'><a href='{e(_fig_path(summary, stem, 'svg'))}'><img src='"
+                f"{e(_fig_path(summary, stem, 'png'))}' alt='{e(caption)}'></a><figcaption>{e(caption)}</figcaption>"
+                "</figure>")
     if kind == "figures":
         return "<div>" + "".join(
             f"<figure><a href='{e(_fig_path(summary, stem, 'svg'))}'><img src='{e(_fig_path(summary, stem, 'png'))}' "

@@ -211,6 +211,7 @@ def _nominal_summary(run) -> dict[str, Any]:
             "left_steering_range_at_s": s.left_steering_range_at_s, "final_alpha": s.final_alpha,
             "saturated_fraction": s.saturated_fraction,
             "certificate_E_ratio": None if s.certificate is None else s.certificate.E_ratio,
+            "cross_track_max": None if s.path_error is None else s.path_error.cross_track_max,
             "drift": None if s.drift is None else s.drift.to_dict()}
 
 
@@ -261,6 +262,18 @@ def _remove(path: Path) -> None:
         shutil.rmtree(path)
 
 
+def _path_summary(settings: ValidateSettings) -> dict[str, Any]:
+    """The runs' path of C: its name and, on the paper circle, the circle's radius [m] from the
+    reference's final curvature (the verdict's 'its 1 m circle')."""
+    import numpy as np
+
+    radius = None
+    if settings.path == "paper-circle":
+        kappa = float(np.asarray(reference_of(settings).kappa)[-1])
+        radius = 1.0 / abs(kappa) if kappa else None
+    return {"name": settings.path, "circle_radius": radius}
+
+
 def _certified_rule() -> dict[str, Any]:
     """The certified design's rule as designs.py writes it, and the omega_r it gives now."""
     import re
@@ -303,7 +316,7 @@ def run_validate(settings: ValidateSettings, out_dir: str | os.PathLike, *, log:
         "seed": settings.seed, "ladder": rungs, "certified_rule": _certified_rule(), "searches": searches,
         "nominal": {name: _nominal_summary(run) for name, run in nominal.items()}, "friction": friction,
         "identification": identification, "paper_example": fig7, "figures": figures,
-        "correction_rung": corrected,
+        "correction_rung": corrected, "path": _path_summary(settings),
         "certified_outside": sum(r["certified_outside"] for r in rungs) + corrected["certified_outside"]
         + sum(s["verdicts"]["certified-outside"] for s in searches),
         "versions": software_versions(),
