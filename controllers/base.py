@@ -147,6 +147,13 @@ class SteeringController:
         """JSON-able description for logs and reports (``controller`` is the law's name)."""
         return {"controller": self.name}
 
+    def label(self) -> str:
+        """One line naming the law and its parameters, for a report's heading."""
+        params = ", ".join(f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}"
+                           for k, v in self.describe().items()
+                           if k != "controller" and not isinstance(v, (dict, list, tuple)))
+        return f"controller {self.name}" + (f" ({params})" if params else "")
+
 
 def law_methods_missing(cls: Any) -> str | None:
     """Why ``cls`` cannot run as a steering law (one line), or None where it can."""

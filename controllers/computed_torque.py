@@ -275,6 +275,9 @@ class ComputedTorque(SteeringController):
 
         return law
 
+    def label(self) -> str:
+        return f"{self.model.name} model, K_P = {self.kp:g}, K_D = {self.kd:g}"
+
     def paper_estimate(self) -> dict[str, float]:
         """The coefficients the paper's analysis takes as this law's estimate: P^, C_V^, F^ (0 with
         friction_sign 'none'), K^."""
@@ -340,6 +343,9 @@ class PDController(SteeringController):
             return u
 
         return law
+
+    def label(self) -> str:
+        return f"PD, {self.model.name} model, K_P = {self.kp:g}, K_D = {self.kd:g}"
 
     def paper_estimate(self) -> dict[str, float]:
         """A PD law has no model-based part but P^ (its gain scale)."""

@@ -72,7 +72,7 @@ def reproduce_command(config, params: dict[str, float], args: argparse.Namespace
     were written exactly)."""
     import shlex
 
-    parts = ["wmr-mj run", f"--preset {args.preset}", f"--controller {config.controller}", f"--model {config.model}",
+    parts = ["wmr-mj run", f"--preset {args.preset}", f"--controller {shlex.quote(str(config.controller))}", f"--model {config.model}",
              f"--kp {config.kp!r}", f"--kd {config.kd!r}", f"--friction-sign {config.friction_sign}",
              f"--friction-width {config.friction_width!r}", f"--path {shlex.quote(path_file or config.path)}",
              f"--duration {config.duration!r}", f"--m1 {config.m1!r}"]
@@ -94,6 +94,11 @@ def reproduce_command(config, params: dict[str, float], args: argparse.Namespace
     parts += [f"--range {shlex.quote(item)}" for item in getattr(args, "range", None) or []]  # the same box
     if getattr(config, "correction", False):
         parts.append("--correction")
+    for kind in ("controller", "tracker"):
+        if kind == "tracker" and isinstance(config.tracker, str):
+            parts.append(f"--tracker {shlex.quote(config.tracker)}")
+        for name, value in getattr(config, f"{kind}_params").items():
+            parts.append(f"--{kind}-param {shlex.quote(f'{name}={json.dumps(value)}')}")
     if config.signals is not None:
         parts.append(f"--signals {shlex.quote(signals_file or json.dumps(config.signals.as_dict()))}")
     if config.reference_bounds is not None:

@@ -85,7 +85,11 @@ def run(args: argparse.Namespace) -> int:
         print_json(summary)
         return 0
     fmt = lambda x: "n/a" if x is None else f"{x:.3f}"  # noqa: E731
-    print(f"{runs.n} runs ({base.model} model, K_P = {base.kp:g}, K_D = {base.kd:g}, m1 over "
+    from wmr_mj.sim.config import controller_for, estimate_of, estimate_parameters
+
+    law = controller_for(base, estimate_parameters())
+    label = law.label()
+    print(f"{runs.n} runs ({label}, m1 over "
           f"{args.m1_range[0]:g}-{args.m1_range[1]:g} kg, {args.sampling}, seed {args.seed}):")
     print("verdicts: " + ", ".join(f"{v} {c}" for v, c in runs.verdicts.items()))
     if runs.certified_outside:
@@ -94,10 +98,13 @@ def run(args: argparse.Namespace) -> int:
     print(f"certificate: worst sup|E|/E_max = {fmt(runs.certificate_E_ratio.value)}, "
           f"worst sup|E'|/Edot_max = {fmt(runs.certificate_Edot_ratio.value)}; "
           f"{runs.growing} runs with |E| still growing at the end")
-    print(f"paper's claim: {runs.paper_inside} inside, {runs.n - runs.paper_inside} outside its region; "
-          f"worst sup|E|/E_max = {fmt(runs.paper_E_ratio.value)}, "
-          f"worst sup|E'|/Edot_max = {fmt(runs.paper_Edot_ratio.value)}; "
-          f"{runs.hit_stop} runs hit the steering stop")
+    if estimate_of(law) is None:
+        print("paper's claim: not applicable (its region is for the paper's computed-torque law, not this one)")
+    else:
+        print(f"paper's claim: {runs.paper_inside} inside, {runs.n - runs.paper_inside} outside its region; "
+              f"worst sup|E|/E_max = {fmt(runs.paper_E_ratio.value)}, "
+              f"worst sup|E'|/Edot_max = {fmt(runs.paper_Edot_ratio.value)}")
+    print(f"{runs.hit_stop} runs hit the steering stop")
     if runs.path_verdicts is not None:
         print(f"path of C: worst sup|cross-track| = {runs.path_cross_track.value:.4g} m "
               f"(m1 = {runs.path_cross_track.m1:g} kg); path verdicts: "

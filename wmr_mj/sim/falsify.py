@@ -129,6 +129,27 @@ def objective_value(summary: Mapping[str, Any], objective: str) -> float | None:
     return summary.get("E_ratio")
 
 
+def check_objective_applies(config: Any, objective: str) -> None:
+    """Refuse, before any run, an objective that says nothing of the run's controller: the certificate's
+    ratio for a law that states no claim, the paper's for a law that is not the paper's.
+
+    Raises:
+        ParameterError: naming the controller and the objectives that apply.
+    """
+    from controllers import SteeringController
+    from wmr_mj.sim.config import controller_for, estimate_of, estimate_parameters
+
+    if objective not in ("certificate", "paper"):
+        return
+    law = controller_for(config, estimate_parameters())
+    if objective == "certificate" and type(law).claim is SteeringController.claim:
+        raise ParameterError(f"controller {law.name!r} states no claim, so there is no certificate to search "
+                             "against: falsify a requirement (--require STL) or maximise sup|E| (--objective sup-E)")
+    if objective == "paper" and estimate_of(law) is None:
+        raise ParameterError(f"the paper's region is for its computed-torque law, not controller {law.name!r}: "
+                             "falsify a requirement (--require STL) or maximise sup|E| (--objective sup-E)")
+
+
 def objective_source(summary: Mapping[str, Any], objective: str) -> str:
     """Which field of the summary :func:`objective_value` read, in words (for the report)."""
     if objective == "sup-E":
@@ -576,6 +597,7 @@ def falsify(spec: FalsifySpec, *, chunk: int = 128, nthread: int = 0, scheduler:
     """
     from wmr_mj.sim.sweep import connect, run_configs
 
+    check_objective_applies(spec.base, spec.objective)
     client = connect(scheduler) if scheduler is not None else None
     evaluations: dict[str, list[Evaluation]] = {"search": [], "random": []}
     total = 2 * spec.budget  # refined once the search has run

@@ -230,6 +230,19 @@ def _run_chunk(spec_json: str, indices: list[int], nthread: int,
     return rows
 
 
+def _differs(state: Mapping[str, Any], spec: SweepSpec) -> str:
+    """What differs between a sweep folder's recorded spec and ``spec``, in a few words."""
+    old = state.get("spec") or {}
+    new = json.loads(spec_to_json(spec))
+    old_base, new_base = old.get("base") or {}, new["base"]
+    for key in ("controller", "controller_params", "controller_plugin", "tracker", "tracker_params"):
+        if old_base.get(key) != new_base.get(key):
+            return f"its {key} is {old_base.get(key)!r}, this one's {new_base.get(key)!r}"
+    keys = sorted(k for k in set(old) | set(new) if k != "base" and old.get(k) != new.get(k))
+    keys += sorted(f"base.{k}" for k in set(old_base) | set(new_base) if old_base.get(k) != new_base.get(k))
+    return "it differs in " + (", ".join(keys[:4]) or "its settings")
+
+
 def spec_to_json(spec: SweepSpec) -> str:
     base = spec.base.as_dict()
     obj = {"n": spec.n, "seed": spec.seed, "sampling": spec.sampling, "m1_range": list(spec.m1_range),
@@ -374,6 +387,9 @@ def run_sweep(spec: SweepSpec, *, out_dir: str | os.PathLike | None = None, chun
             if state.get("fingerprint") == fp:
                 for r in read_results(csv_path):
                     done[int(r["run"])] = r
+            elif state.get("fingerprint") and read_results(csv_path):
+                raise ParameterError(f"--out {str(out)!r} holds the runs of another sweep ({_differs(state, spec)}); "
+                                     "it is not resumed: give another --out, or remove that folder to start afresh")
         write_json_atomic(state_path, {"fingerprint": fp, "spec": json.loads(spec_to_json(spec))})
     todo = [i for i in range(spec.n) if i not in done]
     chunks = [todo[i:i + chunk] for i in range(0, len(todo), chunk)]
