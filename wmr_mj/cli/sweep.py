@@ -114,8 +114,8 @@ def run(args: argparse.Namespace) -> int:
                  else f"{req.min_robustness:+.5g} (run {req.run}, m1 = {req.m1:g} kg)")
         print(f"requirement {req.requirement}: {req.satisfied} hold, {req.violated} violated"
               + (f", {req.undefined} without a region" if req.undefined else "") + f"; least robustness {least}")
-    law = f", {' and '.join(runs.batch_law)} law" if runs.batch_law else ""
-    print(f"{runs.steps} steps in {wall:.1f} s ({summary['steps_per_s']:.3g} steps/s{law})")
+    backend = f", {' and '.join(runs.batch_law)} law" if runs.batch_law else ""
+    print(f"{runs.steps} steps in {wall:.1f} s ({summary['steps_per_s']:.3g} steps/s{backend})")
     print(f"table: {out / 'runs.csv'}\nplot:  {plot_path}")
     return 0
 
