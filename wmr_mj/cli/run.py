@@ -378,4 +378,6 @@ def run(args: argparse.Namespace) -> int:
     if result.status == "interrupted":
         print("wmr-mj: interrupted; the log holds what was simulated", file=sys.stderr)
         return 130
+    if result.status == "failed":
+        return 1  # the law failed mid-run: the report and the log hold what ran before it
     return 0

@@ -105,7 +105,7 @@ class RunLog:
 
     @property
     def status(self) -> str:
-        """"completed", "interrupted", "error" (from the summary), or "truncated"."""
+        """"completed", "interrupted", "error", "failed" (from the summary), or "truncated"."""
         if self.summary is not None and "status" in self.summary:
             return str(self.summary["status"])
         return "truncated" if self.truncated else "unknown"

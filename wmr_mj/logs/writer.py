@@ -70,7 +70,7 @@ if TYPE_CHECKING:
 __all__ = ["RunLogger", "LogHeader", "LogOptions", "run_logged", "terminate_as_interrupt", "measure_logging_overhead",
            "COMPRESSIONS", "STATUSES"]
 
-STATUSES = ("completed", "interrupted", "error")
+STATUSES = ("completed", "interrupted", "error", "failed")  # failed: the law (a plug-in) failed mid-run
 COMPRESSIONS = ("lz4", "zstd", "none")
 
 

@@ -214,10 +214,12 @@ def plugin_source(config: RunConfig, kind: str = "controller"):
         return None
     if isinstance(given, str):
         return resolve(given, getattr(config, f"{kind}_params"), kind=kind)[1]
-    cls = given if isinstance(given, type) else type(given)
+    if callable(given) and not hasattr(given, "describe"):
+        given = given()  # a factory (a class or a function): what it builds names the plug-in
+    cls = type(given)
     describe = getattr(given, "describe", None)
     params = {}
-    if not isinstance(given, type) and callable(describe):
+    if callable(describe):
         params = {k: v for k, v in describe().items() if k not in (kind, "law")}
     from controllers.base import describe_params
 

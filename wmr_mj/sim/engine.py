@@ -174,6 +174,14 @@ class _Block:
         self.sites = np.empty((rows, m.nsite, 3))
         self.C_xy = np.empty((count, 2))  # always: the run's path errors (wmr_mj.analysis.path_error)
 
+    @classmethod
+    def head(cls, block: _Block, count: int) -> _Block:
+        """The first ``count`` control steps of ``block`` (views of its arrays; a log's arrays where it has them)."""
+        out = cls.__new__(cls)
+        for name, value in vars(block).items():
+            setattr(out, name, value[:count] if len(value) else value)
+        return out
+
 
 def _heading(quat: np.ndarray) -> np.ndarray:
     """Yaw of unit quaternions (w, x, y, z), element for element the serial loop's math.atan2."""
@@ -247,6 +255,8 @@ class _CompiledStepper:
 class ControllerFailure(WmrMjError):
     """A law (or tracker) of the user's raised, returned NaN or returned something that is not one voltage:
     the run stops there, as 'failed', with this message."""
+
+    steps_done: int = 0  # the control steps of the failing block that ran before the failure
 
 
 def _checked_call(law: Callable[..., Any], t: float, *state: float) -> float:
@@ -328,7 +338,12 @@ class _PythonStepper:
             a = float(qpos[qa])
             ad = float(qvel[dv])
             if strict:
-                u_cmd = _checked_call(law, (k0 + j) * period, a, ad, a0_all[j], a0d_all[j], a0dd_all[j])
+                try:
+                    u_cmd = _checked_call(law, (k0 + j) * period, a, ad, a0_all[j], a0d_all[j], a0dd_all[j])
+                except ControllerFailure as exc:
+                    exc.steps_done = j  # the control steps of this block recorded before the failing one
+                    block.heading[:j] = _heading(quat[:j])
+                    raise
             else:
                 u_cmd = law((k0 + j) * period, a, ad, a0_all[j], a0d_all[j], a0dd_all[j])
             if u_cmd != u_cmd:  # NaN from a diverged law: apply nothing, keep the record
@@ -506,8 +521,14 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
                 on_progress(cnt)
     except KeyboardInterrupt:
         status = "interrupted"
-    except ControllerFailure as exc:  # the run stops at the failing block; what was simulated stays
+    except ControllerFailure as exc:  # the run stops at the failing step; what was simulated before it stays
         status, failure = "failed", str(exc)
+        done_in_block = exc.steps_done
+        if done_in_block and k == k0:  # the failing block's steps before the failure
+            part = blocks[done_in_block] = _Block.head(blocks[cnt], done_in_block)
+            cnt = done_in_block
+            _record_block(rows, C_xy, part, k0, period, (a0_all, a0d_all, a0dd_all), k_i)
+            k = k0 + done_in_block
     if k:
         hand_over(k)  # a block interrupted between its rows and its hand-over
     wall, cpu = time.perf_counter() - wall0, time.thread_time() - cpu0
