@@ -34,9 +34,9 @@ def _reference(t: float) -> tuple[float, float, float]:
 def test_estimates_converge_and_the_error_decays():
     """From 16-33 % off, every estimate is within 4 % of the plant's at every step of the last
     10 s of a 30 s run. 4 %: the floor the sampled law leaves (its voltage is held over the 1 ms
-    period, a delay of T/2 that the continuous-time argument does not see; the estimates wander
-    about 1 % around a P^ about 1.5 % high, measured); the tracking error over the last 5 s is
-    below a tenth of the first 5 s's."""
+    period, a delay of T/2 that the continuous-time argument does not see). Measured: over the
+    last 10 s P^ averages 0.3903 (1.4 % high) and strays up to 3.5 %, C_V^ 0.5 %, F^ 1.3 %; sup|E|
+    falls from 5.2e-3 rad (first 5 s) to 2.4e-4 rad (last 5 s)."""
     law = AdaptiveComputedTorque(START, lam=5.0, kd=2.0, gamma=(20.0, 200.0, 100.0), friction_width=WIDTH)
     law.reset(control_period=1e-3)
     n = 30000
