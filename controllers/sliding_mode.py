@@ -1,0 +1,265 @@
+"""A sliding-mode steering law with a boundary layer (Slotine & Li, *Applied Nonlinear Control*,
+Prentice Hall 1991, chapter 7: 7.1.3 and 7.2, the boundary layer of thickness phi).
+
+Plant and law (voltage form; X~ = X - X^, truth minus the estimate of ``model``)::
+
+    plant:  P a'' + C_V a' + f + K S(a) + Gam a'/cos^2(a) = u + d_V,   S(a) = sin(a)/cos^3(a)
+            f = F sgn(a') sliding, any f in [-F, F] at rest (stiction);  Gam = gyro V_A
+    E = alpha0 - a,   s = E' + lam E,   a_r'' = alpha0'' + lam E'
+    law:    u = P^ a_r'' + C_V^ a' + F^ sgn(a') + K^ S(a) + Gam^ a'/cos^2(a) + k sat(s/phi)
+
+Since s' = a_r'' - a'', multiplying by P and using the plant's equation::
+
+    P s' = Delta - k sat(s/phi)
+    Delta = P~ a_r'' + C~_V a' + (f - F^ sgn a') + K~ S(a) + Gam~ a'/cos^2(a) - d_V
+
+(exact at every instant, at rest too, with f the friction the joint actually has). Outside the
+layer (|s| >= phi) P s s' = s Delta - k |s| <= -(k - |Delta|) |s| <= -eta |s| when
+k >= sup|Delta| + eta (Slotine & Li's sliding condition (7.5), with P > 0 multiplying s'): |s|
+cannot grow past phi, so |s(0)| <= phi gives |s(t)| <= phi for all t (the layer is invariant).
+Then E is s through the filter 1/(p + lam): with E(0) = 0, |E(t)| <= phi/lam, and
+|E'| = |s - lam E| <= 2 phi (Slotine & Li 7.2, eq. (7.36)-(7.37) with n = 2).
+
+The bound on |Delta| (volts), over the plant box's corners (:class:`~wmr_mj.analysis.claim.ClaimContext`),
+inside the layer (|E| <= phi/lam, |E'| <= 2 phi, so |a_r''| <= max|alpha0''| + 2 lam phi,
+|a'| <= max|alpha0'| + 2 phi, |a| <= alpha_max = max|alpha0| + phi/lam)::
+
+    D = max_P |P - P^| (max|alpha0''| + 2 lam phi) + max|C~_V| (max|alpha0'| + 2 phi)
+        + phi_f + max|K~| S(alpha_max) + max|Gam~| (max|alpha0'| + 2 phi)/cos^2(alpha_max) + d_V,max
+
+with phi_f = sup|f - F^ s| over sliding and rest, the certificate's friction term
+(:func:`wmr_mj.analysis.certificate.friction_term`: max(F_max, F^) for the measured sign, exact
+or smoothed, covering stiction and creep; F_max for 'none'). The claim (:meth:`SlidingMode.claim`)
+is the box |E| <= phi/lam, |E'| <= 2 phi with the checked assumption k >= D + eta.
+
+Sampling. The law is held over each control period T; the argument above is continuous. The
+claim states the check that one period moves s by a small part of the layer: with
+|P s'| <= D + k, the change of s over T is at most T (D + k)/P_min, required
+<= :data:`SAMPLING_FRACTION` phi, and the layer's gain k/phi must not overshoot the layer in one
+period (T k/(P_min phi) <= 1). These are a stated margin, not a sampled-data proof; the tests
+(tests/test_sliding_mode.py) check the bound on a zero-order-hold simulation.
+
+Usage::
+
+    from controllers.sliding_mode import SlidingMode
+    law = SlidingMode(model, lam=5.0, phi=0.2, k=3.0, eta=0.2)
+    u = law.voltage_scalar(alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot)
+    law.uncertainty_bound(context)       # D [V] over the run's plant box
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from controllers.base import BuildContext, SteeringController
+from wmr_mj.analysis.certificate import Assumption, Certificate, friction_term
+from wmr_mj.analysis.claim import ClaimContext, box_claim
+from wmr_mj.errors import ParameterError, UnknownNameError
+from wmr_mj.plant.reduced import SteeringModel
+
+__all__ = ["SlidingMode", "Uncertainty", "SAMPLING_FRACTION", "SLIDING_FRICTION_SIGNS"]
+
+#: The largest change of s over one control period, as a fraction of the layer phi.
+SAMPLING_FRACTION = 0.1
+#: The Coulomb compensation's sign: the measured a' (as computed-torque's default) or none.
+SLIDING_FRICTION_SIGNS = ("measured", "none")
+
+
+def _positive(name: str, value: Any, *, allow_zero: bool = False) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ParameterError(f"sliding-mode {name} = {value!r} is not accepted: a finite number") from None
+    if not math.isfinite(v) or v < 0.0 or (v == 0.0 and not allow_zero):
+        raise ParameterError(f"sliding-mode {name} = {value!r} is not accepted: a finite number "
+                             f"{'>= 0' if allow_zero else '> 0'}")
+    return v
+
+
+def _S(a: float) -> float:
+    return math.sin(a) / math.cos(a) ** 3
+
+
+@dataclass(frozen=True)
+class Uncertainty:
+    """The parts of the bound D on |Delta| [V] (module docstring), each its maximum over the box.
+
+    P_term: |P - P^| max|a_r''|; C_V_term; friction_term (phi_f); K_term; gyro_term;
+    disturbance; total D = their sum; alpha_max [rad], the reachable angle it is computed at.
+    """
+
+    P_term: float
+    C_V_term: float
+    friction_term: float
+    K_term: float
+    gyro_term: float
+    disturbance: float
+    alpha_max: float
+
+    @property
+    def total(self) -> float:
+        return (self.P_term + self.C_V_term + self.friction_term + self.K_term + self.gyro_term
+                + self.disturbance)
+
+    def as_dict(self) -> dict[str, float]:
+        return {"P_term": self.P_term, "C_V_term": self.C_V_term, "friction_term": self.friction_term,
+                "K_term": self.K_term, "gyro_term": self.gyro_term, "disturbance": self.disturbance,
+                "total": self.total, "alpha_max": self.alpha_max}
+
+
+class SlidingMode(SteeringController):
+    """u = P^ a_r'' + C_V^ a' + F^ sgn(a') + K^ S(a) + Gam^ a'/cos^2(a) + k sat(s/phi) (module docstring).
+
+    Parameters: lam [1/s] (the surface's slope), phi [rad/s] (the boundary layer), k [V] (the
+    switching gain), eta [V] (the margin of the sliding condition, used by the claim only),
+    friction_sign 'measured' (F^ sgn a') or 'none', friction_width [rad/s] (sgn smoothed as
+    x/sqrt(x^2 + w^2); 0: exact). Defaults: certified on the default run
+    (``RunConfig(controller="sliding-mode", model="nonholonomic")``, the paper circle, m1 550-750 kg):
+    |E| <= 0.04 rad, |E'| <= 0.4 rad/s, D = 1.80 V < k - eta = 2.8 V, |u| <= 8.5 V.
+    """
+
+    name = "sliding-mode"
+    model: SteeringModel
+
+    def __init__(self, model: SteeringModel, *, lam: float = 5.0, phi: float = 0.2, k: float = 3.0,
+                 eta: float = 0.2, friction_sign: str = "measured", friction_width: float = 0.0) -> None:
+        if not isinstance(model, SteeringModel):
+            raise ParameterError(f"sliding-mode needs a SteeringModel, got {type(model).__name__}")
+        if friction_sign not in SLIDING_FRICTION_SIGNS:
+            raise UnknownNameError("friction sign", str(friction_sign), SLIDING_FRICTION_SIGNS)
+        self.model = model
+        self.lam = _positive("lam", lam)
+        self.phi = _positive("phi", phi)
+        self.k = _positive("k", k, allow_zero=True)
+        self.eta = _positive("eta", eta, allow_zero=True)
+        self.friction_sign = friction_sign
+        self.friction_width = _positive("friction_width", friction_width, allow_zero=True)
+        self._F = 0.0 if friction_sign == "none" else model.F
+        self._gyro_V = model.gyro * model.V_A
+
+    @classmethod
+    def from_context(cls, context: BuildContext, **params: Any) -> SlidingMode:
+        """The law on the run's model (``context.model``: P^, C_V^, F^, K^, gyro^, V_A)."""
+        return cls(context.model, **params)
+
+    # ------------------------------------------------------------------ the law
+    def surface(self, alpha: float, alpha_dot: float, alpha0: float, alpha0_dot: float) -> float:
+        """s = E' + lam E [rad/s]."""
+        return (alpha0_dot - alpha_dot) + self.lam * (alpha0 - alpha)
+
+    def _sign(self, x: float) -> float:
+        w = self.friction_width
+        if w > 0.0:
+            return x / math.sqrt(x * x + w * w)
+        return 1.0 if x > 0.0 else (-1.0 if x < 0.0 else 0.0)
+
+    def voltage_scalar(self, alpha: float, alpha_dot: float, alpha0: float, alpha0_dot: float,
+                       alpha0_ddot: float) -> float:
+        m = self.model
+        E, Ed = alpha0 - alpha, alpha0_dot - alpha_dot
+        s = Ed + self.lam * E
+        sat = min(1.0, max(-1.0, s / self.phi))
+        c = math.cos(alpha)
+        u = m.P * (alpha0_ddot + self.lam * Ed) + m.C_V * alpha_dot + self.k * sat
+        if self._F:
+            u += self._F * self._sign(alpha_dot)
+        if m.K:
+            u += m.K * math.sin(alpha) / (c * c * c)
+        if self._gyro_V:
+            u += self._gyro_V * alpha_dot / (c * c)
+        return u
+
+    def voltage(self, alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot) -> np.ndarray:
+        from wmr_mj.plant.reduced import smooth_sign
+
+        m = self.model
+        a, ad = np.asarray(alpha, dtype=float), np.asarray(alpha_dot, dtype=float)
+        E = np.asarray(alpha0, dtype=float) - a
+        Ed = np.asarray(alpha0_dot, dtype=float) - ad
+        s = Ed + self.lam * E
+        c = np.cos(a)
+        u = m.P * (np.asarray(alpha0_ddot, dtype=float) + self.lam * Ed) + m.C_V * ad
+        u = u + self.k * np.clip(s / self.phi, -1.0, 1.0)
+        if self._F:
+            u = u + self._F * smooth_sign(ad, self.friction_width)
+        if m.K:
+            u = u + m.K * np.sin(a) / (c * c * c)
+        if self._gyro_V:
+            u = u + self._gyro_V * ad / (c * c)
+        return u
+
+    # ------------------------------------------------------------------ the claim
+    def uncertainty(self, context: ClaimContext) -> Uncertainty:
+        """The bound on |Delta| [V] over ``context.plant``'s box inside the layer (module docstring)."""
+        plant, ref, m = context.plant, context.reference, self.model
+        if ref.alpha_max is None:
+            raise ParameterError("sliding-mode's claim needs the reference's max|alpha0| (ReferenceBounds.alpha_max)")
+        lam, phi = self.lam, self.phi
+        a_max = ref.alpha_max + phi / lam
+        ar_dd = ref.alpha_ddot_max + 2.0 * lam * phi
+        rate = ref.alpha_dot_max + 2.0 * phi
+        box = plant.box
+        P_term = max(abs(p - m.P) for p in box.P) * ar_dd
+        C_term = max(abs(c - m.C_V) for c in box.C_V) * rate
+        phi_f = friction_term(self.friction_sign, F=box.F, F_hat=self._F)
+        if a_max < 0.5 * math.pi:
+            K_term = max(abs(kk - m.K) for kk in box.K) * _S(a_max)
+            c2 = math.cos(a_max) ** 2
+            gam = [g * v for g in plant.gyro for v in plant.V_A]
+            G_term = max(abs(g - self._gyro_V) for g in gam) * rate / c2
+        else:
+            K_term = G_term = math.inf
+        return Uncertainty(P_term=P_term, C_V_term=C_term, friction_term=phi_f, K_term=K_term, gyro_term=G_term,
+                           disturbance=plant.disturbance, alpha_max=a_max)
+
+    def uncertainty_bound(self, context: ClaimContext) -> float:
+        """D [V]: the bound on |Delta| over the box (:meth:`uncertainty`)."""
+        return self.uncertainty(context).total
+
+    def voltage_bound(self, context: ClaimContext) -> float:
+        """The law's |u| bound [V] inside the layer (triangle inequality on the law)."""
+        ref, m = context.reference, self.model
+        a_max = (ref.alpha_max or 0.0) + self.phi / self.lam
+        if a_max >= 0.5 * math.pi:
+            return math.inf
+        rate = ref.alpha_dot_max + 2.0 * self.phi
+        return (m.P * (ref.alpha_ddot_max + 2.0 * self.lam * self.phi) + abs(m.C_V) * rate + self._F
+                + abs(m.K) * _S(a_max) + abs(self._gyro_V) * rate / math.cos(a_max) ** 2 + self.k)
+
+    def claim(self, context: ClaimContext) -> Certificate:
+        """|E| <= phi/lam, |E'| <= 2 phi (the boundary layer, Slotine & Li 7.2) with its assumptions:
+        the switching gain above the uncertainty, the sampling margin, and the run's."""
+        unc = self.uncertainty(context)
+        D = unc.total
+        T = float(context.control_period)
+        P_min = context.plant.box.P[0]
+        ds = T * (D + self.k) / P_min  # the largest change of s over one period [rad/s]
+        layer_gain = T * self.k / (P_min * self.phi)
+        own = (
+            Assumption("switching gain above the uncertainty", "k >= D + eta, D = sup|Delta| over the box "
+                       "inside the layer (Slotine & Li (7.5))", self.k >= D + self.eta, D + self.eta, self.k,
+                       "D [V] = " + ", ".join(f"{n} {v:.4g}" for n, v in unc.as_dict().items()
+                                              if n not in ("total", "alpha_max"))
+                       + f"; k = {self.k:g} V, eta = {self.eta:g} V", kind="checked"),
+            Assumption("control period", f"T (D + k)/P_min <= {SAMPLING_FRACTION:g} phi (s moves a small part "
+                       "of the layer in one period) and T k/(P_min phi) <= 1 (continuous-time analysis; a "
+                       "margin, not a sampled-data proof)",
+                       ds <= SAMPLING_FRACTION * self.phi and layer_gain <= 1.0, ds / self.phi, SAMPLING_FRACTION,
+                       f"T = {T:g} s, change of s per period {ds:.4g} rad/s against phi = {self.phi:g} rad/s; "
+                       f"T k/(P_min phi) = {layer_gain:.4g}", kind="checked"),
+        )
+        E_max = self.phi / self.lam
+        return box_claim(claimant=self.name, E_max=E_max, Edot_max=2.0 * self.phi, context=context,
+                         alpha_max=unc.alpha_max, voltage_max=self.voltage_bound(context), own=own,
+                         inputs={"lam": self.lam, "phi": self.phi, "k": self.k, "eta": self.eta,
+                                 "uncertainty_V": unc.as_dict(), "estimate": self.model.coefficients.as_dict(),
+                                 "friction_sign": self.friction_sign, "friction_width": self.friction_width})
+
+    def describe(self) -> dict:
+        return {"controller": self.name, "model": self.model.name, "lam": self.lam, "phi": self.phi, "k": self.k,
+                "eta": self.eta, "friction_sign": self.friction_sign, "friction_width": self.friction_width,
+                "estimate": self.model.coefficients.as_dict()}
