@@ -205,6 +205,7 @@ class _CompiledStepper:
 
         self.model, self.where, self.substeps, self.log = model, where, substeps, log
         self.batch = Batch(model, nsim=1, nthread=1)
+        self.own_model = own_model
         if own_model:  # the simulation runs on ``model`` itself: edits of its reference numeric reach the law
             self.batch.set_models([model])
         self.batch.reset(keyframe=where.keyframe)
@@ -221,6 +222,11 @@ class _CompiledStepper:
 
     def set_fields(self, fields: Mapping[str, np.ndarray]) -> None:
         """A load change: the model's fields for the batch's simulation, then mj_setConst."""
+        if self.own_model:  # the batch runs on this run's own model: set its fields, as the Python stepper does
+            for name, value in fields.items():
+                getattr(self.model, name)[...] = value
+            mujoco.mj_setConst(self.model, mujoco.MjData(self.model))  # scratch data: the run's state stays
+            return
         for name, value in fields.items():
             self.batch.expand(name)[0] = value
         self.batch.set_const()
@@ -565,8 +571,6 @@ def _checked_inputs(schedule: Schedule) -> tuple[tuple[np.ndarray, np.ndarray, n
     if len(a0_all) < n:
         raise ParameterError(f"reference shorter than the run: {len(a0_all)} < {n} samples")
     disturbance, loads = schedule.disturbance, schedule.loads
-    if tracker is not None and (disturbance is not None or loads):
-        raise ParameterError("a path tracker (or --correction) does not run with disturbance or load signals yet")
     if disturbance is not None:
         disturbance = np.asarray(disturbance, dtype=np.float64)
         if len(disturbance) < n:
