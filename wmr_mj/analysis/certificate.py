@@ -360,7 +360,7 @@ class Certificate:
         if self.disturbance_term:
             out["disturbance_term"] = _finite_or_none(self.disturbance_term)
         out["friction_sign"] = self.friction_sign
-        out["regime"] = damping_regime(self.kp, self.kd)
+        out["regime"] = damping_regime(self.kp, self.kd) if self.region == "small-gain" else None
         out["iterations"] = int(self.iterations)
         out["vertices"] = [list(v) for v in self.vertices]
         out["inputs"] = _clean_inputs(self.inputs)

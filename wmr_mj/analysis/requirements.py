@@ -57,7 +57,7 @@ __all__ = [
 
 #: Signals a requirement may name (a run's rows: wmr_mj.sim.closed_loop.ROW_FIELDS), t in s; cross_track
 #: is C's signed distance from its desired path [m] at every control step (computed when a formula names it).
-SIGNALS = ("t", "E", "E_dot", "alpha", "alpha_dot", "alpha0", "voltage", "cross_track")
+SIGNALS = ("t", "E", "E_dot", "alpha", "alpha_dot", "alpha0", "voltage", "voltage_cmd", "cross_track")
 #: Named requirements, resolved against a run's bounds (see :func:`preset_formula`).
 PRESETS = {
     "certificate": "the certificate's rectangle for the whole run: always((abs(E) <= E_max) and "

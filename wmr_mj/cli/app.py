@@ -18,7 +18,7 @@ from collections.abc import Sequence
 
 from wmr_mj.errors import WmrMjError
 
-COMMANDS = ("identify", "robustness", "run", "replay", "sweep", "falsify", "validate", "figures", "model")
+COMMANDS = ("identify", "robustness", "run", "replay", "sweep", "falsify", "compare", "validate", "figures", "model")
 
 
 class _OneLineParser(argparse.ArgumentParser):

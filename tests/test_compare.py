@@ -1,0 +1,109 @@
+"""The versioned suite and `wmr-mj compare`: stable scenario ids, the same numbers as single runs, bad input."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from pathlib import Path
+
+import pytest
+
+from wmr_mj.cli.app import main
+from wmr_mj.errors import ParameterError, UnknownNameError
+from wmr_mj.sim.closed_loop import run_closed_loop
+from wmr_mj.sim.compare import compare, design_from_token
+from wmr_mj.sim.suite import SUITES_DIR, load_suite, suite_names
+
+REPO = Path(__file__).resolve().parents[1]
+#: standard-v1 as released: any change to the file must come as a new suite version (standard-v2)
+STANDARD_V1_SHA256 = "004a627a34e8"
+STANDARD_V1_IDS = [f"{p}/{plant}/{sig}" for p in ("circle", "lane", "eight", "agv", "knots")
+                   for plant in ("nominal", "vertex") for sig in ("none", "pulse", "payload")]
+
+
+def _one_error_line(capsys) -> str:
+    err = capsys.readouterr().err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert lines[0].startswith("wmr-mj: error: ") and "Traceback" not in err
+    return lines[0]
+
+
+def test_the_suite_loads_and_its_ids_are_stable():
+    assert "standard-v1" in suite_names()
+    suite = load_suite("standard-v1")
+    assert (suite.name, suite.version) == ("standard-v1", 1)
+    assert [s.id for s in suite.scenarios] == STANDARD_V1_IDS
+    # the file itself is pinned: a changed scenario, requirement or adversary makes a new version
+    raw = (SUITES_DIR / "standard-v1.toml").read_bytes()
+    assert hashlib.sha256(raw).hexdigest()[:12] == suite.sha256[:12] == STANDARD_V1_SHA256
+    vertex = suite.scenario("lane/vertex/payload")
+    assert vertex.plant_params["m1"] == 750.0 and vertex.signals["loads"][0]["m1"] == 550.0
+    assert suite.scenario("circle/nominal/pulse").signals["disturbance"]["amplitude"] == suite.d_max
+    assert [s.id for s in suite.select(["circle/*"])] == STANDARD_V1_IDS[:6]
+    with pytest.raises(UnknownNameError):
+        suite.select(["nowhere/*"])
+
+
+def test_a_scenario_sets_path_plant_and_signals_on_the_design():
+    suite = load_suite("standard-v1")
+    design = design_from_token("certified", suite)
+    cfg = suite.scenario("agv/vertex/pulse").config(design.config)
+    assert cfg.path == "agv-loop" and cfg.m1 == 750.0 and cfg.plant_overrides["V_A"] == 0.25
+    assert cfg.signals.disturbance.kind == "pulse" and cfg.signals.d_max == 1.0
+    assert cfg.kp == design.config.kp and cfg.box_ranges["V_A"] == (0.15, 0.25)  # the suite's box is declared
+    plug = design_from_token("sliding-mode,lam=4,tracker=pure-pursuit", suite).config
+    assert plug.controller == "sliding-mode" and plug.controller_params == {"lam": 4}
+    assert plug.tracker == "pure-pursuit" and plug.model == "nonholonomic"
+
+
+@pytest.mark.parametrize("token, error", [
+    ("paper,lam=3", ParameterError), ("no-such-law", UnknownNameError), (",k=1", ParameterError),
+    ("computed-torque,k=1", ParameterError)])
+def test_a_bad_design_is_refused(token, error):
+    with pytest.raises(error):
+        design_from_token(token, load_suite("standard-v1"))
+
+
+@pytest.mark.slow
+def test_compare_gives_the_single_runs_numbers_to_the_bit(tmp_path):
+    suite = load_suite("standard-v1")
+    example = REPO / "examples" / "my_pid.py"
+    designs = [design_from_token("certified", suite), design_from_token(f"{example}:MyPID,ki=10", suite)]
+    chosen = ["lane/nominal/none", "circle/vertex/pulse"]
+    result = compare(designs, suite, scenarios=chosen, budget=0, nthread=2)
+    assert [(r.design, r.scenario) for r in result.runs] == [(d.label, s) for d in designs for s in chosen]
+    for r in result.runs:
+        design = next(d for d in designs if d.label == r.design)
+        single = run_closed_loop(suite.scenario(r.scenario).config(design.config), progress=False)
+        s = single.summary.to_dict()
+        for key in ("sup_E", "sup_Edot", "verdict", "control_steps"):
+            assert r.summary[key] == s[key], (r.design, r.scenario, key)
+        assert r.summary["cross_track_max"] == s["path_error"]["cross_track_max"]
+        u = single.rows["voltage"]
+        assert r.rms_voltage == float((u * u).mean() ** 0.5)
+    rows = {row.label: row for row in result.rows}
+    assert rows["certified"].controller == "computed-torque" and rows["certified"].requirements_total == 8
+    assert rows[designs[1].label].controller == "my-pid" and rows[designs[1].label].no_claim == 2
+    from wmr_mj.report.compare import write_report
+
+    paths = write_report(result, tmp_path)
+    md = Path(paths["markdown"]).read_text()
+    assert "standard-v1 (version 1" in md and "my-pid" in md and "MuJoCo" in md
+    assert json.loads(Path(paths["json"]).read_text())["suite"]["name"] == "standard-v1"
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["compare", "certified", "--suite", "standard-v9"], ["unknown suite", "standard-v1"]),
+    (["compare", "no-such-law"], ["unknown controller", "sliding-mode"]),
+    (["compare", "certified", "--budget", "2"], ["budget", "below one"]),
+    (["compare", "certified", "--scenarios", "moon/*"], ["unknown scenario", "circle/nominal/none"]),
+    (["compare", "certified", "certified"], ["named twice"]),
+], ids=["suite", "controller", "budget", "scenario", "twice"])
+def test_bad_compare_input_is_one_line_and_exit_2(tmp_path, capsys, argv, words):
+    out = tmp_path / "out"
+    assert main([*argv, "--out", str(out)]) == 2
+    line = _one_error_line(capsys)
+    for w in words:
+        assert w in line, line
+    assert not out.exists()

@@ -1,0 +1,80 @@
+"""``wmr-mj compare DESIGN...``: every design on every scenario of a versioned suite, then the same adversary.
+
+Each DESIGN is a preset (``paper``, ``certified``), a built-in law (``sliding-mode``,
+``adaptive-computed-torque``, ``computed-torque``, ``pd``), or a law of one's own (``FILE.py:Class``,
+``module:Class``), with ``,key=value`` settings: ``tracker=NAME`` (``stanley-at-C``, ``pure-pursuit``,
+FILE.py:Class), ``correction=true``, ``model=...``, ``kp=...``, ``kd=...``, ``omega_r=...``, or the law's
+own parameters (``sliding-mode,k=5``). Example::
+
+    wmr-mj compare paper certified certified,correction=true sliding-mode adaptive-computed-torque \\
+        sliding-mode,tracker=pure-pursuit --scenarios 'circle/*' --budget 32
+"""
+
+from __future__ import annotations
+
+import argparse
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    from wmr_mj.sim.suite import suite_names
+
+    p = sub.add_parser("compare", help="every design on every scenario of a versioned suite, then the same "
+                                       "adversary: one table (Markdown, CSV, HTML) and a figure",
+                       description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("designs", nargs="+", metavar="DESIGN", help="a preset, a law's name, FILE.py:Class or "
+                                                               "module:Class, with ,key=value settings")
+    p.add_argument("--suite", default="standard-v1",
+                   help=f"the scenario suite: one of {', '.join(suite_names())} or a suite file (.toml)")
+    p.add_argument("--scenarios", action="append", metavar="PATTERN",
+                   help="only the scenarios whose id matches (shell pattern, e.g. 'circle/*'; repeatable)")
+    p.add_argument("--budget", type=int, default=32,
+                   help="the adversary's simulations per design, and as many random ones (default 32; 0: none)")
+    p.add_argument("--seed", type=int, default=0, help="the adversary's seed, the same for every design (default 0)")
+    p.add_argument("--method", default=None, help="the adversary's search method (default: falsify's)")
+    p.add_argument("--nthread", type=int, default=0, help="threads (default 0: every core)")
+    p.add_argument("--scheduler", metavar="ADDRESS", help="run on a Dask cluster (e.g. tcp://127.0.0.1:8786)")
+    p.add_argument("--out", metavar="DIR", help="output folder (default logs/compare-<time>)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
+                   help="progress bar (default: only on a terminal)")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    import time
+    from pathlib import Path
+
+    from wmr_mj._util.files import check_output_path
+    from wmr_mj._util.progress import counter_callback, progress_bar
+    from wmr_mj.cli._common import print_json
+    from wmr_mj.errors import ParameterError
+    from wmr_mj.report.compare import markdown, write_report
+    from wmr_mj.sim.compare import adversary_spec, compare, design_from_token
+    from wmr_mj.sim.suite import load_suite
+
+    if args.budget < 0:
+        raise ParameterError(f"--budget {args.budget} is not accepted: a number of runs >= 0")
+    suite = load_suite(args.suite)
+    suite.select(args.scenarios or [])  # an unknown scenario: one line, before any run
+    designs = [design_from_token(t, suite) for t in args.designs]
+    labels = [d.label for d in designs]
+    if len(set(labels)) != len(labels):
+        twice = sorted({x for x in labels if labels.count(x) > 1})
+        raise ParameterError(f"a design is named twice: {', '.join(twice)}; name each once")
+    if args.budget:
+        for d in designs:  # a budget below one generation, a requirement or box the design refuses: before any run
+            adversary_spec(d, suite, budget=args.budget, seed=args.seed, method=args.method)
+    out = Path(check_output_path(args.out or f"logs/compare-{time.strftime('%Y%m%d-%H%M%S')}", kind="dir",
+                                 option="--out"))
+    with progress_bar(1, desc="compare", unit="runs", enabled=args.progress) as bar:
+        result = compare(designs, suite, scenarios=args.scenarios or [], budget=args.budget, seed=args.seed,
+                         nthread=args.nthread, scheduler=args.scheduler, method=args.method,
+                         progress=counter_callback(bar))
+    paths = write_report(result, out)
+    if args.json:
+        print_json({**result.as_dict(), "files": paths})
+        return 0
+    print(markdown(result).split("\n- **")[0].rstrip())
+    print(f"\nreport: {paths['html']} (also {Path(paths['markdown']).name}, {Path(paths['csv']).name}, "
+          f"{Path(paths['figure']).name}, {Path(paths['json']).name}, {Path(paths['runs']).name})")
+    return 0

@@ -1,0 +1,173 @@
+"""The comparison's table (Markdown, CSV, HTML) and figure (``wmr-mj compare``).
+
+Usage::
+
+    from wmr_mj.report.compare import write_report
+    paths = write_report(result, out_dir)      # compare.md, compare.csv, compare.html, compare.png, compare.json
+"""
+
+from __future__ import annotations
+
+import csv
+import html
+import io
+import math
+from pathlib import Path
+from typing import Any
+
+from wmr_mj.sim.compare import CompareResult, DesignRow, runs_json
+
+__all__ = ["table_rows", "markdown", "csv_text", "html_page", "figure", "write_report", "COLUMNS"]
+
+#: (header, what it says) of every column, in order
+COLUMNS = (
+    ("design", "the design as named (a preset, a built-in law, FILE.py:Class; ,key=value settings)"),
+    ("law", "the steering law's name (and its tracker)"),
+    ("requirements passed", "requirement checks held over every scenario (the suite's STL requirements)"),
+    ("least robustness", "the least robustness / its threshold over every requirement and scenario (< 0: violated)"),
+    ("claim", "the law's own claim: certified-inside runs / runs, and |E| <= E_max on the adversary's box"),
+    ("worst found", "the adversary's worst: -robustness of the suite's requirement (> 0: falsified), beside "
+                    "random sampling at the same budget and seed"),
+    ("where", "the worst case's plant and signal (m1, V_A, the pulse)"),
+    ("tightness", "worst sup|E| found (certified runs) / the claim's E_max: a lower bound over an upper bound"),
+    ("RMS u [V]", "RMS of the applied voltage, mean over scenarios"),
+    ("TV u [V/s]", "total variation of the applied voltage per second, mean over scenarios: chattering"),
+    ("cross-track [m]", "the largest |cross-track| of C over every scenario"),
+    ("us/step", "CPU time of the closed loop per control step (physics included), median, and the law's path"),
+)
+
+
+def _num(x: Any, spec: str = ".3g") -> str:
+    if x is None or (isinstance(x, float) and not math.isfinite(x)):
+        return "n/a"
+    return format(x, spec)
+
+
+def _claim(r: DesignRow) -> str:
+    if r.no_claim == r.runs and r.runs:
+        return "none"
+    e = "" if r.claim_E_max is None else f", E_max {_num(r.claim_E_max)} rad"
+    loud = f", {r.certified_outside} CERTIFIED-OUTSIDE" if r.certified_outside else ""
+    return f"{r.certified_inside}/{r.runs} certified-inside{loud}{e}"
+
+
+def _worst(r: DesignRow) -> str:
+    if r.adversary_worst is None:
+        return "n/a"
+    verdict = (f"falsified at run {r.adversary_runs_to_falsify}" if r.adversary_falsified else "held")
+    rv = "held" if r.random_runs_to_falsify is None else f"falsified at run {r.random_runs_to_falsify}"
+    return f"{_num(r.adversary_worst, '+.4g')} ({verdict}); random {_num(r.random_worst, '+.4g')} ({rv})"
+
+
+def _where(r: DesignRow) -> str:
+    w = r.adversary_where
+    if not w:
+        return "n/a"
+    keys = [k for k in ("m1", "V_A", "disturbance.t1", "disturbance.amplitude") if k in w]
+    return ", ".join(f"{k.replace('disturbance.', 'pulse ')} {w[k]:.4g}" for k in keys)
+
+
+def table_rows(result: CompareResult) -> list[list[str]]:
+    """The table's cells, one list per design (:data:`COLUMNS`)."""
+    out = []
+    for r in result.rows:
+        law = r.controller + ("" if r.tracker is None else f" + {r.tracker}")
+        out.append([r.label, law, f"{r.requirements_passed}/{r.requirements_total}",
+                    f"{_num(r.least_normalised, '+.3g')} ({r.least_at})" if r.least_at else "n/a",
+                    _claim(r), _worst(r), _where(r), _num(r.tightness), _num(r.rms_voltage), _num(r.tv_voltage),
+                    _num(r.cross_track_max), f"{_num(r.cpu_us_per_step, '.1f')} ({r.law})"])
+    return out
+
+
+def _heading(result: CompareResult) -> str:
+    s = result.suite
+    v = result.versions
+    return (f"Suite {s.name} (version {s.version}, sha256 {s.sha256[:12]}), {len(result.scenarios)} scenarios of "
+            f"{s.duration:g} s; adversary: {2 * result.budget} runs per design ({result.budget} searched, "
+            f"{result.budget} random), seed {result.seed}; wmr-mj {v.get('wmr_mj')}, MuJoCo {v.get('mujoco')}")
+
+
+def markdown(result: CompareResult) -> str:
+    """The comparison as Markdown: the heading, the table, what each column says."""
+    head = [c for c, _ in COLUMNS]
+    lines = [f"# wmr-mj compare\n\n{_heading(result)}\n", "| " + " | ".join(head) + " |",
+             "|" + "---|" * len(head)]
+    for row in table_rows(result):
+        lines.append("| " + " | ".join(c.replace("|", "\\|") for c in row) + " |")
+    lines.append("")
+    lines += [f"- **{c}**: {what}" for c, what in COLUMNS]
+    reqs = result.suite.requirements
+    lines.append("\nRequirements: " + "; ".join(f"`{k}` = `{v}`" for k, v in reqs.items()))
+    lines.append(f"\nAdversary requirement: `{result.suite.adversary.requirement}`. Scenarios: "
+                 + ", ".join(s.id for s in result.scenarios) + ".")
+    return "\n".join(lines) + "\n"
+
+
+def csv_text(result: CompareResult) -> str:
+    """One CSV line per design with every figure of :class:`~wmr_mj.sim.compare.DesignRow` (full precision)."""
+    rows = [r.as_dict() for r in result.rows]
+    buf = io.StringIO()
+    names = list(rows[0]) if rows else []
+    w = csv.DictWriter(buf, fieldnames=names, lineterminator="\n")
+    w.writeheader()
+    for r in rows:
+        w.writerow({k: (repr(v) if isinstance(v, float) else v) for k, v in r.items()})
+    return buf.getvalue()
+
+
+def html_page(result: CompareResult, figure_name: str = "compare.png") -> str:
+    """A self-contained page: the heading, the figure, the table, the columns explained."""
+    head = "".join(f"<th title='{html.escape(what, quote=True)}'>{html.escape(c)}</th>" for c, what in COLUMNS)
+    body = "".join("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in row) + "</tr>"
+                   for row in table_rows(result))
+    notes = "".join(f"<li><b>{html.escape(c)}</b>: {html.escape(w)}</li>" for c, w in COLUMNS)
+    return (f"<!doctype html><html><head><meta charset='utf-8'><title>wmr-mj compare</title><style>"
+            "body{font-family:sans-serif;margin:1.5em}table{border-collapse:collapse;font-size:13px}"
+            "td,th{border:1px solid #ccc;padding:3px 6px;text-align:left}th{background:#f3f3f3}</style></head>"
+            f"<body><h1>wmr-mj compare</h1><p>{html.escape(_heading(result))}</p>"
+            f"<img src='{html.escape(figure_name)}' style='max-width:900px'><table><tr>{head}</tr>{body}</table>"
+            f"<ul>{notes}</ul></body></html>\n")
+
+
+def figure(result: CompareResult):
+    """(a) the requirement checks each design held; (b) effort (RMS voltage) against the worst cross-track."""
+    from wmr_mj.report.plots import new_figure
+
+    fig, (a, b) = new_figure(10.0, 3.6, ncols=2)
+    labels = [r.label for r in result.rows]
+    held = [r.requirements_passed / r.requirements_total if r.requirements_total else 0.0 for r in result.rows]
+    y = range(len(labels))
+    a.barh(list(y), held, color="C2")
+    a.set_yticks(list(y), labels, fontsize=8)
+    a.invert_yaxis()
+    a.set_xlim(0, 1)
+    a.set_xlabel("fraction of requirement checks held")
+    a.set_title("(a) requirements over the suite")
+    for i, r in enumerate(result.rows):
+        b.scatter(r.rms_voltage, r.cross_track_max if r.cross_track_max is not None else math.nan, color=f"C{i % 10}",
+                  label=r.label)
+    b.set_xlabel("RMS voltage [V]")
+    b.set_ylabel("worst |cross-track| [m]")
+    b.set_title("(b) effort against C's path")
+    b.legend(fontsize=7, frameon=False)
+    return fig
+
+
+def write_report(result: CompareResult, out: Path) -> dict[str, str]:
+    """compare.md, compare.csv, compare.html, compare.png and compare.json (and runs.jsonl) in ``out``,
+    each written atomically; returns their paths by kind."""
+    import json
+
+    from wmr_mj._util.files import write_json_atomic, write_text_atomic
+    from wmr_mj.report.plots import save_figure
+
+    out.mkdir(parents=True, exist_ok=True)
+    paths = {"markdown": out / "compare.md", "csv": out / "compare.csv", "html": out / "compare.html",
+             "json": out / "compare.json", "runs": out / "runs.jsonl"}
+    write_text_atomic(paths["markdown"], markdown(result))
+    write_text_atomic(paths["csv"], csv_text(result))
+    write_text_atomic(paths["html"], html_page(result))
+    write_text_atomic(paths["runs"], runs_json(result))
+    write_json_atomic(paths["json"], json.loads(json.dumps(result.as_dict(), default=str)))
+    (png,) = save_figure(figure(result), out / "compare", formats=("png",))
+    return {**{k: str(v) for k, v in paths.items()}, "figure": str(png)}

@@ -1,0 +1,397 @@
+"""One yardstick for every controller: each design runs every scenario of a versioned suite, then the same
+adversary falsifies each at the same budget and seed (``wmr-mj compare``).
+
+A design is named by one token (:func:`design_from_token`): a preset (``paper``, ``certified``), a
+built-in law, ``FILE.py:Class`` or ``module:Class``, with ``,key=value`` settings: RunConfig fields
+(``tracker=pure-pursuit``, ``model=...``, ``kp=...``, ``correction=true``) or the law's parameters
+(``lam=5``). A law that is not a preset takes the certified preset's model and gains (its estimate).
+Every design declares the suite's uncertainty box, so a claim covers the plants the suite runs.
+
+Usage::
+
+    from wmr_mj.sim.compare import compare, design_from_token
+    from wmr_mj.sim.suite import load_suite
+    suite = load_suite("standard-v1")
+    designs = [design_from_token(t, suite) for t in ("paper", "certified", "sliding-mode")]
+    result = compare(designs, suite, scenarios=["circle/*"], budget=32, seed=0)
+    result.rows[1].requirements_passed, result.rows[1].tightness
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import json
+import math
+import re
+import threading
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from wmr_mj.errors import ParameterError
+from wmr_mj.params import uncertainty_ranges
+from wmr_mj.plant.mjcf import TIMESTEP
+from wmr_mj.sim.config import RunConfig, config_from_dict, controller_name
+from wmr_mj.sim.suite import Scenario, Suite, versions
+
+__all__ = ["Design", "design_from_token", "ScenarioRun", "DesignRow", "CompareResult", "compare", "run_scenario",
+           "adversary_spec"]
+
+_FIELDS = {"model", "kp", "kd", "friction_sign", "friction_width", "tracker", "correction", "omega_r"}
+
+
+@dataclass(frozen=True)
+class Design:
+    """A design to compare: its ``label`` (the token as given) and its base RunConfig."""
+
+    label: str
+    config: RunConfig
+
+
+def design_from_token(token: str, suite: Suite) -> Design:
+    """A design from ``NAME[,key=value...]`` (module docstring).
+
+    Raises:
+        UnknownNameError, ParameterError: an unknown preset or law, a bad setting (one line each).
+    """
+    from controllers import gains_from_omega_r
+    from controllers.registry import parse_params
+    from wmr_mj.sim.designs import CERTIFIED, PRESET_NAMES, preset
+
+    name, _, rest = str(token).partition(",")
+    name = name.strip()
+    if not name:
+        raise ParameterError(f"design {token!r} is not accepted: NAME[,key=value...]")
+    settings = parse_params([s for s in rest.split(",") if s.strip()] if rest else [], option=f"design {name}")
+    fields = {k: settings.pop(k) for k in list(settings) if k in _FIELDS}
+    if "omega_r" in fields:
+        fields["kp"], fields["kd"] = gains_from_omega_r(float(fields.pop("omega_r")))
+    if "correction" in fields:
+        fields["correction"] = bool(fields["correction"])
+    if name in PRESET_NAMES:
+        if settings:
+            raise ParameterError(f"design {token!r}: a preset takes RunConfig settings ({', '.join(sorted(_FIELDS))}), "
+                                 f"not {sorted(settings)}")
+        changes = {**preset(name).config_changes(), **fields}
+    else:
+        changes = {**CERTIFIED.config_changes(), "controller": name, **fields}
+        if name in ("computed-torque", "pd"):
+            if settings:
+                raise ParameterError(f"design {token!r}: {name} takes RunConfig settings, not {sorted(settings)}")
+        else:
+            changes["controller_params"] = settings
+    box = uncertainty_ranges(suite.adversary.uncertainty)
+    m1_range = box.pop("m1")
+    config = RunConfig(**changes, m1_range=m1_range, box_ranges=box, duration=suite.duration)
+    return Design(label=str(token), config=config)
+
+
+@dataclass(frozen=True)
+class ScenarioRun:
+    """One design on one scenario: the run's summary (JSON), what the requirements gave, the effort."""
+
+    design: str
+    scenario: str
+    summary: Mapping[str, Any]
+    requirements: Mapping[str, Mapping[str, Any]]  # name -> robustness, satisfied, normalised (robustness/threshold)
+    rms_voltage: float  # [V] of the applied voltage
+    tv_voltage: float  # [V/s] total variation of the applied voltage per second: chattering
+    cpu_us_per_step: float  # [us] CPU time of the run's loop per control step
+    law: str  # compiled or python
+
+    @property
+    def verdict(self) -> str | None:
+        return self.summary.get("verdict")
+
+
+def _threshold(text: str) -> float | None:
+    """The number an ``abs(x) <= c`` requirement bounds by (for the robustness in units of it)."""
+    m = re.search(r"<=\s*([0-9.eE+-]+)\s*\)", text)
+    return float(m.group(1)) if m else None
+
+
+def run_scenario(config: RunConfig, requirements: Mapping[str, str], *, parsed: Sequence[Any] | None = None,
+                 monitor: threading.Lock | None = None) -> dict[str, Any]:
+    """One run of ``config`` judged by ``requirements`` (name -> STL): plain data (a Dask task's result).
+
+    ``parsed``: the requirements already parsed (rtamt imports on the calling thread: two threads importing
+    it at once deadlock); ``monitor``: a lock around rtamt's monitor (pure Python, process-wide logging).
+    """
+    from wmr_mj.analysis.requirements import evaluate_run, parse_requirement
+    from wmr_mj.sim.closed_loop import requirement_rows, run_closed_loop
+
+    period = TIMESTEP if config.control_period is None else config.control_period
+    if parsed is None:
+        parsed = [parse_requirement(text, period=period) for text in requirements.values()]
+    result = run_closed_loop(config, progress=False)
+    summary = result.summary.to_dict()
+    with monitor if monitor is not None else _nolock():
+        judged = evaluate_run(parsed, requirement_rows(result, parsed), summary, period=period)
+    reqs = {}
+    for (name, text), r in zip(requirements.items(), judged):
+        c = _threshold(text)
+        rob = r.robustness
+        reqs[name] = {"robustness": rob, "satisfied": r.satisfied,
+                      "normalised": None if rob is None or not c else rob / c}
+    u = np.asarray(result.rows["voltage"], float)
+    duration = len(u) * period
+    return {"summary": _slim(summary), "requirements": reqs,
+            "rms_voltage": float(np.sqrt(np.mean(u * u))) if u.size else math.nan,
+            "tv_voltage": float(np.sum(np.abs(np.diff(u))) / duration) if u.size > 1 else 0.0,
+            "cpu_us_per_step": 1e6 * float(result.cpu_s or 0.0) / max(1, len(u)), "law": result.law}
+
+
+class _nolock:
+    def __enter__(self) -> None:
+        return None
+
+    def __exit__(self, *exc: Any) -> None:
+        return None
+
+
+def _slim(summary: Mapping[str, Any]) -> dict[str, Any]:
+    """The summary's keys the comparison reads (the full summaries stay in runs.json)."""
+    keys = ("status", "controller", "m1", "path", "sup_E", "sup_Edot", "verdict", "failure", "control_steps",
+            "left_steering_range", "saturated_fraction", "wall_s")
+    out = {k: summary.get(k) for k in keys}
+    cert = summary.get("certificate") or {}
+    out["certificate"] = {k: cert.get(k) for k in ("E_max", "Edot_max", "E_ratio", "valid", "certified", "unmet")}
+    pe = summary.get("path_error") or {}
+    out["cross_track_max"] = pe.get("cross_track_max")
+    return out
+
+
+def _scenario_task(config_dict: Mapping[str, Any], requirements: Mapping[str, str]) -> dict[str, Any]:
+    """A Dask task: plain data in, plain data out."""
+    return run_scenario(config_from_dict(config_dict), requirements)
+
+
+def adversary_spec(design: Design, suite: Suite, *, budget: int, seed: int, method: str | None = None):
+    """The FalsifySpec of the suite's adversary for ``design``: its plant box, C's knot path within the declared
+    bounds and a disturbance pulse (start, amplitude within +-d_max), against the suite's requirement."""
+    from wmr_mj.reference.knots import KnotSpace
+    from wmr_mj.sim.falsify import FalsifySpec
+
+    adv = suite.adversary
+    width = adv.pulse_width
+    t1 = adv.pulse_t1[0]
+    signals = {"disturbance": {"kind": "pulse", "amplitude": adv.pulse_amplitude[1], "t1": t1, "t2": t1 + width},
+               "d_max": suite.d_max}
+    base = design.config.replace(path=adv.path, signals=signals, reference_bounds=suite.reference_bounds)
+    box: dict[str, tuple[float, float]] = {"m1": (float(base.m1_range[0]), float(base.m1_range[1])),
+                                           **{k: (float(v[0]), float(v[1])) for k, v in base.box_ranges.items()}}
+    if adv.path_knots:
+        box.update(KnotSpace(adv.path_knots, hold_range=adv.hold_range).ranges(base.reference_bounds))
+    box.update({"disturbance.t1": adv.pulse_t1, "disturbance.amplitude": adv.pulse_amplitude})
+    kwargs: dict[str, Any] = {} if method is None else {"method": method}
+    return FalsifySpec(base=base, box=box, objective="requirement", budget=budget, seed=seed,
+                       requirement=suite.requirements[adv.requirement], **kwargs)
+
+
+@dataclass(frozen=True)
+class DesignRow:
+    """A design's line of the comparison (every figure over the suite's scenarios, then the adversary's)."""
+
+    label: str
+    controller: str
+    tracker: str | None
+    runs: int
+    requirements_passed: int
+    requirements_total: int
+    least_normalised: float | None  # the least robustness / threshold over every requirement and scenario
+    least_at: str  # "requirement @ scenario"
+    certified_inside: int
+    certified_outside: int
+    uncertified: int
+    no_claim: int
+    failed: int
+    claim_E_max: float | None  # [rad] the claim's bound on the adversary's base (None: no claim or no bound)
+    adversary_worst: float | None  # the worst objective found (-robustness of the requirement; > 0 falsified)
+    adversary_falsified: bool
+    adversary_runs_to_falsify: int | None
+    adversary_where: Mapping[str, float]
+    adversary_worst_sup_E: float | None  # [rad]
+    random_worst: float | None  # the random sample's worst objective at the same budget
+    random_runs_to_falsify: int | None  # the random sample's first run that falsified (None: none did)
+    tightness: float | None  # worst sup|E| found (certified runs of the adversary) / claim_E_max
+    rms_voltage: float  # [V] mean over scenarios
+    tv_voltage: float  # [V/s] mean over scenarios
+    cross_track_max: float | None  # [m] worst over scenarios
+    cpu_us_per_step: float  # [us] median over scenarios
+    law: str
+
+    def as_dict(self) -> dict[str, Any]:
+        from dataclasses import asdict
+
+        out = asdict(self)
+        out["adversary_where"] = dict(self.adversary_where)
+        return out
+
+
+@dataclass(frozen=True)
+class CompareResult:
+    """What ``compare`` measured: one row per design, every scenario run, the suite and the versions."""
+
+    suite: Suite
+    scenarios: tuple[Scenario, ...]
+    rows: tuple[DesignRow, ...]
+    runs: tuple[ScenarioRun, ...]
+    budget: int
+    seed: int
+    versions: Mapping[str, str] = field(default_factory=dict)
+    wall_s: float = 0.0
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"suite": self.suite.as_dict(), "versions": dict(self.versions), "budget": self.budget,
+                "seed": self.seed, "scenarios": [s.id for s in self.scenarios],
+                "rows": [r.as_dict() for r in self.rows], "wall_s": self.wall_s}
+
+
+def compare(designs: Sequence[Design], suite: Suite, *, scenarios: Sequence[str] = (), budget: int = 32,
+            seed: int = 0, nthread: int = 0, scheduler: str | None = None, method: str | None = None,
+            progress: Callable[[int, int], None] | None = None) -> CompareResult:
+    """Every design on every (selected) scenario, then the adversary on each design.
+
+    Args:
+        designs: from :func:`design_from_token`.
+        suite: the suite (:func:`wmr_mj.sim.suite.load_suite`).
+        scenarios: shell-style patterns of scenario ids (none: all).
+        budget: the adversary's simulations per design (and as many for its random sample); 0: no adversary.
+        seed: the adversary's seed, the same for every design.
+        nthread: threads for the runs (0: every core); scheduler: a Dask scheduler address instead.
+        method: the adversary's search method (None: falsify's default).
+
+    Returns:
+        CompareResult: one :class:`DesignRow` per design, in order.
+
+    Raises:
+        ParameterError: no design, a budget below one generation (before any run), a design that cannot run.
+    """
+    from wmr_mj.analysis.requirements import parse_requirement
+    from wmr_mj.sim.batch import thread_count
+
+    if not designs:
+        raise ParameterError("compare needs at least one design")
+    chosen = suite.select(scenarios)
+    specs = [adversary_spec(d, suite, budget=budget, seed=seed, method=method) for d in designs] if budget else []
+    wall0 = time.perf_counter()
+    jobs = [(d, s, s.config(d.config)) for d in designs for s in chosen]
+    total = len(jobs) + 2 * budget * len(designs)
+    done = 0
+
+    def tick(k: int = 1) -> None:
+        nonlocal done
+        done += k
+        if progress is not None:
+            progress(done, total)
+
+    results: list[dict[str, Any]]
+    if scheduler is not None:
+        from wmr_mj.sim.sweep import connect
+
+        client = connect(scheduler)
+        futures = [client.submit(_scenario_task, cfg.as_dict(), dict(suite.requirements), pure=False)
+                   for _, _, cfg in jobs]
+        results = []
+        for fut in futures:
+            results.append(fut.result())
+            tick()
+    else:
+        periods = {TIMESTEP if c.control_period is None else c.control_period for _, _, c in jobs}
+        parsed = {p: [parse_requirement(t, period=p) for t in suite.requirements.values()] for p in periods}
+        monitor = threading.Lock()
+
+        def one(cfg: RunConfig) -> dict[str, Any]:
+            p = TIMESTEP if cfg.control_period is None else cfg.control_period
+            out = run_scenario(cfg, suite.requirements, parsed=parsed[p], monitor=monitor)
+            tick()
+            return out
+
+        with concurrent.futures.ThreadPoolExecutor(thread_count(nthread, len(jobs))) as pool:
+            results = list(pool.map(one, [cfg for _, _, cfg in jobs]))
+    runs = tuple(ScenarioRun(design=d.label, scenario=s.id, summary=r["summary"], requirements=r["requirements"],
+                             rms_voltage=r["rms_voltage"], tv_voltage=r["tv_voltage"],
+                             cpu_us_per_step=r["cpu_us_per_step"], law=r["law"])
+                 for (d, s, _), r in zip(jobs, results))
+    rows = []
+    for i, d in enumerate(designs):
+        mine = [r for r in runs if r.design == d.label]
+        adversary = None
+        if specs:
+            from wmr_mj.sim.falsify import falsify
+
+            adversary = falsify(specs[i], nthread=nthread, scheduler=scheduler,
+                                progress=lambda k, n: None)
+            tick(2 * budget)
+        rows.append(_row(d, mine, adversary, specs[i] if specs else None))
+    return CompareResult(suite=suite, scenarios=chosen, rows=tuple(rows), runs=runs, budget=budget, seed=seed,
+                         versions=versions(), wall_s=time.perf_counter() - wall0)
+
+
+def _row(design: Design, runs: Sequence[ScenarioRun], adversary: Any, spec: Any) -> DesignRow:
+    """A design's line from its scenario runs and the adversary's result."""
+    passed = total = 0
+    least, least_at = None, ""
+    for r in runs:
+        for name, q in r.requirements.items():
+            total += 1
+            passed += bool(q["satisfied"])
+            n = q["normalised"]
+            if n is not None and (least is None or n < least):
+                least, least_at = n, f"{name} @ {r.scenario}"
+    verdicts = [r.verdict for r in runs]
+    cross = [float(r.summary["cross_track_max"]) for r in runs if r.summary.get("cross_track_max") is not None]
+    claim_E_max = worst = random_worst = worst_sup_E = tightness = None
+    falsified, runs_to, random_runs_to, where = False, None, None, {}
+    if adversary is not None:
+        from wmr_mj.sim.certify import certificate_for
+        from wmr_mj.sim.config import build_reference, estimate_parameters
+
+        base = spec.base
+        period = TIMESTEP if base.control_period is None else base.control_period
+        reference, _ = build_reference(base.path, estimate_parameters(), dt=period, duration=base.duration)
+        cert = certificate_for(base, reference)
+        if cert is not None and cert.valid:
+            claim_E_max = float(cert.E_max)
+        evals = list(adversary.search) + list(adversary.random)
+        w = adversary.worst
+        worst, where, worst_sup_E = w.objective, dict(w.params), w.sup_E
+        random_worst = adversary.random_worst.objective
+        hits = [e.index + 1 for e in adversary.search if e.objective is not None and e.objective > 0]
+        falsified, runs_to = bool(hits), (hits[0] if hits else None)
+        random_hits = [e.index + 1 for e in adversary.random if e.objective is not None and e.objective > 0]
+        random_runs_to = random_hits[0] if random_hits else None
+        certified = [e.sup_E for e in evals if str(e.verdict).startswith("certified-")]
+        if claim_E_max and certified:
+            tightness = max(certified) / claim_E_max
+    return DesignRow(
+        label=design.label, controller=controller_name(design.config),
+        tracker=None if design.config.tracker is None and not design.config.correction else str(
+            design.config.tracker or "stanley-at-C"),
+        runs=len(runs), requirements_passed=passed, requirements_total=total, least_normalised=least,
+        least_at=least_at, certified_inside=verdicts.count("certified-inside"),
+        certified_outside=verdicts.count("certified-outside"),
+        uncertified=sum(1 for v in verdicts if str(v).startswith("uncertified")),
+        no_claim=verdicts.count("no-claim"), failed=verdicts.count("failed"), claim_E_max=claim_E_max,
+        adversary_worst=worst, adversary_falsified=falsified, adversary_runs_to_falsify=runs_to,
+        adversary_where=where, adversary_worst_sup_E=worst_sup_E, random_worst=random_worst,
+        random_runs_to_falsify=random_runs_to, tightness=tightness,
+        rms_voltage=float(np.mean([r.rms_voltage for r in runs])) if runs else math.nan,
+        tv_voltage=float(np.mean([r.tv_voltage for r in runs])) if runs else math.nan,
+        cross_track_max=max(cross) if cross else None,
+        cpu_us_per_step=float(np.median([r.cpu_us_per_step for r in runs])) if runs else math.nan,
+        law="/".join(sorted({r.law for r in runs})))
+
+
+def runs_json(result: CompareResult) -> str:
+    """Every scenario run of the comparison as JSON lines (design, scenario, slim summary, requirements, effort)."""
+    lines = []
+    for r in result.runs:
+        lines.append(json.dumps({"design": r.design, "scenario": r.scenario, "summary": r.summary,
+                                 "requirements": r.requirements, "rms_voltage": r.rms_voltage,
+                                 "tv_voltage": r.tv_voltage, "cpu_us_per_step": r.cpu_us_per_step, "law": r.law},
+                                default=lambda x: None if isinstance(x, float) and not math.isfinite(x) else str(x)))
+    return "\n".join(lines) + "\n"
