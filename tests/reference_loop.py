@@ -28,7 +28,6 @@ from wmr_mj.sim.closed_loop import (
     RunMeasures,
     RunResult,
     _drift_of,
-    _substeps,
     _sup,
     judge_path,
     path_sample_index,
@@ -44,6 +43,7 @@ from wmr_mj.sim.config import (
     plant_parameters,
 )
 from wmr_mj.sim.log_header import LogHeader
+from wmr_mj.sim.parts import control_substeps
 
 
 def reference_run(
@@ -66,7 +66,7 @@ def reference_run(
     plant = Plant(params, steering_friction=config.steering_friction, tyre_contact=config.tyre_contact)
     m, d = plant.model, plant.data
     dt = m.opt.timestep
-    substeps = _substeps(config, dt)
+    substeps = control_substeps(config, dt)
     period = substeps * dt
     n = int(round(config.duration / period))
     require_run_memory(duration_s=n * period, control_period_s=period)  # before the arrays

@@ -217,7 +217,7 @@ def test_the_example_plug_in_through_run_sweep_falsify_require_and_replay(tmp_pa
     # the same folder with another law is refused, not resumed
     assert main(["sweep", "--controller", spec, "--controller-param", "ki=30", "--n", "2", "--duration", "10",
                  "--out", str(sweep_dir)]) == 2
-    assert "holds the runs of another sweep" in _one_error_line(capsys)
+    assert "holds the runs of another controller" in _one_error_line(capsys)
     # falsify: the certificate's ratio says nothing of a law without a claim; a requirement does
     assert main(["falsify", "--controller", spec, "--budget", "6", "--duration", "10", "--out",
                  str(tmp_path / "f0")]) == 2

@@ -48,11 +48,10 @@ from wmr_mj.errors import ParameterError
 from wmr_mj.params import C80, M1_NOMINAL, C80Parameters
 from wmr_mj.plant.mjcf import TIMESTEP
 from wmr_mj.sim import compiled_law
-from wmr_mj.sim.certify import certificate_for
+from wmr_mj.sim.certify import certificate_of
 from wmr_mj.sim.closed_loop import (
     PathJudgement,
     RunMeasures,
-    _substeps,
     judge_path,
     path_sample_index,
     report,
@@ -61,16 +60,12 @@ from wmr_mj.sim.closed_loop import (
 )
 from wmr_mj.sim.config import (
     RunConfig,
-    analysis_for,
-    build_reference,
-    controller_for,
     estimate_of,
-    estimate_parameters,
     has_tracker,
     plant_parameters,
 )
 from wmr_mj.sim.engine import LAW_BACKENDS, batch_law_backend, batch_model
-from wmr_mj.sim.engine import plant_options as _plant_options
+from wmr_mj.sim.parts import RunParts, resolve_run
 from wmr_mj.sim.summary import BatchFigures, RunSummary
 
 __all__ = ["run_batch", "shares_one_batch", "batch_model", "batch_law_backend", "LAW_BACKENDS", "thread_count",
@@ -345,27 +340,24 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
     if requirements or not shares_one_batch(configs):
         return _run_one_by_one(configs, base=base, progress=progress, law=law, nthread=nthread,
                                requirements=tuple(requirements))
-    estimate = estimate_parameters(base)
-    controller = controller_for(first, estimate)
+    parts = resolve_run(first, base=base)  # the batch's shared parts: law, reference, grid, analysis
+    controller = parts.controller
     if controller.stateful:  # a law with state (or time) has no batch form: each run on the engine
         return _run_one_by_one(configs, base=base, progress=progress, law=law, nthread=nthread)
     backend = batch_law_backend(controller, law)
-    plants = [plant_parameters(c, base) for c in configs]
-    options = _plant_options(first)
+    plants = [parts.plant] + [plant_parameters(c, base) for c in configs[1:]]
+    options = parts.options
     model = batch_model(plants[0], **options)
     nsim = len(configs)
-    dt = model.opt.timestep
-    substeps = _substeps(first, dt)
-    period = substeps * dt
-    n = int(round(first.duration / period))
-    reference, settle_s = build_reference(first.path, estimate, dt=period, duration=n * period)
+    substeps, period, n = parts.substeps, parts.period, parts.n
+    reference, settle_s = parts.reference, parts.settle_s
     rows = (np.asarray(reference.alpha0), np.asarray(reference.alpha0_dot), np.asarray(reference.alpha0_ddot))
     steer = model.joint("steer").id
     where = dict(qpos_adr=int(model.jnt_qposadr[steer]), dof_adr=int(model.jnt_dofadr[steer]),
                  actuator=model.actuator("steering_motor").id,
                  chassis=model.body("chassis").id)  # the same in every simulation's model; the law writes the heading
     models = _simulation_models(backend, controller, plants, options, model, (substeps, n), rows, where)
-    analysis = analysis_for(first, reference, estimate, estimate=estimate_of(controller))
+    analysis = parts.analysis
     path_at = path_sample_index(n, period)
     require_memory(nsim * len(path_at) * 3 * 8, what=f"C's path samples of a batch of {nsim} runs",
                    hint="run fewer at once (a smaller chunk)")
@@ -419,7 +411,7 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
     wall = time.perf_counter() - wall0
     return _summaries(configs, plants, stats, _BatchRun(base=base, reference=reference, settle_s=settle_s,
                                                        analysis=analysis, loop=loop, backend=backend, wall=wall,
-                                                       threads=threads,
+                                                       threads=threads, parts=parts,
                                                        paper_law=estimate_of(controller) is not None))
 
 
@@ -463,6 +455,7 @@ class _BatchRun:
     backend: str
     wall: float
     threads: int  # the batch's threads, which also judge C's paths
+    parts: RunParts  # the first config's, which the batch's simulations share but for the plant
     paper_law: bool = True  # the law is the paper's family (its region applies)
 
 
@@ -473,7 +466,11 @@ def _summaries(configs: Sequence[RunConfig], plants: Sequence[C80Parameters], st
     base, reference, settle_s, analysis = run.base, run.reference, run.settle_s, run.analysis
     n, substeps, period, path_at = run.loop.n, run.loop.substeps, run.loop.period, run.loop.path_at
     backend, wall, nsim = run.backend, run.wall, len(configs)
-    certificates = [certificate_for(c, reference, params=base) for c in configs]
+    parts = run.parts
+    # each simulation's claim: the shared law on its own plant (a plant outside the box fails its assumption)
+    certificates = [parts.claim] + [certificate_of(c, reference, base=base, estimate=parts.estimate, plant=p,
+                                                   controller=parts.controller, tracker=parts.tracker)
+                                    for c, p in zip(configs[1:], plants[1:])]
 
     def path_of(i: int) -> PathJudgement | None:
         return judge_path(reference, path_at * period, stats.C_xy[i], stats.heading[i], settle_s=settle_s,
@@ -492,7 +489,7 @@ def _summaries(configs: Sequence[RunConfig], plants: Sequence[C80Parameters], st
                                final_alpha=stats.final_alpha[i], control_steps=n, steps=n * substeps,
                                wall_s=wall / nsim)
         r = report(c, measured, analysis=analysis, params=p, certificate=certificate,
-                   claims_nothing=certificate is None,
+                   claims_nothing=certificate is None, name=run.parts.controller_name,
                    drift=drift(prev_window=float(stats.drift_prev[i]), last_window=float(stats.drift_last[i]),
                                final_alpha_dot=float(stats.final_alpha_dot[i])),
                    path=paths[i])

@@ -48,7 +48,7 @@ from wmr_mj.sim.config import (
     tracker_for,
 )
 
-__all__ = ["certificate_for", "identified_spread", "box_spans", "outside_the_box", "reference_within"]
+__all__ = ["certificate_for", "certificate_of", "identified_spread", "box_spans", "outside_the_box", "reference_within"]
 
 
 def identified_spread(identified: Any) -> dict[str, tuple[float, float]]:
@@ -163,13 +163,29 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
     max|d| against d_max) is added, and with load changes "load inside the box" (every m1 they
     set against the box's m1 range; the initial m1 is the plant's, checked as every run's by
     :func:`outside_the_box`). A run without signals gets neither.
+
+    Tracker (config.tracker, or config.correction): the claim is computed for the bounds the tracker
+    declares for the reference it writes (measured on every run: ``controllers.tracking.within_declared``),
+    with the assumptions it states.
+
+    Returns:
+        The controller's claim (``SteeringController.claim``: the section-4 certificate for the
+        computed-torque and PD laws) with the run's inputs recorded; None where the law states none.
     """
-    base = params
+    estimate_params = estimate_parameters(params)
+    return certificate_of(config, reference, base=params, estimate=estimate_params,
+                          plant=plant_parameters(config, params), controller=controller_for(config, estimate_params),
+                          tracker=tracker_for(config, estimate_params), k_band=k_band, gyro_band=gyro_band)
+
+
+def certificate_of(config: Any, reference: Any, *, base: C80Parameters, estimate: C80Parameters,
+                   plant: C80Parameters, controller: Any, tracker: Any, k_band: float = PLANT_K_BAND,
+                   gyro_band: tuple[float, float] = GYRO_BAND) -> Certificate | None:
+    """:func:`certificate_for` on parts already resolved (:func:`wmr_mj.sim.parts.resolve_run`): the plant's
+    parameters, the controller's belief, the law and the tracker of the run."""
     k_band = finite_number("k_band", k_band, minimum=0.0)
     gyro_band = interval("gyro_band", gyro_band, positive=True)
-    estimate_params = estimate_parameters(base)
-    controller = controller_for(config, estimate_params)
-    plant = plant_parameters(config, base)
+    estimate_params = estimate
     ranges = {k: (float(v[0]), float(v[1])) for k, v in config.box_ranges.items()}
     plant_box, notes = _plant_box(config, base, estimate_params, ranges, k_band, gyro_band)
     period = config.control_period if config.control_period is not None else TIMESTEP
@@ -182,7 +198,6 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
     bounds = reference_bounds_of(config, reference)
     if config.reference_bounds is not None:
         stated = stated + (reference_within(reference.bounds(), config.reference_bounds),)
-    tracker = tracker_for(config, estimate_params)
     if tracker is not None:
         # the reference the law receives is the tracker's: the claim is computed for the bounds it
         # declares, which every run measures (controllers.tracking.within_declared)

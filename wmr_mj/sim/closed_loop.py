@@ -43,18 +43,13 @@ from wmr_mj.analysis.verdicts import Drift
 from wmr_mj.errors import ParameterError, WmrMjError
 from wmr_mj.params import C80, C80Parameters
 from wmr_mj.plant.mjcf import TIMESTEP, scene_xml
-from wmr_mj.sim.certify import certificate_for
 from wmr_mj.sim.config import (
     RunConfig,
-    analysis_for,
     build_reference,
-    controller_for,
     controller_name,
     estimate_of,
     estimate_parameters,
-    plant_parameters,
     reference_bounds_of,
-    tracker_for,
 )
 from wmr_mj.sim.engine import (
     ROW_FIELDS,
@@ -62,10 +57,10 @@ from wmr_mj.sim.engine import (
     Schedule,
     batch_model,
     load_fields,
-    plant_options,
     run_engine,
 )
 from wmr_mj.sim.log_header import LogHeader
+from wmr_mj.sim.parts import RunParts, control_substeps, resolve_run
 from wmr_mj.sim.summary import RunSummary
 
 __all__ = ["RunResult", "RunMeasures", "run_closed_loop", "report", "run_on_reduced_model", "ROW_FIELDS", "judge_path",
@@ -95,22 +90,12 @@ def requirement_rows(result: RunResult, requirements: Sequence[Any], *, base: C8
     if not any(r.names("cross_track") for r in requirements) or result.C_xy is None:
         return result.rows
     config = result.config
-    period = _substeps(config, TIMESTEP) * TIMESTEP
+    period = control_substeps(config, TIMESTEP) * TIMESTEP
     n = len(result.rows["t"])
     reference, _ = build_reference(config.path, estimate_parameters(base), dt=period,
                                    duration=int(round(config.duration / period)) * period)
     block = {"t": result.rows["t"], "C_pos": result.C_xy[:n], "heading": result.rows["heading"]}
     return {**result.rows, "cross_track": _PathRows(reference, period)(block, 1)["path_cross_track"]}
-
-
-def _substeps(config: RunConfig, timestep: float) -> int:
-    if config.control_period is None:
-        return 1
-    n = round(config.control_period / timestep)
-    if n < 1 or abs(n * timestep - config.control_period) > 1e-9:
-        raise ParameterError(f"control_period = {config.control_period} s must be a multiple of the "
-                             f"physics step {timestep} s")
-    return n
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -132,7 +117,8 @@ class RunMeasures:
 
 
 def report(config: RunConfig, measured: RunMeasures, *, analysis, params: C80Parameters, certificate=None,
-           drift: Drift | None = None, path: PathJudgement | None = None, claims_nothing: bool = False) -> RunSummary:
+           drift: Drift | None = None, path: PathJudgement | None = None, claims_nothing: bool = False,
+           name: str | None = None) -> RunSummary:
     """The run's report: sup errors (whole run and after the entry transient) against the region.
 
     Shared by the single run and the batched sweep so both report alike.
@@ -149,6 +135,7 @@ def report(config: RunConfig, measured: RunMeasures, *, analysis, params: C80Par
         path: C's path errors, bound and verdict (:func:`judge_path`); None: not measured.
         claims_nothing: the controller states no claim (``certificate_for`` gave None): the verdict
             is 'no-claim', never a pass.
+        name: what the summary calls the law (``RunParts.controller_name``; None: from the config).
 
     Returns:
         RunSummary: ``to_dict()`` writes the JSON interface.
@@ -163,7 +150,7 @@ def report(config: RunConfig, measured: RunMeasures, *, analysis, params: C80Par
         judged = judge_run(certificate=certificate, analysis=analysis, sup_E=sup_E, sup_Edot=sup_Edot, drift=drift)
     return RunSummary(
         status=m.status,
-        controller=controller_name(config),
+        controller=controller_name(config) if name is None else name,
         model=config.model,
         m1=float(params.m1),
         kp=config.kp,
@@ -341,22 +328,22 @@ def run_closed_loop(
     receives a block of rows every simulated second and is closed with the summary,
     also when the run is interrupted (KeyboardInterrupt or SIGTERM).
     """
-    params = plant_parameters(config, base)
-    estimate = estimate_parameters(base)
-    controller = controller_for(config, estimate)
-    dt = TIMESTEP
-    substeps = _substeps(config, dt)
-    period = substeps * dt
-    n = int(round(config.duration / period))
-    require_run_memory(duration_s=n * period, control_period_s=period)  # before the arrays
-    reference, settle_s = build_reference(config.path, estimate, dt=period, duration=n * period)
-    analysis = analysis_for(config, reference, estimate, estimate=estimate_of(controller))
-    certificate = certificate_for(config, reference, params=base)
+    require_run_memory(duration_s=config.duration, control_period_s=(config.control_period or TIMESTEP))
+    parts = resolve_run(config, base=base)  # before the arrays: what the run is made of, resolved once
+    return run_parts(parts, logger_factory=logger_factory, progress=progress, law=law)
+
+
+def run_parts(parts: RunParts, *, logger_factory: Callable[..., Any] | None = None, progress: bool | None = None,
+              law: str = "auto") -> RunResult:
+    """:func:`run_closed_loop` of a config already resolved (:func:`wmr_mj.sim.parts.resolve_run`)."""
+    config, params, controller, outer = parts.config, parts.plant, parts.controller, parts.tracker
+    dt, substeps, period, n = TIMESTEP, parts.substeps, parts.period, parts.n
+    reference, settle_s, analysis, certificate = parts.reference, parts.settle_s, parts.analysis, parts.claim
     a0_all, a0d_all, a0dd_all = reference.alpha0, reference.alpha0_dot, reference.alpha0_ddot
     if len(a0_all) < n:
         raise ParameterError(f"reference shorter than the run: {len(a0_all)} < {n} samples")
 
-    options = plant_options(config)
+    options = parts.options
     plain = batch_model(params, **options)  # the plant without its sky texture (no physics in it)
     logger = None
     if logger_factory is not None:
@@ -375,7 +362,6 @@ def run_closed_loop(
             path_errors=_PathRows(reference, period)))
 
     disturbance, loads = _signal_inputs(config, params, options, n, period)
-    outer = tracker_for(config, estimate)
     on_block = None if logger is None else logger.write_block
     bar = progress_bar(n, desc="run", unit="step", unit_scale=True, enabled=progress)
     try:
@@ -407,6 +393,7 @@ def run_closed_loop(
                            final_alpha=done["alpha"][-1], control_steps=k, steps=k * substeps, wall_s=wall)
     summary = report(config, measured, analysis=analysis, params=params,
                      certificate=None if run.failure is not None else certificate, claims_nothing=certificate is None,
+                     name=parts.controller_name,
                      drift=_drift_of(done["E"], done["alpha0_dot"][-1] - done["E_dot"][-1], period),
                      path=judge_path(reference, done["t"][at], run.C_xy[at], done["heading"][at], settle_s=settle_s,
                                      certificate=certificate, steering_range=params.steering_range,

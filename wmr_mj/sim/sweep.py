@@ -230,17 +230,16 @@ def _run_chunk(spec_json: str, indices: list[int], nthread: int,
     return rows
 
 
-def _differs(state: Mapping[str, Any], spec: SweepSpec) -> str:
-    """What differs between a sweep folder's recorded spec and ``spec``, in a few words."""
-    old = state.get("spec") or {}
-    new = json.loads(spec_to_json(spec))
-    old_base, new_base = old.get("base") or {}, new["base"]
-    for key in ("controller", "controller_params", "controller_plugin", "tracker", "tracker_params"):
+def _other_law(state: Mapping[str, Any], spec: SweepSpec) -> str | None:
+    """How a sweep folder's recorded law (controller, tracker, their parameters and sources) differs from
+    ``spec``'s, in a few words; None where it is the same law (another n or seed starts afresh, as always)."""
+    old_base = (state.get("spec") or {}).get("base") or {}
+    new_base = json.loads(spec_to_json(spec))["base"]
+    for key in ("controller", "controller_params", "controller_plugin", "tracker", "tracker_params",
+                "tracker_plugin", "correction"):
         if old_base.get(key) != new_base.get(key):
-            return f"its {key} is {old_base.get(key)!r}, this one's {new_base.get(key)!r}"
-    keys = sorted(k for k in set(old) | set(new) if k != "base" and old.get(k) != new.get(k))
-    keys += sorted(f"base.{k}" for k in set(old_base) | set(new_base) if old_base.get(k) != new_base.get(k))
-    return "it differs in " + (", ".join(keys[:4]) or "its settings")
+            return f"its {key} is {old_base.get(key)!r}, this sweep's {new_base.get(key)!r}"
+    return None
 
 
 def spec_to_json(spec: SweepSpec) -> str:
@@ -387,9 +386,11 @@ def run_sweep(spec: SweepSpec, *, out_dir: str | os.PathLike | None = None, chun
             if state.get("fingerprint") == fp:
                 for r in read_results(csv_path):
                     done[int(r["run"])] = r
-            elif state.get("fingerprint") and read_results(csv_path):
-                raise ParameterError(f"--out {str(out)!r} holds the runs of another sweep ({_differs(state, spec)}); "
-                                     "it is not resumed: give another --out, or remove that folder to start afresh")
+            elif _other_law(state, spec) and read_results(csv_path):
+                # another law's runs are never taken for this one's, nor written over
+                raise ParameterError(f"--out {str(out)!r} holds the runs of another controller "
+                                     f"({_other_law(state, spec)}); they are not resumed: give another --out, or "
+                                     "remove that folder to start afresh")
         write_json_atomic(state_path, {"fingerprint": fp, "spec": json.loads(spec_to_json(spec))})
     todo = [i for i in range(spec.n) if i not in done]
     chunks = [todo[i:i + chunk] for i in range(0, len(todo), chunk)]
