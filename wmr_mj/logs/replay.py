@@ -358,8 +358,8 @@ def _band(ax: Any, bound: float | None, ls: str, color: str, label: str, unit: s
     ax.axhline(-bound, ls=ls, lw=0.8, color=color)
 
 def _path_panels(e: Any, f: Any, lp: LogPath, settle: float | None) -> None:
-    """(e) C's desired path against the actual one; (f) cross-track and along-track over time."""
-    e.set(xlabel="x [m]", ylabel="y [m]", title="(e) path of C")
+    """(c) C's desired path against the actual one; (f) cross-track and along-track over time."""
+    e.set(xlabel="x [m]", ylabel="y [m]", title="(c) path of C")
     f.set(xlabel="t [s]", ylabel="error [m]", title="(f) path errors of C")
     if lp.errors is None:
         for axis in (e, f):
@@ -385,6 +385,16 @@ def _path_panels(e: Any, f: Any, lp: LogPath, settle: float | None) -> None:
 
 def plot(log: RunLog, path: str | os.PathLike, rep: dict[str, Any]) -> Path:
     """Write the replay figure (PNG) for ``rep`` = :func:`summarize` of ``log``; returns the path."""
+    fig = replay_figure(log, rep)
+    out = Path(path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, dpi=200)
+    return out
+
+
+def replay_figure(log: RunLog, rep: dict[str, Any]):
+    """The replay figure: (a) E, (b) E', (c) C's path; (d) the voltage, (e) the error plane with the
+    certificate's region beside the paper's, (f) C's path errors (panels read a b c / d e f)."""
     from matplotlib.figure import Figure
     from matplotlib.patches import Polygon, Rectangle
 
@@ -413,7 +423,7 @@ def plot(log: RunLog, path: str | os.PathLike, rep: dict[str, Any]) -> Path:
         _band(b, cert.get("Edot_max"), "-", "C2", "certificate ±Edot_max", "rad/s")
         _band(b, ed_max, "--", "C3", "paper's claim ±Edot_max", "rad/s")
         b.set(xlabel="t [s]", ylabel="E' [rad/s]", title="(b) error rate")
-        c = ax[1, 0]
+        c = ax[1, 0]  # drawn as (d): the panels read a b c / d e f
         c.plot(t, sig["voltage_cmd"], lw=0.7, color="0.6", label="controller output")
         c.plot(t, sig["voltage"], lw=0.9, color="C2", label="applied (limited)")
         try:
@@ -423,7 +433,7 @@ def plot(log: RunLog, path: str | os.PathLike, rep: dict[str, Any]) -> Path:
         if vlim is not None:
             c.axhline(vlim, ls=":", lw=0.8, color="k", label=f"supply ±{vlim:g} V")
             c.axhline(-vlim, ls=":", lw=0.8, color="k")
-        c.set(xlabel="t [s]", ylabel="u [V]", title="(c) armature voltage")
+        c.set(xlabel="t [s]", ylabel="u [V]", title="(d) armature voltage")
         d = ax[1, 1]
         aE, aEd = np.abs(E), np.abs(Ed)
         late = t >= settle if settle is not None else np.ones(t.size, bool)
@@ -435,11 +445,17 @@ def plot(log: RunLog, path: str | os.PathLike, rep: dict[str, Any]) -> Path:
             d.plot(aE[fin[-1]], aEd[fin[-1]], "o", ms=4, color="C0", label=f"end (t = {t[fin[-1]]:.3g} s)")
         if e_max is not None and ed_max is not None:
             d.add_patch(Rectangle((0, 0), e_max, ed_max, fc="C3", alpha=0.15, ec="C3", ls="--", lw=0.9,
-                                  label="E_max x Edot_max"))
+                                  label="paper's claim: E_max x Edot_max"))
         if poly:
             d.add_patch(Polygon(np.asarray(poly), closed=True, fc="C4", alpha=0.1, ec="C4", lw=0.9,
-                                label="region (4.21)"))
-        d.set(xlabel="|E| [rad]", ylabel="|E'| [rad/s]", title="(d) error plane")
+                                label="paper's claim: region (4.21)"))
+        cert_poly = cert.get("vertices")
+        if isinstance(cert_poly, list) and len(cert_poly) >= 3:
+            # the certificate's region, which the verdict is judged by
+            whose = f" ({cert['claimant']})" if cert.get("claimant") else ""
+            d.add_patch(Polygon(np.asarray(cert_poly, float), closed=True, fc="C2", alpha=0.15, ec="C2", lw=1.2,
+                                label=f"certificate's region{whose}: verdict {(log.summary or {}).get('verdict')}"))
+        d.set(xlabel="|E| [rad]", ylabel="|E'| [rad/s]", title="(e) error plane: both regions")
         d.set_xlim(left=0)
         d.set_ylim(bottom=0)
         for axis in (a, b, c):
@@ -457,10 +473,7 @@ def plot(log: RunLog, path: str | os.PathLike, rep: dict[str, Any]) -> Path:
             verdict += " after settling"
         extra = [v for v in (rep.get("verdict"), verdict, "TRUNCATED" if log.truncated else "") if v]
         fig.suptitle(f"{Path(str(log.path)).name}: " + ", ".join(bits + extra), fontsize=10)
-        out = Path(path)
-        out.parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(out, dpi=200)
-    return out
+    return fig
 
 
 def _fmt(v: Any, unit: str = "") -> str:
@@ -535,7 +548,11 @@ def format_summary(rep: dict[str, Any]) -> str:
     elif rep.get("path_errors_note"):
         lines.append(f"path of C  n/a: {rep['path_errors_note']}")
     if rep["summary"]:
-        extra = {k: v for k, v in rep["summary"].items() if k not in ("status", "rows", "last_t")}
+        # the paper's region under its own names only (a log written before they existed keeps the old ones)
+        from wmr_mj.sim.summary import PAPER_KEYS_DEPRECATED
+
+        renamed = set(PAPER_KEYS_DEPRECATED) if "paper_E_max" in rep["summary"] else set()
+        extra = {k: v for k, v in rep["summary"].items() if k not in ("status", "rows", "last_t") and k not in renamed}
         sc = [f"{k}={_fmt(v) if isinstance(v, float) else v}" for k, v in extra.items()
               if isinstance(v, (str, int, float, bool)) or v is None]
         if sc:

@@ -28,7 +28,14 @@ from wmr_mj.analysis.requirements import RequirementResult
 from wmr_mj.analysis.verdicts import FAILED, NO_CLAIM, Drift, PaperRegion
 from wmr_mj.reference.route import RouteProgress
 
-__all__ = ["RunSummary", "PaperRegion", "Drift", "CertificateJudgement", "Assumption", "BatchFigures"]
+__all__ = ["RunSummary", "PaperRegion", "Drift", "CertificateJudgement", "Assumption", "BatchFigures",
+           "PAPER_KEYS_DEPRECATED"]
+
+
+#: The run summary's keys of the paper's region, deprecated (kept for one version, wmr-mj 0.1), and the
+#: names that replace them: unprefixed, they read as the verdict's, which is the certificate's.
+PAPER_KEYS_DEPRECATED = {"E_max": "paper_E_max", "Edot_max": "paper_Edot_max", "condition": "paper_condition",
+                         "inside": "paper_inside", "E_ratio": "paper_E_ratio", "Edot_ratio": "paper_Edot_ratio"}
 
 
 @dataclass(frozen=True)
@@ -227,6 +234,10 @@ class RunSummary:
             "left_steering_range_at_s": self.left_steering_range_at_s,
             "final_alpha": self.final_alpha,
         }
+        # the same numbers under names that say whose region they are (the unprefixed keys above are kept
+        # for one version, deprecated: PAPER_KEYS_DEPRECATED)
+        out.update({new: out[old] for old, new in PAPER_KEYS_DEPRECATED.items()})
+        out["deprecated_keys"] = dict(PAPER_KEYS_DEPRECATED)
         if self.certificate is not None:
             out["verdict"] = self.certificate.verdict
             out["certificate"] = self.certificate.to_dict()

@@ -167,6 +167,12 @@ class SweepSpec:
         return hashlib.sha256(json.dumps(obj, sort_keys=True, default=str).encode()).hexdigest()[:16]
 
 
+#: sweep summary keys of the paper's region, deprecated (kept for one version), and their new names
+SWEEP_KEYS_DEPRECATED = {"inside": "paper_inside", "outside": "paper_outside", "worst_E_ratio": "worst_paper_E_ratio",
+                         "worst_Edot_ratio": "worst_paper_Edot_ratio", "E_max": "paper_E_max",
+                         "Edot_max": "paper_Edot_max"}
+
+
 def latin_hypercube(n: int, d: int, rng: np.random.Generator) -> np.ndarray:
     """(n, d) points in [0, 1)^d, one in each of the n strata of every axis (scrambled LHS).
 
@@ -630,6 +636,14 @@ class SweepSummary:
             "path_verdicts": None if self.path_verdicts is None else dict(self.path_verdicts),
             **({"requirements": [{**r.to_dict(), "column": requirement_column(i)}
                                  for i, r in enumerate(self.requirements)]} if self.requirements else {}),
+            # the paper's region under names that say so (the unprefixed keys above: deprecated, kept one version)
+            "paper_inside": self.paper_inside,
+            "paper_outside": self.n - self.paper_inside,
+            "worst_paper_E_ratio": self.paper_E_ratio.value,
+            "worst_paper_Edot_ratio": self.paper_Edot_ratio.value,
+            "paper_E_max": self.paper_E_max,
+            "paper_Edot_max": self.paper_Edot_max,
+            "deprecated_keys": dict(SWEEP_KEYS_DEPRECATED),
         }
 
     def rung_dict(self) -> dict[str, Any]:
