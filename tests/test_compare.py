@@ -107,3 +107,19 @@ def test_bad_compare_input_is_one_line_and_exit_2(tmp_path, capsys, argv, words)
     for w in words:
         assert w in line, line
     assert not out.exists()
+
+
+@pytest.mark.slow
+def test_compare_on_dask_gives_the_local_numbers():
+    distributed = pytest.importorskip("distributed")
+    suite = load_suite("standard-v1")
+    example = REPO / "examples" / "my_pid.py"
+    designs = [design_from_token("certified", suite), design_from_token(f"{example}:MyPID", suite)]
+    local = compare(designs, suite, scenarios=["lane/nominal/pulse"], budget=0, nthread=1)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        remote = compare(designs, suite, scenarios=["lane/nominal/pulse"], budget=0,
+                         scheduler=cluster.scheduler_address)
+    for a, b in zip(local.runs, remote.runs):
+        assert (a.design, a.scenario) == (b.design, b.scenario)
+        assert a.summary["sup_E"] == b.summary["sup_E"] and a.requirements == b.requirements
+        assert a.rms_voltage == b.rms_voltage and a.tv_voltage == b.tv_voltage

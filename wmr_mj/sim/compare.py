@@ -293,12 +293,15 @@ def compare(designs: Sequence[Design], suite: Suite, *, scenarios: Sequence[str]
         from wmr_mj.sim.sweep import connect
 
         client = connect(scheduler)
-        futures = [client.submit(_scenario_task, cfg.as_dict(), dict(suite.requirements), pure=False)
-                   for _, _, cfg in jobs]
-        results = []
-        for fut in futures:
-            results.append(fut.result())
-            tick()
+        try:
+            futures = [client.submit(_scenario_task, cfg.as_dict(), dict(suite.requirements), pure=False)
+                       for _, _, cfg in jobs]
+            results = []
+            for fut in futures:
+                results.append(fut.result())
+                tick()
+        finally:
+            client.close()
     else:
         periods = {TIMESTEP if c.control_period is None else c.control_period for _, _, c in jobs}
         parsed = {p: [parse_requirement(t, period=p) for t in suite.requirements.values()] for p in periods}
