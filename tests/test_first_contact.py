@@ -51,8 +51,8 @@ def test_the_replay_plot_draws_both_regions_with_panels_in_reading_order(logged)
     log = load_log(logged[0])
     fig = replay_figure(log, summarize(log))
     titles = [ax.get_title() for ax in fig.axes if ax.get_title()]
-    rows = sorted(((round(ax.get_position().y0, 2) * -1, ax.get_position().x0, ax.get_title()) for ax in fig.axes
-                   if ax.get_title()))
+    rows = sorted((round(ax.get_position().y0, 2) * -1, ax.get_position().x0, ax.get_title()) for ax in fig.axes
+                   if ax.get_title())
     assert [t[:3] for _, _, t in rows] == ["(a)", "(b)", "(c)", "(d)", "(e)", "(f)"], titles
     plane = next(ax for ax in fig.axes if ax.get_title().startswith("(e)"))
     labels = plane.get_legend_handles_labels()[1]

@@ -199,3 +199,16 @@ def test_route_progress_finishes_at_the_route_end():
     assert RouteProgress(length_m=8.1, driven_m=8.1 - 0.5 * FINISHED_TOL_M).finished
     assert not RouteProgress(length_m=8.1, driven_m=8.1 - 2 * FINISHED_TOL_M).finished
     assert route_progress("paper-circle", None, 35.0) is None
+
+
+@pytest.mark.slow
+def test_a_batch_reports_the_route_progress_as_its_single_runs_do():
+    from wmr_mj.sim.batch import run_batch
+    from wmr_mj.sim.closed_loop import run_closed_loop
+    from wmr_mj.sim.config import RunConfig
+
+    configs = [RunConfig(path="agv-loop", duration=10.0, m1=m) for m in (600.0, 700.0)]
+    for batched, config in zip(run_batch(configs, nthread=1), configs):
+        single = run_closed_loop(config, progress=False).summary
+        assert batched.route == single.route and not batched.route.finished
+        assert batched.to_dict()["route_driven_m"] == single.to_dict()["route_driven_m"]

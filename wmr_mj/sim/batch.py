@@ -479,6 +479,9 @@ def _summaries(configs: Sequence[RunConfig], plants: Sequence[C80Parameters], st
     # C's projections are NumPy work that releases the GIL: judged on the batch's threads, each run alone
     with concurrent.futures.ThreadPoolExecutor(max(1, min(run.threads, nsim))) as pool:
         paths = list(pool.map(path_of, range(nsim)))
+    from wmr_mj.reference.route import route_progress
+
+    progress = route_progress(configs[0].path, reference, n * substeps * TIMESTEP)  # one path: one progress
     reports = []
     for i, (c, p) in enumerate(zip(configs, plants)):
         certificate = certificates[i]
@@ -501,7 +504,8 @@ def _summaries(configs: Sequence[RunConfig], plants: Sequence[C80Parameters], st
             serial = run_closed_loop(c, progress=False, base=base).summary
             r = dataclasses.replace(serial, analysis=None, controller_config=None)  # report's fields and the warnings
         else:
-            r = dataclasses.replace(r, mujoco_warnings=int(stats.warnings[i]), paper_law=run.paper_law)
+            r = dataclasses.replace(r, mujoco_warnings=int(stats.warnings[i]), paper_law=run.paper_law,
+                                    route=progress)
         r = dataclasses.replace(r, batch=BatchFigures(
             final_alpha_after_step=float(stats.final_alpha_after_step[i]),  # the serial run reports the last row
             # batch-level figures for benchmarks
