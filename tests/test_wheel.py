@@ -42,7 +42,8 @@ def _IGNORE(folder: str, names: list[str]) -> set[str]:
         ignored.add("logs")
     return ignored
 # files of the source that are package data (everything else in a package folder is a module or a cache)
-_DATA_GLOBS = ("wmr_mj/schemas/*", "wmr_mj/data/*", "wmr_mj/data/routes/*", "wmr_mj/py.typed", "controllers/py.typed")
+_DATA_GLOBS = ("wmr_mj/schemas/*", "wmr_mj/data/*", "wmr_mj/data/routes/*", "wmr_mj/data/suites/*", "wmr_mj/py.typed",
+               "controllers/py.typed")
 _MODEL_FILES = ("c80.xml", "scene.xml", "README.md", "c80.png", "CHANGELOG.md")
 
 
@@ -155,3 +156,16 @@ def test_model_check_compares_the_installed_copy(installed):
                               text=True, timeout=120)
     assert "(checkout)" in checkout.stdout, checkout.stdout + checkout.stderr
     assert (proc.returncode, checkout.returncode) in ((0, 0), (1, 1)), (proc.stdout, checkout.stdout)
+
+
+def test_the_installed_package_runs_a_built_in_plug_in_and_the_packaged_suite(installed):
+    """The built-in laws are found by name and the suite file ships in the wheel (package data)."""
+    bin_dir, _, _, outside, env = installed
+    out = _run([str(bin_dir / "wmr-mj"), "run", "--controller", "sliding-mode", "--model", "nonholonomic",
+                "--path", "lane-change", "--duration", "10", "--no-log", "--json"], cwd=outside, env=env)
+    summary = json.loads(out)
+    assert summary["controller"] == "sliding-mode" and summary["verdict"].endswith(("inside", "outside"))
+    code = ("from wmr_mj.sim.suite import load_suite; s = load_suite('standard-v1'); "
+            "print(s.name, len(s.scenarios), s.source)")
+    printed = _run([str(bin_dir / "python"), "-c", code], cwd=outside, env=env)
+    assert printed.startswith("standard-v1 30 ") and str(bin_dir.parent) in printed
