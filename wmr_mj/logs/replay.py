@@ -299,9 +299,10 @@ def verify_controller(log: RunLog) -> dict[str, Any]:
 
     Returns:
         {"checked": bool, "identical": bool, "controller": name, "rows": n, "reason": why not checked,
-        "first_mismatch_t": s}: ``checked`` False (with ``reason``, one line) where the run cannot be
-        made again: no configuration in the log, a plug-in given as an object, a file or module that is
-        gone, or a source whose SHA-256 differs from the one recorded.
+        "required": bool, "first_mismatch_t": s}: ``checked`` False (with ``reason``, one line) where the
+        run cannot be made again; ``required`` True where that is a failure to reproduce (a plug-in given
+        as an object, a file or module that is gone, a source whose SHA-256 differs from the one
+        recorded), False where the log holds no wmr-mj run configuration at all.
     """
     import mujoco
 
@@ -311,11 +312,15 @@ def verify_controller(log: RunLog) -> dict[str, Any]:
     cfg = log.config
     name = str(cfg.get("controller", "?")) if cfg else "?"
     if not cfg:
-        return {"checked": False, "identical": False, "controller": name, "reason": "the log has no configuration"}
+        return {"checked": False, "identical": False, "controller": name, "required": False,
+                "reason": "the log has no run configuration to re-run"}
     try:
         config = config_from_dict(cfg)
-    except (WmrMjError, TypeError) as exc:
-        return {"checked": False, "identical": False, "controller": name, "reason": str(exc)}
+    except WmrMjError as exc:  # the law cannot be found again, or its source has changed: not reproduced
+        return {"checked": False, "identical": False, "controller": name, "required": True, "reason": str(exc)}
+    except (KeyError, TypeError) as exc:  # a log another program wrote: nothing to re-run
+        return {"checked": False, "identical": False, "controller": name, "required": False,
+                "reason": f"the log's configuration is not a wmr-mj run's ({type(exc).__name__}: {exc})"}
     name = controller_name(config)
     st = log.state
     if not st:
@@ -329,7 +334,7 @@ def verify_controller(log: RunLog) -> dict[str, Any]:
     again = np.asarray(result.rows["voltage"])[:n]
     same = (again == logged[:len(again)]) | (np.isnan(again) & np.isnan(logged[:len(again)]))
     out: dict[str, Any] = {"checked": True, "identical": bool(len(again) == n and same.all()), "controller": name,
-                           "rows": n}
+                           "rows": n, "required": True}
     if not out["identical"]:
         bad = np.flatnonzero(~same)
         k = int(bad[0]) if bad.size else len(again)
