@@ -81,6 +81,13 @@ class Uncompilable(FastLaw):
         return float(decimal.Decimal(alpha))  # a Python object numba does not know
 
 
+class MethodLaw(FastLaw):
+    name = "method-law"
+
+    def law(self, alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot):  # type: ignore[override]
+        return 0.0
+
+
 class NaNLaw(FastLaw):
     name = "nan-law"
 
@@ -196,6 +203,7 @@ def test_a_law_numba_cannot_compile_runs_in_python_and_says_why():
     assert why is not None and why.startswith("numba could not compile Uncompilable.law")
     assert "\n" not in why
     assert compiled_law.external_reason(Uncompilable()) == why  # cached: compiled (or refused) once per function
+    assert "not a staticmethod" in compiled_law.external_reason(MethodLaw())
 
 
 @needs_compiled

@@ -63,6 +63,7 @@ C compiler is found; without it, or with ``WMR_MJ_COMPILED_LAW=0`` in the enviro
 from __future__ import annotations
 
 import ctypes
+import inspect
 import os
 import threading
 from collections.abc import Sequence
@@ -182,6 +183,8 @@ def external_reason(controller: Any) -> str | None:
         return (f"it implements ComputedTorque and PDController, not {name}, which offers no pure law "
                 "function to compile (a staticmethod law(p, alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot) "
                 "with law_parameters(); controllers.base)")
+    if not isinstance(inspect.getattr_static(type(controller), "law"), staticmethod):
+        return f"{name}.law is not a staticmethod: the compiled law calls law(p, alpha, ...) without the object"
     try:
         _parameters(controller)
     except (TypeError, ValueError) as exc:
