@@ -11,7 +11,7 @@ STAMP := $(VENV)/.installed
 $(STAMP): pyproject.toml setup.py wmr_mj/sim/_compiled_law.c
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
-	$(PY) -m pip install -q -e '.[test,dask,video,docs]'
+	$(PY) -m pip install -q -e '.[test,dask,video,docs,fast]'
 	touch $(STAMP)
 
 venv: $(STAMP)
@@ -46,6 +46,7 @@ bench: $(STAMP)
 	$(PY) bench/bench_run.py
 	$(PY) bench/bench_logging.py --end-to-end
 	$(PY) bench/bench_sweep.py
+	$(PY) bench/bench_plugins.py
 	$(PY) bench/bench_video.py
 
 clean:

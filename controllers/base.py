@@ -31,8 +31,25 @@ A law of one's own, in a file of one's own (``wmr-mj run --controller my_law.py:
             return 0.1 * (self.kp * (alpha0 - alpha) + self.kd * (alpha0_dot - alpha_dot))
 
 The built-in computed-torque and PD laws also run compiled in MuJoCo's control callback
-(:mod:`wmr_mj.sim.compiled_law`); any other law runs in Python in the same engine, and the run
-says so.
+(:mod:`wmr_mj.sim.compiled_law`). So does a stateless law of one's own that offers its law as a
+pure function of floats, which numba (``pip install 'wmr-mj[fast]'``) compiles to C::
+
+    class FastPD(SteeringController):
+        name = "fast-pd"
+        def __init__(self, kp=50.0, kd=15.0):
+            self.kp, self.kd = kp, kd
+        def law_parameters(self):                  # p, the law's constants (floats)
+            return [0.1, self.kp, self.kd]
+        @staticmethod
+        def law(p, alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot):   # floats in, V out
+            return p[0] * (p[1] * (alpha0 - alpha) + p[2] * (alpha0_dot - alpha_dot))
+
+``law`` sees ``p`` as a float64 array (``law_parameters()``, fixed for the run) and the state as
+floats; it may use arithmetic, ``math`` and ``if``, nothing of the object. Its Python path
+(:meth:`voltage_scalar`, derived from it) gives the same bits as the compiled one where it keeps
+to IEEE operations and ``math`` functions (``x * x`` rather than ``x ** 2``). Any other law runs
+in Python in the same engine, one call per control step, and the run says so and why
+(``RunResult.law_note``).
 """
 
 from __future__ import annotations
@@ -80,6 +97,9 @@ class SteeringController:
     """
 
     name: str = "controller"
+    #: optional, for the compiled callback: ``law(p, alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot) -> V``,
+    #: a staticmethod of floats with ``p = law_parameters()`` (see the module's docstring)
+    law: Callable[..., float] | None = None
     #: the reduced model the law stands on (its estimate P^, C_V^, F^, K^), where it has one
     model: SteeringModel | None = None
 
@@ -94,7 +114,7 @@ class SteeringController:
     def voltage(self, alpha: ArrayLike, alpha_dot: ArrayLike, alpha0: ArrayLike, alpha0_dot: ArrayLike,
                 alpha0_ddot: ArrayLike) -> np.ndarray:
         """Unsaturated armature voltage [V] for each simulation of a batch (arrays (B,) -> (B,))."""
-        if type(self).voltage_scalar is SteeringController.voltage_scalar:
+        if type(self).voltage_scalar is SteeringController.voltage_scalar and type(self).law is None:
             raise TypeError(f"{type(self).__name__} defines neither voltage nor voltage_scalar")
         a, ad, a0, a0d, a0dd = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in
                                                     (alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot)))
@@ -104,11 +124,19 @@ class SteeringController:
 
     def voltage_scalar(self, alpha: float, alpha_dot: float, alpha0: float, alpha0_dot: float,
                        alpha0_ddot: float) -> float:
-        """The same law on floats [V] (override for speed)."""
+        """The same law on floats [V] (override for speed); a law that offers ``law`` gets ``law(p, ...)``."""
+        fn = type(self).law
+        if fn is not None:
+            return float(fn(np.asarray(self.law_parameters(), dtype=np.float64), alpha, alpha_dot, alpha0,
+                            alpha0_dot, alpha0_ddot))
         if type(self).voltage is SteeringController.voltage:
             raise TypeError(f"{type(self).__name__} defines neither voltage nor voltage_scalar")
         return float(self.voltage(np.array([alpha]), np.array([alpha_dot]), np.array([alpha0]),
                                   np.array([alpha0_dot]), np.array([alpha0_ddot]))[0])
+
+    def law_parameters(self) -> ArrayLike:
+        """The constants ``p`` of :attr:`law` (a sequence of floats; read once per run by the compiled law)."""
+        return ()
 
     def reset(self, *, control_period: float) -> None:
         """Before each run: clear the law's state; ``control_period`` [s] is the time between steps."""
@@ -161,8 +189,8 @@ def law_methods_missing(cls: Any) -> str | None:
         return (f"{getattr(cls, '__name__', cls)!r} is not a steering law: subclass controllers.SteeringController "
                 "and define voltage_scalar (or voltage, or step)")
     if (cls.voltage_scalar is SteeringController.voltage_scalar and cls.voltage is SteeringController.voltage
-            and cls.step is SteeringController.step):
-        return f"{cls.__name__} defines none of voltage_scalar, voltage, step: a steering law needs one"
+            and cls.step is SteeringController.step and cls.law is None):
+        return f"{cls.__name__} defines none of voltage_scalar, voltage, step, law: a steering law needs one"
     return None
 
 

@@ -349,6 +349,12 @@ def run(args: argparse.Namespace) -> int:
         else:
             print(f"wmr-mj: controller {result.summary.controller!r} runs in Python in the engine, one call per "
                   f"control step ({result.law_note})", file=sys.stderr)
+    elif result.law == "compiled":
+        from wmr_mj.sim.config import plugin_source
+
+        if plugin_source(config) is not None:  # a plug-in in the callback: its pure law function, compiled
+            print(f"wmr-mj: controller {result.summary.controller!r} compiled by numba into MuJoCo's control "
+                  "callback, no Python per control step", file=sys.stderr)
     if result.summary.failure is not None:
         print(f"wmr-mj: the run failed: {result.summary.failure}", file=sys.stderr)
     judged = None

@@ -13,6 +13,15 @@
  * loop it replaced (tests/reference_loop.py); tests/test_compiled_law.py and tests/test_engine.py
  * check the bits.
  *
+ * Kind 2, an external law (a plug-in's pure function of floats, compiled by numba.cfunc in
+ * wmr_mj.sim.compiled_law): the law numeric names a slot of the table of law functions that Python
+ * registered (wmr_mj_register_law), never an address, and carries the law's constants after its
+ * LAW_SIZE fields (LAW_NPARAM of them); the callback calls fn(constants, nparam, alpha, alpha',
+ * alpha0, alpha0', alpha0'') and applies the voltage limit and records the userdata as for the
+ * built-in laws. A value that is not finite (the Python path of a plug-in fails the run on it) is
+ * applied as NaN, so that MuJoCo warns (BADCTRL) and the engine re-runs the block with the Python
+ * law, which then fails the run at that step as it would have; an unknown slot gives NaN too.
+ *
  * A third numeric "wmr_mj_disturbance" (wmr_mj.sim.compiled_law.attach, optional) holds a torque
  * on the steering joint per control step (N m); the callback writes it to qfrc_applied at every
  * physics step, before the law (wmr_mj.sim.signals). Models without it are untouched.
@@ -34,7 +43,7 @@
 
 /* the numeric "wmr_mj_law": keep in step with wmr_mj/sim/compiled_law.py (LAW_FIELDS) */
 enum {
-  LAW_KIND,      /* 0: computed torque, 1: PD */
+  LAW_KIND,      /* 0: computed torque, 1: PD, 2: external (a registered function) */
   LAW_P,         /* P^, V s^2/rad */
   LAW_KP,        /* K_P, 1/s^2 */
   LAW_KD,        /* K_D, 1/s */
@@ -51,6 +60,8 @@ enum {
   LAW_DOF,       /* dof address of the steering joint */
   LAW_ACTUATOR,  /* the steering motor */
   LAW_CHASSIS,   /* the chassis body, for the heading (-1: no heading) */
+  LAW_FUNCTION,  /* kind 2: the slot of the law function (wmr_mj_register_law) */
+  LAW_NPARAM,    /* kind 2: the constants that follow the LAW_SIZE fields */
   LAW_SIZE
 };
 
@@ -61,12 +72,36 @@ int wmr_mj_mujoco_version(void) { return mjVERSION_HEADER; }
 /* the index of the optional disturbance numeric: its presence tells Python this build applies it */
 int wmr_mj_disturbance_numeric(void) { return 2; }
 
+/* kind 2: u = fn(constants, nparam, alpha, alpha', alpha0, alpha0', alpha0'') */
+typedef double (*wmr_mj_law_fn)(const double*, int, double, double, double, double, double);
+#define WMR_MJ_MAX_LAWS 4096
+static wmr_mj_law_fn registered[WMR_MJ_MAX_LAWS];
+static int nregistered;
+
+/* the slot of fn (the same slot for the same function), -1 where the table is full; Python calls it
+ * under a lock, before building the models that name the slot, and keeps fn alive for the process */
+int wmr_mj_register_law(void* fn) {
+  for (int i = 0; i < nregistered; i++) {
+    if (registered[i] == (wmr_mj_law_fn)fn) {
+      return i;
+    }
+  }
+  if (fn == NULL || nregistered == WMR_MJ_MAX_LAWS) {
+    return -1;
+  }
+  registered[nregistered] = (wmr_mj_law_fn)fn;
+  return nregistered++;
+}
+
 void wmr_mj_control(const mjModel* m, mjData* d) {
-  if (m->nnumeric < 2 || m->nuserdata < 7 || m->numeric_size[0] != LAW_SIZE ||
+  if (m->nnumeric < 2 || m->nuserdata < 7 || m->numeric_size[0] < LAW_SIZE ||
       strcmp(m->names + m->name_numericadr[0], "wmr_mj_law") != 0) {
     return;
   }
   const mjtNum* law = m->numeric_data + m->numeric_adr[0];
+  if (law[LAW_NPARAM] < 0.0 || m->numeric_size[0] != LAW_SIZE + (int)law[LAW_NPARAM]) {
+    return;
+  }
   const mjtNum* reference = m->numeric_data + m->numeric_adr[1];
   int chassis = (int)law[LAW_CHASSIS];
   if (chassis >= 0 && chassis < m->nbody) {
@@ -95,7 +130,15 @@ void wmr_mj_control(const mjModel* m, mjData* d) {
   double alpha_dot = d->qvel[(int)law[LAW_DOF]];
   double alpha0 = reference[3 * k], alpha0_dot = reference[3 * k + 1], alpha0_ddot = reference[3 * k + 2];
   double u;
-  if (law[LAW_KIND] == 1.0) {
+  int external = law[LAW_KIND] == 2.0;
+  if (external) {
+    int slot = (int)law[LAW_FUNCTION];
+    if (slot >= 0 && slot < nregistered && registered[slot] != NULL) {
+      u = registered[slot](law + LAW_SIZE, (int)law[LAW_NPARAM], alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot);
+    } else {
+      u = NAN;
+    }
+  } else if (law[LAW_KIND] == 1.0) {
     u = law[LAW_P] * (law[LAW_KD] * (alpha0_dot - alpha_dot) + law[LAW_KP] * (alpha0 - alpha));
   } else {
     double servo = alpha0_ddot + law[LAW_KD] * (alpha0_dot - alpha_dot) + law[LAW_KP] * (alpha0 - alpha);
@@ -122,7 +165,9 @@ void wmr_mj_control(const mjModel* m, mjData* d) {
     }
   }
   double limit = law[LAW_LIMIT], applied;
-  if (u != u) {
+  if (external && !isfinite(u)) {
+    applied = NAN;  /* MuJoCo warns (BADCTRL): the engine re-runs the block in Python, which fails there */
+  } else if (u != u) {
     applied = 0.0;  /* NaN from a diverged law: apply nothing, as the Python law */
   } else {
     applied = u > limit ? limit : (u < -limit ? -limit : u);

@@ -436,7 +436,8 @@ def _simulation_models(backend: str, controller: Any, plants: Sequence[C80Parame
         require_memory(nsim * n * 3 * 8, what=f"a batch of {nsim} runs of {n} control steps with the compiled law",
                        hint="run fewer at once (a smaller chunk) or the NumPy law (WMR_MJ_COMPILED_LAW=0)")
         compiled_law.install()
-        # law_vector is None only for a law supports() refuses, and then the backend is not 'compiled'
+        # law_vector is None only for a law compiles() refuses (neither built in nor compiled by numba), and
+        # then the backend is not 'compiled'
         return [batch_model(p, law=(compiled_law.law_vector(controller, voltage_limit=p.voltage_limit,
                                                             substeps=substeps, nstep=n, **where), rows),
                             **options) for p in plants]

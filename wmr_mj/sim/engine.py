@@ -10,9 +10,12 @@
   qfrc_actuator; for a log also qpos, qvel, ctrl and the site positions); the rows are then made
   from these arrays with NumPy, bit for bit what one ``mj_step`` at a time gives
   (tests/test_engine.py against tests/reference_loop.py);
+- a plug-in law that offers a pure function of floats (``law(p, ...)``, :mod:`controllers.base`)
+  runs in the same callback, compiled by numba (:func:`wmr_mj.sim.compiled_law.external_reason`);
 - where the compiled law cannot run (not built, ``WMR_MJ_COMPILED_LAW=0``, a controller
-  subclass), the same engine steps the block with the Python law (``voltage_scalar``), one
-  ``mj_step`` per physics step, into the same record arrays, and says so (``EngineRun.law_note``);
+  subclass, a plug-in without ``law``, with state, or without numba), the same engine steps the
+  block with the Python law (``step``), one ``mj_step`` per physics step, into the same record
+  arrays, and says so (``EngineRun.law_note``);
 - a block in which MuJoCo warns (rollout stops a simulation whose warnings rise) is stepped again
   from its first state with the Python law, which, as ``mj_step`` does, goes on after a warning;
   the rest of the run keeps the Python law.
@@ -117,7 +120,8 @@ def _backend(controller: Any, law: str) -> tuple[str, str | None]:
         return "numpy", "the Python law was asked for"
     why = compiled_law.unavailable_reason()
     if why is None and not compiled_law.supports(controller):
-        why = f"it implements ComputedTorque and PDController, not {type(controller).__name__}"
+        # a plug-in: compiled by numba where it offers a pure law function (compiled_law.external_reason)
+        why = compiled_law.external_reason(controller)
     if why is None:
         return "compiled", None
     if law == "compiled":
@@ -588,7 +592,7 @@ def _compiled_stepper(params: C80Parameters, controller: Any, options: dict[str,
     vector = compiled_law.law_vector(controller, voltage_limit=params.voltage_limit, substeps=substeps, nstep=n,
                                      qpos_adr=where.qpos, dof_adr=where.dof, actuator=where.actuator,
                                      chassis=where.chassis)
-    assert vector is not None  # the backend is 'compiled' only where compiled_law.supports(controller)
+    assert vector is not None  # the backend is 'compiled' only where compiled_law.compiles(controller)
     carried = (vector, reference) + (() if disturbance is None else (disturbance[:n],))
     lawful = batch_model(params, law=carried, **options)
     stepper = _CompiledStepper(lawful, where, substeps, log, own_model=schedule.tracker is not None)
