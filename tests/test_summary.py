@@ -19,6 +19,9 @@ RUN_KEYS = {"E_max", "E_ratio", "Edot_max", "Edot_ratio", "analysis", "certifica
             "sup_E_settled", "sup_Edot", "sup_Edot_settled", "verdict", "wall_s"}
 # added with C's path errors (wmr_mj.analysis.path_error, path_bound)
 PATH_KEYS = {"path_error", "path_bound", "path_verdict"}
+# added with the paper's region under names that say so (the unprefixed ones deprecated, kept)
+PAPER_KEYS = {"paper_E_max", "paper_Edot_max", "paper_condition", "paper_inside", "paper_E_ratio",
+              "paper_Edot_ratio", "deprecated_keys"}
 CERTIFICATE_KEYS = {"C_V_term", "E_max", "E_ratio", "Edot_max", "Edot_ratio", "K_term", "P_term", "alpha_max",
                     "assumptions", "certified", "condition", "dead_band", "delta1", "delta2", "delta3",
                     "friction_sign", "friction_term", "friction_width", "gamma1", "gamma2", "gyro_Edot_term",
@@ -34,7 +37,7 @@ def summary():
 
 def test_the_json_keeps_every_key(summary):
     d = summary.to_dict()
-    assert set(d) == RUN_KEYS | PATH_KEYS  # the path keys are new: every key before is kept
+    assert set(d) == RUN_KEYS | PATH_KEYS | PAPER_KEYS  # new keys added: every key before is kept
     assert set(d["certificate"]) == CERTIFICATE_KEYS
     assert set(d["paper_region"]) == {"E_max", "Edot_max", "condition", "inside"}
     assert set(d["drift"]) == {"final_alpha_dot", "growing", "E_last_window", "E_prev_window", "window_s",
@@ -47,7 +50,7 @@ def test_one_quantity_one_value_by_attribute_and_in_the_json(summary):
     d = summary.to_dict()
     assert summary.certificate.E_ratio == d["certificate"]["E_ratio"] == flat_row(d)["cert_E_ratio"]
     assert summary.sup_E / summary.certificate.E_max == pytest.approx(summary.certificate.E_ratio)
-    assert summary.E_max == summary.paper_region.E_max == d["E_max"] == d["paper_region"]["E_max"]
+    assert summary.E_max == summary.paper_region.E_max == d["E_max"] == d["paper_region"]["E_max"] == d["paper_E_max"]
     assert summary.verdict == summary.certificate.verdict == d["verdict"] == d["certificate"]["verdict"]
     assert summary.drift.growing is d["drift"]["growing"]
     assert summary.left_steering_range is (summary.left_steering_range_at_s is not None)
