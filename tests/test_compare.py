@@ -7,6 +7,7 @@ import json
 from pathlib import Path
 
 import pytest
+from test_cli_errors import _one_error_line
 
 from wmr_mj.cli.app import main
 from wmr_mj.errors import ParameterError, UnknownNameError
@@ -20,13 +21,6 @@ STANDARD_V1_SHA256 = "004a627a34e8"
 STANDARD_V1_IDS = [f"{p}/{plant}/{sig}" for p in ("circle", "lane", "eight", "agv", "knots")
                    for plant in ("nominal", "vertex") for sig in ("none", "pulse", "payload")]
 
-
-def _one_error_line(capsys) -> str:
-    err = capsys.readouterr().err
-    lines = err.strip().splitlines()
-    assert len(lines) == 1, err
-    assert lines[0].startswith("wmr-mj: error: ") and "Traceback" not in err
-    return lines[0]
 
 
 def test_the_suite_loads_and_its_ids_are_stable():

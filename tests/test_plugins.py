@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from test_cli_errors import _one_error_line
 
 from controllers.registry import PluginSource, parse_params, resolve
 from wmr_mj.analysis.verdicts import NO_CLAIM, is_pass
@@ -60,13 +61,6 @@ def law_file(tmp_path):
     path.write_text(LAW)
     return path
 
-
-def _one_error_line(capsys) -> str:
-    err = capsys.readouterr().err
-    lines = err.strip().splitlines()
-    assert len(lines) == 1, err
-    assert lines[0].startswith("wmr-mj: error: ") and "Traceback" not in err
-    return lines[0]
 
 
 # --------------------------------------------------------------------------- finding a law
