@@ -61,6 +61,23 @@ def test_windowed_operators_equal_rtamt_own_to_the_bit(formula):
         assert _spec(formula, 1.0, ("x",)).evaluate(data) == _spec(formula, 1.0, ("x",), stock=True).evaluate(data)
 
 
+@pytest.mark.parametrize("formula", ["always(abs(x) <= 0.7)", "eventually(x >= 0.5)", "always(x == 0.1)",
+                                     "eventually(abs(x) !== 0.2)", "always((x < 1) and (y > -1))",
+                                     "eventually(always(abs(x - y) <= 1.5))", "always[1,4](abs(x) >= 0.1)"])
+@pytest.mark.parametrize("nan", [False, True], ids=["finite", "with-nan"])
+def test_the_numpy_visitor_equals_rtamt_own_to_the_bit(formula, nan):
+    """abs, the comparisons and unbounded always/eventually in NumPy: rtamt's loops' bits, NaN included."""
+    rng = np.random.default_rng(1)
+    for n in (2, 5, 40, 1000):
+        x, y = rng.normal(size=n), rng.normal(size=n)
+        if nan:
+            x[n // 2] = np.nan
+        data = {"time": list(range(n)), "x": x.tolist(), "y": y.tolist()}
+        ours = _spec(formula, 1.0, ("x", "y")).evaluate(data)
+        stock = _spec(formula, 1.0, ("x", "y"), stock=True).evaluate(data)
+        assert np.array_equal(np.asarray(ours, float), np.asarray(stock, float), equal_nan=True), formula
+
+
 def test_presets_resolve_against_the_run_bounds():
     rows = {s: np.zeros(4) for s in SIGNALS}
     rows["E"] = np.array([0.0, 0.01, -0.03, 0.02])

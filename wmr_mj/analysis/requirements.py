@@ -108,6 +108,16 @@ def _window(sample: list[float], lo: int, hi: int, op, fill: float) -> list[floa
     return s[lo + front:lo + front + n].tolist()
 
 
+def _reverse_accumulate(sample: Sequence[float], op, start: float) -> list[float]:
+    """rtamt's unbounded always/eventually as it loops: out[i] = op(sample[i], out[i+1]), Python's min/max."""
+    out, prev = [], start
+    for v in reversed(sample):
+        prev = op(v, prev)
+        out.append(prev)
+    out.reverse()
+    return out
+
+
 def _import_rtamt() -> None:
     """Import rtamt quietly. Its ANTLR-generated parsers import ``typing.io`` (deprecated; gone
     in Python 3.12): where it is missing, an alias module carries the one name they use."""
@@ -132,28 +142,72 @@ def _import_rtamt() -> None:
 
 def _visitor_class():
     _import_rtamt()
+    from rtamt.semantics.enumerations.comp_oper import StlComparisonOperator as Op
     from rtamt.semantics.stl.discrete_time.offline.ast_visitor import StlDiscreteTimeOfflineAstVisitor
 
     class _WindowedVisitor(StlDiscreteTimeOfflineAstVisitor):
-        """rtamt's offline discrete-time visitor; the bounded operators as sliding windows."""
+        """rtamt's offline discrete-time visitor; the bounded operators as sliding windows, and abs, the
+        comparisons and the unbounded always/eventually element by element in NumPy: the same IEEE
+        operations as rtamt's Python loops (a test holds them equal to the bit). With a NaN in the
+        samples the unbounded operators keep rtamt's loop: Python's min/max and NumPy's treat NaN apart.
+        """
+
+        def visitAbs(self, node, *args, **kwargs):
+            return np.abs(np.asarray(self.visit(node.children[0], *args, **kwargs), dtype=float)).tolist()
+
+        def visitPredicate(self, node, *args, **kwargs):
+            left = np.asarray(self.visit(node.children[0], *args, **kwargs), dtype=float)
+            right = np.asarray(self.visit(node.children[1], *args, **kwargs), dtype=float)
+            op = node.operator.value
+            if op in (Op.LEQ.value, Op.LESS.value):
+                return (right - left).tolist()
+            if op in (Op.GEQ.value, Op.GREATER.value):
+                return (left - right).tolist()
+            if op == Op.EQ.value:
+                return (-np.abs(left - right)).tolist()
+            if op == Op.NEQ.value:
+                return np.abs(left - right).tolist()
+            return super().visitPredicate(node, *args, **kwargs)
+
+        def visitAlways(self, node, *args, **kwargs):
+            sample = self.visit(node.children[0], *args, **kwargs)
+            x = np.asarray(sample, dtype=float)
+            if np.isnan(x).any():
+                return _reverse_accumulate(sample, min, math.inf)
+            return np.minimum.accumulate(x[::-1])[::-1].tolist()
+
+        def visitEventually(self, node, *args, **kwargs):
+            sample = self.visit(node.children[0], *args, **kwargs)
+            x = np.asarray(sample, dtype=float)
+            if np.isnan(x).any():
+                return _reverse_accumulate(sample, max, -math.inf)
+            return np.maximum.accumulate(x[::-1])[::-1].tolist()
 
         def visitTimedAlways(self, node, *args, **kwargs):
             sample = self.visit(node.children[0], *args, **kwargs)
+            if np.isnan(np.asarray(sample, dtype=float)).any():  # rtamt's own loop: its min/max of a NaN
+                return super().visitTimedAlways(node, *args, **kwargs)
             begin, end = self.time_unit_transformer(node)
             return _window(sample, begin, end, np.minimum, math.inf)
 
         def visitTimedEventually(self, node, *args, **kwargs):
             sample = self.visit(node.children[0], *args, **kwargs)
+            if np.isnan(np.asarray(sample, dtype=float)).any():  # rtamt's own loop: its min/max of a NaN
+                return super().visitTimedEventually(node, *args, **kwargs)
             begin, end = self.time_unit_transformer(node)
             return _window(sample, begin, end, np.maximum, -math.inf)
 
         def visitTimedHistorically(self, node, *args, **kwargs):
             sample = self.visit(node.children[0], *args, **kwargs)
+            if np.isnan(np.asarray(sample, dtype=float)).any():  # rtamt's own loop: its min/max of a NaN
+                return super().visitTimedHistorically(node, *args, **kwargs)
             begin, end = self.time_unit_transformer(node)
             return _window(sample, -end, -begin, np.minimum, math.inf)
 
         def visitTimedOnce(self, node, *args, **kwargs):
             sample = self.visit(node.children[0], *args, **kwargs)
+            if np.isnan(np.asarray(sample, dtype=float)).any():  # rtamt's own loop: its min/max of a NaN
+                return super().visitTimedOnce(node, *args, **kwargs)
             begin, end = self.time_unit_transformer(node)
             return _window(sample, -end, -begin, np.maximum, -math.inf)
 
@@ -306,8 +360,10 @@ def evaluate(requirement: Requirement, signals: Mapping[str, Any], *, period: fl
     if missing:
         raise UnknownNameError("signal", missing[0], tuple(signals))
     n = len(next(iter(signals.values()))) if signals else 0
-    # a signal the formula does not read is declared but never evaluated: zeros stand in for it
-    columns = {s: signals[s] if s in signals else np.zeros(n) for s in requirement.signals}
+    # a signal the formula does not read is declared but never evaluated: it is left out of the data (two
+    # zeros stand in where the formula reads none, for the length)
+    read = [s for s in requirement.signals if requirement.names(s) or s in formula]
+    columns = {s: signals[s] for s in read if s in signals} or {requirement.signals[0]: np.zeros(n)}
     spec = _spec(formula, period, requirement.signals)
     rob = _robustness(spec, formula, columns, period)
     note = "vacuous: every window lies past the run's end" if math.isinf(rob) and rob > 0 else ""

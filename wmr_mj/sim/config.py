@@ -12,6 +12,7 @@ Usage::
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import os
 from collections.abc import Mapping
@@ -327,9 +328,19 @@ def analysis_box(config: RunConfig, params: C80Parameters = C80):
     if config.box == "paper":
         return ParameterBox.paper()
     box_model = "nonholonomic" if config.model in ("nonholonomic", "identified") else "paper"
-    return ParameterBox.from_parameters(params, m1_range=as_pair(config.m1_range), model=box_model,
-                                        m1_inertia=config.m1_inertia,
-                                        ranges={k: as_pair(v) for k, v in config.box_ranges.items()} or None)
+    return _derived_box(params, as_pair(config.m1_range), box_model, config.m1_inertia,
+                        tuple((k, as_pair(v)) for k, v in config.box_ranges.items()))
+
+
+@functools.lru_cache(maxsize=32)
+def _derived_box(params: C80Parameters, m1_range: tuple[float, float], box_model: str, m1_inertia: str,
+                 ranges: tuple[tuple[str, tuple[float, float]], ...]):
+    """The derived box of :func:`analysis_box`, cached: every run of a sweep or a comparison over a box of
+    several ranged parameters asks for the same one (its corners cost 0.4 s for the full box)."""
+    from wmr_mj.analysis.robustness import ParameterBox
+
+    return ParameterBox.from_parameters(params, m1_range=m1_range, model=box_model, m1_inertia=m1_inertia,
+                                        ranges=dict(ranges) or None)
 
 
 def analysis_for(config: RunConfig, reference, params: C80Parameters = C80, *, estimate=None):
