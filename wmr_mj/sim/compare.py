@@ -57,7 +57,7 @@ def design_from_token(token: str, suite: Suite) -> Design:
     Raises:
         UnknownNameError, ParameterError: an unknown preset or law, a bad setting (one line each).
     """
-    from controllers import gains_from_omega_r
+    from controllers import CONTROLLER_NAMES, gains_from_omega_r
     from controllers.registry import parse_params
     from wmr_mj.sim.designs import CERTIFIED, PRESET_NAMES, preset
 
@@ -78,7 +78,7 @@ def design_from_token(token: str, suite: Suite) -> Design:
         changes = {**preset(name).config_changes(), **fields}
     else:
         changes = {**CERTIFIED.config_changes(), "controller": name, **fields}
-        if name in ("computed-torque", "pd"):
+        if name in CONTROLLER_NAMES:  # the laws configured by RunConfig fields
             if settings:
                 raise ParameterError(f"design {token!r}: {name} takes RunConfig settings, not {sorted(settings)}")
         else:
