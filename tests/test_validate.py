@@ -283,7 +283,8 @@ def test_certified_outside_is_announced_loudly_before_the_answer(validated):
 @pytest.mark.slow
 @pytest.mark.parametrize("args", [("--n", "0"), ("--duration", "0"), ("--duration", "-3"), ("--sampling", "sobol"),
                                   ("--identify-duration", "nan"), ("--nthread", "-1"), ("--search-budget", "3"),
-                                  ("--search-budget", "-1"), ("--seed", "-1")])
+                                  ("--search-budget", "-1"), ("--seed", "-1"), ("--design", "no-such-law"),
+                                  ("--design", "sliding-mode,nope=1")])
 def test_bad_input_exits_2_with_one_line(args, tmp_path):
     proc = _cli("validate", *args, "--out", str(tmp_path / "x"), timeout=60)
     assert proc.returncode == 2
@@ -361,3 +362,25 @@ def test_validate_latest_is_a_copy_where_symlinks_are_unavailable(tmp_path, monk
     assert sorted(p.name for p in tmp_path.iterdir()) == ["validate-1", "validate-2", "validate-3", "validate-latest"]
     monkeypatch.undo()
     assert write_pointer(tmp_path / "validate-1").is_symlink()  # and back to a link over the copy
+
+
+@pytest.mark.slow
+def test_a_design_of_the_users_is_judged_beside_the_ladder(tmp_path):
+    """validate --design: a plug-in's rung (its verdicts against its own claim) and its nominal run, named as
+    itself; a law without a claim counts no pass and the paper's region is not applied to it."""
+    example = Path(__file__).resolve().parents[1] / "examples" / "my_pid.py"
+    folder = tmp_path / "report"
+    proc = _cli("validate", "--n", "2", "--duration", "10", "--identify-duration", "10", "--search-budget", "0",
+                "--design", "sliding-mode", "--design", f"{example}:MyPID,ki=10", "--out", str(folder), "--json")
+    assert proc.returncode == 0, proc.stderr
+    summary = json.loads(proc.stdout)
+    smc, pid = summary["designs"]
+    assert (smc["index"], pid["index"]) == (len(LADDER) + 2, len(LADDER) + 3)
+    assert smc["certificate"]["E_max"] == pytest.approx(0.04) and smc["n"] == 2
+    assert smc["verdicts"]["certified-inside"] + smc["verdicts"]["uncertified-inside"] == 2
+    assert pid["passes"] == 0 and pid["verdicts"].get("no-claim") == 2 and pid["paper_law"] is False
+    assert pid["nominal"]["verdict"] == "no-claim"
+    rows = _rows(folder, pid["runs_csv"])
+    assert len(rows) == 2 and {r["verdict"] for r in rows} == {"no-claim"}
+    md = (folder / "index.md").read_text()
+    assert "sliding-mode" in md and "MyPID,ki=10" in md

@@ -50,6 +50,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--path", default="paper-circle", metavar="NAME|FILE",
                    help="path of C every run follows: a named path (paper-circle, the default), a packaged route "
                         "(agv-loop) or a route file, as for wmr-mj run")
+    p.add_argument("--design", action="append", metavar="DESIGN", default=None,
+                   help="a design of your own, judged beside the ladder (its rung and its nominal run): a preset, "
+                        "a law's name, FILE.py:Class or module:Class, with ,key=value settings as for wmr-mj "
+                        "compare, e.g. 'sliding-mode' or 'my_law.py:MyLaw,k=2' (repeatable)")
     p.add_argument("--nthread", type=_nonneg_int, default=0, help="simulation threads (default 0: all CPUs)")
     p.add_argument("--out", metavar="DIR",
                    help="report folder (default logs/validate-<timestamp>/; an existing folder resumes its sweeps)")
@@ -72,7 +76,8 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     settings = ValidateSettings(n=args.n, seed=args.seed, sampling=args.sampling, duration=args.duration,
                                 identify_duration=args.identify_duration, search_budget=args.search_budget,
-                                nthread=args.nthread, uncertainty=args.uncertainty, path=args.path)
+                                nthread=args.nthread, uncertainty=args.uncertainty, path=args.path,
+                                designs=tuple(args.design or ()))
     out = check_output_path(args.out or default_folder("validate"), kind="dir", option="--out")
     summary = run_validate(settings, out)
     pointer = write_pointer(out)

@@ -19,7 +19,7 @@ from wmr_mj._util.progress import Stages
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import C80, M1_NOMINAL, M1_RANGE
 from wmr_mj.sim.config import RunConfig, build_reference
-from wmr_mj.sim.designs import Design
+from wmr_mj.sim.designs import DesignLike
 from wmr_mj.sim.sweep import max_at  # noqa: F401  (re-exported: the report reads runs.csv with it)
 
 __all__ = [
@@ -71,6 +71,7 @@ class ValidateSettings:
     nominal_m1: float = M1_NOMINAL
     uncertainty: str = "m1"
     path: str = "paper-circle"
+    designs: tuple[str, ...] = ()  # designs of the user's, each judged beside the ladder (validate --design)
 
     def __post_init__(self) -> None:
         from wmr_mj.sim.sweep import SAMPLINGS
@@ -95,6 +96,11 @@ class ValidateSettings:
         if self.uncertainty not in UNCERTAINTY_NAMES:
             raise UnknownNameError("uncertainty box name", str(self.uncertainty), UNCERTAINTY_NAMES)
         RunConfig(path=self.path)  # a named path or a route file: refused here as a run would refuse it
+        from wmr_mj.sim.designs import design_changes
+
+        object.__setattr__(self, "designs", tuple(str(t) for t in self.designs))
+        for token in self.designs:  # an unknown law, a missing file, a bad setting: refused before any run
+            RunConfig(**design_changes(token))
 
     @property
     def ranges(self) -> dict[str, tuple[float, float]]:
@@ -103,7 +109,7 @@ class ValidateSettings:
 
         return {k: v for k, v in uncertainty_ranges(self.uncertainty).items() if k != "m1"}
 
-    def config(self, design: Design) -> RunConfig:
+    def config(self, design: DesignLike) -> RunConfig:
         """The run of ``design`` these settings sweep (m1 at nominal; the sweep draws it)."""
         return RunConfig(**design.config_changes(), duration=self.duration, m1=self.nominal_m1, path=self.path,
                          m1_range=as_pair(self.m1_range), box_ranges=self.ranges, seed=self.seed)
@@ -111,12 +117,19 @@ class ValidateSettings:
     def as_dict(self) -> dict[str, Any]:
         d = asdict(self)
         d["m1_range"] = list(self.m1_range)
+        if not self.designs:
+            del d["designs"]  # the settings written before designs existed, unchanged
+        else:
+            d["designs"] = list(self.designs)
         return d
 
 
 def certificate_summary(cert: Any) -> dict[str, Any]:
     """A certificate's numbers for the report: ``Certificate.as_dict()`` without the bulky
     inputs, plus the reference's max|alpha0|, the steering range, the supply and the box."""
+    if cert is None:  # a law that states no claim
+        return {"certified": False, "valid": False, "unmet": ["no claim (the law states none)"], "E_max": None,
+                "Edot_max": None, "voltage_max": None, "reason": "the law states no claim"}
     d = {k: v for k, v in cert.as_dict().items() if k != "inputs"}
     inputs = cert.inputs
     d["alpha0_max"] = inputs.get("reference", {}).get("alpha0_max")

@@ -211,13 +211,14 @@ LADDER_COLUMNS = ("rung", "design", "change", "certificate", "cert-in", "CERT-OU
 
 def ladder_rows(summary: Mapping[str, Any]) -> list[list[str]]:
     out = []
-    extra = [summary["correction_rung"]] if summary.get("correction_rung") else []
+    extra = ([summary["correction_rung"]] if summary.get("correction_rung") else []) + list(summary.get("designs", []))
     for r in [*summary["ladder"], *extra]:
         v, n = r["verdicts"], r["n"]
         out.append([str(r["index"]), r["label"], r["change"] or "-", _cert_cell(r["certificate"]),
                     f"{v['certified-inside']}/{n}",
                     f"{v['certified-outside']}/{n}" + (" !!!" if v["certified-outside"] else ""),
-                    f"{v['uncertified-inside']}/{n}", f"{v['uncertified-outside']}/{n}", f"{r['paper_inside']}/{n}",
+                    f"{v['uncertified-inside']}/{n}", f"{v['uncertified-outside']}/{n}",
+                    f"{r['paper_inside']}/{n}" if r.get("paper_law", True) else "n/a",
                     _fmt(r["worst_sup_E"]), _fmt(r["worst_certificate_ratio"], ".3f"), f"{r['hit_stop']}/{n}",
                     f"{r['growing']}/{n}", _fmt(r.get("worst_path_cross_track"), ".3g")])
     return out
@@ -752,7 +753,7 @@ def summary_csv(summary: Mapping[str, Any]) -> str:
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(SUMMARY_CSV_COLUMNS)
-    extra = [summary["correction_rung"]] if summary.get("correction_rung") else []
+    extra = ([summary["correction_rung"]] if summary.get("correction_rung") else []) + list(summary.get("designs", []))
     for r in [*summary["ladder"], *extra]:
         c = r["certificate"]
         row = [r["index"], r["name"], r["design"], c["certified"], c.get("E_max"), c.get("Edot_max"),

@@ -50,7 +50,7 @@ from wmr_mj.report.settings import (
     stage_progress,
 )
 from wmr_mj.sim.config import RunConfig
-from wmr_mj.sim.designs import CERTIFIED, LADDER, PAPER, Design
+from wmr_mj.sim.designs import CERTIFIED, LADDER, PAPER, Design, DesignLike
 
 __all__ = [
     "ValidateSettings",  # defined in wmr_mj.report.settings, with the defaults; here beside run_validate
@@ -85,13 +85,13 @@ def summarise_rung(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
     return SweepSummary.of(rows).rung_dict()
 
 
-def ladder_changes(before: Design, after: Design) -> list[str]:
+def ladder_changes(before: DesignLike, after: DesignLike) -> list[str]:
     """The groups of :data:`LADDER_GROUPS` in which ``after`` differs from ``before``."""
     a, b = before.config_changes(), after.config_changes()
     return [group for group, fields in LADDER_GROUPS.items() if any(a[f] != b[f] for f in fields)]
 
 
-def _change_text(before: Design, after: Design) -> str:
+def _change_text(before: DesignLike, after: DesignLike) -> str:
     a, b = before.config_changes(), after.config_changes()
     parts = []
     for group in ladder_changes(before, after):
@@ -145,7 +145,7 @@ def friction_stage(settings: ValidateSettings, st: Stages) -> dict[str, dict[str
 
 
 # --------------------------------------------------------------------------- stage 3: the ladder
-def run_rung(settings: ValidateSettings, k: int, design: Design, folder: Path, st: Stages, reference,
+def run_rung(settings: ValidateSettings, k: int, design: DesignLike, folder: Path, st: Stages, reference,
              before: Design | None) -> dict[str, Any]:
     """Sweep one rung over m1 (resumable in ladder-<k>-<name>/) and summarise it."""
     from wmr_mj.sim.certify import certificate_for
@@ -307,6 +307,9 @@ def run_validate(settings: ValidateSettings, out_dir: str | os.PathLike, *, log:
     friction = friction_stage(settings, st)
     rungs = ladder_stage(settings, folder, st)
     corrected = correction_stage(settings, folder, st)
+    from wmr_mj.report.extra_designs import designs_stage
+
+    designs = designs_stage(settings, folder, st, first_index=len(LADDER) + 2)
     searches = search_stage(settings, folder, st, rungs)
     nominal = nominal_stage(settings, st)
     figures, fig7 = figures_stage(settings, folder, st, rungs, searches, nominal)
@@ -317,7 +320,8 @@ def run_validate(settings: ValidateSettings, out_dir: str | os.PathLike, *, log:
         "nominal": {name: _nominal_summary(run) for name, run in nominal.items()}, "friction": friction,
         "identification": identification, "paper_example": fig7, "figures": figures,
         "correction_rung": corrected, "path": _path_summary(settings),
-        "certified_outside": sum(r["certified_outside"] for r in rungs) + corrected["certified_outside"]
+        **({"designs": designs} if designs else {}),
+        "certified_outside": sum(r["certified_outside"] for r in [*rungs, *designs]) + corrected["certified_outside"]
         + sum(s["verdicts"]["certified-outside"] for s in searches),
         "versions": software_versions(),
     }

@@ -40,8 +40,6 @@ from wmr_mj.sim.suite import Scenario, Suite, versions
 __all__ = ["Design", "design_from_token", "ScenarioRun", "DesignRow", "CompareResult", "compare", "run_scenario",
            "adversary_spec"]
 
-_FIELDS = {"model", "kp", "kd", "friction_sign", "friction_width", "tracker", "correction", "omega_r"}
-
 
 @dataclass(frozen=True)
 class Design:
@@ -52,40 +50,17 @@ class Design:
 
 
 def design_from_token(token: str, suite: Suite) -> Design:
-    """A design from ``NAME[,key=value...]`` (module docstring).
+    """A design from ``NAME[,key=value...]`` (:func:`wmr_mj.sim.designs.design_changes`), declaring the
+    suite's uncertainty box and running the suite's duration.
 
     Raises:
         UnknownNameError, ParameterError: an unknown preset or law, a bad setting (one line each).
     """
-    from controllers import CONTROLLER_NAMES, gains_from_omega_r
-    from controllers.registry import parse_params
-    from wmr_mj.sim.designs import CERTIFIED, PRESET_NAMES, preset
+    from wmr_mj.sim.designs import design_changes
 
-    name, _, rest = str(token).partition(",")
-    name = name.strip()
-    if not name:
-        raise ParameterError(f"design {token!r} is not accepted: NAME[,key=value...]")
-    settings = parse_params([s for s in rest.split(",") if s.strip()] if rest else [], option=f"design {name}")
-    fields = {k: settings.pop(k) for k in list(settings) if k in _FIELDS}
-    if "omega_r" in fields:
-        fields["kp"], fields["kd"] = gains_from_omega_r(float(fields.pop("omega_r")))
-    if "correction" in fields:
-        fields["correction"] = bool(fields["correction"])
-    if name in PRESET_NAMES:
-        if settings:
-            raise ParameterError(f"design {token!r}: a preset takes RunConfig settings ({', '.join(sorted(_FIELDS))}), "
-                                 f"not {sorted(settings)}")
-        changes = {**preset(name).config_changes(), **fields}
-    else:
-        changes = {**CERTIFIED.config_changes(), "controller": name, **fields}
-        if name in CONTROLLER_NAMES:  # the laws configured by RunConfig fields
-            if settings:
-                raise ParameterError(f"design {token!r}: {name} takes RunConfig settings, not {sorted(settings)}")
-        else:
-            changes["controller_params"] = settings
     box = uncertainty_ranges(suite.adversary.uncertainty)
     m1_range = box.pop("m1")
-    config = RunConfig(**changes, m1_range=m1_range, box_ranges=box, duration=suite.duration)
+    config = RunConfig(**design_changes(token), m1_range=m1_range, box_ranges=box, duration=suite.duration)
     return Design(label=str(token), config=config)
 
 

@@ -40,9 +40,9 @@ Usage::
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Protocol
 
-from wmr_mj.errors import UnknownNameError
+from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import PAPER_KD, PAPER_KP
 
 __all__ = [
@@ -143,3 +143,59 @@ def certified_omega_r(*, error_spec: float = ERROR_SPEC, grid: tuple[float, ...]
         if cert is not None and cert.certified and cert.E_max <= error_spec:
             return w
     return None
+
+
+class DesignLike(Protocol):
+    """What a rung of validate's ladder needs of a design: :class:`Design`, or a token's
+    (``wmr_mj.report.extra_designs.TokenDesign``)."""
+
+    @property
+    def name(self) -> str: ...
+
+    @property
+    def label(self) -> str: ...
+
+    def config_changes(self) -> dict[str, Any]: ...
+
+    def describe(self) -> str: ...
+
+
+#: The RunConfig settings a design token may carry beside a law's own parameters.
+TOKEN_FIELDS = ("model", "kp", "kd", "omega_r", "friction_sign", "friction_width", "tracker", "correction")
+
+
+def design_changes(token: str) -> dict[str, Any]:
+    """The RunConfig fields of a design named by one token, ``NAME[,key=value...]``: NAME a preset
+    (:data:`PRESET_NAMES`) or a law (a built-in name, ``FILE.py:Class``, ``module:Class``); a key one of
+    :data:`TOKEN_FIELDS` (``omega_r`` gives K_P, K_D by (3.6)) or, for a plug-in, one of its parameters.
+    A law that is not a preset takes the certified preset's model and gains (its estimate).
+
+    Raises:
+        UnknownNameError: an unknown preset or law (from RunConfig, naming the valid ones).
+        ParameterError: an empty name, a setting the design does not take.
+    """
+    from controllers import CONTROLLER_NAMES, gains_from_omega_r
+    from controllers.registry import parse_params
+
+    name, _, rest = str(token).partition(",")
+    name = name.strip()
+    if not name:
+        raise ParameterError(f"design {token!r} is not accepted: NAME[,key=value...]")
+    settings = parse_params([s for s in rest.split(",") if s.strip()] if rest else [], option=f"design {name}")
+    fields = {k: settings.pop(k) for k in list(settings) if k in TOKEN_FIELDS}
+    if "omega_r" in fields:
+        fields["kp"], fields["kd"] = gains_from_omega_r(float(fields.pop("omega_r")))
+    if "correction" in fields:
+        fields["correction"] = bool(fields["correction"])
+    if name in PRESET_NAMES:
+        if settings:
+            raise ParameterError(f"design {token!r}: a preset takes RunConfig settings ({', '.join(TOKEN_FIELDS)}), "
+                                 f"not {sorted(settings)}")
+        return {**preset(name).config_changes(), **fields}
+    changes: dict[str, Any] = {**CERTIFIED.config_changes(), "controller": name, **fields}
+    if name in CONTROLLER_NAMES:  # the laws configured by RunConfig fields
+        if settings:
+            raise ParameterError(f"design {token!r}: {name} takes RunConfig settings, not {sorted(settings)}")
+    else:
+        changes["controller_params"] = settings
+    return changes
