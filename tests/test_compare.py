@@ -53,7 +53,8 @@ def test_a_scenario_sets_path_plant_and_signals_on_the_design():
 
 @pytest.mark.parametrize("token, error", [
     ("paper,lam=3", ParameterError), ("no-such-law", UnknownNameError), (",k=1", ParameterError),
-    ("computed-torque,k=1", ParameterError)])
+    ("computed-torque,k=1", ParameterError), ("sliding-mode,nope=1", ParameterError),
+    ("certified,tracker=pure-pursuit,lookahead=-1", ParameterError)])
 def test_a_bad_design_is_refused(token, error):
     with pytest.raises(error):
         design_from_token(token, load_suite("standard-v1"))

@@ -99,8 +99,12 @@ class ValidateSettings:
         from wmr_mj.sim.designs import design_changes
 
         object.__setattr__(self, "designs", tuple(str(t) for t in self.designs))
+        from wmr_mj.sim.config import controller_for, estimate_parameters, tracker_for
+
         for token in self.designs:  # an unknown law, a missing file, a bad setting: refused before any run
-            RunConfig(**design_changes(token))
+            config = RunConfig(**design_changes(token))
+            controller_for(config, estimate_parameters())  # built once: a parameter the law does not take
+            tracker_for(config, estimate_parameters())
 
     @property
     def ranges(self) -> dict[str, tuple[float, float]]:

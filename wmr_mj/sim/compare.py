@@ -34,7 +34,14 @@ import numpy as np
 from wmr_mj.errors import ParameterError
 from wmr_mj.params import uncertainty_ranges
 from wmr_mj.plant.mjcf import TIMESTEP
-from wmr_mj.sim.config import RunConfig, config_from_dict, controller_name
+from wmr_mj.sim.config import (
+    RunConfig,
+    config_from_dict,
+    controller_for,
+    controller_name,
+    estimate_parameters,
+    tracker_for,
+)
 from wmr_mj.sim.suite import Scenario, Suite, versions
 
 __all__ = ["Design", "design_from_token", "ScenarioRun", "DesignRow", "CompareResult", "compare", "run_scenario",
@@ -61,6 +68,8 @@ def design_from_token(token: str, suite: Suite) -> Design:
     box = uncertainty_ranges(suite.adversary.uncertainty)
     m1_range = box.pop("m1")
     config = RunConfig(**design_changes(token), m1_range=m1_range, box_ranges=box, duration=suite.duration)
+    controller_for(config, estimate_parameters())  # built once: a parameter the law does not take, before any run
+    tracker_for(config, estimate_parameters())
     return Design(label=str(token), config=config)
 
 
