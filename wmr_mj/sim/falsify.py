@@ -84,6 +84,8 @@ __all__ = [
     "objective_value",
     "objective_source",
     "population_size",
+    "cma_population",
+    "portfolio_vertices",
     "search_worst",
     "random_worst",
     "falsify",
@@ -93,10 +95,11 @@ __all__ = [
 
 OBJECTIVES = ("certificate", "paper", "sup-E", "requirement")
 #: Search methods: the box's vertices then a Nelder-Mead polish (default), or differential evolution.
-METHODS = ("vertices-polish", "lhs-polish", "de")
+METHODS = ("portfolio", "cma", "vertices-polish", "lhs-polish", "de")
 OBJECTIVE_LABELS = {"certificate": "sup|E|/E_max of the certificate", "paper": "sup|E|/E_max of the paper's region",
                     "sup-E": "sup|E| [rad]", "requirement": "-robustness of the requirement (> 0: falsified)"}
 MIN_POPULATION = 5  # scipy's differential evolution needs at least 5 members
+_POPULATION_OF = {"de": "differential evolution", "cma": "CMA-ES", "portfolio": "CMA-ES"}  # methods with generations
 
 
 # -- the objective, read from a run's summary ----------------------------------------------
@@ -224,15 +227,15 @@ def population_size(budget: int, d: int) -> int:
     return max(MIN_POPULATION, min(10 * d, budget // 8))
 
 
-def _check_budget(budget: int, population: int) -> None:
+def _check_budget(budget: int, population: int, what: str = "differential evolution") -> None:
     if isinstance(budget, bool) or not isinstance(budget, int) or budget < 1:
         raise ParameterError(f"budget = {budget!r} is not accepted; give the number of simulations, an integer >= 1")
     if isinstance(population, bool) or not isinstance(population, int) or population < MIN_POPULATION:
-        raise ParameterError(f"population = {population!r} is not accepted; differential evolution needs an "
+        raise ParameterError(f"population = {population!r} is not accepted; {what} needs an "
                              f"integer >= {MIN_POPULATION}")
     if budget < population:
-        raise ParameterError(f"budget = {budget} simulations is below one population of {population} (differential "
-                             f"evolution evaluates a whole population per generation); give a budget >= {population}")
+        raise ParameterError(f"budget = {budget} simulations is below one population of {population} ({what} "
+                             f"evaluates a whole population per generation); give a budget >= {population}")
 
 
 def _unit_to_box(unit: np.ndarray, bounds: np.ndarray) -> np.ndarray:
@@ -258,17 +261,20 @@ def _user_errors_unwrapped():
 
 
 def search_worst(evaluate: Callable[[np.ndarray], np.ndarray], bounds: np.ndarray, *, budget: int, seed: int = 0,
-                 population: int | None = None, method: str = "vertices-polish") -> Trace:
+                 population: int | None = None, method: str = "portfolio") -> Trace:
     """Maximise ``evaluate`` over the box ``bounds`` (d, 2) with ``method`` (:data:`METHODS`).
 
     evaluate(points (S, d)) -> values (S,), NaN where undefined, is called with a batch of
     points at a time. At most ``budget`` points are evaluated. Seeded: the same seed gives
-    the same points. population: differential evolution's members per generation.
+    the same points. population: members per generation of differential evolution or CMA-ES.
     """
     if method not in METHODS:
         raise UnknownNameError("search method", method, METHODS)
     if method == "de":
         return _search_de(evaluate, bounds, budget=budget, seed=seed, population=population)
+    if method in ("portfolio", "cma"):
+        return _search_cma(evaluate, bounds, budget=budget, seed=seed, population=population,
+                           vertices=method == "portfolio")
     return _search_vertices_polish(evaluate, bounds, budget=budget, seed=seed, first=method.split("-")[0])
 
 
@@ -381,6 +387,83 @@ def _search_vertices_polish(evaluate: Callable[[np.ndarray], np.ndarray], bounds
     return rec.trace()
 
 
+#: CMA-ES's starting step, in units of each range (the search runs in the unit box).
+CMA_SIGMA0 = 0.3
+#: The portfolio evaluates all 2^d vertices where they fit this share of the budget (a monotone worst case is
+#: then found exactly) ...
+PORTFOLIO_VERTEX_SHARE = 0.5
+#: ... and where all 2^d do not fit that share, a covering of at most this share (measured: module docstring).
+PORTFOLIO_COVER_SHARE = 0.125
+
+
+def cma_population(d: int) -> int:
+    """CMA-ES's members per generation: its default 4 + floor(3 ln d) (d >= 2; 1-D runs as 2-D)."""
+    return 4 + int(math.floor(3 * math.log(max(d, 2))))
+
+
+def portfolio_vertices(d: int, budget: int) -> int:
+    """How many vertices the portfolio evaluates first: all 2^d where they fit
+    :data:`PORTFOLIO_VERTEX_SHARE` of the budget, else the largest power of two within
+    :data:`PORTFOLIO_COVER_SHARE` of it (a fractional-factorial covering), at least 2."""
+    if 2 ** d <= int(PORTFOLIO_VERTEX_SHARE * budget):
+        return 2 ** d
+    share = int(PORTFOLIO_COVER_SHARE * budget)
+    return max(2, 2 ** int(math.floor(math.log2(max(share, 2)))))
+
+
+def _search_cma(evaluate: Callable[[np.ndarray], np.ndarray], bounds: np.ndarray, *, budget: int, seed: int = 0,
+                population: int | None = None, vertices: bool = True) -> Trace:
+    """CMA-ES (the ``cmaes`` package), a generation per batch, in the unit box with its bounds;
+    with ``vertices`` (the ``portfolio``) the box's vertices first, as one batch, and CMA-ES from
+    the worst of them.
+
+    1. (portfolio) :func:`portfolio_vertices` vertices, one batch: all 2^d where they fit
+       :data:`PORTFOLIO_VERTEX_SHARE` of the budget, else a seeded fractional-factorial covering.
+    2. CMA-ES: mean at the box's centre (not at the worst vertex: measured worse on interior maxima), step
+       :data:`CMA_SIGMA0` of each range, ``population`` (default :func:`cma_population`) members
+       per generation, evaluated as one batch; the package resamples a member outside the box
+       (up to 100 times, then clips it). An undefined value (NaN) ranks below every defined one.
+       When CMA-ES stops (converged, flat) with budget left it restarts from a seeded uniform
+       point with twice the population (IPOP). The last generation is cut to the budget.
+
+    In one dimension (which ``cmaes`` does not take) it searches a square whose second coordinate
+    is ignored. Deterministic for a seed (``cmaes`` keeps its own generator, seeded from it).
+    """
+    from cmaes import CMA
+
+    bounds = np.asarray(bounds, dtype=float)
+    d = len(bounds)
+    lam = cma_population(d) if population is None else population
+    _check_budget(budget, lam, what="CMA-ES")
+    seeds = np.random.SeedSequence(seed).spawn(5)[4]
+    rng = np.random.default_rng(seeds)
+    lo, span = bounds[:, 0], bounds[:, 1] - bounds[:, 0]
+    rec = _Recorder(evaluate)
+    n = max(d, 2)
+
+    def run(unit: np.ndarray) -> np.ndarray:
+        return rec(lo + unit[:, :d] * span)
+
+    if vertices:
+        corners = covering_design(d, portfolio_vertices(d, budget), rng)
+        run(np.hstack([corners, np.full((len(corners), n - d), 0.5)]))
+    mean = np.full(n, 0.5)
+    while rec.spent < budget:
+        opt = CMA(mean=mean, sigma=CMA_SIGMA0, bounds=np.array([[0.0, 1.0]] * n), population_size=lam,
+                  seed=int(rng.integers(2 ** 31 - 1)))
+        while rec.spent < budget:
+            xs = np.array([opt.ask() for _ in range(opt.population_size)])
+            k = min(len(xs), budget - rec.spent)
+            v = run(xs[:k])
+            if k < len(xs):
+                break
+            opt.tell([(x, 1e300 if math.isnan(e) else -e) for x, e in zip(xs, v)])  # cmaes minimises
+            if opt.should_stop():
+                break
+        mean, lam = rng.uniform(0.0, 1.0, n), 2 * lam  # IPOP restart
+    return rec.trace()
+
+
 def _search_de(evaluate: Callable[[np.ndarray], np.ndarray], bounds: np.ndarray, *, budget: int, seed: int = 0,
                  population: int | None = None) -> Trace:
     """Maximise ``evaluate`` over the box ``bounds`` (d, 2) with scipy's differential evolution.
@@ -438,8 +521,8 @@ class FalsifySpec:
     objective: str = "certificate"
     budget: int = 256
     seed: int = 0
-    population: int | None = None  # differential evolution's members per generation
-    method: str = "vertices-polish"  # one of METHODS
+    population: int | None = None  # members per generation of differential evolution or CMA-ES
+    method: str = "portfolio"  # one of METHODS
     requirement: str | None = None  # objective 'requirement': an STL formula (wmr_mj.analysis.requirements)
 
     def __post_init__(self) -> None:
@@ -475,7 +558,8 @@ class FalsifySpec:
         config_for(self.base, self.names, [lo for lo, _ in self.box.values()])  # a bad axis fails before any run
         if isinstance(self.seed, bool) or not isinstance(self.seed, int):
             raise ParameterError(f"seed = {self.seed!r} is not accepted; give an integer")
-        _check_budget(self.budget, self.population_size if self.method == "de" else MIN_POPULATION)
+        _check_budget(self.budget, self.population_size if self.population_size is not None else MIN_POPULATION,
+                      what=_POPULATION_OF.get(self.method, "the search"))
 
     @property
     def parsed_requirement(self):
@@ -494,8 +578,14 @@ class FalsifySpec:
         return np.array([self.box[n] for n in self.names], dtype=float)
 
     @property
-    def population_size(self) -> int:
-        return population_size(self.budget, len(self.box)) if self.population is None else self.population
+    def population_size(self) -> int | None:
+        """Members per generation: differential evolution's or CMA-ES's (its first; None for the polish methods)."""
+        if self.method not in _POPULATION_OF:
+            return None
+        if self.population is not None:
+            return self.population
+        d = len(self.box)
+        return population_size(self.budget, d) if self.method == "de" else cma_population(d)
 
     def config(self, point: Sequence[float]) -> RunConfig:
         """The run at ``point`` (values in ``names`` order): m1, the plant overrides and the signals'
@@ -571,7 +661,7 @@ class FalsifyResult:
             "evaluations": len(self.search),
             "seed": self.spec.seed,
             "method": self.spec.method,
-            "population": self.spec.population_size if self.spec.method == "de" else None,
+            "population": self.spec.population_size,
             "generations": self.generations,
             "requirement": self.spec.requirement,
             "falsified": (w.objective is not None and w.objective > 0.0) if self.spec.objective == "requirement"
