@@ -122,7 +122,8 @@ def bench_space(space: str, args: argparse.Namespace, budgets: list[int]) -> lis
     bounds = spec.bounds
     evaluate = CachedEvaluator(spec, args.nthread)
     t0 = time.perf_counter()
-    corners = bounds[:, 0] + covering_design(len(bounds), 2 ** len(bounds)) * (bounds[:, 1] - bounds[:, 0])
+    unit = covering_design(len(bounds), 2 ** len(bounds))
+    corners = np.where(unit >= 1.0, bounds[:, 1], bounds[:, 0] + unit * (bounds[:, 1] - bounds[:, 0]))  # as searched
     corner_values = evaluate(corners)
     corner_worst = float(np.nanmax(corner_values))
     corner_at = corners[int(np.nanargmax(corner_values))]

@@ -441,8 +441,8 @@ def _search_cma(evaluate: Callable[[np.ndarray], np.ndarray], bounds: np.ndarray
     rec = _Recorder(evaluate)
     n = max(d, 2)
 
-    def run(unit: np.ndarray) -> np.ndarray:
-        return rec(lo + unit[:, :d] * span)
+    def run(unit: np.ndarray) -> np.ndarray:  # a coordinate at 1 is the upper bound itself, not lo + span
+        return rec(np.where(unit[:, :d] >= 1.0, bounds[:, 1], lo + unit[:, :d] * span))
 
     if vertices:
         corners = covering_design(d, portfolio_vertices(d, budget), rng)
