@@ -8,21 +8,47 @@ search can be judged against chance (``bench/bench_falsify.py`` does so over see
 
 Methods (:data:`METHODS`):
 
-- ``vertices-polish`` (the default): the box's 2^d vertices first, as one batch, where the
-  budget allows them (else a fractional-factorial covering of them, :func:`covering_design`),
-  then scipy's Nelder-Mead with bounds from the worst point found, restarted from the
-  next-worst while budget is left. Robust-control worst cases sit at vertices more often than
-  not (the objective is monotone in most parameters: the heaviest chassis, the most friction,
-  the largest R_a); the polish finds an interior maximum next to the worst vertex or confirms it.
-  At a budget of 48 on the full box, differential evolution was beaten by random sampling in
-  3 of 6 seeds and never reached the worst vertex (0.3927 of E_max), which this finds in 27 runs.
-- ``lhs-polish``: a seeded Latin hypercube of half the budget, then the same polish: for spaces whose
-  worst case is interior. Over C's path (3 knots, the hold, m1; budget 48) the vertices' worst was
-  0.68 of E_max and random sampling beat vertices-polish in 6 of 10 seeds (bench_falsify --space paths).
+- ``portfolio`` (the default, of ``falsify`` and of ``validate``'s searches): the box's vertices
+  first, as one batch: all 2^d where they fit half the budget (:data:`PORTFOLIO_VERTEX_SHARE`), so
+  that a monotone worst case (a vertex) is found exactly (the full box, d = 5: its worst vertex,
+  0.3927 of E_max, within the first 32 runs of any budget >= 64), else a seeded fractional-factorial
+  covering of at most an eighth of it (:data:`PORTFOLIO_COVER_SHARE`); then CMA-ES (``cmaes``) from
+  the box's centre with the rest, a generation per batch, restarted with twice the population when
+  it stops (IPOP). The split, measured on synthetic objectives in the unit box (20 seeds each, d = 5
+  and 6, budgets 64/100/300; median best found as a fraction of the true worst): CMA-ES started at
+  the centre beats CMA-ES started at the worst vertex wherever the worst is interior (a Gaussian
+  bump, 6-D, budget 100: 0.555 against 0.367; a mixture of 8 bumps: 0.443 against 0.338) and
+  matches it elsewhere, so the vertices serve as insurance, not as a start; when the 2^d vertices
+  do not fit half the budget, a covering of an eighth instead of a half keeps CMA-ES its runs (bump
+  6-D/100: 0.704 against 0.536; mixture 6-D/100: 0.608 against 0.523) and costs the linear
+  (vertex) objective little (6-D/100: 0.853 against 1.0 of the worst vertex). CMA-ES alone reaches
+  only 0.69-0.85 of a vertex worst case at these budgets, which is why the vertices stay.
+  ``cmaes`` was chosen over ``pycma`` (``cma``) by the same measurement: ahead on interior maxima
+  (bump 5-D/100: 0.909 against 0.864, 6-D/100: 0.732 against 0.603; mixture 5-D/100: 0.801
+  against 0.614), behind on a linear objective (which the vertices cover), and it keeps its own
+  seeded generator (pycma seeds numpy's global one).
+  On those smooth synthetic objectives ``lhs-polish`` does as well or better (bump 6-D/100: 0.916;
+  mixture 5-D/100: 0.818 against the portfolio's 0.572): Nelder-Mead is strong on smooth bumps. Over
+  C's path, which is rough, no polish beat random sampling (below); for the portfolio there see
+  ``bench/bench_falsify.py --spaces paths`` and docs/guides/benchmarks.md.
+- ``cma``: CMA-ES alone, from the box's centre (the portfolio without the vertices).
+- ``vertices-polish``: the box's 2^d vertices first, as one batch, where the budget allows them
+  (else a fractional-factorial covering of them, :func:`covering_design`), then scipy's
+  Nelder-Mead with bounds from the worst point found, restarted from the next-worst while budget
+  is left. At a budget of 48 on the full box, differential evolution was beaten by random sampling
+  in 3 of 6 seeds and never reached the worst vertex (0.3927 of E_max), which this finds in 27 runs.
+- ``lhs-polish``: a seeded Latin hypercube of half the budget, then the same polish. Over C's path
+  (3 knots, the hold, m1; budget 48) the vertices' worst was 0.68 of E_max and random sampling beat
+  vertices-polish in 6 of 10 seeds, lhs-polish in 5 of 10.
 - ``de``: scipy's differential evolution, a generation per batch (``vectorized=True``).
 
 Each batch of points runs as one batch of simulations (``wmr_mj.sim.sweep.run_configs``:
-``mujoco.batch``, or Dask chunks); the polish asks for one point at a time.
+``mujoco.batch``, or Dask chunks); the polish asks for one point at a time. A budget below one
+generation (differential evolution's or CMA-ES's population) is refused before any run.
+
+Where the objective is the certificate's ratio, :attr:`FalsifyResult.tightness` sets the worst
+found (a lower bound on the worst case) beside the certificate's E_max (an upper bound): "the worst
+found is X of the certificate's bound: the certificate is 1/X times the worst case found".
 
 Objectives (:data:`OBJECTIVES`), read from a run's summary by :func:`objective_value`:
 
@@ -397,8 +423,9 @@ PORTFOLIO_COVER_SHARE = 0.125
 
 
 def cma_population(d: int) -> int:
-    """CMA-ES's members per generation: its default 4 + floor(3 ln d) (d >= 2; 1-D runs as 2-D)."""
-    return 4 + int(math.floor(3 * math.log(max(d, 2))))
+    """CMA-ES's members per generation: its default 4 + floor(3 ln d), at least :data:`MIN_POPULATION`
+    (5 in 1-D, 6 in 2-D, 8 in 4-5-D, 9 in 6-D)."""
+    return max(MIN_POPULATION, 4 + int(math.floor(3 * math.log(max(d, 1)))))
 
 
 def portfolio_vertices(d: int, budget: int) -> int:
@@ -650,6 +677,24 @@ class FalsifyResult:
     def generations(self) -> int:
         return 1 + max((e.generation for e in self.search), default=-1)
 
+    @property
+    def tightness(self) -> dict[str, Any] | None:
+        """How tight the certificate is, where the objective is its ratio sup|E|/E_max: the worst
+        found (a lower bound on the worst case: a run reached it) beside the certificate's E_max (an
+        upper bound), their ratio X and 1/X, and the sentence falsify prints. None for other objectives."""
+        if self.spec.objective != "certificate":
+            return None
+        w = self.worst
+        certificate = w.summary.get("certificate")
+        e_max = certificate.get("E_max") if isinstance(certificate, Mapping) else None
+        x = w.objective
+        factor = 1.0 / x if x is not None and x > 0 else math.inf
+        text = (f"the worst found is {x:.4g} of the certificate's bound: the certificate is {factor:.3g} times the "
+                f"worst case found (sup|E| >= {w.sup_E:.4g} rad found, <= "
+                + ("n/a" if e_max is None else f"{float(e_max):.4g}") + " rad certified)")
+        return {"ratio": x, "factor": factor, "found_sup_E": w.sup_E,
+                "E_max": None if e_max is None else float(e_max), "text": text}
+
     def as_dict(self, *, log: str | None = None) -> dict[str, Any]:
         """The ``wmr-mj falsify --json`` object."""
         w, r = self.worst, self.random_worst
@@ -669,6 +714,7 @@ class FalsifyResult:
             "box": {k: [float(lo), float(hi)] for k, (lo, hi) in self.spec.box.items()},
             "worst": {"params": dict(w.params), "objective": w.objective, "sup_E": w.sup_E, "sup_Edot": w.sup_Edot,
                       "verdict": w.verdict, "generation": w.generation, "index": w.index},
+            "tightness": self.tightness,
             "random": {"worst_objective": r.objective, "worst_params": dict(r.params), "evaluations": len(self.random),
                        "sup_E": r.sup_E, "verdict": r.verdict},
             "log": log,
