@@ -22,15 +22,19 @@ Methods (:data:`METHODS`):
   do not fit half the budget, a covering of an eighth instead of a half keeps CMA-ES its runs (bump
   6-D/100: 0.704 against 0.536; mixture 6-D/100: 0.608 against 0.523) and costs the linear
   (vertex) objective little (6-D/100: 0.853 against 1.0 of the worst vertex). CMA-ES alone reaches
-  only 0.69-0.85 of a vertex worst case at these budgets, which is why the vertices stay.
+  only 0.72-0.85 of a vertex worst case at budgets 64-100 (0.95-0.97 at 300), which is why the
+  vertices stay.
   ``cmaes`` was chosen over ``pycma`` (``cma``) by the same measurement: ahead on interior maxima
   (bump 5-D/100: 0.909 against 0.864, 6-D/100: 0.732 against 0.603; mixture 5-D/100: 0.801
   against 0.614), behind on a linear objective (which the vertices cover), and it keeps its own
   seeded generator (pycma seeds numpy's global one).
   On those smooth synthetic objectives ``lhs-polish`` does as well or better (bump 6-D/100: 0.916;
   mixture 5-D/100: 0.818 against the portfolio's 0.572): Nelder-Mead is strong on smooth bumps. Over
-  C's path, which is rough, no polish beat random sampling (below); for the portfolio there see
-  ``bench/bench_falsify.py --spaces paths`` and docs/guides/benchmarks.md.
+  C's path, which is rough, no polish beat random sampling (below). The portfolio there
+  (``bench/bench_falsify.py --spaces paths``: m1, 4 knots and the hold, 20 s runs, 10 seeds) has the
+  larger median worst (0.8307 against random's 0.7665 at budget 100, 0.8892 against 0.8397 at 300)
+  and is >= random in 8 of 10 seeds at 100 but only 7 of 10 at 300 (docs/guides/benchmarks.md);
+  over the full box it reaches the worst vertex at run 27 in every seed from a budget of 64.
 - ``cma``: CMA-ES alone, from the box's centre (the portfolio without the vertices).
 - ``vertices-polish``: the box's 2^d vertices first, as one batch, where the budget allows them
   (else a fractional-factorial covering of them, :func:`covering_design`), then scipy's
