@@ -1,31 +1,33 @@
 """Worst-case search against random sampling at equal budget, ARCH-COMP style (falsification).
 
-    .venv/bin/python bench/bench_falsify.py [--space box|paths|signals] [--trials 10] [--budgets 48,96]
-                                            [--duration 20] [--method vertices-polish] [--threshold 0.05]
-                                            [--nthread 2]
+    .venv/bin/python bench/bench_falsify.py [--spaces box,paths,signals] [--seeds 10] [--budgets 100,300]
+                                            [--duration 20] [--method portfolio] [--path-knots 4]
+                                            [--threshold RAD] [--nthread 2]
 
 The certified design, objective sup|E|/E_max of its certificate (``wmr-mj falsify``'s default),
-over one of three search spaces (``--space``):
+over each of three search spaces (``--spaces``, comma-separated; default all three):
 
   box:     the full uncertainty box (m1, mu, ground_friction, R_a, V_A) on the paper circle;
-  paths:   m1 and C's path: 3 curvature knots and the hold time (``falsify --path-knots 3``),
-           the certificate for the paper's declared reference bounds (5.1);
+  paths:   m1 and C's path: ``--path-knots`` (default 4) curvature knots and the hold time
+           (``falsify --path-knots 4``), the certificate for the paper's declared reference bounds (5.1);
   signals: m1, R_a and a 1 s steering-torque pulse: amplitude -1.5..1.5 N m (d_max 1.5) and its
            start 2..15 s (``falsify --disturbance kind=pulse,... --range disturbance.amplitude=...``).
 
-For each budget and each of ``--trials`` seeds, side by side:
+For each space, each budget and each of ``--seeds`` seeds, side by side:
 
-  search: ``wmr_mj.sim.falsify.search_worst`` with ``--method`` (default: the box's vertices,
-          then Nelder-Mead from the worst);
+  search: ``wmr_mj.sim.falsify.search_worst`` with ``--method`` (default ``portfolio``: the box's
+          vertices, then CMA-ES);
   random: the same number of runs as a seeded Latin hypercube (``random_worst``, as falsify does).
 
-Printed: the worst objective each found per seed, the search's wins (worst >= random's), the
-runs the search needed to come within 1% of the vertices' worst (the 32 corners of the box:
-``wmr-mj sweep --preset certified --uncertainty full --sampling grid --n 32``), and, for the
-requirement always(abs(E) <= --threshold) over the whole run, each method's falsification rate
-and median number of runs to the first falsifying run (in evaluation order). Its robustness is
-``threshold - sup|E|``, which the bench reads off the batch (the batch keeps sup|E|, not the
-signals); a serial run of the worst case checks it against rtamt's monitor (printed).
+Printed per space and budget: the worst objective each found per seed; then, search / random
+side by side, the median worst, the best over the seeds, the seeds where the search's worst is
+>= random's, the runs the search needed to come within 1% of the vertices' worst (all 2^d
+corners), and, for the requirement always(abs(E) <= THRESHOLD) over the whole run, the
+falsification rate and the median number of runs to the first falsifying run (in evaluation
+order). THRESHOLD defaults per space to a level the space can exceed (box 0.05 rad, paths 0.038,
+signals 0.05). Its robustness is ``threshold - sup|E|``, which the bench reads off the batch (the
+batch keeps sup|E|, not the signals); a serial run of the worst vertex checks it against rtamt's
+monitor (printed). A summary table of every space and budget closes the output.
 
 Runs are deterministic (bit-identical for the same plant), so the bench keeps one result per
 plant point and reuses it across seeds and budgets (the vertices are the same for every seed);
@@ -47,7 +49,9 @@ import numpy as np  # noqa: E402
 from wmr_mj.params import M1_RANGE, uncertainty_ranges  # noqa: E402
 from wmr_mj.sim.config import RunConfig  # noqa: E402
 from wmr_mj.sim.designs import CERTIFIED  # noqa: E402
-from wmr_mj.sim.falsify import FalsifySpec, covering_design, objective_value, random_worst, search_worst  # noqa: E402
+from wmr_mj.sim.falsify import METHODS, FalsifySpec, covering_design, objective_value, random_worst, search_worst  # noqa: E402
+
+THRESHOLDS = {"box": 0.05, "paths": 0.038, "signals": 0.05}  # rad: always(abs(E) <= T), one each space can fail
 from wmr_mj.sim.sweep import run_configs  # noqa: E402
 
 
@@ -88,7 +92,7 @@ def median_or_dash(xs: list[int | None]) -> str:
     return f"{statistics.median(got):g}" if got else "-"
 
 
-def make_spec(space: str, duration: float, budget: int, method: str) -> FalsifySpec:
+def make_spec(space: str, duration: float, budget: int, method: str, knots: int = 4) -> FalsifySpec:
     """The search of ``--space`` (module docstring)."""
     if space == "box":
         ranges = {k: v for k, v in uncertainty_ranges("full").items() if k != "m1"}
@@ -101,7 +105,7 @@ def make_spec(space: str, duration: float, budget: int, method: str) -> FalsifyS
 
         bounds = reference_bounds_from("paper")
         base = RunConfig(**CERTIFIED.config_changes(), duration=duration, reference_bounds=bounds)
-        return FalsifySpec(base=base, box={"m1": M1_RANGE, **KnotSpace(3, hold_range=(0.0, 3.0)).ranges(bounds)},
+        return FalsifySpec(base=base, box={"m1": M1_RANGE, **KnotSpace(knots, hold_range=(0.0, 3.0)).ranges(bounds)},
                            objective="certificate", budget=budget, method=method)
     ranges = {"R_a": uncertainty_ranges("full")["R_a"]}
     signals = {"disturbance": {"kind": "pulse", "amplitude": 1.0, "t1": 5.0, "t2": 6.0}, "d_max": 1.5}
@@ -111,40 +115,30 @@ def make_spec(space: str, duration: float, budget: int, method: str) -> FalsifyS
                        objective="certificate", budget=budget, method=method)
 
 
-def main() -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--trials", type=int, default=10, help="seeds per budget (default 10)")
-    ap.add_argument("--budgets", default="48,96", help="comma-separated budgets (default 48,96)")
-    ap.add_argument("--duration", type=float, default=20.0, help="simulated seconds per run (default 20)")
-    ap.add_argument("--method", default="vertices-polish", help="search method (default vertices-polish)")
-    ap.add_argument("--threshold", type=float, default=0.05,
-                    help="the requirement always(abs(E) <= THRESHOLD) rad to falsify (default 0.05)")
-    ap.add_argument("--nthread", type=int, default=2, help="threads of each batch (default 2)")
-    ap.add_argument("--space", default="box", choices=("box", "paths", "signals"),
-                    help="what is searched (default box: the full uncertainty box)")
-    args = ap.parse_args()
-    budgets = [int(b) for b in args.budgets.split(",")]
-    spec = make_spec(args.space, args.duration, max(budgets), args.method)
+def bench_space(space: str, args: argparse.Namespace, budgets: list[int]) -> list[dict]:
+    """Every budget and seed of one space; the summary row of each budget."""
+    threshold = THRESHOLDS[space] if args.threshold is None else args.threshold
+    spec = make_spec(space, args.duration, max(budgets), args.method, args.path_knots)
     bounds = spec.bounds
     evaluate = CachedEvaluator(spec, args.nthread)
     t0 = time.perf_counter()
-    corners = bounds[:, 0] + covering_design(len(bounds), 2 ** len(bounds)) * (bounds[:, 1] - bounds[:, 0])
+    unit = covering_design(len(bounds), 2 ** len(bounds))
+    corners = np.where(unit >= 1.0, bounds[:, 1], bounds[:, 0] + unit * (bounds[:, 1] - bounds[:, 0]))  # as searched
     corner_values = evaluate(corners)
     corner_worst = float(np.nanmax(corner_values))
     corner_at = corners[int(np.nanargmax(corner_values))]
-    print(f"bench_falsify: certified design, space {args.space} ({', '.join(spec.names)}), "
-          f"{args.duration:g} s per run, "
-          f"objective sup|E|/E_max of the certificate; search = {args.method}, random = Latin hypercube; "
-          f"{args.trials} seeds per budget")
+    print(f"\n== space {space} ({', '.join(spec.names)}), {args.duration:g} s per run, objective sup|E|/E_max of the "
+          f"certificate; search = {args.method}, random = Latin hypercube; {args.seeds} seeds per budget")
     print(f"the box's {len(corners)} vertices: worst objective {corner_worst:.6g} at "
           + ", ".join(f"{n} = {v:g}" for n, v in zip(spec.names, corner_at))
           + f" (sup|E| = {float(evaluate.sup_E(corner_at[None])[0]):.6g} rad)")
-    print(f"requirement: always(abs(E) <= {args.threshold:g}) over the whole run; robustness = "
-          f"{args.threshold:g} - sup|E|; falsified when < 0")
-
+    print(f"requirement: always(abs(E) <= {threshold:g}) over the whole run; robustness = "
+          f"{threshold:g} - sup|E|; falsified when < 0")
+    level = np.nextafter(threshold, np.inf)
+    summary = []
     for budget in budgets:
         rows = []
-        for seed in range(args.trials):
+        for seed in range(args.seeds):
             search = search_worst(evaluate, bounds, budget=budget, seed=seed, method=args.method)
             random = random_worst(evaluate, bounds, n=len(search.values), seed=seed)
             s_sup, r_sup = evaluate.sup_E(search.points), evaluate.sup_E(random.points)
@@ -152,11 +146,10 @@ def main() -> int:
                 "seed": seed, "runs": len(search.values),
                 "search": float(np.nanmax(search.values)), "random": float(np.nanmax(random.values)),
                 "to_corner": first_at_least(search.values, 0.99 * corner_worst),
-                "s_fals": first_at_least(s_sup, np.nextafter(args.threshold, np.inf)),
-                "r_fals": first_at_least(r_sup, np.nextafter(args.threshold, np.inf)),
+                "s_fals": first_at_least(s_sup, level), "r_fals": first_at_least(r_sup, level),
             })
         wins = sum(r["search"] >= r["random"] for r in rows)
-        print(f"\nbudget {budget}:")
+        print(f"\n{space}, budget {budget}:")
         print(f"{'seed':>4}  {'runs':>4}  {'search worst':>12}  {'random worst':>12}  {'winner':>6}  "
               f"{'runs to 99% of vertex worst':>27}  {'search falsified at':>19}  {'random falsified at':>19}")
         for r in rows:
@@ -164,16 +157,24 @@ def main() -> int:
                   f"{'search' if r['search'] >= r['random'] else 'random':>6}  {fmt_runs(r['to_corner']):>27}  "
                   f"{fmt_runs(r['s_fals']):>19}  {fmt_runs(r['r_fals']):>19}")
         n = len(rows)
-        print(f"median worst: search {statistics.median(r['search'] for r in rows):.6f}, random "
-              f"{statistics.median(r['random'] for r in rows):.6f}; search >= random in {wins}/{n} seeds")
-        near = sum(r["to_corner"] is not None for r in rows)
-        print(f"within 1% of the vertices' worst {corner_worst:.4f}: search {near}/{n} (median "
-              f"{median_or_dash([r['to_corner'] for r in rows])} runs), random "
-              f"{sum(r['random'] >= 0.99 * corner_worst for r in rows)}/{n}")
-        s_n, r_n = (sum(r[k] is not None for r in rows) for k in ("s_fals", "r_fals"))
-        print(f"falsification of always(abs(E) <= {args.threshold:g}): search {s_n}/{n} (median "
-              f"{median_or_dash([r['s_fals'] for r in rows])} runs to falsify), random {r_n}/{n} (median "
-              f"{median_or_dash([r['r_fals'] for r in rows])})")
+        row = {
+            "space": space, "budget": budget, "n": n, "wins": wins,
+            "median": (statistics.median(r["search"] for r in rows), statistics.median(r["random"] for r in rows)),
+            "best": (max(r["search"] for r in rows), max(r["random"] for r in rows)),
+            "corner": (sum(r["to_corner"] is not None for r in rows), median_or_dash([r["to_corner"] for r in rows]),
+                       sum(r["random"] >= 0.99 * corner_worst for r in rows)),
+            "falsified": (sum(r["s_fals"] is not None for r in rows), sum(r["r_fals"] is not None for r in rows)),
+            "to_falsify": (median_or_dash([r["s_fals"] for r in rows]), median_or_dash([r["r_fals"] for r in rows])),
+            "threshold": threshold,
+        }
+        summary.append(row)
+        print(f"median worst: search {row['median'][0]:.6f}, random {row['median'][1]:.6f}; best: search "
+              f"{row['best'][0]:.6f}, random {row['best'][1]:.6f}; search >= random in {wins}/{n} seeds")
+        print(f"within 1% of the vertices' worst {corner_worst:.4f}: search {row['corner'][0]}/{n} (median "
+              f"{row['corner'][1]} runs), random {row['corner'][2]}/{n}")
+        print(f"falsification of always(abs(E) <= {threshold:g}): search {row['falsified'][0]}/{n} (median "
+              f"{row['to_falsify'][0]} runs to falsify), random {row['falsified'][1]}/{n} (median "
+              f"{row['to_falsify'][1]})")
 
     # the requirement's robustness off the batch against rtamt's monitor on a serial run of the worst corner
     from wmr_mj.analysis.requirements import evaluate_run, parse_requirement
@@ -181,12 +182,46 @@ def main() -> int:
     from wmr_mj.sim.closed_loop import run_closed_loop
 
     result = run_closed_loop(spec.config(corner_at), progress=False)
-    req = parse_requirement(f"always(abs(E) <= {args.threshold!r})", period=TIMESTEP)
+    req = parse_requirement(f"always(abs(E) <= {threshold!r})", period=TIMESTEP)
     (judged,) = evaluate_run([req], result.rows, result.summary.to_dict(), period=TIMESTEP)
-    batch_rob = args.threshold - float(evaluate.sup_E(corner_at[None])[0])
-    print(f"\ncheck: at the worst vertex rtamt's robustness {judged.robustness:.9g}, threshold - sup|E| of the batch "
+    batch_rob = threshold - float(evaluate.sup_E(corner_at[None])[0])
+    print(f"check: at the worst vertex rtamt's robustness {judged.robustness:.9g}, threshold - sup|E| of the batch "
           f"{batch_rob:.9g} ({'equal' if judged.robustness == batch_rob else 'DIFFERENT'})")
     print(f"{evaluate.simulated} distinct runs simulated in {time.perf_counter() - t0:.0f} s")
+    return summary
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seeds", "--trials", dest="seeds", type=int, default=10, help="seeds per budget (default 10)")
+    ap.add_argument("--budgets", default="100,300", help="comma-separated budgets (default 100,300)")
+    ap.add_argument("--duration", type=float, default=20.0, help="simulated seconds per run (default 20)")
+    ap.add_argument("--method", default="portfolio", choices=METHODS, help="search method (default portfolio)")
+    ap.add_argument("--threshold", type=float, default=None,
+                    help="the requirement always(abs(E) <= THRESHOLD) rad to falsify (default per space: "
+                         + ", ".join(f"{k} {v:g}" for k, v in THRESHOLDS.items()) + ")")
+    ap.add_argument("--nthread", type=int, default=2, help="threads of each batch (default 2)")
+    ap.add_argument("--spaces", "--space", dest="spaces", default="box,paths,signals",
+                    help="comma-separated spaces to search: box, paths, signals (default all three)")
+    ap.add_argument("--path-knots", type=int, default=4, help="curvature knots of the paths space (default 4)")
+    args = ap.parse_args()
+    budgets = [int(b) for b in args.budgets.split(",")]
+    spaces = [s.strip() for s in args.spaces.split(",") if s.strip()]
+    bad = [s for s in spaces if s not in THRESHOLDS]
+    if bad or not spaces or any(b < 1 for b in budgets) or args.seeds < 1:
+        ap.error(f"--spaces takes box, paths, signals (got {args.spaces!r}); budgets and seeds >= 1")
+    summary = [row for space in spaces for row in bench_space(space, args, budgets)]
+    print(f"\nsummary ({args.method} against random, {args.seeds} seeds, {args.duration:g} s runs):")
+    print("| space | budget | median worst: search / random | best: search / random | search >= random | "
+          "within 1% of the vertex worst: search (median runs) / random | falsified: search / random "
+          "| median runs to falsify: search / random |")
+    print("|---|---|---|---|---|---|---|---|")
+    for r in summary:
+        n = r["n"]
+        print(f"| {r['space']} | {r['budget']} | {r['median'][0]:.6f} / {r['median'][1]:.6f} | {r['best'][0]:.6f} / "
+              f"{r['best'][1]:.6f} | {r['wins']}/{n} | {r['corner'][0]}/{n} ({r['corner'][1]}) / {r['corner'][2]}/{n} "
+              f"| {r['falsified'][0]}/{n} / {r['falsified'][1]}/{n} (|E| > {r['threshold']:g}) "
+              f"| {r['to_falsify'][0]} / {r['to_falsify'][1]} |")
     return 0
 
 

@@ -62,12 +62,12 @@ def test_vertices_first_find_the_known_worst_corner_within_the_budget():
         calls.append(len(points))
         return bowl(points)
 
-    trace = search_worst(evaluate, BOX, budget=12, seed=0)
+    trace = search_worst(evaluate, BOX, budget=12, seed=0, method="vertices-polish")
     assert calls[0] == 8 and len(trace.values) <= 12  # all 2^3 vertices in one batch, then the polish
     assert np.array_equal(trace.points[trace.best], CORNER)  # the corner itself, exactly
     assert trace.best < 8
     # a budget below 2^d: a fractional-factorial half of the vertices, then the polish climbs to the corner
-    trace = search_worst(bowl, BOX, budget=30, seed=0)
+    trace = search_worst(bowl, BOX, budget=30, seed=0, method="vertices-polish")
     assert np.all(np.abs(trace.points[trace.best] - CORNER) <= 0.02 * (BOX[:, 1] - BOX[:, 0]))
 
 
@@ -79,7 +79,7 @@ def test_the_polish_finds_an_interior_maximum_next_to_the_worst_vertex():
         target = (peak - BOX[:, 0]) / (BOX[:, 1] - BOX[:, 0])
         return -np.sum((unit - target) ** 2, axis=1)
 
-    trace = search_worst(ridge, BOX, budget=60, seed=0)
+    trace = search_worst(ridge, BOX, budget=60, seed=0, method="vertices-polish")
     assert trace.values.max() > -1e-4  # within 1% of each range of the peak
     vertices_only = ridge(BOX[:, 0] + covering_design(3, 8) * (BOX[:, 1] - BOX[:, 0])).max()
     assert trace.values.max() > vertices_only
@@ -95,7 +95,7 @@ def test_covering_design_is_balanced_and_seeded():
     assert a.shape == (8, 5) and not np.array_equal(a, b)
 
 
-@pytest.mark.parametrize("method", ["vertices-polish", "de"])
+@pytest.mark.parametrize("method", ["portfolio", "cma", "vertices-polish", "de"])
 def test_the_same_seed_gives_the_same_search(method):
     a = search_worst(bowl, BOX, budget=60, seed=7, method=method)
     b = search_worst(bowl, BOX, budget=60, seed=7, method=method)
@@ -225,7 +225,7 @@ def test_a_requirement_is_falsified_on_serial_runs():
     (req,) = worst.summary["requirements"]
     assert worst.objective == -req["robustness"] > 0 and not req["satisfied"]  # falsified
     assert req["robustness"] == pytest.approx(0.001 - worst.sup_E, abs=1e-15)  # min(0.001 - |E|)
-    assert result.as_dict()["falsified"] is True and result.as_dict()["method"] == "vertices-polish"
+    assert result.as_dict()["falsified"] is True and result.as_dict()["method"] == "portfolio"
     with pytest.raises(ParameterError, match="requirement"):
         FalsifySpec(base=base, box={"m1": (550.0, 750.0)}, objective="requirement", budget=6)
     with pytest.raises(UnknownNameError, match="signal"):

@@ -213,10 +213,10 @@ def test_the_example_plug_in_through_run_sweep_falsify_require_and_replay(tmp_pa
                  "--out", str(sweep_dir)]) == 2
     assert "holds the runs of another controller" in _one_error_line(capsys)
     # falsify: the certificate's ratio says nothing of a law without a claim; a requirement does
-    assert main(["falsify", "--controller", spec, "--budget", "6", "--duration", "10", "--out",
+    assert main(["falsify", "--controller", spec, "--budget", "8", "--duration", "10", "--out",
                  str(tmp_path / "f0")]) == 2
     assert "states no claim" in _one_error_line(capsys)
-    assert main(["falsify", "--controller", spec, "--controller-param", "ki=20", "--budget", "6", "--duration", "10",
+    assert main(["falsify", "--controller", spec, "--controller-param", "ki=20", "--budget", "8", "--duration", "10",
                  "--out", str(tmp_path / "f1"), "--require", "always[5,10](abs(E) <= 0.01)", "--json"]) == 0
     fals = json.loads(capsys.readouterr().out)
     assert fals["worst"]["verdict"] == NO_CLAIM

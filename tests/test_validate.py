@@ -156,6 +156,7 @@ def test_the_search_beside_the_monte_carlo_worst_and_the_certificate(validated):
     md = (folder / "index.md").read_text()
     searches = {s["key"]: s for s in saved["searches"]}
     assert list(searches) == ["paper", "certified", "certified-full"]
+    assert all(s["method"] == "portfolio" for s in searches.values())  # falsify's default, not DE
     for s in searches.values():
         runs = _rows(folder, s["evaluations_csv"])
         values = [float(r["objective"]) for r in runs]
@@ -189,6 +190,9 @@ def test_the_search_beside_the_monte_carlo_worst_and_the_certificate(validated):
     assert full["verdicts"]["certified-outside"] == 0
     cert = searches["certified"]
     assert f"{cert['worst']['objective']:.4g}" in md and "Tightness" in md
+    section = md[md.index(f"Tightness ({cert['title']}): the worst found is {cert['worst']['objective']:.4g} of the "
+                          "certificate's bound"):]
+    assert section.index("Tightness") < section.index("Search, ")  # the search's sentences lead with it
 
 
 @pytest.fixture(scope="module")

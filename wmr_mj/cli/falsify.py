@@ -14,9 +14,9 @@ _OBJECTIVE_KINDS = ("ratio", "sup-E")
 def register(sub: argparse._SubParsersAction) -> None:
     from wmr_mj.cli.run import add_run_options, add_signal_options
 
-    p = sub.add_parser("falsify", help="worst-case search over the uncertainty box (its vertices, then a local "
-                                       "polish; or differential evolution) on mujoco.batch, beside the same "
-                                       "budget spent at random")
+    p = sub.add_parser("falsify", help="worst-case search over the uncertainty box (its vertices, then CMA-ES; "
+                                       "or a local polish, or differential evolution) on mujoco.batch, beside the "
+                                       "same budget spent at random")
     add_run_options(p)
     p.add_argument("--range", action="append", metavar="NAME=LO:HI",
                    help="add a plant parameter to the box or replace its range (repeatable); with --disturbance "
@@ -30,11 +30,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--against", default="certificate",
                    help="the region of the ratio sup|E|/E_max: certificate (default) or paper (the paper's region)")
     p.add_argument("--objective", default="ratio", help="what is maximised: ratio (default, see --against) or sup-E")
-    p.add_argument("--method", default="vertices-polish",
-                   help="search: vertices-polish (default: the box's vertices, or a fractional-factorial covering "
-                        "of them when 2^d > budget, then scipy's Nelder-Mead from the worst), lhs-polish (a Latin "
-                        "hypercube of half the budget, then the same polish: for interior worst cases, e.g. over C's "
-                        "path) or de (differential evolution)")
+    p.add_argument("--method", default="portfolio",
+                   help="search: portfolio (default: the box's 2^d vertices where they fit half the budget, else a "
+                        "fractional-factorial covering of at most an eighth of it, then CMA-ES from the box's centre, "
+                        "a generation per batch), cma (CMA-ES alone), vertices-polish (the vertices, then scipy's "
+                        "Nelder-Mead from the worst), lhs-polish (a Latin hypercube of half the budget, then the same "
+                        "polish) or de (differential evolution)")
     p.add_argument("--require", metavar="STL",
                    help="falsify an STL requirement (e.g. 'always(abs(E) <= 0.05)', signals as for wmr-mj run "
                         "--require): maximise minus its robustness (> 0: falsified); runs one by one, the batch "
@@ -42,7 +43,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--budget", type=positive_int, default=256,
                    help="simulations of the search (default 256); the random sample gets as many")
     p.add_argument("--population", type=int, default=None,
-                   help="members per generation (default: 10 per parameter, at most budget/8, at least 5)")
+                   help="members per generation: CMA-ES's (default 4 + 3 ln d) or differential evolution's "
+                        "(default: 10 per parameter, at most budget/8, at least 5)")
     p.add_argument("--seed", type=int, default=0, help="seed of the search and of the random sample (default 0)")
     p.add_argument("--chunk", type=positive_int, default=128, help="simulations per batch (default 128)")
     p.add_argument("--nthread", type=int, default=0, help="threads of the batch (default 0: all cores)")
@@ -179,6 +181,13 @@ def run(args: argparse.Namespace) -> int:
     if spec.method == "de":
         how = (f"differential evolution, {summary['population']} per generation x {summary['generations']} "
                "generations")
+    elif spec.method in ("portfolio", "cma"):
+        first = [e for e in result.search if e.generation == 0] if spec.method == "portfolio" else []
+        kind = ("all vertices" if len(first) == 2 ** len(spec.names) else
+                "a fractional-factorial covering of the vertices")
+        cma = (f"CMA-ES from the box's centre ({len(result.search) - len(first)} runs, {summary['population']} per "
+               "generation)")
+        how = f"{kind} ({len(first)} runs), then {cma}" if first else cma
     else:
         first = [e for e in result.search if e.generation == 0]
         kind = ("a Latin hypercube" if spec.method == "lhs-polish" else "all vertices"
@@ -192,6 +201,8 @@ def run(args: argparse.Namespace) -> int:
           f"(sup|E| = {worst.sup_E:.6g} rad, sup|E'| = {worst.sup_Edot:.6g} rad/s, {worst.verdict})")
     rw = result.random_worst
     print(f"random : worst objective {fmt(rw.objective)} in {len(result.random)} runs (Latin hypercube, same seed)")
+    if summary["tightness"] is not None:
+        print(f"tightness: {summary['tightness']['text']}")
     if spec.objective == "requirement":
         first_s = next((e.index + 1 for e in result.search if e.objective is not None and e.objective > 0), None)
         first_r = next((e.index + 1 for e in result.random if e.objective is not None and e.objective > 0), None)

@@ -1,7 +1,8 @@
 """Stage 4 of ``wmr-mj validate``: the worst-case search beside the Monte-Carlo worst and the certificate.
 
-Three searches (:func:`search_plans`), each differential evolution on whole generations
-(:func:`wmr_mj.sim.falsify.search_worst`, every generation one ``mujoco.batch``):
+Three searches (:func:`search_plans`), each falsify's default portfolio: the box's vertices, then
+CMA-ES on whole generations (:func:`wmr_mj.sim.falsify.search_worst`, every batch one ``mujoco.batch``;
+differential evolution until the portfolio replaced it):
 
 - the paper's design over the m1 box, maximising sup|E|/E_max of the paper's claim (it has
   no certificate), beside the worst of rung 1's Monte-Carlo sweep (runs.csv ``E_ratio``);
@@ -95,17 +96,17 @@ def _search_spec(plan: SearchPlan, settings: ValidateSettings):
     extra = {k: v for k, v in uncertainty_ranges(plan.box).items() if k != "m1"}
     base = settings.config(plan.design).replace(box_ranges=extra)
     return FalsifySpec(base=base, box={"m1": as_pair(settings.m1_range), **extra}, objective=plan.objective,
-                       budget=plan.budget, seed=settings.seed, method="de")
+                       budget=plan.budget, seed=settings.seed)  # falsify's default method: the portfolio
 
 
 def _fingerprint(spec) -> str:
     obj = {"base": spec.base.as_dict(), "box": {k: list(v) for k, v in spec.box.items()}, "objective": spec.objective,
-           "budget": spec.budget, "seed": spec.seed, "population": spec.population_size}
+           "budget": spec.budget, "seed": spec.seed, "population": spec.population_size, "method": spec.method}
     return hashlib.sha256(json.dumps(obj, sort_keys=True, default=str).encode()).hexdigest()[:16]
 
 
 def _evaluate_search(spec, *, nthread: int, progress: Callable[[float, int], None]) -> list[dict[str, Any]]:
-    """Run differential evolution on ``spec`` (no random sample: the ladder's sweep is the
+    """Run the search of ``spec`` (no random sample: the ladder's sweep is the
     baseline); every evaluated run as {generation, params, objective, sup_E, sup_Edot, verdict}."""
     from wmr_mj.sim.falsify import objective_value, search_worst
     from wmr_mj.sim.sweep import run_configs
@@ -186,7 +187,8 @@ def _result(plan: SearchPlan, spec, runs: Sequence[Mapping[str, Any]], worst: Ma
         "design_text": plan.design.describe(), "box_name": plan.box,
         "box": {k: list(v) for k, v in spec.box.items()}, "names": list(spec.names), "objective": plan.objective,
         "objective_label": OBJECTIVE_LABELS[plan.objective], "budget": spec.budget,
-        "population": spec.population_size, "generations": 1 + max(r["generation"] for r in runs),
+        "method": spec.method, "population": spec.population_size,
+        "generations": 1 + max(r["generation"] for r in runs),
         "evaluations": len(runs), "seed": spec.seed, "worst": None if worst is None else dict(worst),
         "verdicts": count_verdicts(r["verdict"] for r in runs), "values": [r["objective"] for r in runs],
         "certificate": certificate_summary(certificate),

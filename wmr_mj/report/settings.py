@@ -46,7 +46,7 @@ FULL_BOX_FACTOR = 2
 #: What a ladder rung may change, in groups of RunConfig fields: each rung changes exactly one.
 LADDER_GROUPS = {"controller": ("controller",), "model source": ("model",),
                  "compensation": ("friction_sign", "friction_width"), "gains": ("kp", "kd")}
-_MIN_POPULATION = 5  # differential evolution's smallest generation (wmr_mj.sim.falsify.MIN_POPULATION)
+_MIN_POPULATION = 5  # the smallest generation (wmr_mj.sim.falsify.MIN_POPULATION)
 
 # --------------------------------------------------------------------------- settings
 @dataclass(frozen=True, kw_only=True)
@@ -85,9 +85,6 @@ class ValidateSettings:
         integer_at_least("nthread", self.nthread, 0, "an integer >= 0 (0: all CPUs) is required")
         integer_at_least("search_budget", self.search_budget, 0,
                          f"give 0 (no search) or an integer >= {_MIN_POPULATION}")
-        if 0 < self.search_budget < _MIN_POPULATION:
-            raise ParameterError(f"search_budget = {self.search_budget} is below one generation of differential "
-                                 f"evolution; give 0 (no search) or an integer >= {_MIN_POPULATION}")
         lo, hi = self.m1_range
         if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo < hi):
             raise ParameterError(f"m1_range = {self.m1_range!r} must be (lo, hi) with 0 < lo < hi")
@@ -105,6 +102,21 @@ class ValidateSettings:
             config = RunConfig(**design_changes(token))
             controller_for(config, estimate_parameters())  # built once: a parameter the law does not take
             tracker_for(config, estimate_parameters())
+        if 0 < self.search_budget < self.min_search_budget:
+            raise ParameterError(f"search_budget = {self.search_budget} is below one generation of CMA-ES (the "
+                                 f"searches' portfolio); give 0 (no search) or an integer >= {self.min_search_budget}")
+
+    @property
+    def min_search_budget(self) -> int:
+        """One CMA-ES generation of each search (wmr_mj.report.search.search_plans): the ladder's box and,
+        over the m1 box, the full box at FULL_BOX_FACTOR times the budget."""
+        from wmr_mj.params import uncertainty_ranges
+        from wmr_mj.sim.falsify import cma_population
+
+        need = cma_population(1 + len(self.ranges))
+        if self.uncertainty == "m1":
+            need = max(need, -(-cma_population(len(uncertainty_ranges("full"))) // FULL_BOX_FACTOR))
+        return need
 
     @property
     def ranges(self) -> dict[str, tuple[float, float]]:

@@ -296,18 +296,31 @@ def search_lines(summary: Mapping[str, Any]) -> list[str]:
     searches = summary.get("searches") or []
     if not searches:
         return ["Worst-case search: not run (--search-budget 0)."]
-    lines = []
+    lines = [_tightness_line(s) for s in searches if s["objective"] == "certificate" and (s.get("worst") or {})
+             .get("objective")]  # the section leads with how tight the certificate is
     for s in searches:
         w, mc = s.get("worst") or {}, s.get("mc")
         at = _params_text(w.get("params", {}), s.get("names", ()))
+        how = (f"the vertices, then CMA-ES, {s['population']} per generation" if s.get("method") == "portfolio" else
+               f"{s['generations']} generation(s) of {s['population']}")
         head = (f"Search, {s['title']}: worst {s['objective_label']} = {_fmt(w.get('objective'), '.4g')} at {at} "
-                f"({s['evaluations']} runs: {s['generations']} generation(s) of {s['population']})")
+                f"({s['evaluations']} runs: {how})")
         if mc:
             head += (f"; the Monte-Carlo worst of rung {mc['rung']} is {_fmt(mc['worst_objective'], '.4g')} "
                      f"({mc['n']} runs, m1 = {_fmt(mc['worst_m1'], '.0f')} kg): "
                      + _versus(w.get("objective"), mc["worst_objective"]))
         lines.append(head + ". " + _search_bound_sentence(s, summary))
     return lines
+
+
+def _tightness_line(s: Mapping[str, Any]) -> str:
+    """falsify's tightness sentence for a search against the certificate: the worst found (a lower bound on
+    the worst case) beside the certificate's E_max (an upper bound)."""
+    w, e_max = s["worst"], s["certificate"].get("E_max")
+    x = w["objective"]
+    return (f"Tightness ({s['title']}): the worst found is {x:.4g} of the certificate's bound: the certificate is "
+            f"{1.0 / x:.3g} times the worst case found (sup|E| >= {_fmt(w.get('sup_E'), '.4g')} rad found by the "
+            f"search, <= {_fmt(e_max, '.4g')} rad certified).")
 
 
 def _versus(search: float | None, mc: float | None) -> str:

@@ -9,8 +9,8 @@
    then one change per rung up to the certified design) a sweep of n runs over m1
    (``run_sweep``, atomic and resumable in ladder-<k>-<name>/), judged by the separated
    verdicts (:mod:`wmr_mj.analysis.verdicts`) and summarised from its runs.csv (:func:`summarise_rung`);
-4. :func:`wmr_mj.report.search.search_stage`: the worst-case search (differential evolution
-   on whole generations) for the paper's design against the paper's claim and for the
+4. :func:`wmr_mj.report.search.search_stage`: the worst-case search (falsify's portfolio: the
+   vertices, then CMA-ES on whole generations) for the paper's design against the paper's claim and for the
    certified design against its certificate over the m1 box, beside the Monte-Carlo worst
    of the same rung; and for the certified design over the 'full' uncertainty box;
 5. :func:`nominal_stage`: the paper's and the certified design at m1 = 650 kg (time histories);

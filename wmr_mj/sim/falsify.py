@@ -8,21 +8,51 @@ search can be judged against chance (``bench/bench_falsify.py`` does so over see
 
 Methods (:data:`METHODS`):
 
-- ``vertices-polish`` (the default): the box's 2^d vertices first, as one batch, where the
-  budget allows them (else a fractional-factorial covering of them, :func:`covering_design`),
-  then scipy's Nelder-Mead with bounds from the worst point found, restarted from the
-  next-worst while budget is left. Robust-control worst cases sit at vertices more often than
-  not (the objective is monotone in most parameters: the heaviest chassis, the most friction,
-  the largest R_a); the polish finds an interior maximum next to the worst vertex or confirms it.
-  At a budget of 48 on the full box, differential evolution was beaten by random sampling in
-  3 of 6 seeds and never reached the worst vertex (0.3927 of E_max), which this finds in 27 runs.
-- ``lhs-polish``: a seeded Latin hypercube of half the budget, then the same polish: for spaces whose
-  worst case is interior. Over C's path (3 knots, the hold, m1; budget 48) the vertices' worst was
-  0.68 of E_max and random sampling beat vertices-polish in 6 of 10 seeds (bench_falsify --space paths).
+- ``portfolio`` (the default, of ``falsify`` and of ``validate``'s searches): the box's vertices
+  first, as one batch: all 2^d where they fit half the budget (:data:`PORTFOLIO_VERTEX_SHARE`), so
+  that a monotone worst case (a vertex) is found exactly (the full box, d = 5: its worst vertex,
+  0.3927 of E_max, within the first 32 runs of any budget >= 64), else a seeded fractional-factorial
+  covering of at most an eighth of it (:data:`PORTFOLIO_COVER_SHARE`); then CMA-ES (``cmaes``) from
+  the box's centre with the rest, a generation per batch, restarted with twice the population when
+  it stops (IPOP). The split, measured on synthetic objectives in the unit box (20 seeds each, d = 5
+  and 6, budgets 64/100/300; median best found as a fraction of the true worst): CMA-ES started at
+  the centre beats CMA-ES started at the worst vertex wherever the worst is interior (a Gaussian
+  bump, 6-D, budget 100: 0.555 against 0.367; a mixture of 8 bumps: 0.443 against 0.338) and
+  matches it elsewhere, so the vertices serve as insurance, not as a start; when the 2^d vertices
+  do not fit half the budget, a covering of an eighth instead of a half keeps CMA-ES its runs (bump
+  6-D/100: 0.704 against 0.536; mixture 6-D/100: 0.608 against 0.523) and costs the linear
+  (vertex) objective little (6-D/100: 0.853 against 1.0 of the worst vertex). CMA-ES alone reaches
+  only 0.72-0.85 of a vertex worst case at budgets 64-100 (0.95-0.97 at 300), which is why the
+  vertices stay.
+  ``cmaes`` was chosen over ``pycma`` (``cma``) by the same measurement: ahead on interior maxima
+  (bump 5-D/100: 0.909 against 0.864, 6-D/100: 0.732 against 0.603; mixture 5-D/100: 0.801
+  against 0.614), behind on a linear objective (which the vertices cover), and it keeps its own
+  seeded generator (pycma seeds numpy's global one).
+  On those smooth synthetic objectives ``lhs-polish`` does as well or better (bump 6-D/100: 0.916;
+  mixture 5-D/100: 0.818 against the portfolio's 0.572): Nelder-Mead is strong on smooth bumps. Over
+  C's path, which is rough, no polish beat random sampling (below). The portfolio there
+  (``bench/bench_falsify.py --spaces paths``: m1, 4 knots and the hold, 20 s runs, 10 seeds) has the
+  larger median worst (0.8307 against random's 0.7665 at budget 100, 0.8892 against 0.8397 at 300)
+  and is >= random in 8 of 10 seeds at 100 but only 7 of 10 at 300 (docs/guides/benchmarks.md);
+  over the full box it reaches the worst vertex at run 27 in every seed from a budget of 64.
+- ``cma``: CMA-ES alone, from the box's centre (the portfolio without the vertices).
+- ``vertices-polish``: the box's 2^d vertices first, as one batch, where the budget allows them
+  (else a fractional-factorial covering of them, :func:`covering_design`), then scipy's
+  Nelder-Mead with bounds from the worst point found, restarted from the next-worst while budget
+  is left. At a budget of 48 on the full box, differential evolution was beaten by random sampling
+  in 3 of 6 seeds and never reached the worst vertex (0.3927 of E_max), which this finds in 27 runs.
+- ``lhs-polish``: a seeded Latin hypercube of half the budget, then the same polish. Over C's path
+  (3 knots, the hold, m1; budget 48) the vertices' worst was 0.68 of E_max and random sampling beat
+  vertices-polish in 6 of 10 seeds, lhs-polish in 5 of 10.
 - ``de``: scipy's differential evolution, a generation per batch (``vectorized=True``).
 
 Each batch of points runs as one batch of simulations (``wmr_mj.sim.sweep.run_configs``:
-``mujoco.batch``, or Dask chunks); the polish asks for one point at a time.
+``mujoco.batch``, or Dask chunks); the polish asks for one point at a time. A budget below one
+generation (differential evolution's or CMA-ES's population) is refused before any run.
+
+Where the objective is the certificate's ratio, :attr:`FalsifyResult.tightness` sets the worst
+found (a lower bound on the worst case) beside the certificate's E_max (an upper bound): "the worst
+found is X of the certificate's bound: the certificate is 1/X times the worst case found".
 
 Objectives (:data:`OBJECTIVES`), read from a run's summary by :func:`objective_value`:
 
@@ -84,6 +114,8 @@ __all__ = [
     "objective_value",
     "objective_source",
     "population_size",
+    "cma_population",
+    "portfolio_vertices",
     "search_worst",
     "random_worst",
     "falsify",
@@ -93,10 +125,11 @@ __all__ = [
 
 OBJECTIVES = ("certificate", "paper", "sup-E", "requirement")
 #: Search methods: the box's vertices then a Nelder-Mead polish (default), or differential evolution.
-METHODS = ("vertices-polish", "lhs-polish", "de")
+METHODS = ("portfolio", "cma", "vertices-polish", "lhs-polish", "de")
 OBJECTIVE_LABELS = {"certificate": "sup|E|/E_max of the certificate", "paper": "sup|E|/E_max of the paper's region",
                     "sup-E": "sup|E| [rad]", "requirement": "-robustness of the requirement (> 0: falsified)"}
 MIN_POPULATION = 5  # scipy's differential evolution needs at least 5 members
+_POPULATION_OF = {"de": "differential evolution", "cma": "CMA-ES", "portfolio": "CMA-ES"}  # methods with generations
 
 
 # -- the objective, read from a run's summary ----------------------------------------------
@@ -224,15 +257,15 @@ def population_size(budget: int, d: int) -> int:
     return max(MIN_POPULATION, min(10 * d, budget // 8))
 
 
-def _check_budget(budget: int, population: int) -> None:
+def _check_budget(budget: int, population: int, what: str = "differential evolution") -> None:
     if isinstance(budget, bool) or not isinstance(budget, int) or budget < 1:
         raise ParameterError(f"budget = {budget!r} is not accepted; give the number of simulations, an integer >= 1")
     if isinstance(population, bool) or not isinstance(population, int) or population < MIN_POPULATION:
-        raise ParameterError(f"population = {population!r} is not accepted; differential evolution needs an "
+        raise ParameterError(f"population = {population!r} is not accepted; {what} needs an "
                              f"integer >= {MIN_POPULATION}")
     if budget < population:
-        raise ParameterError(f"budget = {budget} simulations is below one population of {population} (differential "
-                             f"evolution evaluates a whole population per generation); give a budget >= {population}")
+        raise ParameterError(f"budget = {budget} simulations is below one population of {population} ({what} "
+                             f"evaluates a whole population per generation); give a budget >= {population}")
 
 
 def _unit_to_box(unit: np.ndarray, bounds: np.ndarray) -> np.ndarray:
@@ -258,17 +291,20 @@ def _user_errors_unwrapped():
 
 
 def search_worst(evaluate: Callable[[np.ndarray], np.ndarray], bounds: np.ndarray, *, budget: int, seed: int = 0,
-                 population: int | None = None, method: str = "vertices-polish") -> Trace:
+                 population: int | None = None, method: str = "portfolio") -> Trace:
     """Maximise ``evaluate`` over the box ``bounds`` (d, 2) with ``method`` (:data:`METHODS`).
 
     evaluate(points (S, d)) -> values (S,), NaN where undefined, is called with a batch of
     points at a time. At most ``budget`` points are evaluated. Seeded: the same seed gives
-    the same points. population: differential evolution's members per generation.
+    the same points. population: members per generation of differential evolution or CMA-ES.
     """
     if method not in METHODS:
         raise UnknownNameError("search method", method, METHODS)
     if method == "de":
         return _search_de(evaluate, bounds, budget=budget, seed=seed, population=population)
+    if method in ("portfolio", "cma"):
+        return _search_cma(evaluate, bounds, budget=budget, seed=seed, population=population,
+                           vertices=method == "portfolio")
     return _search_vertices_polish(evaluate, bounds, budget=budget, seed=seed, first=method.split("-")[0])
 
 
@@ -381,6 +417,84 @@ def _search_vertices_polish(evaluate: Callable[[np.ndarray], np.ndarray], bounds
     return rec.trace()
 
 
+#: CMA-ES's starting step, in units of each range (the search runs in the unit box).
+CMA_SIGMA0 = 0.3
+#: The portfolio evaluates all 2^d vertices where they fit this share of the budget (a monotone worst case is
+#: then found exactly) ...
+PORTFOLIO_VERTEX_SHARE = 0.5
+#: ... and where all 2^d do not fit that share, a covering of at most this share (measured: module docstring).
+PORTFOLIO_COVER_SHARE = 0.125
+
+
+def cma_population(d: int) -> int:
+    """CMA-ES's members per generation: its default 4 + floor(3 ln d), at least :data:`MIN_POPULATION`
+    (5 in 1-D, 6 in 2-D, 8 in 4-5-D, 9 in 6-D)."""
+    return max(MIN_POPULATION, 4 + int(math.floor(3 * math.log(max(d, 1)))))
+
+
+def portfolio_vertices(d: int, budget: int) -> int:
+    """How many vertices the portfolio evaluates first: all 2^d where they fit
+    :data:`PORTFOLIO_VERTEX_SHARE` of the budget, else the largest power of two within
+    :data:`PORTFOLIO_COVER_SHARE` of it (a fractional-factorial covering), at least 2."""
+    if 2 ** d <= int(PORTFOLIO_VERTEX_SHARE * budget):
+        return 2 ** d
+    share = int(PORTFOLIO_COVER_SHARE * budget)
+    return max(2, 2 ** int(math.floor(math.log2(max(share, 2)))))
+
+
+def _search_cma(evaluate: Callable[[np.ndarray], np.ndarray], bounds: np.ndarray, *, budget: int, seed: int = 0,
+                population: int | None = None, vertices: bool = True) -> Trace:
+    """CMA-ES (the ``cmaes`` package), a generation per batch, in the unit box with its bounds;
+    with ``vertices`` (the ``portfolio``) the box's vertices first, as one batch, and CMA-ES from
+    the worst of them.
+
+    1. (portfolio) :func:`portfolio_vertices` vertices, one batch: all 2^d where they fit
+       :data:`PORTFOLIO_VERTEX_SHARE` of the budget, else a seeded fractional-factorial covering.
+    2. CMA-ES: mean at the box's centre (not at the worst vertex: measured worse on interior maxima), step
+       :data:`CMA_SIGMA0` of each range, ``population`` (default :func:`cma_population`) members
+       per generation, evaluated as one batch; the package resamples a member outside the box
+       (up to 100 times, then clips it). An undefined value (NaN) ranks below every defined one.
+       When CMA-ES stops (converged, flat) with budget left it restarts from a seeded uniform
+       point with twice the population (IPOP). The last generation is cut to the budget.
+
+    In one dimension (which ``cmaes`` does not take) it searches a square whose second coordinate
+    is ignored. Deterministic for a seed (``cmaes`` keeps its own generator, seeded from it).
+    """
+    from cmaes import CMA
+
+    bounds = np.asarray(bounds, dtype=float)
+    d = len(bounds)
+    lam = cma_population(d) if population is None else population
+    _check_budget(budget, lam, what="CMA-ES")
+    seeds = np.random.SeedSequence(seed).spawn(5)[4]
+    rng = np.random.default_rng(seeds)
+    lo, span = bounds[:, 0], bounds[:, 1] - bounds[:, 0]
+    rec = _Recorder(evaluate)
+    n = max(d, 2)
+
+    def run(unit: np.ndarray) -> np.ndarray:  # a coordinate at 1 is the upper bound itself, not lo + span
+        return rec(np.where(unit[:, :d] >= 1.0, bounds[:, 1], lo + unit[:, :d] * span))
+
+    if vertices:
+        corners = covering_design(d, portfolio_vertices(d, budget), rng)
+        run(np.hstack([corners, np.full((len(corners), n - d), 0.5)]))
+    mean = np.full(n, 0.5)
+    while rec.spent < budget:
+        opt = CMA(mean=mean, sigma=CMA_SIGMA0, bounds=np.array([[0.0, 1.0]] * n), population_size=lam,
+                  seed=int(rng.integers(2 ** 31 - 1)))
+        while rec.spent < budget:
+            xs = np.array([opt.ask() for _ in range(opt.population_size)])
+            k = min(len(xs), budget - rec.spent)
+            v = run(xs[:k])
+            if k < len(xs):
+                break
+            opt.tell([(x, 1e300 if math.isnan(e) else -e) for x, e in zip(xs, v)])  # cmaes minimises
+            if opt.should_stop():
+                break
+        mean, lam = rng.uniform(0.0, 1.0, n), 2 * lam  # IPOP restart
+    return rec.trace()
+
+
 def _search_de(evaluate: Callable[[np.ndarray], np.ndarray], bounds: np.ndarray, *, budget: int, seed: int = 0,
                  population: int | None = None) -> Trace:
     """Maximise ``evaluate`` over the box ``bounds`` (d, 2) with scipy's differential evolution.
@@ -438,8 +552,8 @@ class FalsifySpec:
     objective: str = "certificate"
     budget: int = 256
     seed: int = 0
-    population: int | None = None  # differential evolution's members per generation
-    method: str = "vertices-polish"  # one of METHODS
+    population: int | None = None  # members per generation of differential evolution or CMA-ES
+    method: str = "portfolio"  # one of METHODS
     requirement: str | None = None  # objective 'requirement': an STL formula (wmr_mj.analysis.requirements)
 
     def __post_init__(self) -> None:
@@ -475,7 +589,8 @@ class FalsifySpec:
         config_for(self.base, self.names, [lo for lo, _ in self.box.values()])  # a bad axis fails before any run
         if isinstance(self.seed, bool) or not isinstance(self.seed, int):
             raise ParameterError(f"seed = {self.seed!r} is not accepted; give an integer")
-        _check_budget(self.budget, self.population_size if self.method == "de" else MIN_POPULATION)
+        _check_budget(self.budget, self.population_size if self.population_size is not None else MIN_POPULATION,
+                      what=_POPULATION_OF.get(self.method, "the search"))
 
     @property
     def parsed_requirement(self):
@@ -494,8 +609,14 @@ class FalsifySpec:
         return np.array([self.box[n] for n in self.names], dtype=float)
 
     @property
-    def population_size(self) -> int:
-        return population_size(self.budget, len(self.box)) if self.population is None else self.population
+    def population_size(self) -> int | None:
+        """Members per generation: differential evolution's or CMA-ES's (its first; None for the polish methods)."""
+        if self.method not in _POPULATION_OF:
+            return None
+        if self.population is not None:
+            return self.population
+        d = len(self.box)
+        return population_size(self.budget, d) if self.method == "de" else cma_population(d)
 
     def config(self, point: Sequence[float]) -> RunConfig:
         """The run at ``point`` (values in ``names`` order): m1, the plant overrides and the signals'
@@ -560,6 +681,24 @@ class FalsifyResult:
     def generations(self) -> int:
         return 1 + max((e.generation for e in self.search), default=-1)
 
+    @property
+    def tightness(self) -> dict[str, Any] | None:
+        """How tight the certificate is, where the objective is its ratio sup|E|/E_max: the worst
+        found (a lower bound on the worst case: a run reached it) beside the certificate's E_max (an
+        upper bound), their ratio X and 1/X, and the sentence falsify prints. None for other objectives."""
+        if self.spec.objective != "certificate":
+            return None
+        w = self.worst
+        certificate = w.summary.get("certificate")
+        e_max = certificate.get("E_max") if isinstance(certificate, Mapping) else None
+        x = w.objective
+        factor = 1.0 / x if x is not None and x > 0 else math.inf
+        text = (f"the worst found is {x:.4g} of the certificate's bound: the certificate is {factor:.3g} times the "
+                f"worst case found (sup|E| >= {w.sup_E:.4g} rad found, <= "
+                + ("n/a" if e_max is None else f"{float(e_max):.4g}") + " rad certified)")
+        return {"ratio": x, "factor": factor, "found_sup_E": w.sup_E,
+                "E_max": None if e_max is None else float(e_max), "text": text}
+
     def as_dict(self, *, log: str | None = None) -> dict[str, Any]:
         """The ``wmr-mj falsify --json`` object."""
         w, r = self.worst, self.random_worst
@@ -571,7 +710,7 @@ class FalsifyResult:
             "evaluations": len(self.search),
             "seed": self.spec.seed,
             "method": self.spec.method,
-            "population": self.spec.population_size if self.spec.method == "de" else None,
+            "population": self.spec.population_size,
             "generations": self.generations,
             "requirement": self.spec.requirement,
             "falsified": (w.objective is not None and w.objective > 0.0) if self.spec.objective == "requirement"
@@ -579,6 +718,7 @@ class FalsifyResult:
             "box": {k: [float(lo), float(hi)] for k, (lo, hi) in self.spec.box.items()},
             "worst": {"params": dict(w.params), "objective": w.objective, "sup_E": w.sup_E, "sup_Edot": w.sup_Edot,
                       "verdict": w.verdict, "generation": w.generation, "index": w.index},
+            "tightness": self.tightness,
             "random": {"worst_objective": r.objective, "worst_params": dict(r.params), "evaluations": len(self.random),
                        "sup_E": r.sup_E, "verdict": r.verdict},
             "log": log,
