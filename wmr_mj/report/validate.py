@@ -191,6 +191,27 @@ def correction_stage(settings: ValidateSettings, folder: Path, st: Stages) -> di
     return rung
 
 
+def designs_stage(settings: ValidateSettings, folder: Path, st: Stages, *, first_index: int) -> list[dict[str, Any]]:
+    """``validate --design TOKEN``: each design of the user's (a plug-in law, a tracker, other gains; a token
+    as ``wmr-mj compare`` takes it) judged beside the ladder: its rung (:func:`run_rung`: the same m1 sweep,
+    its verdicts against its own claim) and its nominal run (summary.json's ``designs``)."""
+    from wmr_mj.sim.closed_loop import run_closed_loop
+    from wmr_mj.sim.designs import TokenDesign
+
+    out = []
+    for k, token in enumerate(settings.designs, start=first_index):
+        design = TokenDesign(token)
+        rung = run_rung(settings, k, design, folder, st, reference_of(settings), None)
+        st.start(f"design-{k}", f"nominal run of {token} at m1 = {settings.nominal_m1:g} kg")
+        nominal = run_closed_loop(settings.config(design), progress=False)
+        st.done(f"sup|E| = {nominal.summary.sup_E:.3g} rad, {nominal.summary.verdict}")
+        law = "no-claim: judged by requirements only" if nominal.summary.verdict == "no-claim" else ""
+        rung.update(token=token, change="a design of the user's (validate --design)" + (f"; {law}" if law else ""),
+                    nominal=_nominal_summary(nominal), paper_law=nominal.summary.paper_law)
+        out.append(rung)
+    return out
+
+
 # --------------------------------------------------------------------------- stage 5: nominal runs
 def nominal_stage(settings: ValidateSettings, st: Stages) -> dict[str, Any]:
     """The paper's and the certified design at the nominal m1: {name: RunResult}."""
@@ -307,8 +328,6 @@ def run_validate(settings: ValidateSettings, out_dir: str | os.PathLike, *, log:
     friction = friction_stage(settings, st)
     rungs = ladder_stage(settings, folder, st)
     corrected = correction_stage(settings, folder, st)
-    from wmr_mj.report.extra_designs import designs_stage
-
     designs = designs_stage(settings, folder, st, first_index=len(LADDER) + 2)
     searches = search_stage(settings, folder, st, rungs)
     nominal = nominal_stage(settings, st)

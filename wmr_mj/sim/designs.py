@@ -147,7 +147,7 @@ def certified_omega_r(*, error_spec: float = ERROR_SPEC, grid: tuple[float, ...]
 
 class DesignLike(Protocol):
     """What a rung of validate's ladder needs of a design: :class:`Design`, or a token's
-    (``wmr_mj.report.extra_designs.TokenDesign``)."""
+    (:class:`TokenDesign`)."""
 
     @property
     def name(self) -> str: ...
@@ -199,3 +199,29 @@ def design_changes(token: str) -> dict[str, Any]:
     else:
         changes["controller_params"] = settings
     return changes
+
+
+@dataclass(frozen=True)
+class TokenDesign:
+    """A design named by a token (:func:`design_changes`), shaped as :class:`Design` for validate's ladder
+    (``validate --design``)."""
+
+    token: str
+
+    @property
+    def name(self) -> str:
+        import re
+
+        return re.sub(r"[^A-Za-z0-9_.-]+", "-", self.token).strip("-")[:60] or "design"
+
+    @property
+    def label(self) -> str:
+        return self.token
+
+    def config_changes(self) -> dict[str, Any]:
+        return design_changes(self.token)
+
+    def describe(self) -> str:
+        from wmr_mj.sim.config import RunConfig, controller_for, estimate_parameters
+
+        return controller_for(RunConfig(**self.config_changes()), estimate_parameters()).label()
