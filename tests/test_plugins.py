@@ -261,3 +261,37 @@ def test_a_stateful_law_is_reset_before_every_run(tmp_path):
     plain = run_closed_loop(config.replace(controller=module.MyPID(ki=0.0)), progress=False)
     assert not np.array_equal(first.rows["voltage"], plain.rows["voltage"])
     assert math.isfinite(first.summary.sup_E)
+
+
+TRACKER = '''
+from controllers.tracking import StanleyAtC
+
+class GentleStanley(StanleyAtC):
+    name = "gentle-stanley"
+    def __init__(self, k_e=2.0):
+        super().__init__(k_e=k_e)
+'''
+
+
+@pytest.mark.slow
+def test_a_tracker_of_ones_own_runs_named_as_itself_and_replays(tmp_path, capsys):
+    path = tmp_path / "tracker.py"
+    path.write_text(TRACKER)
+    log = tmp_path / "tracked.mcap"
+    assert main(["run", "--preset", "certified", "--tracker", f"{path}:GentleStanley", "--tracker-param", "k_e=3",
+                 "--path", "lane-change", "--duration", "10", "--out", str(log), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["correction"]["law"] == "gentle-stanley" and report["correction"]["k_e"] == 3.0
+    measured = [a for a in report["certificate"]["assumptions"] if a["name"] == "tracker within its declared bounds"]
+    assert measured and measured[0]["kind"] == "checked" and "gentle-stanley" in measured[0]["note"]
+    from wmr_mj.logs.reader import load_log
+
+    plugin = load_log(log).config["tracker_plugin"]
+    assert plugin["name"] == "gentle-stanley" and plugin["params"] == {"k_e": 3} and plugin["origin"] == "file"
+    assert main(["replay", str(log), "--verify"]) == 0
+    assert "bit-identical at all 10000 control steps" in capsys.readouterr().out
+    # a bad tracker parameter: one line, exit 2, before any run
+    assert main(["run", "--tracker", f"{path}:GentleStanley", "--tracker-param", "k_x=1", "--duration", "10",
+                 "--no-log"]) == 2
+    line = _one_error_line(capsys)
+    assert "tracker" in line and "accepted: k_e" in line
