@@ -38,11 +38,14 @@ if TYPE_CHECKING:
     from wmr_mj.logs.writer import LogOptions, RunLogger
     from wmr_mj.sim.certify import certificate_for
     from wmr_mj.sim.closed_loop import RunResult, run_closed_loop
+    from wmr_mj.sim.compare import compare
     from wmr_mj.sim.config import RunConfig, controller_for
     from wmr_mj.sim.designs import CERTIFIED, PAPER, PRESETS, preset
     from wmr_mj.sim.falsify import FalsifySpec, falsify
     from wmr_mj.sim.log_header import LogHeader
+    from wmr_mj.sim.parts import RunParts, resolve_run
     from wmr_mj.sim.signals import Disturbance, LoadChange, Signals
+    from wmr_mj.sim.suite import load_suite
     from wmr_mj.sim.sweep import SweepSpec, run_sweep
 
 #: name -> the module that defines it, imported on first access
@@ -67,6 +70,10 @@ _LAZY: dict[str, str] = {
     "RunLogger": "wmr_mj.logs.writer",
     "LogHeader": "wmr_mj.sim.log_header",
     "LogOptions": "wmr_mj.logs.writer",
+    "resolve_run": "wmr_mj.sim.parts",
+    "RunParts": "wmr_mj.sim.parts",
+    "load_suite": "wmr_mj.sim.suite",
+    "compare": "wmr_mj.sim.compare",
 }
 
 __all__ = [
@@ -82,6 +89,8 @@ __all__ = [
     "RunResult",
     "controller_for",
     "certificate_for",
+    "resolve_run",
+    "RunParts",
     # what acts on the plant during a run: a steering disturbance, load changes
     "Signals",
     "Disturbance",
@@ -96,6 +105,9 @@ __all__ = [
     "run_sweep",
     "FalsifySpec",
     "falsify",
+    # one yardstick for every controller
+    "load_suite",
+    "compare",
     # logs
     "RunLogger",
     "LogHeader",
