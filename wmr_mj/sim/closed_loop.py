@@ -80,6 +80,7 @@ class RunResult:
     law_note: str | None = None  # why the Python law ran
     cpu_s: float | None = None  # CPU time of the run's loop on its thread (wall_s is in the summary)
     C_xy: np.ndarray | None = None  # (control steps, 2) xy of point C [m], as the log's C_pos
+    reference: Any = None  # C's reference the run followed (RunParts.reference): its path, for C's errors
 
 
 def requirement_rows(result: RunResult, requirements: Sequence[Any], *, base: C80Parameters = C80
@@ -92,8 +93,10 @@ def requirement_rows(result: RunResult, requirements: Sequence[Any], *, base: C8
     config = result.config
     period = control_substeps(config, TIMESTEP) * TIMESTEP
     n = len(result.rows["t"])
-    reference, _ = build_reference(config.path, estimate_parameters(base), dt=period,
-                                   duration=int(round(config.duration / period)) * period)
+    reference = result.reference
+    if reference is None:  # a result made elsewhere: the run's reference built again, as resolve_run builds it
+        reference, _ = build_reference(config.path, estimate_parameters(base), dt=period,
+                                       duration=int(round(config.duration / period)) * period)
     block = {"t": result.rows["t"], "C_pos": result.C_xy[:n], "heading": result.rows["heading"]}
     return {**result.rows, "cross_track": _PathRows(reference, period)(block, 1)["path_cross_track"]}
 
@@ -409,8 +412,7 @@ def run_parts(parts: RunParts, *, logger_factory: Callable[..., Any] | None = No
     if logger is not None:
         logger.close(summary.to_dict(), status=status)
     return RunResult(config=config, rows=done, summary=summary, status=status, law=run.law, law_note=run.law_note,
-                     C_xy=run.C_xy,
-                     cpu_s=run.cpu_s)
+                     C_xy=run.C_xy, cpu_s=run.cpu_s, reference=reference)
 
 
 def run_on_reduced_model(
