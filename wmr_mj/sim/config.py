@@ -378,56 +378,51 @@ def controller_for(config: RunConfig, params: C80Parameters) -> SteeringControll
         ParameterError: a plug-in that cannot be built (a parameter it does not take, a factory that
             returns no SteeringController).
     """
-    import copy
-
-    from controllers.base import BuildContext
-    from controllers.registry import build, resolve
-
     given = config.controller
     model = model_from_source(config.model, params=params, identified=config.identified,
                               coefficients=config.coefficients)
     if isinstance(given, str) and given in CONTROLLER_NAMES:
         return make_controller(given, model, kp=config.kp, kd=config.kd,
                                friction_sign=config.friction_sign, friction_width=config.friction_width)
-    if isinstance(given, SteeringController):
-        return copy.deepcopy(given)
-    context = BuildContext(model=model, estimate=params, voltage_limit=params.voltage_limit, kp=config.kp,
-                           kd=config.kd)
-    if isinstance(given, str):
-        cls, _ = resolve(given, config.controller_params, kind="controller")
-        law = build(cls, config.controller_params, context, spec=given)
-    else:
-        law = given()
-    if not isinstance(law, SteeringController):
-        raise ParameterError(f"controller {given!r} built {type(law).__name__}, not a controllers.SteeringController")
-    return law
+    return _plugin_for(config, params, "controller", given, config.controller_params, SteeringController, model)
 
 
 def tracker_for(config: RunConfig, params: C80Parameters):
-    """A fresh instance of the run's path tracker (:class:`controllers.tracking.PathTracker`), None without one."""
-    import copy
-
-    from controllers.base import BuildContext
-    from controllers.registry import build, resolve
+    """A fresh instance of the run's path tracker (:class:`controllers.tracking.PathTracker`), None without one;
+    built as :func:`controller_for` builds a plug-in."""
     from controllers.tracking import PathTracker
 
     given = "stanley-at-C" if config.tracker is None and config.correction else config.tracker
     if given is None:
         return None
-    if isinstance(given, PathTracker):
+    return _plugin_for(config, params, "tracker", given, config.tracker_params, PathTracker)
+
+
+def _plugin_for(config: RunConfig, params: C80Parameters, kind: str, given: Any, plugin_params: Mapping[str, Any],
+                base: type, model: Any = None) -> Any:
+    """A fresh instance of a plug-in (law or tracker): an object deep-copied, a name resolved and built with its
+    parameters on the run's context (``model``: the run's reduced model, built here where None), a factory
+    called; checked to be a ``base``."""
+    import copy
+
+    from controllers.base import BuildContext
+    from controllers.registry import build, resolve
+
+    if isinstance(given, base):
         return copy.deepcopy(given)
     if isinstance(given, str):
-        cls, _ = resolve(given, config.tracker_params, kind="tracker")
-        model = model_from_source(config.model, params=params, identified=config.identified,
-                                  coefficients=config.coefficients)
+        cls, _ = resolve(given, plugin_params, kind=kind)
+        if model is None:
+            model = model_from_source(config.model, params=params, identified=config.identified,
+                                      coefficients=config.coefficients)
         context = BuildContext(model=model, estimate=params, voltage_limit=params.voltage_limit, kp=config.kp,
                                kd=config.kd)
-        tracker = build(cls, config.tracker_params, context, spec=given, kind="tracker")
+        built = build(cls, plugin_params, context, spec=given, kind=kind)
     else:
-        tracker = given()
-    if not isinstance(tracker, PathTracker):
-        raise ParameterError(f"tracker {given!r} built {type(tracker).__name__}, not a controllers.PathTracker")
-    return tracker
+        built = given()
+    if not isinstance(built, base):
+        raise ParameterError(f"{kind} {given!r} built {type(built).__name__}, not a controllers.{base.__name__}")
+    return built
 
 
 def has_tracker(config: RunConfig) -> bool:
