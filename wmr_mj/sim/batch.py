@@ -60,7 +60,6 @@ from wmr_mj.sim.closed_loop import (
 )
 from wmr_mj.sim.config import (
     RunConfig,
-    estimate_of,
     has_tracker,
     plant_parameters,
 )
@@ -411,8 +410,7 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
     wall = time.perf_counter() - wall0
     return _summaries(configs, plants, stats, _BatchRun(base=base, reference=reference, settle_s=settle_s,
                                                        analysis=analysis, loop=loop, backend=backend, wall=wall,
-                                                       threads=threads, parts=parts,
-                                                       paper_law=estimate_of(controller) is not None))
+                                                       threads=threads, parts=parts))
 
 
 def shares_one_batch(configs: Sequence[RunConfig]) -> bool:
@@ -457,7 +455,6 @@ class _BatchRun:
     wall: float
     threads: int  # the batch's threads, which also judge C's paths
     parts: RunParts  # the first config's, which the batch's simulations share but for the plant
-    paper_law: bool = True  # the law is the paper's family (its region applies)
 
 
 def _summaries(configs: Sequence[RunConfig], plants: Sequence[C80Parameters], stats: _BatchStats,
@@ -505,7 +502,7 @@ def _summaries(configs: Sequence[RunConfig], plants: Sequence[C80Parameters], st
             serial = run_closed_loop(c, progress=False, base=base).summary
             r = dataclasses.replace(serial, analysis=None, controller_config=None)  # report's fields and the warnings
         else:
-            r = dataclasses.replace(r, mujoco_warnings=int(stats.warnings[i]), paper_law=run.paper_law,
+            r = dataclasses.replace(r, mujoco_warnings=int(stats.warnings[i]), paper_law=run.parts.paper_law,
                                     route=progress)
         r = dataclasses.replace(r, batch=BatchFigures(
             final_alpha_after_step=float(stats.final_alpha_after_step[i]),  # the serial run reports the last row

@@ -47,7 +47,6 @@ from wmr_mj.sim.config import (
     RunConfig,
     build_reference,
     controller_name,
-    estimate_of,
     estimate_parameters,
     reference_bounds_of,
 )
@@ -176,7 +175,7 @@ def report(config: RunConfig, measured: RunMeasures, *, analysis, params: C80Par
         paper_region=paper_region(analysis, sup_E, sup_Edot) if judged is None else judged.paper_region,
         certificate=None if judged is None else judged.certificate,
         drift=drift if judged is None else judged.drift,
-        claimed=certificate is not None or not claims_nothing,
+        claimed=not claims_nothing,
         path_error=None if path is None else path.errors,
         path_bound=None if path is None else path.bound,
         path_verdict=None if path is None else path.verdict,
@@ -404,7 +403,7 @@ def run_parts(parts: RunParts, *, logger_factory: Callable[..., Any] | None = No
     if outer is not None:
         summary = dataclasses.replace(summary, correction=outer.describe(done))
     summary = dataclasses.replace(summary, mujoco_warnings=run.warnings, failure=run.failure,
-                                  paper_law=estimate_of(controller) is not None,
+                                  paper_law=parts.paper_law,
                                   analysis=analysis.as_dict(), controller_config=controller.describe())
     from wmr_mj.reference.route import route_progress
 

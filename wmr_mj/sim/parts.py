@@ -71,6 +71,7 @@ class RunParts:
         options: the plant's laws (steering friction, tyre contact).
         analysis: the paper's analysis for the run's box, gains and reference bounds.
         claim: the law's own claim (a Certificate), None where it states none.
+        paper_law: the law is the paper's family (computed torque, PD): the paper's region applies to it.
     """
 
     config: RunConfig
@@ -88,6 +89,7 @@ class RunParts:
     options: dict[str, Any]
     analysis: Any
     claim: Certificate | None
+    paper_law: bool = True
 
 
 def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
@@ -107,10 +109,11 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
     period = substeps * TIMESTEP
     n = int(round(config.duration / period))
     reference, settle_s = build_reference(config.path, estimate, dt=period, duration=n * period)
-    analysis = analysis_for(config, reference, estimate, estimate=estimate_of(controller))
+    paper_estimate = estimate_of(controller)  # None: not the paper's law, whose region then says nothing of it
+    analysis = analysis_for(config, reference, estimate, estimate=paper_estimate)
     claim = certificate_of(config, reference, base=base, estimate=estimate, plant=plant,
                            controller=controller, tracker=tracker)
     return RunParts(config=config, base=base, plant=plant, estimate=estimate, controller=controller,
                     controller_name=controller_name(config), tracker=tracker, reference=reference,
                     settle_s=settle_s, substeps=substeps, period=period, n=n, options=plant_options(config),
-                    analysis=analysis, claim=claim)
+                    analysis=analysis, claim=claim, paper_law=paper_estimate is not None)
