@@ -227,9 +227,7 @@ class _CompiledStepper:
     def set_fields(self, fields: Mapping[str, np.ndarray]) -> None:
         """A load change: the model's fields for the batch's simulation, then mj_setConst."""
         if self.own_model:  # the batch runs on this run's own model: set its fields, as the Python stepper does
-            for name, value in fields.items():
-                getattr(self.model, name)[...] = value
-            mujoco.mj_setConst(self.model, mujoco.MjData(self.model))  # scratch data: the run's state stays
+            _set_model_fields(self.model, fields)
             return
         for name, value in fields.items():
             self.batch.expand(name)[0] = value
@@ -260,6 +258,13 @@ class _CompiledStepper:
             block.ctrl[:] = end["ctrl"]
             block.sites[:] = sites
             self._qpos, self._qvel = end["qpos"][-1].copy(), end["qvel"][-1].copy()
+
+
+def _set_model_fields(model: mujoco.MjModel, fields: Mapping[str, np.ndarray]) -> None:
+    """A load change on ``model`` itself: its fields, then mj_setConst (scratch data: the run's state stays)."""
+    for name, value in fields.items():
+        getattr(model, name)[...] = value
+    mujoco.mj_setConst(model, mujoco.MjData(model))
 
 
 class ControllerFailure(WmrMjError):
@@ -315,9 +320,7 @@ class _PythonStepper:
         """A load change: the fields in this stepper's own copy of the model, then mj_setConst."""
         if not self._own:
             self.model, self._own = copy.copy(self.model), True
-        for name, value in fields.items():
-            getattr(self.model, name)[...] = value
-        mujoco.mj_setConst(self.model, mujoco.MjData(self.model))  # scratch data: the run's state stays
+        _set_model_fields(self.model, fields)
 
     def warnings(self) -> int:
         return int(sum(w.number for w in self.data.warning))
