@@ -392,11 +392,10 @@ def run_sweep(spec: SweepSpec, *, out_dir: str | os.PathLike | None = None, chun
             if state.get("fingerprint") == fp:
                 for r in read_results(csv_path):
                     done[int(r["run"])] = r
-            elif _other_law(state, spec) and read_results(csv_path):
+            elif (other := _other_law(state, spec)) and read_results(csv_path):
                 # another law's runs are never taken for this one's, nor written over
-                raise ParameterError(f"--out {str(out)!r} holds the runs of another controller "
-                                     f"({_other_law(state, spec)}); they are not resumed: give another --out, or "
-                                     "remove that folder to start afresh")
+                raise ParameterError(f"--out {str(out)!r} holds the runs of another controller ({other}); they "
+                                     "are not resumed: give another --out, or remove that folder to start afresh")
         write_json_atomic(state_path, {"fingerprint": fp, "spec": json.loads(spec_to_json(spec))})
     todo = [i for i in range(spec.n) if i not in done]
     chunks = [todo[i:i + chunk] for i in range(0, len(todo), chunk)]
@@ -608,7 +607,7 @@ class SweepSummary:
 
     def sweep_dict(self, wall_s: float) -> dict[str, Any]:
         """``wmr-mj sweep --json``'s keys (summary.json of a sweep folder); ``wall_s``: the sweep's wall time [s]."""
-        return {
+        out: dict[str, Any] = {
             "n": self.n,
             "verdicts": dict(self.verdicts),
             "worst_certificate_ratio": self.certificate_E_ratio.value,
@@ -636,15 +635,11 @@ class SweepSummary:
             "path_verdicts": None if self.path_verdicts is None else dict(self.path_verdicts),
             **({"requirements": [{**r.to_dict(), "column": requirement_column(i)}
                                  for i, r in enumerate(self.requirements)]} if self.requirements else {}),
-            # the paper's region under names that say so (the unprefixed keys above: deprecated, kept one version)
-            "paper_inside": self.paper_inside,
-            "paper_outside": self.n - self.paper_inside,
-            "worst_paper_E_ratio": self.paper_E_ratio.value,
-            "worst_paper_Edot_ratio": self.paper_Edot_ratio.value,
-            "paper_E_max": self.paper_E_max,
-            "paper_Edot_max": self.paper_Edot_max,
-            "deprecated_keys": dict(SWEEP_KEYS_DEPRECATED),
         }
+        # the paper's region under names that say so (the unprefixed keys above: deprecated, kept one version)
+        out.update({new: out[old] for old, new in SWEEP_KEYS_DEPRECATED.items()})
+        out["deprecated_keys"] = dict(SWEEP_KEYS_DEPRECATED)
+        return out
 
     def rung_dict(self) -> dict[str, Any]:
         """The keys of one rung of ``wmr-mj validate``'s ladder (summary.json's ``ladder``)."""
