@@ -53,9 +53,9 @@ from wmr_mj.sim.closed_loop import (
     PathJudgement,
     RunMeasures,
     judge_path,
+    judge_requirements,
     path_sample_index,
     report,
-    requirement_rows,
     run_closed_loop,
 )
 from wmr_mj.sim.config import (
@@ -526,7 +526,7 @@ def _run_one_by_one(configs: Sequence[RunConfig], *, base: C80Parameters, progre
     does not keep the state after its last step. ``batch.wall_s`` is the wall time of them
     all, ``batch.cpu_s`` the sum of the threads' CPU time.
     """
-    from wmr_mj.analysis.requirements import evaluate_run, parse_requirement
+    from wmr_mj.analysis.requirements import parse_requirement
 
     def period_of(config: RunConfig) -> float:
         return TIMESTEP if config.control_period is None else config.control_period
@@ -542,9 +542,7 @@ def _run_one_by_one(configs: Sequence[RunConfig], *, base: C80Parameters, progre
         summary = result.summary
         if requirements:
             period = period_of(config)
-            with monitor:
-                rows = requirement_rows(result, parsed[period], base=base)
-                judged = evaluate_run(parsed[period], rows, summary.to_dict(), period=period)
+            judged = judge_requirements(result, parsed[period], period=period, base=base, monitor=monitor)
             summary = dataclasses.replace(summary, requirements=tuple(judged))
         return summary, result.law, time.thread_time() - cpu0
 

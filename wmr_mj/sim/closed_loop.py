@@ -100,6 +100,20 @@ def requirement_rows(result: RunResult, requirements: Sequence[Any], *, base: C8
     return {**result.rows, "cross_track": _PathRows(reference, period)(block, 1)["path_cross_track"]}
 
 
+def judge_requirements(result: RunResult, requirements: Sequence[Any], *, period: float, base: C80Parameters = C80,
+                       monitor: Any = None) -> list[Any]:
+    """Each requirement (parsed: :func:`wmr_mj.analysis.requirements.parse_requirement`) judged on the run's
+    rows (:func:`requirement_rows`), the presets against its summary; ``monitor``: a lock held around rtamt's
+    monitor (pure Python, process-wide logging: one run at a time where runs share threads)."""
+    import contextlib
+
+    from wmr_mj.analysis.requirements import evaluate_run
+
+    with monitor if monitor is not None else contextlib.nullcontext():
+        rows = requirement_rows(result, requirements, base=base)
+        return evaluate_run(requirements, rows, result.summary.to_dict(), period=period)
+
+
 @dataclass(frozen=True, kw_only=True)
 class RunMeasures:
     """What a run measured, before it is judged: the inputs of :func:`report` that come from its steps."""

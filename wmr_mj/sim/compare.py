@@ -104,16 +104,15 @@ def run_scenario(config: RunConfig, requirements: Mapping[str, str], *, parsed: 
     ``parsed``: the requirements already parsed (rtamt imports on the calling thread: two threads importing
     it at once deadlock); ``monitor``: a lock around rtamt's monitor (pure Python, process-wide logging).
     """
-    from wmr_mj.analysis.requirements import evaluate_run, parse_requirement
-    from wmr_mj.sim.closed_loop import requirement_rows, run_closed_loop
+    from wmr_mj.analysis.requirements import parse_requirement
+    from wmr_mj.sim.closed_loop import judge_requirements, run_closed_loop
 
     period = TIMESTEP if config.control_period is None else config.control_period
     if parsed is None:
         parsed = [parse_requirement(text, period=period) for text in requirements.values()]
     result = run_closed_loop(config, progress=False)
     summary = result.summary.to_dict()
-    with monitor if monitor is not None else _nolock():
-        judged = evaluate_run(parsed, requirement_rows(result, parsed), summary, period=period)
+    judged = judge_requirements(result, parsed, period=period, monitor=monitor)
     reqs = {}
     for (name, text), r in zip(requirements.items(), judged):
         c = _threshold(text)
@@ -126,14 +125,6 @@ def run_scenario(config: RunConfig, requirements: Mapping[str, str], *, parsed: 
             "rms_voltage": float(np.sqrt(np.mean(u * u))) if u.size else math.nan,
             "tv_voltage": float(np.sum(np.abs(np.diff(u))) / duration) if u.size > 1 else 0.0,
             "cpu_us_per_step": 1e6 * float(result.cpu_s or 0.0) / max(1, len(u)), "law": result.law}
-
-
-class _nolock:
-    def __enter__(self) -> None:
-        return None
-
-    def __exit__(self, *exc: Any) -> None:
-        return None
 
 
 def _slim(summary: Mapping[str, Any]) -> dict[str, Any]:
