@@ -13,6 +13,7 @@ import pytest
 from wmr_mj.analysis.requirements import (
     SIGNALS,
     RequirementResult,
+    _robustness,
     _spec,
     evaluate,
     evaluate_run,
@@ -76,6 +77,24 @@ def test_the_numpy_visitor_equals_rtamt_own_to_the_bit(formula, nan):
         ours = _spec(formula, 1.0, ("x", "y")).evaluate(data)
         stock = _spec(formula, 1.0, ("x", "y"), stock=True).evaluate(data)
         assert np.array_equal(np.asarray(ours, float), np.asarray(stock, float), equal_nan=True), formula
+
+
+@pytest.mark.parametrize("formula", ["always[1,4](abs(x) <= 0.7)", "eventually(x >= 0.5)", "always(x == 0.1)",
+                                     "always((x < 1) and (y > -1))", "eventually[0,3](always(abs(x - y) <= 1.5))",
+                                     "historically[0,2](x < 1)", "not(always[2,9](x <= y))"])
+@pytest.mark.parametrize("nan", [False, True], ids=["finite", "with-nan"])
+def test_the_robustness_at_zero_is_rtamts_evaluate_to_the_bit(formula, nan):
+    """The monitor's robustness (the tree visited on arrays, rtamt's formatting skipped) against rtamt's own
+    ``evaluate`` with its own visitor: its first sample's value, NaN included."""
+    rng = np.random.default_rng(2)
+    for n in (2, 5, 40, 1000):
+        x, y = rng.normal(size=n), rng.normal(size=n)
+        if nan:
+            x[n // 3] = np.nan
+        stock = _spec(formula, 1.0, ("x", "y"), stock=True).evaluate({"time": list(range(n)), "x": x.tolist(),
+                                                                      "y": y.tolist()})[0][1]
+        ours = _robustness(_spec(formula, 1.0, ("x", "y")), formula, {"x": x, "y": y}, 1.0)
+        assert np.array_equal(ours, stock, equal_nan=True), (formula, n, ours, stock)
 
 
 def test_presets_resolve_against_the_run_bounds():

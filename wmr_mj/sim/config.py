@@ -293,7 +293,30 @@ def build_reference(path: str, params: C80Parameters, *, dt: float, duration: fl
 
     settle_s is when the entry transient ends: for the paper's circle, the
     time C enters the circle; 0 for the other paths.
+
+    The last :data:`REFERENCE_CACHE_SIZE` references are kept (a Reference's arrays are read-only):
+    runs that share a path, as a comparison's scenarios on one path or a sweep's chunks do, build it
+    once (it costs about a quarter of a 35 s run's physics). A route file is keyed by its
+    modification time and size as well as its name, so an edited file is read again.
     """
+    file_key = None
+    if path not in PATH_NAMES and not path.lstrip().startswith("{") and os.path.isfile(path):
+        st = os.stat(path)
+        file_key = (os.path.abspath(path), st.st_mtime_ns, st.st_size)
+    return _cached_reference(path, file_key, params, float(dt), float(duration))
+
+
+#: references kept by :func:`build_reference`
+REFERENCE_CACHE_SIZE = 16
+
+
+@functools.lru_cache(maxsize=REFERENCE_CACHE_SIZE)
+def _cached_reference(path: str, file_key: tuple | None, params: C80Parameters, dt: float, duration: float):
+    return _build_reference(path, params, dt=dt, duration=duration)
+
+
+def _build_reference(path: str, params: C80Parameters, *, dt: float, duration: float):
+    """:func:`build_reference` without the cache."""
     from wmr_mj.reference import paths as ref
 
     if path not in PATH_NAMES:
