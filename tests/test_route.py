@@ -212,3 +212,18 @@ def test_a_batch_reports_the_route_progress_as_its_single_runs_do():
         single = run_closed_loop(config, progress=False).summary
         assert batched.route == single.route and not batched.route.finished
         assert batched.to_dict()["route_driven_m"] == single.to_dict()["route_driven_m"]
+
+
+
+def test_a_reference_is_built_once_and_an_edited_route_file_read_again(tmp_path):
+    """build_reference keeps a path's reference (the same object back); a route file edited in place (its
+    first arc now 2.5 m in radius: a new size and mtime) is read again, and C's desired path changes."""
+    f = tmp_path / "s-bend.toml"
+    f.write_text(S_BEND)
+    first, _ = build_reference(str(f), C80, dt=1e-3, duration=10.0)
+    assert build_reference(str(f), C80, dt=1e-3, duration=10.0)[0] is first
+    assert not first.C_xy.flags.writeable  # kept, so read-only
+    f.write_text(S_BEND.replace("radius = 2.0", "radius = 2.5"))
+    edited, _ = build_reference(str(f), C80, dt=1e-3, duration=10.0)
+    assert edited is not first
+    assert float(np.max(np.abs(edited.C_xy - first.C_xy))) > 0.01  # m: the arc from 0.5 m on is wider
