@@ -172,57 +172,69 @@ def _geometry(reference: Any, spacing: float, extend: float):
 
 
 def _project(gs: np.ndarray, gxy: np.ndarray, gk: np.ndarray, X: np.ndarray, s_start: float, window: float):
-    """Continuous projection of the points X (n, 2) on the polyline: (s, signed distance)."""
+    """Continuous projection of the points X (n, 2) on the polyline: (s, signed distance).
+
+    Points go in blocks of ``_BLOCK``; each block searches the chords within ``window`` m of arc length
+    (and the block's travel) around the previous projection. x and y are kept as separate 2-D arrays
+    (block x chords): the same IEEE operations in the same order as a dot product over the last axis of
+    (block, chords, 2) arrays, a third of the time.
+    """
     n = X.shape[0]
     out_s, out_d = np.empty(n), np.empty(n)
-    A = gxy[:-1]
-    D = np.diff(gxy, axis=0)
-    L2 = np.einsum("ij,ij->i", D, D)
+    Ax, Ay = gxy[:-1, 0].copy(), gxy[:-1, 1].copy()
+    Dx, Dy = np.diff(gxy[:, 0]), np.diff(gxy[:, 1])
+    L2 = Dx * Dx + Dy * Dy
     L2 = np.where(L2 > 0.0, L2, 1e-300)
     seg_len = np.diff(gs)
     kmid = 0.5 * (gk[:-1] + gk[1:])
     steps = np.concatenate([[0.0], np.hypot(*np.diff(X, axis=0).T)])
+    Xx, Xy = X[:, 0].copy(), X[:, 1].copy()
+    nseg = len(Ax)
     s_prev = s_start
     b = 0
     while b < n:
-        Xb = X[b:b + _BLOCK]
-        travel = float(np.sum(steps[b + 1:b + Xb.shape[0]]))
+        e = min(n, b + _BLOCK)
+        travel = float(np.sum(steps[b + 1:e]))
         lo = int(np.searchsorted(gs, s_prev - window - travel, side="right")) - 1
         hi = int(np.searchsorted(gs, s_prev + window + travel, side="left"))
-        lo, hi = max(lo, 0), min(max(hi, lo + 1), len(A))
-        Ab, Db, Lb = A[lo:hi], D[lo:hi], L2[lo:hi]
-        rel = Xb[:, None, :] - Ab[None, :, :]
-        u_raw = np.einsum("bmk,mk->bm", rel, Db) / Lb
-        u = np.clip(u_raw, 0.0, 1.0)
-        diff = rel - u[..., None] * Db[None, :, :]
-        dist2 = np.einsum("bmk,bmk->bm", diff, diff)
+        lo, hi = max(lo, 0), min(max(hi, lo + 1), nseg)
+        Dxb, Dyb = Dx[lo:hi], Dy[lo:hi]
+        rx = Xx[b:e, None] - Ax[None, lo:hi]
+        ry = Xy[b:e, None] - Ay[None, lo:hi]
+        with np.errstate(over="ignore"):  # a diverged run's point, far off: handled as `far` below
+            u_raw = (rx * Dxb + ry * Dyb) / L2[lo:hi]
+            u = np.clip(u_raw, 0.0, 1.0)
+            ex, ey = rx - u * Dxb, ry - u * Dyb
+            dist2 = ex * ex + ey * ey
         j = np.argmin(dist2, axis=1)
-        rows = np.arange(Xb.shape[0])
+        nb = e - b
+        rows = np.arange(nb)
         uj = u[rows, j]
         # a minimum on the window's edge is no local minimum: the projection moves on past it;
         # keep the samples before the first such one, restart there with the window moved
-        edge = ((j == 0) & (uj == 0.0) & (lo > 0)) | ((j == hi - lo - 1) & (uj == 1.0) & (hi < len(A)))
-        m = int(np.argmax(edge)) if edge.any() else Xb.shape[0]
-        seg = lo + j[:m]
+        edge = ((j == 0) & (uj == 0.0) & (lo > 0)) | ((j == hi - lo - 1) & (uj == 1.0) & (hi < nseg))
+        m = int(np.argmax(edge)) if edge.any() else nb
+        jm = j[:m]
+        seg = lo + jm
         uj = uj[:m]
         rows = rows[:m]
-        cross = Db[j[:m], 0] * rel[rows, j[:m], 1] - Db[j[:m], 1] * rel[rows, j[:m], 0]
+        cross = Dxb[jm] * ry[rows, jm] - Dyb[jm] * rx[rows, jm]
+        dj = dist2[rows, jm]
         # a point beyond ~1.3e154 m of the path (only a diverged run's) has a squared distance that
         # overflows to inf: its cross-track is +-inf by its side (+inf on the chord's line), and it
         # keeps the clipped chord parameter (no arc correction: kappa * inf would be NaN on a line)
-        far = np.isinf(dist2[rows, j[:m]])
-        d = np.where(far, np.copysign(np.inf, cross),
-                     np.sign(cross) * np.sqrt(np.where(far, 0.0, dist2[rows, j[:m]])))
+        far = np.isinf(dj)
+        d = np.where(far, np.copysign(np.inf, cross), np.sign(cross) * np.sqrt(np.where(far, 0.0, dj)))
         # the polyline is the curve's chords; the curve lies kappa L^2 u (1-u) / 2 to their right
         d += 0.5 * kmid[seg] * seg_len[seg] ** 2 * uj * (1.0 - uj)
         # and a point d to the left of an arc of curvature kappa projects on the chord at a
         # tangential distance scaled by 1 - kappa d from the arc's: undo that about the midpoint
         scale = np.where(far, -1.0, 1.0 - kmid[seg] * np.where(far, 0.0, d))
-        u_arc = 0.5 + (u_raw[rows, j[:m]] - 0.5) / np.where(scale > 0.0, scale, 1.0)
+        u_arc = 0.5 + (u_raw[rows, jm] - 0.5) / np.where(scale > 0.0, scale, 1.0)
         uj = np.where(scale > 0.0, np.clip(u_arc, 0.0, 1.0), uj)
         out_s[b:b + m] = gs[seg] + uj * seg_len[seg]
         out_d[b:b + m] = d
-        s_prev = float(out_s[b + m - 1]) if m == Xb.shape[0] else float(gs[lo] if j[m] == 0 else gs[hi])
+        s_prev = float(out_s[b + m - 1]) if m == nb else float(gs[lo] if j[m] == 0 else gs[hi])
         b += m
     return out_s, out_d
 

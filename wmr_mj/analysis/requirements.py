@@ -35,6 +35,7 @@ import contextlib
 import logging
 import math
 import re
+import threading
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -271,6 +272,26 @@ def _spec(formula: str, period: float, signals: Sequence[str], *, stock: bool = 
     return spec
 
 
+_PARSED = threading.local()  # each thread's parsed specifications: a spec holds its last run's signals
+_PARSED_KEPT = 16
+
+
+def _parsed(formula: str, period: float, signals: Sequence[str]):
+    """:func:`_spec`, parsed once per thread and kept (the last :data:`_PARSED_KEPT`): a run's requirements
+    are the same formulas run after run, and rtamt's ANTLR parser takes 0.7-4 ms a formula, as long as
+    monitoring it over a 35 s run at 1 ms (2-3 ms; measured on the standard suite's four requirements)."""
+    kept = getattr(_PARSED, "specs", None)
+    if kept is None:
+        kept = _PARSED.specs = {}
+    key = (formula, float(period), tuple(signals))
+    spec = kept.get(key)
+    if spec is None:
+        if len(kept) >= _PARSED_KEPT:
+            kept.pop(next(iter(kept)))
+        spec = kept[key] = _spec(formula, period, signals)
+    return spec
+
+
 def _robustness(spec, formula: str, signals: Mapping[str, Any], period: float) -> float:
     from rtamt.exception.exception import RTAMTException
 
@@ -304,7 +325,10 @@ def _robustness_at_zero(spec, columns: Mapping[str, np.ndarray], n: int) -> floa
         spec.set_ast_flag = True
     interpreter.set_variable_to_ast_from_dataset(columns)
     interpreter.ast.offline_results["time"] = None  # read by rtamt's dense-time visitors only
-    return interpreter.visit_array(interpreter.ast.specs[-1], n)[0]  # visitAst visits every spec: the last counts
+    try:
+        return interpreter.visit_array(interpreter.ast.specs[-1], n)[0]  # visitAst visits every spec: the last counts
+    finally:
+        interpreter.ast.offline_results.clear()  # each node's samples: a kept spec does not hold the run's
 
 
 # -- requirements -----------------------------------------------------------------------------
@@ -392,7 +416,7 @@ def evaluate(requirement: Requirement, signals: Mapping[str, Any], *, period: fl
     # zeros stand in where the formula reads none, for the length)
     read = [s for s in requirement.signals if requirement.names(s) or s in formula]
     columns = {s: signals[s] for s in read if s in signals} or {requirement.signals[0]: np.zeros(n)}
-    spec = _spec(formula, period, requirement.signals)
+    spec = _parsed(formula, period, requirement.signals)
     rob = _robustness(spec, formula, columns, period)
     note = "vacuous: every window lies past the run's end" if math.isinf(rob) and rob > 0 else ""
     return RequirementResult(requirement.text, formula, rob, bool(rob >= 0.0), note=note)

@@ -129,7 +129,7 @@ def run_scenario(config: RunConfig, requirements: Mapping[str, str], *, parsed: 
 
 def _slim(summary: Mapping[str, Any]) -> dict[str, Any]:
     """The summary's keys the comparison reads (the full summaries stay in runs.json)."""
-    keys = ("status", "controller", "m1", "path", "sup_E", "sup_Edot", "verdict", "failure", "control_steps",
+    keys = ("status", "controller", "m1", "path", "sup_E", "sup_Edot", "verdict", "failure", "control_steps", "steps",
             "left_steering_range", "saturated_fraction", "wall_s")
     out = {k: summary.get(k) for k in keys}
     cert = summary.get("certificate") or {}
@@ -218,11 +218,17 @@ class CompareResult:
     seed: int
     versions: Mapping[str, str] = field(default_factory=dict)
     wall_s: float = 0.0
+    steps: int = 0  # physics steps simulated: every scenario run's and every adversary run's
+
+    @property
+    def steps_per_s(self) -> float | None:
+        """Physics steps per second of wall time, the whole comparison (runs, judging, the adversary)."""
+        return self.steps / self.wall_s if self.wall_s > 0 else None
 
     def as_dict(self) -> dict[str, Any]:
         return {"suite": self.suite.as_dict(), "versions": dict(self.versions), "budget": self.budget,
                 "seed": self.seed, "scenarios": [s.id for s in self.scenarios],
-                "rows": [r.as_dict() for r in self.rows], "wall_s": self.wall_s}
+                "rows": [r.as_dict() for r in self.rows], "wall_s": self.wall_s, "steps": self.steps}
 
 
 def compare(designs: Sequence[Design], suite: Suite, *, scenarios: Sequence[str] = (), budget: int = 32,
@@ -295,6 +301,7 @@ def compare(designs: Sequence[Design], suite: Suite, *, scenarios: Sequence[str]
                              cpu_us_per_step=r["cpu_us_per_step"], law=r["law"])
                  for (d, s, _), r in zip(jobs, results))
     rows = []
+    steps = sum(int(r.summary.get("steps") or 0) for r in runs)
     for i, d in enumerate(designs):
         mine = [r for r in runs if r.design == d.label]
         adversary = None
@@ -303,10 +310,11 @@ def compare(designs: Sequence[Design], suite: Suite, *, scenarios: Sequence[str]
 
             adversary = falsify(specs[i], nthread=nthread, scheduler=scheduler,
                                 progress=lambda k, n: None)
+            steps += sum(int(e.summary.get("steps") or 0) for e in [*adversary.search, *adversary.random])
             tick(2 * budget)
         rows.append(_row(d, mine, adversary, specs[i] if specs else None))
     return CompareResult(suite=suite, scenarios=chosen, rows=tuple(rows), runs=runs, budget=budget, seed=seed,
-                         versions=versions(), wall_s=time.perf_counter() - wall0)
+                         versions=versions(), wall_s=time.perf_counter() - wall0, steps=steps)
 
 
 def _row(design: Design, runs: Sequence[ScenarioRun], adversary: Any, spec: Any) -> DesignRow:
