@@ -77,6 +77,8 @@ def test_compare_gives_the_single_runs_numbers_to_the_bit(tmp_path):
         assert r.summary["cross_track_max"] == s["path_error"]["cross_track_max"]
         u = single.rows["voltage"]
         assert r.rms_voltage == float((u * u).mean() ** 0.5)
+    # the physics steps it counts (its steps per second's numerator): 4 runs of 35 s at the 1 ms step
+    assert result.steps == 4 * 35_000 and result.steps_per_s == result.steps / result.wall_s
     rows = {row.label: row for row in result.rows}
     assert rows["certified"].controller == "computed-torque" and rows["certified"].requirements_total == 8
     assert rows[designs[1].label].controller == "my-pid" and rows[designs[1].label].no_claim == 2
