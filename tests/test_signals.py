@@ -97,6 +97,24 @@ def test_load_change_matches_a_run_started_at_that_mass_before_it():
     assert not np.array_equal(changed.rows["E"][k:], plain.rows["E"][k:])
 
 
+@pytest.mark.parametrize("t_load", [1.0, 1.5], ids=["at-a-block-edge", "mid-block"])
+def test_C_moves_continuously_through_a_load_change(t_load):
+    """C's recorded xy (the path errors' input) through a payload step, at a block's edge and inside one:
+    before the change it is the plain run's to the bit; throughout, C moves no faster than it can: A at
+    V_A, C at V_A / cos(alpha) <= V_A / cos(steering range) [m/s], doubled for the drive servo's transients
+    (a block's records lost in the change once left C a second behind, a 0.3 m jump)."""
+    from wmr_mj.params import C80
+
+    changed = run_closed_loop(_config(path="paper-circle", duration=9.0,
+                                      signals={"loads": [{"kind": "step", "t": t_load, "m1": 560.0}]}))
+    plain = run_closed_loop(_config(path="paper-circle", duration=9.0))
+    k = int(round(t_load / 1e-3))
+    assert np.array_equal(changed.C_xy[:k], plain.C_xy[:k])
+    step = np.hypot(*np.diff(changed.C_xy, axis=0).T)  # [m] per 1 ms control step
+    assert step.max() <= 2.0 * C80.V_A / np.cos(C80.steering_range) * 1e-3
+    assert np.abs(changed.C_xy[k:] - plain.C_xy[k:]).max() < 0.05  # [m] 560 kg against 650 kg: C stays near
+
+
 def test_constant_disturbance_shifts_the_steady_error_by_the_closed_form():
     """On MuJoCo: +1 N m shifts the certified design's late error by about -d_V/(P^ K_P) (stiction aside)."""
     from wmr_mj import C80

@@ -486,11 +486,9 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
             part = _Block(s1 - s0, plain, log)
             st.step(part, s0, s1 - s0)
             sl = slice(s0 - k0, s1 - k0)
-            for name in ("alpha", "alpha_dot", "voltage_cmd", "voltage", "force", "torque", "heading"):
-                getattr(b, name)[sl] = getattr(part, name)
-            if log:
-                for name in ("qpos", "qvel", "ctrl", "sites"):
-                    getattr(b, name)[sl] = getattr(part, name)
+            for name, value in vars(part).items():  # every record the part has rows of (C_xy included)
+                if len(value):
+                    getattr(b, name)[sl] = value
 
     k0 = cnt = 0
     wall0, cpu0 = time.perf_counter(), time.thread_time()
