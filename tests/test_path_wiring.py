@@ -79,3 +79,25 @@ def test_runs_csv_columns_and_sweep_summary():
     # rows without the path columns (a runs.csv written before): no path figures
     old = {k: v for k, v in row.items() if not k.startswith("path_")}
     assert SweepSummary.of([old]).path_verdicts is None
+
+
+def test_requirements_cross_track_interpolates_the_path_verdicts_samples():
+    """cross_track as requirements read it: at the path verdict's samples (every PATH_SAMPLE_S) their
+    projection to the bit, linear in between; against projecting C at every control step (the result's
+    samples dropped: the fallback) it is within the linear interpolation's error bound h^2/8 max|d''|
+    (h = 5 ms; d'' from the per-step series' second differences), doubled for that estimate."""
+    import dataclasses
+
+    from wmr_mj.analysis.requirements import parse_requirement
+    from wmr_mj.sim.closed_loop import requirement_rows
+
+    result = run_closed_loop(RunConfig(**CERTIFIED.config_changes(), duration=12.0, path="lane-change"),
+                             progress=False)
+    reqs = [parse_requirement("always(abs(cross_track) <= 0.1)", period=1e-3)]
+    at, judged = result.path_samples
+    interpolated = requirement_rows(result, reqs)["cross_track"]
+    assert np.array_equal(interpolated[at], judged)
+    per_step = requirement_rows(dataclasses.replace(result, path_samples=None), reqs)["cross_track"]
+    h = PATH_SAMPLE_S
+    d2 = np.abs(np.diff(per_step, 2)).max() / 1e-3 ** 2  # [m/s^2]
+    assert 0.0 < np.abs(interpolated - per_step).max() <= 2.0 * h * h / 8.0 * d2
