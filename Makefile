@@ -46,6 +46,7 @@ bench: $(STAMP)
 	$(PY) bench/bench_run.py
 	$(PY) bench/bench_logging.py --end-to-end
 	$(PY) bench/bench_sweep.py
+	$(PY) bench/bench_compare.py
 	$(PY) bench/bench_plugins.py
 	$(PY) bench/bench_video.py
 
