@@ -17,8 +17,10 @@ Side by side in one process, interleaved repeat by repeat (medians over ``--repe
            the search, so they are counted, not replayed).
 
 Printed: steps per second of each and their ratio, compare / rollout (target >= 0.85), and the
-paired ratio (the median of the repeat-by-repeat ratios). The machine may be shared: compare ratios,
-not absolute figures.
+paired ratio (the median of the repeat-by-repeat ratios); then (unless ``--no-cpu``) the same ratio in
+CPU seconds with one thread each side (``compare(nthread=1)`` timed by the process's CPU clock, rollout
+by the thread's), which other processes on the machine do not blur as they blur wall time. The
+machine may be shared: compare ratios, not absolute figures.
 """
 
 from __future__ import annotations
@@ -48,6 +50,7 @@ def main() -> None:
     ap.add_argument("--budgets", default="0,16", help="the adversary's budgets, comma-separated (0: none)")
     ap.add_argument("--nthread", type=int, default=2)
     ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--no-cpu", action="store_true", help="skip the one-thread CPU-time ratios")
     args = ap.parse_args()
     budgets = [int(b) for b in args.budgets.split(",") if b.strip()]
 
@@ -55,11 +58,16 @@ def main() -> None:
     designs = [design_from_token(t.strip(), suite) for t in args.designs.split(",") if t.strip()]
     chosen = suite.select([args.scenarios])
     configs = [s.config(d.config) for d in designs for s in chosen]
-    open_loop = OpenLoop(configs, applied_voltages(configs), args.nthread)
+    voltages = applied_voltages(configs)
+    open_loop = OpenLoop(configs, voltages, args.nthread)
+    one_thread = OpenLoop(configs, voltages, 0)  # 0: rollout on the calling thread
 
     rollout_rates: list[float] = []
     compare_rates: dict[int, list[float]] = {b: [] for b in budgets}
-    with rollout.Rollout(nthread=args.nthread) as pool, tempfile.TemporaryDirectory() as tmp:
+    cpu_rollout: list[float] = []
+    cpu_compare: dict[int, list[float]] = {b: [] for b in budgets}
+    with (rollout.Rollout(nthread=args.nthread) as pool, rollout.Rollout(nthread=0) as caller,
+          tempfile.TemporaryDirectory() as tmp):
         for rep in range(args.repeats):
             rollout_rates.append(open_loop.steps_per_s(pool))
             for budget in budgets:
@@ -69,6 +77,13 @@ def main() -> None:
                 write_report(result, Path(tmp) / f"compare-{budget}-{rep}")
                 wall = time.perf_counter() - t
                 compare_rates[budget].append(result.steps / wall)
+            if not args.no_cpu:  # CPU seconds, one thread each side
+                cpu_rollout.append(one_thread.steps_per_s(caller, clock=time.thread_time))
+                for budget in budgets:
+                    c = time.process_time()
+                    result = compare(designs, suite, scenarios=[args.scenarios], budget=budget, seed=0, nthread=1)
+                    write_report(result, Path(tmp) / f"compare-cpu-{budget}-{rep}")
+                    cpu_compare[budget].append(result.steps / (time.process_time() - c))
 
     ro = statistics.median(rollout_rates)
     print(f"compare of {len(designs)} designs ({args.designs}) x {len(chosen)} scenarios of {suite.name} "
@@ -81,6 +96,12 @@ def main() -> None:
         runs = len(configs) + 2 * budget * len(designs)
         print(f"whole compare, adversary budget {budget} ({runs} runs): {cl:.0f} steps/s, ratio {cl / ro:.3f}, "
               f"paired {paired:.3f} (target >= 0.85)")
+    if cpu_rollout:
+        rc = statistics.median(cpu_rollout)
+        print(f"CPU seconds, one thread each side: rollout {rc:.0f} steps per CPU second")
+        for budget in budgets:
+            cc = statistics.median(cpu_compare[budget])
+            print(f"whole compare, adversary budget {budget}: {cc:.0f} steps per CPU second, ratio {cc / rc:.3f}")
 
 
 if __name__ == "__main__":
