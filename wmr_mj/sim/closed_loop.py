@@ -431,13 +431,13 @@ def run_parts(parts: RunParts, *, logger_factory: Callable[..., Any] | None = No
                            sup_E_settled=_sup(done["E"][after]), sup_Edot_settled=_sup(done["E_dot"][after]),
                            saturated_fraction=saturated / k, left_range_at=left_range_at,
                            final_alpha=done["alpha"][-1], control_steps=k, steps=k * substeps, wall_s=wall)
+    path = judge_path(reference, done["t"][at], run.C_xy[at], done["heading"][at], settle_s=settle_s,
+                      certificate=certificate, steering_range=params.steering_range, corrected=outer is not None)
     summary = report(config, measured, analysis=analysis, params=params,
                      certificate=None if run.failure is not None else certificate, claims_nothing=certificate is None,
                      name=parts.controller_name,
                      drift=_drift_of(done["E"], done["alpha0_dot"][-1] - done["E_dot"][-1], period),
-                     path=(path := judge_path(reference, done["t"][at], run.C_xy[at], done["heading"][at],
-                                              settle_s=settle_s, certificate=certificate,
-                                              steering_range=params.steering_range, corrected=outer is not None)))
+                     path=path)
     if outer is not None:
         summary = dataclasses.replace(summary, correction=outer.describe(done))
     summary = dataclasses.replace(summary, mujoco_warnings=run.warnings, failure=run.failure,
