@@ -2,7 +2,8 @@
 
     .venv/bin/python bench/bench_falsify.py [--spaces box,paths,signals] [--seeds 10] [--budgets 100,300]
                                             [--duration 20] [--method portfolio] [--path-knots 4]
-                                            [--threshold RAD] [--nthread 2]
+                                            [--threshold RAD] [--nthread 2] [--first-seed 0]
+                                            [--cache logs/falsify-cache.json]
 
 The certified design, objective sup|E|/E_max of its certificate (``wmr-mj falsify``'s default),
 over each of three search spaces (``--spaces``, comma-separated; default all three):
@@ -31,12 +32,20 @@ monitor (printed). A summary table of every space and budget closes the output.
 
 Runs are deterministic (bit-identical for the same plant), so the bench keeps one result per
 plant point and reuses it across seeds and budgets (the vertices are the same for every seed);
-each method is still charged every run it asks for.
+each method is still charged every run it asks for. ``--cache PATH`` keeps those results on disk
+(a JSON file, one entry per search space: the base run's configuration, the ranged names and
+their bounds, the objective and the MuJoCo version, hashed), so that a later bench over the same
+space reuses every run it has already simulated; the printed figures are the same with or
+without it. ``--first-seed N`` (default 0) runs seeds N .. N + seeds - 1, so that a search can be
+tuned on seeds the bench's figures do not use.
 """
 
 from __future__ import annotations
 
 import argparse
+import hashlib
+import json
+import os
 import statistics
 import sys
 import time
@@ -55,13 +64,32 @@ THRESHOLDS = {"box": 0.05, "paths": 0.038, "signals": 0.05}  # rad: always(abs(E
 from wmr_mj.sim.sweep import run_configs  # noqa: E402
 
 
-class CachedEvaluator:
-    """evaluate(points) -> objective, running only the points not run before (one batch)."""
+def cache_key(spec: FalsifySpec) -> str:
+    """What a run's result depends on besides its point: the base run (duration, path, reference
+    bounds, design, ...), the ranged names and bounds, the objective and the simulator's version."""
+    import mujoco
 
-    def __init__(self, spec: FalsifySpec, nthread: int):
-        self.spec, self.nthread = spec, nthread
+    what = {"base": repr(spec.base), "names": list(spec.names), "bounds": spec.bounds.tolist(),
+            "objective": spec.objective, "requirement": spec.requirement, "mujoco": mujoco.__version__}
+    return hashlib.sha256(json.dumps(what, sort_keys=True).encode()).hexdigest()[:16]
+
+
+class CachedEvaluator:
+    """evaluate(points) -> objective, running only the points not run before (one batch); with
+    ``path``, the results of earlier benches over the same space (:func:`cache_key`) are read from
+    and written back to that JSON file."""
+
+    def __init__(self, spec: FalsifySpec, nthread: int, path: str | None = None):
+        self.spec, self.nthread, self.path = spec, nthread, path
+        self.key = cache_key(spec)
         self.cache: dict[tuple[float, ...], tuple[float, float]] = {}  # point -> (objective, sup|E|)
         self.simulated = 0
+        self._saved = 0
+        if path is not None and Path(path).exists():
+            entry = json.loads(Path(path).read_text()).get(self.key, {})
+            for point, (v, sup) in zip(entry.get("points", []), entry.get("values", [])):
+                self.cache[tuple(float(x) for x in point)] = (float(v), float(sup))
+        self.loaded = len(self.cache)
 
     def __call__(self, points: np.ndarray) -> np.ndarray:
         new = list(dict.fromkeys(tuple(p.tolist()) for p in points if tuple(p.tolist()) not in self.cache))
@@ -75,6 +103,22 @@ class CachedEvaluator:
 
     def sup_E(self, points: np.ndarray) -> np.ndarray:
         return np.array([self.cache[tuple(p.tolist())][1] for p in points])
+
+    def save(self) -> None:
+        """Write the results to ``path`` (nothing without one, or when nothing was simulated since);
+        other spaces' entries in the file are kept. Floats go through JSON exactly (repr)."""
+        if self.path is None or self.simulated == self._saved:
+            return
+        path = Path(self.path)
+        data = json.loads(path.read_text()) if path.exists() else {}
+        points = list(self.cache)
+        data[self.key] = {"space": list(self.spec.names), "duration": self.spec.base.duration,
+                          "points": [list(p) for p in points], "values": [list(self.cache[p]) for p in points]}
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(path.name + ".tmp")
+        tmp.write_text(json.dumps(data))
+        os.replace(tmp, path)
+        self._saved = self.simulated
 
 
 def first_at_least(values: np.ndarray, level: float) -> int | None:
@@ -120,7 +164,7 @@ def bench_space(space: str, args: argparse.Namespace, budgets: list[int]) -> lis
     threshold = THRESHOLDS[space] if args.threshold is None else args.threshold
     spec = make_spec(space, args.duration, max(budgets), args.method, args.path_knots)
     bounds = spec.bounds
-    evaluate = CachedEvaluator(spec, args.nthread)
+    evaluate = CachedEvaluator(spec, args.nthread, args.cache)
     t0 = time.perf_counter()
     unit = covering_design(len(bounds), 2 ** len(bounds))
     corners = np.where(unit >= 1.0, bounds[:, 1], bounds[:, 0] + unit * (bounds[:, 1] - bounds[:, 0]))  # as searched
@@ -138,7 +182,7 @@ def bench_space(space: str, args: argparse.Namespace, budgets: list[int]) -> lis
     summary = []
     for budget in budgets:
         rows = []
-        for seed in range(args.seeds):
+        for seed in range(args.first_seed, args.first_seed + args.seeds):
             search = search_worst(evaluate, bounds, budget=budget, seed=seed, method=args.method)
             random = random_worst(evaluate, bounds, n=len(search.values), seed=seed)
             s_sup, r_sup = evaluate.sup_E(search.points), evaluate.sup_E(random.points)
@@ -148,6 +192,7 @@ def bench_space(space: str, args: argparse.Namespace, budgets: list[int]) -> lis
                 "to_corner": first_at_least(search.values, 0.99 * corner_worst),
                 "s_fals": first_at_least(s_sup, level), "r_fals": first_at_least(r_sup, level),
             })
+            evaluate.save()
         wins = sum(r["search"] >= r["random"] for r in rows)
         print(f"\n{space}, budget {budget}:")
         print(f"{'seed':>4}  {'runs':>4}  {'search worst':>12}  {'random worst':>12}  {'winner':>6}  "
@@ -187,7 +232,9 @@ def bench_space(space: str, args: argparse.Namespace, budgets: list[int]) -> lis
     batch_rob = threshold - float(evaluate.sup_E(corner_at[None])[0])
     print(f"check: at the worst vertex rtamt's robustness {judged.robustness:.9g}, threshold - sup|E| of the batch "
           f"{batch_rob:.9g} ({'equal' if judged.robustness == batch_rob else 'DIFFERENT'})")
-    print(f"{evaluate.simulated} distinct runs simulated in {time.perf_counter() - t0:.0f} s")
+    evaluate.save()
+    print(f"{evaluate.simulated} distinct runs simulated in {time.perf_counter() - t0:.0f} s"
+          + (f" ({evaluate.loaded} read from the cache {args.cache})" if args.cache is not None else ""))
     return summary
 
 
@@ -204,6 +251,11 @@ def main() -> int:
     ap.add_argument("--spaces", "--space", dest="spaces", default="box,paths,signals",
                     help="comma-separated spaces to search: box, paths, signals (default all three)")
     ap.add_argument("--path-knots", type=int, default=4, help="curvature knots of the paths space (default 4)")
+    ap.add_argument("--first-seed", type=int, default=0, help="the first seed (default 0): seeds FIRST .. FIRST + "
+                    "SEEDS - 1")
+    ap.add_argument("--cache", default=None, metavar="PATH",
+                    help="a JSON file of earlier runs (point -> objective, sup|E|) per search space, read and "
+                         "updated: the runs are deterministic, so a repeated bench reuses them (default: none)")
     args = ap.parse_args()
     budgets = [int(b) for b in args.budgets.split(",")]
     spaces = [s.strip() for s in args.spaces.split(",") if s.strip()]
@@ -211,7 +263,8 @@ def main() -> int:
     if bad or not spaces or any(b < 1 for b in budgets) or args.seeds < 1:
         ap.error(f"--spaces takes box, paths, signals (got {args.spaces!r}); budgets and seeds >= 1")
     summary = [row for space in spaces for row in bench_space(space, args, budgets)]
-    print(f"\nsummary ({args.method} against random, {args.seeds} seeds, {args.duration:g} s runs):")
+    seeds = f"seeds {args.first_seed}-{args.first_seed + args.seeds - 1}" if args.first_seed else f"{args.seeds} seeds"
+    print(f"\nsummary ({args.method} against random, {seeds}, {args.duration:g} s runs):")
     print("| space | budget | median worst: search / random | best: search / random | search >= random | "
           "within 1% of the vertex worst: search (median runs) / random | falsified: search / random "
           "| median runs to falsify: search / random |")
