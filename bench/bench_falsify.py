@@ -26,8 +26,9 @@ side by side, the median worst, the best over the seeds, the seeds where the sea
 corners), and, for the requirement always(abs(E) <= THRESHOLD) over the whole run, the
 falsification rate and the median number of runs to the first falsifying run (in evaluation
 order). THRESHOLD defaults per space to a level the space can exceed (box 0.05 rad, paths 0.038,
-signals 0.05). Its robustness is ``threshold - sup|E|``, which the bench reads off the batch (the
-batch keeps sup|E|, not the signals); a serial run of the worst vertex checks it against rtamt's
+signals 0.045: its 16 vertices reach 0.0431 rad, the worst found 0.0519). Its robustness is
+``threshold - sup|E|``, which the bench reads off the batch (the batch keeps sup|E|, not the
+signals); a serial run of the worst vertex checks it against rtamt's
 monitor (printed). A summary table of every space and budget closes the output.
 
 Runs are deterministic (bit-identical for the same plant), so the bench keeps one result per
@@ -60,7 +61,7 @@ from wmr_mj.sim.config import RunConfig  # noqa: E402
 from wmr_mj.sim.designs import CERTIFIED  # noqa: E402
 from wmr_mj.sim.falsify import METHODS, FalsifySpec, covering_design, objective_value, random_worst, search_worst  # noqa: E402
 
-THRESHOLDS = {"box": 0.05, "paths": 0.038, "signals": 0.05}  # rad: always(abs(E) <= T), one each space can fail
+THRESHOLDS = {"box": 0.05, "paths": 0.038, "signals": 0.045}  # rad: always(abs(E) <= T), one each space can fail
 from wmr_mj.sim.sweep import run_configs  # noqa: E402
 
 
