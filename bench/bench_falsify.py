@@ -28,8 +28,8 @@ falsification rate and the median number of runs to the first falsifying run (in
 order). THRESHOLD defaults per space to a level the space can exceed (box 0.05 rad, paths 0.038,
 signals 0.045: its 16 vertices reach 0.0431 rad, the worst found 0.0519). Its robustness is
 ``threshold - sup|E|``, which the bench reads off the batch (the batch keeps sup|E|, not the
-signals); a serial run of the worst vertex checks it against rtamt's
-monitor (printed). A summary table of every space and budget closes the output.
+signals); a serial run of the worst vertex checks it against rtamt's monitor (printed). A
+summary table of every space and budget closes the output.
 
 Runs are deterministic (bit-identical for the same plant), so the bench keeps one result per
 plant point and reuses it across seeds and budgets (the vertices are the same for every seed);
@@ -46,7 +46,6 @@ from __future__ import annotations
 import argparse
 import hashlib
 import json
-import os
 import statistics
 import sys
 import time
@@ -56,13 +55,14 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 import numpy as np  # noqa: E402
 
+from wmr_mj._util.files import write_text_atomic  # noqa: E402
 from wmr_mj.params import M1_RANGE, uncertainty_ranges  # noqa: E402
 from wmr_mj.sim.config import RunConfig  # noqa: E402
 from wmr_mj.sim.designs import CERTIFIED  # noqa: E402
 from wmr_mj.sim.falsify import METHODS, FalsifySpec, covering_design, objective_value, random_worst, search_worst  # noqa: E402
+from wmr_mj.sim.sweep import run_configs  # noqa: E402
 
 THRESHOLDS = {"box": 0.05, "paths": 0.038, "signals": 0.045}  # rad: always(abs(E) <= T), one each space can fail
-from wmr_mj.sim.sweep import run_configs  # noqa: E402
 
 
 def cache_key(spec: FalsifySpec) -> str:
@@ -115,10 +115,7 @@ class CachedEvaluator:
         points = list(self.cache)
         data[self.key] = {"space": list(self.spec.names), "duration": self.spec.base.duration,
                           "points": [list(p) for p in points], "values": [list(self.cache[p]) for p in points]}
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(path.name + ".tmp")
-        tmp.write_text(json.dumps(data))
-        os.replace(tmp, path)
+        write_text_atomic(path, json.dumps(data))
         self._saved = self.simulated
 
 
