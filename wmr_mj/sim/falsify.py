@@ -508,18 +508,15 @@ def _search_cma(evaluate: Callable[[np.ndarray], np.ndarray], bounds: np.ndarray
     lo, span = bounds[:, 0], bounds[:, 1] - bounds[:, 0]
     rec = _Recorder(evaluate)
     n = max(d, 2)
-    unit_points: list[np.ndarray] = []
-    unit_values: list[np.ndarray] = []
+    unit_points: list[np.ndarray] = []  # what CMA-ES asked, in the unit box (the recorder keeps the box's)
 
     def run(unit: np.ndarray) -> np.ndarray:  # a coordinate at 1 is the upper bound itself, not lo + span
-        v = rec(np.where(unit[:, :d] >= 1.0, bounds[:, 1], lo + unit[:, :d] * span))
         unit_points.append(unit)
-        unit_values.append(v)
-        return v
+        return rec(np.where(unit[:, :d] >= 1.0, bounds[:, 1], lo + unit[:, :d] * span))
 
     def incumbent() -> np.ndarray:
         """The worst point found so far, in the unit box (the first of equals; NaN ranks last)."""
-        v = np.concatenate(unit_values)
+        v = rec.trace().values
         return np.concatenate(unit_points)[int(np.argmax(np.where(np.isnan(v), -np.inf, v)))]
 
     if vertices:
