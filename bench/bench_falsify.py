@@ -260,6 +260,14 @@ def main() -> int:
     bad = [s for s in spaces if s not in THRESHOLDS]
     if bad or not spaces or any(b < 1 for b in budgets) or args.seeds < 1:
         ap.error(f"--spaces takes box, paths, signals (got {args.spaces!r}); budgets and seeds >= 1")
+    if args.cache is not None and Path(args.cache).exists():
+        try:
+            readable = isinstance(json.loads(Path(args.cache).read_text()), dict)
+        except (OSError, ValueError):
+            readable = False
+        if not readable:
+            ap.error(f"--cache {args.cache!r} is not a cache this bench wrote (a JSON object of runs per space); "
+                     "give another path or remove the file")
     summary = [row for space in spaces for row in bench_space(space, args, budgets)]
     seeds = f"seeds {args.first_seed}-{args.first_seed + args.seeds - 1}" if args.first_seed else f"{args.seeds} seeds"
     print(f"\nsummary ({args.method} against random, {seeds}, {args.duration:g} s runs):")

@@ -265,3 +265,16 @@ def test_lhs_polish_finds_an_interior_peak_that_the_vertices_miss():
                                                          method="lhs-polish").points)
     vertices = search_worst(bump, bounds, budget=48, seed=0, method="vertices-polish")
     assert np.max(vertices.values[:32]) < 0.2  # the 32 vertices: the tails only
+
+
+def test_bench_falsify_refuses_a_corrupt_cache_in_one_line(tmp_path):
+    """bench/bench_falsify.py --cache FILE: a file that is not the bench's JSON is named, exit 2, before any run."""
+    from pathlib import Path
+
+    bad = tmp_path / "cache.json"
+    bad.write_text("{broken")
+    bench = Path(__file__).resolve().parent.parent / "bench" / "bench_falsify.py"
+    out = subprocess.run([sys.executable, str(bench), "--spaces", "box", "--budgets", "64", "--seeds", "1",
+                          "--cache", str(bad)], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 2 and "Traceback" not in out.stderr
+    assert f"--cache '{bad}' is not a cache this bench wrote" in out.stderr.splitlines()[-1]
