@@ -7,8 +7,8 @@ STAMP := $(VENV)/.installed
 
 .PHONY: demo test test-fast lint venv bench clean foxglove-reader docs
 
-# the editable install builds the compiled law (wmr_mj/sim/_compiled_law.c) in place: rebuild when it changes
-$(STAMP): pyproject.toml setup.py wmr_mj/sim/_compiled_law.c
+# the editable install builds the compiled law and the projection's loop (the .c files) in place: rebuild when they change
+$(STAMP): pyproject.toml setup.py wmr_mj/sim/_compiled_law.c wmr_mj/analysis/_nearest_chord.c
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
 	$(PY) -m pip install -q -e '.[test,dask,video,docs,fast]'

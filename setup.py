@@ -1,5 +1,6 @@
-"""Build hooks: ship the repository's models/ inside the wheel as ``wmr_mj/models/``, and
-build the steering law as MuJoCo's control callback (``wmr_mj.sim._compiled_law``).
+"""Build hooks: ship the repository's models/ inside the wheel as ``wmr_mj/models/``, build the
+steering law as MuJoCo's control callback (``wmr_mj.sim._compiled_law``) and the inner loop of C's
+projection on its path (``wmr_mj.analysis._nearest_chord``).
 
 All project metadata lives in pyproject.toml. An installed wheel has no
 repository beside it, so ``wmr_mj._util.resources.MODELS_DIR`` falls back to this copy
@@ -8,7 +9,8 @@ repository beside it, so ``wmr_mj._util.resources.MODELS_DIR`` falls back to thi
 The compiled law reads mjModel and mjData, so it is built against the headers of the
 mujoco wheel of the build (pyproject's build requirements) and checks at import that it
 runs with the same MuJoCo. It is optional: without a C compiler the install goes on and
-the batch uses the NumPy law (``wmr_mj.sim.compiled_law.unavailable_reason`` says so).
+the batch uses the NumPy law (``wmr_mj.sim.compiled_law.unavailable_reason`` says so). So is the
+projection's: without it ``wmr_mj.analysis.path_error`` computes the same bits in NumPy.
 """
 
 from pathlib import Path
@@ -48,4 +50,11 @@ def compiled_law_extensions() -> list[Extension]:
                       optional=True)]
 
 
-setup(cmdclass={"build_py": BuildPyWithModels}, ext_modules=compiled_law_extensions())
+def projection_extensions() -> list[Extension]:
+    """wmr_mj.analysis._nearest_chord: plain C, no MuJoCo headers."""
+    # -ffp-contract=off: no fused multiply-adds, so that the loop rounds as NumPy's element-wise operations do
+    return [Extension("wmr_mj.analysis._nearest_chord", sources=["wmr_mj/analysis/_nearest_chord.c"],
+                      extra_compile_args=["-O2", "-ffp-contract=off", "-fno-fast-math"], optional=True)]
+
+
+setup(cmdclass={"build_py": BuildPyWithModels}, ext_modules=compiled_law_extensions() + projection_extensions())

@@ -2,6 +2,7 @@
 
     .venv/bin/python bench/bench_sweep.py [--sizes 16,32,64,128,256] [--seconds 10] [--nthread 2]
                                           [--repeats 3] [--sweep-n 32] [--sweep-seconds 35] [--no-cpu]
+                                          [--projections C,NumPy]
 
 For each batch size, side by side in one process and interleaved repeat by repeat, prints the
 physics steps per second (medians over repeats) of
@@ -23,8 +24,9 @@ thread's share (nsim/nthread runs on one thread each side), which other processe
 machine do not blur as they blur wall time. Then the whole sweep as ``wmr-mj sweep --n 32``
 runs it (``run_sweep`` with its output folder: drawing, compilation, reference, statistics and
 the CSV included; the command's imports and plot excluded) against rollout of the same models
-(target >= 0.85), with either law. The machine may be shared: compare ratios, not absolute
-figures.
+(target >= 0.85), with either law and, with ``--projections C,NumPy``, with C's projection on its
+path in C (``wmr_mj/analysis/_nearest_chord.c``, the default where it is built) and in NumPy side by
+side. The machine may be shared: compare ratios, not absolute figures.
 """
 
 from __future__ import annotations
@@ -106,9 +108,15 @@ def main() -> None:
     ap.add_argument("--sweep-n", type=int, default=32, help="runs of the whole-sweep comparison (0: skip it)")
     ap.add_argument("--sweep-seconds", type=float, default=35.0, help="simulated time per run of the whole sweep")
     ap.add_argument("--no-cpu", action="store_true", help="skip the one-thread CPU-time ratios")
+    ap.add_argument("--projections", default="C", help="how the whole sweep projects C on its path, comma-separated: "
+                    "C (the compiled loop, where built), NumPy (WMR_MJ_COMPILED_PROJECTION=0); both: side by side")
     args = ap.parse_args()
     sizes = [int(x) for x in args.sizes.split(",") if x.strip()]
     laws = [x.strip() for x in args.laws.split(",") if x.strip()]
+    projections = [x.strip() for x in args.projections.split(",") if x.strip()]
+    if not projections or set(projections) - {"C", "NumPy"}:
+        ap.error(f"--projections takes C, NumPy or both (got {args.projections!r})")
+    from wmr_mj.analysis import path_error
 
     cases = {}
     for nsim in sizes:
@@ -123,7 +131,7 @@ def main() -> None:
     cpu = {law: {n: [] for n in sizes} for law in laws}
     same: dict[tuple[str, int], bool] = {}
     sweep_open: list[float] = []
-    sweep_closed: dict[str, list[float]] = {law: [] for law in laws}
+    sweep_closed: dict[tuple[str, str], list[float]] = {(law, p): [] for law in laws for p in projections}
     spec = (SweepSpec(n=args.sweep_n, seed=0, base=RunConfig(model=args.model, duration=args.sweep_seconds))
             if args.sweep_n else None)
     with (rollout.Rollout(nthread=args.nthread) as pool, rollout.Rollout(nthread=0) as caller,
@@ -150,14 +158,23 @@ def main() -> None:
             if sweep_ol is not None:
                 sweep_open.append(sweep_ol.steps_per_s(pool))
                 for law in laws:
-                    # run_sweep takes the compiled law where it can run: the switch turns it off
-                    os.environ["WMR_MJ_COMPILED_LAW"] = "0" if law == "numpy" else "1"
-                    t = time.perf_counter()
-                    results = run_sweep(spec, out_dir=Path(tmp) / f"sweep-{law}-{rep}", chunk=128,
-                                        nthread=args.nthread)
-                    sweep_closed[law].append(sum(r["steps"] for r in results) / (time.perf_counter() - t))
-                    assert {r["batch_law"] for r in results} == {law}, "the sweep ran another law"
+                    for projection in projections:
+                        # run_sweep takes the compiled law and projection where they can run: switches turn them off
+                        os.environ["WMR_MJ_COMPILED_LAW"] = "0" if law == "numpy" else "1"
+                        os.environ["WMR_MJ_COMPILED_PROJECTION"] = "0" if projection == "NumPy" else "1"
+                        path_error._compiled_block.cache_clear()
+                        if path_error.projection_backend() != projection:
+                            sys.exit(f"the {projection} projection cannot run here: wmr_mj.analysis._nearest_chord "
+                                     "is not built")
+                        t = time.perf_counter()
+                        results = run_sweep(spec, out_dir=Path(tmp) / f"sweep-{law}-{projection}-{rep}", chunk=128,
+                                            nthread=args.nthread)
+                        sweep_closed[law, projection].append(sum(r["steps"] for r in results)
+                                                             / (time.perf_counter() - t))
+                        assert {r["batch_law"] for r in results} == {law}, "the sweep ran another law"
                 os.environ.pop("WMR_MJ_COMPILED_LAW")
+                os.environ.pop("WMR_MJ_COMPILED_PROJECTION")
+                path_error._compiled_block.cache_clear()
 
     print(f"{args.model} model, m1 550-750 kg, {args.seconds:g} s per run, {args.nthread} threads, "
           f"{args.repeats} repeats (medians; ratio = median closed / median rollout, "
@@ -179,12 +196,12 @@ def main() -> None:
           "same physics: the open loop ends where the closed loop did, to the bit")
     if sweep_open:
         ro = statistics.median(sweep_open)
-        for law in laws:
-            cl = statistics.median(sweep_closed[law])
-            paired = statistics.median(c / o for c, o in zip(sweep_closed[law], sweep_open))
+        for (law, projection), rates in sweep_closed.items():
+            cl = statistics.median(rates)
+            paired = statistics.median(c / o for c, o in zip(rates, sweep_open))
             print(f"whole sweep --n {args.sweep_n} ({args.sweep_seconds:g} s per run; run_sweep with drawing, "
-                  f"compilation, reference, statistics, CSV), {law} law: rollout {ro:.0f}, sweep {cl:.0f} steps/s, "
-                  f"ratio {cl / ro:.3f}, paired {paired:.3f} (target >= 0.85)")
+                  f"compilation, reference, statistics, CSV), {law} law, {projection} projection: rollout {ro:.0f}, "
+                  f"sweep {cl:.0f} steps/s, ratio {cl / ro:.3f}, paired {paired:.3f} (target >= 0.85)")
 
 
 if __name__ == "__main__":

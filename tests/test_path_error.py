@@ -209,3 +209,47 @@ def test_a_diverged_position_projects_without_a_warning(straight, far):
     assert d[1] == side * math.inf and series.cross_track[1] == side * math.inf
     # on the path; on a line the chords are the path: rounding of metres only
     assert np.all(np.isfinite(s)) and abs(d[0]) < 1e-9
+
+
+def _series_with(backend: str, monkeypatch, *args):
+    from wmr_mj.analysis import path_error
+
+    monkeypatch.setenv("WMR_MJ_COMPILED_PROJECTION", "1" if backend == "C" else "0")
+    path_error._compiled_block.cache_clear()
+    try:
+        if path_error.projection_backend() != backend:
+            pytest.skip("wmr_mj.analysis._nearest_chord is not built (no C compiler at install)")
+        return path_error_series(*args)
+    finally:
+        path_error._compiled_block.cache_clear()
+
+
+def test_the_compiled_projection_gives_numpys_bits(monkeypatch):
+    """C's projection in C (wmr_mj/analysis/_nearest_chord.c) against the NumPy code it replaces, to the
+    bit: paths with curvature of both signs, a crossing and a second lap, points on and off the path,
+    noisy, far (1e3 m), overflowing (beyond 1e154 m: +-inf) and beyond the path's ends, sampled densely
+    and sparsely (windows of a few to thousands of chords); the signs of zeros included."""
+    rng = np.random.default_rng(7)
+    refs = [make_reference(circle(1.0, turns=1.25), C80, dt=2e-3),
+            make_reference(line(0.5) + figure_eight(1.5, laps=2), C80, dt=2e-3),
+            make_reference(line(3.0), C80, dt=2e-3)]
+    compared = 0
+    for ref in refs:
+        t, C, theta = np.asarray(ref.t), np.asarray(ref.C_xy), np.asarray(ref.theta)
+        noisy = C + rng.normal(0.0, 0.3, C.shape)
+        huge = C * 1e150 + 1e152
+        mixed = C.copy()
+        mixed[::97] = rng.choice([-1.0, 1.0], size=mixed[::97].shape) * 10.0 ** rng.uniform(150, 300, mixed[::97].shape)
+        point_sets = {"on": C, "offset": C + [0.4, -0.25], "noisy": noisy, "far": C * 1e3, "huge": huge,
+                      "mixed": mixed, "reversed": C[::-1], "past the end": C + (C[-1] - C[0]) * 0.5}
+        for name, X in point_sets.items():
+            for stride in (1, 5, 50):
+                args = (ref, t[::stride], X[::stride], theta[::stride])
+                with np.errstate(all="ignore"):  # the NumPy code's warnings on overflowing points are not compared
+                    a, b = _series_with("NumPy", monkeypatch, *args), _series_with("C", monkeypatch, *args)
+                for field in ("s", "cross_track", "along_track", "heading_error", "beyond_end"):
+                    x, y = getattr(a, field), getattr(b, field)
+                    assert np.array_equal(x, y, equal_nan=True), (name, stride, field)
+                    assert np.array_equal(np.signbit(x), np.signbit(y)), (name, stride, field)
+                compared += 1
+    assert compared == 3 * 8 * 3

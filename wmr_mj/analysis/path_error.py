@@ -37,8 +37,11 @@ Pure NumPy: no simulation, no file.
 
 from __future__ import annotations
 
+import ctypes
 import math
+import os
 from dataclasses import asdict, dataclass
+from functools import cache
 from typing import Any
 
 import numpy as np
@@ -54,6 +57,7 @@ POLYLINE_SPACING = 4e-3
 #: default half-width of the arc-length window around the previous projection [m]
 WINDOW = 0.1
 _BLOCK = 128  # samples projected together (each block searches one window)
+_COMPILED_ENV = "WMR_MJ_COMPILED_PROJECTION"  # "0": the nearest-chord loop in NumPy even where C is built
 
 
 def wrap_angle(x: ArrayLike) -> np.ndarray:
@@ -171,36 +175,67 @@ def _geometry(reference: Any, spacing: float, extend: float):
     return gs, gxy, gth, gk, float(s[0]), float(s[-1])
 
 
-def _project(gs: np.ndarray, gxy: np.ndarray, gk: np.ndarray, X: np.ndarray, s_start: float, window: float):
-    """Continuous projection of the points X (n, 2) on the polyline: (s, signed distance).
+@cache
+def _compiled_block() -> Any:
+    """``wmr_mj_project_block`` of wmr_mj/analysis/_nearest_chord.c (ctypes; arrays passed as addresses),
+    or None where it is not built or is switched off (``WMR_MJ_COMPILED_PROJECTION=0``)."""
+    if os.environ.get(_COMPILED_ENV, "1") == "0":
+        return None
+    try:
+        from wmr_mj.analysis import _nearest_chord  # type: ignore[attr-defined]  # a C extension, built in place
+    except ImportError:
+        return None
+    fn = ctypes.CDLL(_nearest_chord.__file__).wmr_mj_project_block
+    address, n = ctypes.c_void_p, ctypes.c_int64
+    fn.argtypes = (address, address, n, *[address] * 8, n, n, n, address, address, address, address)
+    fn.restype = ctypes.c_int64
+    return fn
 
-    Points go in blocks of ``_BLOCK``; each block searches the chords within ``window`` m of arc length
-    (and the block's travel) around the previous projection. x and y are kept as separate 2-D arrays
-    (block x chords): the same IEEE operations in the same order as a dot product over the last axis of
-    (block, chords, 2) arrays, a third of the time.
-    """
-    n = X.shape[0]
-    out_s, out_d = np.empty(n), np.empty(n)
-    Ax, Ay = gxy[:-1, 0].copy(), gxy[:-1, 1].copy()
-    Dx, Dy = np.diff(gxy[:, 0]), np.diff(gxy[:, 1])
-    L2 = Dx * Dx + Dy * Dy
-    L2 = np.where(L2 > 0.0, L2, 1e-300)
-    seg_len = np.diff(gs)
-    kmid = 0.5 * (gk[:-1] + gk[1:])
-    steps = np.concatenate([[0.0], np.hypot(*np.diff(X, axis=0).T)])
-    Xx, Xy = X[:, 0].copy(), X[:, 1].copy()
-    nseg = len(Ax)
-    s_prev = s_start
-    b = 0
-    while b < n:
-        e = min(n, b + _BLOCK)
-        travel = float(np.sum(steps[b + 1:e]))
-        lo = int(np.searchsorted(gs, s_prev - window - travel, side="right")) - 1
-        hi = int(np.searchsorted(gs, s_prev + window + travel, side="left"))
-        lo, hi = max(lo, 0), min(max(hi, lo + 1), nseg)
+
+def projection_backend() -> str:
+    """``"C"`` where C's projection runs compiled (wmr_mj/analysis/_nearest_chord.c: the same bits as NumPy,
+    a fraction of the time, without the GIL), else ``"NumPy"``."""
+    return "NumPy" if _compiled_block() is None else "C"
+
+
+class _Polyline:
+    """The polyline's chords and a run's points as the block step reads them: float64, contiguous, and
+    (for the C loop) their addresses."""
+
+    def __init__(self, gs: np.ndarray, gxy: np.ndarray, gk: np.ndarray, X: np.ndarray) -> None:
+        self.gs = np.ascontiguousarray(gs, dtype=np.float64)
+        self.Ax, self.Ay = gxy[:-1, 0].copy(), gxy[:-1, 1].copy()
+        self.Dx, self.Dy = np.diff(gxy[:, 0]), np.diff(gxy[:, 1])
+        L2 = self.Dx * self.Dx + self.Dy * self.Dy
+        self.L2 = np.where(L2 > 0.0, L2, 1e-300)
+        self.seg_len = np.diff(self.gs)
+        self.kmid = 0.5 * (gk[:-1] + gk[1:])
+        self.Xx, self.Xy = X[:, 0].copy(), X[:, 1].copy()
+        self.nseg = len(self.Ax)
+        self.out_s, self.out_d = np.empty(len(X)), np.empty(len(X))
+        self._s_next, self._scratch = np.empty(1), np.empty(self.nseg + 1)
+        self._chords = [a.ctypes.data for a in (self.Ax, self.Ay, self.Dx, self.Dy, self.L2, self.gs, self.seg_len,
+                                                self.kmid)]
+        self._addresses = [a.ctypes.data for a in (self.Xx, self.Xy, self.out_s, self.out_d, self._scratch,
+                                                   self._s_next)]
+
+    def block_c(self, fn: Any, b: int, e: int, lo: int, hi: int) -> tuple[int, float]:
+        """:meth:`block_numpy` in C."""
+        x, y, out_s, out_d, scratch, s_next = self._addresses
+        m = fn(x + 8 * b, y + 8 * b, e - b, *self._chords, lo, hi, self.nseg, scratch, out_s + 8 * b, out_d + 8 * b,
+               s_next)
+        return int(m), float(self._s_next[0])
+
+    def block_numpy(self, b: int, e: int, lo: int, hi: int) -> tuple[int, float]:
+        """Project the points b:e on the chords lo:hi; write out_s, out_d of the first m, and return m and the
+        arc length the next block starts from. m < e - b where a point's nearest chord is an end of the window."""
+        Ax, Ay, Dx, Dy, L2 = self.Ax, self.Ay, self.Dx, self.Dy, self.L2
+        gs, seg_len, kmid, nseg = self.gs, self.seg_len, self.kmid, self.nseg
         Dxb, Dyb = Dx[lo:hi], Dy[lo:hi]
-        rx = Xx[b:e, None] - Ax[None, lo:hi]
-        ry = Xy[b:e, None] - Ay[None, lo:hi]
+        # x and y as separate 2-D arrays (block x chords): the same IEEE operations in the same order as a
+        # dot product over the last axis of (block, chords, 2) arrays, a third of the time
+        rx = self.Xx[b:e, None] - Ax[None, lo:hi]
+        ry = self.Xy[b:e, None] - Ay[None, lo:hi]
         with np.errstate(over="ignore"):  # a diverged run's point, far off: handled as `far` below
             u_raw = (rx * Dxb + ry * Dyb) / L2[lo:hi]
             u = np.clip(u_raw, 0.0, 1.0)
@@ -232,11 +267,36 @@ def _project(gs: np.ndarray, gxy: np.ndarray, gk: np.ndarray, X: np.ndarray, s_s
         scale = np.where(far, -1.0, 1.0 - kmid[seg] * np.where(far, 0.0, d))
         u_arc = 0.5 + (u_raw[rows, jm] - 0.5) / np.where(scale > 0.0, scale, 1.0)
         uj = np.where(scale > 0.0, np.clip(u_arc, 0.0, 1.0), uj)
-        out_s[b:b + m] = gs[seg] + uj * seg_len[seg]
-        out_d[b:b + m] = d
-        s_prev = float(out_s[b + m - 1]) if m == nb else float(gs[lo] if j[m] == 0 else gs[hi])
+        self.out_s[b:b + m] = gs[seg] + uj * seg_len[seg]
+        self.out_d[b:b + m] = d
+        return m, float(self.out_s[b + m - 1]) if m == nb else float(gs[lo] if j[m] == 0 else gs[hi])
+
+
+def _project(gs: np.ndarray, gxy: np.ndarray, gk: np.ndarray, X: np.ndarray, s_start: float, window: float):
+    """Continuous projection of the points X (n, 2) on the polyline: (s, signed distance).
+
+    Points go in blocks of ``_BLOCK``; each block searches the chords within ``window`` m of arc length
+    (and the block's travel) around the previous projection (:meth:`_Polyline.block_numpy`; in C where it
+    is built, :func:`projection_backend`: the same bits).
+    """
+    n = X.shape[0]
+    line = _Polyline(gs, gxy, gk, X)
+    steps = np.concatenate([[0.0], np.hypot(*np.diff(X, axis=0).T)])
+    compiled = _compiled_block()
+    s_prev = s_start
+    b = 0
+    while b < n:
+        e = min(n, b + _BLOCK)
+        travel = float(np.sum(steps[b + 1:e]))
+        lo = int(np.searchsorted(gs, s_prev - window - travel, side="right")) - 1
+        hi = int(np.searchsorted(gs, s_prev + window + travel, side="left"))
+        lo, hi = max(lo, 0), min(max(hi, lo + 1), line.nseg)
+        if compiled is not None and lo < hi:
+            m, s_prev = line.block_c(compiled, b, e, lo, hi)
+        else:
+            m, s_prev = line.block_numpy(b, e, lo, hi)
         b += m
-    return out_s, out_d
+    return line.out_s, line.out_d
 
 
 def path_error_series(reference: Any, t: ArrayLike, C_xy: ArrayLike, heading: ArrayLike, *,
