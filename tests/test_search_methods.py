@@ -1,8 +1,9 @@
 """The search methods of falsify on synthetic objectives with known worst cases, through the routine
 ``falsify`` itself calls (:func:`wmr_mj.sim.falsify.search_worst`, with FalsifySpec's default method):
 CMA-ES and the portfolio find an interior maximum the vertices miss, the portfolio keeps a vertex
-worst case exact within 64 runs, spends its last fifth around the worst point found, a generation is
-one batch, and a budget below one generation is refused in one line."""
+worst case exact within 64 runs, starts CMA-ES on the worse side of the vertices' significant main
+effects, spends its last share around the worst point found, a generation is one batch, and a budget
+below one generation is refused in one line."""
 
 from __future__ import annotations
 
@@ -14,14 +15,14 @@ import pytest
 
 from wmr_mj.errors import ParameterError
 from wmr_mj.sim.falsify import (
-    PORTFOLIO_LOCAL_SHARE,
-    PORTFOLIO_LOCAL_SIGMA,
     FalsifySpec,
     cma_population,
     covering_design,
     falsify,
+    portfolio_local_phase,
     portfolio_vertices,
     random_worst,
+    screened_start,
     search_worst,
 )
 
@@ -127,8 +128,8 @@ def test_a_generation_is_one_batch_and_the_budget_is_exact():
 
 def test_the_portfolio_covers_the_vertices_beyond_32_and_ends_around_the_worst_point_found():
     """6-D at a budget of 300: a covering of 32 of the 64 vertices (not all 64: they left C's path too few
-    runs), and the last fifth of the budget (whole generations before it) a local CMA-ES around the worst
-    point found before it, with steps of PORTFOLIO_LOCAL_SIGMA of each range."""
+    runs), and the last three tenths of the budget (whole generations before it) a local CMA-ES around the
+    worst point found before it, with steps of 0.02 of each range (0.05 for a fifth below 200 runs)."""
     box6 = np.array([[-1.0, 1.0]] * 6)
     peak = np.array([0.3, -0.4, 0.1, 0.25, -0.2, 0.5])
 
@@ -142,16 +143,35 @@ def test_the_portfolio_covers_the_vertices_beyond_32_and_ends_around_the_worst_p
         return bump6(points)
 
     assert portfolio_vertices(6, 300) == 32 and portfolio_vertices(5, 64) == 32 and portfolio_vertices(6, 100) == 8
+    assert portfolio_local_phase(300) == (0.3, 0.02) and portfolio_local_phase(199) == (0.2, 0.05)
     trace = search_worst(evaluate, box6, budget=300, seed=2)
     assert calls[0] == 32 and len(trace.values) == 300
     lam = cma_population(6)
-    local = int(PORTFOLIO_LOCAL_SHARE * 300)
+    share, step = portfolio_local_phase(300)
+    local = int(share * 300)
     start = 32 + (300 - 32 - local) // lam * lam  # where the local phase begins
     assert np.cumsum(calls).tolist().count(start) == 1  # a batch ends there
     before = trace.points[:start][np.argmax(trace.values[:start])]
     spread = np.abs(trace.points[start:] - before) / 2.0  # in units of each range
-    assert np.median(spread) <= 3 * PORTFOLIO_LOCAL_SIGMA and np.max(spread) < 0.5
+    assert np.median(spread) <= 3 * step and np.max(spread) < 0.5
     assert trace.values[trace.best] >= trace.values[:start].max()
+
+
+def test_the_screening_moves_cmas_start_to_the_worse_side_of_significant_effects_only():
+    """Main effects of a two-level design, known by construction: the values rise with u0, fall with u3 and
+    carry a deterministic wiggle (the residual) in which no other parameter has an effect; a symmetric
+    bump at the centre has no main effect at all; a NaN is left out."""
+    corners = covering_design(5, 32)
+    wiggle = 0.05 * np.sin(7.0 * np.arange(32))
+    values = 1.0 + 0.8 * corners[:, 0] - 0.5 * corners[:, 3] + wiggle
+    coef = np.linalg.lstsq(np.column_stack([np.ones(32), 2 * corners - 1]), values, rcond=None)[0]
+    assert abs(coef[1] - 0.4) < 0.05 and abs(coef[4] + 0.25) < 0.05  # half the effect per +-1 level
+    assert np.array_equal(screened_start(corners, values), [0.75, 0.5, 0.5, 0.25, 0.5])
+    values[5] = np.nan
+    assert np.array_equal(screened_start(corners, values), [0.75, 0.5, 0.5, 0.25, 0.5])
+    centred = np.exp(-np.sum((corners - 0.5) ** 2, axis=1))
+    assert np.array_equal(screened_start(corners, centred), np.full(5, 0.5))
+    assert np.array_equal(screened_start(corners[:4], values[:4]), np.full(5, 0.5))  # no residual left
 
 
 @pytest.mark.parametrize("method", ["portfolio", "cma"])

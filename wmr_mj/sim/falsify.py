@@ -450,10 +450,45 @@ PORTFOLIO_MAX_VERTICES = 32
 #: of 300: 32 of its 64 vertices, not all 64 (with the local phase >= random in 9 of 10 tuning seeds, 100-109, but
 #: only 7 of 10 of the bench's seeds 0-9, as before).
 PORTFOLIO_COVER_SHARE = 0.125
-#: The last share of the budget is a local CMA-ES around the worst point found, step PORTFOLIO_LOCAL_SIGMA of each
-#: range (measured: module docstring).
-PORTFOLIO_LOCAL_SHARE = 0.2
-PORTFOLIO_LOCAL_SIGMA = 0.05
+#: The last share of the budget is a local CMA-ES around the worst point found, its step a share of each range
+#: (measured: module docstring): (share of the budget, step) below PORTFOLIO_LONG_BUDGET runs ...
+PORTFOLIO_LOCAL_SHORT = (0.2, 0.05)
+#: ... and from there on, where the global phase has had its runs: a longer, finer local phase.
+PORTFOLIO_LOCAL_LONG = (0.3, 0.02)
+PORTFOLIO_LONG_BUDGET = 200
+#: CMA-ES starts from the box's centre, moved by PORTFOLIO_SCREEN_SHIFT of a range towards the worse side of every
+#: parameter whose main effect over the vertices is significant, |t| > PORTFOLIO_SCREEN_T (a two-level screening).
+PORTFOLIO_SCREEN_T = 3.0
+PORTFOLIO_SCREEN_SHIFT = 0.25
+
+
+def portfolio_local_phase(budget: int) -> tuple[float, float]:
+    """(share of the budget, step as a share of each range) of the portfolio's local phase:
+    :data:`PORTFOLIO_LOCAL_SHORT` below :data:`PORTFOLIO_LONG_BUDGET` runs, else :data:`PORTFOLIO_LOCAL_LONG`."""
+    return PORTFOLIO_LOCAL_LONG if budget >= PORTFOLIO_LONG_BUDGET else PORTFOLIO_LOCAL_SHORT
+
+
+def screened_start(corners: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """CMA-ES's first mean (d,) in the unit box, from the vertices' values: the two-level screening of a
+    designed experiment. The main effects are fitted by least squares on the corners (n, d) in {0, 1}
+    (orthogonal columns for :func:`covering_design`'s designs); a parameter whose effect b_i exceeds
+    :data:`PORTFOLIO_SCREEN_T` standard errors (s / sqrt(n), s from the residuals) starts
+    :data:`PORTFOLIO_SCREEN_SHIFT` from the centre on its worse side, every other at the centre. Undefined
+    (NaN) values are left out; with no residual degree of freedom every parameter starts at the centre."""
+    ok = np.isfinite(values)
+    X, y = 2.0 * np.asarray(corners, dtype=float)[ok] - 1.0, np.asarray(values, dtype=float)[ok]
+    start = np.full(np.shape(corners)[1], 0.5)
+    dof = len(y) - X.shape[1] - 1
+    if dof < 1:
+        return start
+    A = np.column_stack([np.ones(len(y)), X])
+    coef = np.linalg.lstsq(A, y, rcond=None)[0]
+    resid = y - A @ coef
+    se = math.sqrt(float(resid @ resid) / dof / len(y))
+    for i, b in enumerate(coef[1:]):
+        if abs(b) > PORTFOLIO_SCREEN_T * se and b != 0.0:
+            start[i] = 0.5 + PORTFOLIO_SCREEN_SHIFT * math.copysign(1.0, b)
+    return start
 
 
 def cma_population(d: int) -> int:
@@ -482,17 +517,19 @@ def _search_cma(evaluate: Callable[[np.ndarray], np.ndarray], bounds: np.ndarray
     1. (portfolio) :func:`portfolio_vertices` vertices, one batch: all 2^d where they fit
        :data:`PORTFOLIO_VERTEX_SHARE` of the budget and number at most :data:`PORTFOLIO_MAX_VERTICES`,
        else a seeded fractional-factorial covering.
-    2. CMA-ES: mean at the box's centre (not at the worst vertex: measured worse on interior maxima), step
-       :data:`CMA_SIGMA0` of each range, ``population`` (default :func:`cma_population`) members
-       per generation, evaluated as one batch; the package resamples a member outside the box
-       (up to 100 times, then clips it). An undefined value (NaN) ranks below every defined one.
-       When CMA-ES stops (converged, flat) with budget left it restarts from a seeded uniform
-       point with twice the population (IPOP). (portfolio) This global phase runs whole generations of
-       the first population up to the budget less :data:`PORTFOLIO_LOCAL_SHARE` of it.
-    3. (portfolio) The local phase: CMA-ES from the worst point found, step :data:`PORTFOLIO_LOCAL_SIGMA`
-       of each range, the first population (restarted there when it stops), to the budget; none where
-       the global phase would have no whole generation before it (tiny budgets). The last generation
-       of each phase is cut to the budget.
+    2. CMA-ES: mean at the box's centre (not at the worst vertex: measured worse on interior maxima),
+       (portfolio) moved towards the worse side of each parameter whose main effect over the vertices
+       is significant (:func:`screened_start`), step :data:`CMA_SIGMA0` of each range, ``population``
+       (default :func:`cma_population`) members per generation, evaluated as one batch; the package
+       resamples a member outside the box (up to 100 times, then clips it). An undefined value (NaN)
+       ranks below every defined one. When CMA-ES stops (converged, flat) with budget left it
+       restarts from a seeded uniform point with twice the population (IPOP). (portfolio) This global
+       phase runs whole generations of the first population up to the budget less the local phase's
+       share of it (:func:`portfolio_local_phase`).
+    3. (portfolio) The local phase: CMA-ES from the worst point found, its step
+       (:func:`portfolio_local_phase`) of each range, the first population (restarted there when it
+       stops), to the budget; none where the global phase would have no whole generation before it
+       (tiny budgets). The last generation of each phase is cut to the budget.
 
     In one dimension (which ``cmaes`` does not take) it searches a square whose second coordinate
     is ignored. Deterministic for a seed (``cmaes`` keeps its own generator, seeded from it).
@@ -519,19 +556,22 @@ def _search_cma(evaluate: Callable[[np.ndarray], np.ndarray], bounds: np.ndarray
         v = rec.trace().values
         return np.concatenate(unit_points)[int(np.argmax(np.where(np.isnan(v), -np.inf, v)))]
 
+    start = np.full(n, 0.5)
     if vertices:
         corners = covering_design(d, portfolio_vertices(d, budget), rng)
-        run(np.hstack([corners, np.full((len(corners), n - d), 0.5)]))
-    local = int(PORTFOLIO_LOCAL_SHARE * budget) if vertices else 0
+        corner_values = run(np.hstack([corners, np.full((len(corners), n - d), 0.5)]))
+        start[:d] = screened_start(corners, corner_values)
+    local_share, local_sigma = portfolio_local_phase(budget)
+    local = int(local_share * budget) if vertices else 0
     # the global phase in whole generations of the first population, the local phase the rest; a budget
     # that leaves the global phase no whole generation has no local phase (CMA-ES from the centre, as before)
     global_end = rec.spent + (budget - rec.spent - local) // lam0 * lam0 if local else budget
     if global_end <= rec.spent:
         global_end = budget
-    mean, lam, sigma = np.full(n, 0.5), lam0, CMA_SIGMA0
+    mean, lam, sigma = start, lam0, CMA_SIGMA0
     while rec.spent < budget:
         if rec.spent >= global_end:  # the local phase (and its restarts): around the worst point found
-            mean, lam, sigma = np.clip(incumbent(), 0.0, 1.0), lam0, PORTFOLIO_LOCAL_SIGMA
+            mean, lam, sigma = np.clip(incumbent(), 0.0, 1.0), lam0, local_sigma
         opt = CMA(mean=mean, sigma=sigma, bounds=np.array([[0.0, 1.0]] * n), population_size=lam,
                   seed=int(rng.integers(2 ** 31 - 1)))
         end = global_end if rec.spent < global_end else budget
