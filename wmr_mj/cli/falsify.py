@@ -32,10 +32,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--objective", default="ratio", help="what is maximised: ratio (default, see --against) or sup-E")
     p.add_argument("--method", default="portfolio",
                    help="search: portfolio (default: the box's 2^d vertices where they fit half the budget, else a "
-                        "fractional-factorial covering of at most an eighth of it, then CMA-ES from the box's centre, "
-                        "a generation per batch), cma (CMA-ES alone), vertices-polish (the vertices, then scipy's "
-                        "Nelder-Mead from the worst), lhs-polish (a Latin hypercube of half the budget, then the same "
-                        "polish) or de (differential evolution)")
+                        "fractional-factorial covering of at most an eighth of it, then CMA-ES from the box's centre "
+                        "moved to the worse side of significant main effects, a generation per batch, then a local "
+                        "CMA-ES around the worst found), cma (CMA-ES alone), vertices-polish (the vertices, then "
+                        "scipy's Nelder-Mead from the worst), lhs-polish (a Latin hypercube of half the budget, then "
+                        "the same polish) or de (differential evolution)")
     p.add_argument("--require", metavar="STL",
                    help="falsify an STL requirement (e.g. 'always(abs(E) <= 0.05)', signals as for wmr-mj run "
                         "--require): maximise minus its robustness (> 0: falsified); runs one by one, the batch "
@@ -108,6 +109,27 @@ def reproduce_command(config, params: dict[str, float], args: argparse.Namespace
         bounds = ",".join(f"{k}={v!r}" for k, v in config.reference_bounds.as_dict().items())
         parts.append(f"--reference-bounds {bounds}")
     return " ".join(parts)
+
+
+def _portfolio_phases_text(spec, first, population: int) -> str:
+    """What the portfolio did after its vertices: where CMA-ES started (the screening) and its two phases."""
+    import numpy as np
+
+    from wmr_mj.sim.falsify import portfolio_local_phase, portfolio_phases, screened_start
+
+    lo, hi = spec.bounds[:, 0], spec.bounds[:, 1]
+    corners = np.array([[e.params[n] for n in spec.names] for e in first])
+    corners = np.where(hi > lo, (corners - lo) / np.where(hi > lo, hi - lo, 1.0), 0.0)
+    values = np.array([np.nan if e.objective is None else e.objective for e in first])
+    start = screened_start(corners, values)
+    moved = [f"{'up' if u > 0.5 else 'down'} in {n}" for n, u in zip(spec.names, start) if u != 0.5]
+    _, global_runs, local_runs = portfolio_phases(len(spec.names), spec.budget, population)
+    where = "the box's centre" + (f" moved {', '.join(moved)} (the vertices' main effects)" if moved else "")
+    text = f"CMA-ES from {where} ({global_runs} runs, {population} per generation)"
+    if local_runs:
+        text += (f", then a local CMA-ES around the worst found ({local_runs} runs, step "
+                 f"{portfolio_local_phase(spec.budget)[1]:g} of each range)")
+    return text
 
 
 def run(args: argparse.Namespace) -> int:
@@ -187,6 +209,8 @@ def run(args: argparse.Namespace) -> int:
                 "a fractional-factorial covering of the vertices")
         cma = (f"CMA-ES from the box's centre ({len(result.search) - len(first)} runs, {summary['population']} per "
                "generation)")
+        if first:
+            cma = _portfolio_phases_text(spec, first, summary["population"])
         how = f"{kind} ({len(first)} runs), then {cma}" if first else cma
     else:
         first = [e for e in result.search if e.generation == 0]
