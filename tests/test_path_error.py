@@ -230,9 +230,11 @@ def test_the_compiled_projection_gives_numpys_bits(monkeypatch):
     noisy, far (1e3 m), overflowing (beyond 1e154 m: +-inf) and beyond the path's ends, sampled densely
     and sparsely (windows of a few to thousands of chords); the signs of zeros included."""
     rng = np.random.default_rng(7)
-    refs = [make_reference(circle(1.0, turns=1.25), C80, dt=2e-3),
-            make_reference(line(0.5) + figure_eight(1.5, laps=2), C80, dt=2e-3),
-            make_reference(line(3.0), C80, dt=2e-3)]
+    # sampled every 20 ms (4 mm of path at 0.2 m/s): the NumPy side's windows over scattered points span
+    # the whole path, (128 x thousands) arrays a block
+    refs = [make_reference(circle(1.0, turns=1.25), C80, dt=2e-2),
+            make_reference(line(0.5) + figure_eight(1.5, laps=2), C80, dt=2e-2),
+            make_reference(line(3.0), C80, dt=2e-2)]
     compared = 0
     for ref in refs:
         t, C, theta = np.asarray(ref.t), np.asarray(ref.C_xy), np.asarray(ref.theta)
@@ -243,7 +245,10 @@ def test_the_compiled_projection_gives_numpys_bits(monkeypatch):
         point_sets = {"on": C, "offset": C + [0.4, -0.25], "noisy": noisy, "far": C * 1e3, "huge": huge,
                       "mixed": mixed, "reversed": C[::-1], "past the end": C + (C[-1] - C[0]) * 0.5}
         for name, X in point_sets.items():
-            for stride in (1, 5, 50):
+            # scattered points move the window by metres a block: the NumPy side's (128 x chords) arrays
+            # then span the whole path, so they go sparser
+            scattered = name in ("noisy", "far", "huge", "mixed")
+            for stride in (15, 50) if scattered else (1, 5, 50):
                 args = (ref, t[::stride], X[::stride], theta[::stride])
                 with np.errstate(all="ignore"):  # the NumPy code's warnings on overflowing points are not compared
                     a, b = _series_with("NumPy", monkeypatch, *args), _series_with("C", monkeypatch, *args)
@@ -252,4 +257,30 @@ def test_the_compiled_projection_gives_numpys_bits(monkeypatch):
                     assert np.array_equal(x, y, equal_nan=True), (name, stride, field)
                     assert np.array_equal(np.signbit(x), np.signbit(y)), (name, stride, field)
                 compared += 1
-    assert compared == 3 * 8 * 3
+    assert compared == 3 * (4 * 3 + 4 * 2)
+
+
+def test_the_compiled_projection_takes_numpys_first_nan(monkeypatch):
+    """numpy.argmin returns the first NaN of a row; the C loop must too. No finite run's point makes a NaN
+    distance (the inputs are checked finite), so the polyline is crafted: a straight line of 4 mm chords,
+    one vertex NaN, single points projected from arc lengths around it (a NaN projection ends the
+    search, so one point a call)."""
+    from wmr_mj.analysis import path_error
+
+    s = np.arange(0.0, 2.0, 4e-3)
+    gxy = np.column_stack([s, np.zeros_like(s)])
+    gxy[300] = np.nan  # s = 1.2 m
+    gk = np.zeros_like(s)
+    starts = np.linspace(0.9, 1.5, 61)
+    out = {}
+    for backend in ("NumPy", "C"):
+        monkeypatch.setenv("WMR_MJ_COMPILED_PROJECTION", "1" if backend == "C" else "0")
+        path_error._compiled_block.cache_clear()
+        if path_error.projection_backend() != backend:
+            pytest.skip("wmr_mj.analysis._nearest_chord is not built (no C compiler at install)")
+        with np.errstate(all="ignore"):
+            out[backend] = np.array([path_error._project(s, gxy, gk, np.array([[x, 0.03]]), x, 0.1)
+                                     for x in starts])
+    path_error._compiled_block.cache_clear()
+    assert np.isnan(out["NumPy"]).any() and np.isfinite(out["NumPy"]).any()  # windows with and without it
+    assert np.array_equal(out["NumPy"], out["C"], equal_nan=True)

@@ -32,7 +32,8 @@ Usage::
     err = path_errors(reference, rows["t"], C_xy, heading)      # C_xy (n, 2) m, heading (n,) rad
     err.cross_track_max, err.along_track_final, err.to_dict()
 
-Pure NumPy: no simulation, no file.
+NumPy, with the projection's loop in C where ``pip install`` built it (``_nearest_chord.c``, the same
+bits; :func:`projection_backend` says which): no simulation, no file.
 """
 
 from __future__ import annotations
@@ -210,7 +211,7 @@ class _Polyline:
         self.L2 = np.where(L2 > 0.0, L2, 1e-300)
         self.seg_len = np.diff(self.gs)
         self.kmid = 0.5 * (gk[:-1] + gk[1:])
-        self.Xx, self.Xy = X[:, 0].copy(), X[:, 1].copy()
+        self.Xx, self.Xy = (np.ascontiguousarray(X[:, k], dtype=np.float64) for k in (0, 1))  # read only
         self.nseg = len(self.Ax)
         self.out_s, self.out_d = np.empty(len(X)), np.empty(len(X))
         self._s_next, self._scratch = np.empty(1), np.empty(self.nseg + 1)

@@ -473,8 +473,7 @@ CMA_SIGMA0 = 0.3
 PORTFOLIO_VERTEX_SHARE = 0.5
 PORTFOLIO_MAX_VERTICES = 32
 #: ... else a covering of at most this share of the budget (measured: module docstring). C's path (d = 6) at a budget
-#: of 300: 32 of its 64 vertices, not all 64 (with the local phase >= random in 9 of 10 tuning seeds, 100-109, but
-#: only 7 of 10 of the bench's seeds 0-9, as before).
+#: of 300: 32 of its 64 vertices, not all 64.
 PORTFOLIO_COVER_SHARE = 0.125
 #: The last share of the budget is a local CMA-ES around the worst point found, its step a share of each range
 #: (measured: module docstring): (share of the budget, step) below PORTFOLIO_LONG_BUDGET runs ...
