@@ -162,7 +162,6 @@ def main() -> None:
                         # run_sweep takes the compiled law and projection where they can run: switches turn them off
                         os.environ["WMR_MJ_COMPILED_LAW"] = "0" if law == "numpy" else "1"
                         os.environ["WMR_MJ_COMPILED_PROJECTION"] = "0" if projection == "NumPy" else "1"
-                        path_error._compiled_block.cache_clear()
                         if path_error.projection_backend() != projection:
                             sys.exit(f"the {projection} projection cannot run here: wmr_mj.analysis._nearest_chord "
                                      "is not built")
@@ -174,7 +173,6 @@ def main() -> None:
                         assert {r["batch_law"] for r in results} == {law}, "the sweep ran another law"
                 os.environ.pop("WMR_MJ_COMPILED_LAW")
                 os.environ.pop("WMR_MJ_COMPILED_PROJECTION")
-                path_error._compiled_block.cache_clear()
 
     print(f"{args.model} model, m1 550-750 kg, {args.seconds:g} s per run, {args.nthread} threads, "
           f"{args.repeats} repeats (medians; ratio = median closed / median rollout, "

@@ -215,13 +215,9 @@ def _series_with(backend: str, monkeypatch, *args):
     from wmr_mj.analysis import path_error
 
     monkeypatch.setenv("WMR_MJ_COMPILED_PROJECTION", "1" if backend == "C" else "0")
-    path_error._compiled_block.cache_clear()
-    try:
-        if path_error.projection_backend() != backend:
-            pytest.skip("wmr_mj.analysis._nearest_chord is not built (no C compiler at install)")
-        return path_error_series(*args)
-    finally:
-        path_error._compiled_block.cache_clear()
+    if path_error.projection_backend() != backend:
+        pytest.skip("wmr_mj.analysis._nearest_chord is not built (no C compiler at install)")
+    return path_error_series(*args)
 
 
 def test_the_compiled_projection_gives_numpys_bits(monkeypatch):
@@ -275,12 +271,10 @@ def test_the_compiled_projection_takes_numpys_first_nan(monkeypatch):
     out = {}
     for backend in ("NumPy", "C"):
         monkeypatch.setenv("WMR_MJ_COMPILED_PROJECTION", "1" if backend == "C" else "0")
-        path_error._compiled_block.cache_clear()
         if path_error.projection_backend() != backend:
             pytest.skip("wmr_mj.analysis._nearest_chord is not built (no C compiler at install)")
         with np.errstate(all="ignore"):
             out[backend] = np.array([path_error._project(s, gxy, gk, np.array([[x, 0.03]]), x, 0.1)
                                      for x in starts])
-    path_error._compiled_block.cache_clear()
     assert np.isnan(out["NumPy"]).any() and np.isfinite(out["NumPy"]).any()  # windows with and without it
     assert np.array_equal(out["NumPy"], out["C"], equal_nan=True)

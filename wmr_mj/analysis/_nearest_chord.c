@@ -2,7 +2,7 @@
  * wmr_mj.analysis.path_error._project, which is otherwise a (points x chords) NumPy computation per block.
  *
  * For each point i of the block and each chord k of the window lo:hi it computes, operation for operation
- * as the NumPy code (_project_block_numpy),
+ * as the NumPy code (_Polyline.block_numpy),
  *
  *     rx = x_i - ax_k;  ry = y_i - ay_k
  *     u  = clip((rx dx_k + ry dy_k) / l2_k, 0, 1)       (NaN stays NaN, -0 stays -0, as numpy.clip)

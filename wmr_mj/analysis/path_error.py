@@ -177,11 +177,9 @@ def _geometry(reference: Any, spacing: float, extend: float):
 
 
 @cache
-def _compiled_block() -> Any:
+def _library_block() -> Any:
     """``wmr_mj_project_block`` of wmr_mj/analysis/_nearest_chord.c (ctypes; arrays passed as addresses),
-    or None where it is not built or is switched off (``WMR_MJ_COMPILED_PROJECTION=0``)."""
-    if os.environ.get(_COMPILED_ENV, "1") == "0":
-        return None
+    or None where it is not built (loaded once)."""
     try:
         from wmr_mj.analysis import _nearest_chord  # type: ignore[attr-defined]  # a C extension, built in place
     except ImportError:
@@ -191,6 +189,12 @@ def _compiled_block() -> Any:
     fn.argtypes = (address, address, n, *[address] * 8, n, n, n, address, address, address, address)
     fn.restype = ctypes.c_int64
     return fn
+
+
+def _compiled_block() -> Any:
+    """The C block step, or None where it is not built or is switched off (``WMR_MJ_COMPILED_PROJECTION=0``,
+    read at every projection, as the compiled law reads its switch)."""
+    return None if os.environ.get(_COMPILED_ENV, "1") == "0" else _library_block()
 
 
 def projection_backend() -> str:
