@@ -220,3 +220,14 @@ def test_cli_sweep_reports_each_requirement_and_the_signals(tmp_path, capsys):
     assert [r["robustness"] for r in single["requirements"]] == [row["requirement_1_robustness"],
                                                                  row["requirement_2_robustness"]]
     assert single["sup_E"] == row["sup_E"]
+
+
+def test_bench_sweep_refuses_an_unknown_projection_in_one_line():
+    """bench/bench_sweep.py --projections: only C and NumPy; anything else is named, exit 2, before any run."""
+    from pathlib import Path
+
+    bench = Path(__file__).resolve().parent.parent / "bench" / "bench_sweep.py"
+    out = subprocess.run([sys.executable, str(bench), "--projections", "C,numba"], capture_output=True, text=True,
+                         timeout=120)
+    assert out.returncode == 2 and "Traceback" not in out.stderr
+    assert "--projections takes C, NumPy or both (got 'C,numba')" in out.stderr.splitlines()[-1]
