@@ -19,6 +19,7 @@ from wmr_mj.sim.falsify import (
     cma_population,
     covering_design,
     falsify,
+    portfolio_global_runs,
     portfolio_local_phase,
     portfolio_vertices,
     random_worst,
@@ -157,6 +158,45 @@ def test_the_portfolio_covers_the_vertices_beyond_32_and_ends_around_the_worst_p
     assert trace.values[trace.best] >= trace.values[:start].max()
 
 
+def test_from_200_runs_the_global_phase_is_two_independent_cma_runs_from_the_screened_start(monkeypatch):
+    """6-D at 300: 32 vertices, then 19 generations of 9 split 9 + 10 between two CMA-ES runs, then the local
+    phase. The first run is the one-run portfolio's own, to the bit, up to the split; the second is a fresh
+    CMA-ES at the vertices' screened start with the first step (0.3 of each range), to the bit."""
+    import wmr_mj.sim.falsify as falsify_module
+
+    box6 = np.array([[-1.0, 1.0]] * 6)
+    peak = np.array([0.6, 0.6, 0.6, -0.6, 0.6, 0.6])
+
+    def sphere(points: np.ndarray) -> np.ndarray:  # main effects at the vertices: the screening moves the start
+        return -np.sum((points - peak) ** 2, axis=1)
+
+    assert portfolio_global_runs(300) == 2 and portfolio_global_runs(199) == 1
+    calls: list[int] = []
+    two = search_worst(lambda p: calls.append(len(p)) or sphere(p), box6, budget=300, seed=4)
+    split, global_end = 32 + 9 * 9, 32 + 19 * 9
+    ends = np.cumsum(calls).tolist()
+    assert calls[ends.index(split) + 1:ends.index(global_end) + 1] == [9] * 10  # the second run: 10 generations of 9
+    monkeypatch.setattr(falsify_module, "PORTFOLIO_GLOBAL_RUNS_LONG", 1)
+    one = search_worst(sphere, box6, budget=300, seed=4)
+    assert np.array_equal(two.points[:split], one.points[:split])
+    assert not np.array_equal(two.points[split:global_end], one.points[split:global_end])
+    unit = (two.points + 1.0) / 2.0
+    start = screened_start(unit[:32], two.values[:32])
+    assert np.array_equal(start, [0.75, 0.75, 0.75, 0.25, 0.75, 0.75])
+    # the second run's first generation, drawn by cmaes directly: a fresh CMA-ES at the start, step 0.3,
+    # seeded by the search's second draw (the first seeded the first run; the covering's sign flips come before)
+    from cmaes import CMA
+
+    rng = np.random.default_rng(np.random.SeedSequence(4).spawn(5)[4])
+    covering_design(6, 32, rng)
+    rng.integers(2**31 - 1)
+    fresh = CMA(mean=start, sigma=0.3, bounds=np.array([[0.0, 1.0]] * 6), population_size=9,
+                seed=int(rng.integers(2**31 - 1)))
+    first_generation = np.array([fresh.ask() for _ in range(9)])
+    assert np.array_equal(two.points[split:split + 9], np.where(first_generation >= 1.0, 1.0,
+                                                                 -1.0 + 2.0 * first_generation))
+
+
 def test_the_screening_moves_cmas_start_to_the_worse_side_of_significant_effects_only():
     """Main effects of a two-level design, known by construction: the values rise with u0, fall with u3 and
     carry a deterministic wiggle (the residual) in which no other parameter has an effect; a symmetric
@@ -194,3 +234,28 @@ def test_cli_falsify_budget_below_a_generation_exits_2(tmp_path):
     assert len(proc.stderr.strip().splitlines()) == 1 and "Traceback" not in proc.stderr, proc.stderr
     assert "budget = 7" in proc.stderr and "CMA-ES" in proc.stderr
     assert not (tmp_path / "f").exists()
+
+
+def test_falsifys_printout_names_the_portfolios_phases_as_the_search_spends_them():
+    """The printout's runs per phase are portfolio_phases' (6-D at 300: 32 vertices, 19 generations of 9 in two
+    runs, the rest local), and its start is the screening's (values rising with the first parameter only)."""
+    from types import SimpleNamespace
+
+    from wmr_mj.cli.falsify import _portfolio_phases_text
+    from wmr_mj.sim.falsify import Evaluation, portfolio_phases
+
+    names = ("m1", "a", "b", "c", "d", "e")
+    bounds = np.array([[550.0, 750.0]] + [[-1.0, 1.0]] * 5)
+    corners = covering_design(6, 32)
+    points = bounds[:, 0] + corners * np.ptp(bounds, axis=1)
+    first = [Evaluation(phase="search", index=i, generation=0, params=dict(zip(names, p)),
+                        objective=0.5 + 0.1 * c[0] + 0.001 * np.sin(7.0 * i), summary={})
+             for i, (p, c) in enumerate(zip(points, corners))]
+    vertices, global_runs, local_runs = portfolio_phases(6, 300, 9)
+    assert (vertices, global_runs, local_runs) == (32, 171, 97)
+    text = _portfolio_phases_text(SimpleNamespace(names=names, bounds=bounds, budget=300), first, 9)
+    assert text == ("CMA-ES from the box's centre moved up in m1 (the vertices' main effects) (171 runs in 2 "
+                    "independent runs, 9 per generation), then a local CMA-ES around the worst found (97 runs, "
+                    "step 0.02 of each range)")
+    text = _portfolio_phases_text(SimpleNamespace(names=names, bounds=bounds, budget=150), first, 9)
+    assert "independent" not in text and "step 0.05" in text

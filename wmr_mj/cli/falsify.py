@@ -115,7 +115,7 @@ def _portfolio_phases_text(spec, first, population: int) -> str:
     """What the portfolio did after its vertices: where CMA-ES started (the screening) and its two phases."""
     import numpy as np
 
-    from wmr_mj.sim.falsify import portfolio_local_phase, portfolio_phases, screened_start
+    from wmr_mj.sim.falsify import portfolio_global_runs, portfolio_local_phase, portfolio_phases, screened_start
 
     lo, hi = spec.bounds[:, 0], spec.bounds[:, 1]
     corners = np.array([[e.params[n] for n in spec.names] for e in first])
@@ -125,7 +125,9 @@ def _portfolio_phases_text(spec, first, population: int) -> str:
     moved = [f"{'up' if u > 0.5 else 'down'} in {n}" for n, u in zip(spec.names, start) if u != 0.5]
     _, global_runs, local_runs = portfolio_phases(len(spec.names), spec.budget, population)
     where = "the box's centre" + (f" moved {', '.join(moved)} (the vertices' main effects)" if moved else "")
-    text = f"CMA-ES from {where} ({global_runs} runs, {population} per generation)"
+    runs = min(portfolio_global_runs(spec.budget), global_runs // population) if local_runs else 1
+    split = f" in {runs} independent runs" if runs > 1 else ""
+    text = f"CMA-ES from {where} ({global_runs} runs{split}, {population} per generation)"
     if local_runs:
         text += (f", then a local CMA-ES around the worst found ({local_runs} runs, step "
                  f"{portfolio_local_phase(spec.budget)[1]:g} of each range)")
