@@ -31,8 +31,8 @@ Methods (:data:`METHODS`):
   maxima of both seed sets at 300 together, the share of them a search's worst reaches went from
   0.935 to 0.960 (tuning seeds) and from 0.820 to 0.895 (bench seeds); on ten more seeds, 110-119,
   searched afterwards, from 0.900 to 0.925 (lowest worst 0.8507 to 0.8575, median 0.8792 to 0.8770).
-  Tried on the tuning seeds and
-  not kept: the screened start moved 0.4 of a range instead of 0.25 (8 of 10, median 0.8831), that
+  Tried on the tuning seeds and not kept: the screened start moved 0.4 of a range instead of 0.25
+  (8 of 10, median 0.8831), that
   with a third of the step along the screened parameters (9 of 10, median 0.9084; with the two runs
   too, 2 seeds of the first 7 lost), an elitist local phase (every batch around the worst found,
   step 0.005 or 0.01: 10 of 10, medians 0.8835 and 0.8825), a local phase per global run (10 of 10,
@@ -596,7 +596,9 @@ def _search_cma(evaluate: Callable[[np.ndarray], np.ndarray], bounds: np.ndarray
        ranks below every defined one. When CMA-ES stops (converged, flat) with budget left it
        restarts from a seeded uniform point with twice the population (IPOP). (portfolio) This global
        phase runs whole generations of the first population up to the budget less the local phase's
-       share of it (:func:`portfolio_local_phase`).
+       share of it (:func:`portfolio_local_phase`), from 200 runs on as :func:`portfolio_global_runs`
+       independent runs from the same start (step CMA_SIGMA0, the first population), equal in whole
+       generations; a run that stops early restarts within its share as above.
     3. (portfolio) The local phase: CMA-ES from the worst point found, its step
        (:func:`portfolio_local_phase`) of each range, the first population (restarted there when it
        stops), to the budget; none where the global phase would have no whole generation before it
