@@ -170,7 +170,8 @@ def test_from_200_runs_the_global_phase_is_two_independent_cma_runs_from_the_scr
     def sphere(points: np.ndarray) -> np.ndarray:  # main effects at the vertices: the screening moves the start
         return -np.sum((points - peak) ** 2, axis=1)
 
-    assert portfolio_global_runs(300) == 2 and portfolio_global_runs(199) == 1
+    assert portfolio_global_runs(6, 300) == 2 and portfolio_global_runs(6, 199) == 1
+    assert portfolio_global_runs(6, 300, population=150) == 1  # no second whole generation before the local phase
     calls: list[int] = []
     two = search_worst(lambda p: calls.append(len(p)) or sphere(p), box6, budget=300, seed=4)
     split, global_end = 32 + 9 * 9, 32 + 19 * 9

@@ -125,7 +125,7 @@ def _portfolio_phases_text(spec, first, population: int) -> str:
     moved = [f"{'up' if u > 0.5 else 'down'} in {n}" for n, u in zip(spec.names, start) if u != 0.5]
     _, global_runs, local_runs = portfolio_phases(len(spec.names), spec.budget, population)
     where = "the box's centre" + (f" moved {', '.join(moved)} (the vertices' main effects)" if moved else "")
-    runs = min(portfolio_global_runs(spec.budget), global_runs // population) if local_runs else 1
+    runs = portfolio_global_runs(len(spec.names), spec.budget, population)
     split = f" in {runs} independent runs" if runs > 1 else ""
     text = f"CMA-ES from {where} ({global_runs} runs{split}, {population} per generation)"
     if local_runs:

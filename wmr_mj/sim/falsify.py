@@ -521,10 +521,14 @@ def portfolio_local_phase(budget: int) -> tuple[float, float]:
     return PORTFOLIO_LOCAL_LONG if budget >= PORTFOLIO_LONG_BUDGET else PORTFOLIO_LOCAL_SHORT
 
 
-def portfolio_global_runs(budget: int) -> int:
-    """How many independent CMA-ES runs, from the same start, share the portfolio's global phase: one below
-    :data:`PORTFOLIO_LONG_BUDGET` runs, :data:`PORTFOLIO_GLOBAL_RUNS_LONG` from there on."""
-    return PORTFOLIO_GLOBAL_RUNS_LONG if budget >= PORTFOLIO_LONG_BUDGET else 1
+def portfolio_global_runs(d: int, budget: int, population: int | None = None) -> int:
+    """How many independent CMA-ES runs, from the same start, share the portfolio's global phase in d parameters
+    at ``budget``, as :func:`search_worst` spends them: one below :data:`PORTFOLIO_LONG_BUDGET` runs,
+    :data:`PORTFOLIO_GLOBAL_RUNS_LONG` from there on, at most one per whole generation of ``population``
+    (default :func:`cma_population`) in :func:`portfolio_phases`' global phase."""
+    lam = cma_population(d) if population is None else population
+    runs = PORTFOLIO_GLOBAL_RUNS_LONG if budget >= PORTFOLIO_LONG_BUDGET else 1
+    return max(1, min(runs, portfolio_phases(d, budget, lam)[1] // lam))
 
 
 def portfolio_phases(d: int, budget: int, population: int | None = None) -> tuple[int, int, int]:
@@ -640,15 +644,14 @@ def _search_cma(evaluate: Callable[[np.ndarray], np.ndarray], bounds: np.ndarray
     # that leaves the global phase no whole generation has no local phase (CMA-ES from the centre, as before)
     global_end = rec.spent + portfolio_phases(d, budget, lam0)[1] if vertices else budget
     generations = (global_end - rec.spent) // lam0
-    runs = max(1, min(portfolio_global_runs(budget) if vertices else 1, generations))
+    runs = portfolio_global_runs(d, budget, lam0) if vertices else 1
     run_ends = [rec.spent + generations * (i + 1) // runs * lam0 for i in range(runs - 1)] + [global_end]
     mean, lam, sigma = start, lam0, CMA_SIGMA0
     while rec.spent < budget:
         if rec.spent >= global_end:  # the local phase (and its restarts): around the worst point found
             mean, lam, sigma = np.clip(incumbent(), 0.0, 1.0), lam0, local_sigma
         elif rec.spent >= run_ends[0]:  # the global phase's next independent run, from the same start
-            while rec.spent >= run_ends[0]:
-                run_ends.pop(0)
+            run_ends.pop(0)
             mean, lam, sigma = start, lam0, CMA_SIGMA0
         opt = CMA(mean=mean, sigma=sigma, bounds=np.array([[0.0, 1.0]] * n), population_size=lam,
                   seed=int(rng.integers(2 ** 31 - 1)))
