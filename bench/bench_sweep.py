@@ -118,6 +118,10 @@ def main() -> None:
         ap.error(f"--projections takes C, NumPy or both (got {args.projections!r})")
     from wmr_mj.analysis import path_error
 
+    os.environ.pop("WMR_MJ_COMPILED_PROJECTION", None)  # each case sets it below
+    if "C" in projections and path_error.projection_backend() != "C":
+        ap.error("--projections C: the C projection is not built here (wmr_mj.analysis._nearest_chord); give NumPy")
+
     cases = {}
     for nsim in sizes:
         configs = [RunConfig(model=args.model, duration=args.seconds, m1=float(m))
@@ -162,9 +166,6 @@ def main() -> None:
                         # run_sweep takes the compiled law and projection where they can run: switches turn them off
                         os.environ["WMR_MJ_COMPILED_LAW"] = "0" if law == "numpy" else "1"
                         os.environ["WMR_MJ_COMPILED_PROJECTION"] = "0" if projection == "NumPy" else "1"
-                        if path_error.projection_backend() != projection:
-                            sys.exit(f"the {projection} projection cannot run here: wmr_mj.analysis._nearest_chord "
-                                     "is not built")
                         t = time.perf_counter()
                         results = run_sweep(spec, out_dir=Path(tmp) / f"sweep-{law}-{projection}-{rep}", chunk=128,
                                             nthread=args.nthread)

@@ -231,3 +231,17 @@ def test_bench_sweep_refuses_an_unknown_projection_in_one_line():
                          timeout=120)
     assert out.returncode == 2 and "Traceback" not in out.stderr
     assert "--projections takes C, NumPy or both (got 'C,numba')" in out.stderr.splitlines()[-1]
+
+
+def test_bench_sweep_refuses_the_c_projection_where_it_is_not_built_in_one_line():
+    """--projections C where wmr_mj.analysis._nearest_chord cannot be imported (here: blocked in sys.modules):
+    one line naming the way out, exit 2, before any run."""
+    from pathlib import Path
+
+    bench = Path(__file__).resolve().parent.parent / "bench" / "bench_sweep.py"
+    code = ("import runpy, sys; sys.modules['wmr_mj.analysis._nearest_chord'] = None; "
+            f"sys.argv = [{str(bench)!r}, '--projections', 'C']; runpy.run_path(sys.argv[0], run_name='__main__')")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 2 and "Traceback" not in out.stderr
+    assert out.stderr.splitlines()[-1].endswith("--projections C: the C projection is not built here "
+                                                "(wmr_mj.analysis._nearest_chord); give NumPy")
