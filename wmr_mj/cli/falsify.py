@@ -112,10 +112,18 @@ def reproduce_command(config, params: dict[str, float], args: argparse.Namespace
 
 
 def _portfolio_phases_text(spec, first, population: int) -> str:
-    """What the portfolio did after its vertices: where CMA-ES started (the screening) and its two phases."""
+    """What the portfolio did after its vertices: where CMA-ES started (the screening), its global and local
+    phases, and (from 200 runs) the coordinate moves that end it."""
     import numpy as np
 
-    from wmr_mj.sim.falsify import portfolio_global_runs, portfolio_local_phase, portfolio_phases, screened_start
+    from wmr_mj.sim.falsify import (
+        PORTFOLIO_COORDINATE_STEP,
+        portfolio_coordinate_runs,
+        portfolio_global_runs,
+        portfolio_local_phase,
+        portfolio_phases,
+        screened_start,
+    )
 
     lo, hi = spec.bounds[:, 0], spec.bounds[:, 1]
     corners = np.array([[e.params[n] for n in spec.names] for e in first])
@@ -128,9 +136,13 @@ def _portfolio_phases_text(spec, first, population: int) -> str:
     runs = portfolio_global_runs(len(spec.names), spec.budget, population)
     split = f" in {runs} independent runs" if runs > 1 else ""
     text = f"CMA-ES from {where} ({global_runs} runs{split}, {population} per generation)"
-    if local_runs:
-        text += (f", then a local CMA-ES around the worst found ({local_runs} runs, step "
+    coordinate_runs = portfolio_coordinate_runs(len(spec.names), spec.budget, population)
+    if local_runs > coordinate_runs:
+        text += (f", then a local CMA-ES around the worst found ({local_runs - coordinate_runs} runs, step "
                  f"{portfolio_local_phase(spec.budget)[1]:g} of each range)")
+    if coordinate_runs:
+        text += (f", then coordinate moves of the worst found ({coordinate_runs} runs, each parameter moved with "
+                 f"probability 1/{len(spec.names)}, step {PORTFOLIO_COORDINATE_STEP:g} of its range)")
     return text
 
 

@@ -20,93 +20,15 @@ Methods (:data:`METHODS`):
   generations up to the local phase; from 200 runs on, that global phase is two independent CMA-ES
   runs from the same start, equal in generations (:func:`portfolio_global_runs`); then a local
   CMA-ES from the worst point found (:func:`portfolio_local_phase`): the last fifth of the budget,
-  step 0.05 of each range, below 200 runs, the last three tenths, step 0.02, from 200 on.
-  The two global runs from 200 on are the latest change, for C's path, where one run's mean wanders
-  (its ranking is mostly the objective's roughness) and sometimes settles in a poorer region: on the
-  tuning seeds 100-109 (real runs, budget 300) the portfolio stayed >= random in 10 of 10 seeds, its
-  lowest worst rising from 0.8461 to 0.8734 (median 0.9033 to 0.8837); on the bench's seeds 0-9, run
-  once afterwards, it stayed at 8 of 10 (seed 0 now wins, 0.9016 against 0.8423, and seed 9 loses,
-  0.8831 against 0.9003; seed 5 is unchanged, 0.8648 against 0.8680), the lowest worst rising from
-  0.7778 to 0.8533 and the median falling from 0.8957 to 0.8691. Counted against the 20 random
-  maxima of both seed sets at 300 together, the share of them a search's worst reaches went from
-  0.935 to 0.960 (tuning seeds) and from 0.820 to 0.895 (bench seeds); on ten more seeds, 110-119,
-  searched afterwards, from 0.900 to 0.925 (lowest worst 0.8507 to 0.8575, median 0.8792 to 0.8770).
-  Tried on the tuning seeds and not kept: the screened start moved 0.4 of a range instead of 0.25
-  (8 of 10, median 0.8831), that
-  with a third of the step along the screened parameters (9 of 10, median 0.9084; with the two runs
-  too, 2 seeds of the first 7 lost), an elitist local phase (every batch around the worst found,
-  step 0.005 or 0.01: 10 of 10, medians 0.8835 and 0.8825), a local phase per global run (10 of 10,
-  median 0.8799) and a local phase of 0.45 of the budget (10 of 10, median 0.8846): none clearly
-  better over ten seeds; three global runs reached 0.897 of the random maxima over seeds 100-119
-  (two: 0.943, one: 0.918). On synthetic objectives at 300 (20 seeds; a bump of width 0.15, a mixture
-  of 8 bumps of width 0.12 and weights 0.5-1, centres drawn per seed; median fraction of the true
-  worst; one run against two) the two runs cost the bumps a little (5-D 0.999 against 0.995, 6-D
-  0.997 against 0.987), gain on the 5-D mixture (0.905 against 0.958), match on the 6-D mixture
-  (0.833 against 0.830) and on a linear (vertex) objective (1.000); below 200 runs they lost on
-  the bumps (5-D/100: 0.848 against 0.755), hence one run there.
-  The split, measured on synthetic objectives in the unit box (20 seeds each, d = 5
-  and 6, budgets 64/100/300; median best found as a fraction of the true worst): CMA-ES started at
-  the centre beats CMA-ES started at the worst vertex wherever the worst is interior (a Gaussian
-  bump, 6-D, budget 100: 0.555 against 0.367; a mixture of 8 bumps: 0.443 against 0.338) and
-  matches it elsewhere, so the vertices serve as insurance, not as a start; when the 2^d vertices
-  do not fit half the budget, a covering of an eighth instead of a half keeps CMA-ES its runs (bump
-  6-D/100: 0.704 against 0.536; mixture 6-D/100: 0.608 against 0.523) and costs the linear
-  (vertex) objective little (6-D/100: 0.853 against 1.0 of the worst vertex). CMA-ES alone reaches
-  only 0.72-0.85 of a vertex worst case at budgets 64-100 (0.95-0.97 at 300), which is why the
-  vertices stay.
-  ``cmaes`` was chosen over ``pycma`` (``cma``) by the same measurement: ahead on interior maxima
-  (bump 5-D/100: 0.909 against 0.864, 6-D/100: 0.732 against 0.603; mixture 5-D/100: 0.801
-  against 0.614), behind on a linear objective (which the vertices cover), and it keeps its own
-  seeded generator (pycma seeds numpy's global one).
-  The screening and the longer, finer local phase from 200 runs were added for C's path. Its
-  objective is rough at every scale (stiction): around the portfolio's best points (0.88-0.92 of
-  E_max), ten runs each 0.003, 0.01 and 0.03 of a range away gave means of 0.73-0.80, 0.69-0.75
-  and 0.61-0.72 (some above the best point), while over a Latin hypercube of 3000 runs the mean rises
-  from 0.49 (m1 in its lowest tenth) to 0.65 (its highest) and, there, with the knots' magnitudes.
-  A stand-in with that structure (a trend in one parameter, a rough field of correlation length
-  0.03, 150 seeds) put the portfolio >= random sampling in 72% of seeds at budget 100 and 83% at
-  300; with the screening 77% and 82%; with the screening and, from 200 runs, the long local phase
-  77% and 89%. On the bench's tuning seeds 100-109 (real runs, budget 300) the
-  portfolio went from 9 to 10 seeds of 10 >= random (median worst 0.8926 to 0.9033; random 0.8275).
-  On the bench's own seeds 0-9, run once afterwards: >= random in 9 of 10 at budget 100 (median
-  0.8567 against 0.7665; 8 of 10 before) and 8 of 10 at 300 (0.8957 against 0.8397; 7 of 10 before),
-  still short of 9 of 10 there (seed 0: 0.7778 against 0.8423; seed 5: 0.8648 against 0.8680); over
-  signals 9 and 10 of 10 (medians 0.3910 and 0.3978; 10 and 10 before, at 0.3907 and 0.3937).
-  On the synthetic objectives below (20 seeds, median fraction of the true worst, the portfolio
-  before against after) the screening changes nothing on the bumps and mixtures at budgets 64 and
-  100 (their vertices show no significant effect there) and gains on the linear objective in 6-D
-  (64: 0.878 against 0.898; 100: 0.897 against 0.919); at 300, with the long local phase, every
-  objective gains a little (bump 5-D 0.993 against 0.999, 6-D 0.984 against 0.996; mixture 5-D
-  0.810 against 0.818, 6-D 0.781 against 0.802; linear 6-D 0.974 against 0.986). The long local
-  phase at budgets 64 and 100 lost on the bumps and mixtures (bump 5-D/100: 0.837 against 0.547 with
-  a step of 0.02 and three tenths of the budget; 0.738 with 0.02 and a fifth), hence the split at
-  200 runs.
-  The cap of 32 vertices and the first local phase were chosen on C's path too:
-  there the earlier portfolio (all 64 vertices at a budget of 300, no local phase) was >= random
-  sampling in 8 of ``bench/bench_falsify.py --spaces paths``'s 10 seeds at budget 100 and only 7 of
-  10 at 300, while its 64 vertices reach only 0.6815 of E_max. Tuned on other seeds (100-109,
-  ``--first-seed 100``; m1, 4 knots and the hold, 20 s runs), the portfolio as it is now was >=
-  random in 9 of 10 seeds at 300 (median worst 0.8926 against random's 0.8276) and 7 of 10 at 100
-  (0.8412 against 0.8151). On the bench's own seeds 0-9, run once afterwards (not tuned on), it is
-  >= random in 8 of 10 at budget 100 (median 0.8215 against 0.7665) but still only 7 of 10 at 300
-  (median 0.8764 against 0.8397; seeds 4, 5 and 9 lose: 0.8041 / 0.8521, 0.8673 / 0.8680, 0.8500
-  / 0.9003): the tuning seeds overstated the gain at 300. Over the full box it still reaches the
-  worst vertex at run 27 in every seed at budgets 64 and 100.
-  On the synthetic objectives (20 seeds; a bump of width 0.15 and a
-  mixture of 8 bumps of width 0.12, centres drawn per seed; median fraction of the true worst, the
-  earlier portfolio against this one) the local phase gains on interior maxima (bump 5-D/64: 0.326
-  against 0.540, 5-D/100: 0.738 against 0.848, 6-D/100: 0.705 against 0.779; mixture 5-D/100:
-  0.388 against 0.679, 6-D/100: 0.349 against 0.528, 6-D/300: 0.752 against 0.847) and the linear
-  (vertex) objective loses a little in 6-D at 300, where 32 of the 64 vertices are run (1.0 against
-  0.970; unchanged at d = 5). Measured there and not kept: twice or four times CMA-ES's population
-  (the earlier portfolio, bump 6-D/300: 0.936 and 0.724 against 0.983; mixture 6-D/300: 0.616 and
-  0.413 against 0.752), a Latin hypercube of a quarter of
-  the budget before CMA-ES (bump 5-D/100: 0.480), a local phase of a tenth or a third of the budget
-  or with a step of 0.02 or 0.1 (no better overall), BIPOP-style alternation (no restart happened
-  within these budgets).
-  On smooth synthetic objectives ``lhs-polish`` does as well or better than the portfolio before
-  its local phase (bump 6-D/100: 0.916; mixture 5-D/100: 0.818 against its 0.572): Nelder-Mead is
-  strong on smooth bumps. Over C's path, which is rough, no polish beat random sampling (below).
+  step 0.05 of each range, below 200 runs, the last three tenths, step 0.02, from 200 on, where the
+  second half of it (:func:`portfolio_coordinate_runs`) is coordinate moves of the worst point found
+  instead: each parameter moved with probability 1/d (at least one), by a normal step of 0.05 of its
+  range (:data:`PORTFOLIO_COORDINATE_STEP`), a generation's worth per batch, the worst found taken
+  anew before each batch. Over C's path the high values lie on thin ridges (two adjacent curvature
+  knots about 0.075 1/m apart), which a move of the coordinates off a ridge's normal stays on.
+  How each part was measured and chosen, on synthetic objectives with known worst cases and on C's
+  path with tuning seeds other than the bench's, and what else was tried: the benchmarks guide
+  (``docs/guides/benchmarks.md``, "How the portfolio was chosen").
 - ``cma``: CMA-ES alone, from the box's centre (the portfolio without the vertices).
 - ``vertices-polish``: the box's 2^d vertices first, as one batch, where the budget allows them
   (else a fractional-factorial covering of them, :func:`covering_design`), then scipy's
@@ -189,6 +111,7 @@ __all__ = [
     "cma_population",
     "portfolio_vertices",
     "portfolio_global_runs",
+    "portfolio_coordinate_runs",
     "search_worst",
     "random_worst",
     "falsify",
@@ -497,11 +420,11 @@ CMA_SIGMA0 = 0.3
 #: PORTFOLIO_MAX_VERTICES (a monotone worst case is then found exactly: the full box, d = 5, at any budget >= 64) ...
 PORTFOLIO_VERTEX_SHARE = 0.5
 PORTFOLIO_MAX_VERTICES = 32
-#: ... else a covering of at most this share of the budget (measured: module docstring). C's path (d = 6) at a budget
-#: of 300: 32 of its 64 vertices, not all 64.
+#: ... else a covering of at most this share of the budget (measured: the benchmarks guide). C's path (d = 6)
+#: at a budget of 300: 32 of its 64 vertices, not all 64.
 PORTFOLIO_COVER_SHARE = 0.125
 #: The last share of the budget is a local CMA-ES around the worst point found, its step a share of each range
-#: (measured: module docstring): (share of the budget, step) below PORTFOLIO_LONG_BUDGET runs ...
+#: (measured: the benchmarks guide): (share of the budget, step) below PORTFOLIO_LONG_BUDGET runs ...
 PORTFOLIO_LOCAL_SHORT = (0.2, 0.05)
 #: ... and from there on, where the global phase has had its runs: a longer, finer local phase.
 PORTFOLIO_LOCAL_LONG = (0.3, 0.02)
@@ -513,6 +436,12 @@ PORTFOLIO_SCREEN_SHIFT = 0.25
 #: From PORTFOLIO_LONG_BUDGET runs on, the global phase is this many independent CMA-ES runs from the same start,
 #: equal in whole generations (below it, one): on a rough objective one run's mean can wander off to a poorer region.
 PORTFOLIO_GLOBAL_RUNS_LONG = 2
+#: From PORTFOLIO_LONG_BUDGET runs on, this share of the local phase (its end) is coordinate moves of the worst point
+#: found: each member moves each coordinate with probability 1/d (at least one) by a normal step of
+#: PORTFOLIO_COORDINATE_STEP of its range. On C's path the high values lie on thin ridges (two adjacent knots a set
+#: step apart): a move of the coordinates off a ridge's normal stays on it, an isotropic step seldom does.
+PORTFOLIO_COORDINATE_SHARE = 0.5
+PORTFOLIO_COORDINATE_STEP = 0.05
 
 
 def portfolio_local_phase(budget: int) -> tuple[float, float]:
@@ -529,6 +458,18 @@ def portfolio_global_runs(d: int, budget: int, population: int | None = None) ->
     lam = cma_population(d) if population is None else population
     runs = PORTFOLIO_GLOBAL_RUNS_LONG if budget >= PORTFOLIO_LONG_BUDGET else 1
     return max(1, min(runs, portfolio_phases(d, budget, lam)[1] // lam))
+
+
+def portfolio_coordinate_runs(d: int, budget: int, population: int | None = None) -> int:
+    """How many of the portfolio's local runs (:func:`portfolio_phases`' last) are coordinate moves of the worst
+    point found, at the end: none below :data:`PORTFOLIO_LONG_BUDGET` runs, else what is left after the local
+    CMA-ES has :data:`PORTFOLIO_COORDINATE_SHARE`'s complement of them in whole generations of ``population``
+    (default :func:`cma_population`)."""
+    lam = cma_population(d) if population is None else population
+    local = portfolio_phases(d, budget, lam)[2]
+    if budget < PORTFOLIO_LONG_BUDGET or PORTFOLIO_COORDINATE_SHARE <= 0.0:
+        return 0
+    return local - int((1.0 - PORTFOLIO_COORDINATE_SHARE) * local) // lam * lam
 
 
 def portfolio_phases(d: int, budget: int, population: int | None = None) -> tuple[int, int, int]:
@@ -607,7 +548,11 @@ def _search_cma(evaluate: Callable[[np.ndarray], np.ndarray], bounds: np.ndarray
     3. (portfolio) The local phase: CMA-ES from the worst point found, its step
        (:func:`portfolio_local_phase`) of each range, the first population (restarted there when it
        stops), to the budget; none where the global phase would have no whole generation before it
-       (tiny budgets). The last generation of each phase is cut to the budget.
+       (tiny budgets). From 200 runs on the local CMA-ES ends early, in whole generations, and the
+       rest (:func:`portfolio_coordinate_runs`) is coordinate moves: batches of ``population`` copies
+       of the worst point found so far, each with every coordinate moved with probability 1/d (at
+       least one) by a normal step of :data:`PORTFOLIO_COORDINATE_STEP`, clipped to the box. The last
+       generation of each phase is cut to the budget.
 
     In one dimension (which ``cmaes`` does not take) it searches a square whose second coordinate
     is ignored. Deterministic for a seed (``cmaes`` keeps its own generator, seeded from it).
@@ -646,8 +591,9 @@ def _search_cma(evaluate: Callable[[np.ndarray], np.ndarray], bounds: np.ndarray
     generations = (global_end - rec.spent) // lam0
     runs = portfolio_global_runs(d, budget, lam0) if vertices else 1
     run_ends = [rec.spent + generations * (i + 1) // runs * lam0 for i in range(runs - 1)] + [global_end]
+    local_end = budget - (portfolio_coordinate_runs(d, budget, lam0) if vertices else 0)
     mean, lam, sigma = start, lam0, CMA_SIGMA0
-    while rec.spent < budget:
+    while rec.spent < local_end:
         if rec.spent >= global_end:  # the local phase (and its restarts): around the worst point found
             mean, lam, sigma = np.clip(incumbent(), 0.0, 1.0), lam0, local_sigma
         elif rec.spent >= run_ends[0]:  # the global phase's next independent run, from the same start
@@ -655,7 +601,7 @@ def _search_cma(evaluate: Callable[[np.ndarray], np.ndarray], bounds: np.ndarray
             mean, lam, sigma = start, lam0, CMA_SIGMA0
         opt = CMA(mean=mean, sigma=sigma, bounds=np.array([[0.0, 1.0]] * n), population_size=lam,
                   seed=int(rng.integers(2 ** 31 - 1)))
-        end = run_ends[0] if rec.spent < global_end else budget
+        end = run_ends[0] if rec.spent < global_end else local_end
         while rec.spent < end:
             xs = np.array([opt.ask() for _ in range(opt.population_size)])
             k = min(len(xs), end - rec.spent)
@@ -666,6 +612,14 @@ def _search_cma(evaluate: Callable[[np.ndarray], np.ndarray], bounds: np.ndarray
             if opt.should_stop():
                 break
         mean, lam = rng.uniform(0.0, 1.0, n), 2 * lam  # IPOP restart (of the global phase)
+    while rec.spent < budget:  # coordinate moves of the worst point found, a generation's worth per batch
+        k = min(lam0, budget - rec.spent)
+        moved = rng.random((k, d)) < 1.0 / d
+        unmoved = ~moved.any(axis=1)
+        moved[unmoved, rng.integers(d, size=int(unmoved.sum()))] = True  # at least one coordinate each
+        xs = np.repeat(incumbent()[None, :], k, axis=0)
+        xs[:, :d] += np.where(moved, PORTFOLIO_COORDINATE_STEP * rng.standard_normal((k, d)), 0.0)
+        run(np.clip(xs, 0.0, 1.0))
     return rec.trace()
 
 
