@@ -465,10 +465,10 @@ def portfolio_coordinate_runs(d: int, budget: int, population: int | None = None
     point found, at the end: none below :data:`PORTFOLIO_LONG_BUDGET` runs, else what is left after the local
     CMA-ES has :data:`PORTFOLIO_COORDINATE_SHARE`'s complement of them in whole generations of ``population``
     (default :func:`cma_population`)."""
-    lam = cma_population(d) if population is None else population
-    local = portfolio_phases(d, budget, lam)[2]
     if budget < PORTFOLIO_LONG_BUDGET or PORTFOLIO_COORDINATE_SHARE <= 0.0:
         return 0
+    lam = cma_population(d) if population is None else population
+    local = portfolio_phases(d, budget, lam)[2]
     return local - int((1.0 - PORTFOLIO_COORDINATE_SHARE) * local) // lam * lam
 
 
