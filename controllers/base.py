@@ -84,8 +84,31 @@ class BuildContext:
         kp, kd: the run's K_P [1/s^2], K_D [1/s] (a law with a PD servo of its own may take them).
     """
 
+    #: the attributes that carry a run's settings (``--model``, ``--kp``, ``--kd``); reading one is recorded
+    SETTINGS = ("model", "kp", "kd")
+
     def __init__(self, *, model: SteeringModel, estimate: Any, voltage_limit: float, kp: float, kd: float) -> None:
-        self.model, self.estimate, self.voltage_limit, self.kp, self.kd = model, estimate, voltage_limit, kp, kd
+        self.estimate, self.voltage_limit = estimate, voltage_limit
+        self._settings = {"model": model, "kp": kp, "kd": kd}
+        #: the settings the law read while it was built (names of :data:`SETTINGS`): the run's options that
+        #: reach it, and the only ones its outputs report as the law's
+        self.read: set[str] = set()
+
+    def _setting(self, name: str) -> Any:
+        self.read.add(name)
+        return self._settings[name]
+
+    @property
+    def model(self) -> SteeringModel:
+        return self._setting("model")
+
+    @property
+    def kp(self) -> float:
+        return self._setting("kp")
+
+    @property
+    def kd(self) -> float:
+        return self._setting("kd")
 
 
 class SteeringController:

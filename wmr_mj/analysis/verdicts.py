@@ -197,6 +197,10 @@ def _num(x: Any, spec: str = ".5g") -> str:
     return "n/a" if x is None or (isinstance(x, float) and not math.isfinite(x)) else format(x, spec)
 
 
+#: What every output says of the paper's region for a law outside the paper's family.
+PAPER_CLAIM_NOT_APPLICABLE = "not applicable (its region is for the paper's computed-torque law, not this one)"
+
+
 def format_verdict(summary: Mapping[str, Any]) -> list[str]:
     """Text lines of a judged run summary: the verdict first, then both regions and the drift.
 
@@ -233,9 +237,12 @@ def format_verdict(summary: Mapping[str, Any]) -> list[str]:
     lines.append(f"certificate:   |E| <= {_num(cert.get('E_max'))} rad, |E'| <= {_num(cert.get('Edot_max'))} rad/s"
                  f", (4.23) = {_num(cert.get('condition'), '.4f')}, run "
                  f"{'inside' if cert.get('inside') else 'OUTSIDE'}")
-    lines.append(f"paper's claim: |E| <= {_num(paper.get('E_max'))} rad, |E'| <= {_num(paper.get('Edot_max'))} rad/s"
-                 f", (4.23) = {_num(paper.get('condition'), '.4f')}, run "
-                 f"{'inside' if paper.get('inside') else 'OUTSIDE'}")
+    if summary.get("paper_claim_applies") is False:
+        lines.append(f"paper's claim: {PAPER_CLAIM_NOT_APPLICABLE}")
+    else:
+        lines.append(f"paper's claim: |E| <= {_num(paper.get('E_max'))} rad, |E'| <= "
+                     f"{_num(paper.get('Edot_max'))} rad/s, (4.23) = {_num(paper.get('condition'), '.4f')}, run "
+                     f"{'inside' if paper.get('inside') else 'OUTSIDE'}")
     if dr:
         lines.append(f"drift: final alpha' = {_num(dr.get('final_alpha_dot'), '.3g')} rad/s, |E| "
                      f"{'STILL GROWING' if dr.get('growing') else 'not growing'} over the last "

@@ -129,6 +129,10 @@ def config_from_args(args: argparse.Namespace, **extra):
     tracker_params = parse_params(getattr(args, "tracker_param", None), option="--tracker-param")
     if bool(getattr(args, "correction", False)) and tracker not in (None, "stanley-at-C"):
         raise ParameterError(f"--correction is the tracker stanley-at-C; give it or --tracker {tracker}, not both")
+    settings = {"model": model, "kp": kp, "kd": kd, "friction_sign": friction_sign, "friction_width": friction_width}
+    controller_params = _law_options(args, controller, controller_params, settings, design)
+    model, kp, kd = settings["model"], settings["kp"], settings["kd"]
+    friction_sign, friction_width = settings["friction_sign"], settings["friction_width"]
     return RunConfig(controller=controller, controller_params=controller_params, tracker=tracker,
                      tracker_params=tracker_params, model=model, duration=args.duration,
                      control_period=args.control_period, kp=kp, kd=kd, friction_sign=friction_sign,
@@ -139,6 +143,59 @@ def config_from_args(args: argparse.Namespace, **extra):
                      tyre_contact=args.tyre_contact, box_ranges=box_ranges_from_args(args),
                      correction=bool(getattr(args, "correction", False)),
                      reference_bounds=getattr(args, "reference_bounds", None), **extra)
+
+
+#: the run options that configure a steering law, and the RunConfig fields they set
+_LAW_OPTIONS = {"--model": ("model",), "--kp": ("kp",), "--kd": ("kd",), "--omega-r": ("kp", "kd"),
+                "--friction-sign": ("friction_sign",), "--friction-width": ("friction_width",)}
+
+
+def _law_options(args: argparse.Namespace, controller: str, params: dict, settings: dict, design) -> dict:
+    """The explicit law options (--model, --kp, --kd, --omega-r, --friction-sign, --friction-width) of a law
+    other than computed-torque: each goes to the law as the parameter of that name where it declares one
+    (its constructor or from_context: moved from ``settings`` into the returned parameters, ``settings``
+    keeping the preset's value), stays a RunConfig setting where its build reads it from the context
+    (``BuildContext``: model, kp, kd), and is refused otherwise. A preset's own values are never refused.
+
+    Raises:
+        ParameterError: an option the law neither declares nor reads (one line naming what it takes), or
+            one given both as an option and as --controller-param.
+    """
+    from controllers.computed_torque import CONTROLLER_NAMES
+    from wmr_mj.errors import ParameterError
+    from wmr_mj.params import C80
+    from wmr_mj.sim.config import RunConfig, controller_and_settings, declared_parameters, estimate_parameters
+
+    given = {option: fields for option, fields in _LAW_OPTIONS.items()
+             if getattr(args, option[2:].replace("-", "_"), None) is not None}
+    if not given or controller == "computed-torque":
+        return params
+    if controller in CONTROLLER_NAMES:  # pd: fields, as computed-torque, but no Coulomb compensation
+        declared: frozenset[str] = frozenset()
+        reads = frozenset({"model", "kp", "kd"})
+    else:
+        declared = declared_parameters(controller) - {"model"}  # a model is the context's, never a parameter
+        preset_values = {k: getattr(design, k) for k in settings}
+        probe = RunConfig(controller=controller, controller_params=params, model=preset_values["model"]
+                          if preset_values["model"] != "identified" else "paper", kp=design.kp, kd=design.kd)
+        reads = controller_and_settings(probe, estimate_parameters(C80))[1]
+    out = dict(params)
+    for option, fields in given.items():
+        passed = [f for f in fields if f in declared]
+        if passed and len(passed) == len(fields):
+            for f in fields:
+                if f in out:
+                    raise ParameterError(f"{option} and --controller-param {f}=... both set {f}; give one")
+                out[f] = settings[f]
+                settings[f] = getattr(design, f)  # the RunConfig field the law does not read keeps the preset's
+            continue
+        if all(f in reads for f in fields):
+            continue
+        takes = sorted(declared - {"self"})
+        raise ParameterError(
+            f"{option} does not apply to controller {controller!r}: it reads no {'/'.join(fields)}; give its own "
+            f"parameters with --controller-param NAME=VALUE (it takes: {', '.join(takes) or 'none'})")
+    return out
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -281,18 +338,20 @@ def format_report(s: RunSummary) -> str:
         params = ", ".join(f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}"
                            for k, v in (s.controller_config or {}).items()
                            if k != "controller" and not isinstance(v, (dict, list)))
-        who = (f"controller {s.controller} ({params or 'no parameters'}), plant m1 = {s.m1:g} kg (the paper's "
-               "region is for its own law: shown, not judged)")
+        who = f"controller {s.controller} ({params or 'no parameters'}), plant m1 = {s.m1:g} kg"
     rate = "" if s.realtime_factor is None else f" ({s.realtime_factor:.0f}x real time)"
+    # a run that ended before the entry transient did has no samples after it: n/a, not the empty sup's 0
+    settled = s.duration > s.settle_s
+    paper = (lambda bound, r: f" {bound:12.5g} {ratio(r):>8s}") if s.paper_law else (lambda bound, r: "")
     lines = [
         f"{who}, {s.duration:g} s, {s.steps} steps in {s.wall_s:.2f} s{rate}",
         *format_verdict(s.to_dict()),
-        f"{'':22s} {'whole run':>12s} {after:>12s} {'certificate':>12s} {'ratio':>8s} {'paper':>12s} {'ratio':>8s}",
-        f"{'sup|E|   [rad]':22s} {s.sup_E:12.5g} {s.sup_E_settled:12.5g} {num(cert_E_max):>12s} "
-        f"{ratio(cert_E_ratio):>8s} {s.E_max:12.5g} {ratio(s.E_ratio):>8s}",
-        f"{'sup|E|dot [rad/s]':22s} {s.sup_Edot:12.5g} {s.sup_Edot_settled:12.5g} "
-        f"{num(cert_Edot_max):>12s} {ratio(cert_Edot_ratio):>8s} {s.Edot_max:12.5g} "
-        f"{ratio(s.Edot_ratio):>8s}",
+        f"{'':22s} {'whole run':>12s} {after:>12s} {'certificate':>12s} {'ratio':>8s}"
+        + (f" {'paper':>12s} {'ratio':>8s}" if s.paper_law else ""),
+        f"{'sup|E|   [rad]':22s} {s.sup_E:12.5g} {num(s.sup_E_settled if settled else None):>12s} "
+        f"{num(cert_E_max):>12s} {ratio(cert_E_ratio):>8s}" + paper(s.E_max, s.E_ratio),
+        f"{'sup|E|dot [rad/s]':22s} {s.sup_Edot:12.5g} {num(s.sup_Edot_settled if settled else None):>12s} "
+        f"{num(cert_Edot_max):>12s} {ratio(cert_Edot_ratio):>8s}" + paper(s.Edot_max, s.Edot_ratio),
         f"voltage saturated {100 * s.saturated_fraction:.1f}% of the time",
     ]
     if s.path_error is not None:

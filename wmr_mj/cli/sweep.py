@@ -99,7 +99,9 @@ def run(args: argparse.Namespace) -> int:
           f"worst sup|E'|/Edot_max = {fmt(runs.certificate_Edot_ratio.value)}; "
           f"{runs.growing} runs with |E| still growing at the end")
     if estimate_of(law) is None:
-        print("paper's claim: not applicable (its region is for the paper's computed-torque law, not this one)")
+        from wmr_mj.analysis.verdicts import PAPER_CLAIM_NOT_APPLICABLE
+
+        print(f"paper's claim: {PAPER_CLAIM_NOT_APPLICABLE}")
     else:
         print(f"paper's claim: {runs.paper_inside} inside, {runs.n - runs.paper_inside} outside its region; "
               f"worst sup|E|/E_max = {fmt(runs.paper_E_ratio.value)}, "

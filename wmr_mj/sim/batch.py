@@ -503,7 +503,7 @@ def _summaries(configs: Sequence[RunConfig], plants: Sequence[C80Parameters], st
             r = dataclasses.replace(serial, analysis=None, controller_config=None)  # report's fields and the warnings
         else:
             r = dataclasses.replace(r, mujoco_warnings=int(stats.warnings[i]), paper_law=run.parts.paper_law,
-                                    route=progress)
+                                    law_settings=run.parts.law_settings, route=progress)
         r = dataclasses.replace(r, batch=BatchFigures(
             final_alpha_after_step=float(stats.final_alpha_after_step[i]),  # the serial run reports the last row
             # batch-level figures for benchmarks

@@ -441,7 +441,7 @@ def run_parts(parts: RunParts, *, logger_factory: Callable[..., Any] | None = No
     if outer is not None:
         summary = dataclasses.replace(summary, correction=outer.describe(done))
     summary = dataclasses.replace(summary, mujoco_warnings=run.warnings, failure=run.failure,
-                                  paper_law=parts.paper_law,
+                                  paper_law=parts.paper_law, law_settings=parts.law_settings,
                                   analysis=analysis.as_dict(), controller_config=controller.describe())
     from wmr_mj.reference.route import route_progress
 

@@ -34,6 +34,9 @@ __all__ = [
     "plant_parameters",
     "estimate_parameters",
     "controller_for",
+    "controller_and_settings",
+    "declared_parameters",
+    "LAW_SETTINGS",
     "tracker_for",
     "has_tracker",
     "plugin_source",
@@ -401,13 +404,51 @@ def controller_for(config: RunConfig, params: C80Parameters) -> SteeringControll
         ParameterError: a plug-in that cannot be built (a parameter it does not take, a factory that
             returns no SteeringController).
     """
+    return controller_and_settings(config, params)[0]
+
+
+#: The RunConfig fields that configure a steering law beside its own parameters (``--model``, ``--kp``,
+#: ``--kd``, ``--friction-sign``, ``--friction-width``): the computed-torque law reads them all.
+LAW_SETTINGS = ("model", "kp", "kd", "friction_sign", "friction_width")
+#: The ones the PD law reads (it has no Coulomb compensation).
+_PD_SETTINGS = ("model", "kp", "kd")
+
+
+def controller_and_settings(config: RunConfig, params: C80Parameters) -> tuple[SteeringController, frozenset[str]]:
+    """:func:`controller_for`, and the names of :data:`LAW_SETTINGS` the law reads: all of them for the
+    computed-torque law, model, kp and kd for PD; for a law built by name, those of its build context
+    (``controllers.base.BuildContext``) its ``from_context`` read; none for an object or a factory.
+    Only these describe the law in its outputs (the others' values were never used)."""
     given = config.controller
     model = model_from_source(config.model, params=params, identified=config.identified,
                               coefficients=config.coefficients)
     if isinstance(given, str) and given in CONTROLLER_NAMES:
-        return make_controller(given, model, kp=config.kp, kd=config.kd,
-                               friction_sign=config.friction_sign, friction_width=config.friction_width)
-    return _plugin_for(config, params, "controller", given, config.controller_params, SteeringController, model)
+        law = make_controller(given, model, kp=config.kp, kd=config.kd,
+                              friction_sign=config.friction_sign, friction_width=config.friction_width)
+        return law, frozenset(_PD_SETTINGS if given == "pd" else LAW_SETTINGS)
+    read: set[str] = set()
+    law = _plugin_for(config, params, "controller", given, config.controller_params, SteeringController, model,
+                      read=read)
+    return law, frozenset(read)
+
+
+def declared_parameters(spec: str) -> frozenset[str]:
+    """The keyword parameters the law named ``spec`` (a built-in name, FILE.py:Class, module:Class) declares
+    in its constructor or its ``from_context`` (which a run's ``controller_params`` may set)."""
+    import inspect
+
+    from controllers.registry import resolve
+
+    cls, _ = resolve(spec, kind="controller")
+    names: set[str] = set()
+    for fn in (cls, cls.from_context):
+        try:
+            sig = inspect.signature(fn)
+        except (TypeError, ValueError):
+            continue
+        names.update(n for n, p in sig.parameters.items()
+                     if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY) and n not in ("self", "cls", "context"))
+    return frozenset(names)
 
 
 def tracker_for(config: RunConfig, params: C80Parameters):
@@ -422,10 +463,11 @@ def tracker_for(config: RunConfig, params: C80Parameters):
 
 
 def _plugin_for(config: RunConfig, params: C80Parameters, kind: str, given: Any, plugin_params: Mapping[str, Any],
-                base: type, model: Any = None) -> Any:
+                base: type, model: Any = None, read: set[str] | None = None) -> Any:
     """A fresh instance of a plug-in (law or tracker): an object deep-copied, a name resolved and built with its
     parameters on the run's context (``model``: the run's reduced model, built here where None), a factory
-    called; checked to be a ``base``."""
+    called; checked to be a ``base``. ``read``: a set given here receives the context's settings the build
+    read (``BuildContext.read``)."""
     import copy
 
     from controllers.base import BuildContext
@@ -441,6 +483,8 @@ def _plugin_for(config: RunConfig, params: C80Parameters, kind: str, given: Any,
         context = BuildContext(model=model, estimate=params, voltage_limit=params.voltage_limit, kp=config.kp,
                                kd=config.kd)
         built = build(cls, plugin_params, context, spec=given, kind=kind)
+        if read is not None:
+            read.update(context.read)
     else:
         built = given()
     if not isinstance(built, base):

@@ -27,7 +27,7 @@ from wmr_mj.sim.config import (
     RunConfig,
     analysis_for,
     build_reference,
-    controller_for,
+    controller_and_settings,
     controller_name,
     estimate_of,
     estimate_parameters,
@@ -72,6 +72,7 @@ class RunParts:
         analysis: the paper's analysis for the run's box, gains and reference bounds.
         claim: the law's own claim (a Certificate), None where it states none.
         paper_law: the law is the paper's family (computed torque, PD): the paper's region applies to it.
+        law_settings: the RunConfig settings the law reads (``controller_and_settings``: model, kp, kd, ...).
     """
 
     config: RunConfig
@@ -90,6 +91,7 @@ class RunParts:
     analysis: Any
     claim: Certificate | None
     paper_law: bool = True
+    law_settings: frozenset[str] | None = None
 
 
 def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
@@ -103,7 +105,7 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
 
     plant = plant_parameters(config, base)
     estimate = estimate_parameters(base)
-    controller = controller_for(config, estimate)
+    controller, law_settings = controller_and_settings(config, estimate)
     tracker = tracker_for(config, estimate)
     substeps = control_substeps(config)
     period = substeps * TIMESTEP
@@ -116,4 +118,5 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
     return RunParts(config=config, base=base, plant=plant, estimate=estimate, controller=controller,
                     controller_name=controller_name(config), tracker=tracker, reference=reference,
                     settle_s=settle_s, substeps=substeps, period=period, n=n, options=plant_options(config),
-                    analysis=analysis, claim=claim, paper_law=paper_estimate is not None)
+                    analysis=analysis, claim=claim, paper_law=paper_estimate is not None,
+                    law_settings=law_settings)

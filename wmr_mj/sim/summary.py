@@ -146,6 +146,9 @@ class RunSummary:
     failure: str | None = None  # status 'failed': why the law (or tracker) failed; the run has no verdict but this
     claimed: bool = True  # False: the controller states no claim (judged by its requirements only, never a pass)
     paper_law: bool = True  # False: the law is not the paper's family, so the paper's region says nothing of it
+    # the RunConfig settings (model, kp, kd, ...) the law reads (wmr_mj.sim.config.controller_and_settings);
+    # None: all of them (the computed-torque law, and a summary of a caller that did not say)
+    law_settings: frozenset[str] | None = None
 
     # the paper's claim, read through paper_region (the JSON also writes these at the top level)
     @property
@@ -195,6 +198,22 @@ class RunSummary:
         if not self.claimed:
             return NO_CLAIM
         return None if self.certificate is None else self.certificate.verdict
+
+    def _not_applicable(self) -> dict[str, Any]:
+        """For a law outside the paper's family: the paper's region's keys and the settings the law does not
+        read (model, kp, kd) as null, and ``not_applicable``, each such key's reason."""
+        law = f"controller {self.controller!r}"
+        region = f"the paper's region is for its computed-torque law (computed-torque, pd), not {law}"
+        out: dict[str, Any] = {k: None for k in (*PAPER_KEYS_DEPRECATED, *PAPER_KEYS_DEPRECATED.values(), "stable",
+                                                 "paper_region")}
+        reasons = {"paper_region": region}
+        read = self.law_settings
+        for key in ("model", "kp", "kd"):
+            if read is not None and key not in read:
+                out[key] = None
+                reasons[key] = f"{law} does not read the run's {key} (its own parameters: controller_config)"
+        out["not_applicable"] = reasons
+        return out
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON interface: every key the summary has always written, with the same values.
@@ -251,9 +270,10 @@ class RunSummary:
             out["failure"] = self.failure
         if not self.paper_law:
             out["paper_claim_applies"] = False  # the paper's region is for its computed-torque family only
+            out.update(self._not_applicable())
         if self.mujoco_warnings is not None:
             out["mujoco_warnings"] = self.mujoco_warnings
-        if self.analysis is not None:
+        if self.analysis is not None and self.paper_law:
             out["analysis"] = dict(self.analysis)
         if self.controller_config is not None:
             out["controller_config"] = dict(self.controller_config)
