@@ -75,11 +75,16 @@ def reproduce_command(config, params: dict[str, float], args: argparse.Namespace
     were written exactly)."""
     import shlex
 
+    from wmr_mj.sim.config import controller_and_settings, estimate_parameters
+
+    read = controller_and_settings(config, estimate_parameters())[1]  # only the settings the law reads
     parts = ["wmr-mj run", f"--preset {args.preset}", f"--controller {shlex.quote(str(config.controller))}",
-             f"--model {config.model}",
-             f"--kp {config.kp!r}", f"--kd {config.kd!r}", f"--friction-sign {config.friction_sign}",
-             f"--friction-width {config.friction_width!r}", f"--path {shlex.quote(path_file or config.path)}",
-             f"--duration {config.duration!r}", f"--m1 {config.m1!r}"]
+             *(f"--{name.replace('_', '-')} {value}" for name, value in (
+                 ("model", config.model), ("kp", repr(config.kp)), ("kd", repr(config.kd)),
+                 ("friction_sign", config.friction_sign), ("friction_width", repr(config.friction_width)))
+               if name in read),
+             f"--path {shlex.quote(path_file or config.path)}", f"--duration {config.duration!r}",
+             f"--m1 {config.m1!r}"]
     if args.identified:
         parts.append(f"--identified {args.identified}")
     for name, value in (config.coefficients or {}).items():

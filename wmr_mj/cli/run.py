@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from wmr_mj.cli._common import box_ranges_from_args, parse_assignments, positive_float, positive_int
 from wmr_mj.params import M1_NOMINAL
@@ -129,7 +129,8 @@ def config_from_args(args: argparse.Namespace, **extra):
     tracker_params = parse_params(getattr(args, "tracker_param", None), option="--tracker-param")
     if bool(getattr(args, "correction", False)) and tracker not in (None, "stanley-at-C"):
         raise ParameterError(f"--correction is the tracker stanley-at-C; give it or --tracker {tracker}, not both")
-    settings = {"model": model, "kp": kp, "kd": kd, "friction_sign": friction_sign, "friction_width": friction_width}
+    settings: dict[str, Any] = {"model": model, "kp": kp, "kd": kd, "friction_sign": friction_sign,
+                                "friction_width": friction_width}
     controller_params = _law_options(args, controller, controller_params, settings, design)
     model, kp, kd = settings["model"], settings["kp"], settings["kd"]
     friction_sign, friction_width = settings["friction_sign"], settings["friction_width"]
@@ -406,8 +407,10 @@ def run(args: argparse.Namespace) -> int:
             print(f"wmr-mj: the Python law ran ({result.law_note}); the numbers are the same, the run slower",
                   file=sys.stderr)
         else:
-            print(f"wmr-mj: controller {result.summary.controller!r} runs in Python in the engine, one call per "
-                  f"control step ({result.law_note})", file=sys.stderr)
+            from wmr_mj.sim.engine import law_path
+
+            print(f"wmr-mj: controller {result.summary.controller!r} runs {law_path(result.law)} ({result.law_note})",
+                  file=sys.stderr)
     elif result.law == "compiled":
         from wmr_mj.sim.config import plugin_source
 

@@ -98,7 +98,7 @@ def run(args: argparse.Namespace) -> int:
     print(f"certificate: worst sup|E|/E_max = {fmt(runs.certificate_E_ratio.value)}, "
           f"worst sup|E'|/Edot_max = {fmt(runs.certificate_Edot_ratio.value)}; "
           f"{runs.growing} runs with |E| still growing at the end")
-    if estimate_of(law) is None:
+    if estimate_of(law) is None or runs.paper_inside is None:
         from wmr_mj.analysis.verdicts import PAPER_CLAIM_NOT_APPLICABLE
 
         print(f"paper's claim: {PAPER_CLAIM_NOT_APPLICABLE}")
@@ -116,7 +116,9 @@ def run(args: argparse.Namespace) -> int:
                  else f"{req.min_robustness:+.5g} (run {req.run}, m1 = {req.m1:g} kg)")
         print(f"requirement {req.requirement}: {req.satisfied} hold, {req.violated} violated"
               + (f", {req.undefined} without a region" if req.undefined else "") + f"; least robustness {least}")
-    backend = f", {' and '.join(runs.batch_law)} law" if runs.batch_law else ""
+    from wmr_mj.sim.engine import law_path
+
+    backend = f"; the law ran {' and '.join(law_path(b) for b in runs.batch_law)}" if runs.batch_law else ""
     print(f"{runs.steps} steps in {wall:.1f} s ({summary['steps_per_s']:.3g} steps/s{backend})")
     print(f"table: {out / 'runs.csv'}\nplot:  {plot_path}")
     return 0

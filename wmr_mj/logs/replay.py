@@ -460,7 +460,9 @@ def replay_figure(log: RunLog, rep: dict[str, Any]):
             whose = f" ({cert['claimant']})" if cert.get("claimant") else ""
             d.add_patch(Polygon(np.asarray(cert_poly, float), closed=True, fc="C2", alpha=0.15, ec="C2", lw=1.2,
                                 label=f"certificate's region{whose}: verdict {(log.summary or {}).get('verdict')}"))
-        d.set(xlabel="|E| [rad]", ylabel="|E'| [rad/s]", title="(e) error plane: both regions")
+        own = (log.summary or {}).get("paper_claim_applies") is False
+        d.set(xlabel="|E| [rad]", ylabel="|E'| [rad/s]",
+              title="(e) error plane: the law's own claim" if own else "(e) error plane: both regions")
         d.set_xlim(left=0)
         d.set_ylim(bottom=0)
         for axis in (a, b, c):
@@ -469,13 +471,19 @@ def replay_figure(log: RunLog, rep: dict[str, Any]):
         _path_panels(ax[0, 2], ax[1, 2], path_of_log(log, settle), settle)
         for axis in (a, b, c, d):
             axis.legend(loc="best", fontsize=7, frameon=False)
-        cfg = log.config or {}
+        from wmr_mj.sim.summary import shown_config
+
+        cfg = shown_config(log.config or {}, log.summary)  # the law's own settings only
         bits = [f"{k}={cfg[k]}" for k in ("controller", "path", "model", "seed")
                 if k in cfg and not isinstance(cfg[k], (dict, list))]
         key = "inside_after_settle" if rep.get("inside_after_settle") is not None else "inside"
         verdict = {True: "inside the paper's claim", False: "outside the paper's claim", None: ""}[rep.get(key)]
         if verdict and key == "inside_after_settle":
             verdict += " after settling"
+        if (log.summary or {}).get("paper_claim_applies") is False:  # judged by its own claim only
+            claim = f"{cert['claimant']}'s" if cert.get("claimant") else "its own"
+            inside = cert.get("inside")
+            verdict = "" if inside is None else f"{'inside' if inside else 'outside'} {claim} claim"
         extra = [v for v in (rep.get("verdict"), verdict, "TRUNCATED" if log.truncated else "") if v]
         fig.suptitle(f"{Path(str(log.path)).name}: " + ", ".join(bits + extra), fontsize=10)
     return fig
@@ -502,7 +510,9 @@ def format_summary(rep: dict[str, Any]) -> str:
     if rep["truncated"]:
         lines.append(f"TRUNCATED  the file ends without its footer ({rep.get('truncated_reason')}): the run was "
                      "killed; what was flushed is shown")
-    cfg = rep["config"] or {}
+    from wmr_mj.sim.summary import shown_config
+
+    cfg = shown_config(rep["config"] or {}, rep.get("summary"))  # the law's own settings only
     scalars = [f"{k}={v}" for k, v in cfg.items() if isinstance(v, (str, int, float, bool)) or v is None]
     if scalars:
         lines.append("config     " + "  ".join(scalars))
@@ -520,7 +530,11 @@ def format_summary(rep: dict[str, Any]) -> str:
     if rep.get("max_abs_voltage") is not None:
         lines.append(f"voltage    max |u| = {_fmt(rep['max_abs_voltage'], 'V')}, saturated "
                      f"{100 * rep['voltage_saturated_fraction']:.1f}% of rows")
-    if rep["E_max"] is not None or rep["Edot_max"] is not None:
+    if (rep.get("summary") or {}).get("paper_claim_applies") is False:
+        from wmr_mj.analysis.verdicts import PAPER_CLAIM_NOT_APPLICABLE
+
+        lines.append(f"paper's claim {PAPER_CLAIM_NOT_APPLICABLE}")
+    elif rep["E_max"] is not None or rep["Edot_max"] is not None:
         def verdict(inside: Any, count: Any) -> str:
             return {True: "INSIDE", False: f"OUTSIDE ({count} samples)", None: "n/a"}[inside]
 
@@ -554,9 +568,13 @@ def format_summary(rep: dict[str, Any]) -> str:
         lines.append(f"path of C  n/a: {rep['path_errors_note']}")
     if rep["summary"]:
         # the paper's region under its own names only (a log written before they existed keeps the old ones)
-        from wmr_mj.sim.summary import PAPER_KEYS_DEPRECATED
+        from wmr_mj.sim.summary import PAPER_KEYS_DEPRECATED, PAPER_REGION_KEYS
 
         renamed = set(PAPER_KEYS_DEPRECATED) if "paper_E_max" in rep["summary"] else set()
+        # a law outside the paper's family: the keys it has no value for (the paper's region, settings it
+        # does not read) are null with a reason; not printed
+        renamed |= {k for k, v in rep["summary"].items() if v is None and (
+            k in PAPER_REGION_KEYS or k in (rep["summary"].get("not_applicable") or {}))}
         extra = {k: v for k, v in rep["summary"].items() if k not in ("status", "rows", "last_t") and k not in renamed}
         sc = [f"{k}={_fmt(v) if isinstance(v, float) else v}" for k, v in extra.items()
               if isinstance(v, (str, int, float, bool)) or v is None]

@@ -690,7 +690,7 @@ def figure_verdict_plane(sup_E: Sequence[float], sup_Edot: Sequence[float], verd
     return fig
 
 
-def figure_ladder(labels: Sequence[str], counts: Sequence[Mapping[str, int]], paper_inside: Sequence[int], *,
+def figure_ladder(labels: Sequence[str], counts: Sequence[Mapping[str, int]], paper_inside: Sequence[int | None], *,
                   title: str | None = None) -> Figure:
     """Verdict counts per rung as stacked horizontal bars (first rung on top), each with its
     count, and the runs inside the paper's claim beside each bar."""
@@ -709,6 +709,8 @@ def figure_ladder(labels: Sequence[str], counts: Sequence[Mapping[str, int]], pa
                         va="center", fontsize=7)
         left += widths
     for yi, k, total in zip(y, paper_inside, n):
+        if k is None:  # a law outside the paper's family: its region says nothing of the rung
+            continue
         ax.text(1.01 * max(n), yi, f"paper's claim: {k}/{total} inside", va="center", fontsize=7, color="#a04000")
     ax.set_yticks(y, labels)
     ax.set_xlim(0.0, 1.45 * max(n))

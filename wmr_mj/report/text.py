@@ -423,8 +423,9 @@ def _rung_finding(before: Mapping[str, Any], r: Mapping[str, Any]) -> str:
     cb, ca = before["certificate"], r["certificate"]
     cert = ("certificate: " + ("none" if not cb.get("certified") else f"E_max {_fmt(cb['E_max'])} rad") + " -> "
             + ("none" if not ca.get("certified") else f"E_max {_fmt(ca['E_max'], '.4g')} rad, all assumptions met"))
-    return (f"Rung {r['index']} ({r['change']}): certified-inside {step('passes')}, inside the paper's claim "
-            f"{step('paper_inside')}, at the stop {step('hit_stop')}, |E| growing {step('growing')} of {r['n']}; "
+    paper = "" if r["paper_inside"] is None else f", inside the paper's claim {step('paper_inside')}"
+    return (f"Rung {r['index']} ({r['change']}): certified-inside {step('passes')}{paper}, "
+            f"at the stop {step('hit_stop')}, |E| growing {step('growing')} of {r['n']}; "
             f"worst sup|E| {step('worst_sup_E', '.3g')} rad; {cert}.")
 
 

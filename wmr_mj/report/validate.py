@@ -165,8 +165,9 @@ def run_rung(settings: ValidateSettings, k: int, design: DesignLike, folder: Pat
                 certificate=certificate_summary(certificate_for(base, reference)),
                 paper_region=_paper_region(base, reference),
                 runs_csv=(sweep_dir / "runs.csv").relative_to(folder).as_posix())
-    st.done(f"{rung['passes']}/{rung['n']} certified-inside, {rung['paper_inside']}/{rung['n']} inside the "
-            f"paper's claim" + loud(rung["certified_outside"], f"rung {k}"))
+    paper = ("" if rung["paper_inside"] is None
+             else f", {rung['paper_inside']}/{rung['n']} inside the paper's claim")
+    st.done(f"{rung['passes']}/{rung['n']} certified-inside{paper}" + loud(rung["certified_outside"], f"rung {k}"))
     return rung
 
 

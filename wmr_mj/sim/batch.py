@@ -572,7 +572,7 @@ def _run_one_by_one(configs: Sequence[RunConfig], *, base: C80Parameters, progre
     steps = sum(s.steps for s, _, _ in done)
     return [dataclasses.replace(s, analysis=None, controller_config=None, batch=BatchFigures(
         final_alpha_after_step=math.nan, wall_s=wall, steps_per_s=steps / wall if wall > 0 else None, cpu_s=cpu,
-        law="compiled" if used == "compiled" else "numpy")) for s, used, _ in done]
+        law=used)) for s, used, _ in done]  # 'compiled' or 'python': one by one on the engine, as run
 
 
 # -- sweeps: chunks, resume, Dask ---------------------------------------------------------

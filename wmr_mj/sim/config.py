@@ -441,7 +441,7 @@ def declared_parameters(spec: str) -> frozenset[str]:
 
     cls, _ = resolve(spec, kind="controller")
     names: set[str] = set()
-    for fn in (cls, cls.from_context):
+    for fn in (cls, getattr(cls, "from_context", cls)):
         try:
             sig = inspect.signature(fn)
         except (TypeError, ValueError):

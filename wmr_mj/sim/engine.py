@@ -50,7 +50,8 @@ from wmr_mj.errors import ParameterError, UnknownNameError, WmrMjError
 from wmr_mj.params import C80Parameters
 from wmr_mj.sim import compiled_law
 
-__all__ = ["run_engine", "Schedule", "EngineRun", "batch_model", "batch_law_backend", "LAW_BACKENDS", "plant_options",
+__all__ = ["run_engine", "Schedule", "EngineRun", "batch_model", "batch_law_backend", "LAW_BACKENDS", "LAW_PATHS",
+           "law_path", "plant_options",
            "ROW_FIELDS", "LOAD_FIELDS", "load_fields", "ControllerFailure"]
 
 # scalar fields recorded for every control step (see wmr_mj.sim.closed_loop.RunResult.rows)
@@ -101,6 +102,18 @@ def batch_model(params: C80Parameters, *, law: tuple[Any, ...] | None = None,
     if law is not None:
         compiled_law.attach(spec, *law)
     return spec.compile()
+
+
+#: How a run's law was evaluated, in the words every output uses (``run``'s note, ``sweep``'s last line):
+#: 'compiled' (a batch or a run), 'numpy' (a batch's vectorised law), 'python' (one call per control step).
+LAW_PATHS = {"compiled": "compiled in MuJoCo's control callback",
+             "numpy": "in Python, vectorised with NumPy over the batch",
+             "python": "in Python in the engine, one call per control step"}
+
+
+def law_path(used: str) -> str:
+    """The words for how a law ran (:data:`LAW_PATHS`: 'compiled', 'numpy' or 'python'; else ``used``)."""
+    return LAW_PATHS.get(used, used)
 
 
 def batch_law_backend(controller: Any, law: str = "auto") -> str:

@@ -29,13 +29,16 @@ from wmr_mj.analysis.verdicts import FAILED, NO_CLAIM, Drift, PaperRegion
 from wmr_mj.reference.route import RouteProgress
 
 __all__ = ["RunSummary", "PaperRegion", "Drift", "CertificateJudgement", "Assumption", "BatchFigures",
-           "PAPER_KEYS_DEPRECATED"]
+           "PAPER_KEYS_DEPRECATED", "PAPER_REGION_KEYS", "shown_config"]
 
 
 #: The run summary's keys of the paper's region, deprecated (kept for one version, wmr-mj 0.1), and the
 #: names that replace them: unprefixed, they read as the verdict's, which is the certificate's.
 PAPER_KEYS_DEPRECATED = {"E_max": "paper_E_max", "Edot_max": "paper_Edot_max", "condition": "paper_condition",
                          "inside": "paper_inside", "E_ratio": "paper_E_ratio", "Edot_ratio": "paper_Edot_ratio"}
+
+#: A run summary's keys of the paper's region: null in the summary of a law outside the paper's family.
+PAPER_REGION_KEYS = (*PAPER_KEYS_DEPRECATED, *PAPER_KEYS_DEPRECATED.values(), "stable", "paper_region")
 
 
 @dataclass(frozen=True)
@@ -204,10 +207,11 @@ class RunSummary:
         read (model, kp, kd) as null, and ``not_applicable``, each such key's reason."""
         law = f"controller {self.controller!r}"
         region = f"the paper's region is for its computed-torque law (computed-torque, pd), not {law}"
-        out: dict[str, Any] = {k: None for k in (*PAPER_KEYS_DEPRECATED, *PAPER_KEYS_DEPRECATED.values(), "stable",
-                                                 "paper_region")}
+        out: dict[str, Any] = dict.fromkeys(PAPER_REGION_KEYS)
         reasons = {"paper_region": region}
         read = self.law_settings
+        if read is not None:
+            out["law_settings"] = sorted(read)  # the run's settings that reach the law (its config's others do not)
         for key in ("model", "kp", "kd"):
             if read is not None and key not in read:
                 out[key] = None
@@ -292,3 +296,14 @@ class RunSummary:
         if self.route is not None:
             out.update(self.route.to_dict())
         return out
+
+
+def shown_config(config: Mapping[str, Any], summary: Mapping[str, Any] | None) -> dict[str, Any]:
+    """A run's config (``RunConfig.as_dict()``) as its outputs show it: without the law settings (model, kp,
+    kd, friction_sign, friction_width) that the run's law does not read, as its summary records them
+    (``law_settings``); unchanged for the computed-torque and PD laws and for a summary that does not say."""
+    read = (summary or {}).get("law_settings")
+    if read is None:
+        return dict(config)
+    unread = {"model", "kp", "kd", "friction_sign", "friction_width"} - set(read)
+    return {k: v for k, v in config.items() if k not in unread}

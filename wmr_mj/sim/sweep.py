@@ -508,7 +508,8 @@ class SweepSummary:
     Attributes:
         n: number of runs.
         verdicts: the count of each verdict (``wmr_mj.analysis.verdicts.VERDICTS``, zeros included).
-        paper_inside: runs inside the paper's claim.
+        paper_inside: runs inside the paper's claim; None where no run has the paper's region (a law
+            outside the paper's family).
         sup_E: the worst sup|E| [rad].
         sup_Edot: the worst sup|E'| [rad/s].
         certificate_E_ratio: the worst sup|E|/E_max of the certificate [-].
@@ -532,7 +533,7 @@ class SweepSummary:
 
     n: int
     verdicts: Mapping[str, int]
-    paper_inside: int
+    paper_inside: int | None
     sup_E: Worst
     sup_Edot: Worst
     certificate_E_ratio: Worst
@@ -570,7 +571,9 @@ class SweepSummary:
         return cls(
             n=len(rows),
             verdicts=count_verdicts(str(r["verdict"]) for r in rows if r.get("verdict")),
-            paper_inside=sum(bool(r["inside"]) for r in rows),
+            # None: no run has the paper's region (a law outside the paper's family), so nothing to count
+            paper_inside=(sum(bool(r["inside"]) for r in rows) if any(r.get("inside") is not None for r in rows)
+                          else None),
             sup_E=Worst(*max_at(rows, "sup_E")),
             sup_Edot=Worst(*max_at(rows, "sup_Edot")),
             certificate_E_ratio=Worst(*max_at(rows, "cert_E_ratio")),
@@ -616,7 +619,7 @@ class SweepSummary:
             "certificate_Edot_max": self.certificate_Edot_max,
             "drift_growing": self.growing,
             "inside": self.paper_inside,
-            "outside": self.n - self.paper_inside,
+            "outside": None if self.paper_inside is None else self.n - self.paper_inside,
             "worst_E_ratio": self.paper_E_ratio.value,
             "worst_Edot_ratio": self.paper_Edot_ratio.value,
             "worst_sup_E": self.sup_E.value,
@@ -639,6 +642,10 @@ class SweepSummary:
         # the paper's region under names that say so (the unprefixed keys above: deprecated, kept one version)
         out.update({new: out[old] for old, new in SWEEP_KEYS_DEPRECATED.items()})
         out["deprecated_keys"] = dict(SWEEP_KEYS_DEPRECATED)
+        if self.paper_inside is None:
+            out["paper_claim_applies"] = False
+            out["not_applicable"] = {"paper_inside": "the paper's region is for its computed-torque law "
+                                                     "(computed-torque, pd), not this one: no run was judged by it"}
         return out
 
     def rung_dict(self) -> dict[str, Any]:
