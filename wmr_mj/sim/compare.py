@@ -37,10 +37,7 @@ from wmr_mj.plant.mjcf import TIMESTEP
 from wmr_mj.sim.config import (
     RunConfig,
     config_from_dict,
-    controller_for,
     controller_name,
-    estimate_parameters,
-    tracker_for,
 )
 from wmr_mj.sim.suite import Scenario, Suite, versions
 
@@ -68,8 +65,9 @@ def design_from_token(token: str, suite: Suite) -> Design:
     box = uncertainty_ranges(suite.adversary.uncertainty)
     m1_range = box.pop("m1")
     config = RunConfig(**design_changes(token), m1_range=m1_range, box_ranges=box, duration=suite.duration)
-    controller_for(config, estimate_parameters())  # built once: a parameter the law does not take, before any run
-    tracker_for(config, estimate_parameters())
+    from wmr_mj.sim.parts import resolve_run
+
+    resolve_run(config)  # built once: a parameter the law does not take, a claim() that raises, before any run
     return Design(label=str(token), config=config)
 
 

@@ -1,0 +1,86 @@
+"""Every command takes every law with a claim: robustness --certificate prints a law's own claim (the
+sliding-mode law's, a plug-in's) with the E_max that certificate_for computes; a claim() that raises or
+returns the wrong type is one line naming the law, exit status 2, before any step (run, sweep)."""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import pytest
+from test_cli_errors import _one_error_line, _tree
+
+from wmr_mj.cli.app import main
+from wmr_mj.params import C80
+from wmr_mj.sim.certify import certificate_for
+from wmr_mj.sim.config import RunConfig, build_reference
+from wmr_mj.sim.designs import CERTIFIED
+
+LAWS = Path(__file__).resolve().parent / "data" / "claim_laws.py"
+CLAIMED = f"{LAWS}:ClaimedPD"
+
+
+def _python_certificate(controller: str, **changes):
+    """certificate_for on the config `robustness --certificate --preset certified --controller ...` builds."""
+    config = RunConfig(**{**CERTIFIED.config_changes(), "controller": controller, **changes})
+    reference, _ = build_reference(config.path, C80, dt=1e-3, duration=config.duration)
+    return certificate_for(config, reference)
+
+
+def _printed(text: str, row: str) -> str:
+    (line,) = [ln for ln in text.splitlines() if ln.strip().startswith(row)]
+    return line
+
+
+@pytest.mark.parametrize("controller", ["sliding-mode", CLAIMED])
+def test_robustness_certificate_prints_a_law_s_own_claim(controller, capsys):
+    assert main(["robustness", "--certificate", "--preset", "certified", "--controller", controller]) == 0
+    text = capsys.readouterr().out
+    cert = _python_certificate(controller)
+    assert cert is not None and cert.region == "box"
+    # the printed E_max (4 significant digits) is the one certificate_for computes in Python
+    printed = float(re.search(r"\|E\| <= ([0-9.e+-]+) rad", _printed(text, "claim")).group(1))
+    assert printed == float(f"{cert.E_max:.4g}")
+    # every assumption, with its verdict
+    for a in cert.assumptions:
+        assert re.search(rf"\[{'met    ' if a.met else 'NOT met'}\] {re.escape(a.name)}\s", text), a.name
+    assert ("CERTIFIED:" in text) == cert.certified
+    assert f"Claim of controller {cert.claimant}" in text
+
+
+@pytest.mark.parametrize("controller", ["sliding-mode", CLAIMED])
+def test_robustness_certificate_json_of_a_law_s_own_claim(controller, capsys):
+    assert main(["robustness", "--certificate", "--preset", "certified", "--controller", controller, "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    cert = _python_certificate(controller)
+    assert out["E_max"] == cert.E_max and out["region"] == "box"
+    assert [a["name"] for a in out["assumptions"]] == [a.name for a in cert.assumptions]
+
+
+def test_robustness_certificate_of_a_law_without_a_claim_is_one_line(capsys):
+    assert main(["robustness", "--certificate", "--controller", "adaptive-computed-torque"]) == 2
+    assert "states no claim" in _one_error_line(capsys)
+
+
+@pytest.mark.parametrize("cls, name, error", [
+    ("ClaimDividesByZero", "claim-divides-by-zero", "claim() raised ZeroDivisionError"),
+    ("ClaimReturnsNumber", "claim-returns-number", "claim() returned float")])
+@pytest.mark.parametrize("command", ["run", "sweep"])
+def test_a_broken_claim_is_one_line_and_exit_2_before_any_step(command, cls, name, error, tmp_path, capsys):
+    argv = [command, "--controller", f"{LAWS}:{cls}", "--path", "lane-change", "--duration", "4"]
+    argv += ["--out", str(tmp_path / "out")] + (["--n", "2"] if command == "sweep" else [])
+    assert main(argv) == 2
+    line = _one_error_line(capsys)
+    assert error in line and f"controller {name!r}" in line
+    assert _tree(tmp_path) == []  # no log, no sweep folder: refused before any step
+
+
+def test_a_broken_claim_is_refused_by_compare_and_falsify(tmp_path, capsys):
+    spec = f"{LAWS}:ClaimDividesByZero"
+    assert main(["compare", spec, "--budget", "0", "--scenarios", "lane*", "--out", str(tmp_path / "c")]) == 2
+    assert "claim() raised ZeroDivisionError" in _one_error_line(capsys)
+    assert main(["falsify", "--controller", spec, "--budget", "8", "--path", "lane-change", "--duration", "4",
+                 "--out", str(tmp_path / "f")]) == 2
+    assert "claim() raised ZeroDivisionError" in _one_error_line(capsys)
+    assert _tree(tmp_path) == []
