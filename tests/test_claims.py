@@ -84,3 +84,39 @@ def test_a_broken_claim_is_refused_by_compare_and_falsify(tmp_path, capsys):
                  "--out", str(tmp_path / "f")]) == 2
     assert "claim() raised ZeroDivisionError" in _one_error_line(capsys)
     assert _tree(tmp_path) == []
+
+
+# --------------------------------------------------------------------------- provenance in every JSON
+def _expected_source(params: dict) -> dict:
+    """What the log records of ClaimedPD, the SHA-256 computed here from the file's bytes."""
+    import hashlib
+
+    return {"spec": CLAIMED, "name": "claimed-pd", "origin": "file", "import_path": f"{LAWS.resolve()}:ClaimedPD",
+            "params": params, "source_sha256": hashlib.sha256(LAWS.read_bytes()).hexdigest()}
+
+
+def test_run_json_names_the_plug_in_s_file_class_parameters_and_source_sha256(tmp_path, capsys):
+    assert main(["run", "--controller", CLAIMED, "--controller-param", "bound=0.08", "--path", "lane-change",
+                 "--duration", "4", "--no-log", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["controller_source"] == _expected_source({"bound": 0.08})
+    # the built-in laws built from the config's fields keep the keys they always had
+    assert main(["run", "--path", "lane-change", "--duration", "4", "--no-log", "--json"]) == 0
+    assert "controller_source" not in json.loads(capsys.readouterr().out)
+
+
+@pytest.mark.slow
+def test_sweep_falsify_and_compare_json_name_the_plug_in_s_source(tmp_path, capsys):
+    expected = _expected_source({})
+    assert main(["sweep", "--controller", CLAIMED, "--path", "lane-change", "--duration", "4", "--n", "2",
+                 "--out", str(tmp_path / "s"), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["controller_source"] == expected
+    assert json.loads((tmp_path / "s" / "summary.json").read_text())["controller_source"] == expected
+    assert main(["falsify", "--controller", CLAIMED, "--path", "lane-change", "--duration", "4", "--budget", "8",
+                 "--out", str(tmp_path / "f"), "--json"]) in (0, 1)
+    assert json.loads(capsys.readouterr().out)["controller_source"] == expected
+    assert json.loads((tmp_path / "f" / "falsify.json").read_text())["controller_source"] == expected
+    assert main(["compare", CLAIMED, "paper", "--budget", "0", "--scenarios", "lane/nominal/none", "--out",
+                 str(tmp_path / "c"), "--json"]) == 0
+    rows = json.loads(capsys.readouterr().out)["rows"]
+    assert rows[0]["controller_source"] == expected and rows[1]["controller_source"] is None

@@ -189,6 +189,9 @@ def run(args: argparse.Namespace) -> int:
     logged = run_logged(config, str(log_path))
     worst = result.worst
     summary = result.as_dict(log=str(log_path))
+    from wmr_mj.cli._common import add_controller_source
+
+    add_controller_source(summary, base)
     signals_file = path_file = None
     if config.signals is not None:  # the worst run's signals, every parameter: --signals takes them back
         signals_file = str(out / "worst-signals.json")

@@ -368,6 +368,9 @@ def run(args: argparse.Namespace) -> int:
     report = {**result.summary.to_dict(), "log": path, **({"requirements": judged} if judged else {})}
     if config.signals is not None:
         report["signals"] = config.signals.as_dict()  # every parameter: --signals takes it back
+    from wmr_mj.cli._common import add_controller_source
+
+    add_controller_source(report, config)
     if args.json:
         print_json(report)
     else:

@@ -71,6 +71,9 @@ def run(args: argparse.Namespace) -> int:
                     "ranges": {"m1": list(args.m1_range), **{k: list(v) for k, v in ranges.items()}}})
     if base.signals is not None:
         summary["signals"] = base.signals.as_dict()  # every run's, with every parameter
+    from wmr_mj.cli._common import add_controller_source
+
+    add_controller_source(summary, base)
     plot_path = _plot(results, runs, out / "region")
     summary["plot"] = str(plot_path)
     if args.log:

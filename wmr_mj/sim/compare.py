@@ -195,12 +195,16 @@ class DesignRow:
     cross_track_max: float | None  # [m] worst over scenarios
     cpu_us_per_step: float  # [us] median over scenarios
     law: str
+    # where the law comes from, as its log records it (controllers.registry.PluginSource.as_dict: file or
+    # module, class, parameters, source SHA-256); None for the laws built from RunConfig fields
+    controller_source: Mapping[str, Any] | None = None
 
     def as_dict(self) -> dict[str, Any]:
         from dataclasses import asdict
 
         out = asdict(self)
         out["adversary_where"] = dict(self.adversary_where)
+        out["controller_source"] = None if self.controller_source is None else dict(self.controller_source)
         return out
 
 
@@ -367,7 +371,15 @@ def _row(design: Design, runs: Sequence[ScenarioRun], adversary: Any, spec: Any)
         tv_voltage=float(np.mean([r.tv_voltage for r in runs])) if runs else math.nan,
         cross_track_max=max(cross) if cross else None,
         cpu_us_per_step=float(np.median([r.cpu_us_per_step for r in runs])) if runs else math.nan,
-        law="/".join(sorted({r.law for r in runs})))
+        law="/".join(sorted({r.law for r in runs})), controller_source=_source_of(design.config))
+
+
+def _source_of(config: RunConfig) -> dict[str, Any] | None:
+    """:func:`wmr_mj.sim.config.plugin_source` of the design's law as JSON (None: computed-torque, pd)."""
+    from wmr_mj.sim.config import plugin_source
+
+    source = plugin_source(config, "controller")
+    return None if source is None else source.as_dict()
 
 
 def runs_json(result: CompareResult) -> str:
