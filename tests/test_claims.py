@@ -120,3 +120,49 @@ def test_sweep_falsify_and_compare_json_name_the_plug_in_s_source(tmp_path, caps
                  str(tmp_path / "c"), "--json"]) == 0
     rows = json.loads(capsys.readouterr().out)["rows"]
     assert rows[0]["controller_source"] == expected and rows[1]["controller_source"] is None
+
+
+# --------------------------------------------------------------------------- built-ins that mean what they say
+def _run_config(argv: list[str]) -> RunConfig:
+    """The RunConfig `wmr-mj run ARGV` builds (its own parser and config_from_args)."""
+    from wmr_mj.cli.app import build_parser
+    from wmr_mj.cli.run import config_from_args
+
+    args = build_parser().parse_args(["run", *argv])
+    return config_from_args(args, m1=args.m1)
+
+
+def test_each_law_s_default_estimate_is_its_own_and_the_paper_default_is_unchanged():
+    from wmr_mj.sim.designs import PAPER
+
+    # the paper's design: RunConfig(), run with no option, run --controller computed-torque, compare's token
+    from wmr_mj.sim.designs import design_changes
+
+    paper = RunConfig(**PAPER.config_changes())
+    assert RunConfig() == paper == RunConfig(controller="computed-torque") == _run_config([])
+    assert _run_config(["--controller", "computed-torque"]) == paper == RunConfig(**design_changes("computed-torque"))
+    assert RunConfig().as_dict()["model"] == "paper"
+    # sliding-mode: the non-holonomic model by default everywhere; an explicit paper model stays the paper's
+    smc = RunConfig(controller="sliding-mode")
+    assert smc.model == "nonholonomic" == _run_config(["--controller", "sliding-mode"]).model
+    assert RunConfig(**design_changes("sliding-mode")) == smc
+    assert RunConfig(controller="sliding-mode", model="paper").model == "paper"
+    assert _run_config(["--controller", "sliding-mode", "--model", "paper"]).model == "paper"
+    assert _run_config(["--preset", "paper", "--controller", "sliding-mode"]).model == "paper"  # the preset's
+    # under its default estimate the claim holds on the paper circle; under the paper's (K^ = 5.33 V) it cannot
+    reference, _ = build_reference("paper-circle", C80, dt=1e-3, duration=35.0)
+    assert certificate_for(smc, reference).certified
+    under_paper = certificate_for(smc.replace(model="paper"), reference)
+    assert "switching gain above the uncertainty" in under_paper.unmet
+
+
+def test_a_built_in_whose_claim_holds_under_no_estimate_says_so_in_one_line(capsys):
+    from wmr_mj.cli.run import no_estimate_note
+
+    note = no_estimate_note(RunConfig(controller="pd"))
+    assert note is not None and "holds under no estimate" in note and "(4.23) small gain" in note
+    assert no_estimate_note(RunConfig(controller="sliding-mode")) is None  # the non-holonomic estimate: it holds
+    assert no_estimate_note(RunConfig(controller="adaptive-computed-torque")) is None  # states no claim
+    assert main(["run", "--controller", "pd", "--path", "paper-circle", "--duration", "10", "--no-log"]) == 0
+    err = capsys.readouterr().err.splitlines()
+    assert err[0] == f"wmr-mj: note: {note}"

@@ -75,7 +75,7 @@ def reproduce_command(config, params: dict[str, float], args: argparse.Namespace
     were written exactly)."""
     import shlex
 
-    parts = ["wmr-mj run", f"--preset {args.preset}", f"--controller {shlex.quote(str(config.controller))}",
+    parts = ["wmr-mj run", f"--preset {args.preset or 'paper'}", f"--controller {shlex.quote(str(config.controller))}",
              f"--model {config.model}",
              f"--kp {config.kp!r}", f"--kd {config.kd!r}", f"--friction-sign {config.friction_sign}",
              f"--friction-width {config.friction_width!r}", f"--path {shlex.quote(path_file or config.path)}",

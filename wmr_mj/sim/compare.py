@@ -4,7 +4,10 @@ adversary falsifies each at the same budget and seed (``wmr-mj compare``).
 A design is named by one token (:func:`design_from_token`): a preset (``paper``, ``certified``), a
 built-in law, ``FILE.py:Class`` or ``module:Class``, with ``,key=value`` settings: RunConfig fields
 (``tracker=pure-pursuit``, ``model=...``, ``kp=...``, ``correction=true``) or the law's parameters
-(``lam=5``). A law that is not a preset takes the certified preset's model and gains (its estimate).
+(``lam=5``). A law's name means the law with its own defaults, as ``wmr-mj run --controller NAME`` and
+``RunConfig(controller=NAME)`` mean it (:func:`wmr_mj.sim.designs.design_changes`): ``computed-torque`` is the
+paper's design (the ``paper`` preset: paper model, K_P = 6, K_D = 9), ``sliding-mode`` runs on the non-holonomic
+model, its default estimate, under which its claim can hold. ``certified`` is the certified design.
 Every design declares the suite's uncertainty box, so a claim covers the plants the suite runs.
 
 Usage::
