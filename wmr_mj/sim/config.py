@@ -104,7 +104,7 @@ class RunConfig:
         if self.model is None:
             object.__setattr__(self, "model", default_model(self.controller, self.controller_params))
         if self.model not in MODEL_SOURCES:
-            raise UnknownNameError("model source", self.model, MODEL_SOURCES)
+            raise UnknownNameError("model source", str(self.model), MODEL_SOURCES)
         if self.friction_sign not in FRICTION_SIGNS:
             raise UnknownNameError("friction sign", self.friction_sign, FRICTION_SIGNS)
         _check_path(self)
@@ -427,7 +427,7 @@ def controller_for(config: RunConfig, params: C80Parameters) -> SteeringControll
             returns no SteeringController).
     """
     given = config.controller
-    model = model_from_source(config.model, params=params, identified=config.identified,
+    model = model_from_source(str(config.model), params=params, identified=config.identified,
                               coefficients=config.coefficients)
     if isinstance(given, str) and given in CONTROLLER_NAMES:
         return make_controller(given, model, kp=config.kp, kd=config.kd,
@@ -461,7 +461,7 @@ def _plugin_for(config: RunConfig, params: C80Parameters, kind: str, given: Any,
     if isinstance(given, str):
         cls, _ = resolve(given, plugin_params, kind=kind)
         if model is None:
-            model = model_from_source(config.model, params=params, identified=config.identified,
+            model = model_from_source(str(config.model), params=params, identified=config.identified,
                                       coefficients=config.coefficients)
         context = BuildContext(model=model, estimate=params, voltage_limit=params.voltage_limit, kp=config.kp,
                                kd=config.kd)
