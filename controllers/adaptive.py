@@ -89,6 +89,8 @@ class AdaptiveComputedTorque(SteeringController):
     """
 
     name = "adaptive-computed-torque"
+    # its K^ and gyro^ are not adapted: the non-holonomic model's (K^ = 0), the plant's own reduced model
+    default_model = "nonholonomic"
     model: SteeringModel
 
     def __init__(self, model: SteeringModel, *, lam: float = 5.0, kd: float = 10.0,

@@ -125,6 +125,10 @@ class SteeringController:
     law: Callable[..., float] | None = None
     #: the reduced model the law stands on (its estimate P^, C_V^, F^, K^), where it has one
     model: SteeringModel | None = None
+    #: the model source of that estimate where the run names none (``RunConfig(model=None)``, ``wmr-mj run``
+    #: without --model or --preset): one of controllers.computed_torque.MODEL_SOURCES under which the law's
+    #: claim can hold at its default parameters
+    default_model: str = "paper"
 
     @classmethod
     def from_context(cls, context: BuildContext, **params: Any) -> SteeringController:

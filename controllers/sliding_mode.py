@@ -123,6 +123,9 @@ class SlidingMode(SteeringController):
     """
 
     name = "sliding-mode"
+    # under the paper's model K^ = 5.33 V while the plant's K is about 0: the uncertainty bound D = 9.6 V
+    # exceeds the default switching gain k = 3 V, so the claim cannot hold; the non-holonomic model's K^ = 0
+    default_model = "nonholonomic"
     model: SteeringModel
 
     def __init__(self, model: SteeringModel, *, lam: float = 5.0, phi: float = 0.2, k: float = 3.0,

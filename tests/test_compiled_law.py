@@ -160,7 +160,7 @@ def test_the_law_backend_is_chosen_and_refused_clearly(monkeypatch):
 
     custom = Custom(controller.model)
     assert batch_law_backend(custom) == "numpy"
-    with pytest.raises(ParameterError, match="not Custom"):
+    with pytest.raises(ParameterError, match="and PDController; Custom offers no pure law function"):
         batch_law_backend(custom, "compiled")
     monkeypatch.setenv("WMR_MJ_COMPILED_LAW", "0")
     assert batch_law_backend(controller) == "numpy"

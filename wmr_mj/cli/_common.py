@@ -9,6 +9,19 @@ import sys
 from typing import Any
 
 
+def add_controller_source(out: dict[str, Any], config: Any) -> dict[str, Any]:
+    """``out`` with ``controller_source``: where the run's law comes from, as its MCAP log records it
+    (:class:`controllers.registry.PluginSource`: spec, name, origin, import path of the file or module and
+    class, parameters, the SHA-256 of its source), for every law but those built from the config's fields
+    (computed-torque, pd), whose JSON keeps the keys it always had. The JSON of run, sweep and falsify."""
+    from wmr_mj.sim.config import plugin_source
+
+    source = plugin_source(config, "controller")
+    if source is not None:
+        out["controller_source"] = source.as_dict()
+    return out
+
+
 def positive_float(text: str) -> float:
     """argparse type: a finite number > 0."""
     try:

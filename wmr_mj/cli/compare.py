@@ -4,7 +4,10 @@ Each DESIGN is a preset (``paper``, ``certified``), a built-in law (``sliding-mo
 ``adaptive-computed-torque``, ``computed-torque``, ``pd``), or a law of one's own (``FILE.py:Class``,
 ``module:Class``), with ``,key=value`` settings: ``tracker=NAME`` (``stanley-at-C``, ``pure-pursuit``,
 FILE.py:Class), ``correction=true``, ``model=...``, ``kp=...``, ``kd=...``, ``omega_r=...``, or the law's
-own parameters (``sliding-mode,k=5``). Example::
+own parameters (``sliding-mode,k=5``). A law's name means what ``wmr-mj run --controller NAME`` means: the
+law with its own defaults (``computed-torque`` and ``pd`` with the paper's model and gains, so
+``computed-torque`` is the ``paper`` preset; ``sliding-mode`` and ``adaptive-computed-torque`` on the
+non-holonomic model); ``certified`` names the certified design. Example::
 
     wmr-mj compare paper certified certified,correction=true sliding-mode adaptive-computed-torque \\
         sliding-mode,tracker=pure-pursuit --scenarios 'circle/*' --budget 32

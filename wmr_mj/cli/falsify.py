@@ -78,7 +78,8 @@ def reproduce_command(config, params: dict[str, float], args: argparse.Namespace
     from wmr_mj.sim.config import controller_and_settings, estimate_parameters
 
     read = controller_and_settings(config, estimate_parameters())[1]  # only the settings the law reads
-    parts = ["wmr-mj run", f"--preset {args.preset}", f"--controller {shlex.quote(str(config.controller))}",
+    parts = ["wmr-mj run", *([f"--preset {args.preset}"] if args.preset else []),
+             f"--controller {shlex.quote(str(config.controller))}",
              *(f"--{name.replace('_', '-')} {value}" for name, value in (
                  ("model", config.model), ("kp", repr(config.kp)), ("kd", repr(config.kd)),
                  ("friction_sign", config.friction_sign), ("friction_width", repr(config.friction_width)))
@@ -194,6 +195,9 @@ def run(args: argparse.Namespace) -> int:
     logged = run_logged(config, str(log_path))
     worst = result.worst
     summary = result.as_dict(log=str(log_path))
+    from wmr_mj.cli._common import add_controller_source
+
+    add_controller_source(summary, base)
     signals_file = path_file = None
     if config.signals is not None:  # the worst run's signals, every parameter: --signals takes them back
         signals_file = str(out / "worst-signals.json")

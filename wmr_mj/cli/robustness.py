@@ -292,7 +292,65 @@ def _box_ranges(args: argparse.Namespace) -> tuple[tuple[float, float], dict[str
     return as_pair(m1_range), ranges
 
 
+def _claim_table(cert) -> str:
+    """The text report of a law's own box claim (:func:`wmr_mj.analysis.claim.box_claim`: |E| <= E_max,
+    |E'| <= Edot_max), its inputs and every assumption."""
+    inp = cert.inputs
+
+    def fmt(x) -> str:
+        return "unbounded" if x is None or not math.isfinite(x) else f"{x:.4g}"
+
+    def scalar(v) -> str:
+        return f"{v:.4g}" if isinstance(v, float) else str(v)
+
+    own = {k: v for k, v in inp.items() if k not in _CLAIM_RUN_INPUTS and not isinstance(v, (dict, list, tuple))}
+    nested = {k: v for k, v in inp.items() if k not in _CLAIM_RUN_INPUTS and isinstance(v, dict)}
+    rows = [
+        ("controller", f"{cert.claimant or inp.get('controller')} ({inp.get('model')} model)"),
+        ("claim", f"|E| <= {fmt(cert.E_max)} rad, "
+                  + (f"|E'| <= {fmt(cert.Edot_max)} rad/s" if math.isfinite(cert.Edot_max) else "|E'| not bounded")
+                  + " (the law's own box claim)"),
+        ("box rule", f"{inp.get('box_rule')}, m1 {inp['m1_range'][0]:g}-{inp['m1_range'][1]:g} kg"
+                     + "".join(f", {k} {lo:g}-{hi:g}" for k, (lo, hi) in inp["box_ranges"].items())
+                     + f"; plant m1 = {inp['plant_m1']:g} kg"),
+        ("law's inputs", ", ".join(f"{k} = {scalar(v)}" for k, v in own.items()) or "none (the claim records none)"),
+        *((k, ", ".join(f"{n} {scalar(x)}" for n, x in v.items())) for k, v in nested.items()),
+        ("alpha_max [rad]", fmt(cert.alpha_max)),
+        ("voltage needed [V]", fmt(cert.voltage_max)),
+    ]
+    width = max(len(k) for k, _ in rows)
+    lines = [f"Claim of controller {cert.claimant or inp.get('controller')} for the plant as simulated "
+             "(its own claim, not the paper's section 4)"]
+    lines += [f"  {k:<{width}}  {v}" for k, v in rows]
+    return "\n".join(lines + _assumption_lines(cert, fmt))
+
+
+#: the inputs :func:`wmr_mj.sim.certify.certificate_of` records of the run (the rest are the law's own)
+_CLAIM_RUN_INPUTS = ("model", "controller", "box_rule", "m1_range", "box_ranges", "plant_m1", "notes",
+                     "steering_friction", "signals", "d_max")
+
+
+def _assumption_lines(cert, fmt) -> list[str]:
+    """Every assumption of ``cert`` (met or not, value against limit), then the verdict it gives runs."""
+    lines = ["  assumptions:"]
+    aw = max((len(a.name) for a in cert.assumptions), default=0)
+    for a in cert.assumptions:
+        mark = "met    " if a.met else "NOT met"
+        kind = " (stated)" if a.kind == "stated" else ""
+        lines.append(f"    [{mark}] {a.name:<{aw}}  {fmt(a.value)} vs {fmt(a.limit)}{kind}: {a.equation}")
+    if cert.reason:
+        lines.append(f"  no bound: {cert.reason}")
+    if cert.certified:
+        lines.append("  CERTIFIED: every assumption holds; a run inside the region is certified-inside")
+    else:
+        lines.append(f"  NOT CERTIFIED: {', '.join(cert.unmet) or 'no finite bound'} not met; runs are "
+                     "uncertified-* whatever they do")
+    return lines
+
+
 def _certificate_table(cert, config, paper) -> str:
+    if cert.region == "box":
+        return _claim_table(cert)
     inp = cert.inputs
     box, est, ref = inp["box"], inp["estimate"], inp["reference"]
 
@@ -334,19 +392,7 @@ def _certificate_table(cert, config, paper) -> str:
     width = max(len(k) for k, _ in rows)
     lines = ["Certificate for the controller as run on the plant as simulated (section 4 redone)"]
     lines += [f"  {k:<{width}}  {v}" for k, v in rows]
-    lines.append("  assumptions:")
-    aw = max(len(a.name) for a in cert.assumptions)
-    for a in cert.assumptions:
-        mark = "met    " if a.met else "NOT met"
-        kind = " (stated)" if a.kind == "stated" else ""
-        lines.append(f"    [{mark}] {a.name:<{aw}}  {fmt(a.value)} vs {fmt(a.limit)}{kind}: {a.equation}")
-    if cert.reason:
-        lines.append(f"  no bound: {cert.reason}")
-    if cert.certified:
-        lines.append("  CERTIFIED: every assumption holds; a run inside the region is certified-inside")
-    else:
-        lines.append(f"  NOT CERTIFIED: {', '.join(cert.unmet)} not met; runs are uncertified-* whatever they do")
-    return "\n".join(lines)
+    return "\n".join(lines + _assumption_lines(cert, fmt))
 
 
 def run_certificate(args: argparse.Namespace) -> int:

@@ -22,9 +22,11 @@ def add_run_options(p: argparse.ArgumentParser) -> None:
     from wmr_mj.sim.config import PATH_NAMES
     from wmr_mj.sim.designs import PRESET_NAMES
 
-    p.add_argument("--preset", default="paper",
+    p.add_argument("--preset", default=None,
                    help=f"controller design: one of {', '.join(PRESET_NAMES)} (default paper: paper model, K_P = 6, "
-                        "K_D = 9, exact sign; certified: see wmr_mj/sim/designs.py); explicit options override it")
+                        "K_D = 9, exact sign; certified: see wmr_mj/sim/designs.py); explicit options override it. "
+                        "With --controller and no --preset, the law's estimate is its own default model (as "
+                        "RunConfig(controller=NAME) and wmr-mj compare NAME: non-holonomic for sliding-mode)")
     p.add_argument("--controller", default=None, metavar="NAME|FILE.py:Class|module:Class",
                    help=f"the steering law: one of {', '.join(controller_names())}, a class in a file of your own "
                         "(FILE.py:Class), or of an importable module (module:Class) (default: the preset's; see "
@@ -98,7 +100,7 @@ def config_from_args(args: argparse.Namespace, **extra):
     from wmr_mj.sim.config import RunConfig
     from wmr_mj.sim.designs import preset
 
-    design = preset(args.preset)
+    design = preset("paper" if args.preset is None else args.preset)
     if args.omega_r is not None and (args.kp is not None or args.kd is not None):
         raise ParameterError("give either --omega-r or --kp/--kd, not both")
     if args.omega_r is not None:
@@ -107,7 +109,9 @@ def config_from_args(args: argparse.Namespace, **extra):
         kp = design.kp if args.kp is None else args.kp
         kd = design.kd if args.kd is None else args.kd
     controller = design.controller if args.controller is None else args.controller
-    model = design.model if args.model is None else args.model
+    model = args.model
+    if model is None and (args.preset is not None or args.controller is None):
+        model = design.model  # else None: the law's own default (RunConfig resolves it)
     friction_sign = design.friction_sign if args.friction_sign is None else args.friction_sign
     friction_width = design.friction_width if args.friction_width is None else args.friction_width
     if not math.isfinite(friction_width) or friction_width < 0:
@@ -372,6 +376,38 @@ def format_report(s: RunSummary) -> str:
     return "\n".join(lines)
 
 
+#: the model sources whose estimate needs no data (identified and explicit need the user's)
+_ESTIMATES = ("paper", "nonholonomic")
+
+
+def no_estimate_note(config) -> str | None:
+    """One line where a built-in law's claim holds under none of the estimates :data:`_ESTIMATES` at the
+    run's other settings (gains, box, path): which assumptions fail under each; None where it can hold,
+    states no claim, or the law is not built in."""
+    from controllers.registry import is_builtin
+    from wmr_mj.params import C80
+    from wmr_mj.plant.mjcf import TIMESTEP
+    from wmr_mj.sim.certify import certificate_for
+    from wmr_mj.sim.config import build_reference, controller_for, estimate_parameters
+
+    if not is_builtin(config.controller) or config.model not in _ESTIMATES:
+        return None
+    period = config.control_period or TIMESTEP
+    n = int(round(config.duration / period))
+    reference, _ = build_reference(config.path, estimate_parameters(C80), dt=period, duration=n * period)
+    unmet = {}
+    for model in _ESTIMATES:
+        cert = certificate_for(config.replace(model=model), reference)
+        if cert is None or cert.certified:
+            return None
+        unmet[model] = ", ".join(cert.unmet) or "no finite bound"
+    label = controller_for(config, estimate_parameters(C80)).label()
+    return (f"the claim of controller {config.controller!r} ({label}) holds under no estimate at these settings (" +
+            "; ".join(f"{m} model: {u} not met" for m, u in unmet.items()) +
+            "): its runs are uncertified whatever they do; --preset certified is a computed-torque design whose "
+            "claim holds")
+
+
 def run(args: argparse.Namespace) -> int:
     import functools
     import sys
@@ -398,6 +434,9 @@ def run(args: argparse.Namespace) -> int:
         factory = functools.partial(RunLogger, path, options=LogOptions(log_every=args.log_every, background=True))
     from wmr_mj.logs.writer import terminate_as_interrupt
 
+    note = no_estimate_note(config)
+    if note:
+        print(f"wmr-mj: note: {note}", file=sys.stderr)
     with terminate_as_interrupt():
         result = run_closed_loop(config, logger_factory=factory, progress=args.progress)
     if result.law_note:
@@ -430,6 +469,9 @@ def run(args: argparse.Namespace) -> int:
     report = {**result.summary.to_dict(), "log": path, **({"requirements": judged} if judged else {})}
     if config.signals is not None:
         report["signals"] = config.signals.as_dict()  # every parameter: --signals takes it back
+    from wmr_mj.cli._common import add_controller_source
+
+    add_controller_source(report, config)
     if args.json:
         print_json(report)
     else:

@@ -53,6 +53,9 @@ def run(args: argparse.Namespace) -> int:
     ranges = box_ranges_from_args(args)  # --uncertainty (default m1), then --range
     out = check_output_path(args.out or f"logs/sweep-{time.strftime('%Y%m%d-%H%M%S')}", kind="dir", option="--out")
     base = config_from_args(args)
+    from wmr_mj.sim.parts import resolve_run
+
+    resolve_run(base)  # what the runs would raise (a law's claim() that raises): one line, before any output
     requirements = tuple(r.text for r in requirements_from_args(args, args.control_period or TIMESTEP))
     spec = SweepSpec(n=args.n, seed=args.seed, sampling=args.sampling, m1_range=tuple(args.m1_range),
                      ranges=ranges, base=base, requirements=requirements)
@@ -68,6 +71,9 @@ def run(args: argparse.Namespace) -> int:
                     "ranges": {"m1": list(args.m1_range), **{k: list(v) for k, v in ranges.items()}}})
     if base.signals is not None:
         summary["signals"] = base.signals.as_dict()  # every run's, with every parameter
+    from wmr_mj.cli._common import add_controller_source
+
+    add_controller_source(summary, base)
     plot_path = _plot(results, runs, out / "region")
     summary["plot"] = str(plot_path)
     if args.log:

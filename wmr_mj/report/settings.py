@@ -96,12 +96,11 @@ class ValidateSettings:
         from wmr_mj.sim.designs import design_changes
 
         object.__setattr__(self, "designs", tuple(str(t) for t in self.designs))
-        from wmr_mj.sim.config import controller_for, estimate_parameters, tracker_for
+        from wmr_mj.sim.parts import resolve_run
 
         for token in self.designs:  # an unknown law, a missing file, a bad setting: refused before any run
-            config = RunConfig(**design_changes(token))
-            controller_for(config, estimate_parameters())  # built once: a parameter the law does not take
-            tracker_for(config, estimate_parameters())
+            # built once: a parameter the law does not take, a claim() that raises or returns no Certificate
+            resolve_run(RunConfig(**design_changes(token)))
         if 0 < self.search_budget < self.min_search_budget:
             raise ParameterError(f"search_budget = {self.search_budget} is below one generation of CMA-ES (the "
                                  f"searches' portfolio); give 0 (no search) or an integer >= {self.min_search_budget}")

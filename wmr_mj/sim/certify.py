@@ -206,7 +206,11 @@ def certificate_of(config: Any, reference: Any, *, base: C80Parameters, estimate
     context = ClaimContext(plant=plant_box, reference=bounds,
                            limits=PlantLimits(steering_range=plant.steering_range, voltage_limit=plant.voltage_limit),
                            control_period=period, initial_error=initial, stated=stated, estimate=estimate_params)
-    cert = controller.claim(context)
+    try:
+        cert = controller.claim(context)
+    except Exception as exc:  # noqa: BLE001  (any error of a law's own claim: one line naming the law, before any step)
+        raise ParameterError(f"controller {controller.name!r}: claim() raised {type(exc).__name__}: {exc}; a claim "
+                             "returns a Certificate (see wmr_mj.analysis.claim.box_claim) or None") from None
     if cert is None:
         return None
     if not isinstance(cert, Certificate):

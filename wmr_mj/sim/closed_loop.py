@@ -179,7 +179,7 @@ def report(config: RunConfig, measured: RunMeasures, *, analysis, params: C80Par
     return RunSummary(
         status=m.status,
         controller=controller_name(config) if name is None else name,
-        model=config.model,
+        model=str(config.model),
         m1=float(params.m1),
         kp=config.kp,
         kd=config.kd,

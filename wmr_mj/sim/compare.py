@@ -4,7 +4,10 @@ adversary falsifies each at the same budget and seed (``wmr-mj compare``).
 A design is named by one token (:func:`design_from_token`): a preset (``paper``, ``certified``), a
 built-in law, ``FILE.py:Class`` or ``module:Class``, with ``,key=value`` settings: RunConfig fields
 (``tracker=pure-pursuit``, ``model=...``, ``kp=...``, ``correction=true``) or the law's parameters
-(``lam=5``). A law that is not a preset takes the certified preset's model and gains (its estimate).
+(``lam=5``). A law's name means the law with its own defaults, as ``wmr-mj run --controller NAME`` and
+``RunConfig(controller=NAME)`` mean it (:func:`wmr_mj.sim.designs.design_changes`): ``computed-torque`` is the
+paper's design (the ``paper`` preset: paper model, K_P = 6, K_D = 9), ``sliding-mode`` runs on the non-holonomic
+model, its default estimate, under which its claim can hold. ``certified`` is the certified design.
 Every design declares the suite's uncertainty box, so a claim covers the plants the suite runs.
 
 Usage::
@@ -37,10 +40,7 @@ from wmr_mj.plant.mjcf import TIMESTEP
 from wmr_mj.sim.config import (
     RunConfig,
     config_from_dict,
-    controller_for,
     controller_name,
-    estimate_parameters,
-    tracker_for,
 )
 from wmr_mj.sim.suite import Scenario, Suite, versions
 
@@ -68,8 +68,9 @@ def design_from_token(token: str, suite: Suite) -> Design:
     box = uncertainty_ranges(suite.adversary.uncertainty)
     m1_range = box.pop("m1")
     config = RunConfig(**design_changes(token), m1_range=m1_range, box_ranges=box, duration=suite.duration)
-    controller_for(config, estimate_parameters())  # built once: a parameter the law does not take, before any run
-    tracker_for(config, estimate_parameters())
+    from wmr_mj.sim.parts import resolve_run
+
+    resolve_run(config)  # built once: a parameter the law does not take, a claim() that raises, before any run
     return Design(label=str(token), config=config)
 
 
@@ -197,12 +198,16 @@ class DesignRow:
     cross_track_max: float | None  # [m] worst over scenarios
     cpu_us_per_step: float  # [us] median over scenarios
     law: str
+    # where the law comes from, as its log records it (controllers.registry.PluginSource.as_dict: file or
+    # module, class, parameters, source SHA-256); None for the laws built from RunConfig fields
+    controller_source: Mapping[str, Any] | None = None
 
     def as_dict(self) -> dict[str, Any]:
         from dataclasses import asdict
 
         out = asdict(self)
         out["adversary_where"] = dict(self.adversary_where)
+        out["controller_source"] = None if self.controller_source is None else dict(self.controller_source)
         return out
 
 
@@ -369,7 +374,15 @@ def _row(design: Design, runs: Sequence[ScenarioRun], adversary: Any, spec: Any)
         tv_voltage=float(np.mean([r.tv_voltage for r in runs])) if runs else math.nan,
         cross_track_max=max(cross) if cross else None,
         cpu_us_per_step=float(np.median([r.cpu_us_per_step for r in runs])) if runs else math.nan,
-        law="/".join(sorted({r.law for r in runs})))
+        law="/".join(sorted({r.law for r in runs})), controller_source=_source_of(design.config))
+
+
+def _source_of(config: RunConfig) -> dict[str, Any] | None:
+    """:func:`wmr_mj.sim.config.plugin_source` of the design's law as JSON (None: computed-torque, pd)."""
+    from wmr_mj.sim.config import plugin_source
+
+    source = plugin_source(config, "controller")
+    return None if source is None else source.as_dict()
 
 
 def runs_json(result: CompareResult) -> str:

@@ -180,7 +180,7 @@ def external_reason(controller: Any) -> str | None:
         return f"{name} keeps state (it overrides step or reset), which the compiled law does not hold"
     fn = _law_function(controller)
     if fn is None or not callable(fn):
-        return (f"it implements ComputedTorque and PDController, not {name}, which offers no pure law "
+        return (f"the compiled law implements ComputedTorque and PDController; {name} offers no pure law "
                 "function to compile (a staticmethod law(p, alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot) "
                 "with law_parameters(); controllers.base)")
     if not isinstance(inspect.getattr_static(type(controller), "law"), staticmethod):

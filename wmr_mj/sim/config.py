@@ -41,6 +41,7 @@ __all__ = [
     "has_tracker",
     "plugin_source",
     "controller_name",
+    "default_model",
     "config_from_dict",
     "estimate_of",
     "build_reference",
@@ -61,7 +62,10 @@ class RunConfig:
     # with controller_params), or a SteeringController object or a factory of one (a library user's own)
     controller: Any = "computed-torque"
     controller_params: Mapping[str, Any] = field(default_factory=dict)  # NAME: value for a plug-in's constructor
-    model: str = "paper"  # model source of the controller's estimate
+    # model source of the controller's estimate (MODEL_SOURCES); None: the law's own default, resolved here
+    # once (SteeringController.default_model: 'paper' for computed-torque, pd and a plug-in that names none,
+    # 'nonholonomic' for sliding-mode and adaptive-computed-torque)
+    model: str | None = None
     m1: float = M1_NOMINAL  # plant chassis mass, kg
     duration: float = 35.0  # s
     control_period: float | None = None  # s; None: every physics step
@@ -100,8 +104,10 @@ class RunConfig:
     def __post_init__(self) -> None:
         _check_plugin(self, "controller")
         _check_plugin(self, "tracker")
+        if self.model is None:
+            object.__setattr__(self, "model", default_model(self.controller, self.controller_params))
         if self.model not in MODEL_SOURCES:
-            raise UnknownNameError("model source", self.model, MODEL_SOURCES)
+            raise UnknownNameError("model source", str(self.model), MODEL_SOURCES)
         if self.friction_sign not in FRICTION_SIGNS:
             raise UnknownNameError("friction sign", self.friction_sign, FRICTION_SIGNS)
         _check_path(self)
@@ -230,6 +236,25 @@ def plugin_source(config: RunConfig, kind: str = "controller"):
     return PluginSource(spec=f"{cls.__module__}:{cls.__qualname__}", name=str(getattr(given, "name", cls.__name__)),
                         origin="instance", import_path=f"{cls.__module__}:{cls.__qualname__}",
                         params=describe_params(params), source_sha256=source_hash(cls))
+
+
+def default_model(controller: Any, params: Mapping[str, Any] | None = None) -> str:
+    """The model source a law runs with where the run names none: its class's ``default_model``
+    (:attr:`controllers.base.SteeringController.default_model`); 'paper' for computed-torque, pd and a
+    factory (its class is known only once built)."""
+    from controllers.base import SteeringController
+    from controllers.registry import resolve
+
+    cls: Any = None
+    if isinstance(controller, str):
+        cls = None if controller in CONTROLLER_NAMES else resolve(controller, params, kind="controller")[0]
+    elif isinstance(controller, SteeringController):
+        cls = type(controller)
+    model = getattr(cls, "default_model", "paper")
+    if model not in MODEL_SOURCES:
+        raise UnknownNameError(f"default_model of controller {getattr(cls, 'name', controller)!r}", str(model),
+                               MODEL_SOURCES)
+    return str(model)
 
 
 def controller_name(config: RunConfig) -> str:
@@ -420,7 +445,7 @@ def controller_and_settings(config: RunConfig, params: C80Parameters) -> tuple[S
     (``controllers.base.BuildContext``) its ``from_context`` read; none for an object or a factory.
     Only these describe the law in its outputs (the others' values were never used)."""
     given = config.controller
-    model = model_from_source(config.model, params=params, identified=config.identified,
+    model = model_from_source(str(config.model), params=params, identified=config.identified,
                               coefficients=config.coefficients)
     if isinstance(given, str) and given in CONTROLLER_NAMES:
         law = make_controller(given, model, kp=config.kp, kd=config.kd,
@@ -478,7 +503,7 @@ def _plugin_for(config: RunConfig, params: C80Parameters, kind: str, given: Any,
     if isinstance(given, str):
         cls, _ = resolve(given, plugin_params, kind=kind)
         if model is None:
-            model = model_from_source(config.model, params=params, identified=config.identified,
+            model = model_from_source(str(config.model), params=params, identified=config.identified,
                                       coefficients=config.coefficients)
         context = BuildContext(model=model, estimate=params, voltage_limit=params.voltage_limit, kp=config.kp,
                                kd=config.kd)

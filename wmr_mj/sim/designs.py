@@ -168,7 +168,10 @@ def design_changes(token: str) -> dict[str, Any]:
     """The RunConfig fields of a design named by one token, ``NAME[,key=value...]``: NAME a preset
     (:data:`PRESET_NAMES`) or a law (a built-in name, ``FILE.py:Class``, ``module:Class``); a key one of
     :data:`TOKEN_FIELDS` (``omega_r`` gives K_P, K_D by (3.6)) or, for a plug-in, one of its parameters.
-    A law that is not a preset takes the certified preset's model and gains (its estimate).
+    A law's name means what ``RunConfig(controller=NAME)`` and ``wmr-mj run --controller NAME`` mean: the
+    law with its own defaults (its estimate the law's ``default_model``: the paper's model for
+    computed-torque and pd, whose defaults are the paper's gains, so ``computed-torque`` is the ``paper``
+    preset; the non-holonomic model for sliding-mode). A preset's name means the preset.
 
     Raises:
         UnknownNameError: an unknown preset or law (from RunConfig, naming the valid ones).
@@ -192,7 +195,7 @@ def design_changes(token: str) -> dict[str, Any]:
             raise ParameterError(f"design {token!r}: a preset takes RunConfig settings ({', '.join(TOKEN_FIELDS)}), "
                                  f"not {sorted(settings)}")
         return {**preset(name).config_changes(), **fields}
-    changes: dict[str, Any] = {**CERTIFIED.config_changes(), "controller": name, **fields}
+    changes: dict[str, Any] = {"controller": name, **fields}
     if name in CONTROLLER_NAMES:  # the laws configured by RunConfig fields
         if settings:
             raise ParameterError(f"design {token!r}: {name} takes RunConfig settings, not {sorted(settings)}")

@@ -927,13 +927,11 @@ def falsify(spec: FalsifySpec, *, chunk: int = 128, nthread: int = 0, scheduler:
 def check_runnable(base: RunConfig) -> None:
     """Raise what the first batch would raise for ``base`` (a duration too short for the path,
     a control period that does not fit), before any search starts: the reference every
-    evaluation shares depends on the base configuration only (path, duration, period)."""
-    from wmr_mj.plant.mjcf import TIMESTEP
-    from wmr_mj.sim.config import build_reference, estimate_parameters
+    evaluation shares depends on the base configuration only (path, duration, period), and a law's
+    claim() that raises or returns what is not a claim (:func:`wmr_mj.sim.certify.certificate_of`)."""
+    from wmr_mj.sim.parts import resolve_run
 
-    period = TIMESTEP if base.control_period is None else base.control_period
-    n = int(round(base.duration / period))
-    build_reference(base.path, estimate_parameters(), dt=period, duration=n * period)
+    resolve_run(base)
 
 
 def worst_config(result: FalsifyResult) -> RunConfig:
