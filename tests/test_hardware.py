@@ -103,6 +103,10 @@ def test_steps_out_of_turn_are_refused():
     chain.step(0, 0.1, 0.0, 6.0)
     with pytest.raises(ValueError, match="step 2 called where step 1 is next"):
         chain.step(2, 0.1, 0.0, 6.0)
+    for k in range(1, 10):
+        chain.step(k, 0.1, 0.0, 6.0)
+    with pytest.raises(ValueError, match="step 10 called where step 10 is next \\(of 10\\)"):
+        chain.step(10, 0.1, 0.0, 6.0)
 
 
 # ---------------------------------------------------------------- (c) noise

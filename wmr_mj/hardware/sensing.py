@@ -44,9 +44,10 @@ coefficients c, a and 1 - a are computed once here and read from :attr:`SensingC
 step calls no ``exp``. The layouts (index constants of this module):
 
 - parameters (float64): ``P_TICKS_PER_RAD`` c (0 without an encoder), ``P_GEAR_RATIO`` i2, ``P_PERIOD`` T (s),
-  ``P_FILTER_A`` a, ``P_FILTER_ONE_MINUS_A`` 1 - a, ``P_DELAY_STEPS`` d, ``P_ENCODER`` (0 none, 1 axis,
-  2 motor), ``P_ROUNDING`` (0 rint, 1 floor), ``P_VELOCITY`` (0 exact, 1 tachometer, 2 difference,
-  3 filtered), ``P_ALPHA_NOISE_ON``, ``P_ALPHA_DOT_NOISE_ON`` (0 or 1); ``N_PARAMETERS`` in all.
+  ``P_FILTER_A`` a, ``P_FILTER_ONE_MINUS_A`` 1 - a, ``P_DELAY_STEPS`` d, ``P_ENCODER_SIDE`` (0 axis, 1 motor;
+  the angle is quantised where c != 0), ``P_ROUNDING`` (0 rint, 1 floor), ``P_VELOCITY`` (0 exact,
+  1 tachometer, 2 difference, 3 filtered), ``P_ALPHA_NOISE_ON``, ``P_ALPHA_DOT_NOISE_ON`` (0 or 1);
+  ``N_PARAMETERS`` in all.
 - state (float64, ``STATE_HEADER + 3 (d + 1)``): ``S_NEXT_STEP`` the k the next call must pass,
   ``S_PREVIOUS_ALPHA`` alpha_m[k-1] (rad), ``S_FILTER`` y_{k-1} (rad/s), then the ring: slot j at
   ``S_RING + 3 j`` holds (alpha rad, alpha' rad/s, motor angle rad) of the last step k with k mod (d+1) = j.
@@ -92,13 +93,13 @@ NoiseKind = Literal["none", "uniform", "gaussian"]
 
 # parameter layout (see the module docstring)
 P_TICKS_PER_RAD, P_GEAR_RATIO, P_PERIOD, P_FILTER_A, P_FILTER_ONE_MINUS_A, P_DELAY_STEPS = range(6)
-P_ENCODER, P_ROUNDING, P_VELOCITY, P_ALPHA_NOISE_ON, P_ALPHA_DOT_NOISE_ON = range(6, 11)
+P_ENCODER_SIDE, P_ROUNDING, P_VELOCITY, P_ALPHA_NOISE_ON, P_ALPHA_DOT_NOISE_ON = range(6, 11)
 N_PARAMETERS = 11
 # state layout
 S_NEXT_STEP, S_PREVIOUS_ALPHA, S_FILTER, S_RING = range(4)
 STATE_HEADER = S_RING
 
-_ENCODER_CODES = {None: 0, "axis": 1, "motor": 2}
+_SIDE_CODES = {"axis": 0, "motor": 1}
 _ROUNDING_CODES = {"round": 0, "floor": 1}
 _VELOCITY_CODES = {"exact": 0, "tachometer": 1, "difference": 2, "filtered": 3}
 _NOISE_FORMS = "'none', 'uniform:BOUND' or 'gaussian:SIGMA'"
@@ -339,9 +340,7 @@ class SensingChain:
             p[P_FILTER_A] = math.exp(-self.control_period / sensing.filter_tau)
             p[P_FILTER_ONE_MINUS_A] = 1.0 - p[P_FILTER_A]
         p[P_DELAY_STEPS] = d
-        p[P_ENCODER] = _ENCODER_CODES[sensing.encoder_side if sensing.encoder_ticks is not None else None]
-        if sensing.encoder_ticks is None and sensing.encoder_side == "motor":
-            p[P_ENCODER] = 2  # exact motor angle / i2, no quantiser: P_TICKS_PER_RAD = 0 says which
+        p[P_ENCODER_SIDE] = _SIDE_CODES[sensing.encoder_side]
         p[P_ROUNDING] = _ROUNDING_CODES[sensing.encoder_rounding]
         p[P_VELOCITY] = _VELOCITY_CODES[sensing.velocity]
         p[P_ALPHA_NOISE_ON] = sensing.noise_kind != "none"
@@ -354,8 +353,9 @@ class SensingChain:
         self.state = np.zeros(STATE_HEADER + 3 * (d + 1))
         # the step reads these as Python numbers (IEEE doubles, the same operations as numpy's, faster)
         self._ticks_per_rad = float(p[P_TICKS_PER_RAD])
+        self._i2 = i2
         self._floor = sensing.encoder_rounding == "floor"
-        self._motor = p[P_ENCODER] == 2
+        self._motor = sensing.encoder_side == "motor"
         self._velocity = _VELOCITY_CODES[sensing.velocity]
         self._a, self._one_minus_a = float(p[P_FILTER_A]), float(p[P_FILTER_ONE_MINUS_A])
         self._noise_on = bool(p[P_ALPHA_NOISE_ON])
@@ -379,11 +379,12 @@ class SensingChain:
             (alpha_m rad, alpha'_m rad/s), Python floats.
 
         Raises:
-            ValueError: k out of turn (the chain holds state from step k - 1).
+            ValueError: k out of turn (the chain holds state from step k - 1) or k >= n_steps.
         """
         s = self.state
-        if k != s[S_NEXT_STEP]:
-            raise ValueError(f"sensing chain: step {k} called where step {int(s[S_NEXT_STEP])} is next")
+        if k != s[S_NEXT_STEP] or k >= self.n_steps:
+            raise ValueError(f"sensing chain: step {k} called where step {int(s[S_NEXT_STEP])} is next "
+                             f"(of {self.n_steps})")
         slots = self.delay_steps + 1
         j = S_RING + 3 * (k % slots)
         s[j], s[j + 1], s[j + 2] = alpha, alpha_dot, motor_angle
@@ -391,24 +392,23 @@ class SensingChain:
             for i in range(S_RING, S_RING + 3 * slots, 3):
                 s[i], s[i + 1], s[i + 2] = alpha, alpha_dot, motor_angle
         r = S_RING + 3 * ((k + 1) % slots)  # slot of step k - d (k - d = k + 1 mod d + 1)
-        i2 = float(self.parameters[P_GEAR_RATIO])
-        theta = float(s[r + 2]) if self._motor else float(s[r])
+        theta = s.item(r + 2) if self._motor else s.item(r)
         c = self._ticks_per_rad
         if c != 0.0:
             x = theta * c
             theta = (math.floor(x) if self._floor else round(x)) / c  # ints < 2**53 convert exactly
-        alpha_m = theta / i2 if self._motor else theta
+        alpha_m = theta / self._i2 if self._motor else theta
         if self._noise_on:
-            alpha_m = alpha_m + float(self.alpha_noise[k])
+            alpha_m = alpha_m + self.alpha_noise.item(k)
         if self._velocity <= 1:  # exact, tachometer
-            v = float(s[r + 1])
+            v = s.item(r + 1)
         else:
-            v = 0.0 if k == 0 else (alpha_m - float(s[S_PREVIOUS_ALPHA])) / self.control_period
+            v = 0.0 if k == 0 else (alpha_m - s.item(S_PREVIOUS_ALPHA)) / self.control_period
             if self._velocity == 3:
-                v = self._a * float(s[S_FILTER]) + self._one_minus_a * v
+                v = self._a * s.item(S_FILTER) + self._one_minus_a * v
                 s[S_FILTER] = v
         if self._dot_noise_on:
-            v = v + float(self.alpha_dot_noise[k])
+            v = v + self.alpha_dot_noise.item(k)
         s[S_PREVIOUS_ALPHA] = alpha_m
         s[S_NEXT_STEP] = k + 1
         return alpha_m, v
