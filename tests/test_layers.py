@@ -7,15 +7,16 @@ with ``ast`` and walks all ``import`` and ``from ... import`` nodes. The layers,
 rank  modules                                     what
 ====  ==========================================  =====================================================
 0     wmr_mj.errors, params, _version, _util      errors, the parameter set, files, memory, progress
-1     wmr_mj.plant                                MJCF model, derivation, reduced models, friction, identification
-2     wmr_mj.reference                            paths of C and alpha0(t)
-3     wmr_mj.analysis                             the paper's section 4, the certificate, verdicts
-4     controllers                                 steering laws and path trackers, each with its claim
-5     wmr_mj.sim                                  closed loop, batch, sweep, falsify, designs
-6     wmr_mj.logs                                 MCAP format, writer, reader, replay, video
-7     wmr_mj.report                               validate, text, HTML, figures
-8     wmr_mj.cli                                  the wmr-mj commands
-9     wmr_mj (its ``__init__``)                   the public API: may import any layer
+1     wmr_mj.hardware                             sensing, actuation, transmission: typed parts, presets
+2     wmr_mj.plant                                MJCF model, derivation, reduced models, friction, identification
+3     wmr_mj.reference                            paths of C and alpha0(t)
+4     wmr_mj.analysis                             the paper's section 4, the certificate, verdicts
+5     controllers                                 steering laws and path trackers, each with its claim
+6     wmr_mj.sim                                  closed loop, batch, sweep, falsify, designs
+7     wmr_mj.logs                                 MCAP format, writer, reader, replay, video
+8     wmr_mj.report                               validate, text, HTML, figures
+9     wmr_mj.cli                                  the wmr-mj commands
+10    wmr_mj (its ``__init__``)                   the public API: may import any layer
 ====  ==========================================  =====================================================
 """
 
@@ -27,6 +28,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 LAYERS: tuple[tuple[str, ...], ...] = (
     ("wmr_mj.errors", "wmr_mj.params", "wmr_mj._version", "wmr_mj._util"),
+    ("wmr_mj.hardware",),
     ("wmr_mj.plant",),
     ("wmr_mj.reference",),
     ("wmr_mj.analysis",),
@@ -87,10 +89,11 @@ def _graph() -> dict[str, set[str]]:
 
 
 def test_rank_of_known_modules():
-    assert rank("wmr_mj.plant.mjcf") == 1
+    assert rank("wmr_mj.plant.mjcf") == 2
     assert rank("wmr_mj.params") == 0
+    assert rank("wmr_mj.hardware.sensing") == 1
     assert rank("wmr_mj") == len(LAYERS) - 1
-    assert rank("controllers.computed_torque") == 4
+    assert rank("controllers.computed_torque") == 5
     assert rank("numpy") is None
 
 

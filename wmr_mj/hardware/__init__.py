@@ -1,0 +1,53 @@
+"""The cart as it is built: sensing, actuation and transmission as typed parts, each tested alone.
+
+Pure Python and NumPy; imports nothing of wmr_mj but :mod:`wmr_mj.errors`, so every layer above may use it.
+
+Usage::
+
+    from wmr_mj.hardware import Sensing, SensingChain, Actuation, Transmission, measurement_error_bounds
+
+    sensing = Sensing.from_spec("magnetic-12bit-axis")          # or "encoder_ticks=4096,velocity=difference"
+    chain = SensingChain(sensing, control_period=0.001, n_steps=35_000, gear_ratio=60.0)
+    alpha_m, alpha_dot_m = chain.step(0, alpha, alpha_dot, motor_angle)
+    measurement_error_bounds(sensing, control_period=0.001, gear_ratio=60.0)
+
+Modules: :mod:`.spec` (the one parser), :mod:`.sensing`, :mod:`.actuation`, :mod:`.transmission`,
+:mod:`.presets` (named hardware with sources).
+"""
+
+from __future__ import annotations
+
+from wmr_mj.hardware.actuation import Actuation
+from wmr_mj.hardware.presets import (
+    SENSING_PRESET_SOURCES,
+    actuation_preset_names,
+    quadrature_encoder_spec,
+    sensing_preset_names,
+)
+from wmr_mj.hardware.sensing import (
+    SENSING_SPEC_KEYS,
+    MeasurementBounds,
+    Sensing,
+    SensingChain,
+    measurement_error_bounds,
+    sensing_preset,
+)
+from wmr_mj.hardware.spec import parse_spec, whole_periods
+from wmr_mj.hardware.transmission import Transmission
+
+__all__ = [
+    "Sensing",
+    "SensingChain",
+    "MeasurementBounds",
+    "measurement_error_bounds",
+    "SENSING_SPEC_KEYS",
+    "sensing_preset",
+    "sensing_preset_names",
+    "SENSING_PRESET_SOURCES",
+    "quadrature_encoder_spec",
+    "Actuation",
+    "actuation_preset_names",
+    "Transmission",
+    "parse_spec",
+    "whole_periods",
+]

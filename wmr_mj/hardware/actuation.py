@@ -1,0 +1,108 @@
+"""The actuation chain between the law's voltage and the motor: a delay, the armature inductance, a current
+limit. The typed specification only; the model (MuJoCo's actuator ``delay`` and ``dcmotor`` attributes)
+reads it.
+
+Usage::
+
+    from wmr_mj.hardware import Actuation
+
+    a = Actuation.from_spec("delay=0.002,inductance=0.0005,current_limit=20")
+    a.electrical_time_constant(R_a=1.0)        # L_a / R_a = 0.0005 s
+    Actuation().is_ideal                       # True: today's plant
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from wmr_mj.errors import ParameterError
+from wmr_mj.hardware.presets import ACTUATION_PRESETS
+from wmr_mj.hardware.spec import SpecSource, field_converters, parse_spec, to_float, whole_periods
+
+__all__ = ["Actuation"]
+
+
+@dataclass(frozen=True, kw_only=True)
+class Actuation:
+    """Delay, armature inductance and current limit of the steering motor; the default is ideal.
+
+    Raises:
+        ParameterError: a negative delay or inductance, a current limit that is not > 0.
+    """
+
+    delay: float = 0.0  # s, from the law's output to the motor's terminals
+    inductance: float = 0.0  # H, the armature inductance L_a (0: the current follows the voltage at once)
+    current_limit: float | None = None  # A, |i_a| <= this; None: no limit
+
+    def __post_init__(self) -> None:
+        for name, unit in (("delay", "s"), ("inductance", "H")):
+            value = to_float("actuation", name, getattr(self, name))
+            if value < 0.0:
+                raise ParameterError(f"actuation: {name} = {getattr(self, name)!r} {unit} is not accepted; "
+                                     f"a value >= 0 {unit} is required")
+            object.__setattr__(self, name, value)
+        if self.current_limit is not None:
+            limit = to_float("actuation", "current_limit", self.current_limit)
+            if limit <= 0.0:
+                raise ParameterError(f"actuation: current_limit = {self.current_limit!r} A is not accepted; a "
+                                     "limit > 0 A or none is required")
+            object.__setattr__(self, "current_limit", limit)
+
+    @property
+    def is_ideal(self) -> bool:
+        """True for today's plant: no delay, no inductance, no current limit."""
+        return self.delay == 0.0 and self.inductance == 0.0 and self.current_limit is None
+
+    def electrical_time_constant(self, R_a: float) -> float:
+        """tau_e = L_a / R_a, s, for the armature resistance ``R_a`` (Ohm, > 0).
+
+        Raises:
+            ParameterError: R_a not > 0.
+        """
+        r = to_float("actuation", "R_a", R_a)
+        if r <= 0.0:
+            raise ParameterError(f"actuation: R_a = {R_a!r} Ohm is not accepted; a resistance > 0 is required")
+        return self.inductance / r
+
+    def delay_steps(self, timestep: float) -> int:
+        """The delay as a whole number of ``timestep`` (s; MuJoCo's actuator delay reads its ring buffer by
+        physics steps).
+
+        Raises:
+            ParameterError: a delay that is not a whole multiple of the step (the message names both).
+        """
+        return whole_periods("actuation delay", self.delay, timestep)
+
+    def as_dict(self) -> dict[str, Any]:
+        """The spec form (JSON-ready; :meth:`from_spec` reads it back)."""
+        return {"delay": self.delay, "inductance": self.inductance, "current_limit": self.current_limit}
+
+    def label(self) -> str:
+        """One short line: 'ideal', or e.g. 'delay 2 ms, L_a 0.5 mH, current limit 20 A'."""
+        if self.is_ideal:
+            return "ideal"
+        parts = []
+        if self.delay:
+            parts.append(f"delay {self.delay * 1e3:g} ms")
+        if self.inductance:
+            parts.append(f"L_a {self.inductance * 1e3:g} mH")
+        if self.current_limit is not None:
+            parts.append(f"current limit {self.current_limit:g} A")
+        return ", ".join(parts)
+
+    @classmethod
+    def from_spec(cls, spec: SpecSource) -> Actuation:
+        """An Actuation from ``"delay=...,inductance=...,current_limit=..."``, a mapping, a ``.json``/``.toml``
+        file, a preset name ('ideal') or None (ideal).
+
+        Raises:
+            UnknownNameError: an unknown key or preset.
+            ParameterError: a malformed value or a range refused.
+        """
+        presets = {name: parse_spec(dict(spec), cls, what="actuation", keys=_SPEC_KEYS)
+                   for name, spec in ACTUATION_PRESETS.items()}
+        return parse_spec(spec, cls, what="actuation", keys=_SPEC_KEYS, presets=presets)
+
+
+_SPEC_KEYS = field_converters(Actuation)
