@@ -82,6 +82,7 @@ __all__ = [
     "GEAR_PLAY_TENDON",
     "MOTOR_ARMATURE",
     "GEAR_PLAY_SOLREF",
+    "GEAR_PLAY_SOLIMP",
     "SteeringAddresses",
     "steering_joint_addresses",
 ]
@@ -142,6 +143,11 @@ MOTOR_ARMATURE = 0.01
 # The play's end stops (the tendon's limit constraint): timeconst = 2 steps, the least MuJoCo
 # takes at 1 ms (as STICTION_SOLREF), so a stop behaves as a tooth contact, not a spring.
 GEAR_PLAY_SOLREF = (0.002, 1.0)  # (timeconst s, dampratio)
+# and impedance 0.999 (STICTION_SOLIMP's). A stop is still compliant: its stiffness is about
+# motor_armature / timeconst^2 = 2500 N m/rad at MOTOR_ARMATURE, so pushing the axle against its
+# friction (7.24 N m) presses it 2.37 mrad (2.52 with MuJoCo's default impedance 0.9); measured
+# by tests/test_backlash_model.py. A larger motor_armature_kgm2 stiffens it in proportion.
+GEAR_PLAY_SOLIMP = STICTION_SOLIMP
 
 
 def round_sig(x: float, digits: int = SIGNIFICANT_DIGITS) -> float:
@@ -397,6 +403,7 @@ def _add_gear_play(spec: mujoco.MjSpec, chassis: mujoco.MjsBody, p: C80Parameter
                     armature=round_sig(drive.motor_armature_kgm2))
     play = spec.add_tendon(name=GEAR_PLAY_TENDON, range=_r((-drive.backlash_rad, drive.backlash_rad)))
     play.solref_limit = list(GEAR_PLAY_SOLREF)
+    play.solimp_limit = list(GEAR_PLAY_SOLIMP)
     play.wrap_joint(STEERING_JOINT, 1.0)
     play.wrap_joint(MOTOR_JOINT, -1.0)
 
