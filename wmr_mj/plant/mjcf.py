@@ -54,7 +54,7 @@ from typing import Literal, get_args
 import mujoco
 import numpy as np
 
-from wmr_mj.errors import ModelFileError, UnknownNameError
+from wmr_mj.errors import ModelFileError, ParameterError, UnknownNameError
 from wmr_mj.params import C80, C80Parameters
 
 __all__ = [
@@ -77,6 +77,14 @@ __all__ = [
     "STICTION_SOLIMP",
     "TYRE_CONTACT_MODELS",
     "TYRE_CONTACT_SOLREF",
+    "STEERING_JOINT",
+    "MOTOR_JOINT",
+    "GEAR_PLAY_TENDON",
+    "MOTOR_ARMATURE",
+    "GEAR_PLAY_SOLREF",
+    "GEAR_PLAY_SOLIMP",
+    "SteeringAddresses",
+    "steering_joint_addresses",
 ]
 
 from wmr_mj._util.resources import MODELS_DIR  # noqa: E402  (re-exported)
@@ -119,6 +127,28 @@ TYRE_CONTACT_MODELS = ("stiff", "soft")
 # wmr_mj.plant.friction.measure_contact_softness; numbers in models/README.md.
 TYRE_CONTACT_SOLREF = (0.002, 1.0)  # (timeconst s, dampratio)
 
+#: The steering joint: the axle's angle alpha (the law, the engine and the certificate read it).
+STEERING_JOINT = "steer"
+#: With backlash: the motor side of the gear play, a hinge coaxial with STEERING_JOINT, its angle
+#: at the steering axis (the motor shaft turns i2 times it).
+MOTOR_JOINT = "steer_motor"
+#: With backlash: the fixed tendon steer - steer_motor, limited to +-b (the play of the gear).
+GEAR_PLAY_TENDON = "gear_play"
+# Motor side of the play, kg m^2 at the steering axis. The paper's model has no rotor inertia
+# (P = J R_a / (i2 k_i) with J the load alone), but inside the play the motor side must have
+# some, or the joint-space inertia matrix is singular (modeling.rst, "Backlash"). 0.01 kg m^2
+# (0.5% of J = 1.836; a rotor of 2.8e-6 kg m^2 through i2 = 60) keeps P within 0.6% of the
+# paper's; larger values are a real motor's and a keyword of the builders.
+MOTOR_ARMATURE = 0.01
+# The play's end stops (the tendon's limit constraint): timeconst = 2 steps, the least MuJoCo
+# takes at 1 ms (as STICTION_SOLREF), so a stop behaves as a tooth contact, not a spring.
+GEAR_PLAY_SOLREF = (0.002, 1.0)  # (timeconst s, dampratio)
+# and impedance 0.999 (STICTION_SOLIMP's). A stop is still compliant: its stiffness is about
+# motor_armature / timeconst^2 = 2500 N m/rad at MOTOR_ARMATURE, so pushing the axle against its
+# friction (7.24 N m) presses it 2.37 mrad (2.52 with MuJoCo's default impedance 0.9); measured
+# by tests/test_backlash_model.py. A larger motor_armature_kgm2 stiffens it in proportion.
+GEAR_PLAY_SOLIMP = STICTION_SOLIMP
+
 
 def round_sig(x: float, digits: int = SIGNIFICANT_DIGITS) -> float:
     """``x`` rounded to ``digits`` significant digits (what the MJCF text can carry)."""
@@ -134,6 +164,63 @@ def _check_models(steering_friction: str, tyre_contact: str) -> None:
         raise UnknownNameError("steering friction model", steering_friction, STEERING_FRICTION_MODELS)
     if tyre_contact not in TYRE_CONTACT_MODELS:
         raise UnknownNameError("tyre contact model", tyre_contact, TYRE_CONTACT_MODELS)
+
+
+@dataclass(frozen=True)
+class _DriveTrain:
+    """The steering motor's actuation and the gear's play (the builders' keyword options).
+
+    The defaults are today's plant: no delay, no inductance, no current limit, no play.
+    """
+
+    actuation_delay_s: float = 0.0  # s, a whole number of physics steps
+    inductance_H: float = 0.0  # H, the armature inductance L_a (0: the current is algebraic)
+    current_limit_A: float | None = None  # A, the driver's current limit (None: none)
+    backlash_rad: float = 0.0  # rad at the steering axis, half-width b of the play
+    motor_armature_kgm2: float = MOTOR_ARMATURE  # kg m^2 at the steering axis, motor side (with play)
+
+    @property
+    def delay_steps(self) -> int:
+        return int(round(self.actuation_delay_s / TIMESTEP))
+
+    def comment(self) -> str:
+        """The non-default options, for the scene's comment ('' for today's plant)."""
+        default = _DriveTrain()
+        changed = [f"{name}={getattr(self, name)!r}" for name in (
+            "actuation_delay_s", "inductance_H", "current_limit_A", "backlash_rad")
+            if getattr(self, name) != getattr(default, name)]
+        if changed and self.backlash_rad > 0:
+            changed.append(f"motor_armature_kgm2={self.motor_armature_kgm2!r}")
+        return ", ".join(changed)
+
+
+def _finite_at_least_zero(name: str, value: float, unit: str) -> float:
+    if not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
+        raise ParameterError(f"{name} must be a finite number >= 0 {unit}, got {value!r}")
+    return float(value)
+
+
+def _drive_train(*, actuation_delay_s: float = 0.0, inductance_H: float = 0.0, current_limit_A: float | None = None,
+                 backlash_rad: float = 0.0, motor_armature_kgm2: float = MOTOR_ARMATURE) -> _DriveTrain:
+    """The checked options; bad values raise ParameterError naming the option and what is accepted."""
+    delay = _finite_at_least_zero("actuation_delay_s", actuation_delay_s, "s")
+    steps = delay / TIMESTEP
+    # 1e-9 of a step: 0.003 / 0.001 = 2.9999999999999996 is three steps, 0.0025 is not
+    if abs(steps - round(steps)) > 1e-9:
+        raise ParameterError(f"actuation_delay_s = {delay!r} s is not a whole number of physics steps of "
+                             f"{TIMESTEP!r} s (MuJoCo reads a delayed ctrl at whole steps); give a multiple of it")
+    inductance = _finite_at_least_zero("inductance_H", inductance_H, "H")
+    if current_limit_A is not None:
+        limit = _finite_at_least_zero("current_limit_A", current_limit_A, "A (or None for no limit)")
+        if limit == 0:
+            raise ParameterError("current_limit_A must be > 0 A (or None for no limit), got 0")
+    backlash = _finite_at_least_zero("backlash_rad", backlash_rad, "rad")
+    armature = _finite_at_least_zero("motor_armature_kgm2", motor_armature_kgm2, "kg m^2")
+    if backlash > 0 and armature == 0:
+        raise ParameterError("motor_armature_kgm2 must be > 0 kg m^2 with backlash_rad > 0 (the motor side "
+                             "of the play needs inertia)")
+    return _DriveTrain(actuation_delay_s=delay, inductance_H=inductance, current_limit_A=current_limit_A,
+                       backlash_rad=backlash, motor_armature_kgm2=armature)
 
 
 _HINGE = mujoco.mjtJoint.mjJNT_HINGE
@@ -199,21 +286,39 @@ def _inertial(body: mujoco.MjsBody, *, mass: float, inertia: Sequence[float], po
 
 
 def robot_spec(params: C80Parameters = C80, *, steering_friction: str = "stiction",
-               tyre_contact: str = "stiff") -> mujoco.MjSpec:
+               tyre_contact: str = "stiff", actuation_delay_s: float = 0.0,
+               inductance_H: float = 0.0, current_limit_A: float | None = None, backlash_rad: float = 0.0,
+               motor_armature_kgm2: float = MOTOR_ARMATURE) -> mujoco.MjSpec:
     """The C80 alone (no floor) as an MjSpec; every number comes from ``params``.
+
+    With every actuation and backlash option at its default the spec is today's, byte for byte.
 
     Args:
         params: the parameter set.
         steering_friction: one of STEERING_FRICTION_MODELS.
         tyre_contact: one of TYRE_CONTACT_MODELS.
+        actuation_delay_s: s, the steering motor reads its voltage this long ago (MuJoCo's actuator
+            ``delay`` with ``nsample``, zero-order hold); a whole number of physics steps.
+        inductance_H: H, the armature inductance L_a of the ``dcmotor`` (one activation, the current;
+            electrical time constant L_a / R_a); 0: the current is algebraic (today's).
+        current_limit_A: A, the driver's current limit (the ``dcmotor``'s ``saturation`` current:
+            a force range of +-k I_max); None: no limit.
+        backlash_rad: rad at the steering axis, half-width b of the gear's play: a motor-side hinge
+            ``steer_motor`` carrying the motor and its armature, and the tendon ``gear_play`` =
+            steer - steer_motor limited to +-b; 0: no play, one steering joint (today's).
+        motor_armature_kgm2: kg m^2 at the steering axis, the motor side's inertia (used with play only).
 
     Returns:
         The spec: chassis (unit a), drive unit (b), steering unit (c), actuators, sensors and the ``home`` key.
 
     Raises:
         UnknownNameError: an unknown friction or contact model.
+        ParameterError: a negative or non-finite option, a delay that is not a whole number of steps.
     """
     _check_models(steering_friction, tyre_contact)
+    drive = _drive_train(actuation_delay_s=actuation_delay_s, inductance_H=inductance_H,
+                      current_limit_A=current_limit_A, backlash_rad=backlash_rad,
+                      motor_armature_kgm2=motor_armature_kgm2)
     p = params
     spec = mujoco.MjSpec()
     spec.modelname = "c80"
@@ -228,9 +333,11 @@ def robot_spec(params: C80Parameters = C80, *, steering_friction: str = "stictio
     chassis = _add_chassis(spec, p)
     _add_drive_unit(spec, chassis, p)
     _add_steering_unit(spec, chassis, p)
-    _add_actuators(spec, p)
-    _add_sensors(spec)
-    _add_home_key(spec, p)
+    if drive.backlash_rad > 0:
+        _add_gear_play(spec, chassis, p, drive)
+    _add_actuators(spec, p, drive)
+    _add_sensors(spec, drive)
+    _add_home_key(spec, p, drive)
     return spec
 
 
@@ -275,15 +382,56 @@ def _add_steering_unit(spec: mujoco.MjSpec, chassis: mujoco.MjsBody, p: C80Param
                    spin=p.I_y3, diametral=p.I_z3)
 
 
-def _add_actuators(spec: mujoco.MjSpec, p: C80Parameters) -> None:
-    """The open differential, the DC steering motor (2.9)-(2.11) and the drive's velocity servo."""
+# The motor side's body only carries its hinge: MuJoCo's compiler refuses a moving body without
+# mass; these are far below anything the dynamics sees (the armature is the motor's inertia).
+_SHAFT_MASS, _SHAFT_INERTIA = 1e-6, 1e-9  # kg, kg m^2
+
+
+def _add_gear_play(spec: mujoco.MjSpec, chassis: mujoco.MjsBody, p: C80Parameters, drive: _DriveTrain) -> None:
+    """The gear's play: the motor side's hinge and the tendon limiting steer - steer_motor to +-b.
+
+    The motor side is a shaft body coaxial with the steering pivot, added after the steering unit
+    so that every address of today's model (steer's qpos 9 and dof 8, the wheels') is kept and
+    steer_motor's come last. Its hinge carries the motor's armature and no friction: the Coulomb
+    torque (l3 l4 / l1) mu Q of (2.5) is the front tyres' scrub on the floor, a load on the axle,
+    so it stays on ``steer`` (the axle's bearing side of the play). The steering range (the
+    axle's stops) stays on ``steer`` too; the motor side is unlimited.
+    """
+    shaft = chassis.add_body(name="steer_motor_shaft", pos=_r((p.l1, 0.0, p.r3 - p.r2)))
+    _inertial(shaft, mass=_SHAFT_MASS, inertia=(_SHAFT_INERTIA, _SHAFT_INERTIA, _SHAFT_INERTIA))
+    shaft.add_joint(name=MOTOR_JOINT, type=_HINGE, axis=[0.0, 0.0, 1.0],
+                    armature=round_sig(drive.motor_armature_kgm2))
+    play = spec.add_tendon(name=GEAR_PLAY_TENDON, range=_r((-drive.backlash_rad, drive.backlash_rad)))
+    play.solref_limit = list(GEAR_PLAY_SOLREF)
+    play.solimp_limit = list(GEAR_PLAY_SOLIMP)
+    play.wrap_joint(STEERING_JOINT, 1.0)
+    play.wrap_joint(MOTOR_JOINT, -1.0)
+
+
+def _add_actuators(spec: mujoco.MjSpec, p: C80Parameters, drive: _DriveTrain) -> None:
+    """The open differential, the DC steering motor (2.9)-(2.11) and the drive's velocity servo.
+
+    The motor drives ``steer`` (no play) or the motor side ``steer_motor`` (play); its delay,
+    inductance and current limit are MuJoCo's (``nsample``/``delay``, ``inductance``,
+    ``saturation``), set only where they differ from today's so the default text is unchanged.
+    """
     # open differential: the drive acts on the mean rear-wheel angle, equal torque to each wheel
     differential = spec.add_tendon(name="differential")
     differential.wrap_joint("rear_left_spin", 0.5)
     differential.wrap_joint("rear_right_spin", 0.5)
 
-    motor = spec.add_actuator(name="steering_motor", target="steer", trntype=mujoco.mjtTrn.mjTRN_JOINT)
-    motor.set_to_dcmotor(motorconst=_r((p.k_i, p.k_b)), resistance=round_sig(p.R_a))
+    target = MOTOR_JOINT if drive.backlash_rad > 0 else STEERING_JOINT
+    motor = spec.add_actuator(name="steering_motor", target=target, trntype=mujoco.mjtTrn.mjTRN_JOINT)
+    electrical: dict[str, list[float]] = {}
+    if drive.inductance_H > 0:
+        electrical["inductance"] = [round_sig(drive.inductance_H), 0.0]
+    if drive.current_limit_A is not None:
+        electrical["saturation"] = [0.0, round_sig(drive.current_limit_A), 0.0]
+    motor.set_to_dcmotor(motorconst=_r((p.k_i, p.k_b)), resistance=round_sig(p.R_a), **electrical)
+    if drive.delay_steps > 0:
+        # the ring buffer holds exactly the delay: MuJoCo reads ctrl at time - delay (zoh)
+        motor.nsample = drive.delay_steps
+        motor.delay = round_sig(drive.delay_steps * TIMESTEP)
     motor.gear = [round_sig(p.i2), 0.0, 0.0, 0.0, 0.0, 0.0]
     motor.ctrlrange = _r((-p.voltage_limit, p.voltage_limit))
     # drive servo gain at the motor, N m s/rad: time constant of the vehicle's speed
@@ -294,29 +442,38 @@ def _add_actuators(spec: mujoco.MjSpec, p: C80Parameters) -> None:
     servo.gear = [round_sig(p.i1), 0.0, 0.0, 0.0, 0.0, 0.0]
 
 
-def _add_sensors(spec: mujoco.MjSpec) -> None:
-    """Steering angle, rate and torques; positions of A and C; the chassis's attitude; A's velocity."""
+def _add_sensors(spec: mujoco.MjSpec, drive: _DriveTrain) -> None:
+    """Steering angle, rate and torques; positions of A and C; the chassis's attitude; A's velocity.
+
+    With play, ``steer_joint_torque`` is the motor's torque at its side of the play (the only
+    joint the motor acts on) and ``steer_motor_angle`` is added last.
+    """
     sens, obj_t = mujoco.mjtSensor, mujoco.mjtObj
+    motor_joint = MOTOR_JOINT if drive.backlash_rad > 0 else STEERING_JOINT
     for name, kind, objtype, obj in (
         ("steer_angle", sens.mjSENS_JOINTPOS, obj_t.mjOBJ_JOINT, "steer"),
         ("steer_rate", sens.mjSENS_JOINTVEL, obj_t.mjOBJ_JOINT, "steer"),
         ("steer_motor_torque", sens.mjSENS_ACTUATORFRC, obj_t.mjOBJ_ACTUATOR, "steering_motor"),
-        ("steer_joint_torque", sens.mjSENS_JOINTACTFRC, obj_t.mjOBJ_JOINT, "steer"),
+        ("steer_joint_torque", sens.mjSENS_JOINTACTFRC, obj_t.mjOBJ_JOINT, motor_joint),
         ("A_pos", sens.mjSENS_FRAMEPOS, obj_t.mjOBJ_SITE, "A"),
         ("C_pos", sens.mjSENS_FRAMEPOS, obj_t.mjOBJ_SITE, "C"),
         ("chassis_quat", sens.mjSENS_FRAMEQUAT, obj_t.mjOBJ_BODY, "chassis"),
         ("A_vel", sens.mjSENS_FRAMELINVEL, obj_t.mjOBJ_SITE, "A"),
     ):
         spec.add_sensor(name=name, type=kind, objtype=objtype, objname=obj)
+    if drive.backlash_rad > 0:
+        spec.add_sensor(name="steer_motor_angle", type=sens.mjSENS_JOINTPOS, objtype=obj_t.mjOBJ_JOINT,
+                        objname=MOTOR_JOINT)
 
 
-def _add_home_key(spec: mujoco.MjSpec, p: C80Parameters) -> None:
+def _add_home_key(spec: mujoco.MjSpec, p: C80Parameters, drive: _DriveTrain) -> None:
     """The ``home`` key: rolling straight ahead at V_A, the drive commanding i1 V_A / r2."""
-    # qpos order: free joint (7), rear_left, rear_right, steer, front_left, front_right
+    # qpos order: free joint (7), rear_left, rear_right, steer, front_left, front_right[, steer_motor]
     w2, w3 = p.V_A / p.r2, p.V_A / p.r3
+    extra = (0.0,) if drive.backlash_rad > 0 else ()
     spec.add_key(name="home",
-                 qpos=_r((0.0, 0.0, p.r2, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)),
-                 qvel=_r((p.V_A, 0.0, 0.0, 0.0, 0.0, 0.0, w2, w2, 0.0, w3, w3)),
+                 qpos=_r((0.0, 0.0, p.r2, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0) + extra),
+                 qvel=_r((p.V_A, 0.0, 0.0, 0.0, 0.0, 0.0, w2, w2, 0.0, w3, w3) + extra),
                  ctrl=_r((0.0, p.i1 * w2)))
 
 
@@ -343,19 +500,34 @@ def _add_world(spec: mujoco.MjSpec, params: C80Parameters, tyre_contact: str = "
 
 
 def scene_spec(params: C80Parameters = C80, *, steering_friction: str = "stiction",
-               tyre_contact: str = "stiff") -> mujoco.MjSpec:
-    """The robot and the floor in one MjSpec (what runs simulate)."""
-    spec = robot_spec(params, steering_friction=steering_friction, tyre_contact=tyre_contact)
+               tyre_contact: str = "stiff", actuation_delay_s: float = 0.0,
+               inductance_H: float = 0.0, current_limit_A: float | None = None, backlash_rad: float = 0.0,
+               motor_armature_kgm2: float = MOTOR_ARMATURE) -> mujoco.MjSpec:
+    """The robot and the floor in one MjSpec (what runs simulate); options as :func:`robot_spec`."""
+    spec = robot_spec(params, steering_friction=steering_friction, tyre_contact=tyre_contact,
+                      actuation_delay_s=actuation_delay_s, inductance_H=inductance_H,
+                      current_limit_A=current_limit_A, backlash_rad=backlash_rad,
+                      motor_armature_kgm2=motor_armature_kgm2)
     spec.modelname = "c80 scene"
+    options = _drive_train(actuation_delay_s=actuation_delay_s, inductance_H=inductance_H,
+                      current_limit_A=current_limit_A, backlash_rad=backlash_rad,
+                      motor_armature_kgm2=motor_armature_kgm2).comment()
     spec.comment = (" C80 scene (robot and floor), generated by wmr_mj.plant.mjcf.scene_spec from wmr_mj.params "
-                    f"with steering_friction={steering_friction!r}, tyre_contact={tyre_contact!r}. ")
+                    f"with steering_friction={steering_friction!r}, tyre_contact={tyre_contact!r}"
+                    + (f", {options}" if options else "") + ". ")
     _add_world(spec, params, tyre_contact)
     return spec
 
 
-def robot_xml(params: C80Parameters = C80, *, steering_friction: str = "stiction", tyre_contact: str = "stiff") -> str:
-    """MJCF of the C80 alone (no floor): ``robot_spec(params).to_xml()``."""
-    return robot_spec(params, steering_friction=steering_friction, tyre_contact=tyre_contact).to_xml()
+def robot_xml(params: C80Parameters = C80, *, steering_friction: str = "stiction", tyre_contact: str = "stiff",
+              actuation_delay_s: float = 0.0,
+               inductance_H: float = 0.0, current_limit_A: float | None = None, backlash_rad: float = 0.0,
+               motor_armature_kgm2: float = MOTOR_ARMATURE) -> str:
+    """MJCF of the C80 alone (no floor): ``robot_spec(params, ...).to_xml()``."""
+    return robot_spec(params, steering_friction=steering_friction, tyre_contact=tyre_contact,
+                      actuation_delay_s=actuation_delay_s, inductance_H=inductance_H,
+                      current_limit_A=current_limit_A, backlash_rad=backlash_rad,
+                      motor_armature_kgm2=motor_armature_kgm2).to_xml()
 
 
 #: The comment scene.xml carries above its floor.
@@ -387,9 +559,15 @@ def scene_file_xml(params: C80Parameters = C80) -> str:
     return head + sep + '  <include file="c80.xml"/>\n\n' + tail
 
 
-def scene_xml(params: C80Parameters = C80, *, steering_friction: str = "stiction", tyre_contact: str = "stiff") -> str:
+def scene_xml(params: C80Parameters = C80, *, steering_friction: str = "stiction", tyre_contact: str = "stiff",
+              actuation_delay_s: float = 0.0,
+               inductance_H: float = 0.0, current_limit_A: float | None = None, backlash_rad: float = 0.0,
+               motor_armature_kgm2: float = MOTOR_ARMATURE) -> str:
     """One self-contained MJCF string: the robot and the floor (what runs simulate)."""
-    return spec_xml(scene_spec(params, steering_friction=steering_friction, tyre_contact=tyre_contact))
+    return spec_xml(scene_spec(params, steering_friction=steering_friction, tyre_contact=tyre_contact,
+                               actuation_delay_s=actuation_delay_s, inductance_H=inductance_H,
+                      current_limit_A=current_limit_A, backlash_rad=backlash_rad,
+                      motor_armature_kgm2=motor_armature_kgm2))
 
 
 def spec_xml(spec: mujoco.MjSpec) -> str:
@@ -427,12 +605,18 @@ def _compile(xml: str, source: str) -> mujoco.MjModel:
 
 
 def compile_model(params: C80Parameters = C80, *, steering_friction: str = "stiction",
-                  tyre_contact: str = "stiff") -> tuple[mujoco.MjModel, str]:
+                  tyre_contact: str = "stiff", actuation_delay_s: float = 0.0,
+               inductance_H: float = 0.0, current_limit_A: float | None = None, backlash_rad: float = 0.0,
+               motor_armature_kgm2: float = MOTOR_ARMATURE) -> tuple[mujoco.MjModel, str]:
     """(model, xml) of the C80 scene for ``params``; xml is exactly what was compiled.
 
-    steering_friction: one of STEERING_FRICTION_MODELS; tyre_contact: one of TYRE_CONTACT_MODELS.
+    steering_friction: one of STEERING_FRICTION_MODELS; tyre_contact: one of TYRE_CONTACT_MODELS;
+    the actuation and backlash options as :func:`robot_spec` (their defaults: today's model).
     """
-    xml = scene_xml(params, steering_friction=steering_friction, tyre_contact=tyre_contact)
+    xml = scene_xml(params, steering_friction=steering_friction, tyre_contact=tyre_contact,
+                    actuation_delay_s=actuation_delay_s, inductance_H=inductance_H,
+                      current_limit_A=current_limit_A, backlash_rad=backlash_rad,
+                      motor_armature_kgm2=motor_armature_kgm2)
     return _compile(xml, "generated C80 scene"), xml
 
 
@@ -448,6 +632,49 @@ def load_model_file(path: str | Path) -> mujoco.MjModel:
         raise ModelFileError(f"model file {str(path)!r} is not a valid MJCF model: {first}") from None
 
 
+@dataclass(frozen=True)
+class SteeringAddresses:
+    """Where a compiled C80 keeps its steering: the axle (alpha), the motor side, the current.
+
+    Without play the motor side is the axle (``motor_qpos == axle_qpos``). The motor shaft's
+    angle is ``i2 * data.qpos[motor_qpos]`` (an encoder on the motor shaft reads it); the
+    armature current is ``data.act[current_act]`` A where the motor has inductance, else it is
+    algebraic and equals ``data.actuator_force[actuator] / sqrt(k_i k_b)``.
+    """
+
+    axle_qpos: int  # qpos address of ``steer``: alpha, rad
+    axle_dof: int  # dof address of ``steer``: alpha', rad/s
+    motor_qpos: int  # qpos address of the motor side at the steering axis, rad
+    motor_dof: int  # dof address of the motor side (where the motor's torque acts)
+    actuator: int  # id of ``steering_motor``
+    current_act: int | None  # index into data.act of the armature current, A; None: no inductance
+    play_tendon: int | None  # id of the ``gear_play`` tendon (steer - steer_motor, rad); None: no play
+
+    @property
+    def has_play(self) -> bool:
+        return self.play_tendon is not None
+
+
+def steering_joint_addresses(model: mujoco.MjModel) -> SteeringAddresses:
+    """The steering's addresses in ``model`` (any C80 built here, with or without play).
+
+    Raises:
+        ModelFileError: the model has no ``steer`` joint or ``steering_motor`` actuator.
+    """
+    try:
+        axle = model.joint(STEERING_JOINT).id
+        actuator = model.actuator("steering_motor").id
+    except KeyError:
+        raise ModelFileError("the model has no 'steer' joint or 'steering_motor' actuator; "
+                             "give a C80 model built by wmr_mj.plant.mjcf") from None
+    motor = int(model.actuator_trnid[actuator, 0])
+    play = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TENDON, GEAR_PLAY_TENDON)
+    current = int(model.actuator_actadr[actuator]) if model.actuator_actnum[actuator] > 0 else None
+    return SteeringAddresses(axle_qpos=int(model.jnt_qposadr[axle]), axle_dof=int(model.jnt_dofadr[axle]),
+                             motor_qpos=int(model.jnt_qposadr[motor]), motor_dof=int(model.jnt_dofadr[motor]),
+                             actuator=int(actuator), current_act=current, play_tendon=play if play >= 0 else None)
+
+
 @dataclass
 class Plant:
     """A compiled C80 scene with MjData at the home keyframe and named indices.
@@ -458,15 +685,24 @@ class Plant:
     params: C80Parameters = C80
     steering_friction: str = field(default="stiction", kw_only=True)  # one of STEERING_FRICTION_MODELS
     tyre_contact: str = field(default="stiff", kw_only=True)  # one of TYRE_CONTACT_MODELS
+    actuation_delay_s: float = field(default=0.0, kw_only=True)  # s, see robot_spec
+    inductance_H: float = field(default=0.0, kw_only=True)  # H
+    current_limit_A: float | None = field(default=None, kw_only=True)  # A, None: no limit
+    backlash_rad: float = field(default=0.0, kw_only=True)  # rad at the steering axis
+    motor_armature_kgm2: float = field(default=MOTOR_ARMATURE, kw_only=True)  # kg m^2, with play only
     model: mujoco.MjModel = field(init=False)
     data: mujoco.MjData = field(init=False)
     xml: str = field(init=False)
 
     def __post_init__(self) -> None:
-        self.model, self.xml = compile_model(self.params, steering_friction=self.steering_friction,
-                                             tyre_contact=self.tyre_contact)
+        self.model, self.xml = compile_model(
+            self.params, steering_friction=self.steering_friction, tyre_contact=self.tyre_contact,
+            actuation_delay_s=self.actuation_delay_s, inductance_H=self.inductance_H,
+            current_limit_A=self.current_limit_A, backlash_rad=self.backlash_rad,
+            motor_armature_kgm2=self.motor_armature_kgm2)
         self.data = mujoco.MjData(self.model)
         m = self.model
+        self.steering = steering_joint_addresses(m)
         self.steer_qpos = m.jnt_qposadr[m.joint("steer").id]
         self.steer_dof = m.jnt_dofadr[m.joint("steer").id]
         self.steer_actuator = m.actuator("steering_motor").id
@@ -499,8 +735,8 @@ class Plant:
         return float(self.data.actuator_force[self.steer_actuator]) / self.params.k_i
 
     def steer_torque(self) -> float:
-        """Torque of the motor at the steering joint (after the gear), N m."""
-        return float(self.data.qfrc_actuator[self.steer_dof])
+        """Torque of the motor at the steering joint (after the gear; with play, at its motor side), N m."""
+        return float(self.data.qfrc_actuator[self.steering.motor_dof])
 
 
 def write_model_files(params: C80Parameters = C80, directory: Path = MODELS_DIR) -> list[Path]:
