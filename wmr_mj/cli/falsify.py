@@ -12,11 +12,16 @@ _OBJECTIVE_KINDS = ("ratio", "sup-E")
 
 
 def register(sub: argparse._SubParsersAction) -> None:
+    from wmr_mj.cli._common import CLAIM_BROKEN_EXIT
     from wmr_mj.cli.run import add_run_options, add_signal_options
 
     p = sub.add_parser("falsify", help="worst-case search over the uncertainty box (its vertices, then CMA-ES; "
                                        "or a local polish, or differential evolution) on mujoco.batch, beside the "
-                                       "same budget spent at random")
+                                       "same budget spent at random",
+                       epilog=f"exit status: 0 nothing falsified; {CLAIM_BROKEN_EXIT} falsified: a run of the search "
+                              "or of the random sample is certified-outside (it breaks the law's claim), or the "
+                              "--require is falsified; 1 the serial re-run of the worst run did not reproduce it; "
+                              "2 bad input")
     add_run_options(p)
     p.add_argument("--range", action="append", metavar="NAME=LO:HI",
                    help="add a plant parameter to the box or replace its range (repeatable); with --disturbance "
@@ -212,7 +217,7 @@ def run(args: argparse.Namespace) -> int:
     write_json_atomic(out / "falsify.json", summary)
     if args.json:
         print_json(summary)
-        return 0 if summary["reproduced"] else 1
+        return exit_status(summary)
     names = ", ".join(spec.names)
     if spec.method == "de":
         how = (f"differential evolution, {summary['population']} per generation x {summary['generations']} "
@@ -239,6 +244,8 @@ def run(args: argparse.Namespace) -> int:
           f"(sup|E| = {worst.sup_E:.6g} rad, sup|E'| = {worst.sup_Edot:.6g} rad/s, {worst.verdict})")
     rw = result.random_worst
     print(f"random : worst objective {fmt(rw.objective)} in {len(result.random)} runs (Latin hypercube, same seed)")
+    for line in claim_lines(summary):
+        print(line)
     if summary["tightness"] is not None:
         print(f"tightness: {summary['tightness']['text']}")
     if spec.objective == "requirement":
@@ -262,7 +269,37 @@ def run(args: argparse.Namespace) -> int:
         print(f"WARNING: the serial re-run gave sup|E| = {logged.sup_E!r}, the search {worst.sup_E!r}",
               flush=True)
     print(f"log:   {log_path}\nplot:  {summary['plot'][0]}\ntable: {summary['table']}")
-    return 0 if summary["reproduced"] else 1
+    return exit_status(summary)
+
+
+def exit_status(summary: dict) -> int:
+    """falsify's exit status from its JSON: 1 when the serial re-run did not reproduce the worst run (its
+    numbers cannot be trusted), else CLAIM_BROKEN_EXIT when it falsified (a claim broken or the
+    requirement falsified), else 0."""
+    from wmr_mj.cli._common import CLAIM_BROKEN_EXIT
+
+    if not summary["reproduced"]:
+        return 1
+    return CLAIM_BROKEN_EXIT if summary["falsified"] else 0
+
+
+def claim_lines(summary: dict) -> list[str]:
+    """Beside the verdict: the banner and the run that broke the claim (where one did), and the worst
+    run's unmet assumptions (name, value vs limit)."""
+    from wmr_mj.analysis.verdicts import certified_outside_banner, format_unmet
+
+    lines = []
+    broken = summary.get("claim_broken")
+    if broken is not None:
+        where = (f"{broken['count']} run(s) break the claim; the worst, {broken['phase']} run {broken['run']} "
+                 f"(sup|E| = {broken['sup_E']:.6g} rad, {broken['ratio']:.3g} times E_max = "
+                 f"{broken['E_max']:.4g} rad)")
+        lines += [certified_outside_banner(where),
+                  "broken by: " + ", ".join(f"{k} = {v!r}" for k, v in broken["params"].items())]
+    unmet = summary["worst"].get("unmet")
+    if unmet:
+        lines.append(f"worst run {summary['worst']['verdict']}: assumptions not met: {format_unmet(unmet)}")
+    return lines
 
 
 def _table(result) -> str:
