@@ -218,7 +218,48 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print_json(summary)
         return exit_status(summary)
-    names = ", ".join(spec.names)
+    names, how = ", ".join(spec.names), _how_text(spec, result, summary)
+    print(f"worst-case search over {len(spec.names)} parameter(s) ({names}; box {args.uncertainty}): {how}, "
+          f"seed {spec.seed}")
+    print(f"objective: {OBJECTIVE_LABELS[objective]}  [{result.objective_source}]")
+    fmt = lambda x: "n/a" if x is None else f"{x:.6g}"  # noqa: E731
+    print(f"search : worst objective {fmt(worst.objective)} in {len(result.search)} runs "
+          f"(sup|E| = {worst.sup_E:.6g} rad, sup|E'| = {worst.sup_Edot:.6g} rad/s, {worst.verdict})")
+    rw = result.random_worst
+    print(f"random : worst objective {fmt(rw.objective)} in {len(result.random)} runs (Latin hypercube, same seed)")
+    print("".join(f"{line}\n" for line in claim_lines(summary)), end="")
+    if summary["tightness"] is not None:
+        print(f"tightness: {summary['tightness']['text']}")
+    if spec.objective == "requirement":
+        first_s = next((e.index + 1 for e in result.search if e.objective is not None and e.objective > 0), None)
+        first_r = next((e.index + 1 for e in result.random if e.objective is not None and e.objective > 0), None)
+        print(f"requirement {spec.requirement}: "
+              + (f"FALSIFIED, first at run {first_s} of the search" if first_s else "not falsified by the search")
+              + (f"; random: first at run {first_r}" if first_r else "; random: not falsified"))
+    print("worst parameters: " + ", ".join(f"{k} = {v!r}" for k, v in worst.params.items()))
+    if signals_file is not None:
+        print(f"worst signals: {json.dumps(summary['worst']['signals'], separators=(',', ':'))}")
+    if path_file is not None:
+        print(f"worst path: {path_file} (a knot path within the declared reference bounds)")
+    if base.reference_bounds is not None:
+        print(_bounds_line(base.reference_bounds))
+    print(f"reproduce: {summary['reproduce']}")
+    if not summary["reproduced"]:
+        print(f"WARNING: the serial re-run gave sup|E| = {logged.sup_E!r}, the search {worst.sup_E!r}",
+              flush=True)
+    print(f"log:   {log_path}\nplot:  {summary['plot'][0]}\ntable: {summary['table']}")
+    return exit_status(summary)
+
+
+def _bounds_line(b) -> str:
+    """The declared reference bounds ``b`` (a ReferenceBounds), as falsify prints them."""
+    return (f"reference bounds declared: |alpha0'| <= {b.alpha_dot_max:g} rad/s, |alpha0''| <= "
+            f"{b.alpha_ddot_max:g} rad/s^2, |alpha0| <= {b.angle_max:.6g} rad (the certificate holds for every "
+            "reference within them)")
+
+
+def _how_text(spec, result, summary: dict) -> str:
+    """How the search spent its runs, for falsify's first line."""
     if spec.method == "de":
         how = (f"differential evolution, {summary['population']} per generation x {summary['generations']} "
                "generations")
@@ -236,40 +277,7 @@ def run(args: argparse.Namespace) -> int:
         kind = ("a Latin hypercube" if spec.method == "lhs-polish" else "all vertices"
                 if len(first) == 2 ** len(spec.names) else "a fractional-factorial covering of the vertices")
         how = (f"{kind} ({len(first)} runs), then Nelder-Mead from the worst ({len(result.search) - len(first)} runs)")
-    print(f"worst-case search over {len(spec.names)} parameter(s) ({names}; box {args.uncertainty}): {how}, "
-          f"seed {spec.seed}")
-    print(f"objective: {OBJECTIVE_LABELS[objective]}  [{result.objective_source}]")
-    fmt = lambda x: "n/a" if x is None else f"{x:.6g}"  # noqa: E731
-    print(f"search : worst objective {fmt(worst.objective)} in {len(result.search)} runs "
-          f"(sup|E| = {worst.sup_E:.6g} rad, sup|E'| = {worst.sup_Edot:.6g} rad/s, {worst.verdict})")
-    rw = result.random_worst
-    print(f"random : worst objective {fmt(rw.objective)} in {len(result.random)} runs (Latin hypercube, same seed)")
-    for line in claim_lines(summary):
-        print(line)
-    if summary["tightness"] is not None:
-        print(f"tightness: {summary['tightness']['text']}")
-    if spec.objective == "requirement":
-        first_s = next((e.index + 1 for e in result.search if e.objective is not None and e.objective > 0), None)
-        first_r = next((e.index + 1 for e in result.random if e.objective is not None and e.objective > 0), None)
-        print(f"requirement {spec.requirement}: "
-              + (f"FALSIFIED, first at run {first_s} of the search" if first_s else "not falsified by the search")
-              + (f"; random: first at run {first_r}" if first_r else "; random: not falsified"))
-    print("worst parameters: " + ", ".join(f"{k} = {v!r}" for k, v in worst.params.items()))
-    if signals_file is not None:
-        print(f"worst signals: {json.dumps(summary['worst']['signals'], separators=(',', ':'))}")
-    if path_file is not None:
-        print(f"worst path: {path_file} (a knot path within the declared reference bounds)")
-    if base.reference_bounds is not None:
-        b = base.reference_bounds
-        print(f"reference bounds declared: |alpha0'| <= {b.alpha_dot_max:g} rad/s, |alpha0''| <= "
-              f"{b.alpha_ddot_max:g} rad/s^2, |alpha0| <= {b.angle_max:.6g} rad (the certificate holds for every "
-              "reference within them)")
-    print(f"reproduce: {summary['reproduce']}")
-    if not summary["reproduced"]:
-        print(f"WARNING: the serial re-run gave sup|E| = {logged.sup_E!r}, the search {worst.sup_E!r}",
-              flush=True)
-    print(f"log:   {log_path}\nplot:  {summary['plot'][0]}\ntable: {summary['table']}")
-    return exit_status(summary)
+    return how
 
 
 def exit_status(summary: dict) -> int:
