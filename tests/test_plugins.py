@@ -217,9 +217,9 @@ def test_the_example_plug_in_through_run_sweep_falsify_require_and_replay(tmp_pa
                  str(tmp_path / "f0")]) == 2
     assert "states no claim" in _one_error_line(capsys)
     assert main(["falsify", "--controller", spec, "--controller-param", "ki=20", "--budget", "8", "--duration", "10",
-                 "--out", str(tmp_path / "f1"), "--require", "always[5,10](abs(E) <= 0.01)", "--json"]) == 0
-    fals = json.loads(capsys.readouterr().out)
-    assert fals["worst"]["verdict"] == NO_CLAIM
+                 "--out", str(tmp_path / "f1"), "--require", "always[5,10](abs(E) <= 0.01)", "--json"]) == 3
+    fals = json.loads(capsys.readouterr().out)  # exit 3: the requirement falsified (sup|E| > 0.01 rad)
+    assert fals["worst"]["verdict"] == NO_CLAIM and fals["falsified"] is True and fals["worst"]["sup_E"] > 0.01
     assert main(["replay", str(tmp_path / "f1" / "worst.mcap"), "--verify"]) == 0
     capsys.readouterr()
     # a changed source: replay says in one line why it cannot re-run the law

@@ -48,6 +48,11 @@ __all__ = [
     "paper_region",
     "is_pass",
     "count_verdicts",
+    "CERTIFIED_OUTSIDE",
+    "certified_outside_banner",
+    "unmet_assumptions",
+    "count_unmet",
+    "format_unmet",
 ]
 
 PASS = "certified-inside"
@@ -57,6 +62,8 @@ NO_CLAIM = "no-claim"
 FAILED = "failed"
 #: Name (prefix) of the assumption a plant outside the certificate's box fails (wmr_mj.sim.certify).
 OUTSIDE_THE_BOX = "plant inside the box"
+#: The verdict of a run that breaks its law's claim: every assumption holds and the run is outside.
+CERTIFIED_OUTSIDE = "certified-outside"
 #: Length of each of the two windows that compare |E| at the end of a run, s.
 DRIFT_WINDOW_S = 5.0
 #: |E| grows when the last window's max exceeds the previous window's by more than this, rad.
@@ -199,6 +206,48 @@ def _num(x: Any, spec: str = ".5g") -> str:
 
 #: What every output says of the paper's region for a law outside the paper's family.
 PAPER_CLAIM_NOT_APPLICABLE = "not applicable (its region is for the paper's computed-torque law, not this one)"
+def certified_outside_banner(where: str = "") -> str:
+    """The one banner of a broken claim, as ``run`` prints it above its verdict and ``falsify``, ``sweep``
+    and ``compare`` print it above the run that broke it.
+
+    Args:
+        where: the run (or runs) that broke it, e.g. "search run 7 of 16"; empty: this run.
+    """
+    subject = f"{where}: " if where else ""
+    return (f"!!! CERTIFIED-OUTSIDE: {subject}every assumption of the certificate holds and the run is OUTSIDE it. "
+            "This is a bug or a modelling gap: report it. !!!")
+
+
+def unmet_assumptions(certificate: Mapping[str, Any] | None) -> list[dict[str, Any]]:
+    """The assumptions a judged certificate does not meet, each as {name, value, limit} (value and limit
+    in the assumption's own units; None where not finite), in the certificate's order.
+
+    Args:
+        certificate: a certificate's JSON (``Certificate.as_dict()``, a run summary's ``certificate``);
+            None or one without ``assumptions`` (a slim summary, a law without a claim): [].
+    """
+    return [{"name": str(a.get("name")), "value": a.get("value"), "limit": a.get("limit")}
+            for a in (certificate or {}).get("assumptions") or [] if not a.get("met")]
+
+
+def count_unmet(per_run: Iterable[Iterable[Mapping[str, Any]]]) -> list[dict[str, Any]]:
+    """Each assumption unmet in some run, once, in the order first met: {name, value, limit} of the first
+    run that does not meet it and ``runs``, how many do not.
+
+    Args:
+        per_run: each run's unmet assumptions ({name, value, limit}: :func:`unmet_assumptions`).
+    """
+    seen: dict[str, dict[str, Any]] = {}
+    for unmet in per_run:
+        for a in unmet:
+            seen.setdefault(str(a["name"]), {"name": str(a["name"]), "value": a.get("value"),
+                                             "limit": a.get("limit"), "runs": 0})["runs"] += 1
+    return list(seen.values())
+
+
+def format_unmet(unmet: Iterable[Mapping[str, Any]]) -> str:
+    """'name (value vs limit); ...' of unmet assumptions ({name, value, limit}: :func:`unmet_assumptions`)."""
+    return "; ".join(f"{a['name']} ({_num(a.get('value'), '.4g')} vs {_num(a.get('limit'), '.4g')})" for a in unmet)
 
 
 def format_verdict(summary: Mapping[str, Any]) -> list[str]:
@@ -220,17 +269,15 @@ def format_verdict(summary: Mapping[str, Any]) -> list[str]:
     paper = summary.get("paper_region") or {}
     dr = summary.get("drift") or {}
     lines = []
-    if verdict == "certified-outside":
-        lines.append("!!! CERTIFIED-OUTSIDE: every assumption of the certificate holds and the run is OUTSIDE it. "
-                     "This is a bug or a modelling gap: report it. !!!")
+    if verdict == CERTIFIED_OUTSIDE:
+        lines.append(certified_outside_banner())
     ratio = cert.get("E_ratio")
     lines.append(f"verdict: {verdict.upper()}"
                  + ("" if ratio is None else f"  (tightness sup|E|/E_max = {ratio:.3f})")
                  + ("" if is_pass(verdict) else "  -- not a pass"))
     unmet = [a for a in cert.get("assumptions", []) if not a.get("met")]
     if unmet:
-        lines.append("certificate NOT valid; assumptions not met: " + "; ".join(
-            f"{a['name']} ({_num(a.get('value'), '.4g')} vs {_num(a.get('limit'), '.4g')})" for a in unmet))
+        lines.append("certificate NOT valid; assumptions not met: " + format_unmet(unmet))
     for a in unmet:
         if str(a.get("name", "")).startswith(OUTSIDE_THE_BOX):
             lines.append(f"plant outside the box: {a.get('equation', '')} fails; {a.get('note', '')}")

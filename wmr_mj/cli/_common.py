@@ -8,6 +8,11 @@ import math
 import sys
 from typing import Any
 
+#: Exit status of ``run``, ``sweep``, ``compare`` and ``falsify`` when a run breaks its law's claim (a
+#: ``certified-outside`` run), and of ``falsify`` when it falsifies its ``--require``: a CI job can gate on
+#: it. Distinct from bad input's 2 and from a failed or irreproducible run's 1 (docs/reference/commands.md).
+CLAIM_BROKEN_EXIT = 3
+
 
 def add_controller_source(out: dict[str, Any], config: Any) -> dict[str, Any]:
     """``out`` with ``controller_source``: where the run's law comes from, as its MCAP log records it

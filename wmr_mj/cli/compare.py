@@ -19,11 +19,15 @@ import argparse
 
 
 def register(sub: argparse._SubParsersAction) -> None:
+    from wmr_mj.cli._common import CLAIM_BROKEN_EXIT
     from wmr_mj.sim.suite import suite_names
 
     p = sub.add_parser("compare", help="every design on every scenario of a versioned suite, then the same "
                                        "adversary: one table (Markdown, CSV, HTML) and a figure",
-                       description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+                       description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter,
+                       epilog=f"exit status: 0; {CLAIM_BROKEN_EXIT} when a run of a design (a scenario's or the "
+                              "adversary's) is certified-outside: it breaks that design's claim (a banner above "
+                              "the table names the run); 2 bad input")
     p.add_argument("designs", nargs="+", metavar="DESIGN", help="a preset, a law's name, FILE.py:Class or "
                                                                "module:Class, with ,key=value settings")
     p.add_argument("--suite", default="standard-v1",
@@ -49,7 +53,7 @@ def run(args: argparse.Namespace) -> int:
 
     from wmr_mj._util.files import check_output_path
     from wmr_mj._util.progress import counter_callback, progress_bar
-    from wmr_mj.cli._common import print_json
+    from wmr_mj.cli._common import CLAIM_BROKEN_EXIT, print_json
     from wmr_mj.errors import ParameterError
     from wmr_mj.report.compare import markdown, write_report
     from wmr_mj.sim.compare import adversary_spec, compare, design_from_token
@@ -74,10 +78,11 @@ def run(args: argparse.Namespace) -> int:
                          nthread=args.nthread, scheduler=args.scheduler, method=args.method,
                          progress=counter_callback(bar))
     paths = write_report(result, out)
+    status = CLAIM_BROKEN_EXIT if result.claims_broken else 0
     if args.json:
         print_json({**result.as_dict(), "files": paths})
-        return 0
-    print(markdown(result).split("\n- **")[0].rstrip())
+        return status
+    print(markdown(result).rstrip())  # compare.md: the banners, the table and what each column says
     print(f"\nreport: {paths['html']} (also {Path(paths['markdown']).name}, {Path(paths['csv']).name}, "
           f"{Path(paths['figure']).name}, {Path(paths['json']).name}, {Path(paths['runs']).name})")
-    return 0
+    return status

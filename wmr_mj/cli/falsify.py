@@ -12,11 +12,16 @@ _OBJECTIVE_KINDS = ("ratio", "sup-E")
 
 
 def register(sub: argparse._SubParsersAction) -> None:
+    from wmr_mj.cli._common import CLAIM_BROKEN_EXIT
     from wmr_mj.cli.run import add_run_options, add_signal_options
 
     p = sub.add_parser("falsify", help="worst-case search over the uncertainty box (its vertices, then CMA-ES; "
                                        "or a local polish, or differential evolution) on mujoco.batch, beside the "
-                                       "same budget spent at random")
+                                       "same budget spent at random",
+                       epilog=f"exit status: 0 nothing falsified; {CLAIM_BROKEN_EXIT} falsified: a run of the search "
+                              "or of the random sample is certified-outside (it breaks the law's claim), or the "
+                              "--require is falsified; 1 the serial re-run of the worst run did not reproduce it; "
+                              "2 bad input")
     add_run_options(p)
     p.add_argument("--range", action="append", metavar="NAME=LO:HI",
                    help="add a plant parameter to the box or replace its range (repeatable); with --disturbance "
@@ -221,8 +226,49 @@ def run(args: argparse.Namespace) -> int:
     write_json_atomic(out / "falsify.json", summary)
     if args.json:
         print_json(summary)
-        return 0 if summary["reproduced"] else 1
-    names = ", ".join(spec.names)
+        return exit_status(summary)
+    names, how = ", ".join(spec.names), _how_text(spec, result, summary)
+    print(f"worst-case search over {len(spec.names)} parameter(s) ({names}; box {args.uncertainty}): {how}, "
+          f"seed {spec.seed}")
+    print(f"objective: {OBJECTIVE_LABELS[objective]}  [{result.objective_source}]")
+    fmt = lambda x: "n/a" if x is None else f"{x:.6g}"  # noqa: E731
+    print(f"search : worst objective {fmt(worst.objective)} in {len(result.search)} runs "
+          f"(sup|E| = {worst.sup_E:.6g} rad, sup|E'| = {worst.sup_Edot:.6g} rad/s, {worst.verdict})")
+    rw = result.random_worst
+    print(f"random : worst objective {fmt(rw.objective)} in {len(result.random)} runs (Latin hypercube, same seed)")
+    print("".join(f"{line}\n" for line in claim_lines(summary)), end="")
+    if summary["tightness"] is not None:
+        print(f"tightness: {summary['tightness']['text']}")
+    if spec.objective == "requirement":
+        first_s = next((e.index + 1 for e in result.search if e.objective is not None and e.objective > 0), None)
+        first_r = next((e.index + 1 for e in result.random if e.objective is not None and e.objective > 0), None)
+        print(f"requirement {spec.requirement}: "
+              + (f"FALSIFIED, first at run {first_s} of the search" if first_s else "not falsified by the search")
+              + (f"; random: first at run {first_r}" if first_r else "; random: not falsified"))
+    print("worst parameters: " + ", ".join(f"{k} = {v!r}" for k, v in worst.params.items()))
+    if signals_file is not None:
+        print(f"worst signals: {json.dumps(summary['worst']['signals'], separators=(',', ':'))}")
+    if path_file is not None:
+        print(f"worst path: {path_file} (a knot path within the declared reference bounds)")
+    if base.reference_bounds is not None:
+        print(_bounds_line(base.reference_bounds))
+    print(f"reproduce: {summary['reproduce']}")
+    if not summary["reproduced"]:
+        print(f"WARNING: the serial re-run gave sup|E| = {logged.sup_E!r}, the search {worst.sup_E!r}",
+              flush=True)
+    print(f"log:   {log_path}\nplot:  {summary['plot'][0]}\ntable: {summary['table']}")
+    return exit_status(summary)
+
+
+def _bounds_line(b) -> str:
+    """The declared reference bounds ``b`` (a ReferenceBounds), as falsify prints them."""
+    return (f"reference bounds declared: |alpha0'| <= {b.alpha_dot_max:g} rad/s, |alpha0''| <= "
+            f"{b.alpha_ddot_max:g} rad/s^2, |alpha0| <= {b.angle_max:.6g} rad (the certificate holds for every "
+            "reference within them)")
+
+
+def _how_text(spec, result, summary: dict) -> str:
+    """How the search spent its runs, for falsify's first line."""
     if spec.method == "de":
         how = (f"differential evolution, {summary['population']} per generation x {summary['generations']} "
                "generations")
@@ -240,38 +286,37 @@ def run(args: argparse.Namespace) -> int:
         kind = ("a Latin hypercube" if spec.method == "lhs-polish" else "all vertices"
                 if len(first) == 2 ** len(spec.names) else "a fractional-factorial covering of the vertices")
         how = (f"{kind} ({len(first)} runs), then Nelder-Mead from the worst ({len(result.search) - len(first)} runs)")
-    print(f"worst-case search over {len(spec.names)} parameter(s) ({names}; box {args.uncertainty}): {how}, "
-          f"seed {spec.seed}")
-    print(f"objective: {OBJECTIVE_LABELS[objective]}  [{result.objective_source}]")
-    fmt = lambda x: "n/a" if x is None else f"{x:.6g}"  # noqa: E731
-    print(f"search : worst objective {fmt(worst.objective)} in {len(result.search)} runs "
-          f"(sup|E| = {worst.sup_E:.6g} rad, sup|E'| = {worst.sup_Edot:.6g} rad/s, {worst.verdict})")
-    rw = result.random_worst
-    print(f"random : worst objective {fmt(rw.objective)} in {len(result.random)} runs (Latin hypercube, same seed)")
-    if summary["tightness"] is not None:
-        print(f"tightness: {summary['tightness']['text']}")
-    if spec.objective == "requirement":
-        first_s = next((e.index + 1 for e in result.search if e.objective is not None and e.objective > 0), None)
-        first_r = next((e.index + 1 for e in result.random if e.objective is not None and e.objective > 0), None)
-        print(f"requirement {spec.requirement}: "
-              + (f"FALSIFIED, first at run {first_s} of the search" if first_s else "not falsified by the search")
-              + (f"; random: first at run {first_r}" if first_r else "; random: not falsified"))
-    print("worst parameters: " + ", ".join(f"{k} = {v!r}" for k, v in worst.params.items()))
-    if signals_file is not None:
-        print(f"worst signals: {json.dumps(summary['worst']['signals'], separators=(',', ':'))}")
-    if path_file is not None:
-        print(f"worst path: {path_file} (a knot path within the declared reference bounds)")
-    if base.reference_bounds is not None:
-        b = base.reference_bounds
-        print(f"reference bounds declared: |alpha0'| <= {b.alpha_dot_max:g} rad/s, |alpha0''| <= "
-              f"{b.alpha_ddot_max:g} rad/s^2, |alpha0| <= {b.angle_max:.6g} rad (the certificate holds for every "
-              "reference within them)")
-    print(f"reproduce: {summary['reproduce']}")
+    return how
+
+
+def exit_status(summary: dict) -> int:
+    """falsify's exit status from its JSON: 1 when the serial re-run did not reproduce the worst run (its
+    numbers cannot be trusted), else CLAIM_BROKEN_EXIT when it falsified (a claim broken or the
+    requirement falsified), else 0."""
+    from wmr_mj.cli._common import CLAIM_BROKEN_EXIT
+
     if not summary["reproduced"]:
-        print(f"WARNING: the serial re-run gave sup|E| = {logged.sup_E!r}, the search {worst.sup_E!r}",
-              flush=True)
-    print(f"log:   {log_path}\nplot:  {summary['plot'][0]}\ntable: {summary['table']}")
-    return 0 if summary["reproduced"] else 1
+        return 1
+    return CLAIM_BROKEN_EXIT if summary["falsified"] else 0
+
+
+def claim_lines(summary: dict) -> list[str]:
+    """Beside the verdict: the banner and the run that broke the claim (where one did), and the worst
+    run's unmet assumptions (name, value vs limit)."""
+    from wmr_mj.analysis.verdicts import certified_outside_banner, format_unmet
+
+    lines = []
+    broken = summary.get("claim_broken")
+    if broken is not None:
+        where = (f"{broken['count']} run(s) break the claim; the worst, {broken['phase']} run {broken['run']} "
+                 f"(sup|E| = {broken['sup_E']:.6g} rad, {broken['ratio']:.3g} times E_max = "
+                 f"{broken['E_max']:.4g} rad)")
+        lines += [certified_outside_banner(where),
+                  "broken by: " + ", ".join(f"{k} = {v!r}" for k, v in broken["params"].items())]
+    unmet = summary["worst"].get("unmet")
+    if unmet:
+        lines.append(f"worst run {summary['worst']['verdict']}: assumptions not met: {format_unmet(unmet)}")
+    return lines
 
 
 def _table(result) -> str:

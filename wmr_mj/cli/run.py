@@ -204,8 +204,12 @@ def _law_options(args: argparse.Namespace, controller: str, params: dict, settin
 
 
 def register(sub: argparse._SubParsersAction) -> None:
+    from wmr_mj.cli._common import CLAIM_BROKEN_EXIT
+
     p = sub.add_parser(
         "run", help="simulate the circle headless with a controller and report the errors",
+        epilog=f"exit status: 0; {CLAIM_BROKEN_EXIT} when the run is certified-outside: it breaks the law's claim "
+               "(the banner above the verdict); 1 the law failed mid-run; 2 bad input; 130 interrupted",
         description="One closed-loop run on the MuJoCo plant, reported against the regions. The run is a "
                     "batch of one: the steering law runs compiled in MuJoCo's control callback and "
                     "mujoco.batch steps a simulated second per call, recording every control step as "
@@ -490,4 +494,7 @@ def run(args: argparse.Namespace) -> int:
         return 130
     if result.status == "failed":
         return 1  # the law failed mid-run: the report and the log hold what ran before it
-    return 0
+    from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE
+    from wmr_mj.cli._common import CLAIM_BROKEN_EXIT
+
+    return CLAIM_BROKEN_EXIT if result.summary.verdict == CERTIFIED_OUTSIDE else 0

@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from wmr_mj.cli._common import positive_int
+from wmr_mj.cli._common import CLAIM_BROKEN_EXIT, positive_int
 
 if TYPE_CHECKING:
     from wmr_mj.sim.sweep import SweepSummary
@@ -17,7 +17,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 
     p = sub.add_parser("sweep",
                        help="Monte-Carlo over m1 (and --uncertainty/--range) on mujoco.batch: per-run "
-                            "verdicts, table and plot")
+                            "verdicts, table and plot",
+                       epilog=f"exit status: 0; {CLAIM_BROKEN_EXIT} when a run is certified-outside: it breaks the "
+                              "law's claim (a banner names the run; summary.json's claim_broken); 2 bad input")
     add_run_options(p)
     p.add_argument("--n", type=int, default=200, help="number of runs (default 200)")
     p.add_argument("--seed", type=int, default=0, help="seed of the draw (default 0)")
@@ -64,7 +66,7 @@ def run(args: argparse.Namespace) -> int:
         results = run_sweep(spec, out_dir=out, chunk=args.chunk, nthread=args.nthread, scheduler=args.scheduler,
                             progress=counter_callback(bar))
     wall = time.perf_counter() - t0
-    runs = SweepSummary.of(results, spec.requirements)  # the one aggregator of sweep and validate
+    runs = SweepSummary.of(results, spec.requirements, names=spec.names)  # the one aggregator of sweep and validate
     summary = runs.sweep_dict(wall)
     summary.update({"folder": str(out), "model": base.model, "controller": base.controller, "seed": args.seed,
                     "sampling": args.sampling,
@@ -87,9 +89,10 @@ def run(args: argparse.Namespace) -> int:
                             progress=False)
         summary["mcap_dir"] = str(logs_dir)
     write_json_atomic(out / "summary.json", summary)
+    status = CLAIM_BROKEN_EXIT if runs.claim_broken is not None else 0
     if args.json:
         print_json(summary)
-        return 0
+        return status
     fmt = lambda x: "n/a" if x is None else f"{x:.3f}"  # noqa: E731
     from wmr_mj.sim.config import controller_for, estimate_of, estimate_parameters
 
@@ -98,9 +101,7 @@ def run(args: argparse.Namespace) -> int:
     print(f"{runs.n} runs ({label}, m1 over "
           f"{args.m1_range[0]:g}-{args.m1_range[1]:g} kg, {args.sampling}, seed {args.seed}):")
     print("verdicts: " + ", ".join(f"{v} {c}" for v, c in runs.verdicts.items()))
-    if runs.certified_outside:
-        print(f"!!! {runs.certified_outside} run(s) CERTIFIED-OUTSIDE: the certificate's assumptions hold and "
-              "the run is outside it: a bug or a modelling gap; see runs.csv !!!")
+    print("\n".join(claim_lines(runs)))
     print(f"certificate: worst sup|E|/E_max = {fmt(runs.certificate_E_ratio.value)}, "
           f"worst sup|E'|/Edot_max = {fmt(runs.certificate_Edot_ratio.value)}; "
           f"{runs.growing} runs with |E| still growing at the end")
@@ -127,7 +128,25 @@ def run(args: argparse.Namespace) -> int:
     backend = f"; the law ran {' and '.join(law_path(b) for b in runs.batch_law)}" if runs.batch_law else ""
     print(f"{runs.steps} steps in {wall:.1f} s ({summary['steps_per_s']:.3g} steps/s{backend})")
     print(f"table: {out / 'runs.csv'}\nplot:  {plot_path}")
-    return 0
+    return status
+
+
+def claim_lines(runs: SweepSummary) -> list[str]:
+    """Beside the verdicts: the banner and the run that broke the claim (where one did), and the claim's
+    unmet assumptions (name, value vs limit, in how many runs)."""
+    from wmr_mj.analysis.verdicts import certified_outside_banner, format_unmet
+
+    lines = []
+    b = runs.claim_broken
+    if b is not None:
+        lines += [certified_outside_banner(
+            f"{b['count']} of {runs.n} run(s) break the claim; the worst, run {b['run']} (sup|E| = "
+            f"{b['sup_E']:.6g} rad, {b['ratio']:.3g} times E_max = {b['E_max']:.4g} rad; see runs.csv)"),
+            "broken by: " + ", ".join(f"{k} = {v!r}" for k, v in b["params"].items())]
+    if runs.unmet:
+        lines.append("assumptions not met: " + "; ".join(f"{format_unmet([a])} in {a['runs']}/{runs.n} runs"
+                                                         for a in runs.unmet))
+    return lines
 
 
 def _plot(results: list[dict], runs: SweepSummary, stem: Path) -> Path:

@@ -17,7 +17,8 @@ from typing import Any
 
 from wmr_mj.sim.compare import CompareResult, DesignRow, runs_json
 
-__all__ = ["table_rows", "markdown", "csv_text", "html_page", "figure", "write_report", "COLUMNS"]
+__all__ = ["table_rows", "markdown", "csv_text", "html_page", "figure", "write_report", "COLUMNS", "legend_lines",
+           "banner_lines"]
 
 #: (header, what it says) of every column, in order
 COLUMNS = (
@@ -26,6 +27,8 @@ COLUMNS = (
     ("requirements passed", "requirement checks held over every scenario (the suite's STL requirements)"),
     ("least robustness", "the least robustness / its threshold over every requirement and scenario (< 0: violated)"),
     ("claim", "the law's own claim: certified-inside runs / runs, and |E| <= E_max on the adversary's box"),
+    ("not met", "why the claim does not certify: each assumption not met (value vs limit, the assumption's "
+                "units), in how many scenario runs"),
     ("worst found", "the adversary's worst: -robustness of the suite's requirement (> 0: falsified), beside "
                     "random sampling at the same budget and seed"),
     ("where", "the worst case's plant and signal (m1, V_A, the pulse)"),
@@ -51,6 +54,35 @@ def _claim(r: DesignRow) -> str:
     return f"{r.certified_inside}/{r.runs} certified-inside{loud}{e}"
 
 
+def _not_met(r: DesignRow) -> str:
+    from wmr_mj.analysis.verdicts import format_unmet
+
+    return "; ".join(f"{format_unmet([a])} in {a['runs']}/{r.runs}" for a in r.unmet) or "none"
+
+
+def banner_lines(result: CompareResult) -> list[str]:
+    """``run``'s banner for each design whose claim a run breaks, with that run (its scenario or its
+    plant and signal); [] when no claim is broken."""
+    from wmr_mj.analysis.verdicts import certified_outside_banner
+
+    out = []
+    for r in result.rows:
+        b = r.claim_broken
+        if b is None:
+            continue
+        run = f"scenario {b['scenario']}" if b["scenario"] else str(b["where"])
+        out.append(certified_outside_banner(
+            f"design {r.label}: {b['count']} run(s) break its claim; the worst, {run} (sup|E| = "
+            f"{_num(b['sup_E'], '.6g')} rad, {_num(b['ratio'])} times E_max = {_num(b['E_max'], '.4g')} rad), "
+            "broken by " + ", ".join(f"{k} = {v!r}" for k, v in b["params"].items())))
+    return out
+
+
+def legend_lines() -> list[str]:
+    """What each column says, one Markdown item per column (compare.md's and the console's legend)."""
+    return [f"- **{c}**: {what}" for c, what in COLUMNS]
+
+
 def _worst(r: DesignRow) -> str:
     if r.adversary_worst is None:
         return "n/a"
@@ -74,8 +106,8 @@ def table_rows(result: CompareResult) -> list[list[str]]:
         law = r.controller + ("" if r.tracker is None else f" + {r.tracker}")
         out.append([r.label, law, f"{r.requirements_passed}/{r.requirements_total}",
                     f"{_num(r.least_normalised, '+.3g')} ({r.least_at})" if r.least_at else "n/a",
-                    _claim(r), _worst(r), _where(r), _num(r.tightness), _num(r.rms_voltage), _num(r.tv_voltage),
-                    _num(r.cross_track_max), f"{_num(r.cpu_us_per_step, '.1f')} ({r.law})"])
+                    _claim(r), _not_met(r), _worst(r), _where(r), _num(r.tightness), _num(r.rms_voltage),
+                    _num(r.tv_voltage), _num(r.cross_track_max), f"{_num(r.cpu_us_per_step, '.1f')} ({r.law})"])
     return out
 
 
@@ -90,12 +122,13 @@ def _heading(result: CompareResult) -> str:
 def markdown(result: CompareResult) -> str:
     """The comparison as Markdown: the heading, the table, what each column says."""
     head = [c for c, _ in COLUMNS]
-    lines = [f"# wmr-mj compare\n\n{_heading(result)}\n", "| " + " | ".join(head) + " |",
-             "|" + "---|" * len(head)]
+    banners = banner_lines(result)
+    lines = [f"# wmr-mj compare\n\n{_heading(result)}\n", *(f"**{b}**\n" for b in banners),
+             "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for row in table_rows(result):
         lines.append("| " + " | ".join(c.replace("|", "\\|") for c in row) + " |")
     lines.append("")
-    lines += [f"- **{c}**: {what}" for c, what in COLUMNS]
+    lines += legend_lines()
     reqs = result.suite.requirements
     lines.append("\nRequirements: " + "; ".join(f"`{k}` = `{v}`" for k, v in reqs.items()))
     lines.append(f"\nAdversary requirement: `{result.suite.adversary.requirement}`. Scenarios: "
@@ -105,13 +138,20 @@ def markdown(result: CompareResult) -> str:
 
 def csv_text(result: CompareResult) -> str:
     """One CSV line per design with every figure of :class:`~wmr_mj.sim.compare.DesignRow` (full precision)."""
+    import json
+
+    from wmr_mj.analysis.verdicts import format_unmet
+
     rows = [r.as_dict() for r in result.rows]
     buf = io.StringIO()
     names = list(rows[0]) if rows else []
     w = csv.DictWriter(buf, fieldnames=names, lineterminator="\n")
     w.writeheader()
     for r in rows:
-        w.writerow({k: (repr(v) if isinstance(v, float) else v) for k, v in r.items()})
+        cells = {k: (repr(v) if isinstance(v, float) else v) for k, v in r.items()}
+        cells["claim_broken"] = "" if r["claim_broken"] is None else json.dumps(r["claim_broken"])
+        cells["unmet"] = format_unmet(r["unmet"])  # name (value vs limit); ...
+        w.writerow(cells)
     return buf.getvalue()
 
 
@@ -125,6 +165,7 @@ def html_page(result: CompareResult, figure_name: str = "compare.png") -> str:
             "body{font-family:sans-serif;margin:1.5em}table{border-collapse:collapse;font-size:13px}"
             "td,th{border:1px solid #ccc;padding:3px 6px;text-align:left}th{background:#f3f3f3}</style></head>"
             f"<body><h1>wmr-mj compare</h1><p>{html.escape(_heading(result))}</p>"
+            + "".join(f"<p style='color:#e00000'><b>{html.escape(b)}</b></p>" for b in banner_lines(result)) +
             f"<img src='{html.escape(figure_name)}' style='max-width:900px'><table><tr>{head}</tr>{body}</table>"
             f"<ul>{notes}</ul></body></html>\n")
 

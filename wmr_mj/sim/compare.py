@@ -34,6 +34,7 @@ from typing import Any
 
 import numpy as np
 
+from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE, count_unmet, unmet_assumptions
 from wmr_mj.errors import ParameterError
 from wmr_mj.params import uncertainty_ranges
 from wmr_mj.plant.mjcf import TIMESTEP
@@ -134,7 +135,9 @@ def _slim(summary: Mapping[str, Any]) -> dict[str, Any]:
             "left_steering_range", "saturated_fraction", "wall_s")
     out = {k: summary.get(k) for k in keys}
     cert = summary.get("certificate") or {}
-    out["certificate"] = {k: cert.get(k) for k in ("E_max", "Edot_max", "E_ratio", "valid", "certified", "unmet")}
+    slim: dict[str, Any] = {k: cert.get(k) for k in ("E_max", "Edot_max", "E_ratio", "valid", "certified", "unmet")}
+    slim["unmet_assumptions"] = unmet_assumptions(cert)  # why, beside the verdict: value and limit
+    out["certificate"] = slim
     pe = summary.get("path_error") or {}
     out["cross_track_max"] = pe.get("cross_track_max")
     return out
@@ -201,6 +204,11 @@ class DesignRow:
     # where the law comes from, as its log records it (controllers.registry.PluginSource.as_dict: file or
     # module, class, parameters, source SHA-256); None for the laws built from RunConfig fields
     controller_source: Mapping[str, Any] | None = None
+    # the run that breaks the law's claim most (a certified-outside run of a scenario or of the adversary,
+    # of the largest sup|E|/E_max): {where, scenario, params, sup_E [rad], E_max [rad], ratio, count}; None: none
+    claim_broken: Mapping[str, Any] | None = None
+    # the claim's assumptions not met over the scenarios: {name, value, limit, runs} (value and limit of the first)
+    unmet: tuple[Mapping[str, Any], ...] = ()
 
     def as_dict(self) -> dict[str, Any]:
         from dataclasses import asdict
@@ -208,6 +216,7 @@ class DesignRow:
         out = asdict(self)
         out["adversary_where"] = dict(self.adversary_where)
         out["controller_source"] = None if self.controller_source is None else dict(self.controller_source)
+        out["unmet"] = [dict(a) for a in self.unmet]
         return out
 
 
@@ -230,10 +239,16 @@ class CompareResult:
         """Physics steps per second of wall time, the whole comparison (runs, judging, the adversary)."""
         return self.steps / self.wall_s if self.wall_s > 0 else None
 
+    @property
+    def claims_broken(self) -> list[str]:
+        """The designs one of whose runs (a scenario's or the adversary's) breaks its claim, in order."""
+        return [r.label for r in self.rows if r.claim_broken is not None]
+
     def as_dict(self) -> dict[str, Any]:
         return {"suite": self.suite.as_dict(), "versions": dict(self.versions), "budget": self.budget,
                 "seed": self.seed, "scenarios": [s.id for s in self.scenarios],
-                "rows": [r.as_dict() for r in self.rows], "wall_s": self.wall_s, "steps": self.steps}
+                "rows": [r.as_dict() for r in self.rows], "claims_broken": self.claims_broken,
+                "wall_s": self.wall_s, "steps": self.steps}
 
 
 def compare(designs: Sequence[Design], suite: Suite, *, scenarios: Sequence[str] = (), budget: int = 32,
@@ -374,7 +389,31 @@ def _row(design: Design, runs: Sequence[ScenarioRun], adversary: Any, spec: Any)
         tv_voltage=float(np.mean([r.tv_voltage for r in runs])) if runs else math.nan,
         cross_track_max=max(cross) if cross else None,
         cpu_us_per_step=float(np.median([r.cpu_us_per_step for r in runs])) if runs else math.nan,
-        law="/".join(sorted({r.law for r in runs})), controller_source=_source_of(design.config))
+        law="/".join(sorted({r.law for r in runs})), controller_source=_source_of(design.config),
+        claim_broken=_claim_broken(runs, adversary),
+        unmet=tuple(count_unmet((r.summary.get("certificate") or {}).get("unmet_assumptions") or [] for r in runs)))
+
+
+def _claim_broken(runs: Sequence[ScenarioRun], adversary: Any) -> dict[str, Any] | None:
+    """DesignRow.claim_broken: of the certified-outside scenario runs and the adversary's
+    (:attr:`~wmr_mj.sim.falsify.FalsifyResult.claim_broken`), the one of the largest sup|E|/E_max
+    (scenarios first among equals)."""
+    found: list[dict[str, Any]] = []
+    for r in runs:
+        if r.verdict == CERTIFIED_OUTSIDE:
+            cert = r.summary.get("certificate") or {}
+            found.append({"where": "scenario", "scenario": r.scenario, "params": {"m1": r.summary.get("m1")},
+                          "sup_E": r.summary.get("sup_E"), "E_max": cert.get("E_max"), "ratio": cert.get("E_ratio")})
+    broken = None if adversary is None else adversary.claim_broken
+    if broken is not None:
+        found.append({"where": f"adversary {broken['phase']} run {broken['run']}", "scenario": None,
+                      "params": broken["params"], "sup_E": broken["sup_E"], "E_max": broken["E_max"],
+                      "ratio": broken["ratio"]})
+    if not found:
+        return None
+    count = len(found) - (broken is not None) + (0 if broken is None else int(broken["count"]))
+    worst = max(found, key=lambda f: -math.inf if f["ratio"] is None else float(f["ratio"]))
+    return {**worst, "count": count}
 
 
 def _source_of(config: RunConfig) -> dict[str, Any] | None:

@@ -46,7 +46,13 @@ generation (differential evolution's or CMA-ES's population) is refused before a
 
 Where the objective is the certificate's ratio, :attr:`FalsifyResult.tightness` sets the worst
 found (a lower bound on the worst case) beside the certificate's E_max (an upper bound): "the worst
-found is X of the certificate's bound: the certificate is 1/X times the worst case found".
+found is X of the certificate's bound: the certificate is 1/X times the worst case found"; where X
+exceeds 1, "the worst run is X times the claimed bound: the claim is exceeded".
+
+Whatever the objective, a run of either phase that is ``certified-outside`` breaks the law's claim:
+:attr:`FalsifyResult.claim_broken` names the one that breaks it most (its parameters), and
+:attr:`FalsifyResult.falsified` is then True (``wmr-mj falsify`` prints the banner ``run`` prints and
+exits with :data:`wmr_mj.cli._common.CLAIM_BROKEN_EXIT`).
 
 Objectives (:data:`OBJECTIVES`), read from a run's summary by :func:`objective_value`:
 
@@ -92,6 +98,7 @@ from typing import Any
 
 import numpy as np
 
+from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE, VERDICTS
 from wmr_mj.errors import ParameterError, UnknownNameError, WmrMjError
 from wmr_mj.params import parameter_names
 from wmr_mj.sim.config import RunConfig
@@ -821,14 +828,55 @@ class FalsifyResult:
         e_max = certificate.get("E_max") if isinstance(certificate, Mapping) else None
         x = w.objective
         factor = 1.0 / x if x is not None and x > 0 else math.inf
-        text = (f"the worst found is {x:.4g} of the certificate's bound: the certificate is {factor:.3g} times the "
-                f"worst case found (sup|E| >= {w.sup_E:.4g} rad found, <= "
-                + ("n/a" if e_max is None else f"{float(e_max):.4g}") + " rad certified)")
+        bound = "n/a" if e_max is None else f"{float(e_max):.4g}"
+        if x is not None and x > 1.0:  # exceeded: said as such, never as a fraction of the worst case
+            text = (f"the worst run is {x:.3g} times the claimed bound (sup|E| = {w.sup_E:.4g} rad found, <= "
+                    f"{bound} rad claimed): the claim is exceeded"
+                    + (" and its assumptions hold: CERTIFIED-OUTSIDE" if w.verdict == CERTIFIED_OUTSIDE else
+                       f" where its assumptions are not all met ({w.verdict}): not a broken claim"))
+        else:
+            text = (f"the worst found is {x:.4g} of the certificate's bound: the certificate is {factor:.3g} times "
+                    f"the worst case found (sup|E| >= {w.sup_E:.4g} rad found, <= {bound} rad certified)")
         return {"ratio": x, "factor": factor, "found_sup_E": w.sup_E,
                 "E_max": None if e_max is None else float(e_max), "text": text}
 
+    @property
+    def claim_broken(self) -> dict[str, Any] | None:
+        """The run (of the search or the random sample) that breaks the law's claim most, whatever the
+        objective: the ``certified-outside`` run of the largest sup|E|/E_max (the first of equals, the
+        search's first), as {phase, run (1-based in its phase), params, sup_E [rad], sup_Edot [rad/s],
+        E_max [rad], ratio, count (certified-outside runs of both phases)}; None when no run breaks it."""
+        broken = [e for e in (*self.search, *self.random) if e.verdict == CERTIFIED_OUTSIDE]
+        if not broken:
+            return None
+
+        def ratio(e: Evaluation) -> float:
+            value = (e.summary.get("certificate") or {}).get("E_ratio")
+            return -math.inf if value is None else float(value)
+
+        e = max(broken, key=ratio)  # max keeps the first of equals
+        e_max = (e.summary.get("certificate") or {}).get("E_max")
+        return {"phase": e.phase, "run": e.index + 1, "params": dict(e.params), "sup_E": e.sup_E,
+                "sup_Edot": e.sup_Edot, "E_max": None if e_max is None else float(e_max),
+                "ratio": None if ratio(e) == -math.inf else ratio(e), "count": len(broken)}
+
+    @property
+    def falsified(self) -> bool | None:
+        """True when a run breaks the law's claim (:attr:`claim_broken`) or, for the objective
+        'requirement', when the worst run falsifies it; False when neither, where there is a claim or a
+        requirement to falsify; None when there is neither (every run without a claim)."""
+        if self.claim_broken is not None:
+            return True
+        if self.spec.objective == "requirement":
+            w = self.worst
+            return w.objective is not None and w.objective > 0.0
+        judged = any(e.verdict in VERDICTS for e in (*self.search, *self.random))
+        return False if judged else None
+
     def as_dict(self, *, log: str | None = None) -> dict[str, Any]:
         """The ``wmr-mj falsify --json`` object."""
+        from wmr_mj.analysis.verdicts import unmet_assumptions
+
         w, r = self.worst, self.random_worst
         return {
             "objective": self.spec.objective,
@@ -841,11 +889,12 @@ class FalsifyResult:
             "population": self.spec.population_size,
             "generations": self.generations,
             "requirement": self.spec.requirement,
-            "falsified": (w.objective is not None and w.objective > 0.0) if self.spec.objective == "requirement"
-            else None,
+            "falsified": self.falsified,
+            "claim_broken": self.claim_broken,
             "box": {k: [float(lo), float(hi)] for k, (lo, hi) in self.spec.box.items()},
             "worst": {"params": dict(w.params), "objective": w.objective, "sup_E": w.sup_E, "sup_Edot": w.sup_Edot,
-                      "verdict": w.verdict, "generation": w.generation, "index": w.index},
+                      "verdict": w.verdict, "generation": w.generation, "index": w.index,
+                      "unmet": unmet_assumptions(w.summary.get("certificate"))},
             "tightness": self.tightness,
             "random": {"worst_objective": r.objective, "worst_params": dict(r.params), "evaluations": len(self.random),
                        "sup_E": r.sup_E, "verdict": r.verdict},

@@ -498,6 +498,34 @@ class RequirementSweep:
                 "undefined": self.undefined}
 
 
+def _claim_broken(rows: Sequence[Mapping[str, Any]], names: Sequence[str]) -> dict[str, Any] | None:
+    """SweepSummary.claim_broken of ``rows``: the certified-outside run of the largest cert_E_ratio."""
+    from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE
+
+    broken = [r for r in rows if r.get("verdict") == CERTIFIED_OUTSIDE]
+    if not broken:
+        return None
+
+    def ratio(r: Mapping[str, Any]) -> float:
+        return -math.inf if r.get("cert_E_ratio") is None else float(r["cert_E_ratio"])
+
+    r = max(broken, key=ratio)  # max keeps the first of equals
+    return {"run": int(r["run"]) if r.get("run") is not None else None,
+            "params": {n: float(r[n]) for n in names if r.get(n) is not None}, "sup_E": float(r["sup_E"]),
+            "sup_Edot": float(r["sup_Edot"]),
+            "E_max": None if r.get("cert_E_max") is None else float(r["cert_E_max"]),
+            "ratio": None if ratio(r) == -math.inf else ratio(r), "count": len(broken)}
+
+
+def _unmet_over(rows: Sequence[Mapping[str, Any]]) -> tuple[dict[str, Any], ...]:
+    """SweepSummary.unmet of ``rows``: each unmet assumption once, its first run's value and limit, and
+    the number of runs that do not meet it."""
+    from wmr_mj.analysis.verdicts import count_unmet, unmet_assumptions
+
+    certificates = (r.get("certificate") for r in rows)
+    return tuple(count_unmet(unmet_assumptions(c if isinstance(c, Mapping) else None) for c in certificates))
+
+
 @dataclass(frozen=True)
 class SweepSummary:
     """What a sweep's runs add up to: the one aggregator of ``wmr-mj sweep`` and validate's rungs.
@@ -529,6 +557,14 @@ class SweepSummary:
         batch_law: how this call's batches evaluated the law (``wmr_mj.sim.batch.LAW_BACKENDS``).
         path_cross_track: the worst sup|cross-track| of C [m] (None for rows without it).
         path_verdicts: the count of each path verdict ('within-bound', 'beyond-bound', 'no-guarantee').
+        requirements: each STL requirement over the runs.
+        claim_broken: the ``certified-outside`` run of the largest sup|E|/E_max (the first of equals), the
+            run that breaks the law's claim most, as {run, params (m1 [kg] and each ranged parameter),
+            sup_E [rad], sup_Edot [rad/s], E_max [rad], ratio, count (certified-outside runs)}; None when
+            no run breaks it.
+        unmet: the claim's assumptions not met in some run, as {name, value, limit, runs}: value and
+            limit of the first such run (the assumption's units), runs: how many; from rows that carry
+            their certificate (a resumed sweep's rows, read from runs.csv, do not).
     """
 
     n: int
@@ -554,11 +590,15 @@ class SweepSummary:
     path_cross_track: Worst = Worst(None, None)
     path_verdicts: Mapping[str, int] | None = None
     requirements: tuple[RequirementSweep, ...] = ()
+    claim_broken: Mapping[str, Any] | None = None
+    unmet: tuple[Mapping[str, Any], ...] = ()
 
     @classmethod
-    def of(cls, rows: Sequence[Mapping[str, Any]], requirements: Sequence[str] = ()) -> SweepSummary:
+    def of(cls, rows: Sequence[Mapping[str, Any]], requirements: Sequence[str] = (), *,
+           names: Sequence[str] = ("m1",)) -> SweepSummary:
         """Summarise ``rows`` (runs.csv columns: :data:`RESULT_COLUMNS`; ``requirements``: the sweep's,
-        whose robustness columns the rows carry, :func:`requirement_column`).
+        whose robustness columns the rows carry, :func:`requirement_column`; ``names``: the drawn
+        parameters, m1 first, that name the run that breaks the claim).
 
         Raises:
             ParameterError: no rows.
@@ -594,6 +634,8 @@ class SweepSummary:
             path_cross_track=Worst(*max_at(rows, "path_cross_track_max")),
             path_verdicts=_count_path_verdicts(rows),
             requirements=tuple(RequirementSweep.of(rows, i, text) for i, text in enumerate(requirements)),
+            claim_broken=_claim_broken(rows, names),
+            unmet=_unmet_over(rows),
         )
 
     @property
@@ -638,6 +680,9 @@ class SweepSummary:
             "path_verdicts": None if self.path_verdicts is None else dict(self.path_verdicts),
             **({"requirements": [{**r.to_dict(), "column": requirement_column(i)}
                                  for i, r in enumerate(self.requirements)]} if self.requirements else {}),
+            # a broken claim, whatever else the sweep measured (None: no run is certified-outside)
+            "claim_broken": None if self.claim_broken is None else dict(self.claim_broken),
+            "unmet": [dict(a) for a in self.unmet],
         }
         # the paper's region under names that say so (the unprefixed keys above: deprecated, kept one version)
         out.update({new: out[old] for old, new in SWEEP_KEYS_DEPRECATED.items()})
