@@ -368,7 +368,7 @@ def _section4(context: ClaimContext, estimate: Estimate, compensation: Compensat
     """:func:`wmr_mj.analysis.certificate.certify` on the run's context."""
     return certify(plant=context.plant, estimate=estimate, gains=Gains(kp=kp, kd=kd), reference=context.reference,
                    limits=context.limits, compensation=compensation, control_period=context.control_period,
-                   initial_error=context.initial_error, stated=context.stated)
+                   initial_error=context.initial_error, stated=context.stated, measurement=context.measurement)
 
 
 def make_controller(name: str, model: SteeringModel, *, kp: float = PAPER_KP, kd: float = PAPER_KD,

@@ -50,7 +50,7 @@ Usage::
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -58,15 +58,22 @@ import numpy as np
 from controllers.base import BuildContext, SteeringController
 from wmr_mj.analysis.certificate import Assumption, Certificate, friction_term
 from wmr_mj.analysis.claim import ClaimContext, box_claim
+from wmr_mj.analysis.measurement import (
+    DELAY_FIXED_POINT,
+    coverage_assumption_fields,
+    inv_cos2_slope,
+    sin_cos3_slope,
+)
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.plant.reduced import SteeringModel
 
-__all__ = ["SlidingMode", "Uncertainty", "SAMPLING_FRACTION", "SLIDING_FRICTION_SIGNS"]
+__all__ = ["SlidingMode", "Uncertainty", "MeasuredLayer", "SAMPLING_FRACTION", "SLIDING_FRICTION_SIGNS"]
 
 #: The largest change of s over one control period, as a fraction of the layer phi.
 SAMPLING_FRACTION = 0.1
 #: The Coulomb compensation's sign: the measured a' (as computed-torque's default) or none.
 SLIDING_FRICTION_SIGNS = ("measured", "none")
+_LAYER_ITERATIONS = 10000
 
 
 def _positive(name: str, value: Any, *, allow_zero: bool = False) -> float:
@@ -109,6 +116,27 @@ class Uncertainty:
         return {"P_term": self.P_term, "C_V_term": self.C_V_term, "friction_term": self.friction_term,
                 "K_term": self.K_term, "gyro_term": self.gyro_term, "disturbance": self.disturbance,
                 "total": self.total, "alpha_max": self.alpha_max}
+
+
+@dataclass(frozen=True)
+class MeasuredLayer:
+    """The boundary layer under measurement errors and a delay (:meth:`SlidingMode.measured_layer`).
+
+    layer: Phi [rad/s], |s| <= Phi (inf when it does not close); D [V]: the bound on |Delta| with the law's
+    measured-input terms; e_alpha [rad], e_alpha_dot [rad/s]: the law's input errors (static plus the
+    delay's); rho [-]: tau c_v/P_min; alpha_m [rad]: the measured angle's bound; voltage_max [V]: the
+    law's |u| bound; uncertainty: today's terms at the layer; reason: why there is no layer ('' if there is).
+    """
+
+    layer: float
+    D: float
+    e_alpha: float
+    e_alpha_dot: float
+    rho: float
+    alpha_m: float
+    voltage_max: float
+    uncertainty: Uncertainty | None
+    reason: str
 
 
 class SlidingMode(SteeringController):
@@ -196,12 +224,13 @@ class SlidingMode(SteeringController):
         return u
 
     # ------------------------------------------------------------------ the claim
-    def uncertainty(self, context: ClaimContext) -> Uncertainty:
-        """The bound on |Delta| [V] over ``context.plant``'s box inside the layer (module docstring)."""
+    def uncertainty(self, context: ClaimContext, *, layer: float | None = None) -> Uncertainty:
+        """The bound on |Delta| [V] over ``context.plant``'s box inside the layer |s| <= ``layer`` [rad/s]
+        (None: phi, the law's own; module docstring)."""
         plant, ref, m = context.plant, context.reference, self.model
         if ref.alpha_max is None:
             raise ParameterError("sliding-mode's claim needs the reference's max|alpha0| (ReferenceBounds.alpha_max)")
-        lam, phi = self.lam, self.phi
+        lam, phi = self.lam, (self.phi if layer is None else float(layer))
         a_max = ref.alpha_max + phi / lam
         ar_dd = ref.alpha_ddot_max + 2.0 * lam * phi
         rate = ref.alpha_dot_max + 2.0 * phi
@@ -233,9 +262,73 @@ class SlidingMode(SteeringController):
         return (m.P * (ref.alpha_ddot_max + 2.0 * self.lam * self.phi) + abs(m.C_V) * rate + self._F
                 + abs(m.K) * _S(a_max) + abs(self._gyro_V) * rate / math.cos(a_max) ** 2 + self.k)
 
+    def measured_layer(self, context: ClaimContext) -> MeasuredLayer:
+        """The layer |s| <= Phi [rad/s] when the law reads alpha + e_a, alpha' + e_v and acts tau late
+        (``context.measurement``; module docstring, "Measurement errors and delay").
+
+        Phi = phi + e_s with e_s = e_v + lam e_a the error of the law's s, e_a <= e_a,max + tau sup|a'|,
+        e_v <= e_v,max + tau sup|a''|, sup|a'| <= max|a0'| + 2 Phi, sup|a''| <= max|a0''| + (D_m + k)/P_min
+        + 2 lam Phi; D_m = (D(Phi) + the law's measured-input terms)/(1 - rho), rho = tau c_v/P_min, solved
+        as the least fixed point of Phi (iterated from phi). ``valid`` False with the reason when it
+        does not close (rho >= 1, the measured angle reaching pi/2, no convergence).
+        """
+        meas, ref = context.measurement, context.reference
+        tau, P_lo = meas.delay_s, context.plant.box.P[0]
+        flip = self.friction_sign == "measured" and (meas.alpha_dot_error_max > 0.0 or tau > 0.0)
+        layer, last = self.phi, None
+        for _ in range(_LAYER_ITERATIONS):
+            step = self._layer_step(context, layer, tau, P_lo, flip)
+            if step.reason:
+                return step
+            last = step
+            if step.layer <= layer * (1.0 + 1e-13):
+                return replace(step, layer=max(layer, step.layer))
+            layer = step.layer
+            if (ref.alpha_max or 0.0) + layer / self.lam >= 0.5 * math.pi:
+                break
+        reason = "the layer did not settle" if last is None else f"the layer did not settle (Phi = {layer:.4g})"
+        return MeasuredLayer(layer=math.inf, D=math.inf, e_alpha=math.inf, e_alpha_dot=math.inf, rho=math.inf,
+                             alpha_m=math.inf, voltage_max=math.inf, uncertainty=None, reason=reason)
+
+    def _layer_step(self, context: ClaimContext, layer: float, tau: float, P_lo: float, flip: bool) -> MeasuredLayer:
+        """One step Phi -> phi + e_s(Phi) of :meth:`measured_layer`."""
+        meas, ref, m = context.measurement, context.reference, self.model
+        lam, k = self.lam, self.k
+        unc = self.uncertainty(context, layer=layer)
+        rate = ref.alpha_dot_max + 2.0 * layer
+        e_a = meas.alpha_error_max + tau * rate
+        A_m = unc.alpha_max + e_a
+        if not math.isfinite(unc.total) or A_m >= 0.5 * math.pi:
+            return MeasuredLayer(layer=math.inf, D=math.inf, e_alpha=e_a, e_alpha_dot=math.inf, rho=math.inf,
+                                 alpha_m=A_m, voltage_max=math.inf, uncertainty=unc,
+                                 reason=f"the measured angle reaches pi/2 (alpha_max + e_alpha = {A_m:.4g} rad)")
+        c2_m = math.cos(A_m) ** 2
+        c_v = m.P * lam + abs(m.C_V) + abs(self._gyro_V) / c2_m  # V per rad/s of the law's velocity error
+        c_a = abs(m.K) * sin_cos3_slope(A_m) + abs(self._gyro_V) * inv_cos2_slope(A_m) * rate  # V per rad
+        rho = tau * c_v / P_lo
+        if rho >= 1.0:
+            return MeasuredLayer(layer=math.inf, D=math.inf, e_alpha=e_a, e_alpha_dot=math.inf, rho=rho,
+                                 alpha_m=A_m, voltage_max=math.inf, uncertainty=unc,
+                                 reason=f"tau c_v/P_min = {rho:.4g} >= 1: the delayed velocity's error feeds back")
+        F_max = context.plant.box.F[1]
+        flip_V = (F_max + self._F - unc.friction_term) if flip else 0.0  # the sign of a measured a' may be wrong
+        ff = 2.0 * m.P * ref.alpha_ddot_max if tau > 0.0 else 0.0  # a0''(t - tau) - a0''(t) [V]
+        e_v0 = meas.alpha_dot_error_max + tau * (ref.alpha_ddot_max + k / P_lo + 2.0 * lam * layer)
+        D = (unc.total + flip_V + ff + c_a * e_a + c_v * e_v0) / (1.0 - rho)
+        e_v = e_v0 + tau * D / P_lo
+        new_layer = self.phi + e_v + lam * e_a
+        rate_m = rate + e_v
+        voltage = (m.P * (ref.alpha_ddot_max + lam * (2.0 * layer + e_v)) + abs(m.C_V) * rate_m + self._F
+                   + abs(m.K) * _S(A_m) + abs(self._gyro_V) * rate_m / c2_m + k)
+        return MeasuredLayer(layer=new_layer, D=D, e_alpha=e_a, e_alpha_dot=e_v, rho=rho, alpha_m=A_m,
+                             voltage_max=voltage, uncertainty=unc, reason="")
+
     def claim(self, context: ClaimContext) -> Certificate:
         """|E| <= phi/lam, |E'| <= 2 phi (the boundary layer, Slotine & Li 7.2) with its assumptions:
-        the switching gain above the uncertainty, the sampling margin, and the run's."""
+        the switching gain above the uncertainty, the sampling margin, and the run's. Under
+        ``context.measurement`` (not exact) the layer grows to :meth:`measured_layer`'s Phi."""
+        if not context.measurement.is_exact:
+            return self._measured_claim(context)
         unc = self.uncertainty(context)
         D = unc.total
         T = float(context.control_period)
@@ -260,6 +353,44 @@ class SlidingMode(SteeringController):
                          alpha_max=unc.alpha_max, voltage_max=self.voltage_bound(context), own=own,
                          inputs={"lam": self.lam, "phi": self.phi, "k": self.k, "eta": self.eta,
                                  "uncertainty_V": unc.as_dict(), "estimate": self.model.coefficients.as_dict(),
+                                 "friction_sign": self.friction_sign, "friction_width": self.friction_width})
+
+    def _measured_claim(self, context: ClaimContext) -> Certificate:
+        """The claim with the layer of :meth:`measured_layer` and the assumption 'sensing and actuation covered'."""
+        meas = context.measurement
+        lay = self.measured_layer(context)
+        T, P_min = float(context.control_period), context.plant.box.P[0]
+        D = lay.D
+        ds = T * (D + self.k) / P_min
+        layer_gain = T * self.k / (P_min * self.phi)
+        unc = lay.uncertainty
+        own = [
+            Assumption("switching gain above the uncertainty", "k >= D + eta, D = sup|Delta| over the box inside "
+                       "the grown layer, with the law's measured-input terms (Slotine & Li (7.5))",
+                       bool(math.isfinite(D) and self.k >= D + self.eta), D + self.eta, self.k,
+                       f"D = {D:.4g} V with e_alpha = {lay.e_alpha:.4g} rad, e_alpha' = {lay.e_alpha_dot:.4g} rad/s, "
+                       f"delay {meas.delay_s:g} s; k = {self.k:g} V, eta = {self.eta:g} V", kind="checked"),
+            Assumption("control period", f"T (D + k)/P_min <= {SAMPLING_FRACTION:g} phi and T k/(P_min phi) <= 1 "
+                       "(continuous-time analysis; a margin, not a sampled-data proof)",
+                       bool(ds <= SAMPLING_FRACTION * self.phi and layer_gain <= 1.0), ds / self.phi,
+                       SAMPLING_FRACTION, f"T = {T:g} s, T k/(P_min phi) = {layer_gain:.4g}", kind="checked"),
+            Assumption(**coverage_assumption_fields(meas, self.name)),
+        ]
+        if meas.delay_s > 0.0:
+            own.append(Assumption(DELAY_FIXED_POINT, "tau c_v/P_min < 1 and the grown layer Phi = phi + e_v + lam e_a "
+                                  "settles", not lay.reason, lay.rho, 1.0,
+                                  lay.reason or f"Phi = {lay.layer:.4g} rad/s against phi = {self.phi:g}",
+                                  kind="checked"))
+        a0 = context.reference.alpha_max or 0.0
+        E_max = lay.layer / self.lam
+        return box_claim(claimant=self.name, E_max=E_max, Edot_max=2.0 * lay.layer, context=context,
+                         alpha_max=a0 + E_max if math.isfinite(E_max) else math.inf, voltage_max=lay.voltage_max,
+                         own=own, reason=lay.reason,
+                         inputs={"lam": self.lam, "phi": self.phi, "k": self.k, "eta": self.eta,
+                                 "layer": lay.layer, "measurement": {**meas.as_dict(), "eps_alpha": lay.e_alpha,
+                                                                     "eps_alpha_dot": lay.e_alpha_dot, "rho": lay.rho},
+                                 "uncertainty_V": unc.as_dict() if unc is not None else None,
+                                 "estimate": self.model.coefficients.as_dict(),
                                  "friction_sign": self.friction_sign, "friction_width": self.friction_width})
 
     def describe(self) -> dict:

@@ -154,6 +154,13 @@ from typing import Any, Literal, get_args
 
 from wmr_mj._util.checks import finite_number as _number
 from wmr_mj._util.checks import interval as _interval
+from wmr_mj.analysis.measurement import (
+    DELAY_FIXED_POINT,
+    MeasurementErrors,
+    coverage_assumption_fields,
+    inv_cos2_slope,
+    sin_cos3_slope,
+)
 from wmr_mj.analysis.robustness import ParameterBox, _check_gains, damping_regime, exact_gammas
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import C80Parameters
@@ -271,6 +278,8 @@ class Certificate:
     gyro_Edot_term: float = 0.0
     dead_band: float = 0.0
     disturbance_term: float = 0.0
+    #: the measurement errors' and delay's part of delta1 [rad/s^2] (written to the JSON only when not 0)
+    measurement_term: float = 0.0
     kp: float = 0.0
     kd: float = 0.0
     friction_sign: str = "measured"
@@ -359,6 +368,8 @@ class Certificate:
             out[name] = _finite_or_none(getattr(self, name))
         if self.disturbance_term:
             out["disturbance_term"] = _finite_or_none(self.disturbance_term)
+        if self.measurement_term:
+            out["measurement_term"] = _finite_or_none(self.measurement_term)
         out["friction_sign"] = self.friction_sign
         out["regime"] = damping_regime(self.kp, self.kd) if self.region == "small-gain" else None
         out["iterations"] = int(self.iterations)
@@ -707,6 +718,7 @@ def certify(
     control_period: float,
     initial_error: tuple[float, float] = (0.0, 0.0),
     stated: Sequence[Assumption] = (),
+    measurement: MeasurementErrors | None = None,
 ) -> Certificate:
     """The certificate for the law (3.2)-(3.3) with ``estimate`` on any plant of ``plant``.
 
@@ -721,6 +733,11 @@ def certify(
         control_period: the law's period [s], > 0.
         initial_error: (E(0) [rad], E'(0) [rad/s]).
         stated: the caller's stated assumptions, appended to the checked ones.
+        measurement: bounds on what the law reads instead of the true state, and its delay
+            (:class:`~wmr_mj.analysis.measurement.MeasurementErrors`); None or ``exact()``: today's
+            certificate, bit for bit. Otherwise the terms of :class:`_Measured` enter delta1, delta2,
+            delta3 inside the fixed point, and the assumptions 'sensing and actuation covered' and
+            (with a delay) 'delay inside the fixed point' are appended after the checked ones.
 
     Returns:
         Certificate: E_max, Edot_max and every assumption with its value and limit; ``valid``
@@ -742,6 +759,13 @@ def certify(
     E0, Ed0 = (_number("initial_error", v) for v in initial_error)
 
     bound = _Bound.of(plant, estimate, gains, reference, compensation, a0)
+    if measurement is not None and not isinstance(measurement, MeasurementErrors):
+        raise ParameterError(f"measurement must be a MeasurementErrors, got {type(measurement).__name__}")
+    if measurement is not None and not measurement.is_exact:
+        return _certify_measured(bound, _Measured(bound, measurement, compensation.friction_width),
+                                 compensation=compensation, limits=limits, gains=gains,
+                                 control_period=control_period, initial_error=(E0, Ed0),
+                                 stated=stated)
     E_max, iterations, reason = fixed_point(bound.E_max_at, a0)
     valid = math.isfinite(E_max)
     alpha_max = a0 + E_max if valid else math.inf
@@ -900,6 +924,166 @@ def _voltage_max(bound: _Bound, b: _AtAngle, E_max: float, Edot_max: float) -> f
     rate = bound.a0d + Edot_max
     return (est.P * (bound.P_ff / est.P * bound.a0dd + bound.kd * Edot_max + bound.kp * E_max)
             + abs(est.K) * b.S + abs(est.C_V) * rate + bound.F_comp + abs(bound.Gam_hat) * rate / b.c2)
+
+
+@dataclass(frozen=True)
+class _MeasuredAt:
+    """The bound with the measurement terms at the candidate E_max = x (:meth:`_Measured.at`).
+
+    delta1 [rad/s^2], delta2 [1/s^2], delta3 [1/s], condition: (4.18)-(4.23) with the terms in;
+    delta1_exact: today's delta1 at the same angle; S, c2: sin/cos^3 and cos^2 of the true angle bound;
+    alpha_m [rad]: the bound on the measured angle; eps_alpha [rad]: the law's angle error (static plus
+    the delay's); rho [-]: tau c_v, the delay's velocity-error loop; c_v [1/s], c_a [1/s^2]: the
+    coefficients of the velocity and angle errors in |w|; failure: why there is no bound ('' if there is).
+    """
+
+    delta1: float
+    delta2: float
+    delta3: float
+    condition: float
+    delta1_exact: float
+    S: float
+    c2: float
+    alpha_m: float
+    eps_alpha: float
+    rho: float
+    c_v: float
+    c_a: float
+    failure: str = ""
+
+
+@dataclass(frozen=True)
+class _Measured:
+    """The section-4 bound for a law that reads alpha + e_a, alpha' + e_v and acts tau late.
+
+    With the law's inputs off by e_a, e_v the error equation E'' + K_D E' + K_P E = w gains
+    (P^ (K_P e_a + K_D e_v) + C_V^ e_v + K^ (S(a_m) - S(a)) + Gam^ (a_m'/cos^2 a_m - a'/cos^2 a)
+    + F^ (s(a_m') - s(a')))/P, bounded per unit error by c_a = (P^ K_P + |K^| S'(alpha_m)
+    + |Gam^| (2 sin/cos^3)(alpha_m) (max|a0'| + |E'|))/P_min and c_v = (P^ K_D + |C_V^| + |Gam^|/cos^2
+    alpha_m)/P_min; the compensation's sign from a measured a' may be wrong, so the friction term is
+    F_max + F^ (smoothed sign, no delay: max(F_max, F^) + F^ min(2, e_v/w), whichever is less).
+    A delay tau adds e_a <= tau (max|a0'| + |E'|), e_v <= tau (max|a0''| + K_P |E| + K_D |E'| + |w|) and,
+    where the reference is delayed with the law, the feedforward's 2 P^ max|a0''|; |w| appears on both
+    sides and is solved for with rho = tau c_v < 1. Derivation: docs/guides/certificates.md.
+    """
+
+    bound: _Bound
+    measurement: MeasurementErrors
+    friction_width: float
+
+    def _phi_at(self, p: float, flip: bool) -> float:
+        b = self.bound
+        base = b.phi_at(p)
+        if not flip:
+            return base
+        F, r = b.plant.box.F, b.plant.friction_over_P
+        cap = (F[1] if r is None else min(F[1], r * p)) + b.F_comp  # |f| <= F, |s| <= 1 of either sign
+        m = self.measurement
+        if m.delay_s == 0.0 and self.friction_width > 0.0:  # x/sqrt(x^2+w^2) is 1/w-Lipschitz
+            return min(cap, base + b.F_comp * min(2.0, m.alpha_dot_error_max / self.friction_width))
+        return cap
+
+    def at(self, x: float) -> _MeasuredAt:
+        """The terms with |E| <= x and |E'| <= (gamma2/gamma1) x (the region's corner), x [rad]."""
+        b, m = self.bound, self.measurement
+        tau = m.delay_s
+        A = b.a0 + x
+        y = b.g2 / b.g1 * x
+        rate = b.a0d + y
+        eps_a = m.alpha_error_max + tau * rate
+        A_m = A + eps_a
+        inf = math.inf
+        if A >= 0.5 * math.pi or A_m >= 0.5 * math.pi:
+            return _MeasuredAt(inf, inf, inf, inf, inf, inf, 0.0, A_m, eps_a, inf, inf, inf,
+                               f"the measured angle reaches pi/2 (max|alpha0| + E_max + e_alpha = {A_m:.4g} rad)")
+        exact = b.at(A)
+        est, P_lo = b.estimate, b.P_corners[0]
+        c2_m = math.cos(A_m) ** 2
+        c_v = (b.P_hat * b.kd + abs(est.C_V) + abs(b.Gam_hat) / c2_m) / P_lo
+        c_a = (b.P_hat * b.kp + abs(est.K) * sin_cos3_slope(A_m) + abs(b.Gam_hat) * inv_cos2_slope(A_m) * rate) / P_lo
+        rho = c_v * tau
+        if rho >= 1.0:
+            return _MeasuredAt(inf, inf, inf, inf, exact.delta1, exact.S, exact.c2, A_m, eps_a, rho, c_v, c_a,
+                               f"tau c_v = {tau:g} s x {c_v:.4g} 1/s = {rho:.4g} >= 1: the delayed velocity's error "
+                               "feeds back on itself")
+        flip = b.friction_sign == "measured" and (m.alpha_dot_error_max > 0.0 or tau > 0.0)
+        ff = 2.0 * b.P_ff * b.a0dd if tau > 0.0 else 0.0  # a0''(t - tau) - a0''(t), no jerk bound [V]
+        rest = b.dK * exact.S + b.dC * b.a0d + b.dG * b.a0d / exact.c2
+        delta1_0 = max((abs(p - b.P_ff) * b.a0dd + self._phi_at(p, flip) + rest + ff
+                        + (b.dist_at(p) if b.plant.disturbance else 0.0)) / p for p in b.P_corners)
+        q = 1.0 / (1.0 - rho)
+        delta1 = (delta1_0 + c_a * (m.alpha_error_max + tau * b.a0d) + c_v * (m.alpha_dot_error_max + tau * b.a0dd)) * q
+        delta2 = (b.delta2 + rho * b.kp) * q
+        delta3 = (exact.delta3 + c_a * tau + rho * b.kd) * q
+        cond = b.g1 * delta2 + b.g2 * delta3
+        return _MeasuredAt(delta1, delta2, delta3, cond, exact.delta1, exact.S, exact.c2, A_m, eps_a, rho, c_v, c_a)
+
+    def eps_alpha_dot(self, at: _MeasuredAt, E_max: float, Edot_max: float) -> float:
+        """The law's velocity error [rad/s] in the region: static plus tau sup|a''|."""
+        b, m = self.bound, self.measurement
+        w = at.delta1 + at.delta2 * E_max + at.delta3 * Edot_max
+        return m.alpha_dot_error_max + m.delay_s * (b.a0dd + b.kp * E_max + b.kd * Edot_max + w)
+
+    def voltage_max(self, at: _MeasuredAt, E_max: float, Edot_max: float) -> float:
+        """The law's |u| bound [V] in the region, with its inputs off by e_alpha, e_alpha'."""
+        b, est = self.bound, self.bound.estimate
+        eps_v = self.eps_alpha_dot(at, E_max, Edot_max)
+        rate = b.a0d + Edot_max + eps_v
+        return (est.P * (b.P_ff / est.P * b.a0dd + b.kd * (Edot_max + eps_v) + b.kp * (E_max + at.eps_alpha))
+                + abs(est.K) * _S(at.alpha_m) + abs(est.C_V) * rate + b.F_comp
+                + abs(b.Gam_hat) * rate / math.cos(at.alpha_m) ** 2)
+
+
+def _certify_measured(bound: _Bound, meas: _Measured, *, compensation: Compensation, limits: PlantLimits,
+                      gains: Gains, control_period: float, initial_error: tuple[float, float],
+                      stated: Sequence[Assumption]) -> Certificate:
+    """:func:`certify` with the measurement terms (:class:`_Measured`) inside the fixed point."""
+    failures: list[str] = []
+
+    def phi(x: float) -> float:
+        at = meas.at(x)
+        if at.failure or at.condition >= 1.0:
+            failures.append(at.failure or f"(4.23) with the measurement terms = {at.condition:.4g} >= 1 at "
+                                          f"E_max = {x:.4g} rad")
+            return math.inf
+        return bound.g1 * at.delta1 / (1.0 - at.condition)
+
+    a0, m = bound.a0, meas.measurement
+    E_max, iterations, reason = fixed_point(phi, a0)
+    valid = math.isfinite(E_max)
+    if not valid and failures:
+        reason = "no fixed point with the measurement terms: " + failures[-1]
+    at = meas.at(E_max if valid else 0.0)
+    alpha_max = a0 + E_max if valid else math.inf
+    Edot_max = bound.g2 * at.delta1 / (1.0 - at.condition) if valid else math.inf
+    voltage_max = meas.voltage_max(at, E_max, Edot_max) if valid else math.inf
+    own = [Assumption(**coverage_assumption_fields(m))]
+    if m.delay_s > 0.0:
+        own.append(Assumption(
+            DELAY_FIXED_POINT, "tau c_v < 1 and a fixed point with |a(t-tau) - a(t)| <= tau sup|a'|, "
+            "|a'(t-tau) - a'(t)| <= tau sup|a''| inside it", valid and at.rho < 1.0, at.rho, 1.0,
+            f"tau = {m.delay_s:g} s, c_v = {at.c_v:.4g} 1/s" + (f"; {reason}" if not valid else ""), kind="checked"))
+    assumptions = _assumptions(cond=at.condition, valid=valid, alpha_max=alpha_max, reason=reason,
+                               iterations=iterations, voltage_max=voltage_max, limits=limits, gains=gains,
+                               control_period=control_period, initial_error=initial_error, stated=(*own, *stated))
+    P_lo, est = bound.P_corners[0], bound.estimate
+    inputs = _inputs_record(bound.plant, est, compensation, a0, bound, limits, control_period, initial_error)
+    eps_v = meas.eps_alpha_dot(at, E_max, Edot_max) if valid else math.inf
+    inputs["measurement"] = {**m.as_dict(), "eps_alpha": at.eps_alpha, "eps_alpha_dot": eps_v,
+                             "alpha_m_max": at.alpha_m, "rho": at.rho, "c_v": at.c_v, "c_a": at.c_a}
+    return Certificate(
+        E_max=E_max, Edot_max=Edot_max, condition=at.condition, valid=valid, assumptions=assumptions,
+        gamma1=bound.g1, gamma2=bound.g2, delta1=at.delta1, delta2=at.delta2, delta3=at.delta3,
+        alpha_max=alpha_max, voltage_max=voltage_max,
+        friction_term=max(bound.phi_at(p) / p for p in bound.P_corners), gyro_term=bound.dG * bound.a0d / at.c2 / P_lo,
+        K_term=bound.dK * at.S / P_lo, P_term=max(abs(p - bound.P_ff) / p for p in bound.P_corners) * bound.a0dd,
+        C_V_term=bound.dC * bound.a0d / P_lo, gyro_Edot_term=bound.dG / at.c2 / P_lo,
+        dead_band=bound.plant.box.F[1] / (est.P * bound.kp),
+        disturbance_term=max(bound.dist_at(p) / p for p in bound.P_corners) if bound.plant.disturbance else 0.0,
+        measurement_term=at.delta1 - at.delta1_exact,
+        kp=bound.kp, kd=bound.kd, friction_sign=bound.friction_sign, friction_width=meas.friction_width,
+        reason=reason, iterations=iterations, inputs=inputs,
+    )
 
 
 def _assumptions(*, cond: float, valid: bool, alpha_max: float, reason: str, iterations: int, voltage_max: float,

@@ -38,11 +38,12 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from wmr_mj.analysis.certificate import Assumption, Certificate, PlantBox, PlantLimits
+from wmr_mj.analysis.measurement import MEASUREMENT_COVERED, MeasurementErrors, coverage_assumption_fields
 from wmr_mj.errors import ParameterError
 from wmr_mj.params import C80Parameters
 from wmr_mj.reference.bounds import ReferenceBounds
 
-__all__ = ["ClaimContext", "box_claim", "run_assumptions", "with_measured"]
+__all__ = ["ClaimContext", "box_claim", "run_assumptions", "with_measured", "covers_measurement"]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -61,6 +62,9 @@ class ClaimContext:
         stated: the assumptions the run brings (each checked against the run, or stated with its
             source); a claim appends them to its own.
         estimate: the controller's belief, the nominal parameter set.
+        measurement: bounds on what the law reads instead of the true state and its delay
+            (:class:`~wmr_mj.analysis.measurement.MeasurementErrors`; default exact, today's runs). A claim
+            that does not absorb them must not cover the run: :func:`covers_measurement`.
     """
 
     plant: PlantBox
@@ -71,6 +75,11 @@ class ClaimContext:
     stated: tuple[Assumption, ...] = ()
     estimate: C80Parameters
     notes: Mapping[str, Any] = field(default_factory=dict)
+    measurement: MeasurementErrors = field(default_factory=MeasurementErrors.exact)
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.measurement, MeasurementErrors):
+            raise ParameterError(f"measurement must be a MeasurementErrors, got {type(self.measurement).__name__}")
 
 
 def run_assumptions(*, alpha_max: float, voltage_max: float, context: ClaimContext,
@@ -131,3 +140,18 @@ def with_measured(cert: Certificate, assumption: Assumption) -> Certificate:
 
     kept = tuple(a for a in cert.assumptions if a.name != assumption.name)
     return dataclasses.replace(cert, assumptions=(*kept, assumption))
+
+
+def covers_measurement(cert: Certificate, measurement: MeasurementErrors) -> Certificate:
+    """``cert`` as it covers ``measurement``: unchanged where the measurement is exact or the claim states
+    the assumption :data:`~wmr_mj.analysis.measurement.MEASUREMENT_COVERED` itself (it absorbed the
+    errors); else with that assumption unmet: a claim that says nothing about sensing covers exact
+    measurement only, so the run is uncertified."""
+    if measurement.is_exact or any(a.name == MEASUREMENT_COVERED for a in cert.assumptions):
+        return cert
+    import dataclasses
+
+    fields = coverage_assumption_fields(measurement, cert.claimant)
+    fields.update(met=False, value=1.0, note=(f"{cert.claimant or 'the claim'} states nothing about sensing or "
+                                              "actuation: it covers exact measurement only"))
+    return dataclasses.replace(cert, assumptions=(*cert.assumptions, Assumption(**fields)))

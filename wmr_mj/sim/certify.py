@@ -34,7 +34,8 @@ from wmr_mj.analysis.certificate import (
     friction_over_P_max,
     replace_inputs,
 )
-from wmr_mj.analysis.claim import ClaimContext
+from wmr_mj.analysis.claim import ClaimContext, covers_measurement
+from wmr_mj.analysis.measurement import MeasurementErrors
 from wmr_mj.analysis.robustness import ParameterBox
 from wmr_mj.analysis.verdicts import OUTSIDE_THE_BOX
 from wmr_mj.errors import ParameterError
@@ -137,7 +138,8 @@ def reference_within(measured: Any, declared: Any) -> Assumption:
 
 
 def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
-                    k_band: float = PLANT_K_BAND, gyro_band: tuple[float, float] = GYRO_BAND) -> Certificate | None:
+                    k_band: float = PLANT_K_BAND, gyro_band: tuple[float, float] = GYRO_BAND,
+                    measurement: MeasurementErrors | None = None) -> Certificate | None:
     """The certificate of a :class:`wmr_mj.sim.closed_loop.RunConfig` run on ``reference``.
 
     Plant box: P, C_V, F by the rule of ``simulate.analysis_box``: derived from ``params``
@@ -168,6 +170,11 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
     declares for the reference it writes (measured on every run: ``controllers.tracking.within_declared``),
     with the assumptions it states.
 
+    Measurement (``measurement``, :class:`~wmr_mj.analysis.measurement.MeasurementErrors`; None: exact,
+    every number as before): handed to the claim as ``ClaimContext.measurement``; the computed-torque,
+    PD and sliding-mode claims absorb the bounds, and a claim that does not state the assumption
+    'sensing and actuation covered' gets it unmet (:func:`wmr_mj.analysis.claim.covers_measurement`).
+
     Returns:
         The controller's claim (``SteeringController.claim``: the section-4 certificate for the
         computed-torque and PD laws) with the run's inputs recorded; None where the law states none.
@@ -175,12 +182,14 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
     estimate_params = estimate_parameters(params)
     return certificate_of(config, reference, base=params, estimate=estimate_params,
                           plant=plant_parameters(config, params), controller=controller_for(config, estimate_params),
-                          tracker=tracker_for(config, estimate_params), k_band=k_band, gyro_band=gyro_band)
+                          tracker=tracker_for(config, estimate_params), k_band=k_band, gyro_band=gyro_band,
+                          measurement=measurement)
 
 
 def certificate_of(config: Any, reference: Any, *, base: C80Parameters, estimate: C80Parameters,
                    plant: C80Parameters, controller: Any, tracker: Any, k_band: float = PLANT_K_BAND,
-                   gyro_band: tuple[float, float] = GYRO_BAND) -> Certificate | None:
+                   gyro_band: tuple[float, float] = GYRO_BAND,
+                   measurement: MeasurementErrors | None = None) -> Certificate | None:
     """:func:`certificate_for` on parts already resolved (:func:`wmr_mj.sim.parts.resolve_run`): the plant's
     parameters, the controller's belief, the law and the tracker of the run."""
     k_band = finite_number("k_band", k_band, minimum=0.0)
@@ -203,9 +212,11 @@ def certificate_of(config: Any, reference: Any, *, base: C80Parameters, estimate
         # declares, which every run measures (controllers.tracking.within_declared)
         bounds = tracker.declared_bounds(bounds)
         stated = stated + tracker.stated_assumptions()
+    measurement = MeasurementErrors.exact() if measurement is None else measurement
     context = ClaimContext(plant=plant_box, reference=bounds,
                            limits=PlantLimits(steering_range=plant.steering_range, voltage_limit=plant.voltage_limit),
-                           control_period=period, initial_error=initial, stated=stated, estimate=estimate_params)
+                           control_period=period, initial_error=initial, stated=stated, estimate=estimate_params,
+                           measurement=measurement)
     try:
         cert = controller.claim(context)
     except Exception as exc:  # noqa: BLE001  (any error of a law's own claim: one line naming the law, before any step)
@@ -216,6 +227,7 @@ def certificate_of(config: Any, reference: Any, *, base: C80Parameters, estimate
     if not isinstance(cert, Certificate):
         raise ParameterError(f"controller {controller.name!r}: claim() returned {type(cert).__name__}, not a "
                              "Certificate (see wmr_mj.analysis.claim.box_claim) or None")
+    cert = covers_measurement(cert, measurement)
     inputs = dict(cert.inputs)
     inputs.update(model=config.model, controller=controller.name, box_rule=config.box,
                   m1_range=list(config.m1_range), box_ranges={k: list(v) for k, v in ranges.items()},

@@ -1,0 +1,138 @@
+"""What a law reads instead of the true state: bounded measurement errors and a delay, as the
+certificates take them (derivations in ``docs/guides/certificates.md``, "Measurement errors and delays").
+
+A law reads alpha_m = alpha + e_a and alpha_m' = alpha' + e_v (the true state plus an error) with
+|e_a| <= ``alpha_error_max`` and |e_v| <= ``alpha_dot_error_max``, and acts ``delay_s`` late (a
+sensing delay, an actuation delay, or both: the sum). The error E = alpha0 - alpha is judged on the
+true state. :func:`wmr_mj.analysis.certificate.certify` (``measurement=``) and the sliding-mode claim
+(:meth:`controllers.sliding_mode.SlidingMode.claim`, through ``ClaimContext.measurement``) absorb
+these bounds; where no bound is derived (Gaussian noise, backlash with the encoder on the motor side,
+an inductance beyond what the proof covers) the caller passes ``covered=False`` with ``why_not``, and
+the certificate gets the unmet assumption :data:`MEASUREMENT_COVERED`.
+
+Usage::
+
+    from wmr_mj.analysis.measurement import MeasurementErrors
+    exact = MeasurementErrors.exact()                       # today's: every number unchanged
+    encoder = MeasurementErrors(alpha_error_max=2 * math.pi / 4096 / 2, alpha_dot_error_max=1.5, delay_s=0.0)
+    late = MeasurementErrors(alpha_error_max=0.0, alpha_dot_error_max=0.0, delay_s=0.005)
+    gauss = MeasurementErrors(0.0, 0.0, 0.0, covered=False, why_not="Gaussian noise on alpha has no bound")
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+from wmr_mj._util.checks import finite_number
+from wmr_mj.errors import ParameterError
+
+__all__ = [
+    "MeasurementErrors",
+    "MEASUREMENT_COVERED",
+    "DELAY_FIXED_POINT",
+    "coverage_assumption_fields",
+    "sin_cos3_slope",
+    "inv_cos2_slope",
+    "delayed_switching_bound",
+]
+
+#: Name of the assumption "every measurement and actuation error of the run has a derived bound".
+MEASUREMENT_COVERED = "sensing and actuation covered"
+#: Name of the assumption "the delay's terms close inside the certificate's fixed point".
+DELAY_FIXED_POINT = "delay inside the fixed point"
+
+
+@dataclass(frozen=True)
+class MeasurementErrors:
+    """Bounds on what a law reads instead of the true state (module docstring).
+
+    Attributes:
+        alpha_error_max: sup |alpha_m - alpha| [rad], >= 0 (quantisation Delta/2 or Delta, a
+            uniform noise bound, a backlash half-width with the encoder on the far side).
+        alpha_dot_error_max: sup |alpha_m' - alpha'| [rad/s], >= 0 (a differenced velocity's error
+            and lag, a filter's lag, a tachometer's noise bound).
+        delay_s: the delay [s] >= 0 between the state and the voltage it produces (sensing plus
+            actuation; the reference may be delayed by any part of it).
+        covered: False where some error of the run has no derived bound; the certificate is then
+            uncertified (assumption :data:`MEASUREMENT_COVERED`).
+        why_not: what is not covered (required when ``covered`` is False).
+
+    Raises:
+        ParameterError: a bound that is not a finite number >= 0, ``covered`` not a bool, or
+            ``covered`` False without ``why_not``.
+    """
+
+    alpha_error_max: float
+    alpha_dot_error_max: float
+    delay_s: float
+    covered: bool = True
+    why_not: str | None = None
+
+    def __post_init__(self) -> None:
+        for name in ("alpha_error_max", "alpha_dot_error_max", "delay_s"):
+            object.__setattr__(self, name, finite_number(name, getattr(self, name), minimum=0.0))
+        if not isinstance(self.covered, bool):
+            raise ParameterError(f"covered = {self.covered!r} is not accepted: True or False")
+        if not self.covered and not (isinstance(self.why_not, str) and self.why_not.strip()):
+            raise ParameterError("covered = False needs why_not: a sentence naming what has no derived bound")
+
+    @classmethod
+    def exact(cls) -> MeasurementErrors:
+        """The law reads the true state at once (today's runs): all bounds 0, covered."""
+        return cls(alpha_error_max=0.0, alpha_dot_error_max=0.0, delay_s=0.0)
+
+    @property
+    def is_exact(self) -> bool:
+        """No error, no delay, covered: the certificates are today's, bit for bit."""
+        return (self.covered and self.alpha_error_max == 0.0 and self.alpha_dot_error_max == 0.0
+                and self.delay_s == 0.0)
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready: the five fields."""
+        return {"alpha_error_max": self.alpha_error_max, "alpha_dot_error_max": self.alpha_dot_error_max,
+                "delay_s": self.delay_s, "covered": self.covered, "why_not": self.why_not}
+
+
+def coverage_assumption_fields(measurement: MeasurementErrors, claimant: str = "") -> dict[str, Any]:
+    """The fields of the assumption :data:`MEASUREMENT_COVERED` (an ``Assumption(**fields)``).
+
+    value 0 (covered) or 1 (not) against the limit 0; the note names what is missing.
+    """
+    who = f"{claimant}: " if claimant else ""
+    note = (f"{who}bounds |e_alpha| <= {measurement.alpha_error_max:.4g} rad, |e_alpha'| <= "
+            f"{measurement.alpha_dot_error_max:.4g} rad/s, delay {measurement.delay_s:.4g} s")
+    if not measurement.covered:
+        note = f"{who}no bound derived: {measurement.why_not}"
+    return dict(name=MEASUREMENT_COVERED, equation="every sensing and actuation error of the run has a derived bound",
+                met=bool(measurement.covered), value=0.0 if measurement.covered else 1.0, limit=0.0, note=note,
+                kind="checked")
+
+
+def sin_cos3_slope(alpha: float) -> float:
+    """max |d/da sin(a)/cos^3(a)| over |a| <= alpha < pi/2: (1 + 2 sin^2 alpha)/cos^4 alpha (increasing)."""
+    s, c = math.sin(alpha), math.cos(alpha)
+    return (1.0 + 2.0 * s * s) / c ** 4
+
+
+def inv_cos2_slope(alpha: float) -> float:
+    """max |d/da 1/cos^2(a)| over |a| <= alpha < pi/2: 2 sin(alpha)/cos^3(alpha) (increasing)."""
+    return 2.0 * math.sin(abs(alpha)) / math.cos(alpha) ** 3
+
+
+def delayed_switching_bound(k: float, d_max: float, tau: float) -> float:
+    """sup|s| for s' = -k sign(s(t - tau)) + d, |d| <= d_max < k, s = 0 on [-tau, 0]: (k + d_max) tau.
+
+    While |s| <= (k + d_max) tau fails, s(t - tau) has the sign of s(t) (|s'| <= k + d_max moves s by
+    at most (k + d_max) tau in tau), so s' = -k sign(s) + d drives |s| down: it cannot cross the level.
+
+    Raises:
+        ParameterError: a negative argument, or d_max >= k (no sliding).
+    """
+    k = finite_number("k", k, minimum=0.0, strict=True)
+    d_max = finite_number("d_max", d_max, minimum=0.0)
+    tau = finite_number("tau", tau, minimum=0.0)
+    if d_max >= k:
+        raise ParameterError(f"d_max = {d_max:g} >= k = {k:g}: the switching does not dominate, no bound")
+    return (k + d_max) * tau
