@@ -177,7 +177,7 @@ def test_without_numba_a_run_takes_the_python_path_and_says_so(monkeypatch):
 @needs_compiled
 def test_a_law_without_a_pure_function_or_with_state_is_never_compiled():
     why = compiled_law.external_reason(SlowLaw())
-    assert why is not None and "not SlowLaw" in why and "no pure law function" in why
+    assert why is not None and "SlowLaw offers no pure law function" in why
     assert StatefulLaw().stateful and not FastLaw().stateful
     why = compiled_law.external_reason(StatefulLaw())
     assert why is not None and "keeps state" in why
