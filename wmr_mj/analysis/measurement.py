@@ -6,8 +6,9 @@ A law reads alpha_m = alpha + e_a and alpha_m' = alpha' + e_v (the true state pl
 sensing delay, an actuation delay, or both: the sum). The error E = alpha0 - alpha is judged on the
 true state. :func:`wmr_mj.analysis.certificate.certify` (``measurement=``) and the sliding-mode claim
 (:meth:`controllers.sliding_mode.SlidingMode.claim`, through ``ClaimContext.measurement``) absorb
-these bounds; where no bound is derived (Gaussian noise, backlash with the encoder on the motor side,
-an inductance beyond what the proof covers) the caller passes ``covered=False`` with ``why_not``, and
+these bounds; where no bound is derived (Gaussian noise, backlash between the motor and an encoder on the
+steering axis, an inductance or a current limit, which the proof's model has not) the caller passes
+``covered=False`` with ``why_not``, and
 the certificate gets the unmet assumption :data:`MEASUREMENT_COVERED`.
 
 Usage::

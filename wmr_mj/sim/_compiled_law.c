@@ -26,12 +26,20 @@
  * on the steering joint per control step (N m); the callback writes it to qfrc_applied at every
  * physics step, before the law (wmr_mj.sim.signals). Models without it are untouched.
  *
- * userdata (7 per simulation), written at every control step for the statistics and the rows of a
+ * A numeric "wmr_mj_sensing" (wmr_mj.sim.compiled_law.attach, optional, after the others) puts the steering
+ * sensor (wmr_mj.hardware.sensing.SensingChain) between the plant and the law: its header (SENSE_*), the
+ * chain's parameters (wmr_mj.hardware.sensing P_*), then the noise on alpha and on alpha' per control step.
+ * The law then reads the measured alpha and alpha'; E and E' stay the true errors. The chain's state lives in
+ * userdata after the 9 fields below (its layout: wmr_mj.hardware.sensing S_*), so a block continues where
+ * the last one stopped and a state read back carries it. Models without it are untouched.
+ *
+ * userdata (7 per simulation; 9 and the chain's state with sensing), written at every control step for the statistics and the rows of a
  * single run (wmr_mj.sim.engine):
  *   alpha (rad), E = alpha0 - alpha (rad), E' = alpha0' - alpha' (rad/s), unsaturated law (V),
  *   alpha' (rad/s), applied voltage (V),
  * and at every physics step, where the law names the chassis body (LAW_CHASSIS >= 0):
- *   heading (rad), the chassis's yaw from xquat as the serial loop computed it (math.atan2).
+ *   heading (rad), the chassis's yaw from xquat as the serial loop computed it (math.atan2);
+ * with sensing, also the measured alpha (rad) and alpha' (rad/s) the law read.
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
@@ -71,6 +79,85 @@ int wmr_mj_mujoco_version(void) { return mjVERSION_HEADER; }
 
 /* the index of the optional disturbance numeric: its presence tells Python this build applies it */
 int wmr_mj_disturbance_numeric(void) { return 2; }
+
+/* the sensing numeric's header, then the chain's parameters: keep in step with compiled_law.py (SENSE_FIELDS)
+ * and wmr_mj/hardware/sensing.py (P_*, S_*) */
+enum { SENSE_MOTOR_QPOS, SENSE_NSTEP, SENSE_HEADER };
+enum { P_TICKS_PER_RAD, P_GEAR_RATIO, P_PERIOD, P_FILTER_A, P_FILTER_ONE_MINUS_A, P_DELAY_STEPS,
+       P_ENCODER_SIDE, P_ROUNDING, P_VELOCITY, P_ALPHA_NOISE_ON, P_ALPHA_DOT_NOISE_ON, N_PARAMETERS };
+enum { S_NEXT_STEP, S_PREVIOUS_ALPHA, S_FILTER, S_RING };
+#define SENSE_USERDATA 9 /* the chain's state starts here in userdata */
+
+int wmr_mj_sensing_layout(void) { return 1000 * SENSE_HEADER + 10 * N_PARAMETERS + S_RING; }
+
+/* SensingChain.step of wmr_mj/hardware/sensing.py, operation for operation (the same bits) */
+static void sense(const mjtNum* sp, mjtNum* s, long long k, double alpha, double alpha_dot, double motor,
+                  double* alpha_m_out, double* alpha_dot_m_out) {
+  const mjtNum* p = sp + SENSE_HEADER;
+  long long nstep = (long long)sp[SENSE_NSTEP];
+  const mjtNum* alpha_noise = p + N_PARAMETERS;
+  const mjtNum* alpha_dot_noise = alpha_noise + nstep;
+  long long slots = (long long)p[P_DELAY_STEPS] + 1;
+  mjtNum* ring = s + S_RING;
+  long long j = 3 * (k % slots);
+  ring[j] = alpha;
+  ring[j + 1] = alpha_dot;
+  ring[j + 2] = motor;
+  if (k == 0) { /* before d steps have passed, every slot holds the state at t = 0 */
+    for (long long i = 0; i < 3 * slots; i += 3) {
+      ring[i] = alpha;
+      ring[i + 1] = alpha_dot;
+      ring[i + 2] = motor;
+    }
+  }
+  long long r = 3 * ((k + 1) % slots); /* the slot of step k - d */
+  int motor_side = p[P_ENCODER_SIDE] == 1.0;
+  double theta = motor_side ? ring[r + 2] : ring[r];
+  double c = p[P_TICKS_PER_RAD];
+  if (c != 0.0) {
+    double x = theta * c;
+    theta = (p[P_ROUNDING] == 1.0 ? floor(x) : nearbyint(x)) / c;
+  }
+  double alpha_m = motor_side ? theta / p[P_GEAR_RATIO] : theta;
+  if (p[P_ALPHA_NOISE_ON] != 0.0) {
+    alpha_m = alpha_m + alpha_noise[k];
+  }
+  double v;
+  if (p[P_VELOCITY] <= 1.0) { /* exact, tachometer */
+    v = ring[r + 1];
+  } else {
+    v = k == 0 ? 0.0 : (alpha_m - s[S_PREVIOUS_ALPHA]) / p[P_PERIOD];
+    if (p[P_VELOCITY] == 3.0) {
+      v = p[P_FILTER_A] * s[S_FILTER] + p[P_FILTER_ONE_MINUS_A] * v;
+      s[S_FILTER] = v;
+    }
+  }
+  if (p[P_ALPHA_DOT_NOISE_ON] != 0.0) {
+    v = v + alpha_dot_noise[k];
+  }
+  s[S_PREVIOUS_ALPHA] = alpha_m;
+  s[S_NEXT_STEP] = (double)(k + 1);
+  *alpha_m_out = alpha_m;
+  *alpha_dot_m_out = v;
+}
+
+/* the sensing numeric of the model, or NULL */
+static const mjtNum* sensing_of(const mjModel* m, const mjData* d) {
+  for (int i = m->nnumeric - 1; i >= 2; i--) {
+    if (strcmp(m->names + m->name_numericadr[i], "wmr_mj_sensing") == 0) {
+      const mjtNum* sp = m->numeric_data + m->numeric_adr[i];
+      long long nstep = (long long)sp[SENSE_NSTEP];
+      long long slots = (long long)sp[SENSE_HEADER + P_DELAY_STEPS] + 1;
+      if (m->numeric_size[i] != SENSE_HEADER + N_PARAMETERS + 2 * nstep ||
+          m->nuserdata < SENSE_USERDATA + S_RING + 3 * slots) {
+        return NULL;
+      }
+      (void)d;
+      return sp;
+    }
+  }
+  return NULL;
+}
 
 /* kind 2: u = fn(constants, nparam, alpha, alpha', alpha0, alpha0', alpha0'') */
 typedef double (*wmr_mj_law_fn)(const double*, int, double, double, double, double, double);
@@ -129,6 +216,17 @@ void wmr_mj_control(const mjModel* m, mjData* d) {
   double alpha = d->qpos[(int)law[LAW_QPOS]];
   double alpha_dot = d->qvel[(int)law[LAW_DOF]];
   double alpha0 = reference[3 * k], alpha0_dot = reference[3 * k + 1], alpha0_ddot = reference[3 * k + 2];
+  double true_alpha = alpha, true_alpha_dot = alpha_dot;
+  const mjtNum* sensing = m->nnumeric >= 3 ? sensing_of(m, d) : NULL;
+  if (sensing != NULL) {
+    if (k >= (long long)sensing[SENSE_NSTEP]) {
+      return;
+    }
+    double motor = sensing[SENSE_HEADER + P_GEAR_RATIO] * d->qpos[(int)sensing[SENSE_MOTOR_QPOS]];
+    sense(sensing, d->userdata + SENSE_USERDATA, k, true_alpha, true_alpha_dot, motor, &alpha, &alpha_dot);
+    d->userdata[7] = alpha;
+    d->userdata[8] = alpha_dot;
+  }
   double u;
   int external = law[LAW_KIND] == 2.0;
   if (external) {
@@ -173,11 +271,11 @@ void wmr_mj_control(const mjModel* m, mjData* d) {
     applied = u > limit ? limit : (u < -limit ? -limit : u);
   }
   d->ctrl[(int)law[LAW_ACTUATOR]] = applied;
-  d->userdata[0] = alpha;
-  d->userdata[1] = alpha0 - alpha;
-  d->userdata[2] = alpha0_dot - alpha_dot;
+  d->userdata[0] = true_alpha;
+  d->userdata[1] = alpha0 - true_alpha;
+  d->userdata[2] = alpha0_dot - true_alpha_dot;
   d->userdata[3] = u;
-  d->userdata[4] = alpha_dot;
+  d->userdata[4] = true_alpha_dot;
   d->userdata[5] = applied;
 }
 

@@ -186,6 +186,47 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
                           measurement=measurement)
 
 
+def measurement_errors_of(config: Any, plant: C80Parameters) -> MeasurementErrors:
+    """What the run's law reads instead of the true state, as the certificates take it
+    (:mod:`wmr_mj.analysis.measurement`),
+    from the cart as it is built (``config.sensing``, ``actuation``, ``transmission``; :mod:`wmr_mj.hardware`).
+
+    Bounded, and so covered: the encoder's quantisation, a uniform noise, the gear's play where the encoder
+    is on the motor side (the motor's angle / i2 is within b of alpha), a differenced or filtered velocity's
+    error (:func:`wmr_mj.hardware.sensing.measurement_error_bounds`); its lag, the sensing delay and the
+    actuation delay are charged together as one delay (a lag on alpha' alone is within a delay of both).
+    Not covered (the certificate is then uncertified, saying why): Gaussian noise, the play with the encoder
+    on the steering axis (it lies between the motor and the measured angle, on the actuator's side), the
+    armature inductance and a current limit (the proof's motor has neither).
+
+    Returns:
+        :meth:`MeasurementErrors.exact` for an ideal cart (every number as before).
+    """
+    from wmr_mj.hardware import measurement_error_bounds
+
+    sensing, actuation, transmission = config.sensing, config.actuation, config.transmission
+    if sensing.is_ideal and actuation.is_ideal and transmission.is_ideal:
+        return MeasurementErrors.exact()
+    period = config.control_period if config.control_period is not None else TIMESTEP
+    motor_side = sensing.encoder_side == "motor" and sensing.encoder_ticks is not None
+    bounds = measurement_error_bounds(sensing, control_period=period, gear_ratio=plant.i2,
+                                      backlash=transmission.backlash if motor_side else 0.0)
+    why: list[str] = [] if bounds.covered else [str(bounds.why_not)]
+    if not transmission.is_ideal and not motor_side:
+        why.append(f"the gear's play (b = {transmission.backlash:g} rad) lies between the motor and an encoder on "
+                   "the steering axis: no bound is derived for play on the actuator's side")
+    if actuation.inductance > 0:
+        why.append(f"the armature inductance (L_a = {actuation.inductance:g} H, L_a/R_a = "
+                   f"{actuation.electrical_time_constant(plant.R_a) * 1e3:.3g} ms) is not in the proof's motor model")
+    if actuation.current_limit is not None:
+        why.append(f"the current limit ({actuation.current_limit:g} A) is not in the proof's motor model")
+    finite = bounds.covered
+    return MeasurementErrors(alpha_error_max=bounds.alpha_error_max if finite else 0.0,
+                             alpha_dot_error_max=bounds.alpha_dot_error_max if finite else 0.0,
+                             delay_s=bounds.delay + actuation.delay + (bounds.alpha_dot_lag if finite else 0.0),
+                             covered=not why, why_not="; ".join(why) or None)
+
+
 def certificate_of(config: Any, reference: Any, *, base: C80Parameters, estimate: C80Parameters,
                    plant: C80Parameters, controller: Any, tracker: Any, k_band: float = PLANT_K_BAND,
                    gyro_band: tuple[float, float] = GYRO_BAND,
@@ -212,7 +253,8 @@ def certificate_of(config: Any, reference: Any, *, base: C80Parameters, estimate
         # declares, which every run measures (controllers.tracking.within_declared)
         bounds = tracker.declared_bounds(bounds)
         stated = stated + tracker.stated_assumptions()
-    measurement = MeasurementErrors.exact() if measurement is None else measurement
+    if measurement is None:
+        measurement = measurement_errors_of(config, plant)
     context = ClaimContext(plant=plant_box, reference=bounds,
                            limits=PlantLimits(steering_range=plant.steering_range, voltage_limit=plant.voltage_limit),
                            control_period=period, initial_error=initial, stated=stated, estimate=estimate_params,

@@ -406,7 +406,8 @@ def run_parts(parts: RunParts, *, logger_factory: Callable[..., Any] | None = No
     bar = progress_bar(n, desc="run", unit="step", unit_scale=True, enabled=progress)
     try:
         schedule = Schedule(reference=(a0_all, a0d_all, a0dd_all), n=n, substeps=substeps, period=period,
-                            disturbance=disturbance, loads=loads, tracker=outer, path_reference=reference)
+                            disturbance=disturbance, loads=loads, tracker=outer, path_reference=reference,
+                            sensing=config.sensing)
         run = run_engine(params=params, controller=controller, options=options, model=plain, schedule=schedule,
                          law=law, on_block=on_block, on_progress=bar.update)
     finally:

@@ -75,7 +75,8 @@ import numpy as np
 
 from wmr_mj.errors import ParameterError
 
-__all__ = ["LAW_FIELDS", "USERDATA_FIELDS", "unavailable_reason", "install", "supports", "law_vector", "attach",
+__all__ = ["LAW_FIELDS", "USERDATA_FIELDS", "SENSING_USERDATA_FIELDS", "SENSING_STATE_ADR", "sensing_numeric",
+            "unavailable_reason", "install", "supports", "law_vector", "attach",
            "external_reason", "external_law", "compiles"]
 
 #: The numeric "wmr_mj_law", in order (the enum of _compiled_law.c).
@@ -87,6 +88,13 @@ EXTERNAL_KIND = 2
 #: where the law names the chassis body).
 USERDATA_FIELDS = ("alpha", "E", "E_dot", "voltage_cmd", "alpha_dot", "voltage", "heading")
 LAW_NUMERIC, REFERENCE_NUMERIC, DISTURBANCE_NUMERIC = "wmr_mj_law", "wmr_mj_reference", "wmr_mj_disturbance"
+#: the numeric of the steering sensor (wmr_mj.hardware.sensing.SensingChain): SENSE_FIELDS, the chain's
+#: parameters, then its noise on alpha and on alpha' per control step
+SENSING_NUMERIC = "wmr_mj_sensing"
+SENSE_FIELDS = ("motor_qpos_adr", "nstep")
+#: userdata after USERDATA_FIELDS where the run has a sensor: what the law read; the chain's state follows
+SENSING_USERDATA_FIELDS = ("alpha_measured", "alpha_dot_measured")
+SENSING_STATE_ADR = len(USERDATA_FIELDS) + len(SENSING_USERDATA_FIELDS)
 _ENV = "WMR_MJ_COMPILED_LAW"
 _install_lock = threading.Lock()
 
@@ -103,9 +111,24 @@ def _library() -> tuple[ctypes.CDLL | None, str | None]:
     if built_for != running:
         return None, f"wmr_mj.sim._compiled_law was built for MuJoCo {built_for}, this is {running}; reinstall wmr-mj"
     if (int(lib.wmr_mj_law_size()) != len(LAW_FIELDS) or not hasattr(lib, "wmr_mj_disturbance_numeric")
-            or not hasattr(lib, "wmr_mj_register_law")):
+            or not hasattr(lib, "wmr_mj_register_law") or not hasattr(lib, "wmr_mj_sensing_layout")
+            or int(lib.wmr_mj_sensing_layout()) != _sensing_layout()):
         return None, "wmr_mj.sim._compiled_law does not match wmr_mj.sim.compiled_law (LAW_FIELDS); reinstall wmr-mj"
     return lib, None
+
+
+def _sensing_layout() -> int:
+    """The sensing layout's sizes as the C file encodes them (wmr_mj_sensing_layout)."""
+    from wmr_mj.hardware.sensing import N_PARAMETERS, S_RING
+
+    return 1000 * len(SENSE_FIELDS) + 10 * N_PARAMETERS + S_RING
+
+
+def sensing_numeric(chain: Any, *, motor_qpos_adr: int) -> np.ndarray:
+    """The numeric "wmr_mj_sensing" of ``chain`` (a :class:`wmr_mj.hardware.sensing.SensingChain`):
+    SENSE_FIELDS, its parameters, its noise on alpha and on alpha' (n_steps each)."""
+    return np.concatenate([np.array([float(motor_qpos_adr), float(chain.n_steps)]), chain.parameters,
+                           chain.alpha_noise, chain.alpha_dot_noise])
 
 
 def _address(fn: Any) -> int | None:
@@ -275,12 +298,14 @@ def law_vector(controller: Any, *, voltage_limit: float, substeps: int, nstep: i
 
 
 def attach(spec: mujoco.MjSpec, law: np.ndarray, reference: Sequence[np.ndarray],
-           disturbance: np.ndarray | None = None) -> None:
+           disturbance: np.ndarray | None = None, sensing: tuple[np.ndarray, int] | None = None) -> None:
     """Give the model of ``spec`` the law: the numerics the callback reads, and its userdata.
 
     ``reference`` is (alpha0, alpha0', alpha0'') on the control grid, nstep samples each;
     ``disturbance``, where given, a torque on the steering joint per control step [N m] (nstep
-    samples), the third numeric, which the callback writes to qfrc_applied at every physics step.
+    samples), the third numeric, which the callback writes to qfrc_applied at every physics step;
+    ``sensing``, where given, (the numeric of :func:`sensing_numeric`, the chain's state size): the
+    law then reads the measured state, and userdata holds SENSING_USERDATA_FIELDS and the chain's state.
     """
     if len(spec.numerics):
         raise ParameterError("attach needs a spec without numerics: the law must be the model's first numeric")
@@ -301,3 +326,7 @@ def attach(spec: mujoco.MjSpec, law: np.ndarray, reference: Sequence[np.ndarray]
             raise ParameterError(f"disturbance must be {nstep} finite samples")
         spec.add_numeric(name=DISTURBANCE_NUMERIC, data=torque.tolist())
     spec.nuserdata = len(USERDATA_FIELDS)
+    if sensing is not None:
+        values, state_size = sensing
+        spec.add_numeric(name=SENSING_NUMERIC, data=np.asarray(values, dtype=float).tolist())
+        spec.nuserdata = SENSING_STATE_ADR + int(state_size)

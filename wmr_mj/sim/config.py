@@ -100,6 +100,13 @@ class RunConfig:
     # mapping or 'key=value,...'): the certificate and the paper's region are computed for every
     # reference within them, and the run's own is checked against them; None: the run's own bounds
     reference_bounds: Any = None
+    # the cart as it is built (wmr_mj.hardware): the steering sensor between the plant and the law (a Sensing,
+    # its 'KEY=VALUE,...' form, a mapping, a .json/.toml file or a preset name), the motor's actuation (delay,
+    # inductance, current limit) and the gear's play (a Transmission, or its backlash half-width in rad);
+    # None: ideal, today's plant (as_dict then has none of these keys)
+    sensing: Any = None
+    actuation: Any = None
+    transmission: Any = None
 
     def __post_init__(self) -> None:
         _check_plugin(self, "controller")
@@ -132,6 +139,7 @@ class RunConfig:
         from wmr_mj.sim.signals import signals_from
 
         object.__setattr__(self, "signals", signals_from(self.signals))
+        _check_hardware(self)
         from wmr_mj.reference.bounds import reference_bounds_from
 
         object.__setattr__(self, "reference_bounds", reference_bounds_from(self.reference_bounds))
@@ -162,6 +170,12 @@ class RunConfig:
                     d[kind] = source.name  # an object: its name (the plugin record says where it came from)
         if self.tracker is None:
             del d["tracker"]
+        for name in ("sensing", "actuation", "transmission"):  # likewise: only where the cart is not ideal
+            part = getattr(self, name)
+            if part.is_ideal:
+                del d[name]
+            else:
+                d[name] = part.as_dict()
         if self.reference_bounds is None:
             del d["reference_bounds"]  # likewise
         else:
@@ -175,6 +189,23 @@ class RunConfig:
 
     def replace(self, **changes: Any) -> RunConfig:
         return dataclasses.replace(self, **changes)
+
+
+def _check_hardware(config: RunConfig) -> None:
+    """The config's sensing, actuation and transmission as their typed parts (:mod:`wmr_mj.hardware`; None:
+    ideal), each delay checked against the grid it runs on: the sensing's against the control period, the
+    actuation's against the physics step (MuJoCo's actuator delay).
+
+    Raises:
+        ParameterError, UnknownNameError: a malformed spec, a bad value, a delay the grid cannot represent.
+    """
+    from wmr_mj.hardware import Actuation, Sensing, Transmission
+
+    for name, cls in (("sensing", Sensing), ("actuation", Actuation), ("transmission", Transmission)):
+        given = getattr(config, name)
+        object.__setattr__(config, name, given if isinstance(given, cls) else cls.from_spec(given))
+    config.sensing.delay_steps(TIMESTEP if config.control_period is None else config.control_period)
+    config.actuation.delay_steps(TIMESTEP)
 
 
 def _check_plugin(config: RunConfig, kind: str) -> None:

@@ -47,6 +47,7 @@ import mujoco
 import numpy as np
 
 from wmr_mj.errors import ParameterError, UnknownNameError, WmrMjError
+from wmr_mj.hardware.sensing import P_GEAR_RATIO, SensingChain
 from wmr_mj.params import C80Parameters
 from wmr_mj.sim import compiled_law
 
@@ -57,6 +58,9 @@ __all__ = ["run_engine", "Schedule", "EngineRun", "batch_model", "batch_law_back
 # scalar fields recorded for every control step (see wmr_mj.sim.closed_loop.RunResult.rows)
 ROW_FIELDS = ("t", "alpha", "alpha_dot", "alpha0", "alpha0_dot", "alpha0_ddot", "E", "E_dot",
               "voltage_cmd", "voltage", "current", "steer_torque", "heading")
+#: recorded besides where the run has a sensor (wmr_mj.hardware.sensing): what the law read [rad, rad/s];
+#: alpha, alpha_dot, E and E_dot stay the true state's
+SENSED_ROW_FIELDS = ("alpha_measured", "alpha_dot_measured")
 
 #: how a run evaluates the law: "compiled" (C, in MuJoCo's control callback), "numpy"
 #: (Python: the vectorised law of a batch, ``voltage_scalar`` of a single run), "auto"
@@ -79,8 +83,19 @@ def load_fields(params: C80Parameters, **plant_options: Any) -> dict[str, np.nda
 
 
 def plant_options(config: Any) -> dict[str, Any]:
-    """The plant-law keywords the config carries (compile_model and Plant take them)."""
-    return {name: getattr(config, name) for name in _PLANT_OPTIONS if hasattr(config, name)}
+    """The plant-law keywords the config carries (compile_model and Plant take them): the steering friction
+    and tyre contact laws, and where the cart is not ideal its actuation (MuJoCo's actuator delay, the
+    dcmotor's inductance and current limit) and its gear's play (:mod:`wmr_mj.plant.mjcf`); an ideal cart adds
+    no keyword, so its model is today's."""
+    options = {name: getattr(config, name) for name in _PLANT_OPTIONS if hasattr(config, name)}
+    actuation = getattr(config, "actuation", None)
+    if actuation is not None and not actuation.is_ideal:
+        options.update(actuation_delay_s=actuation.delay, inductance_H=actuation.inductance,
+                       current_limit_A=actuation.current_limit)
+    transmission = getattr(config, "transmission", None)
+    if transmission is not None and not transmission.is_ideal:
+        options.update(backlash_rad=transmission.backlash)
+    return options
 
 
 def batch_model(params: C80Parameters, *, law: tuple[Any, ...] | None = None,
@@ -162,10 +177,14 @@ class _Plant:
     """Indices and constants the engine reads, from a compiled model."""
 
     def __init__(self, m: mujoco.MjModel) -> None:
-        steer = m.joint("steer").id
-        self.qpos = int(m.jnt_qposadr[steer])
-        self.dof = int(m.jnt_dofadr[steer])
-        self.actuator = int(m.actuator("steering_motor").id)
+        from wmr_mj.plant.mjcf import steering_joint_addresses
+
+        steering = steering_joint_addresses(m)
+        self.qpos, self.dof = steering.axle_qpos, steering.axle_dof  # alpha, alpha'
+        # the motor side (the axle's joint itself where the gear has no play): the motor's torque acts on its
+        # dof, and an encoder on the motor shaft reads i2 times its angle
+        self.motor_qpos, self.motor_dof = steering.motor_qpos, steering.motor_dof
+        self.actuator = steering.actuator
         self.chassis = int(m.body("chassis").id)
         self.site_A, self.site_C = int(m.site("A").id), int(m.site("C").id)
         self.keyframe = int(m.key("home").id)
@@ -181,7 +200,7 @@ class _Block:
     step's start, ctrl as applied (logs only: without a log they have no rows).
     """
 
-    def __init__(self, count: int, m: mujoco.MjModel, log: bool) -> None:
+    def __init__(self, count: int, m: mujoco.MjModel, log: bool, sensing: bool = False) -> None:
         self.alpha, self.alpha_dot, self.voltage_cmd, self.voltage, self.force, self.torque, self.heading = (
             np.empty(count) for _ in range(7))
         rows = count if log else 0
@@ -190,6 +209,9 @@ class _Block:
         self.ctrl = np.empty((rows, m.nu))
         self.sites = np.empty((rows, m.nsite, 3))
         self.C_xy = np.empty((count, 2))  # always: the run's path errors (wmr_mj.analysis.path_error)
+        # what the law read where the run has a sensor (wmr_mj.hardware.sensing); else no rows
+        sensed = count if sensing else 0
+        self.alpha_measured, self.alpha_dot_measured = np.empty(sensed), np.empty(sensed)
 
     @classmethod
     def head(cls, block: _Block, count: int) -> _Block:
@@ -217,7 +239,8 @@ class _CompiledStepper:
     actuator's force and qfrc_actuator (computed after the callback), and for a log the state.
     """
 
-    def __init__(self, model: mujoco.MjModel, where: _Plant, substeps: int, log: bool, own_model: bool = False) -> None:
+    def __init__(self, model: mujoco.MjModel, where: _Plant, substeps: int, log: bool, own_model: bool = False,
+                 sensing: bool = False) -> None:
         from mujoco.batch import Batch
 
         self.model, self.where, self.substeps, self.log = model, where, substeps, log
@@ -232,7 +255,8 @@ class _CompiledStepper:
             # the state at the next control step's start (the rollout records the state after each step)
             self._qpos, self._qvel = self.batch.qpos[0].copy(), self.batch.qvel[0].copy()
         self._out: dict[int, dict[Any, np.ndarray]] = {}  # record buffers per block length, reused
-        self._fields = {name: i for i, name in enumerate(compiled_law.USERDATA_FIELDS)}
+        self._fields = {name: i for i, name in enumerate(compiled_law.USERDATA_FIELDS
+                                                         + compiled_law.SENSING_USERDATA_FIELDS * sensing)}
 
     def warnings(self) -> int:
         return int(self.batch.warning[0, :, 1].sum())  # (nsim, mjNWARNING, (lastinfo, number))
@@ -261,8 +285,11 @@ class _CompiledStepper:
         block.voltage_cmd[:] = ud[:, f["voltage_cmd"]]
         block.voltage[:] = ud[:, f["voltage"]]
         block.heading[:] = ud[:, f["heading"]]  # written at every substep: the last one's
+        if len(block.alpha_measured):
+            block.alpha_measured[:] = ud[:, f["alpha_measured"]]
+            block.alpha_dot_measured[:] = ud[:, f["alpha_dot_measured"]]
         block.force[:] = end["actuator_force"][:, w.actuator]
-        block.torque[:] = end["qfrc_actuator"][:, w.dof]
+        block.torque[:] = end["qfrc_actuator"][:, w.motor_dof]
         sites = end["site_xpos"].reshape(count, -1, 3)
         block.C_xy[:] = sites[:, w.site_C, :2]
         if self.log:
@@ -317,8 +344,9 @@ class _PythonStepper:
     def __init__(self, model: mujoco.MjModel, where: _Plant, substeps: int, log: bool, law: Callable[..., float],
                  reference: tuple[np.ndarray, np.ndarray, np.ndarray], voltage_limit: float,
                  disturbance: np.ndarray | None = None, fields: Mapping[str, np.ndarray] | None = None, *,
-                 period: float = 1.0, strict: bool = False) -> None:
+                 period: float = 1.0, strict: bool = False, chain: Any = None) -> None:
         self.model, self.where, self.substeps, self.log = model, where, substeps, log
+        self.chain = chain  # the sensor between the plant and the law (wmr_mj.hardware.SensingChain), or None
         self.period, self.strict = period, strict
         self._own = False  # whether self.model is this stepper's own copy (made at the first load change)
         if fields:
@@ -346,11 +374,14 @@ class _PythonStepper:
         values = np.empty(mujoco.mj_stateSize(model, spec))
         mujoco.mj_getState(model, full, values, spec)
         mujoco.mj_setState(self.model, self.data, values, spec)
+        if self.chain is not None:  # the sensor's memory, where the compiled law kept it
+            adr = compiled_law.SENSING_STATE_ADR
+            self.chain.state[:] = full.userdata[adr:adr + len(self.chain.state)]
 
     def step(self, block: _Block, k0: int, count: int) -> None:
         m, d, w = self.model, self.data, self.where
         qpos, qvel, ctrl = d.qpos, d.qvel, d.ctrl
-        qa, dv, act, chassis, site_C = w.qpos, w.dof, w.actuator, w.chassis, w.site_C
+        qa, dv, act, chassis, site_C, motor_dof = w.qpos, w.dof, w.actuator, w.chassis, w.site_C, w.motor_dof
         xquat, site_xpos, act_force, qfrc_act = d.xquat, d.site_xpos, d.actuator_force, d.qfrc_actuator
         limit, law, substeps, log, step = self.limit, self.law, self.substeps, self.log, mujoco.mj_step
         a0_all, a0d_all, a0dd_all = (r[k0:k0 + count].tolist() for r in self.reference)
@@ -358,20 +389,26 @@ class _PythonStepper:
         qfrc_applied = d.qfrc_applied
         quat = np.empty((count, 4))
         period, strict = self.period, self.strict
+        chain, motor_qpos = self.chain, w.motor_qpos
+        i2 = 0.0 if chain is None else float(chain.parameters[P_GEAR_RATIO])  # as the callback reads it
         for j in range(count):
             if dist is not None:
                 qfrc_applied[dv] = dist[j]  # held over the control step's physics steps, as the callback does
             a = float(qpos[qa])
             ad = float(qvel[dv])
+            am, adm = a, ad  # what the law reads: the state, or where the run has a sensor what it measures
+            if chain is not None:
+                am, adm = chain.step(k0 + j, a, ad, i2 * float(qpos[motor_qpos]))
+                block.alpha_measured[j], block.alpha_dot_measured[j] = am, adm
             if strict:
                 try:
-                    u_cmd = _checked_call(law, (k0 + j) * period, a, ad, a0_all[j], a0d_all[j], a0dd_all[j])
+                    u_cmd = _checked_call(law, (k0 + j) * period, am, adm, a0_all[j], a0d_all[j], a0dd_all[j])
                 except ControllerFailure as exc:
                     exc.steps_done = j  # the control steps of this block recorded before the failing one
                     block.heading[:j] = _heading(quat[:j])
                     raise
             else:
-                u_cmd = law((k0 + j) * period, a, ad, a0_all[j], a0d_all[j], a0dd_all[j])
+                u_cmd = law((k0 + j) * period, am, adm, a0_all[j], a0d_all[j], a0dd_all[j])
             if u_cmd != u_cmd:  # NaN from a diverged law: apply nothing, keep the record
                 u = 0.0
             else:
@@ -388,7 +425,7 @@ class _PythonStepper:
             block.voltage_cmd[j] = u_cmd
             block.voltage[j] = u
             block.force[j] = act_force[act]
-            block.torque[j] = qfrc_act[dv]
+            block.torque[j] = qfrc_act[motor_dof]
             quat[j] = xquat[chassis]
             block.C_xy[j] = site_xpos[site_C, :2]
             if log:
@@ -418,6 +455,7 @@ class Schedule:
     loads: Sequence[tuple[int, Mapping[str, np.ndarray]]] = ()
     tracker: Any = None  # a controllers.tracking.PathTracker
     path_reference: Any = None  # the path's Reference, which the tracker is reset with
+    sensing: Any = None  # the steering sensor (wmr_mj.hardware.Sensing); None or ideal: the law reads the state
 
 
 def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any], schedule: Schedule,
@@ -442,24 +480,26 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
     in_effect: dict[str, np.ndarray] = {}  # the load fields set so far (a Python stepper made later starts with them)
 
     strict = not compiled_law.supports(controller)
+    chain = _sensing_chain(schedule, params)
+    sensed = chain is not None
     controller.reset(control_period=period)
     if tracker is not None:
         tracker.reset(schedule.path_reference, control_period=period)
 
     def python_stepper(fields: Mapping[str, np.ndarray] | None = None) -> _PythonStepper:
         return _PythonStepper(plain, where, substeps, log, controller.step, (a0_all, a0d_all, a0dd_all),
-                              params.voltage_limit, disturbance, fields, period=period, strict=strict)
+                              params.voltage_limit, disturbance, fields, period=period, strict=strict, chain=chain)
 
     lawful = None
     ref_adr = 0
     stepper: _CompiledStepper | _PythonStepper
     if backend == "compiled":
         stepper, lawful, ref_adr = _compiled_stepper(params, controller, options, where, schedule,
-                                                     (a0_all, a0d_all, a0dd_all), disturbance, log)
+                                                     (a0_all, a0d_all, a0dd_all), disturbance, log, chain)
     else:
         stepper = python_stepper()
     used = "compiled" if backend == "compiled" else "python"
-    rows = {key: np.empty(n) for key in ROW_FIELDS}
+    rows = {key: np.empty(n) for key in ROW_FIELDS + SENSED_ROW_FIELDS * sensed}
     C_xy = np.empty((n, 2))
     block_len = max(1, int(round(1.0 / period)))  # one simulated second per block
     if tracker is not None:
@@ -476,7 +516,7 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
         if on_block is None or upto <= sent:
             return
         sl = slice(sent, upto)
-        block = {key: rows[key][sl] for key in ROW_FIELDS}
+        block = {key: rows[key][sl] for key in rows}
         b = blocks[cnt]
         lo = sent - k0  # the rows of this block not handed over yet
         block.update(qpos=b.qpos[lo:], qvel=b.qvel[lo:], ctrl=b.ctrl[lo:],
@@ -496,7 +536,7 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
                 if kc == s0:
                     st.set_fields(f)
                     in_effect.update(f)
-            part = _Block(s1 - s0, plain, log)
+            part = _Block(s1 - s0, plain, log, len(b.alpha_measured) > 0)
             st.step(part, s0, s1 - s0)
             sl = slice(s0 - k0, s1 - k0)
             for name, value in vars(part).items():  # every record the part has rows of (C_xy included)
@@ -514,7 +554,7 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
             cnt = min(block_len, n - k0)
             b = blocks.get(cnt)
             if b is None:
-                b = blocks[cnt] = _Block(cnt, plain, log)
+                b = blocks[cnt] = _Block(cnt, plain, log, sensed)
             if tracker is not None:
                 if k0:
                     # C's speed over the control step before (NaN until two samples exist)
@@ -597,19 +637,32 @@ def _checked_inputs(schedule: Schedule) -> tuple[tuple[np.ndarray, np.ndarray, n
     return (a0_all, a0d_all, a0dd_all), disturbance, ordered
 
 
+def _sensing_chain(schedule: Schedule, params: C80Parameters) -> SensingChain | None:
+    """The run's sensor as a chain over its control steps; None where the law reads the state itself."""
+    sensing = schedule.sensing
+    if sensing is None or sensing.is_ideal:
+        return None
+    return SensingChain(sensing, control_period=schedule.period, n_steps=schedule.n, gear_ratio=params.i2)
+
+
 def _compiled_stepper(params: C80Parameters, controller: Any, options: dict[str, Any], where: _Plant,
                       schedule: Schedule, reference: tuple[np.ndarray, np.ndarray, np.ndarray],
-                      disturbance: np.ndarray | None, log: bool) -> tuple[_CompiledStepper, mujoco.MjModel, int]:
-    """The compiled law's stepper, its model (which carries the reference) and the reference's address in it."""
+                      disturbance: np.ndarray | None, log: bool,
+                      chain: SensingChain | None = None) -> tuple[_CompiledStepper, mujoco.MjModel, int]:
+    """The compiled law's stepper, its model (which carries the reference and the sensor) and the reference's
+    address in it."""
     n, substeps = schedule.n, schedule.substeps
     compiled_law.install()
     vector = compiled_law.law_vector(controller, voltage_limit=params.voltage_limit, substeps=substeps, nstep=n,
                                      qpos_adr=where.qpos, dof_adr=where.dof, actuator=where.actuator,
                                      chassis=where.chassis)
     assert vector is not None  # the backend is 'compiled' only where compiled_law.compiles(controller)
-    carried = (vector, reference) + (() if disturbance is None else (disturbance[:n],))
+    sensing = None if chain is None else (compiled_law.sensing_numeric(chain, motor_qpos_adr=where.motor_qpos),
+                                          len(chain.state))
+    carried = (vector, reference, None if disturbance is None else disturbance[:n], sensing)
     lawful = batch_model(params, law=carried, **options)
-    stepper = _CompiledStepper(lawful, where, substeps, log, own_model=schedule.tracker is not None)
+    stepper = _CompiledStepper(lawful, where, substeps, log, own_model=schedule.tracker is not None,
+                               sensing=chain is not None)
     ref_numeric = lawful.numeric(compiled_law.REFERENCE_NUMERIC)
     return stepper, lawful, int(lawful.numeric_adr[ref_numeric.id])
 
@@ -634,3 +687,6 @@ def _record_block(rows: dict[str, np.ndarray], C_xy: np.ndarray, b: _Block, k0: 
     rows["steer_torque"][sl] = b.torque
     rows["heading"][sl] = b.heading
     C_xy[sl] = b.C_xy
+    if len(b.alpha_measured):
+        rows["alpha_measured"][sl] = b.alpha_measured
+        rows["alpha_dot_measured"][sl] = b.alpha_dot_measured

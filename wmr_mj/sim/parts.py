@@ -21,6 +21,7 @@ from typing import Any
 from controllers import PathTracker, SteeringController
 from wmr_mj.analysis.certificate import Certificate
 from wmr_mj.errors import ParameterError
+from wmr_mj.hardware import Actuation, Sensing, Transmission
 from wmr_mj.params import C80, C80Parameters
 from wmr_mj.plant.mjcf import TIMESTEP
 from wmr_mj.sim.config import (
@@ -92,6 +93,9 @@ class RunParts:
     claim: Certificate | None
     paper_law: bool = True
     law_settings: frozenset[str] | None = None
+    sensing: Sensing = Sensing()
+    actuation: Actuation = Actuation()
+    transmission: Transmission = Transmission()
 
 
 def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
@@ -119,4 +123,5 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
                     controller_name=controller_name(config), tracker=tracker, reference=reference,
                     settle_s=settle_s, substeps=substeps, period=period, n=n, options=plant_options(config),
                     analysis=analysis, claim=claim, paper_law=paper_estimate is not None,
-                    law_settings=law_settings)
+                    law_settings=law_settings, sensing=config.sensing, actuation=config.actuation,
+                    transmission=config.transmission)
