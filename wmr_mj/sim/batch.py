@@ -414,12 +414,17 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
 
 
 def shares_one_batch(configs: Sequence[RunConfig]) -> bool:
-    """Whether ``configs`` run as one batch: no signals, no tracker, and nothing but m1 and
-    plant_overrides differs (the batch's simulations share one reference and one law)."""
-    if any(c.signals is not None or has_tracker(c) for c in configs):
+    """Whether ``configs`` run as one batch: no signals, no tracker, an ideal cart (no sensor, actuation or
+    play: the batch's loops read the state and drive the axle), and nothing but m1 and plant_overrides differs
+    (the batch's simulations share one reference and one law)."""
+    if any(c.signals is not None or has_tracker(c) or not _ideal_cart(c) for c in configs):
         return False
     shared = configs[0].replace(m1=M1_NOMINAL, plant_overrides={})
     return all(c.replace(m1=M1_NOMINAL, plant_overrides={}) == shared for c in configs[1:])
+
+
+def _ideal_cart(config: RunConfig) -> bool:
+    return config.sensing.is_ideal and config.actuation.is_ideal and config.transmission.is_ideal
 
 
 def _simulation_models(backend: str, controller: Any, plants: Sequence[C80Parameters], options: dict[str, Any],
