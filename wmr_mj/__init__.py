@@ -29,6 +29,7 @@ from wmr_mj.errors import (
     UnknownNameError,
     WmrMjError,
 )
+from wmr_mj.hardware import Actuation, Sensing, SensingChain, Transmission, sensing_preset_names
 from wmr_mj.params import C80, C80Parameters, Coefficients, parameter_names, with_params
 
 from ._version import __version__ as __version__
@@ -91,6 +92,12 @@ __all__ = [
     "certificate_for",
     "resolve_run",
     "RunParts",
+    # the cart as it is built: the steering sensor, the motor's actuation, the gear's play
+    "Sensing",
+    "SensingChain",
+    "Actuation",
+    "Transmission",
+    "sensing_preset_names",
     # what acts on the plant during a run: a steering disturbance, load changes
     "Signals",
     "Disturbance",
