@@ -325,3 +325,19 @@ def test_foxglove_reader_decodes_the_sensed_channels(sensed):
     plot = log.channel("/steering/measured")
     for k, msg in enumerate(fox["topics"]["/steering/measured"]["messages"]):
         assert msg == {name: float(plot[name][k]) for name in msg}
+
+
+def test_a_motor_side_encoder_through_the_play_verifies(tmp_path):
+    """The regenerated chain reads the motor shaft's joint (i2 times its angle) where the encoder is on the motor
+    side of a gear with play, at a 2 ms control period (two physics steps per row), with an actuator delay."""
+    config = IDEAL.replace(sensing="encoder_ticks=2000,encoder_side=motor,velocity=difference,noise=gaussian:0.0001,"
+                                   "seed=1", transmission=0.002, actuation="delay=0.002", control_period=0.002)
+    path = tmp_path / "motor.mcap"
+    result = _run(config, path)
+    log = load_log(path)
+    ver = verify(log)
+    assert ver["identical"] and ver["mj_steps"] == 6000 and ver["measured"]["rows"] == 3000
+    # the motor-side reading leaves the axle's quantised angle by more than 1 mrad somewhere: the play (half-width
+    # 2 mrad), not the noise (sd 0.1 mrad), so the chain above must have read the motor's joint
+    axle = np.rint(result.rows["alpha"] * 60 * 2000 / (2 * np.pi)) / (60 * 2000 / (2 * np.pi))
+    assert np.count_nonzero(np.abs(log.measured["alpha_measured"] - axle) > 1e-3) > 0
