@@ -19,9 +19,19 @@ topic           schema (encoding)                  messages    rate             
 /path           wmr_mj/msg/PathError               cdr         plot rate          one row: t cross_track along_track
                                                                                   heading_error (C against its path)
 /bounds         wmr_mj/msg/Bounds                  cdr         one per block      +-E_max, +-Edot_max, +-voltage limit
+/measured       wmr_mj/msg/MeasuredBlock           cdr         one per block      sensed runs only: every control step:
+                                                                                  t, alpha, alpha_dot as the law read
+                                                                                  them (replay --verify regenerates)
+/steering/      wmr_mj/msg/SteeringMeasured        cdr         plot rate          sensed runs only: one row: t alpha
+  measured                                                                        alpha_dot as the law read them
 /tf             foxglove_msgs/msg/FrameTransforms  cdr         tf rate (50 Hz)    world -> chassis -> ... -> wheels
 /scene          foxglove.SceneUpdate (jsonschema)  json        once, at t = 0     the vehicle's shapes, desired path
 ==============  =================================  ==========  =================  ==================================
+
+/signals and /steering hold the true state (alpha, alpha_dot, E, E_dot) whatever the sensing. Where the
+run has a sensor (``RunConfig.sensing`` not ideal; :attr:`wmr_mj.sim.log_header.LogHeader.sensed`), what the
+law read instead (:data:`SENSED_BLOCK_KEYS`) goes to the two channels marked ``sensed_only``
+(:func:`sensed_only`); an ideal run's log has neither, and its bytes are what they were before them.
 
 A *block* is what the runner hands the logger about once per simulated second; its rows are
 packed into one message per block channel, so that the full-rate data costs a few messages a
@@ -60,6 +70,11 @@ __all__ = [
     "STATE_TOPIC",
     "PLOT_TOPICS",
     "BOUNDS_TOPIC",
+    "MEASURED_TOPIC",
+    "MEASURED_PLOT_TOPIC",
+    "PACKED_TOPICS",
+    "SENSED_BLOCK_KEYS",
+    "sensed_only",
     "TF_TOPIC",
     "SCENE_TOPIC",
     "BLOCK_KEYS",
@@ -85,6 +100,10 @@ SIGNALS_TOPIC = "/signals"
 STATE_TOPIC = "/sim/state"
 PLOT_TOPICS = ("/steering", "/motor", "/pose", "/path")
 BOUNDS_TOPIC = "/bounds"
+MEASURED_TOPIC = "/measured"  # sensed runs only: what the law read, every control step
+MEASURED_PLOT_TOPIC = "/steering/measured"  # sensed runs only: the same at the plot rate, for Foxglove
+#: The block channels, one message per block (their chunks are CRC-checked when the log is loaded).
+PACKED_TOPICS = (SIGNALS_TOPIC, STATE_TOPIC, MEASURED_TOPIC)
 TF_TOPIC = "/tf"
 SCENE_TOPIC = "/scene"
 
@@ -96,6 +115,9 @@ BLOCK_KEYS = (
 )  # fmt: skip
 #: What the runner may add to a block: C's path errors (NaN where absent), for the /path channel.
 OPTIONAL_BLOCK_KEYS = ("path_cross_track", "path_along_track", "path_heading_error")
+#: What the runner adds to a block where the run has a sensor (wmr_mj.sim.engine.SENSED_ROW_FIELDS): alpha
+#: [rad] and alpha' [rad/s] as the law read them, (N,) each; required by a logger whose header says sensed.
+SENSED_BLOCK_KEYS = ("alpha_measured", "alpha_dot_measured")
 
 _PRIMITIVES = {
     "float64": "<f8", "float32": "<f4", "int8": "i1", "uint8": "u1", "int16": "<i2", "uint16": "<u2",
@@ -120,6 +142,11 @@ def channel_layouts() -> dict[str, Any]:
 def foxglove_schema(name: str) -> dict[str, Any]:
     """A vendored Foxglove JSON schema, e.g. ``foxglove_schema("foxglove.SceneUpdate")``."""
     return json.loads(schema_text(f"{name}.json"))
+
+
+def sensed_only(topic: str) -> bool:
+    """True for a channel written only in the log of a run with a sensor (``"sensed_only"`` in its layout)."""
+    return bool(channel_layouts()["channels"][topic].get("sensed_only", False))
 
 
 @functools.cache

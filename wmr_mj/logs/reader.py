@@ -6,6 +6,8 @@
     log = load_log("logs/run.mcap")
     s = log.signals                      # t, alpha, E, E_dot, voltage, A_pos (N, 2), ... every logged row
     st = log.state                       # t, qpos (N, nq), qvel (N, nv), ctrl (N, nu): every control step
+    ms = log.measured                    # a sensed run: t, alpha_measured, alpha_dot_measured (what the law
+                                         # read) at every control step; None for an ideal run (log.sensed)
     steer = log.channel("/steering")     # one channel's fields as arrays (+ "log_time" [ns] for per-row channels)
     log.config, log.summary, log.metadata, log.attachments, log.mjcf_xml, log.initial_state
     log.truncated                        # True when the run was killed before the footer
@@ -293,6 +295,22 @@ class RunLog:
         return out
 
     @property
+    def sensed(self) -> bool:
+        """True for the log of a run with a sensor between the plant and the law (it has /measured)."""
+        return lf.MEASURED_TOPIC in self._channels
+
+    @cached_property
+    def measured(self) -> dict[str, np.ndarray] | None:
+        """/measured of a sensed run: t [s], alpha_measured [rad], alpha_dot_measured [rad/s], what the law read
+        at every control step (whatever log_every), (N,) each, keyed as the runner's block; None for the log of
+        an ideal run, where the law read the state that /signals holds."""
+        if not self.sensed:
+            return None
+        fields = lf.channel_layouts()["channels"][lf.MEASURED_TOPIC]["fields"]
+        ch = self.channel(lf.MEASURED_TOPIC)
+        return {f["block"]: ch.get(f["name"], np.empty(0)) for f in fields}
+
+    @property
     def rows(self) -> int:
         """Number of control steps logged (rows of /sim/state)."""
         return int(self.state["t"].size)
@@ -337,7 +355,7 @@ def _load_indexed(log: RunLog, f: Any) -> None:
         log.attachments[att.name] = bytes(att.data)
         log.attachment_types[att.name] = att.media_type
     log._indexed = True
-    packed = {c.id for c in summary.channels.values() if c.topic in (lf.SIGNALS_TOPIC, lf.STATE_TOPIC)}
+    packed = {c.id for c in summary.channels.values() if c.topic in lf.PACKED_TOPICS}
     for ci in summary.chunk_indexes:  # chunks that the packed read below does not check
         if not packed & set(ci.message_index_offsets):
             f.seek(ci.chunk_start_offset + 9)  # past the record's opcode and length
@@ -458,8 +476,8 @@ def load_log(path: str | Path) -> RunLog:
             f"{', '.join(SUPPORTED_SCHEMA_VERSIONS)} (write the log again with `wmr-mj run`)"
         )
     # the full-rate channels now (their chunks' CRCs checked), so that a bad file is reported here
-    packed = [t for t in (lf.SIGNALS_TOPIC, lf.STATE_TOPIC) if t in log._channels and t not in log._messages]
+    packed = [t for t in lf.PACKED_TOPICS if t in log._channels and t not in log._messages]
     if packed:
         log._read_indexed(packed, validate_crcs=True)
-    _ = log.signals, log.state
+    _ = log.signals, log.state, log.measured
     return log

@@ -4,7 +4,9 @@
   analytic bounds E_max, Edot_max of (4.21)-(4.23) when the log carries them (the run's summary,
   else its config), with the run's status; a JSON-ready dict.
 - :func:`verify`: rebuild the model from the attached MJCF, set the attached initial state,
-  re-apply the logged ctrl and compare qpos and qvel at every control step, bit for bit.
+  re-apply the logged ctrl and compare qpos and qvel at every control step, bit for bit; where the
+  run had a sensor, regenerate what the law read (the sensing chain of the config in the header, its
+  noise from its seed) from the reproduced state and compare it with /measured, bit for bit.
 - :func:`path_of_log`: C's Cartesian errors (:mod:`wmr_mj.analysis.path_error`) against the desired
   path of C, rebuilt from the log's configuration as the run built it; :func:`summarize` adds
   their sup, RMS and final values under ``path_errors``.
@@ -38,7 +40,8 @@ from wmr_mj.logs.reader import RunLog
 if TYPE_CHECKING:
     from matplotlib.typing import RcKeyType
 
-__all__ = ["summarize", "verify", "plot", "format_summary", "format_verify", "path_of_log", "LogPath"]
+__all__ = ["summarize", "verify", "plot", "format_summary", "format_verify", "path_of_log", "LogPath",
+           "hardware_labels"]
 
 
 def _number(value: Any) -> float | None:
@@ -134,6 +137,25 @@ def path_of_log(log: RunLog, settle_s: float | None = None) -> LogPath:
                    verdict=path_verdict(errors, bound))
 
 
+def hardware_labels(config: dict[str, Any] | None) -> dict[str, str]:
+    """The cart a logged run simulated, as one short line per part: ``{"sensing", "actuation", "gear"}``, each
+    the ``label()`` of :class:`wmr_mj.hardware.Sensing`, :class:`~wmr_mj.hardware.Actuation` and
+    :class:`~wmr_mj.hardware.Transmission` (the gear's backlash) read from the config in the header; "ideal"
+    where it names none (``RunConfig.as_dict`` leaves an ideal part out), "not read (...)" where wmr_mj does
+    not accept what it names. Never raises."""
+    from wmr_mj.hardware import Actuation, Sensing, Transmission
+
+    out = {}
+    for key, name, cls in (("sensing", "sensing", Sensing), ("actuation", "actuation", Actuation),
+                           ("gear", "transmission", Transmission)):
+        spec = (config or {}).get(name)
+        try:
+            out[key] = cls.from_spec(spec).label()
+        except WmrMjError as exc:
+            out[key] = f"not read ({exc})"
+    return out
+
+
 def summarize(log: RunLog, settle_s: float | None = None) -> dict[str, Any]:
     """The replay summary of a loaded log (JSON-ready). ``settle_s`` [s] defaults to the log's."""
     sig = log.signals
@@ -157,6 +179,8 @@ def summarize(log: RunLog, settle_s: float | None = None) -> dict[str, Any]:
         "duration_s": float(t[-1]) if t.size else None,
         "seed": log.seed,
         "config": log.config,
+        "hardware": hardware_labels(log.config),
+        "sensed": log.sensed,
     }
     if log.truncated:
         out["truncated_reason"] = log.truncated_reason
@@ -275,7 +299,10 @@ def verify(log: RunLog) -> dict[str, Any]:
     same_v = (sim_v == qvel) | (np.isnan(sim_v) & np.isnan(qvel))
     row_ok = same_q.all(axis=1) & same_v.all(axis=1)
     out: dict[str, Any] = {"rows": n, "mj_steps": n * sub, "identical": bool(row_ok.all())}
-    if not out["identical"]:
+    measured = _verify_measured(log, m, sim_q, sim_v)
+    if measured is not None:  # a sensed run: what the law read is reproduced too, or the log is not
+        out["measured"] = measured
+    if not row_ok.all():
         with np.errstate(invalid="ignore"):
             dev = np.maximum(
                 np.where(same_q, 0.0, np.nan_to_num(np.abs(sim_q - qpos), nan=np.inf)).max(axis=1, initial=0.0),
@@ -289,6 +316,76 @@ def verify(log: RunLog) -> dict[str, Any]:
             first_mismatch_t=float(t[first]), first_mismatch_row=first,
             mismatched_rows=int(np.count_nonzero(~row_ok)),
         )  # fmt: skip
+    if measured is not None:
+        out["state_identical"] = out["identical"]
+        out["identical"] = bool(out["identical"] and measured["identical"])
+    return out
+
+
+def _bitwise_mismatch(again: np.ndarray, logged: np.ndarray) -> np.ndarray:
+    """True where two float arrays differ in value (NaN equals NaN; +0.0 equals -0.0, as ``==`` says)."""
+    return ~((again == logged) | (np.isnan(again) & np.isnan(logged)))
+
+
+def _verify_measured(log: RunLog, m: Any, qpos: np.ndarray, qvel: np.ndarray) -> dict[str, Any] | None:
+    """What the law read, regenerated and compared with the log's /measured; None for an ideal run.
+
+    The sensing chain (:class:`wmr_mj.hardware.SensingChain`) is built from the config in the header (its
+    noise drawn again from its seed, over the run's control steps) and stepped over the reproduced true state,
+    as the runner steps it: alpha and alpha' on the axle, the motor shaft's angle i2 times its joint's.
+
+    Returns:
+        {"identical": bool, "rows": n, "sensing": its label} and where it is not identical
+        "reason" (one line), and for differing values "first_mismatch_t" [s], "max_deviation",
+        "max_deviation_in" ("alpha_measured" rad or "alpha_dot_measured" rad/s), "mismatched_rows".
+
+    Raises:
+        LogError: a sensing spec in the header that wmr_mj does not accept.
+    """
+    from wmr_mj.hardware import Sensing, SensingChain
+    from wmr_mj.plant.mjcf import steering_joint_addresses
+
+    spec = (log.config or {}).get("sensing")
+    if spec is None and not log.sensed:
+        return None
+    n = len(qpos)
+    if spec is None:
+        return {"identical": False, "rows": n, "sensing": "ideal",
+                "reason": "the log has a /measured channel but its configuration names no sensing"}
+    try:
+        sensing = Sensing.from_spec(spec)
+    except WmrMjError as exc:
+        raise LogError(f"{log.path}: the sensing in the log's configuration is not accepted ({exc})") from None
+    out: dict[str, Any] = {"identical": False, "rows": n, "sensing": sensing.label()}
+    logged = log.measured
+    if logged is None:
+        return {**out, "reason": "the configuration names a sensor but the log has no /measured channel"}
+    if len(logged["t"]) != n:
+        return {**out, "reason": f"/measured has {len(logged['t'])} rows; /sim/state has {n}"}
+    period = log.timestep * log.control_substeps
+    duration = _number((log.config or {}).get("duration"))
+    steps = n if duration is None else max(n, int(round(duration / period)))  # the noise is drawn for the run
+    try:
+        chain = SensingChain(sensing, control_period=period, n_steps=max(steps, 1),
+                             gear_ratio=float(log.parameters["i2"]))
+    except (WmrMjError, KeyError, TypeError, ValueError) as exc:
+        raise LogError(f"{log.path}: its sensing cannot be regenerated ({type(exc).__name__}: {exc})") from None
+    where = steering_joint_addresses(m)
+    i2 = float(log.parameters["i2"])
+    again = np.array([chain.step(k, float(qpos[k, where.axle_qpos]), float(qvel[k, where.axle_dof]),
+                                 i2 * float(qpos[k, where.motor_qpos])) for k in range(n)]).reshape(n, 2)
+    names = ("alpha_measured", "alpha_dot_measured")
+    bad = np.stack([_bitwise_mismatch(again[:, j], np.asarray(logged[k], float)) for j, k in enumerate(names)], 1)
+    out["identical"] = not bad.any()
+    if bad.any():
+        rows = np.flatnonzero(bad.any(axis=1))
+        with np.errstate(invalid="ignore"):
+            dev = np.where(bad, np.nan_to_num(np.abs(again - np.stack([logged[k] for k in names], 1)), nan=np.inf),
+                           0.0)
+        worst = np.unravel_index(int(np.argmax(dev)), dev.shape)
+        out.update(reason=f"{rows.size} of {n} rows differ", first_mismatch_t=float(logged["t"][rows[0]]),
+                   max_deviation=float(dev[worst]), max_deviation_in=names[worst[1]],
+                   mismatched_rows=int(rows.size))
     return out
 
 
@@ -341,6 +438,20 @@ def verify_controller(log: RunLog) -> dict[str, Any]:
         out["first_mismatch_t"] = float(np.asarray(st["t"])[min(k, n - 1)])
         out["reason"] = (f"the re-run stopped after {len(again)} of {n} control steps" if len(again) < n else
                          f"{bad.size} of {n} voltages differ")
+    elif log.measured is not None:  # a sensed run: the re-run's law read what the log says it read
+        differs = np.zeros(n, bool)
+        for key, logged_k in log.measured.items():
+            if key == "t":
+                continue
+            again_k = np.asarray(result.rows.get(key, np.full(n, np.inf)))[:n]
+            if len(logged_k) != n or len(again_k) != n:
+                differs[:] = True
+                continue
+            differs |= _bitwise_mismatch(again_k, np.asarray(logged_k))
+        if differs.any():
+            out.update(identical=False, first_mismatch_t=float(np.asarray(st["t"])[int(np.argmax(differs))]),
+                       reason=f"the voltages agree, but at {int(differs.sum())} of {n} control steps the re-run's law "
+                              "read other values than /measured")
     return out
 
 
@@ -388,6 +499,18 @@ def _path_panels(e: Any, f: Any, lp: LogPath, settle: float | None) -> None:
     f.legend(loc="best", fontsize=7, frameon=False)
 
 
+def _measured_error_line(ax: Any, log: RunLog, sig: dict[str, np.ndarray]) -> None:
+    """Where the run was sensed: the error as the law read it, alpha0 - alpha_measured [rad], beside the true E,
+    at the /signals rows (every log_every-th control step of /measured); nothing for an ideal run."""
+    ms = log.measured
+    if ms is None or not len(ms["t"]):
+        return
+    alpha_m = np.asarray(ms["alpha_measured"])[::max(1, log.log_every)]
+    k = min(len(alpha_m), len(sig["t"]))
+    ax.plot(sig["t"][:k], sig["alpha0"][:k] - alpha_m[:k], lw=0.6, color="C5", alpha=0.8,
+            label="measured (what the law read)")
+
+
 def plot(log: RunLog, path: str | os.PathLike, rep: dict[str, Any]) -> Path:
     """Write the replay figure (PNG) for ``rep`` = :func:`summarize` of ``log``; returns the path."""
     fig = replay_figure(log, rep)
@@ -418,7 +541,8 @@ def replay_figure(log: RunLog, rep: dict[str, Any]):
         fig = Figure(figsize=(15, 6.8), constrained_layout=True)
         ax = fig.subplots(2, 3)
         a = ax[0, 0]
-        a.plot(t, E, lw=0.9, color="C0", label="E = alpha0 - alpha")
+        a.plot(t, E, lw=0.9, color="C0", label="E = alpha0 - alpha" + (" (true)" if log.sensed else ""))
+        _measured_error_line(a, log, sig)
         cert = (log.summary or {}).get("certificate") or {}
         _band(a, cert.get("E_max"), "-", "C2", "certificate ±E_max", "rad")
         _band(a, e_max, "--", "C3", "paper's claim ±E_max", "rad")
@@ -485,7 +609,9 @@ def replay_figure(log: RunLog, rep: dict[str, Any]):
             inside = cert.get("inside")
             verdict = "" if inside is None else f"{'inside' if inside else 'outside'} {claim} claim"
         extra = [v for v in (rep.get("verdict"), verdict, "TRUNCATED" if log.truncated else "") if v]
-        fig.suptitle(f"{Path(str(log.path)).name}: " + ", ".join(bits + extra), fontsize=10)
+        hw = rep.get("hardware") or hardware_labels(log.config)
+        fig.suptitle(f"{Path(str(log.path)).name}: " + ", ".join(bits + extra) + "\n"
+                     + f"sensing: {hw['sensing']} | actuation: {hw['actuation']} | gear: {hw['gear']}", fontsize=10)
     return fig
 
 
@@ -519,6 +645,10 @@ def format_summary(rep: dict[str, Any]) -> str:
     nested = [k for k, v in cfg.items() if isinstance(v, (dict, list))]
     if nested:
         lines.append("           (+ " + ", ".join(nested) + ": see --json)")
+    hw = rep.get("hardware")
+    if hw:
+        lines.append(f"cart       sensing: {hw['sensing']} | actuation: {hw['actuation']} | gear: {hw['gear']}"
+                     + ("; the law read /measured, E is judged on the true state" if rep.get("sensed") else ""))
     settle = rep["settle_s"]
     after = f" (t >= {settle:g} s: " if settle is not None else None
     lines.append(f"sup|E|     {_fmt(rep['sup_abs_E'], 'rad')}"
@@ -584,10 +714,21 @@ def format_summary(rep: dict[str, Any]) -> str:
 
 
 def format_verify(ver: dict[str, Any]) -> str:
-    """One line for :func:`verify`'s dict."""
-    if ver["identical"]:
-        return (f"verify     bit-identical: qpos and qvel reproduced exactly at all {ver['rows']} control steps "
+    """The text for :func:`verify`'s dict: one line, and a second for a sensed run's /measured."""
+    if ver.get("state_identical", ver["identical"]):
+        text = (f"verify     bit-identical: qpos and qvel reproduced exactly at all {ver['rows']} control steps "
                 f"({ver['mj_steps']} mj_step calls)")
-    return (f"verify     MISMATCH: largest deviation {ver['max_deviation']:.3g} in {ver['max_deviation_in']} at "
-            f"t = {ver['max_deviation_t']:.6g} s (row {ver['max_deviation_row']}); first at "
-            f"t = {ver['first_mismatch_t']:.6g} s; {ver['mismatched_rows']} of {ver['rows']} rows differ")
+    else:
+        text = (f"verify     MISMATCH: largest deviation {ver['max_deviation']:.3g} in {ver['max_deviation_in']} at "
+                f"t = {ver['max_deviation_t']:.6g} s (row {ver['max_deviation_row']}); first at "
+                f"t = {ver['first_mismatch_t']:.6g} s; {ver['mismatched_rows']} of {ver['rows']} rows differ")
+    ms = ver.get("measured")
+    if ms is None:
+        return text
+    if ms["identical"]:
+        return text + (f"\n           bit-identical: what the law read (/measured: alpha, alpha') regenerated "
+                       f"exactly at all {ms['rows']} control steps by the sensing in the header ({ms['sensing']})")
+    where = (f": largest deviation {ms['max_deviation']:.3g} in {ms['max_deviation_in']}, first at "
+             f"t = {ms['first_mismatch_t']:.6g} s" if "max_deviation" in ms else "")
+    return text + (f"\n           MISMATCH in what the law read (/measured, sensing {ms['sensing']}): "
+                   f"{ms['reason']}{where}")

@@ -8,6 +8,10 @@ becomes, through the official writer, two chunks that are flushed to the file at
 2. what Foxglove draws: one message per row at ``plot_rate_hz`` on ``/steering``, ``/motor``,
    ``/pose`` (Plot panel), ``/tf`` at ``tf_rate_hz`` (3D panel) and ``/bounds``.
 
+Where the header says the run is sensed (``LogHeader.sensed``), each block also carries what the law read
+(``logformat.SENSED_BLOCK_KEYS``): it goes to ``/measured`` (every control step, in the first chunk) and
+``/steering/measured`` (plot rate, in the second); an ideal run's log has neither channel.
+
 ``close`` adds the summary as a metadata record, then the writer's index and footer. Channels
 and encodings: :mod:`wmr_mj.logs.logformat`; frames and scene: :mod:`wmr_mj.logs.foxglove`; reading:
 :func:`wmr_mj.logs.reader.load_log`.
@@ -246,6 +250,8 @@ class RunLogger:
         initial_state, timestep, control_substeps = header.initial_state, header.timestep, header.control_substeps
         reference_path, bounds, model = header.reference_path, header.bounds, header.model
         self._path_errors = header.path_errors
+        self._sensed = bool(header.sensed)  # /measured and /steering/measured, and their block keys
+        self._keys = (*lf.BLOCK_KEYS, *lf.SENSED_BLOCK_KEYS) if self._sensed else lf.BLOCK_KEYS
         log_every, plot_rate_hz, tf_rate_hz = options.log_every, options.plot_rate_hz, options.tf_rate_hz
         flush_period_s, compression = options.flush_period_s, options.compression
         fsync, background = options.fsync, options.background
@@ -333,6 +339,8 @@ class RunLogger:
         w = self._w
         self._cid: dict[str, int] = {}
         for topic, spec in lf.channel_layouts()["channels"].items():
+            if lf.sensed_only(topic) and not self._sensed:
+                continue  # registered last, so that an ideal run's channel ids are what they were
             sid = w.register_schema(spec["schema"], "ros2msg", lf.ros2msg_text(topic).encode())
             units = {f["name"]: f.get("unit", "") for f in spec["fields"]}
             self._cid[topic] = w.register_channel(topic, "cdr", sid, {"units": json.dumps(units)})
@@ -408,16 +416,17 @@ class RunLogger:
     def _write_block(self, block: Mapping[str, np.ndarray]) -> None:
         if self._closed:
             raise LogError(f"{self.path}: write_block after close")
-        missing = [k for k in lf.BLOCK_KEYS if k not in block]
+        missing = [k for k in self._keys if k not in block]
         if missing:
-            raise ParameterError(f"block lacks {', '.join(missing)}; a block has {', '.join(lf.BLOCK_KEYS)}")
+            raise ParameterError(f"block lacks {', '.join(missing)}; a block has {', '.join(self._keys)}"
+                                 + (" (the header says the run is sensed)" if self._sensed else ""))
         t = np.asarray(block["t"], np.float64).ravel()
         n = t.size
         if n == 0:
             return
         shapes = {"A_pos": (n, 2), "C_pos": (n, 2), "qpos": (n, self.nq), "qvel": (n, self.nv), "ctrl": (n, self.nu)}
         clean: dict[str, np.ndarray] = {}
-        for k in lf.BLOCK_KEYS:
+        for k in self._keys:
             a = np.asarray(block[k], np.float64)
             want = shapes.get(k, (n,))
             if a.shape != want:
@@ -439,7 +448,7 @@ class RunLogger:
     def _take_pending(self) -> dict[str, np.ndarray]:
         self._taken_rows += self._pending_rows
         blocks, self._pending, self._pending_rows = self._pending, [], 0
-        keys = (*lf.BLOCK_KEYS, *lf.OPTIONAL_BLOCK_KEYS)
+        keys = (*self._keys, *lf.OPTIONAL_BLOCK_KEYS)
         return blocks[0] if len(blocks) == 1 else {k: np.concatenate([b[k] for b in blocks]) for k in keys}
 
     def flush(self) -> None:
@@ -494,11 +503,15 @@ class RunLogger:
             fields = lf.channel_layouts()["channels"][lf.SIGNALS_TOPIC]["fields"]
             sig = {f["name"]: b[f["block"]][sel] for f in fields}
             self._add(lf.SIGNALS_TOPIC, int(lt[sel[0]]), lf.encode_block(lf.SIGNALS_TOPIC, sig))
+        if self._sensed:  # what the law read, at every control step (replay --verify compares all of them)
+            fields = lf.channel_layouts()["channels"][lf.MEASURED_TOPIC]["fields"]
+            measured = {f["name"]: b[f["block"]] for f in fields}
+            self._add(lf.MEASURED_TOPIC, int(lt[0]), lf.encode_block(lf.MEASURED_TOPIC, measured))
         self._w.flush()
         # 2. what Foxglove draws, one message per row
         plot = np.flatnonzero(rows % self.plot_every == 0)
         tf = np.flatnonzero(rows % self.tf_every == 0)
-        for topic in lf.PLOT_TOPICS:
+        for topic in (*lf.PLOT_TOPICS, *((lf.MEASURED_PLOT_TOPIC,) if self._sensed else ())):
             sel = tf if lf.channel_layouts()["channels"][topic]["rate"] == "tf" else plot
             self._add_many(topic, lt[sel], lf.encode_rows(topic, b, sel))
         keep, payloads = self._tf.encode(lt[tf], b["qpos"][tf])

@@ -399,7 +399,7 @@ def run_parts(parts: RunParts, *, logger_factory: Callable[..., Any] | None = No
             bounds=({"E_max": certificate.E_max, "Edot_max": certificate.Edot_max} if certificate is not None
                     else {"E_max": math.inf, "Edot_max": math.inf}),
             reference_path=np.asarray(reference.C_xy)[::max(1, len(reference.C_xy) // 2000)],
-            path_errors=_PathRows(reference, period)))
+            path_errors=_PathRows(reference, period), sensed=not config.sensing.is_ideal))
 
     disturbance, loads = _signal_inputs(config, params, options, n, period)
     on_block = None if logger is None else logger.write_block

@@ -45,6 +45,10 @@ class LogHeader:
             C_pos, heading and t, every ``every``-th control step; called once per written chunk of
             rows, in order (it keeps the projection's continuity), on the writer's thread when it
             has one; None: the rows' own columns (NaN where the runner gave none).
+        sensed: True where the run has a sensor between the plant and the law (``RunConfig.sensing`` not
+            ideal): its blocks then carry alpha_measured [rad] and alpha_dot_measured [rad/s], what the law
+            read, and the log gains the channels /measured and /steering/measured; False (an ideal run) writes
+            neither.
     """
 
     mjcf_xml: str
@@ -57,3 +61,4 @@ class LogHeader:
     bounds: Mapping[str, float] | None = None  # E_max [rad], Edot_max [rad/s]
     model: Any = None  # mujoco.MjModel compiled from mjcf_xml, or None
     path_errors: Any = None  # Callable[[Mapping[str, np.ndarray], int], Mapping[str, np.ndarray]] | None
+    sensed: bool = False  # blocks carry what the law read (engine.SENSED_ROW_FIELDS)
