@@ -39,7 +39,8 @@ CASES = (
 def main() -> None:
     base = wm.RunConfig(**wm.CERTIFIED.config_changes(), m1=750.0, duration=DURATION_S)
     ideal_bound = None
-    print("| cart | sup\\|E\\| [rad] | E_max [rad] | sup\\|E\\| / ideal E_max | verdict | not met | RMS u [V] | TV u [V/s] |")
+    print("| cart | sup\\|E\\| [rad] | E_max [rad] | sup\\|E\\| / ideal E_max | verdict | not met | RMS u [V] "
+          "| TV u [V/s] |")
     print("|---|---|---|---|---|---|---|---|")
     for name, changes in CASES:
         result = wm.run_closed_loop(base.replace(**changes), progress=False)
