@@ -104,7 +104,8 @@ def test_a_sensing_delay_off_a_coarser_control_period_is_refused(capsys):
 
 
 @pytest.mark.parametrize("argv, words", [
-    (["sweep", "--n", "2", "--range", "sensing.colour=0:1"], ["sensing.colour", "sensing.delay", "transmission.backlash"]),
+    (["sweep", "--n", "2", "--range", "sensing.colour=0:1"],
+     ["sensing.colour", "sensing.delay", "transmission.backlash"]),
     (["sweep", "--n", "2", "--range", "sensing.delay=-0.01:0"], ["sensing.delay", "0 <= LO <= HI"]),
     (["falsify", "--budget", "10", "--range", "transmission.play=0:1"], ["transmission.play",
                                                                         "transmission.backlash"]),

@@ -180,25 +180,21 @@ def _portfolio_phases_text(spec, first, population: int) -> str:
     return text
 
 
-def run(args: argparse.Namespace) -> int:
-    import time
+def _base_and_box(args: argparse.Namespace):
+    """(base RunConfig, search box) of falsify's options. The signals', the path's and the cart's axes are
+    searched, not certified over: the certificate's box is the plant's (each run's claim covers its own cart).
 
-    from wmr_mj._util.files import check_output_path, write_json_atomic, write_text_atomic
-    from wmr_mj._util.progress import counter_callback, progress_bar
-    from wmr_mj.cli._common import box_ranges_from_args, parse_range, print_json
+    Raises:
+        ParameterError: a bad --path-knots or range (one line).
+    """
+    from wmr_mj.cli._common import box_ranges_from_args, parse_range
     from wmr_mj.cli.run import config_from_args
     from wmr_mj.errors import ParameterError
-    from wmr_mj.logs.writer import run_logged
-    from wmr_mj.report.plots import falsify_history, save_figure
-    from wmr_mj.sim.falsify import OBJECTIVE_LABELS, FalsifySpec, check_runnable, falsify, worst_config
     from wmr_mj.sim.search_space import hardware_axis, path_axis, signal_axis
 
-    objective = _objective(args)
-    args.uncertainty = args.uncertainty or "full"
-    # the signals', the path's and the cart's axes are searched, not certified over: the certificate's box is the
-    # plant's (each run's claim covers its own cart)
     parsed = [(item, parse_range(item)) for item in args.range or []]
-    searched = dict(span for _, span in parsed if signal_axis(span[0]) or path_axis(span[0]) or hardware_axis(span[0]))
+    searched = dict(span for _, span in parsed
+                    if signal_axis(span[0]) or path_axis(span[0]) or hardware_axis(span[0]))
     args.range = [item for item, (name, _) in parsed if name not in searched]
     if args.path_knots < 0:
         raise ParameterError(f"--path-knots {args.path_knots} is not accepted: a number of knots >= 0")
@@ -211,6 +207,22 @@ def run(args: argparse.Namespace) -> int:
         space = KnotSpace(args.path_knots, hold_range=(0.0, 3.0))
         searched = {**space.ranges(base.reference_bounds), **searched}
     box = {"m1": tuple(args.m1_range), **box_ranges_from_args(args), **searched}
+    return base, box
+
+
+def run(args: argparse.Namespace) -> int:
+    import time
+
+    from wmr_mj._util.files import check_output_path, write_json_atomic, write_text_atomic
+    from wmr_mj._util.progress import counter_callback, progress_bar
+    from wmr_mj.cli._common import print_json
+    from wmr_mj.logs.writer import run_logged
+    from wmr_mj.report.plots import falsify_history, save_figure
+    from wmr_mj.sim.falsify import OBJECTIVE_LABELS, FalsifySpec, check_runnable, falsify, worst_config
+
+    objective = _objective(args)
+    args.uncertainty = args.uncertainty or "full"
+    base, box = _base_and_box(args)
     spec = FalsifySpec(base=base, box=box, objective=objective, budget=args.budget, seed=args.seed,
                        population=args.population, method=args.method, requirement=args.require)
     check_runnable(base)  # a duration too short for the path: one line, before any output or search

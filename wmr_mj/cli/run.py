@@ -103,13 +103,14 @@ def add_hardware_options(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("the cart as it is built (wmr_mj/hardware; default ideal: the exact alpha and alpha', "
                              "no delay, no inductance, no play); shown in every summary and JSON where not ideal")
     g.add_argument("--sensing", metavar="KEY=VALUE,...|PRESET|FILE", default=None,
-                   help=f"the steering sensor between the plant and the law: a preset ({', '.join(sensing_preset_names())}), "
-                        f"KEY=VALUE pairs ({', '.join(SENSING_SPEC_KEYS)}, preset; e.g. encoder_ticks=4096,"
-                        "velocity=difference,delay=0.005,noise=uniform:0.0005,seed=3; the delay a whole number of "
+                   help="the steering sensor between the plant and the law: a preset "
+                        f"({', '.join(sensing_preset_names())}), KEY=VALUE pairs ({', '.join(SENSING_SPEC_KEYS)}, "
+                        "preset; e.g. encoder_ticks=4096,velocity=difference,delay=0.005,noise=uniform:0.0005,seed=3; "
+                        "the delay a whole number of "
                         "control periods) or a .json/.toml file of the same")
     g.add_argument("--actuation", metavar="KEY=VALUE,...|FILE", default=None,
-                   help="the motor's actuation: delay (s, whole 1 ms physics steps), inductance (H), current_limit (A), "
-                        "e.g. delay=0.002,inductance=0.0005,current_limit=20, or a .json/.toml file")
+                   help="the motor's actuation: delay (s, whole 1 ms physics steps), inductance (H), current_limit "
+                        "(A), e.g. delay=0.002,inductance=0.0005,current_limit=20, or a .json/.toml file")
     g.add_argument("--backlash", metavar="RAD", default=None,
                    help="the gear's play: half-width b >= 0, rad at the steering axis (e.g. 0.002)")
 

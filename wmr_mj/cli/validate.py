@@ -73,10 +73,9 @@ def run(args: argparse.Namespace) -> int:
     from wmr_mj._util.files import check_output_path
     from wmr_mj.cli._common import print_json
     from wmr_mj.cli.figures import default_folder
+    from wmr_mj.cli.run import hardware_from_args
     from wmr_mj.report.text import format_headline
     from wmr_mj.report.validate import ValidateSettings, run_validate, write_pointer
-
-    from wmr_mj.cli.run import hardware_from_args
 
     t0 = time.perf_counter()
     settings = ValidateSettings(n=args.n, seed=args.seed, sampling=args.sampling, duration=args.duration,
