@@ -30,8 +30,10 @@ from dataclasses import dataclass
 from typing import Any
 
 from wmr_mj.analysis.certificate import VERDICTS, Certificate, CertificateJudgement, judge
+from wmr_mj.analysis.measurement import DELAY_FIXED_POINT, MEASUREMENT_COVERED
 
 __all__ = [
+    "CART_ASSUMPTIONS",
     "VERDICTS",
     "PASS",
     "NO_CLAIM",
@@ -218,15 +220,23 @@ def certified_outside_banner(where: str = "") -> str:
             "This is a bug or a modelling gap: report it. !!!")
 
 
+#: The assumptions about the cart (sensing, actuation, play) whose value and limit say little alone (1 vs 0:
+#: not covered): an unmet one carries its note (why: what has no derived bound) wherever it is listed.
+CART_ASSUMPTIONS = (MEASUREMENT_COVERED, DELAY_FIXED_POINT)
+
+
 def unmet_assumptions(certificate: Mapping[str, Any] | None) -> list[dict[str, Any]]:
     """The assumptions a judged certificate does not meet, each as {name, value, limit} (value and limit
-    in the assumption's own units; None where not finite), in the certificate's order.
+    in the assumption's own units; None where not finite), in the certificate's order; an assumption about
+    the cart (:data:`CART_ASSUMPTIONS`) also with its ``note`` (why it is not met), the others without (the
+    JSON of a run on an ideal cart keeps its keys).
 
     Args:
         certificate: a certificate's JSON (``Certificate.as_dict()``, a run summary's ``certificate``);
             None or one without ``assumptions`` (a slim summary, a law without a claim): [].
     """
-    return [{"name": str(a.get("name")), "value": a.get("value"), "limit": a.get("limit")}
+    return [{"name": str(a.get("name")), "value": a.get("value"), "limit": a.get("limit"),
+             **({"note": a.get("note")} if a.get("name") in CART_ASSUMPTIONS and a.get("note") else {})}
             for a in (certificate or {}).get("assumptions") or [] if not a.get("met")]
 
 
@@ -240,14 +250,20 @@ def count_unmet(per_run: Iterable[Iterable[Mapping[str, Any]]]) -> list[dict[str
     seen: dict[str, dict[str, Any]] = {}
     for unmet in per_run:
         for a in unmet:
-            seen.setdefault(str(a["name"]), {"name": str(a["name"]), "value": a.get("value"),
-                                             "limit": a.get("limit"), "runs": 0})["runs"] += 1
+            first = {"name": str(a["name"]), "value": a.get("value"), "limit": a.get("limit"),
+                     **({"note": a["note"]} if a.get("note") and a["name"] in CART_ASSUMPTIONS else {}), "runs": 0}
+            seen.setdefault(str(a["name"]), first)["runs"] += 1
     return list(seen.values())
 
 
 def format_unmet(unmet: Iterable[Mapping[str, Any]]) -> str:
-    """'name (value vs limit); ...' of unmet assumptions ({name, value, limit}: :func:`unmet_assumptions`)."""
-    return "; ".join(f"{a['name']} ({_num(a.get('value'), '.4g')} vs {_num(a.get('limit'), '.4g')})" for a in unmet)
+    """'name (value vs limit); ...' of unmet assumptions ({name, value, limit}: :func:`unmet_assumptions`); an
+    assumption about the cart (:data:`CART_ASSUMPTIONS`) with its note, 'name (value vs limit: note)'."""
+    def why(a: Mapping[str, Any]) -> str:
+        return f": {a['note']}" if a.get("note") and a.get("name") in CART_ASSUMPTIONS else ""
+
+    return "; ".join(f"{a['name']} ({_num(a.get('value'), '.4g')} vs {_num(a.get('limit'), '.4g')}{why(a)})"
+                     for a in unmet)
 
 
 def format_verdict(summary: Mapping[str, Any]) -> list[str]:

@@ -102,14 +102,29 @@ def parse_range(item: str) -> tuple[str, tuple[float, float]]:
 def box_ranges_from_args(args: argparse.Namespace) -> dict[str, tuple[float, float]]:
     """The ranged plant parameters besides m1 (whose range is --m1-range): those of the
     --uncertainty box (``wmr_mj.params.uncertainty_ranges``; 'm1' when not given), then each
-    --range NAME=LO:HI, which adds a parameter or replaces its range."""
+    --range NAME=LO:HI, which adds a parameter or replaces its range. The cart's axes
+    (sensing.*, actuation.*, transmission.*: :func:`hardware_ranges_from_args`) are drawn or
+    searched, never part of the certificate's plant box: they are left out here."""
     from wmr_mj.errors import ParameterError
     from wmr_mj.params import uncertainty_ranges
+    from wmr_mj.sim.search_space import hardware_axis
 
     ranges = {k: v for k, v in uncertainty_ranges(getattr(args, "uncertainty", None) or "m1").items() if k != "m1"}
     for item in getattr(args, "range", None) or []:
         name, span = parse_range(item)
+        if hardware_axis(name):
+            continue
         if name == "m1":
             raise ParameterError("give m1's range with --m1-range LO HI, not --range m1=...")
         ranges[name] = span
     return ranges
+
+
+def hardware_ranges_from_args(args: argparse.Namespace) -> dict[str, tuple[float, float]]:
+    """The cart's axes among the --range NAME=LO:HI items (``sensing.delay``, ``sensing.encoder_ticks``, ...:
+    :data:`wmr_mj.sim.search_space.HARDWARE_AXES`), in the order given; each is checked where the sweep
+    or the search is built."""
+    from wmr_mj.sim.search_space import hardware_axis
+
+    spans = (parse_range(item) for item in getattr(args, "range", None) or [])
+    return {name: span for name, span in spans if hardware_axis(name)}

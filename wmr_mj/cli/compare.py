@@ -11,6 +11,11 @@ non-holonomic model); ``certified`` names the certified design. Example::
 
     wmr-mj compare paper certified certified,correction=true sliding-mode adaptive-computed-torque \\
         sliding-mode,tracker=pure-pursuit --scenarios 'circle/*' --budget 32
+
+The cart (``--sensing``, ``--actuation``, ``--backlash``, as for ``wmr-mj run``) applies to every design: to
+each scenario's run and to the adversary's. A scenario that names its own sensing, actuation or backlash
+(the suite's hardware scenarios) runs with its own: the suite's scenario is the condition compared, the
+option the cart of every other run. An option overrides a design's own ``,sensing=PRESET`` setting.
 """
 
 from __future__ import annotations
@@ -44,7 +49,20 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                    help="progress bar (default: only on a terminal)")
+    from wmr_mj.cli.run import add_hardware_options
+
+    add_hardware_options(p)  # every design's cart: its scenarios (but one that names its own) and its adversary
     p.set_defaults(func=run)
+
+
+def _cart_options(args: argparse.Namespace) -> dict:
+    """The parts of the cart that --sensing, --actuation, --backlash give (each overrides a design's own
+    ``,sensing=...`` setting; a part not given stays the design's)."""
+    from wmr_mj.cli.run import hardware_from_args
+
+    parts = hardware_from_args(args)
+    given = {"sensing": args.sensing, "actuation": args.actuation, "transmission": args.backlash}
+    return {name: part for name, part in parts.items() if given[name] is not None}
 
 
 def run(args: argparse.Namespace) -> int:
@@ -63,7 +81,8 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError(f"--budget {args.budget} is not accepted: a number of runs >= 0")
     suite = load_suite(args.suite)
     suite.select(args.scenarios or [])  # an unknown scenario: one line, before any run
-    designs = [design_from_token(t, suite) for t in args.designs]
+    cart = _cart_options(args)
+    designs = [design_from_token(t, suite, cart=cart) for t in args.designs]
     labels = [d.label for d in designs]
     if len(set(labels)) != len(labels):
         twice = sorted({x for x in labels if labels.count(x) > 1})

@@ -26,7 +26,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--range", action="append", metavar="NAME=LO:HI",
                    help="add a plant parameter to the box or replace its range (repeatable); with --disturbance "
                         "or --load, also their parameters: disturbance.amplitude, disturbance.t1, ..., load0.m1, "
-                        "load0.t, ..., d_max (a ranged amplitude without --d-max declares the box's largest)")
+                        "load0.t, ..., d_max (a ranged amplitude without --d-max declares the box's largest); "
+                        "and the cart's axes, searched but not in the certificate's box (each run's claim covers its "
+                        "own cart): sensing.delay (whole control periods), sensing.encoder_ticks (whole ticks), "
+                        "sensing.encoder_bits (2**round(bits) ticks), sensing.noise_alpha, "
+                        "sensing.velocity_noise_alpha_dot, sensing.filter_tau, actuation.delay (whole 1 ms steps), "
+                        "actuation.inductance, actuation.current_limit, transmission.backlash")
     p.add_argument("--path-knots", type=int, default=0, metavar="N",
                    help="search C's path too: N curvature knots (path.k1..path.kN, each within +-kappa_max of the "
                         "declared reference bounds) and the hold time at each (path.hold, 0-3 s), every path "
@@ -119,7 +124,25 @@ def reproduce_command(config, params: dict[str, float], args: argparse.Namespace
     if config.reference_bounds is not None:
         bounds = ",".join(f"{k}={v!r}" for k, v in config.reference_bounds.as_dict().items())
         parts.append(f"--reference-bounds {bounds}")
+    parts += _cart_options(config)
     return " ".join(parts)
+
+
+def _cart_options(config) -> list[str]:
+    """--sensing, --actuation, --backlash of ``config``'s cart (the parts that are not ideal), every field
+    written out at full precision, so that ``wmr-mj run`` builds the same parts."""
+    import shlex
+
+    from wmr_mj.hardware.spec import spec_string
+
+    out = []
+    for option, part in (("--sensing", config.sensing), ("--actuation", config.actuation)):
+        if not part.is_ideal:
+            spec = {k: repr(v) if isinstance(v, float) else v for k, v in part.as_dict().items()}
+            out.append(f"{option} {shlex.quote(spec_string(spec))}")
+    if not config.transmission.is_ideal:
+        out.append(f"--backlash {config.transmission.backlash!r}")
+    return out
 
 
 def _portfolio_phases_text(spec, first, population: int) -> str:
@@ -157,24 +180,21 @@ def _portfolio_phases_text(spec, first, population: int) -> str:
     return text
 
 
-def run(args: argparse.Namespace) -> int:
-    import time
+def _base_and_box(args: argparse.Namespace):
+    """(base RunConfig, search box) of falsify's options. The signals', the path's and the cart's axes are
+    searched, not certified over: the certificate's box is the plant's (each run's claim covers its own cart).
 
-    from wmr_mj._util.files import check_output_path, write_json_atomic, write_text_atomic
-    from wmr_mj._util.progress import counter_callback, progress_bar
-    from wmr_mj.cli._common import box_ranges_from_args, parse_range, print_json
+    Raises:
+        ParameterError: a bad --path-knots or range (one line).
+    """
+    from wmr_mj.cli._common import box_ranges_from_args, parse_range
     from wmr_mj.cli.run import config_from_args
     from wmr_mj.errors import ParameterError
-    from wmr_mj.logs.writer import run_logged
-    from wmr_mj.report.plots import falsify_history, save_figure
-    from wmr_mj.sim.falsify import OBJECTIVE_LABELS, FalsifySpec, check_runnable, falsify, worst_config
-    from wmr_mj.sim.search_space import path_axis, signal_axis
+    from wmr_mj.sim.search_space import hardware_axis, path_axis, signal_axis
 
-    objective = _objective(args)
-    args.uncertainty = args.uncertainty or "full"
-    # the signals' and the path's axes are searched, not certified over: the certificate's box is the plant's
     parsed = [(item, parse_range(item)) for item in args.range or []]
-    searched = dict(span for _, span in parsed if signal_axis(span[0]) or path_axis(span[0]))
+    searched = dict(span for _, span in parsed
+                    if signal_axis(span[0]) or path_axis(span[0]) or hardware_axis(span[0]))
     args.range = [item for item, (name, _) in parsed if name not in searched]
     if args.path_knots < 0:
         raise ParameterError(f"--path-knots {args.path_knots} is not accepted: a number of knots >= 0")
@@ -187,6 +207,22 @@ def run(args: argparse.Namespace) -> int:
         space = KnotSpace(args.path_knots, hold_range=(0.0, 3.0))
         searched = {**space.ranges(base.reference_bounds), **searched}
     box = {"m1": tuple(args.m1_range), **box_ranges_from_args(args), **searched}
+    return base, box
+
+
+def run(args: argparse.Namespace) -> int:
+    import time
+
+    from wmr_mj._util.files import check_output_path, write_json_atomic, write_text_atomic
+    from wmr_mj._util.progress import counter_callback, progress_bar
+    from wmr_mj.cli._common import print_json
+    from wmr_mj.logs.writer import run_logged
+    from wmr_mj.report.plots import falsify_history, save_figure
+    from wmr_mj.sim.falsify import OBJECTIVE_LABELS, FalsifySpec, check_runnable, falsify, worst_config
+
+    objective = _objective(args)
+    args.uncertainty = args.uncertainty or "full"
+    base, box = _base_and_box(args)
     spec = FalsifySpec(base=base, box=box, objective=objective, budget=args.budget, seed=args.seed,
                        population=args.population, method=args.method, requirement=args.require)
     check_runnable(base)  # a duration too short for the path: one line, before any output or search
@@ -201,8 +237,11 @@ def run(args: argparse.Namespace) -> int:
     worst = result.worst
     summary = result.as_dict(log=str(log_path))
     from wmr_mj.cli._common import add_controller_source
+    from wmr_mj.hardware import cart_dict
 
     add_controller_source(summary, base)
+    summary.update(cart_dict(base))  # the base's cart where not ideal; the worst run's beside its parameters
+    summary["worst"].update(cart_dict(config))
     signals_file = path_file = None
     if config.signals is not None:  # the worst run's signals, every parameter: --signals takes them back
         signals_file = str(out / "worst-signals.json")
@@ -246,6 +285,7 @@ def run(args: argparse.Namespace) -> int:
               + (f"FALSIFIED, first at run {first_s} of the search" if first_s else "not falsified by the search")
               + (f"; random: first at run {first_r}" if first_r else "; random: not falsified"))
     print("worst parameters: " + ", ".join(f"{k} = {v!r}" for k, v in worst.params.items()))
+    _print_cart(base, config, spec.names)
     if signals_file is not None:
         print(f"worst signals: {json.dumps(summary['worst']['signals'], separators=(',', ':'))}")
     if path_file is not None:
@@ -258,6 +298,19 @@ def run(args: argparse.Namespace) -> int:
               flush=True)
     print(f"log:   {log_path}\nplot:  {summary['plot'][0]}\ntable: {summary['table']}")
     return exit_status(summary)
+
+
+def _print_cart(base, worst, names) -> None:
+    """The cart's line where it is not ideal or is searched: the base's, and the worst run's (its hardware axes
+    rounded as the run had them)."""
+    from wmr_mj.hardware import cart_line, is_ideal_cart
+    from wmr_mj.sim.search_space import hardware_axis
+
+    searched = [n for n in names if hardware_axis(n)]
+    if not is_ideal_cart(base) and not searched:
+        print(cart_line(base))
+    elif searched:
+        print(f"worst {cart_line(worst)} (searched: {', '.join(searched)})")
 
 
 def _bounds_line(b) -> str:

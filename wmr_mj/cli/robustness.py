@@ -439,4 +439,8 @@ def run_certificate(args: argparse.Namespace) -> int:
         print_json(out)
         return 0
     print(_certificate_table(cert, config, paper))
+    from wmr_mj.hardware import cart_line, is_ideal_cart
+
+    if not is_ideal_cart(config):
+        print(cart_line(config))
     return 0

@@ -91,6 +91,43 @@ def add_run_options(p: argparse.ArgumentParser) -> None:
                         "the default of run and sweep; full: also steering and tyre friction, R_a and V_A, the "
                         "default of falsify; sources in wmr_mj/params.py). A run draws nothing: the box is what "
                         "its analysis covers; m1's range is --m1-range")
+    add_hardware_options(p)
+
+
+def add_hardware_options(p: argparse.ArgumentParser) -> None:
+    """--sensing, --actuation, --backlash: the cart as it is built (wmr_mj.hardware), RunConfig's sensing,
+    actuation and transmission (``run``, ``sweep``, ``falsify``, ``robustness --certificate``, ``compare``,
+    ``validate``). Each is parsed by its part: bad values raise one line (exit status 2)."""
+    from wmr_mj.hardware import SENSING_SPEC_KEYS, sensing_preset_names
+
+    g = p.add_argument_group("the cart as it is built (wmr_mj/hardware; default ideal: the exact alpha and alpha', "
+                             "no delay, no inductance, no play); shown in every summary and JSON where not ideal")
+    g.add_argument("--sensing", metavar="KEY=VALUE,...|PRESET|FILE", default=None,
+                   help="the steering sensor between the plant and the law: a preset "
+                        f"({', '.join(sensing_preset_names())}), KEY=VALUE pairs ({', '.join(SENSING_SPEC_KEYS)}, "
+                        "preset; e.g. encoder_ticks=4096,velocity=difference,delay=0.005,noise=uniform:0.0005,seed=3; "
+                        "the delay a whole number of "
+                        "control periods) or a .json/.toml file of the same")
+    g.add_argument("--actuation", metavar="KEY=VALUE,...|FILE", default=None,
+                   help="the motor's actuation: delay (s, whole 1 ms physics steps), inductance (H), current_limit "
+                        "(A), e.g. delay=0.002,inductance=0.0005,current_limit=20, or a .json/.toml file")
+    g.add_argument("--backlash", metavar="RAD", default=None,
+                   help="the gear's play: half-width b >= 0, rad at the steering axis (e.g. 0.002)")
+
+
+def hardware_from_args(args: argparse.Namespace) -> dict[str, Any]:
+    """RunConfig's sensing, actuation and transmission from --sensing, --actuation, --backlash: each typed part
+    (wmr_mj.hardware; ideal where the option is not given).
+
+    Raises:
+        ParameterError, UnknownNameError: a malformed spec, an unknown key or preset, a value out of range (a
+            delay on the control period's grid is checked where RunConfig is built).
+    """
+    from wmr_mj.hardware import Actuation, Sensing, Transmission
+
+    return {"sensing": Sensing.from_spec(getattr(args, "sensing", None)),
+            "actuation": Actuation.from_spec(getattr(args, "actuation", None)),
+            "transmission": Transmission.from_spec(getattr(args, "backlash", None))}
 
 
 def config_from_args(args: argparse.Namespace, **extra):
@@ -147,7 +184,7 @@ def config_from_args(args: argparse.Namespace, **extra):
                      m1_range=tuple(args.m1_range), steering_friction=args.steering_friction,
                      tyre_contact=args.tyre_contact, box_ranges=box_ranges_from_args(args),
                      correction=bool(getattr(args, "correction", False)),
-                     reference_bounds=getattr(args, "reference_bounds", None), **extra)
+                     reference_bounds=getattr(args, "reference_bounds", None), **hardware_from_args(args), **extra)
 
 
 #: the run options that configure a steering law, and the RunConfig fields they set
@@ -474,12 +511,16 @@ def run(args: argparse.Namespace) -> int:
     if config.signals is not None:
         report["signals"] = config.signals.as_dict()  # every parameter: --signals takes it back
     from wmr_mj.cli._common import add_controller_source
+    from wmr_mj.hardware import cart_dict, cart_line, is_ideal_cart
 
     add_controller_source(report, config)
+    report.update(cart_dict(config))  # the parts that are not ideal: an ideal run's JSON keeps its keys
     if args.json:
         print_json(report)
     else:
         print(format_report(result.summary))
+        if not is_ideal_cart(config):
+            print(cart_line(config))
         if judged:
             print("\n".join(format_requirements(judged)))
         if config.signals is not None:

@@ -25,7 +25,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--seed", type=int, default=0, help="seed of the draw (default 0)")
     p.add_argument("--sampling", default="lhs", help="uniform, lhs (Latin hypercube, default) or grid")
     p.add_argument("--range", action="append", metavar="NAME=LO:HI",
-                   help="draw another plant parameter over a range too (repeatable); the box includes it")
+                   help="draw another plant parameter over a range too (repeatable); the box includes it. Or a "
+                        "hardware axis of the cart, drawn per run but not in the certificate's box (each run's claim "
+                        "covers its own cart): sensing.delay (rounded to whole control periods), "
+                        "sensing.encoder_ticks (rounded to whole ticks), sensing.encoder_bits (2**round(bits) "
+                        "ticks), sensing.noise_alpha, sensing.velocity_noise_alpha_dot, sensing.filter_tau, "
+                        "actuation.delay (whole 1 ms steps), actuation.inductance, actuation.current_limit, "
+                        "transmission.backlash; runs.csv records the value each run used")
     p.add_argument("--out", metavar="DIR", help="output folder (default logs/sweep-<time>); rerun to resume")
     p.add_argument("--chunk", type=positive_int, default=128, help="simulations per batch (default 128)")
     p.add_argument("--nthread", type=int, default=0, help="threads of the batch (default 0: all cores)")
@@ -44,7 +50,7 @@ def run(args: argparse.Namespace) -> int:
 
     from wmr_mj._util.files import check_output_path, write_json_atomic
     from wmr_mj._util.progress import counter_callback, progress_bar
-    from wmr_mj.cli._common import box_ranges_from_args, print_json
+    from wmr_mj.cli._common import box_ranges_from_args, hardware_ranges_from_args, print_json
     from wmr_mj.cli.run import config_from_args, requirements_from_args
     from wmr_mj.errors import ParameterError
     from wmr_mj.plant.mjcf import TIMESTEP
@@ -52,7 +58,8 @@ def run(args: argparse.Namespace) -> int:
 
     if args.n < 1:
         raise ParameterError(f"--n {args.n} is not accepted; the number of runs must be >= 1")
-    ranges = box_ranges_from_args(args)  # --uncertainty (default m1), then --range
+    # --uncertainty (default m1), then --range: the plant's, then the cart's axes (drawn, not in the box)
+    ranges = {**box_ranges_from_args(args), **hardware_ranges_from_args(args)}
     out = check_output_path(args.out or f"logs/sweep-{time.strftime('%Y%m%d-%H%M%S')}", kind="dir", option="--out")
     base = config_from_args(args)
     from wmr_mj.sim.parts import resolve_run
@@ -74,8 +81,13 @@ def run(args: argparse.Namespace) -> int:
     if base.signals is not None:
         summary["signals"] = base.signals.as_dict()  # every run's, with every parameter
     from wmr_mj.cli._common import add_controller_source
+    from wmr_mj.hardware import cart_dict, cart_line, is_ideal_cart
+    from wmr_mj.sim.search_space import HARDWARE_AXES
 
     add_controller_source(summary, base)
+    summary.update(cart_dict(base))  # the cart every run shares, where not ideal
+    if spec.hardware_names:  # and the cart's axes each run draws, with what a drawn value becomes
+        summary["hardware_axes"] = {n: HARDWARE_AXES[n] for n in spec.hardware_names}
     plot_path = _plot(results, runs, out / "region")
     summary["plot"] = str(plot_path)
     if args.log:
@@ -84,7 +96,7 @@ def run(args: argparse.Namespace) -> int:
 
         logs_dir = out / "mcap"
         for r in results:
-            cfg = base.replace(m1=r["m1"], plant_overrides={**base.plant_overrides, **{k: r[k] for k in ranges}})
+            cfg = spec.config_at([r[k] for k in spec.names])
             run_closed_loop(cfg, logger_factory=functools.partial(RunLogger, logs_dir / f"run-{r['run']:05d}.mcap"),
                             progress=False)
         summary["mcap_dir"] = str(logs_dir)
@@ -100,6 +112,9 @@ def run(args: argparse.Namespace) -> int:
     label = law.label()
     print(f"{runs.n} runs ({label}, m1 over "
           f"{args.m1_range[0]:g}-{args.m1_range[1]:g} kg, {args.sampling}, seed {args.seed}):")
+    if not is_ideal_cart(base) or spec.hardware_names:
+        drawn = f" (drawn per run: {', '.join(spec.hardware_names)})" if spec.hardware_names else ""
+        print(cart_line(base) + drawn)
     print("verdicts: " + ", ".join(f"{v} {c}" for v, c in runs.verdicts.items()))
     print("\n".join(claim_lines(runs)))
     print(f"certificate: worst sup|E|/E_max = {fmt(runs.certificate_E_ratio.value)}, "

@@ -58,6 +58,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", metavar="DIR",
                    help="report folder (default logs/validate-<timestamp>/; an existing folder resumes its sweeps)")
     p.add_argument("--json", action="store_true", help="print the summary object (summary.json) on stdout")
+    from wmr_mj.cli.run import add_hardware_options
+
+    add_hardware_options(p)  # the cart of every run of the report (summary.json's settings record it)
     p.set_defaults(func=run)
 
 
@@ -70,6 +73,7 @@ def run(args: argparse.Namespace) -> int:
     from wmr_mj._util.files import check_output_path
     from wmr_mj.cli._common import print_json
     from wmr_mj.cli.figures import default_folder
+    from wmr_mj.cli.run import hardware_from_args
     from wmr_mj.report.text import format_headline
     from wmr_mj.report.validate import ValidateSettings, run_validate, write_pointer
 
@@ -77,7 +81,7 @@ def run(args: argparse.Namespace) -> int:
     settings = ValidateSettings(n=args.n, seed=args.seed, sampling=args.sampling, duration=args.duration,
                                 identify_duration=args.identify_duration, search_budget=args.search_budget,
                                 nthread=args.nthread, uncertainty=args.uncertainty, path=args.path,
-                                designs=tuple(args.design or ()))
+                                designs=tuple(args.design or ()), **hardware_from_args(args))
     out = check_output_path(args.out or default_folder("validate"), kind="dir", option="--out")
     summary = run_validate(settings, out)
     pointer = write_pointer(out)
@@ -87,6 +91,10 @@ def run(args: argparse.Namespace) -> int:
         print(f"validate: total wall time {wall:.1f} s; report {out}/index.html", file=sys.stderr)
         return 0
     print(format_headline(summary))
+    from wmr_mj.hardware import cart_line, is_ideal_cart
+
+    if not is_ideal_cart(settings):
+        print(f"every run on the {cart_line(settings)}")
     print()
     print(f"report: {out}/index.html (also index.md, summary.json, summary.csv); pointer: {pointer}")
     print(f"total wall time {wall:.1f} s")

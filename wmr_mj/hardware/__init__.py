@@ -12,12 +12,13 @@ Usage::
     measurement_error_bounds(sensing, control_period=0.001, gear_ratio=60.0)
 
 Modules: :mod:`.spec` (the one parser), :mod:`.sensing`, :mod:`.actuation`, :mod:`.transmission`,
-:mod:`.presets` (named hardware with sources).
+:mod:`.presets` (named hardware with sources), :mod:`.cart` (the three parts in one line and one mapping).
 """
 
 from __future__ import annotations
 
 from wmr_mj.hardware.actuation import Actuation
+from wmr_mj.hardware.cart import CART_PARTS, cart_dict, cart_line, is_ideal_cart
 from wmr_mj.hardware.presets import (
     SENSING_PRESET_SOURCES,
     actuation_preset_names,
@@ -50,4 +51,8 @@ __all__ = [
     "Transmission",
     "parse_spec",
     "whole_periods",
+    "CART_PARTS",
+    "cart_dict",
+    "cart_line",
+    "is_ideal_cart",
 ]

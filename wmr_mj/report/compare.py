@@ -18,7 +18,7 @@ from typing import Any
 from wmr_mj.sim.compare import CompareResult, DesignRow, runs_json
 
 __all__ = ["table_rows", "markdown", "csv_text", "html_page", "figure", "write_report", "COLUMNS", "legend_lines",
-           "banner_lines"]
+           "banner_lines", "cart_text"]
 
 #: (header, what it says) of every column, in order
 COLUMNS = (
@@ -116,7 +116,31 @@ def _heading(result: CompareResult) -> str:
     v = result.versions
     return (f"Suite {s.name} (version {s.version}, sha256 {s.sha256[:12]}), {len(result.scenarios)} scenarios of "
             f"{s.duration:g} s; adversary: {2 * result.budget} runs per design ({result.budget} searched, "
-            f"{result.budget} random), seed {result.seed}; wmr-mj {v.get('wmr_mj')}, MuJoCo {v.get('mujoco')}")
+            f"{result.budget} random), seed {result.seed}; wmr-mj {v.get('wmr_mj')}, MuJoCo {v.get('mujoco')}"
+            + cart_text(result))
+
+
+def cart_text(result: CompareResult) -> str:
+    """'' where every design runs the ideal cart; else '. Cart (...): sensing ...; actuation ...; transmission
+    ...', once where every design shares it, else per design (a scenario that names its own cart keeps it)."""
+    from types import SimpleNamespace
+
+    from wmr_mj.hardware import Actuation, Sensing, Transmission, cart_line
+
+    carts = [dict(r.cart) for r in result.rows]
+    if not any(carts):
+        return ""
+
+    def line(cart: dict[str, Any]) -> str:
+        parts = SimpleNamespace(sensing=Sensing.from_spec(cart.get("sensing")),
+                                actuation=Actuation.from_spec(cart.get("actuation")),
+                                transmission=Transmission.from_spec(cart.get("transmission")))
+        return cart_line(parts)[len("cart: "):]
+
+    where = " (a scenario that names its own cart keeps it)"
+    if all(c == carts[0] for c in carts):
+        return f". Cart of every design{where}: {line(carts[0])}"
+    return f". Cart{where}: " + " | ".join(f"{r.label}: {line(c)}" for r, c in zip(result.rows, carts))
 
 
 def markdown(result: CompareResult) -> str:
@@ -144,12 +168,14 @@ def csv_text(result: CompareResult) -> str:
 
     rows = [r.as_dict() for r in result.rows]
     buf = io.StringIO()
-    names = list(rows[0]) if rows else []
+    names = list(dict.fromkeys(k for r in rows for k in r))  # "cart" only where a design's cart is not ideal
     w = csv.DictWriter(buf, fieldnames=names, lineterminator="\n")
     w.writeheader()
     for r in rows:
         cells = {k: (repr(v) if isinstance(v, float) else v) for k, v in r.items()}
         cells["claim_broken"] = "" if r["claim_broken"] is None else json.dumps(r["claim_broken"])
+        if "cart" in r:
+            cells["cart"] = json.dumps(r["cart"])
         cells["unmet"] = format_unmet(r["unmet"])  # name (value vs limit); ...
         w.writerow(cells)
     return buf.getvalue()

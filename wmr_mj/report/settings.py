@@ -72,6 +72,11 @@ class ValidateSettings:
     uncertainty: str = "m1"
     path: str = "paper-circle"
     designs: tuple[str, ...] = ()  # designs of the user's, each judged beside the ladder (validate --design)
+    # the cart every run of the report runs on (wmr_mj.hardware parts or their specs, as RunConfig takes them;
+    # validate --sensing/--actuation/--backlash); None: ideal (as_dict then has none of these keys)
+    sensing: Any = None
+    actuation: Any = None
+    transmission: Any = None
 
     def __post_init__(self) -> None:
         from wmr_mj.sim.sweep import SAMPLINGS
@@ -92,7 +97,11 @@ class ValidateSettings:
 
         if self.uncertainty not in UNCERTAINTY_NAMES:
             raise UnknownNameError("uncertainty box name", str(self.uncertainty), UNCERTAINTY_NAMES)
-        RunConfig(path=self.path)  # a named path or a route file: refused here as a run would refuse it
+        # a named path or a route file, and the cart (a bad spec, a delay off the grid): refused as a run would
+        probe = RunConfig(path=self.path, sensing=self.sensing, actuation=self.actuation,
+                          transmission=self.transmission)
+        for name in ("sensing", "actuation", "transmission"):
+            object.__setattr__(self, name, getattr(probe, name))  # the typed part
         from wmr_mj.sim.designs import design_changes
 
         object.__setattr__(self, "designs", tuple(str(t) for t in self.designs))
@@ -127,7 +136,8 @@ class ValidateSettings:
     def config(self, design: DesignLike) -> RunConfig:
         """The run of ``design`` these settings sweep (m1 at nominal; the sweep draws it)."""
         return RunConfig(**design.config_changes(), duration=self.duration, m1=self.nominal_m1, path=self.path,
-                         m1_range=as_pair(self.m1_range), box_ranges=self.ranges, seed=self.seed)
+                         m1_range=as_pair(self.m1_range), box_ranges=self.ranges, seed=self.seed,
+                         sensing=self.sensing, actuation=self.actuation, transmission=self.transmission)
 
     def as_dict(self) -> dict[str, Any]:
         d = asdict(self)
@@ -136,6 +146,12 @@ class ValidateSettings:
             del d["designs"]  # the settings written before designs existed, unchanged
         else:
             d["designs"] = list(self.designs)
+        for name in ("sensing", "actuation", "transmission"):  # likewise: only where the cart is not ideal
+            part = getattr(self, name)
+            if part.is_ideal:
+                del d[name]
+            else:
+                d[name] = part.as_dict()
         return d
 
 

@@ -36,6 +36,7 @@ import numpy as np
 
 from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE, count_unmet, unmet_assumptions
 from wmr_mj.errors import ParameterError
+from wmr_mj.hardware import cart_dict
 from wmr_mj.params import uncertainty_ranges
 from wmr_mj.plant.mjcf import TIMESTEP
 from wmr_mj.sim.config import (
@@ -57,9 +58,16 @@ class Design:
     config: RunConfig
 
 
-def design_from_token(token: str, suite: Suite) -> Design:
+def design_from_token(token: str, suite: Suite, *, cart: Mapping[str, Any] | None = None) -> Design:
     """A design from ``NAME[,key=value...]`` (:func:`wmr_mj.sim.designs.design_changes`), declaring the
     suite's uncertainty box and running the suite's duration.
+
+    Args:
+        token: the design as named.
+        suite: the suite it runs.
+        cart: RunConfig's sensing, actuation, transmission for this design (``wmr-mj compare --sensing``, ...;
+            each overrides the token's own setting of it): its runs and its adversary's run on that cart,
+            but for a scenario that names its own.
 
     Raises:
         UnknownNameError, ParameterError: an unknown preset or law, a bad setting (one line each).
@@ -68,7 +76,8 @@ def design_from_token(token: str, suite: Suite) -> Design:
 
     box = uncertainty_ranges(suite.adversary.uncertainty)
     m1_range = box.pop("m1")
-    config = RunConfig(**design_changes(token), m1_range=m1_range, box_ranges=box, duration=suite.duration)
+    changes = {**design_changes(token), **(cart or {})}
+    config = RunConfig(**changes, m1_range=m1_range, box_ranges=box, duration=suite.duration)
     from wmr_mj.sim.parts import resolve_run
 
     resolve_run(config)  # built once: a parameter the law does not take, a claim() that raises, before any run
@@ -209,6 +218,9 @@ class DesignRow:
     claim_broken: Mapping[str, Any] | None = None
     # the claim's assumptions not met over the scenarios: {name, value, limit, runs} (value and limit of the first)
     unmet: tuple[Mapping[str, Any], ...] = ()
+    # the design's cart where not ideal (wmr_mj.hardware.cart_dict: sensing, actuation, transmission in spec
+    # form); a scenario that names its own cart runs with that one. {}: ideal (as_dict then has no "cart")
+    cart: Mapping[str, Any] = field(default_factory=dict)
 
     def as_dict(self) -> dict[str, Any]:
         from dataclasses import asdict
@@ -217,6 +229,8 @@ class DesignRow:
         out["adversary_where"] = dict(self.adversary_where)
         out["controller_source"] = None if self.controller_source is None else dict(self.controller_source)
         out["unmet"] = [dict(a) for a in self.unmet]
+        if not self.cart:
+            del out["cart"]  # a comparison on the ideal cart keeps the keys it always had
         return out
 
 
@@ -391,7 +405,8 @@ def _row(design: Design, runs: Sequence[ScenarioRun], adversary: Any, spec: Any)
         cpu_us_per_step=float(np.median([r.cpu_us_per_step for r in runs])) if runs else math.nan,
         law="/".join(sorted({r.law for r in runs})), controller_source=_source_of(design.config),
         claim_broken=_claim_broken(runs, adversary),
-        unmet=tuple(count_unmet((r.summary.get("certificate") or {}).get("unmet_assumptions") or [] for r in runs)))
+        unmet=tuple(count_unmet((r.summary.get("certificate") or {}).get("unmet_assumptions") or [] for r in runs)),
+        cart=cart_dict(design.config))
 
 
 def _claim_broken(runs: Sequence[ScenarioRun], adversary: Any) -> dict[str, Any] | None:

@@ -702,12 +702,15 @@ class FalsifySpec:
             raise ParameterError("the objective 'requirement' goes with a requirement (an STL formula), and only it")
         if self.requirement is not None:
             self.parsed_requirement  # noqa: B018  (refused here, before any run, when malformed)
-        from wmr_mj.sim.search_space import config_for, path_axis, signal_axis
+        from wmr_mj.sim.search_space import check_hardware_range, config_for, hardware_axis, path_axis, signal_axis
 
         if not self.box:
             raise ParameterError("the box is empty; give at least one ranged parameter (e.g. --uncertainty m1)")
         names = parameter_names()
         for name, (lo, hi) in self.box.items():
+            if hardware_axis(name):  # the cart's: searched, each run's claim covering its own cart
+                check_hardware_range(self.base, name, lo, hi)
+                continue
             if signal_axis(name) or path_axis(name):
                 if not (math.isfinite(lo) and math.isfinite(hi) and lo <= hi):
                     raise ParameterError(f"range of {name} = {lo!r}:{hi!r} is not accepted: finite LO <= HI")

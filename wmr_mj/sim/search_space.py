@@ -12,8 +12,14 @@ Each name is
   (:mod:`wmr_mj.reference.knots`) feasible for the base's declared reference bounds
   (``RunConfig.reference_bounds``, which a path axis requires); knots not ranged are 0 (straight),
   the hold not ranged is :data:`DEFAULT_HOLD_S`;
+- ``sensing.<field>``, ``actuation.<field>``, ``transmission.backlash`` (:data:`HARDWARE_AXES`): the cart as
+  it is built (:mod:`wmr_mj.hardware`), each a field of the base's part changed; a delay is rounded to the
+  grid it runs on (the sensing's to whole control periods, the actuation's to whole 1 ms physics steps) and
+  the encoder's resolution to whole ticks (``sensing.encoder_ticks``) or to whole bits
+  (``sensing.encoder_bits``: 2**round(bits) ticks), so every drawn value is one a run can have
+  (:func:`hardware_values` gives the value a run used);
 
-so a search over plants, signals and paths at once is a box over these names (``wmr-mj falsify
+so a search over plants, signals, paths and the cart at once is a box over these names (``wmr-mj falsify
 --range disturbance.amplitude=-1.5:1.5 --path-knots 3``). The config of a point carries its signals with every
 parameter, so its ``as_dict()["signals"]`` is the ``--signals`` that reproduces the run::
 
@@ -27,15 +33,18 @@ parameter, so its ``as_dict()["signals"]`` is the ``--signals`` that reproduces 
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Sequence
+import math
+from collections.abc import Mapping, Sequence
 from typing import Any
 
-from wmr_mj.errors import ParameterError
+from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import parameter_names
 from wmr_mj.sim.config import RunConfig
 from wmr_mj.sim.signals import Signals
 
-__all__ = ["config_for", "signal_axis", "path_axis", "DISTURBANCE_FIELDS", "LOAD_FIELDS", "DEFAULT_HOLD_S"]
+__all__ = ["config_for", "signal_axis", "path_axis", "DISTURBANCE_FIELDS", "LOAD_FIELDS", "DEFAULT_HOLD_S",
+           "HARDWARE_AXES", "hardware_axis", "hardware_values", "with_hardware", "check_hardware_range",
+           "axis_names_text"]
 
 #: The fields of a disturbance and of a load change that a search may range.
 DISTURBANCE_FIELDS = ("amplitude", "t1", "t2", "bandwidth", "seed")
@@ -44,6 +53,109 @@ LOAD_FIELDS = ("t", "t1", "t2", "m1", "every")
 
 #: The hold time [s] of a knot path whose ``path.hold`` is not ranged.
 DEFAULT_HOLD_S = 2.0
+
+
+#: The cart's axes (:mod:`wmr_mj.hardware`): name -> what a drawn value becomes (units, rounding).
+HARDWARE_AXES = {
+    "sensing.delay": "s, rounded to the nearest whole number of control periods",
+    "sensing.encoder_ticks": "ticks per revolution, rounded to the nearest integer (ties to even), >= 1",
+    "sensing.encoder_bits": "bits: 2**round(bits) ticks per revolution (a draw over 10:14 gives 10, ..., 14 bits)",
+    "sensing.noise_alpha": "rad, the noise on alpha: the base's kind (uniform where it has none), this bound or sigma",
+    "sensing.velocity_noise_alpha_dot": "rad/s, the noise on alpha': the base's kind (uniform where none)",
+    "sensing.filter_tau": "s, the low-pass time constant (the base's velocity must be filtered)",
+    "actuation.delay": "s, rounded to the nearest whole number of 1 ms physics steps",
+    "actuation.inductance": "H, the armature inductance",
+    "actuation.current_limit": "A, the current limit (> 0)",
+    "transmission.backlash": "rad at the steering axis, the gear's half-width of play",
+}
+_CART_PREFIXES = ("sensing.", "actuation.", "transmission.")
+
+
+def hardware_axis(name: str) -> bool:
+    """Whether ``name`` names a part of the cart (sensing.*, actuation.*, transmission.*); an unknown field of
+    one is refused by :func:`with_hardware`, naming :data:`HARDWARE_AXES`."""
+    return name.startswith(_CART_PREFIXES)
+
+
+def _grid_delay(value: float, period: float) -> float:
+    return round(value / period) * period  # n * period: whole_periods accepts it exactly
+
+
+def hardware_values(base: RunConfig, values: Mapping[str, float]) -> dict[str, float]:
+    """The value each hardware axis of ``values`` takes in a run of ``base`` (rounded as
+    :data:`HARDWARE_AXES` says): what runs.csv and a search record as the run's.
+
+    Raises:
+        UnknownNameError: a name that is not in :data:`HARDWARE_AXES`.
+        ParameterError: a negative number of bits.
+    """
+    from wmr_mj.plant.mjcf import TIMESTEP
+
+    out: dict[str, float] = {}
+    for name, value in values.items():
+        if name not in HARDWARE_AXES:
+            raise UnknownNameError("hardware axis name", name, HARDWARE_AXES)
+        v = float(value)
+        if name == "sensing.delay":
+            v = _grid_delay(v, TIMESTEP if base.control_period is None else base.control_period)
+        elif name == "actuation.delay":
+            v = _grid_delay(v, TIMESTEP)
+        elif name == "sensing.encoder_ticks":
+            v = float(max(1, round(v)))
+        elif name == "sensing.encoder_bits":
+            if round(v) < 0:
+                raise ParameterError(f"sensing.encoder_bits = {value!r} is not accepted; a number of bits >= 0")
+            v = float(round(v))
+        out[name] = v
+    return out
+
+
+def with_hardware(base: RunConfig, values: Mapping[str, float]) -> RunConfig:
+    """``base`` with each hardware axis of ``values`` set in its part (sensing, actuation, transmission), the
+    values rounded by :func:`hardware_values`; the part checks the rest (one line naming the culprit).
+
+    Raises:
+        UnknownNameError: a name that is not in :data:`HARDWARE_AXES`.
+        ParameterError: a value its part refuses (a negative delay, a filter time constant without
+            velocity=filtered, a current limit of 0).
+    """
+    if not values:
+        return base
+    changes: dict[str, dict[str, Any]] = {"sensing": {}, "actuation": {}, "transmission": {}}
+    for name, v in hardware_values(base, values).items():
+        part, _, key = name.partition(".")
+        if name == "sensing.encoder_ticks":
+            changes[part]["encoder_ticks"] = int(v)
+        elif name == "sensing.encoder_bits":
+            changes[part]["encoder_ticks"] = 2 ** int(v)
+        elif name in ("sensing.noise_alpha", "sensing.velocity_noise_alpha_dot"):
+            kind = "noise_kind" if key == "noise_alpha" else "velocity_noise_kind"
+            changes[part][kind] = "uniform" if getattr(base.sensing, kind) == "none" else getattr(base.sensing, kind)
+            changes[part][key] = v
+        else:
+            changes[part][key] = v
+    return base.replace(**{part: dataclasses.replace(getattr(base, part), **fields)
+                           for part, fields in changes.items() if fields})
+
+
+def check_hardware_range(base: RunConfig, name: str, lo: float, hi: float) -> None:
+    """A hardware axis's range: finite, 0 <= LO <= HI, and both ends a cart its part accepts.
+
+    Raises:
+        UnknownNameError, ParameterError: one line naming the axis and what is accepted.
+    """
+    if not (math.isfinite(lo) and math.isfinite(hi) and 0.0 <= lo <= hi):
+        raise ParameterError(f"range of {name} = {lo!r}:{hi!r} is not accepted: finite 0 <= LO <= HI "
+                             f"({HARDWARE_AXES.get(name, 'a hardware axis')})")
+    for end in (lo, hi):
+        with_hardware(base, {name: end})
+
+
+def axis_names_text() -> str:
+    """The axes a search may range, for a message: m1, the plant's parameters, the signals', the cart's."""
+    return (f"m1, a plant parameter ({', '.join(sorted(parameter_names()))}), d_max, disturbance.<field> "
+            "(amplitude, t1, t2, bandwidth, seed), load<i>.<field> (t, t1, t2, m1, every), path.k<i>, path.hold, "
+            f"or a hardware axis ({', '.join(HARDWARE_AXES)})")
 
 
 def path_axis(name: str) -> bool:
@@ -57,9 +169,9 @@ def signal_axis(name: str) -> bool:
 
 
 def config_for(base: RunConfig, names: Sequence[str], x: Sequence[float]) -> RunConfig:
-    """``base`` with each named value of ``x`` set: m1, plant parameters, and the parameters of
+    """``base`` with each named value of ``x`` set: m1, plant parameters, the parameters of
     base's signals (seeds rounded to integers; a pulse's t2 is kept after its t1 by its template
-    width when t1 moves alone).
+    width when t1 moves alone), C's knot path, and the cart's hardware axes (:func:`with_hardware`).
 
     Raises:
         ParameterError: a name that is no axis, or a signal axis the base's signals do not have.
@@ -72,10 +184,13 @@ def config_for(base: RunConfig, names: Sequence[str], x: Sequence[float]) -> Run
     loads = [dict() for _ in template.loads]  # type: list[dict[str, Any]]
     m1, overrides, d_max = base.m1, dict(base.plant_overrides), template.d_max
     knots: dict[str, float] = {}
+    hardware: dict[str, float] = {}
     for name, value in zip(names, x):
         v = float(value)
         if path_axis(name):
             knots[name] = v
+        elif hardware_axis(name):
+            hardware[name] = v
         elif name == "m1":
             m1 = v
         elif name == "d_max":
@@ -100,9 +215,7 @@ def config_for(base: RunConfig, names: Sequence[str], x: Sequence[float]) -> Run
         elif name in parameter_names():
             overrides[name] = v
         else:
-            raise ParameterError(f"{name!r} is not a search axis; accepted: m1, a plant parameter "
-                                 f"({', '.join(sorted(parameter_names()))}), d_max, disturbance.<field> "
-                                 "(amplitude, t1, t2, bandwidth, seed) or load<i>.<field> (t, t1, t2, m1, every)")
+            raise ParameterError(f"{name!r} is not a search axis; accepted: {axis_names_text()}")
     if dist is not None and d_changes:
         if dist.t2 is not None and "t1" in d_changes and "t2" not in d_changes:
             d_changes["t2"] = d_changes["t1"] + (dist.t2 - dist.t1)
@@ -112,7 +225,8 @@ def config_for(base: RunConfig, names: Sequence[str], x: Sequence[float]) -> Run
     changes: dict[str, Any] = {}
     if knots:
         changes["path"] = _knot_route(base, knots)
-    return base.replace(m1=m1, plant_overrides=overrides, signals=None if signals.empty else signals, **changes)
+    config = base.replace(m1=m1, plant_overrides=overrides, signals=None if signals.empty else signals, **changes)
+    return with_hardware(config, hardware)
 
 
 def _knot_route(base: RunConfig, values: dict[str, float]) -> str:

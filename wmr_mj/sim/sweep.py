@@ -131,10 +131,15 @@ class SweepSpec:
         if self.sampling not in SAMPLINGS:
             raise UnknownNameError("sampling", self.sampling, SAMPLINGS)
         positive_range("m1", *self.m1_range)
+        from wmr_mj.sim.search_space import HARDWARE_AXES, check_hardware_range, hardware_axis
+
         names = set(parameter_names()) - {"m1"}
         for name, (lo, hi) in self.ranges.items():
+            if hardware_axis(name):
+                check_hardware_range(self.base, name, lo, hi)
+                continue
             if name not in names:
-                raise UnknownNameError("parameter", name, names)
+                raise UnknownNameError("axis name", name, [*sorted(names), *HARDWARE_AXES])
             positive_range(name, lo, hi)
         if self.sampling == "grid":
             d = 1 + len(self.ranges)
@@ -150,8 +155,38 @@ class SweepSpec:
     def bounds(self) -> np.ndarray:
         return np.array([self.m1_range, *self.ranges.values()], dtype=float)
 
+    @property
+    def hardware_names(self) -> tuple[str, ...]:
+        """The ranged axes of the cart (:data:`wmr_mj.sim.search_space.HARDWARE_AXES`), in order: drawn per run,
+        never part of the certificate's plant box (each run's claim covers its own cart)."""
+        from wmr_mj.sim.search_space import hardware_axis
+
+        return tuple(n for n in self.ranges if hardware_axis(n))
+
     def base_for_box(self) -> RunConfig:
-        return self.base.replace(m1_range=tuple(self.m1_range), box_ranges=dict(self.ranges))
+        plant = {k: v for k, v in self.ranges.items() if k not in self.hardware_names}
+        return self.base.replace(m1_range=tuple(self.m1_range), box_ranges=plant)
+
+    def config_at(self, values: Sequence[float]) -> RunConfig:
+        """The run of one draw (``values`` in :attr:`names` order: m1 first): m1 and the plant parameters set,
+        the cart's axes set in its parts (rounded to what a run can have)."""
+        from wmr_mj.sim.search_space import with_hardware
+
+        base = self.base_for_box()
+        hardware = set(self.hardware_names)
+        overrides = dict(base.plant_overrides)
+        overrides.update({n: float(v) for n, v in zip(self.names[1:], values[1:]) if n not in hardware})
+        config = base.replace(m1=float(values[0]), plant_overrides=overrides)
+        return with_hardware(config, {n: float(v) for n, v in zip(self.names[1:], values[1:]) if n in hardware})
+
+    def recorded_values(self, values: Sequence[float]) -> dict[str, float]:
+        """Each ranged axis but m1 -> the value its run used (runs.csv's columns): a plant parameter as drawn,
+        a hardware axis as rounded (:func:`wmr_mj.sim.search_space.hardware_values`)."""
+        from wmr_mj.sim.search_space import hardware_values
+
+        out = {n: float(v) for n, v in zip(self.names[1:], values[1:])}
+        out.update(hardware_values(self.base, {n: out[n] for n in self.hardware_names}))
+        return out
 
     @property
     def requirement_columns(self) -> tuple[str, ...]:
@@ -205,13 +240,7 @@ def draw_samples(spec: SweepSpec) -> np.ndarray:
 
 
 def _run_configs(spec: SweepSpec, samples: np.ndarray) -> list[RunConfig]:
-    base = spec.base_for_box()
-    out = []
-    for row in samples:
-        overrides = dict(base.plant_overrides)
-        overrides.update({name: float(v) for name, v in zip(spec.names[1:], row[1:])})
-        out.append(base.replace(m1=float(row[0]), plant_overrides=overrides))
-    return out
+    return [spec.config_at(row) for row in samples]
 
 
 def _run_chunk(spec_json: str, indices: list[int], nthread: int,
@@ -230,8 +259,7 @@ def _run_chunk(spec_json: str, indices: list[int], nthread: int,
                                              requirements=spec.requirements)):
         r = summary.to_dict()
         r["run"] = int(i)
-        for name, value in zip(spec.names[1:], samples[i][1:]):
-            r[name] = float(value)
+        r.update(spec.recorded_values(samples[i]))
         rows.append(r)
     return rows
 
