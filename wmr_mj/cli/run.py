@@ -442,11 +442,18 @@ def no_estimate_note(config) -> str | None:
         if cert is None or cert.certified:
             return None
         unmet[model] = ", ".join(cert.unmet) or "no finite bound"
+    from wmr_mj.hardware.cart import is_ideal_cart
+    from wmr_mj.sim.designs import CERTIFIED
+
     label = controller_for(config, estimate_parameters(C80)).label()
+    hint = ""
+    if is_ideal_cart(config) and config.replace(**CERTIFIED.config_changes()) != config:
+        hint = "; --preset certified is a computed-torque design whose claim holds"
+    elif not is_ideal_cart(config):
+        hint = " on this cart (its sensing, actuation or play: see the assumptions not met)"
     return (f"the claim of controller {config.controller!r} ({label}) holds under no estimate at these settings (" +
             "; ".join(f"{m} model: {u} not met" for m, u in unmet.items()) +
-            "): its runs are uncertified whatever they do; --preset certified is a computed-torque design whose "
-            "claim holds")
+            "): its runs are uncertified whatever they do" + hint)
 
 
 def run(args: argparse.Namespace) -> int:
