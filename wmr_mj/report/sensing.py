@@ -89,6 +89,8 @@ def _dead_band_prediction(config, reference) -> dict[str, float]:
     from wmr_mj.sim.certify import certificate_for
 
     cert = certificate_for(config, reference)
+    if cert is None:  # the certified design's computed-torque law always states one
+        raise RuntimeError("the certified design states no certificate")
     est = cert.inputs["estimate"]
     return {"F_estimate": float(est["F"]), "P_estimate": float(est["P"]), "kp": float(cert.kp),
             "dead_band": float(est["F"]) / (float(est["P"]) * float(cert.kp)),

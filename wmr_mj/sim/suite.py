@@ -200,7 +200,7 @@ def _hardware(name: str, spec: Mapping[str, Any], where: str) -> dict[str, Any]:
     try:
         return {"sensing": Sensing.from_spec(spec.get("sensing")),
                 "actuation": Actuation.from_spec(spec.get("actuation")),
-                "transmission": Transmission.from_spec(float(spec.get("backlash", 0.0)))}
+                "transmission": Transmission.from_spec(spec.get("backlash", 0.0))}
     except ParameterError as exc:
         raise ParameterError(f"{where}: [hardware.{name}] {exc}") from None
 
