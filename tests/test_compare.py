@@ -120,3 +120,65 @@ def test_compare_on_dask_gives_the_local_numbers():
         assert (a.design, a.scenario) == (b.design, b.scenario)
         assert a.summary["sup_E"] == b.summary["sup_E"] and a.requirements == b.requirements
         assert a.rms_voltage == b.rms_voltage and a.tv_voltage == b.tv_voltage
+
+
+# ----------------------------------------------------------------------------- standard-v2: the cart as built
+V2_HARDWARE = ("magnetic-12bit", "magnetic-14bit", "incremental-500", "sensing-delay-5ms", "inductance-1.5mH",
+               "backlash-2mrad")
+STANDARD_V2_IDS = STANDARD_V1_IDS + [f"{p}/nominal/none/{h}" for p in ("circle", "lane") for h in V2_HARDWARE]
+
+
+def test_standard_v2_is_v1_then_the_cart_as_built_and_v1_stays_pinned():
+    from wmr_mj.hardware import Actuation, Sensing, Transmission
+    from wmr_mj.params import C80
+
+    v1, v2 = load_suite("standard-v1"), load_suite("standard-v2")
+    assert (v2.name, v2.version) == ("standard-v2", 2) and [s.id for s in v2.scenarios] == STANDARD_V2_IDS
+    assert v1.sha256[:12] == STANDARD_V1_SHA256 and "hardware" not in v1.as_dict()  # v1's JSON keys as before
+    design = design_from_token("certified", v2)
+    for a, b in zip(v1.scenarios, v2.scenarios):  # v1's scenarios, unchanged: the same configs to the field
+        assert a == b and a.hardware is None
+        assert a.config(design.config) == b.config(design.config)
+    built = {s.id.rsplit("/", 1)[1]: s for s in v2.scenarios[30:] if s.path == "paper-circle"}
+    assert built["magnetic-12bit"].sensing == Sensing.from_spec("magnetic-12bit-axis")
+    assert built["incremental-500"].sensing.encoder_side == "motor"
+    assert built["sensing-delay-5ms"].sensing == Sensing(delay=0.005)
+    # L_a / R_a = 1.5 ms at the nominal R_a (1.0 Ohm): inside the 1-2 ms the suite's comment gives
+    assert built["inductance-1.5mH"].actuation.electrical_time_constant(C80.R_a) == pytest.approx(1.5e-3)
+    assert built["backlash-2mrad"].transmission == Transmission(backlash=0.002)
+    assert built["backlash-2mrad"].sensing.encoder_side == "motor"  # the play is seen from the motor side
+    cfg = built["inductance-1.5mH"].config(design.config)
+    assert cfg.actuation == Actuation(inductance=0.0015) and cfg.sensing.is_ideal and cfg.m1 == 650.0
+    assert set(v2.as_dict()["hardware"]) == set(STANDARD_V2_IDS[30:])
+
+
+@pytest.mark.parametrize("table, words", [
+    ('[hardware.x]\nsensing = "encoder_ticks=0"\n', ["[hardware.x]", "encoder_ticks"]),
+    ('[hardware.x]\nnoise = 1\n', ["[hardware.x] key", "sensing"]),
+    ('[hardware.x]\nbacklash = -0.1\n', ["[hardware.x]", "backlash"]),
+], ids=["ticks", "key", "backlash"])
+def test_a_bad_hardware_table_is_one_line_naming_it(tmp_path, table, words):
+    text = (SUITES_DIR / "standard-v2.toml").read_text()
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text.replace("[hardware.magnetic-12bit]", table + "\n[hardware.magnetic-12bit]", 1))
+    with pytest.raises((ParameterError, UnknownNameError)) as info:
+        load_suite(str(bad))
+    message = str(info.value)
+    assert "\n" not in message and all(w in message for w in words), message
+    bad.write_text(text.replace('hardware = "magnetic-14bit"', 'hardware = "nope"', 1))
+    with pytest.raises(UnknownNameError, match="hardware 'nope'"):
+        load_suite(str(bad))
+
+
+@pytest.mark.slow
+def test_compare_on_a_sensed_scenario_gives_the_single_runs_numbers():
+    suite = load_suite("standard-v2")
+    design = design_from_token("certified", suite)
+    chosen = ["circle/nominal/none/incremental-500", "lane/nominal/none/backlash-2mrad"]
+    result = compare([design], suite, scenarios=chosen, budget=0, nthread=2)
+    for r in result.runs:
+        single = run_closed_loop(suite.scenario(r.scenario).config(design.config), progress=False)
+        assert "alpha_measured" in single.rows  # the law read the encoder
+        for key in ("sup_E", "sup_Edot", "verdict"):
+            assert r.summary[key] == single.summary.to_dict()[key], (r.scenario, key)
+        assert r.summary["verdict"] != "certified-outside"

@@ -264,11 +264,12 @@ def test_a_rerun_resumes_and_prints_the_answer_first(rerun, validated):
     out = proc.stdout.splitlines()
     assert out[0].startswith("Question: ") and out[6].startswith("wmr-mj validate")
     assert out[8] == "(a) The paper's design:"
-    heads = [line for line in out if re.match(r"^\([a-d]\) ", line)]
-    assert [h[:3] for h in heads] == ["(a)", "(b)", "(c)", "(d)"]
+    heads = [line for line in out if re.match(r"^\([a-e]\) ", line)]
+    assert [h[:3] for h in heads] == ["(a)", "(b)", "(c)", "(d)", "(e)"]
     md = (folder / "index.md").read_text()
     assert md.index("## (a) The paper's design") < md.index("## (b)") < md.index("## (c)") < md.index("## (d)")
-    assert md.index("## (d)") < md.index("## (e) Identification") < md.index("## (f) Findings")
+    assert md.index("## (d)") < md.index("## (e) The certified design on realistic sensing")
+    assert md.index("## (e)") < md.index("## (f) Identification") < md.index("## (g) Findings")
 
 
 @pytest.mark.slow
@@ -388,3 +389,26 @@ def test_a_design_of_the_users_is_judged_beside_the_ladder(tmp_path):
     assert len(rows) == 2 and {r["verdict"] for r in rows} == {"no-claim"}
     md = (folder / "index.md").read_text()
     assert "sliding-mode" in md and "MyPID,ki=10" in md
+
+
+@pytest.mark.slow
+def test_the_certified_design_on_realistic_sensing_section(validated):
+    from wmr_mj.report.sensing import REALISTIC_SENSING
+
+    folder, _, _ = validated
+    summary = _saved(folder)
+    sec = summary["sensing"]
+    assert [r["sensing"] for r in sec["runs"]] == ["ideal", *REALISTIC_SENSING] and sec["m1"] == 750.0
+    assert sec["dead_band"] == sec["F_estimate"] / (sec["P_estimate"] * sec["kp"])
+    assert sec["dead_band"] == pytest.approx(1.52 / (0.385 * 100), rel=0.01)  # ../shared/notes/mismatch.md
+    for r in sec["runs"]:
+        assert r["sup_E_over_ideal_E_max"] == r["sup_E"] / sec["ideal_E_max"]
+        assert r["verdict"] != "certified-outside"
+        assert (r["verdict"] == "certified-inside") == (not r["unmet"])  # a verdict short of it names why
+        assert r["settled_E"]["min"] <= r["settled_E"]["mean"] <= r["settled_E"]["max"] <= r["sup_E"]
+    ideal, twelve = sec["runs"][0], sec["runs"][1]
+    assert ideal["verdict"] == "certified-inside" and twelve["tv_voltage"] > 10 * ideal["tv_voltage"]
+    md, text = (folder / "index.md").read_text(), format_headline(summary)
+    for doc in (md, text):
+        assert "(e) The certified design on realistic sensing" in doc and "magnetic-12bit-axis" in doc
+    assert any("On realistic sensing" in f for f in summary["findings"])

@@ -11,8 +11,9 @@ path and the paths C travelled under both designs) follows directly. Then, in or
 (b) the ladder from the paper's design to the certified one, verdict counts per rung;
 (c) the certified design: its rule, its certificate with every assumption, its counts,
     the worst-case search beside the Monte-Carlo worst and the certificate, the full box;
-(d) the plant's measured friction law; (e) identification; (f) findings (computed
-sentences); figures; files; software.
+(d) the plant's measured friction law; (e) the certified design on realistic sensing (encoders on the
+steering axis and the motor shaft: verdict, voltage activity, dead band; where the report has it);
+(f) identification; (g) findings (computed sentences); figures; files; software.
 
 A ``certified-outside`` run (a bug or a modelling gap) is announced in a banner directly under
 the verdict, above the details, wherever it appears (the verdict's certified-design line names
@@ -414,7 +415,58 @@ def identification_rows(summary: Mapping[str, Any]) -> list[list[str]]:
     return out
 
 
-# --------------------------------------------------------------------------- (f) findings
+# --------------------------------------------------------------------------- (e) realistic sensing
+SENSING_COLUMNS = ("sensing", "verdict", "its E_max rad", "sup|E|/E_max (exact)", "settled |E| rad", "RMS u V",
+                   "TV u V/s", "max |u| V", "unmet (value vs limit)")
+
+
+def sensing_rows(summary: Mapping[str, Any]) -> list[list[str]]:
+    """One row per run of summary.json's ``sensing`` (:mod:`wmr_mj.report.sensing`)."""
+    from wmr_mj.analysis.verdicts import format_unmet
+
+    out = []
+    for r in summary["sensing"]["runs"]:
+        plateau = r["settled_E"]
+        name = r["sensing"] if r["label"] == r["sensing"] else f"{r['sensing']} ({r['label']})"
+        out.append([name, r["verdict"], _fmt(r["certificate_E_max"], ".3g", "none"),
+                    _fmt(r["sup_E_over_ideal_E_max"]), f"{_fmt(plateau['mean'])} ({_fmt(plateau['min'])}-"
+                    f"{_fmt(plateau['max'])})", _fmt(r["rms_voltage"]), _fmt(r["tv_voltage"]),
+                    _fmt(r["max_abs_voltage"]), format_unmet(r["unmet"]) or "-"])
+    return out
+
+
+def sensing_blocks(summary: Mapping[str, Any]) -> list[Block]:
+    """Section (e), where the report has it (reports written before it have no ``sensing``)."""
+    sec = summary.get("sensing")
+    if not sec:
+        return []
+    return [("h2", f"(e) The certified design on realistic sensing (m1 = {sec['m1']:g} kg, {sec['duration']:g} s)"),
+            ("table", SENSING_COLUMNS, sensing_rows(summary)),
+            ("p", f"The law reads the encoder (alpha' its backward difference, filtered for the 14-bit preset); E is "
+                  f"judged on the true state. Each run is judged against its own certificate, which covers the "
+                  f"sensing's measurement errors or names the assumption it lacks; sup|E|/E_max is of the exact-"
+                  f"measurement certificate (E_max = {_fmt(sec['ideal_E_max'], '.4g')} rad). TV u: total variation "
+                  f"of the voltage per second. Settled |E|: mean (min-max) of |E| over the last "
+                  f"{_fmt(sec['runs'][0]['settled_E']['window_s'], 'g')} s, beside the dead band F^/(P^ K_P) = "
+                  f"{_fmt(sec['F_estimate'])}/({_fmt(sec['P_estimate'])} x {_fmt(sec['kp'], 'g')}) = "
+                  f"{_fmt(sec['dead_band'])} rad, where the PD part alone supplies the Coulomb voltage once the "
+                  f"differenced velocity reads 0.")]
+
+
+def sensing_finding(section: Mapping[str, Any]) -> str:
+    """One sentence: which presets keep the certificate, what the coarsest costs, where the dead band sits."""
+    runs = section["runs"]
+    ideal, others = runs[0], runs[1:]
+    kept = [r["sensing"] for r in others if r["verdict"] == "certified-inside"]
+    worst = max(others, key=lambda r: r["tv_voltage"]) if others else ideal
+    return (f"On realistic sensing (m1 = {section['m1']:g} kg) the certified design's certificate still closes on "
+            f"{len(kept)}/{len(others)} presets ({', '.join(kept) or 'none'}); the most active, {worst['sensing']}, "
+            f"asks {worst['tv_voltage']:.3g} V/s of total variation of u against {ideal['tv_voltage']:.3g} V/s with "
+            f"exact sensing, and its |E| settles at {worst['settled_E']['mean']:.3g} rad, beside "
+            f"F^/(P^ K_P) = {section['dead_band']:.3g} rad.")
+
+
+# --------------------------------------------------------------------------- (g) findings
 def _rung_finding(before: Mapping[str, Any], r: Mapping[str, Any]) -> str:
     def step(key: str, fmt: str = "d") -> str:
         a, b = before[key], r[key]
@@ -504,6 +556,8 @@ def findings(summary: Mapping[str, Any]) -> list[str]:
                f"{_fmt(last['certificate'].get('E_max'), '.4g')} rad.")
     out += _search_findings(summary)
     out += _friction_finding(summary) + _identification_finding(summary) + _paper_view_finding(summary)
+    if summary.get("sensing"):
+        out.append(sensing_finding(summary["sensing"]))
     n_out = summary.get("certified_outside", 0)
     out.append("No run of this report is certified-outside." if not n_out else
                f"!!! {n_out} run(s) are CERTIFIED-OUTSIDE: a bug or a modelling gap; report it. !!!")
@@ -518,6 +572,8 @@ def banner(summary: Mapping[str, Any]) -> list[Block]:
     where = [f"rung {r['index']} ({r['certified_outside']})" for r in summary["ladder"] if r["certified_outside"]]
     where += [f"search {s['key']} ({s['verdicts']['certified-outside']})" for s in summary.get("searches") or []
               if s["verdicts"]["certified-outside"]]
+    if (summary.get("sensing") or {}).get("certified_outside"):
+        where.append(f"realistic sensing ({summary['sensing']['certified_outside']})")
     return [("loud", f"!!! CERTIFIED-OUTSIDE: {n} run(s) ({', '.join(where)}) are outside a certificate whose "
                      "assumptions all hold. This is a bug or a modelling gap: report it. !!!")]
 
@@ -549,6 +605,7 @@ def answer_blocks(summary: Mapping[str, Any], *, brief: bool = False, with_banne
         ("h2", "(d) The plant's measured friction law (steering joint, m1 = "
                f"{summary['settings']['nominal_m1']:g} kg, constant voltages from the home keyframe)"),
         ("table", FRICTION_COLUMNS, friction_rows(summary)),
+        *sensing_blocks(summary),
     ]
 
 
@@ -621,10 +678,10 @@ def document(summary: Mapping[str, Any]) -> list[Block]:
         ("h1", "wmr-mj validate: does the paper's steering controller keep its promise on the MuJoCo C80?"),
         ("p", f"{summary['created']} - {_settings_line(summary)}."),
         *answer_blocks(summary, with_banner=False),
-        ("h2", f"(e) Identification (m1 = {ident['m1']:g} kg, {ident['duration']:g} s excitation)"),
+        ("h2", f"(f) Identification (m1 = {ident['m1']:g} kg, {ident['duration']:g} s excitation)"),
         ("table", IDENT_COLUMNS, identification_rows(summary)),
         ("p", "diff = (identified - predicted) / |predicted|."),
-        ("h2", "(f) Findings"),
+        ("h2", "(g) Findings"),
         ("ul", summary["findings"]),
         ("h2", "Figures"),
         *_figure_blocks(summary),

@@ -14,6 +14,8 @@
    certified design against its certificate over the m1 box, beside the Monte-Carlo worst
    of the same rung; and for the certified design over the 'full' uncertainty box;
 5. :func:`nominal_stage`: the paper's and the certified design at m1 = 650 kg (time histories);
+5b. :func:`wmr_mj.report.sensing.sensing_stage`: the certified design at the top of the m1 box on exact
+   sensing and on realistic encoders (verdict, voltage activity, dead band; summary.json's ``sensing``);
 6. :func:`wmr_mj.report.figures.figures_stage`: PNG + SVG in figures/;
 7. :func:`write_report`: summary.json, summary.csv, index.md, index.html (atomic), rendered
    by :mod:`wmr_mj.report.text`, which opens with the answer.
@@ -319,6 +321,7 @@ def run_validate(settings: ValidateSettings, out_dir: str | os.PathLike, *, log:
     """
     from wmr_mj.report.figures import figures_stage
     from wmr_mj.report.search import search_stage
+    from wmr_mj.report.sensing import sensing_stage
     from wmr_mj.report.text import findings
 
     wall0 = time.perf_counter()
@@ -332,6 +335,7 @@ def run_validate(settings: ValidateSettings, out_dir: str | os.PathLike, *, log:
     designs = designs_stage(settings, folder, st, first_index=len(LADDER) + 2)
     searches = search_stage(settings, folder, st, rungs)
     nominal = nominal_stage(settings, st)
+    sensing = sensing_stage(settings, st)
     figures, fig7 = figures_stage(settings, folder, st, rungs, searches, nominal)
     st.start("report", "summary.json, summary.csv, index.md, index.html")
     summary: dict[str, Any] = {
@@ -342,7 +346,8 @@ def run_validate(settings: ValidateSettings, out_dir: str | os.PathLike, *, log:
         "correction_rung": corrected, "path": _path_summary(settings),
         **({"designs": designs} if designs else {}),
         "certified_outside": sum(r["certified_outside"] for r in [*rungs, *designs]) + corrected["certified_outside"]
-        + sum(s["verdicts"]["certified-outside"] for s in searches),
+        + sum(s["verdicts"]["certified-outside"] for s in searches) + sensing["certified_outside"],
+        "sensing": sensing,
         "versions": software_versions(),
     }
     summary["findings"] = findings(summary)

@@ -1,10 +1,11 @@
 """Versioned scenario suites: one yardstick for every controller (``wmr-mj compare``).
 
 A suite (``wmr_mj/data/suites/<name>.toml``, e.g. ``standard-v1``) is data: scenarios, each a path of
-C x a plant x signals on the plant with a stable identifier; requirements in STL that every run is
-judged by; and the adversary's box, over which ``compare`` falsifies every controller at the same
-budget and seed. Changing any of it makes a new suite version; results name the suite's name and
-version with the wmr-mj and MuJoCo versions (:func:`versions`).
+C x a plant x signals on the plant (x, from ``standard-v2``, the cart as it is built: its sensing, actuation
+and gear play, a ``[hardware.<name>]`` table; ideal where a scenario names none) with a stable identifier;
+requirements in STL that every run is judged by; and the adversary's box, over which ``compare`` falsifies
+every controller at the same budget and seed. Changing any of it makes a new suite version; results name the
+suite's name and version with the wmr-mj and MuJoCo versions (:func:`versions`).
 
 Usage::
 
@@ -12,6 +13,7 @@ Usage::
     suite = load_suite("standard-v1")
     [s.id for s in suite.scenarios][:2]      # ['circle/nominal/none', 'circle/nominal/pulse']
     config = suite.scenarios[0].config(base)  # the RunConfig of that scenario for a design's base config
+    load_suite("standard-v2").scenario("circle/nominal/none/magnetic-12bit").sensing   # Sensing(4096 ticks, ...)
 """
 
 from __future__ import annotations
@@ -46,9 +48,16 @@ class Scenario:
     signals: Mapping[str, Any] | None
     duration: float
     reference_bounds: str | None
+    #: the cart as it is built (``[hardware.<name>]``): None where the scenario names none (the design's own,
+    #: ideal by default; every scenario of standard-v1), else the typed parts the run gets
+    hardware: str | None = None
+    sensing: Any = None  # wmr_mj.hardware.Sensing
+    actuation: Any = None  # wmr_mj.hardware.Actuation
+    transmission: Any = None  # wmr_mj.hardware.Transmission
 
     def config(self, base: RunConfig) -> RunConfig:
-        """``base`` (a design: its controller, tracker, gains, model) on this scenario."""
+        """``base`` (a design: its controller, tracker, gains, model) on this scenario; on the scenario's
+        hardware where it names one (its sensing, actuation and transmission replace the design's)."""
         params = dict(self.plant_params)
         m1 = params.pop("m1", None)
         changes: dict[str, Any] = {"path": self.path, "duration": self.duration,
@@ -57,6 +66,8 @@ class Scenario:
                                    "reference_bounds": self.reference_bounds}
         if m1 is not None:
             changes["m1"] = float(m1)
+        if self.hardware is not None:
+            changes.update(sensing=self.sensing, actuation=self.actuation, transmission=self.transmission)
         return base.replace(**changes)
 
 
@@ -115,9 +126,16 @@ class Suite:
         return tuple(out)
 
     def as_dict(self) -> dict[str, Any]:
-        return {"name": self.name, "version": self.version, "sha256": self.sha256, "duration": self.duration,
-                "d_max": self.d_max, "reference_bounds": self.reference_bounds,
-                "requirements": dict(self.requirements), "scenarios": [s.id for s in self.scenarios]}
+        """JSON form; ``hardware`` (scenario id -> its sensing, actuation and transmission labels) only where a
+        scenario names hardware (a suite without, standard-v1, gives the keys it always gave)."""
+        out = {"name": self.name, "version": self.version, "sha256": self.sha256, "duration": self.duration,
+               "d_max": self.d_max, "reference_bounds": self.reference_bounds,
+               "requirements": dict(self.requirements), "scenarios": [s.id for s in self.scenarios]}
+        built = {s.id: {"hardware": s.hardware, "sensing": s.sensing.label(), "actuation": s.actuation.label(),
+                        "transmission": s.transmission.label()} for s in self.scenarios if s.hardware is not None}
+        if built:
+            out["hardware"] = built
+        return out
 
 
 def suite_names() -> tuple[str, ...]:
@@ -155,9 +173,36 @@ def load_suite(name: str) -> Suite:
     where = f"suite {name!r}"
     try:
         return _build(data, where, str(path), hashlib.sha256(raw).hexdigest())
+    except (ParameterError, UnknownNameError):
+        raise  # already one line naming the table and what is accepted
     except (KeyError, TypeError, ValueError) as exc:
         raise ParameterError(f"{where}: malformed ({type(exc).__name__}: {exc}); see "
                              "wmr_mj/data/suites/standard-v1.toml for the format") from None
+
+
+_HARDWARE_KEYS = ("sensing", "actuation", "backlash")
+
+
+def _hardware(name: str, spec: Mapping[str, Any], where: str) -> dict[str, Any]:
+    """A ``[hardware.<name>]`` table as typed parts: ``sensing`` and ``actuation`` in the spec forms of
+    :meth:`wmr_mj.hardware.Sensing.from_spec` / :meth:`~wmr_mj.hardware.Actuation.from_spec` (a preset name,
+    ``"KEY=VALUE,..."`` or an inline table), ``backlash`` in rad at the steering axis; each ideal where absent.
+
+    Raises:
+        UnknownNameError: an unknown key of the table (or of a spec).
+        ParameterError: a bad value (the part's message, prefixed with the table).
+    """
+    from wmr_mj.hardware import Actuation, Sensing, Transmission
+
+    for key in spec:
+        if key not in _HARDWARE_KEYS:
+            raise UnknownNameError(f"{where}: [hardware.{name}] key", str(key), _HARDWARE_KEYS)
+    try:
+        return {"sensing": Sensing.from_spec(spec.get("sensing")),
+                "actuation": Actuation.from_spec(spec.get("actuation")),
+                "transmission": Transmission.from_spec(spec.get("backlash", 0.0))}
+    except ParameterError as exc:
+        raise ParameterError(f"{where}: [hardware.{name}] {exc}") from None
 
 
 def _build(data: Mapping[str, Any], where: str, source: str, sha256: str) -> Suite:
@@ -177,6 +222,7 @@ def _build(data: Mapping[str, Any], where: str, source: str, sha256: str) -> Sui
     for sig, content in data["signals"].items():
         signal_sets[sig] = ({**content, "d_max": d_max} if content else None)
     requirements = {str(k): str(v) for k, v in data["requirements"].items()}
+    hardware = {str(name): _hardware(name, spec, where) for name, spec in data.get("hardware", {}).items()}
     scenarios, seen = [], set()
     for s in data["scenario"]:
         sid = str(s["id"])
@@ -187,9 +233,14 @@ def _build(data: Mapping[str, Any], where: str, source: str, sha256: str) -> Sui
             raise UnknownNameError(f"{where}: scenario {sid!r} plant", s["plant"], tuple(plants))
         if s["signals"] not in signal_sets:
             raise UnknownNameError(f"{where}: scenario {sid!r} signals", s["signals"], tuple(signal_sets))
+        built: dict[str, Any] = {}
+        if "hardware" in s:
+            if s["hardware"] not in hardware:
+                raise UnknownNameError(f"{where}: scenario {sid!r} hardware", s["hardware"], tuple(hardware))
+            built = {"hardware": str(s["hardware"]), **hardware[s["hardware"]]}
         scenarios.append(Scenario(id=sid, path=str(s["path"]), plant=str(s["plant"]), plant_params=plants[s["plant"]],
                                   signals_name=str(s["signals"]), signals=signal_sets[s["signals"]],
-                                  duration=duration, reference_bounds=bounds))
+                                  duration=duration, reference_bounds=bounds, **built))
     adv = data["adversary"]
     if adv["requirement"] not in requirements:
         raise UnknownNameError(f"{where}: [adversary] requirement", adv["requirement"], tuple(requirements))
