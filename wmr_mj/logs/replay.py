@@ -610,8 +610,9 @@ def replay_figure(log: RunLog, rep: dict[str, Any]):
             verdict = "" if inside is None else f"{'inside' if inside else 'outside'} {claim} claim"
         extra = [v for v in (rep.get("verdict"), verdict, "TRUNCATED" if log.truncated else "") if v]
         hw = rep.get("hardware") or hardware_labels(log.config)
-        fig.suptitle(f"{Path(str(log.path)).name}: " + ", ".join(bits + extra) + "\n"
-                     + f"sensing: {hw['sensing']} | actuation: {hw['actuation']} | gear: {hw['gear']}", fontsize=10)
+        cart = ("" if all(v == "ideal" for v in hw.values())  # an ideal cart's title as it was
+                else f"\nsensing: {hw['sensing']} | actuation: {hw['actuation']} | gear: {hw['gear']}")
+        fig.suptitle(f"{Path(str(log.path)).name}: " + ", ".join(bits + extra) + cart, fontsize=10)
     return fig
 
 
