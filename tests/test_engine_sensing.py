@@ -63,7 +63,6 @@ def _offline(config: RunConfig, rows) -> tuple[np.ndarray, np.ndarray]:
 
 
 @needs_compiled
-@pytest.mark.slow
 @pytest.mark.parametrize("spec", SENSINGS)
 def test_compiled_and_python_sensed_runs_are_the_same_bits_and_the_offline_chain(spec):
     config = CERTIFIED.replace(sensing=spec)
@@ -98,7 +97,6 @@ def test_the_sensors_delay_reads_the_true_angle_exactly_d_steps_before():
 
 
 @needs_compiled
-@pytest.mark.slow
 def test_a_sensed_run_with_the_correction_is_the_same_bits_on_both_paths():
     """The tracker's outer loop rewrites the reference in the compiled model (own_model) block by block."""
     config = CERTIFIED.replace(sensing="encoder_ticks=4096,velocity=difference,delay=0.005,noise=uniform:0.0005,"
@@ -113,7 +111,6 @@ def test_a_sensed_run_with_the_correction_is_the_same_bits_on_both_paths():
 
 
 @needs_compiled
-@pytest.mark.slow
 def test_a_sensed_run_with_a_load_change_and_a_disturbance_is_the_same_bits_on_both_paths():
     """A load change steps the block in parts: the chain's state runs on through them."""
     signals = {"disturbance": {"kind": "step", "amplitude": 1.0, "t1": 2.0},
@@ -185,7 +182,6 @@ def test_set_state_restores_the_chain_from_the_compiled_models_userdata():
 
 @needs_compiled
 @needs_numba
-@pytest.mark.slow
 def test_a_plug_ins_compiled_law_compiles_with_sensing_and_reads_the_measured_state():
     """examples/fast_pd.py:FastPD (a pure ``law``) runs compiled by numba with a sensor, the same bits as its
     Python path; its voltage is its ``law`` of the measured rows."""

@@ -27,6 +27,12 @@ sets the chassis's model fields (:data:`LOAD_FIELDS`, as the model compiled for 
 them) at its control step, then mj_setConst, the block being stepped in parts around it. A run
 without signals steps exactly as before.
 
+A sensor (``Schedule.sensing``, :class:`wmr_mj.hardware.SensingChain`) sits between the plant and the law in
+both steppers: in the compiled callback (a numeric of the model, its state in userdata) and in the Python
+stepper (``SensingChain.step``), the same bits; the rows gain what the law read (:data:`SENSED_ROW_FIELDS`).
+The block loop (:class:`_BlockLoop`) knows nothing of it, and chooses its other hooks (the tracker, the
+fall-back, load changes) once, before the first block.
+
 Each block is handed to ``on_block`` (the MCAP logger) as arrays: the rows plus qpos, qvel, ctrl
 at every control step's start and the positions of sites A and C.
 
