@@ -48,6 +48,7 @@ bench: $(STAMP)
 	$(PY) bench/bench_sweep.py
 	$(PY) bench/bench_compare.py
 	$(PY) bench/bench_plugins.py
+	$(PY) bench/bench_sensing.py
 	$(PY) bench/bench_video.py
 
 clean:

@@ -116,7 +116,9 @@ static void sense(const mjtNum* sp, mjtNum* s, long long k, double alpha, double
   double c = p[P_TICKS_PER_RAD];
   if (c != 0.0) {
     double x = theta * c;
-    theta = (p[P_ROUNDING] == 1.0 ? floor(x) : nearbyint(x)) / c;
+    /* + 0.0: a count of zero ticks is +0, as Python's int 0 (round, math.floor) converts; rint and floor
+     * keep the sign of -0.3 or -0.0 and would give -0 (no other value changes: x + 0.0 = x for x != 0) */
+    theta = ((p[P_ROUNDING] == 1.0 ? floor(x) : nearbyint(x)) + 0.0) / c;
   }
   double alpha_m = motor_side ? theta / p[P_GEAR_RATIO] : theta;
   if (p[P_ALPHA_NOISE_ON] != 0.0) {

@@ -27,6 +27,12 @@ sets the chassis's model fields (:data:`LOAD_FIELDS`, as the model compiled for 
 them) at its control step, then mj_setConst, the block being stepped in parts around it. A run
 without signals steps exactly as before.
 
+A sensor (``Schedule.sensing``, :class:`wmr_mj.hardware.SensingChain`) sits between the plant and the law in
+both steppers: in the compiled callback (a numeric of the model, its state in userdata) and in the Python
+stepper (``SensingChain.step``), the same bits; the rows gain what the law read (:data:`SENSED_ROW_FIELDS`).
+The block loop (:class:`_BlockLoop`) knows nothing of it, and chooses its other hooks (the tracker, the
+fall-back, load changes) once, before the first block.
+
 Each block is handed to ``on_block`` (the MCAP logger) as arrays: the rows plus qpos, qvel, ctrl
 at every control step's start and the positions of sites A and C.
 
@@ -41,7 +47,7 @@ import math
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, cast
 
 import mujoco
 import numpy as np
@@ -463,70 +469,172 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
                on_progress: Callable[[int], None] | None = None, model: mujoco.MjModel | None = None) -> EngineRun:
     """Run ``schedule.n`` control steps of ``controller`` on the plant of ``params``; rows of every control step.
 
-    ``schedule`` (:class:`Schedule`): the reference, the control grid, the signals and the
-    tracker. ``on_block(block)``, where given, receives the rows of every simulated second with qpos,
+    ``schedule`` (:class:`Schedule`): the reference, the control grid, the signals, the tracker and the
+    sensor. ``on_block(block)``, where given, receives the rows of every simulated second with qpos,
     qvel, ctrl (at each control step's start, ctrl as applied), A_pos and C_pos (xy of sites A
     and C); ``on_progress(steps)`` the control steps of each block. KeyboardInterrupt (Ctrl-C,
     SIGTERM made one) ends the run as "interrupted" with the blocks simulated so far; a block
     committed but not yet handed to ``on_block`` is handed over before returning. ``model``:
     ``batch_model(params, **options)`` where the caller has it already.
+
+    The steps: resolve the backend and the plant's indices, check the inputs, reset the law (and the
+    tracker), build the first stepper (:func:`_first_stepper`), then :class:`_BlockLoop` steps the blocks.
     """
-    n, substeps, period, tracker = schedule.n, schedule.substeps, schedule.period, schedule.tracker
     backend, note = _backend(controller, law)
     plain = batch_model(params, **options) if model is None else model
     where = _Plant(plain)
-    log = on_block is not None
-    (a0_all, a0d_all, a0dd_all), disturbance, loads = _checked_inputs(schedule)
-    in_effect: dict[str, np.ndarray] = {}  # the load fields set so far (a Python stepper made later starts with them)
-
+    reference, disturbance, loads = _checked_inputs(schedule)
     strict = not compiled_law.supports(controller)
     chain = _sensing_chain(schedule, params)
-    sensed = chain is not None
-    controller.reset(control_period=period)
-    if tracker is not None:
-        tracker.reset(schedule.path_reference, control_period=period)
+    controller.reset(control_period=schedule.period)
+    if schedule.tracker is not None:
+        schedule.tracker.reset(schedule.path_reference, control_period=schedule.period)
 
     def python_stepper(fields: Mapping[str, np.ndarray] | None = None) -> _PythonStepper:
-        return _PythonStepper(plain, where, substeps, log, controller.step, (a0_all, a0d_all, a0dd_all),
-                              params.voltage_limit, disturbance, fields, period=period, strict=strict, chain=chain)
+        return _PythonStepper(plain, where, schedule.substeps, on_block is not None, controller.step, reference,
+                              params.voltage_limit, disturbance, fields, period=schedule.period, strict=strict,
+                              chain=chain)
 
-    lawful = None
-    ref_adr = 0
-    stepper: _CompiledStepper | _PythonStepper
     if backend == "compiled":
-        stepper, lawful, ref_adr = _compiled_stepper(params, controller, options, where, schedule,
-                                                     (a0_all, a0d_all, a0dd_all), disturbance, log, chain)
+        first: _CompiledStepper | _PythonStepper
+        first, lawful, ref_adr = _compiled_stepper(params, controller, options, where, schedule, reference,
+                                                   disturbance, on_block is not None, chain)
     else:
-        stepper = python_stepper()
-    used = "compiled" if backend == "compiled" else "python"
-    rows = {key: np.empty(n) for key in ROW_FIELDS + SENSED_ROW_FIELDS * sensed}
-    C_xy = np.empty((n, 2))
-    block_len = max(1, int(round(1.0 / period)))  # one simulated second per block
-    if tracker is not None:
-        block_len = tracker.block_steps  # the outer loop's period
-    blocks: dict[int, _Block] = {}
-    k_i = params.k_i
-    warned = 0  # warnings counted by a stepper left behind
-    status = "completed"
-    failure: str | None = None
-    k = sent = 0
+        first, lawful, ref_adr = python_stepper(), None, 0
+    loop = _BlockLoop(first, python_stepper, schedule=schedule, plain=plain, where=where, reference=reference,
+                      loads=loads, sensed=chain is not None, k_i=params.k_i, on_block=on_block, lawful=lawful,
+                      ref_adr=ref_adr, note=note)
+    return loop.run(on_progress)
 
-    def hand_over(upto: int) -> None:
-        nonlocal sent
-        if on_block is None or upto <= sent:
+
+class _BlockLoop:
+    """The block loop of :func:`run_engine` and the state its steps share: the stepper (which may fall back to
+    the Python law), the reference (which a tracker rewrites), the rows, the load fields in effect and the
+    rows handed over so far.
+
+    Every feature of a run is chosen once, here, never per block: the tracker's outer loop is the hook run
+    before each block (:meth:`_track`, else nothing), the fall-back is the compiled stepper's way of stepping
+    (:meth:`_step_watching`, else :meth:`_step_plain`), load changes are cut into the block by
+    :meth:`_step_block`, and the sensor lives in the steppers.
+    """
+
+    def __init__(self, stepper: _CompiledStepper | _PythonStepper,
+                 python_stepper: Callable[[Mapping[str, np.ndarray] | None], _PythonStepper], *, schedule: Schedule,
+                 plain: mujoco.MjModel, where: _Plant, reference: tuple[np.ndarray, np.ndarray, np.ndarray],
+                 loads: list[tuple[int, dict[str, np.ndarray]]], sensed: bool, k_i: float,
+                 on_block: Callable[[dict[str, np.ndarray]], None] | None, lawful: mujoco.MjModel | None,
+                 ref_adr: int, note: str | None) -> None:
+        self.stepper, self.python_stepper = stepper, python_stepper
+        self.n, self.period, self.tracker = schedule.n, schedule.period, schedule.tracker
+        self.plain, self.where, self.reference, self.loads = plain, where, reference, loads
+        self.sensed, self.k_i, self.on_block = sensed, k_i, on_block
+        self.lawful, self.ref_adr = lawful, ref_adr  # the compiled law's model and its reference's address
+        self.log = on_block is not None
+        self.used = "compiled" if isinstance(stepper, _CompiledStepper) else "python"
+        self.note = note
+        self.rows = {key: np.empty(self.n) for key in ROW_FIELDS + SENSED_ROW_FIELDS * sensed}
+        self.C_xy = np.empty((self.n, 2))
+        self.block_len = max(1, int(round(1.0 / self.period)))  # one simulated second per block
+        if self.tracker is not None:
+            self.block_len = self.tracker.block_steps  # the outer loop's period
+        self.blocks: dict[int, _Block] = {}
+        self.in_effect: dict[str, np.ndarray] = {}  # the load fields set so far (a later Python stepper starts so)
+        self.warned = 0  # warnings counted by a stepper left behind
+        self.k0 = self.cnt = self.k = self.sent = 0  # the block being stepped, the steps done, the rows handed over
+        self.before_block: Callable[[int, int], None] = self._track if self.tracker is not None else _nothing
+        self.advance: Callable[[_Block, int, int], None] = (
+            self._step_watching if isinstance(stepper, _CompiledStepper) else self._step_plain)
+
+    def run(self, on_progress: Callable[[int], None] | None) -> EngineRun:
+        """Step every block; an interrupt or a law's failure ends the run with the steps done before it."""
+        status, failure = "completed", None
+        wall0, cpu0 = time.perf_counter(), time.thread_time()
+        try:
+            # The hot loop: one rollout call, or one Python stepper call, per block of control steps and no
+            # Python per physics step; no branch per feature (the hooks were chosen in __init__).
+            for k0 in range(0, self.n, self.block_len):
+                self.k0 = k0
+                self.cnt = cnt = min(self.block_len, self.n - k0)
+                b = self.blocks.get(cnt)
+                if b is None:
+                    b = self.blocks[cnt] = _Block(cnt, self.plain, self.log, self.sensed)
+                self.before_block(k0, cnt)
+                self.advance(b, k0, cnt)
+                _record_block(self.rows, self.C_xy, b, k0, self.period, self.reference, self.k_i)
+                self.k = k0 + cnt
+                self.hand_over(self.k)
+                if on_progress is not None:
+                    on_progress(cnt)
+        except KeyboardInterrupt:
+            status = "interrupted"
+        except ControllerFailure as exc:  # the run stops at the failing step; what was simulated before it stays
+            status, failure = "failed", str(exc)
+            self._keep_steps_before(exc.steps_done)
+        if self.k:
+            self.hand_over(self.k)  # a block interrupted between its rows and its hand-over
+        wall, cpu = time.perf_counter() - wall0, time.thread_time() - cpu0
+        k = self.k
+        return EngineRun(rows={key: v[:k] for key, v in self.rows.items()}, steps=k, status=status,
+                         warnings=self.warned + self.stepper.warnings(), law=self.used, law_note=self.note,
+                         wall_s=wall, cpu_s=cpu, C_xy=self.C_xy[:k], failure=failure)
+
+    def _keep_steps_before(self, done_in_block: int) -> None:
+        """A law failed in the block at k0: its ``done_in_block`` steps before the failure become rows."""
+        if done_in_block and self.k == self.k0:
+            part = self.blocks[done_in_block] = _Block.head(self.blocks[self.cnt], done_in_block)
+            self.cnt = done_in_block
+            _record_block(self.rows, self.C_xy, part, self.k0, self.period, self.reference, self.k_i)
+            self.k = self.k0 + done_in_block
+
+    def hand_over(self, upto: int) -> None:
+        """The rows up to control step ``upto`` not handed to ``on_block`` yet, with the block's log arrays."""
+        if self.on_block is None or upto <= self.sent:
             return
-        sl = slice(sent, upto)
-        block = {key: rows[key][sl] for key in rows}
-        b = blocks[cnt]
-        lo = sent - k0  # the rows of this block not handed over yet
+        rows, b, where = self.rows, self.blocks[self.cnt], self.where
+        block = {key: rows[key][self.sent:upto] for key in rows}
+        lo = self.sent - self.k0  # the rows of this block not handed over yet
         block.update(qpos=b.qpos[lo:], qvel=b.qvel[lo:], ctrl=b.ctrl[lo:],
                      A_pos=b.sites[lo:, where.site_A, :2], C_pos=b.sites[lo:, where.site_C, :2])
-        sent = upto  # first: an interrupt raised as the block is written must not send it twice
-        on_block(block)
+        self.sent = upto  # first: an interrupt raised as the block is written must not send it twice
+        self.on_block(block)
 
-    def step_block(st: _CompiledStepper | _PythonStepper, b: _Block, k0: int, cnt: int) -> None:
+    def _track(self, k0: int, cnt: int) -> None:
+        """The tracker's outer loop: it measures C after the last block, then writes this block's reference."""
+        tracker, C_xy, rows, period = self.tracker, self.C_xy, self.rows, self.period
+        if k0:
+            # C's speed over the control step before (NaN until two samples exist)
+            speed = (math.hypot(*(C_xy[k0 - 1] - C_xy[k0 - 2])) / period) if k0 >= 2 else math.nan
+            tracker.measure(rows["t"][k0 - 1], C_xy[k0 - 1], rows["heading"][k0 - 1], speed)
+        sl = slice(k0, k0 + cnt)
+        a0_all, a0d_all, a0dd_all = self.reference
+        a0_all[sl], a0d_all[sl], a0dd_all[sl] = _tracker_block(tracker, k0, cnt)
+        if self.lawful is not None:  # the compiled law reads its reference from the model
+            self.lawful.numeric_data[self.ref_adr + 3 * k0:self.ref_adr + 3 * (k0 + cnt)] = np.stack(
+                [a0_all[sl], a0d_all[sl], a0dd_all[sl]], axis=1).ravel()
+
+    def _step_plain(self, b: _Block, k0: int, cnt: int) -> None:
+        self._step_block(self.stepper, b, k0, cnt)
+
+    def _step_watching(self, b: _Block, k0: int, cnt: int) -> None:
+        """A block on the compiled law; where MuJoCo warns (rollout stops a simulation whose warnings rise), the
+        block again from its first state with the Python law, which goes on after a warning as mj_step does,
+        and the rest of the run with it (the sensor's memory carried over: :meth:`_PythonStepper.set_state`)."""
+        stepper = cast(_CompiledStepper, self.stepper)  # this way of stepping is chosen for the compiled stepper
+        before, start, fields_before = stepper.warnings(), stepper.state(), dict(self.in_effect)
+        self._step_block(stepper, b, k0, cnt)
+        if stepper.warnings() == before:
+            return
+        python = self.python_stepper(fields_before)
+        python.set_state(self.lawful, start)
+        self.warned, self.stepper, self.used, self.advance = before, python, "python", self._step_plain
+        self.note = "MuJoCo warned; the run went on from that block with the Python law"
+        self.in_effect.clear()
+        self.in_effect.update(fields_before)
+        self._step_block(python, b, k0, cnt)
+
+    def _step_block(self, st: _CompiledStepper | _PythonStepper, b: _Block, k0: int, cnt: int) -> None:
         """Step one block; with load changes in it, in parts, each change set at its control step."""
-        due = [(kc, f) for kc, f in loads if k0 <= kc < k0 + cnt]
+        due = [(kc, f) for kc, f in self.loads if k0 <= kc < k0 + cnt]
         if not due:
             st.step(b, k0, cnt)
             return
@@ -535,70 +643,17 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
             for kc, f in due:
                 if kc == s0:
                     st.set_fields(f)
-                    in_effect.update(f)
-            part = _Block(s1 - s0, plain, log, len(b.alpha_measured) > 0)
+                    self.in_effect.update(f)
+            part = _Block(s1 - s0, self.plain, self.log, len(b.alpha_measured) > 0)
             st.step(part, s0, s1 - s0)
             sl = slice(s0 - k0, s1 - k0)
             for name, value in vars(part).items():  # every record the part has rows of (C_xy included)
                 if len(value):
                     getattr(b, name)[sl] = value
 
-    k0 = cnt = 0
-    wall0, cpu0 = time.perf_counter(), time.thread_time()
-    # The block loop stays in one piece: it is the hot loop (one rollout call, or one Python
-    # stepper call, per block of control steps and no Python per physics step), and its state
-    # (the stepper, which may fall back to the Python law, the reference the tracker rewrites,
-    # the rows handed over so far) is shared by every part of it.
-    try:
-        for k0 in range(0, n, block_len):
-            cnt = min(block_len, n - k0)
-            b = blocks.get(cnt)
-            if b is None:
-                b = blocks[cnt] = _Block(cnt, plain, log, sensed)
-            if tracker is not None:
-                if k0:
-                    # C's speed over the control step before (NaN until two samples exist)
-                    speed = (math.hypot(*(C_xy[k0 - 1] - C_xy[k0 - 2])) / period) if k0 >= 2 else math.nan
-                    tracker.measure(rows["t"][k0 - 1], C_xy[k0 - 1], rows["heading"][k0 - 1], speed)
-                sl = slice(k0, k0 + cnt)
-                a0_all[sl], a0d_all[sl], a0dd_all[sl] = _tracker_block(tracker, k0, cnt)
-                if lawful is not None:  # the compiled law reads its reference from the model
-                    lawful.numeric_data[ref_adr + 3 * k0:ref_adr + 3 * (k0 + cnt)] = np.stack(
-                        [a0_all[sl], a0d_all[sl], a0dd_all[sl]], axis=1).ravel()
-            if isinstance(stepper, _CompiledStepper):
-                before, start, fields_before = stepper.warnings(), stepper.state(), dict(in_effect)
-                step_block(stepper, b, k0, cnt)
-                if stepper.warnings() != before:  # rollout stopped the simulation: this block again, stepwise
-                    python = python_stepper(fields_before)
-                    python.set_state(lawful, start)
-                    warned, stepper, used = before, python, "python"
-                    note = "MuJoCo warned; the run went on from that block with the Python law"
-                    in_effect.clear()
-                    in_effect.update(fields_before)
-                    step_block(stepper, b, k0, cnt)
-            else:
-                step_block(stepper, b, k0, cnt)
-            _record_block(rows, C_xy, b, k0, period, (a0_all, a0d_all, a0dd_all), k_i)
-            k = k0 + cnt
-            hand_over(k)
-            if on_progress is not None:
-                on_progress(cnt)
-    except KeyboardInterrupt:
-        status = "interrupted"
-    except ControllerFailure as exc:  # the run stops at the failing step; what was simulated before it stays
-        status, failure = "failed", str(exc)
-        done_in_block = exc.steps_done
-        if done_in_block and k == k0:  # the failing block's steps before the failure
-            part = blocks[done_in_block] = _Block.head(blocks[cnt], done_in_block)
-            cnt = done_in_block
-            _record_block(rows, C_xy, part, k0, period, (a0_all, a0d_all, a0dd_all), k_i)
-            k = k0 + done_in_block
-    if k:
-        hand_over(k)  # a block interrupted between its rows and its hand-over
-    wall, cpu = time.perf_counter() - wall0, time.thread_time() - cpu0
-    done = {key: v[:k] for key, v in rows.items()}
-    return EngineRun(rows=done, steps=k, status=status, warnings=warned + stepper.warnings(), law=used,
-                     law_note=note, wall_s=wall, cpu_s=cpu, C_xy=C_xy[:k], failure=failure)
+
+def _nothing(k0: int, cnt: int) -> None:
+    """No hook before a block (a run without a tracker)."""
 
 
 def _tracker_block(tracker: Any, k0: int, cnt: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
