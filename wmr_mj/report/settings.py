@@ -17,6 +17,7 @@ from typing import Any
 from wmr_mj._util.checks import as_pair, integer_at_least, positive_number
 from wmr_mj._util.progress import Stages
 from wmr_mj.errors import ParameterError, UnknownNameError
+from wmr_mj.hardware.cart import CART_PARTS, cart_dict
 from wmr_mj.params import C80, M1_NOMINAL, M1_RANGE
 from wmr_mj.sim.config import RunConfig, build_reference
 from wmr_mj.sim.designs import DesignLike
@@ -146,12 +147,9 @@ class ValidateSettings:
             del d["designs"]  # the settings written before designs existed, unchanged
         else:
             d["designs"] = list(self.designs)
-        for name in ("sensing", "actuation", "transmission"):  # likewise: only where the cart is not ideal
-            part = getattr(self, name)
-            if part.is_ideal:
-                del d[name]
-            else:
-                d[name] = part.as_dict()
+        for name in CART_PARTS:  # likewise: only the parts of the cart that are not ideal
+            del d[name]
+        d.update(cart_dict(self))
         return d
 
 

@@ -25,6 +25,7 @@ from controllers import SteeringController, make_controller, model_from_source
 from controllers.computed_torque import CONTROLLER_NAMES, FRICTION_SIGNS, MODEL_SOURCES
 from wmr_mj._util.checks import as_pair
 from wmr_mj.errors import ParameterError, UnknownNameError
+from wmr_mj.hardware.cart import CART_PARTS, cart_dict
 from wmr_mj.params import C80, M1_NOMINAL, M1_RANGE, PAPER_KD, PAPER_KP, C80Parameters, parameter_names, with_params
 from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS, TIMESTEP, TYRE_CONTACT_MODELS
 
@@ -170,12 +171,9 @@ class RunConfig:
                     d[kind] = source.name  # an object: its name (the plugin record says where it came from)
         if self.tracker is None:
             del d["tracker"]
-        for name in ("sensing", "actuation", "transmission"):  # likewise: only where the cart is not ideal
-            part = getattr(self, name)
-            if part.is_ideal:
-                del d[name]
-            else:
-                d[name] = part.as_dict()
+        for name in CART_PARTS:  # likewise: only the parts of the cart that are not ideal
+            del d[name]
+        d.update(cart_dict(self))
         if self.reference_bounds is None:
             del d["reference_bounds"]  # likewise
         else:
