@@ -1061,7 +1061,8 @@ def _certify_measured(bound: _Bound, meas: _Measured, *, compensation: Compensat
     if m.delay_s > 0.0:
         own.append(Assumption(
             DELAY_FIXED_POINT, "tau c_v < 1 and a fixed point with |a(t-tau) - a(t)| <= tau sup|a'|, "
-            "|a'(t-tau) - a'(t)| <= tau sup|a''| inside it", valid and at.rho < 1.0, at.rho, 1.0,
+            "|a'(t-tau) - a'(t)| <= tau sup|a''| inside it", valid and at.rho < 1.0,
+            at.rho if valid else math.inf, 1.0,  # without a fixed point there is no rho to show as met
             f"tau = {m.delay_s:g} s, c_v = {at.c_v:.4g} 1/s" + (f"; {reason}" if not valid else ""), kind="checked"))
     assumptions = _assumptions(cond=at.condition, valid=valid, alpha_max=alpha_max, reason=reason,
                                iterations=iterations, voltage_max=voltage_max, limits=limits, gains=gains,
