@@ -180,7 +180,8 @@ def verdict_lines(summary: Mapping[str, Any]) -> list[str]:
     question = (f"Question: does the paper's robustness region hold for the C80 under m1 in {lo:g}-{hi:g} kg? "
                 f"({summary['ladder'][0]['n']} MuJoCo runs per design on {_path_words(s)}, {s['duration']:g} s each)")
     report = (f"Report: {summary['folder']}/index.html (also index.md, summary.json); the details follow: (a) the "
-              "paper's design, (b) the ladder between the designs, (c) the certified design, (d) the friction law.")
+              "paper's design, (b) the ladder between the designs, (c) the certified design, (d) the friction law, "
+              "(e) the certified design on realistic sensing.")
     return [question, _paper_verdict(summary), _why_verdict(summary), _certified_verdict(summary), report]
 
 
