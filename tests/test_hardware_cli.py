@@ -9,6 +9,7 @@ import json
 import math
 
 import pytest
+from test_cli_errors import _one_error_line
 
 from wmr_mj.analysis.measurement import MEASUREMENT_COVERED
 from wmr_mj.analysis.verdicts import format_unmet, unmet_assumptions
@@ -22,14 +23,6 @@ from wmr_mj.sim.search_space import HARDWARE_AXES, config_for, with_hardware
 
 #: a short run: the lane change reaches its manoeuvre in 6 s
 SHORT = ["--preset", "certified", "--path", "lane-change", "--duration", "6"]
-
-
-def _one_error_line(capsys) -> str:
-    err = capsys.readouterr().err
-    lines = err.strip().splitlines()
-    assert len(lines) == 1, err
-    assert lines[0].startswith("wmr-mj: error: ") and "Traceback" not in err
-    return lines[0]
 
 
 def _json(capsys) -> dict:
