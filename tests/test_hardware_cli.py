@@ -202,3 +202,16 @@ def test_robustness_certificate_and_validate_take_the_cart(capsys):
     assert main(["validate", "--n", "1", "--sensing", "delay=0.0007"]) == 2
     assert "0.0007" in _one_error_line(capsys)
     assert math.isclose(Sensing.from_spec("delay=0.002").delay, 0.002)
+
+
+def test_validate_s_report_names_a_built_cart_and_keeps_today_s_line():
+    """The report's settings line (index.md, the console) names the cart where one part is not ideal, from the
+    settings' own record; today's plant keeps the line it had."""
+    from wmr_mj.report.settings import ValidateSettings
+    from wmr_mj.report.text import _settings_line
+
+    ideal = _settings_line({"settings": ValidateSettings().as_dict()})
+    built = _settings_line({"settings": ValidateSettings(sensing="magnetic-12bit-axis", transmission=0.002).as_dict()})
+    assert "cart" not in ideal and built.startswith(ideal)
+    assert built[len(ideal):] == ("; cart: sensing " + Sensing.from_spec("magnetic-12bit-axis").label()
+                                  + ", transmission backlash +-2 mrad")

@@ -623,7 +623,18 @@ def _settings_line(summary: Mapping[str, Any]) -> str:
     others = "" if box == "m1" else " and the rest of the full uncertainty box (wmr_mj/params.py)"
     return (f"{s['n']} runs per rung, {s['sampling']} sampling of m1 over {s['m1_range'][0]:g}-{s['m1_range'][1]:g} "
             f"kg{others}, seed {s['seed']}, {s['duration']:g} s per run on {_path_words(s)}; {search}; identification "
-            f"{s['identify_duration']:g} s at m1 = {s['nominal_m1']:g} kg")
+            f"{s['identify_duration']:g} s at m1 = {s['nominal_m1']:g} kg" + _cart_words(s))
+
+
+def _cart_words(settings: Mapping[str, Any]) -> str:
+    """'; cart: ...' naming the parts of the cart that are not ideal (the settings carry only those); '' for
+    today's plant."""
+    from wmr_mj.hardware import Actuation, Sensing, Transmission
+
+    parts = [(name, cls) for name, cls in (("sensing", Sensing), ("actuation", Actuation),
+                                           ("transmission", Transmission)) if settings.get(name)]
+    return "".join(("; cart: " if i == 0 else ", ") + f"{name} {cls.from_spec(settings[name]).label()}"
+                   for i, (name, cls) in enumerate(parts))
 
 
 def fig4_caption(summary: Mapping[str, Any]) -> str:
