@@ -19,11 +19,11 @@ def add_controller_source(out: dict[str, Any], config: Any) -> dict[str, Any]:
     (:class:`controllers.registry.PluginSource`: spec, name, origin, import path of the file or module and
     class, parameters, the SHA-256 of its source), for every law but those built from the config's fields
     (computed-torque, pd), whose JSON keeps the keys it always had. The JSON of run, sweep and falsify."""
-    from wmr_mj.sim.config import plugin_source
+    from wmr_mj.sim.config import controller_source
 
-    source = plugin_source(config, "controller")
+    source = controller_source(config)
     if source is not None:
-        out["controller_source"] = source.as_dict()
+        out["controller_source"] = source
     return out
 
 

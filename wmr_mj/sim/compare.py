@@ -43,6 +43,7 @@ from wmr_mj.sim.config import (
     RunConfig,
     config_from_dict,
     controller_name,
+    controller_source,
 )
 from wmr_mj.sim.suite import Scenario, Suite, versions
 
@@ -403,7 +404,7 @@ def _row(design: Design, runs: Sequence[ScenarioRun], adversary: Any, spec: Any)
         tv_voltage=float(np.mean([r.tv_voltage for r in runs])) if runs else math.nan,
         cross_track_max=max(cross) if cross else None,
         cpu_us_per_step=float(np.median([r.cpu_us_per_step for r in runs])) if runs else math.nan,
-        law="/".join(sorted({r.law for r in runs})), controller_source=_source_of(design.config),
+        law="/".join(sorted({r.law for r in runs})), controller_source=controller_source(design.config),
         claim_broken=_claim_broken(runs, adversary),
         unmet=tuple(count_unmet((r.summary.get("certificate") or {}).get("unmet_assumptions") or [] for r in runs)),
         cart=cart_dict(design.config))
@@ -429,14 +430,6 @@ def _claim_broken(runs: Sequence[ScenarioRun], adversary: Any) -> dict[str, Any]
     count = len(found) - (broken is not None) + (0 if broken is None else int(broken["count"]))
     worst = max(found, key=lambda f: -math.inf if f["ratio"] is None else float(f["ratio"]))
     return {**worst, "count": count}
-
-
-def _source_of(config: RunConfig) -> dict[str, Any] | None:
-    """:func:`wmr_mj.sim.config.plugin_source` of the design's law as JSON (None: computed-torque, pd)."""
-    from wmr_mj.sim.config import plugin_source
-
-    source = plugin_source(config, "controller")
-    return None if source is None else source.as_dict()
 
 
 def runs_json(result: CompareResult) -> str:

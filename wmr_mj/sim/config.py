@@ -42,6 +42,7 @@ __all__ = [
     "has_tracker",
     "plugin_source",
     "controller_name",
+    "controller_source",
     "default_model",
     "config_from_dict",
     "estimate_of",
@@ -284,6 +285,14 @@ def default_model(controller: Any, params: Mapping[str, Any] | None = None) -> s
         raise UnknownNameError(f"default_model of controller {getattr(cls, 'name', controller)!r}", str(model),
                                MODEL_SOURCES)
     return str(model)
+
+
+def controller_source(config: RunConfig) -> dict[str, Any] | None:
+    """Where the run's law comes from as JSON (:func:`plugin_source`'s record, as the MCAP log keeps it: spec,
+    name, origin, import path, parameters, the SHA-256 of its source); None for computed-torque and pd, built
+    from the config's fields. The ``controller_source`` of every command's JSON."""
+    source = plugin_source(config, "controller")
+    return None if source is None else source.as_dict()
 
 
 def controller_name(config: RunConfig) -> str:
