@@ -426,10 +426,12 @@ def no_estimate_note(config) -> str | None:
     run's other settings (gains, box, path): which assumptions fail under each; None where it can hold,
     states no claim, or the law is not built in."""
     from controllers.registry import is_builtin
+    from wmr_mj.hardware.cart import is_ideal_cart
     from wmr_mj.params import C80
     from wmr_mj.plant.mjcf import TIMESTEP
     from wmr_mj.sim.certify import certificate_for
     from wmr_mj.sim.config import build_reference, controller_for, estimate_parameters
+    from wmr_mj.sim.designs import CERTIFIED
 
     if not is_builtin(config.controller) or config.model not in _ESTIMATES:
         return None
@@ -442,9 +444,6 @@ def no_estimate_note(config) -> str | None:
         if cert is None or cert.certified:
             return None
         unmet[model] = ", ".join(cert.unmet) or "no finite bound"
-    from wmr_mj.hardware.cart import is_ideal_cart
-    from wmr_mj.sim.designs import CERTIFIED
-
     label = controller_for(config, estimate_parameters(C80)).label()
     hint = ""
     if is_ideal_cart(config) and config.replace(**CERTIFIED.config_changes()) != config:
