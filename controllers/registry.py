@@ -39,7 +39,8 @@ from typing import Any
 
 from wmr_mj.errors import ParameterError, UnknownNameError
 
-__all__ = ["PluginSource", "resolve", "parse_params", "BUILTIN_CONTROLLERS", "BUILTIN_TRACKERS", "ENTRY_POINT_GROUPS",
+__all__ = ["PluginSource", "LocatedSource", "resolve", "parse_params", "locate_source", "check_recorded_source",
+           "recorded_spec", "BUILTIN_CONTROLLERS", "BUILTIN_TRACKERS", "ENTRY_POINT_GROUPS",
            "controller_names", "tracker_names", "source_hash", "is_builtin"]
 
 #: built-in steering laws: name -> "module:Class"
@@ -180,29 +181,55 @@ def _from_module(module_name: str, class_name: str, kind: str) -> tuple[type, st
     return obj, f"{module_name}:{class_name}"
 
 
-def _class_of(spec: str, kind: str) -> tuple[type, str, str]:
-    """(class, origin, import path) of a name."""
+def _form_of(spec: str, kind: str) -> tuple[str, str, str]:
+    """How a name is found, without finding it: (form, where, class name).
+
+    form: 'builtin' (where: its module), 'file' (where: the path as given), 'module' (where: the module
+    name) or 'entry-point' (where: the name; class name empty). :func:`resolve` imports by this form and
+    :func:`locate_source` finds the same file without importing, so both read it here.
+
+    Raises:
+        ParameterError: ``where:Class`` with an empty ``where`` or a class name that is not an identifier.
+    """
     builtins = BUILTIN_CONTROLLERS if kind == "controller" else BUILTIN_TRACKERS
     if spec in builtins:
         module_name, class_name = builtins[spec].split(":")
-        cls, path = _from_module(module_name, class_name, kind)
-        return cls, "builtin", path
+        return "builtin", module_name, class_name
     if ":" in spec:
         where, _, class_name = spec.rpartition(":")
         if not class_name.replace(".", "_").isidentifier() or not where:
             raise ParameterError(f"{kind} {spec!r} is not accepted: FILE.py:Class or module:Class")
         if where.endswith(".py") or "/" in where or "\\" in where:
-            cls, path = _from_file(where, class_name, kind)
-            return cls, "file", path
-        cls, path = _from_module(where, class_name, kind)
-        return cls, "module", path
+            return "file", where, class_name
+        return "module", where, class_name
+    return "entry-point", spec, ""
+
+
+def _entry_point(name: str, kind: str) -> Any:
+    """The installed entry point called ``name`` in the kind's group (read from metadata: nothing loaded);
+    None where there is none."""
     for ep in entry_points(group=ENTRY_POINT_GROUPS[kind]):
-        if ep.name == spec:
-            try:
-                cls = ep.load()
-            except Exception as exc:  # noqa: BLE001
-                raise ParameterError(f"{kind} entry point {spec!r} ({ep.value}) fails to load: {exc}") from None
-            return cls, "entry-point", ep.value
+        if ep.name == name:
+            return ep
+    return None
+
+
+def _class_of(spec: str, kind: str) -> tuple[type, str, str]:
+    """(class, origin, import path) of a name."""
+    form, where, class_name = _form_of(spec, kind)
+    if form == "file":
+        cls, path = _from_file(where, class_name, kind)
+        return cls, "file", path
+    if form in ("builtin", "module"):
+        cls, path = _from_module(where, class_name, kind)
+        return cls, form, path
+    ep = _entry_point(spec, kind)
+    if ep is not None:
+        try:
+            cls = ep.load()
+        except Exception as exc:  # noqa: BLE001
+            raise ParameterError(f"{kind} entry point {spec!r} ({ep.value}) fails to load: {exc}") from None
+        return cls, "entry-point", ep.value
     names = controller_names() if kind == "controller" else tracker_names()
     if spec.endswith(".py"):
         raise ParameterError(f"{kind} {spec!r} is not accepted: name the class too, FILE.py:Class")
@@ -265,3 +292,121 @@ def _accepted(cls: type) -> list[str]:
     except (TypeError, ValueError):
         return []
     return [n for n, p in sig.parameters.items() if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)]
+
+
+# --------------------------------------------------------------------------- a recorded plug-in, checked before import
+
+
+@dataclass(frozen=True)
+class LocatedSource:
+    """A plug-in's file, found without running any code (:func:`locate_source`).
+
+    Attributes:
+        spec: the name it is imported by (a built-in name, ``FILE.py:Class``, ``module:Class``, an entry point).
+        form: 'builtin', 'file', 'module' or 'entry-point' (how :func:`resolve` reads ``spec``).
+        path: the file import executes for it (a module's own file, a package's ``__init__.py``).
+        module: the module it is imported as; None for a file.
+        runs_first: the enclosing packages' ``__init__.py`` that import runs before ``path`` (not checked:
+            the record hashes one file).
+        sha256: the SHA-256 of ``path`` as found now.
+    """
+
+    spec: str
+    form: str
+    path: Path
+    module: str | None = None
+    runs_first: tuple[Path, ...] = ()
+    sha256: str = ""
+
+    def describe(self) -> str:
+        """One line: the file, the module it is imported as, what import runs before it."""
+        text = str(self.path) if self.module is None else f"{self.path} (module {self.module})"
+        if self.runs_first:
+            text += "; import runs first " + ", ".join(map(str, self.runs_first))
+        return text
+
+
+def recorded_spec(record: Mapping[str, Any]) -> str:
+    """The name a log's plug-in record is found again by: its ``spec``; for a file that is not where the
+    spec says (relative to another folder), the absolute path the record holds. This is the name
+    :func:`wmr_mj.sim.config.config_from_dict` resolves, so it is the name to check before that import."""
+    spec = str(record.get("spec"))
+    if record.get("origin") == "file" and not Path(spec.rpartition(":")[0]).is_file():
+        spec = str(record.get("import_path"))
+    return spec
+
+
+def locate_source(spec: str, *, kind: str = "controller") -> LocatedSource:
+    """The file that :func:`resolve` would import for ``spec``, found without importing or running anything.
+
+    A file is read as given (relative to the working folder); a module is found level by level
+    (:func:`wmr_mj._util.modules.find_module_file`: no enclosing package's ``__init__`` runs on the
+    way, as it would under ``importlib.util.find_spec``); an entry point is read from the installed
+    packages' metadata, not loaded, and its module found likewise.
+
+    Raises:
+        ParameterError: a file that is gone, a module or entry point that cannot be found without running
+            code, a malformed name.
+    """
+    from wmr_mj._util.modules import ModuleNotLocated, find_module_file
+
+    form, where, _ = _form_of(spec.strip(), kind)
+    if form == "file":
+        path = Path(where).expanduser()
+        if not path.is_file():
+            raise ParameterError(f"{kind} plug-in file {where} is gone")
+        path = path.resolve()
+        return LocatedSource(spec=spec, form=form, path=path, sha256=_file_hash(path))
+    if form == "entry-point":
+        ep = _entry_point(where, kind)
+        if ep is None:
+            raise ParameterError(f"{kind} entry point {where!r} is not installed (group "
+                                 f"{ENTRY_POINT_GROUPS[kind]})")
+        where = ep.module
+    try:
+        found = find_module_file(where)
+    except ModuleNotLocated as exc:
+        raise ParameterError(f"{kind} plug-in {spec!r}: {exc}, by a search that runs no code (a module that is "
+                             "gone, or one whose package extends its __path__ when imported)") from None
+    return LocatedSource(spec=spec, form=form, path=found.path, module=found.name,
+                         runs_first=found.runs_first, sha256=_file_hash(found.path))
+
+
+def check_recorded_source(record: Mapping[str, Any], *, kind: str = "controller") -> LocatedSource:
+    """A log's plug-in record (``controller_plugin``, ``tracker_plugin``) checked against the file it names,
+    before anything is imported: the file is found (:func:`locate_source`) and hashed, and must have the
+    SHA-256 the record holds.
+
+    Returns:
+        The file, to be imported (by :func:`wmr_mj.sim.config.config_from_dict`).
+
+    Raises:
+        ParameterError: the file is gone or cannot be found without running code, the record holds no
+            SHA-256, or the file's SHA-256 differs from the record's (one line: the file, both prefixes).
+    """
+    name = record.get("name")
+    recorded = str(record.get("source_sha256") or "")
+    try:
+        located = locate_source(recorded_spec(record), kind=kind)
+    except ParameterError as exc:
+        raise ParameterError(f"{exc}: the {kind} {name!r} of the log is not imported (the record's SHA-256 "
+                             f"{_prefix(recorded)}, found: no file)") from None
+    if not recorded:
+        raise ParameterError(f"the {kind} plug-in {name!r} ({located.path}) has no SHA-256 in the log's record, so "
+                             "its source cannot be checked: not imported")
+    if located.sha256 != recorded:
+        elsewhere = ("; or the class is defined in another file than its module's, which cannot be found without "
+                     "running code" if located.module is not None else "")
+        raise ParameterError(f"the {kind} plug-in {name!r} ({located.path}) has changed since it ran: its file's "
+                             f"SHA-256 is {_prefix(located.sha256)}, the record's {_prefix(recorded)}; not imported "
+                             f"(restore that source to reproduce the run{elsewhere})")
+    return located
+
+
+def _file_hash(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _prefix(sha256: str) -> str:
+    """A SHA-256 as a message shows it: its first 12 hex digits."""
+    return f"{sha256[:12]}..." if sha256 else "none"

@@ -9,11 +9,13 @@ and prints.
   ``settle_s``, the analytic bounds E_max / Edot_max when the log carries them, inside/outside);
   ``--json`` prints it as one JSON object;
 - ``--plot PATH.png``: E and E' over time, the armature voltage, and the (|E|, |E'|) plane;
-- ``--verify``: rebuild the model from the attached MJCF, set the initial state, re-apply the
-  logged ctrl and compare qpos/qvel at every control step; then re-run the logged configuration with
-  its controller imported again (a plug-in by its recorded path, its source's SHA-256 checked) and
-  compare the voltages it applies with the logged ones: exit 0 when both are bit-identical, 1 otherwise
-  (with one line saying why a controller could not be re-run);
+- ``--verify``: first hash each plug-in file the log names (its law's, its tracker's) and refuse,
+  before anything is imported, one whose SHA-256 is not the log's record or that is gone (exit 2, one
+  line); say on stderr which file it will import. Then rebuild the model from the attached MJCF, set
+  the initial state, re-apply the logged ctrl and compare qpos/qvel at every control step; then re-run
+  the logged configuration with its controller imported again (which runs the plug-in's code: verify
+  only logs whose plug-ins you trust) and compare the voltages it applies with the logged ones: exit 0
+  when both are bit-identical, 1 otherwise (with one line saying why a controller could not be re-run);
 - ``--video PATH.mp4``: the run rendered offscreen by :mod:`wmr_mj.logs.video` (MuJoCo's Renderer on EGL
   or OSMesa, imageio's ffmpeg writer): the steering seen through the chassis, E against E_max.
 """
@@ -21,6 +23,7 @@ and prints.
 from __future__ import annotations
 
 import argparse
+import sys
 from typing import Any
 
 from wmr_mj.cli._common import positive_float, positive_int, print_json
@@ -52,6 +55,7 @@ def register(subparsers: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     from wmr_mj.logs.reader import load_log
     from wmr_mj.logs.replay import (
+        checked_plugins,
         format_summary,
         format_verify,
         format_verify_controller,
@@ -62,6 +66,9 @@ def run(args: argparse.Namespace) -> int:
     )
 
     log = load_log(args.log)
+    if args.verify:  # a changed or missing plug-in is refused before any work, and before it is imported
+        for plugin in checked_plugins(log):
+            print(plugin.will_import(), file=sys.stderr)
     rep = summarize(log, args.settle)
     status = 0
     if args.plot:

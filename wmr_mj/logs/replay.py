@@ -13,6 +13,10 @@
 - :func:`plot`: E and E' over time with the bounds, the armature voltage with the supply limit,
   the (|E|, |E'|) plane with the bounds' rectangle and the region polygon (4.21), and C's path:
   desired against actual, and the cross-track and along-track errors over time.
+- :func:`checked_plugins`: the plug-in files the log names (its law's, its tracker's), each hashed and
+  checked against the log's record before anything is imported; :func:`verify_controller` imports
+  them only then, to re-run the law. Importing a file runs its code: verify only logs whose
+  plug-ins you trust.
 - :func:`format_summary`, :func:`format_verify`: the command's text.
 
 Usage::
@@ -34,14 +38,16 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from wmr_mj.errors import LogError, WmrMjError
+from wmr_mj.errors import LogError, ParameterError, WmrMjError
 from wmr_mj.logs.reader import RunLog
 
 if TYPE_CHECKING:
     from matplotlib.typing import RcKeyType
 
+    from controllers.registry import LocatedSource
+
 __all__ = ["summarize", "verify", "plot", "format_summary", "format_verify", "path_of_log", "LogPath",
-           "hardware_labels"]
+           "hardware_labels", "checked_plugins", "CheckedPlugin"]
 
 
 def _number(value: Any) -> float | None:
@@ -390,6 +396,60 @@ def _verify_measured(log: RunLog, m: Any, qpos: np.ndarray, qvel: np.ndarray) ->
 
 
 
+@dataclass(frozen=True)
+class CheckedPlugin:
+    """A plug-in the log names, its file checked against the log's record (:func:`checked_plugins`).
+
+    Attributes:
+        kind: 'controller' or 'tracker'.
+        name: its name, as the record gives it.
+        source: its file (:class:`controllers.registry.LocatedSource`), whose SHA-256 is the record's.
+    """
+
+    kind: str
+    name: str
+    source: LocatedSource
+
+    def will_import(self) -> str:
+        """The line said before the file is imported (and so run)."""
+        return (f"replay: will import the {self.kind} plug-in {self.name!r} from {self.source.describe()}; its "
+                f"SHA-256 {self.source.sha256[:12]}... is the log's")
+
+
+def checked_plugins(log: RunLog) -> list[CheckedPlugin]:
+    """The plug-in files that re-running the log imports, each found and hashed without running any code,
+    and checked against the SHA-256 the log records (:func:`controllers.registry.check_recorded_source`).
+
+    A plug-in given as an object is left out: it is not imported (:func:`verify_controller` says it cannot be
+    rebuilt). A law or tracker named without a record is a built-in or an installed entry point, code of
+    this installation, not of the log.
+
+    Raises:
+        ParameterError: a plug-in's file that is gone, cannot be found without running code or has changed
+            since the run (one line: the file, the recorded and the found SHA-256 prefix); a plug-in named in
+            the configuration without its record (nothing to check it against).
+    """
+    from controllers.registry import check_recorded_source
+
+    cfg = log.config or {}
+    out: list[CheckedPlugin] = []
+    for kind in ("controller", "tracker"):
+        record = cfg.get(f"{kind}_plugin")
+        given = cfg.get(kind)
+        if record is None:
+            if isinstance(given, str) and ":" in given:  # FILE.py:Class, module:Class
+                raise ParameterError(f"{log.path}: the {kind} {given!r} is a plug-in and the log holds no record of "
+                                     f"its source ({kind}_plugin, its SHA-256) to check it by: not imported")
+            continue
+        if not isinstance(record, dict):
+            raise ParameterError(f"{log.path}: the log's {kind}_plugin is not a plug-in record: not imported")
+        if record.get("origin") == "instance":
+            continue
+        out.append(CheckedPlugin(kind=kind, name=str(record.get("name")),
+                                 source=check_recorded_source(record, kind=kind)))
+    return out
+
+
 def verify_controller(log: RunLog) -> dict[str, Any]:
     """Re-run the log's configuration with its controller (and tracker) imported again, and compare the
     voltage the law applied at every logged control step with the log's, bit for bit.
@@ -412,7 +472,8 @@ def verify_controller(log: RunLog) -> dict[str, Any]:
         return {"checked": False, "identical": False, "controller": name, "required": False,
                 "reason": "the log has no run configuration to re-run"}
     try:
-        config = config_from_dict(cfg)
+        checked_plugins(log)  # a changed or missing plug-in file is refused here, before it is imported
+        config = config_from_dict(cfg)  # imports the plug-ins (and checks their source again, once imported)
     except WmrMjError as exc:  # the law cannot be found again, or its source has changed: not reproduced
         return {"checked": False, "identical": False, "controller": name, "required": True, "reason": str(exc)}
     except (KeyError, TypeError) as exc:  # a log another program wrote: nothing to re-run
@@ -680,7 +741,7 @@ def format_summary(rep: dict[str, Any]) -> str:
     if rep.get("summary"):
         from wmr_mj.analysis.verdicts import format_verdict
 
-        lines.extend("verdict    " + line for line in format_verdict(rep["summary"]))
+        lines.extend(_verdict_block(format_verdict(rep["summary"])))
     pe = rep.get("path_errors")
     if pe:
         def signed(v: float, pos: str, neg: str) -> str:
@@ -712,6 +773,23 @@ def format_summary(rep: dict[str, Any]) -> str:
         if sc:
             lines.append("summary    " + "  ".join(sc))
     return "\n".join(lines)
+
+
+def _verdict_block(verdict_lines: list[str]) -> list[str]:
+    """The verdict's lines (:func:`wmr_mj.analysis.verdicts.format_verdict`) under the label ``verdict``: the
+    verdict on the labelled line (its own "verdict: " dropped), the lines after it indented under it, a
+    CERTIFIED-OUTSIDE banner above it as ``run`` prints it."""
+    out: list[str] = []
+    labelled = False
+    for line in verdict_lines:
+        if line.startswith("!!!") and not labelled:
+            out.append(line)
+        elif not labelled:
+            out.append("verdict    " + line.removeprefix("verdict: "))
+            labelled = True
+        else:
+            out.append(" " * len("verdict    ") + line)
+    return out
 
 
 def format_verify(ver: dict[str, Any]) -> str:
