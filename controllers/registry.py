@@ -14,8 +14,9 @@ A controller (or tracker) is named by one string:
 with its parameters as NAME=VALUE strings (``--controller-param``): a value is read as JSON where
 it parses (numbers, true/false, lists), else kept as a string. :func:`resolve` returns the class
 and a :class:`PluginSource`: what the log records to find it again (the import path, the
-parameters, the SHA-256 of the file that defines it), so that ``replay --verify`` re-imports it
-and refuses a source that has changed.
+parameters, the SHA-256 of the file that defines it). :func:`check_recorded_source` finds that file
+again without running any code (:func:`locate_source`) and compares its SHA-256 with the record's, so
+that ``replay --verify`` refuses a source that has changed, or is gone, before importing it.
 
 Usage::
 
