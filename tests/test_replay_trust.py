@@ -1,7 +1,8 @@
 """`replay --verify` checks a plug-in's file before it imports it: a file changed since the run, or gone,
 is refused (exit 2, one line naming the file and both SHA-256 prefixes) and never executed; a module
 plug-in's file is found without running its package's ``__init__``; an unchanged file is said (on
-stderr) and then imported. And the replay's verdict line carries its label once.
+stderr) and then imported; an entry point is found from its metadata, not loaded. And the replay's
+verdict line carries its label once.
 
 The plug-ins here write a marker file when imported: that marker is the witness of whether their code
 ran. A run in this process leaves the plug-in's module in ``sys.modules`` (where a re-import would not
@@ -188,6 +189,17 @@ def test_a_changed_module_plug_in_is_refused_before_its_package_runs(package, tm
                                 f"markpkg.law); import runs first {package['pkg'] / '__init__.py'}; its SHA-256 "
                                 f"{recorded[:12]}... is the log's"]
     assert package["init_marker"].exists() and package["law_marker"].exists()
+
+
+def test_an_entry_point_is_located_from_its_metadata_without_loading_it(package):
+    dist = package["root"] / "markplug-0.1.dist-info"  # an installed distribution, as pip leaves it
+    dist.mkdir()
+    (dist / "METADATA").write_text("Metadata-Version: 2.1\nName: markplug\nVersion: 0.1\n")
+    (dist / "entry_points.txt").write_text("[wmr_mj.controllers]\nmarked = markpkg.law:MarkedPD\n")
+    found = locate_source("marked")
+    assert found.form == "entry-point" and found.module == "markpkg.law" and found.path == package["pkg"] / "law.py"
+    assert found.runs_first == (package["pkg"] / "__init__.py",)
+    assert not package["init_marker"].exists() and not package["law_marker"].exists()
 
 
 def test_a_module_that_cannot_be_found_without_running_code_is_refused(package):
