@@ -40,7 +40,9 @@ def register(subparsers: Any) -> None:
     p.add_argument("--plot", metavar="PATH.png",
                    help="write a figure: E, E', voltage over time and the (|E|,|E'|) plane")
     p.add_argument("--verify", action="store_true",
-                   help="re-simulate from the attached MJCF and initial state; exit 1 unless bit-identical")
+                   help="re-simulate from the attached MJCF and initial state, and re-run the law (a plug-in's file "
+                        "is checked against its SHA-256 before it is imported and run; exit 2 if changed or gone); "
+                        "exit 1 unless bit-identical")
     p.add_argument("--video", metavar="PATH.mp4", help="render the run offscreen to MP4 (needs EGL or OSMesa)")
     p.add_argument("--settle", type=positive_float, metavar="S",
                    help="settling time for the sup after settling [s] (default: the log's settle_s)")
