@@ -191,12 +191,14 @@ def measurement_errors_of(config: Any, plant: C80Parameters) -> MeasurementError
     (:mod:`wmr_mj.analysis.measurement`),
     from the cart as it is built (``config.sensing``, ``actuation``, ``transmission``; :mod:`wmr_mj.hardware`).
 
-    Bounded, and so covered: the encoder's quantisation, a uniform noise, the gear's play where the encoder
-    is on the motor side (the motor's angle / i2 is within b of alpha), a differenced or filtered velocity's
+    Bounded, and so covered: the encoder's quantisation, a uniform noise, a differenced or filtered velocity's
     error (:func:`wmr_mj.hardware.sensing.measurement_error_bounds`); its lag, the sensing delay and the
     actuation delay are charged together as one delay (a lag on alpha' alone is within a delay of both).
     Not covered (the certificate is then uncertified, saying why): Gaussian noise, the play with the encoder
     on the steering axis (it lies between the motor and the measured angle, on the actuator's side), the
+    play with the encoder on the motor side (the motor angle / i2 would be within b of alpha with a rigid
+    stop, but MuJoCo's stop is a soft limit pressed in under torque: measured 0.00554 rad against b +
+    Delta/i2 = 0.005013 rad, docs/guides/hardware.md, and no sound bound of its penetration is derived), the
     armature inductance and a current limit (the proof's motor has neither).
 
     Returns:
@@ -215,6 +217,10 @@ def measurement_errors_of(config: Any, plant: C80Parameters) -> MeasurementError
     if not transmission.is_ideal and not motor_side:
         why.append(f"the gear's play (b = {transmission.backlash:g} rad) lies between the motor and an encoder on "
                    "the steering axis: no bound is derived for play on the actuator's side")
+    elif not transmission.is_ideal:
+        why.append(f"the play's stop is soft: its penetration is not bounded (b = {transmission.backlash:g} rad; "
+                   "MuJoCo's limit on the gear_play tendon is pressed in under torque, so the motor angle / i2 "
+                   "can lie more than b from alpha)")
     if actuation.inductance > 0:
         why.append(f"the armature inductance (L_a = {actuation.inductance:g} H, L_a/R_a = "
                    f"{actuation.electrical_time_constant(plant.R_a) * 1e3:.3g} ms) is not in the proof's motor model")
