@@ -189,7 +189,8 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
 def measurement_errors_of(config: Any, plant: C80Parameters) -> MeasurementErrors:
     """What the run's law reads instead of the true state, as the certificates take it
     (:mod:`wmr_mj.analysis.measurement`),
-    from the cart as it is built (``config.sensing``, ``actuation``, ``transmission``; :mod:`wmr_mj.hardware`).
+    from the cart as it is built: the sum of each part's own coverage (``config.sensing.coverage``,
+    ``transmission.coverage``, ``actuation.coverage``; :class:`wmr_mj.hardware.Coverage`).
 
     Bounded, and so covered: the encoder's quantisation, a uniform noise, a differenced or filtered velocity's
     error (:func:`wmr_mj.hardware.sensing.measurement_error_bounds`); its lag, the sensing delay and the
