@@ -11,14 +11,20 @@ Usage::
     alpha_m, alpha_dot_m = chain.step(0, alpha, alpha_dot, motor_angle)
     measurement_error_bounds(sensing, control_period=0.001, gear_ratio=60.0)
 
-Modules: :mod:`.spec` (the one parser), :mod:`.sensing`, :mod:`.actuation`, :mod:`.transmission`,
-:mod:`.presets` (named hardware with sources), :mod:`.cart` (the three parts in one line and one mapping).
+Each part declares, in its one class, its model change (``model_options()``: what :mod:`wmr_mj.plant.mjcf`
+builds), its coverage (``coverage(...)``: a :class:`Coverage`, the error bound a claim may use or why none is
+derived) and its ``label()``; the model, the engine and the claims read them there (:mod:`.coverage`).
+
+Modules: :mod:`.spec` (the one parser), :mod:`.coverage`, :mod:`.sensing`, :mod:`.actuation`,
+:mod:`.transmission`, :mod:`.presets` (named hardware with sources), :mod:`.cart` (the three parts in one line
+and one mapping).
 """
 
 from __future__ import annotations
 
 from wmr_mj.hardware.actuation import Actuation
 from wmr_mj.hardware.cart import CART_PARTS, cart_dict, cart_line, is_ideal_cart
+from wmr_mj.hardware.coverage import Coverage
 from wmr_mj.hardware.presets import (
     SENSING_PRESET_SOURCES,
     actuation_preset_names,
@@ -49,6 +55,7 @@ __all__ = [
     "Actuation",
     "actuation_preset_names",
     "Transmission",
+    "Coverage",
     "parse_spec",
     "whole_periods",
     "CART_PARTS",

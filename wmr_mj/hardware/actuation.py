@@ -1,6 +1,8 @@
 """The actuation chain between the law's voltage and the motor: a delay, the armature inductance, a current
-limit. The typed specification only; the model (MuJoCo's actuator ``delay`` and ``dcmotor`` attributes)
-reads it.
+limit. The part declares its model change (:meth:`Actuation.model_options`: MuJoCo's actuator ``delay`` and the
+``dcmotor``'s inductance and saturation, which :mod:`wmr_mj.plant.mjcf` builds), its coverage
+(:meth:`Actuation.coverage`: the delay the claims charge; the inductance and the current limit are not in the
+proof's motor model) and its label (:mod:`wmr_mj.hardware.coverage`).
 
 Usage::
 
@@ -9,6 +11,8 @@ Usage::
     a = Actuation.from_spec("delay=0.002,inductance=0.0005,current_limit=20")
     a.electrical_time_constant(R_a=1.0)        # L_a / R_a = 0.0005 s
     Actuation().is_ideal                       # True: today's plant
+    a.model_options()                          # {'actuation_delay_s': 0.002, 'inductance_H': 0.0005, ...}
+    a.coverage(R_a=1.0).why_not                # ('the armature inductance (L_a = 0.0005 H, ...) is not in ...', ...)
 """
 
 from __future__ import annotations
@@ -17,6 +21,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from wmr_mj.errors import ParameterError
+from wmr_mj.hardware.coverage import Coverage, from_model_options
 from wmr_mj.hardware.presets import ACTUATION_PRESETS
 from wmr_mj.hardware.spec import SpecSource, field_converters, parse_spec, to_float, whole_periods
 
@@ -78,6 +83,37 @@ class Actuation:
         """The spec form (JSON-ready; :meth:`from_spec` reads it back)."""
         return {"delay": self.delay, "inductance": self.inductance, "current_limit": self.current_limit}
 
+    def model_options(self) -> dict[str, Any]:
+        """The keywords of :func:`wmr_mj.plant.mjcf.robot_spec` this part sets ({} where ideal: today's model):
+        ``actuation_delay_s`` (s), ``inductance_H`` (H), ``current_limit_A`` (A or None)."""
+        if self.is_ideal:
+            return {}
+        return {keyword: getattr(self, field) for field, keyword in MODEL_KEYWORDS.items()}
+
+    @classmethod
+    def from_model_options(cls, **options: Any) -> Actuation:
+        """The part from :meth:`model_options`'s keywords (any of them; the rest ideal).
+
+        Raises:
+            ParameterError: a value refused, the message naming its keyword (``inductance_H = -1.0 ...``).
+        """
+        return from_model_options(cls, MODEL_KEYWORDS, options)
+
+    def coverage(self, *, R_a: float) -> Coverage:
+        """The delay the claims charge (s), and what the proof's motor model has not: the inductance (with its
+        time constant L_a/R_a for the armature resistance ``R_a``, Ohm) and a current limit.
+
+        Raises:
+            ParameterError: R_a not > 0 where an inductance is set.
+        """
+        why: list[str] = []
+        if self.inductance > 0:
+            why.append(f"the armature inductance (L_a = {self.inductance:g} H, L_a/R_a = "
+                       f"{self.electrical_time_constant(R_a) * 1e3:.3g} ms) is not in the proof's motor model")
+        if self.current_limit is not None:
+            why.append(f"the current limit ({self.current_limit:g} A) is not in the proof's motor model")
+        return Coverage(delay=self.delay, why_not=tuple(why))
+
     def label(self) -> str:
         """One short line: 'ideal', or e.g. 'delay 2 ms, L_a 0.5 mH, current limit 20 A'."""
         if self.is_ideal:
@@ -106,3 +142,5 @@ class Actuation:
 
 
 _SPEC_KEYS = field_converters(Actuation)
+#: Each field's keyword in the model's builders (:func:`wmr_mj.plant.mjcf.robot_spec`), with its unit.
+MODEL_KEYWORDS = {"delay": "actuation_delay_s", "inductance": "inductance_H", "current_limit": "current_limit_A"}

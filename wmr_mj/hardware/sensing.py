@@ -63,6 +63,7 @@ from typing import Any, Literal, get_args
 import numpy as np
 
 from wmr_mj.errors import ParameterError, UnknownNameError
+from wmr_mj.hardware.coverage import Coverage
 from wmr_mj.hardware.presets import SENSING_PRESETS
 from wmr_mj.hardware.spec import (
     Converter,
@@ -200,6 +201,71 @@ class Sensing:
                 1e-9 relative (the message names both).
         """
         return whole_periods("sensing delay", self.delay, control_period)
+
+    # ---- each stage's bound (measurement_error_bounds sums them; mismatch.md item 4); (a) the delay is its
+    # own bound: the reading stands for the truth ``delay`` earlier
+    def encoder_step(self, gear_ratio: float) -> float:
+        """(b) Delta, rad at the steering axis: 2 pi / N on the axis, 2 pi / (N i2) on the motor side; 0 without
+        an encoder."""
+        if self.encoder_ticks is None:
+            return 0.0
+        return 2.0 * math.pi / self.encoder_ticks / (gear_ratio if self.encoder_side == "motor" else 1.0)
+
+    def encoder_bound(self, gear_ratio: float) -> float:
+        """(b) |quantised - theta| <= Delta/2 (round) or Delta (floor: the error lies in [0, Delta)), rad, padded
+        for the float operations of the step (_ROUNDING_PAD)."""
+        return self.encoder_step(gear_ratio) * _ROUNDING_PAD * (0.5 if self.encoder_rounding == "round" else 1.0)
+
+    def encoder_spread(self, gear_ratio: float) -> float:
+        """(b) the largest change of the quantisation error between two readings, rad: Delta (round and floor
+        alike), padded; what a differenced velocity divides by T."""
+        return self.encoder_step(gear_ratio) * _ROUNDING_PAD
+
+    def noise_bound(self) -> float:
+        """(c) |noise on alpha| <= this, rad: 0 (none), B (uniform on [-B, B)), inf (Gaussian: no bound)."""
+        return {"none": 0.0, "uniform": self.noise_alpha, "gaussian": math.inf}[self.noise_kind]
+
+    def velocity_noise_bound(self) -> float:
+        """(d) |noise on alpha'| <= this, rad/s: 0, its bound B, or inf (Gaussian)."""
+        return {"none": 0.0, "uniform": self.velocity_noise_alpha_dot,
+                "gaussian": math.inf}[self.velocity_noise_kind]
+
+    def estimate_bound(self, control_period: float, *, angle_spread: float) -> tuple[float, float]:
+        """(d) the velocity estimate's error bound (rad/s) and its lag (s, times sup|alpha''| in the bound).
+
+        exact and tachometer: the velocity noise's bound, no lag. difference: the angle's error changes by at
+        most ``angle_spread`` (rad) in a period T, so ``angle_spread / T`` plus the velocity noise, with the lag
+        T/2 of a mean over the period; filtered: the same error (the filter's weights are >= 0 and sum to at
+        most 1) and the lag tau_f + T/2 (:func:`measurement_error_bounds`).
+        """
+        if self.velocity in ("exact", "tachometer"):
+            return self.velocity_noise_bound(), 0.0
+        dot_error = angle_spread / control_period + self.velocity_noise_bound()
+        return dot_error, control_period / 2.0 + (self.filter_tau or 0.0)  # filter_tau is set for 'filtered' only
+
+    @property
+    def encoder_on_motor(self) -> bool:
+        """True where an encoder reads the motor shaft (the gear's play then lies between it and alpha)."""
+        return self.encoder_side == "motor" and self.encoder_ticks is not None
+
+    def model_options(self) -> dict[str, Any]:
+        """The model keywords this part sets: none (the sensor runs in the control callback, not the model)."""
+        return {}
+
+    def coverage(self, *, control_period: float, gear_ratio: float, play: float = 0.0) -> Coverage:
+        """The stages' bounds summed (:func:`measurement_error_bounds`), as a :class:`Coverage`; not covered
+        where a noise is Gaussian (its bounds then 0 here, the reason in ``why_not``).
+
+        Args:
+            control_period: T, s (> 0).
+            gear_ratio: i2 (> 0).
+            play: rad at the steering axis, what the gear's play adds where the encoder is on the motor side.
+        """
+        bounds = measurement_error_bounds(self, control_period=control_period, gear_ratio=gear_ratio, backlash=play)
+        if not bounds.covered:
+            return Coverage(delay=bounds.delay, why_not=(str(bounds.why_not),))
+        return Coverage(alpha_error=bounds.alpha_error_max, alpha_dot_error=bounds.alpha_dot_error_max,
+                        delay=bounds.delay, lag=bounds.alpha_dot_lag)
 
     def as_dict(self) -> dict[str, Any]:
         """The spec form (JSON-ready; :meth:`from_spec` reads it back to an equal Sensing)."""
@@ -510,20 +576,11 @@ def measurement_error_bounds(sensing: Sensing, *, control_period: float, gear_ra
     if i2 <= 0.0 or b < 0.0:
         raise ParameterError(f"measurement bounds: gear_ratio = {gear_ratio!r} (> 0 required) or backlash = "
                              f"{backlash!r} rad (>= 0 required) is not accepted")
-    motor = sensing.encoder_side == "motor"
-    delta = 0.0 if sensing.encoder_ticks is None else 2.0 * math.pi / sensing.encoder_ticks / (i2 if motor else 1.0)
-    quantisation = delta * _ROUNDING_PAD * (0.5 if sensing.encoder_rounding == "round" else 1.0)
-    noise = {"none": 0.0, "uniform": sensing.noise_alpha, "gaussian": math.inf}[sensing.noise_kind]
-    dot_noise = {"none": 0.0, "uniform": sensing.velocity_noise_alpha_dot,
-                 "gaussian": math.inf}[sensing.velocity_noise_kind]
-    play = b if motor else 0.0
-    alpha_error = quantisation + noise + play
-    if sensing.velocity in ("exact", "tachometer"):
-        dot_error, lag = dot_noise, 0.0
-    else:
-        spread = delta * _ROUNDING_PAD + 2.0 * noise + 2.0 * play
-        dot_error = spread / T + dot_noise
-        lag = T / 2.0 + (sensing.filter_tau or 0.0)  # filter_tau is set for 'filtered' only
+    play = b if sensing.encoder_side == "motor" else 0.0
+    noise = sensing.noise_bound()
+    alpha_error = sensing.encoder_bound(i2) + noise + play
+    spread = sensing.encoder_spread(i2) + 2.0 * noise + 2.0 * play
+    dot_error, lag = sensing.estimate_bound(T, angle_spread=spread)
     gaussian = "gaussian" in (sensing.noise_kind, sensing.velocity_noise_kind)
     return MeasurementBounds(alpha_error_max=alpha_error, alpha_dot_error_max=dot_error, alpha_dot_lag=lag,
                              delay=sensing.delay, covered=not gaussian,

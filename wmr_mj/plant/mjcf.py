@@ -55,6 +55,8 @@ import mujoco
 import numpy as np
 
 from wmr_mj.errors import ModelFileError, ParameterError, UnknownNameError
+from wmr_mj.hardware.actuation import Actuation
+from wmr_mj.hardware.transmission import Transmission
 from wmr_mj.params import C80, C80Parameters
 
 __all__ = [
@@ -168,59 +170,56 @@ def _check_models(steering_friction: str, tyre_contact: str) -> None:
 
 @dataclass(frozen=True)
 class _DriveTrain:
-    """The steering motor's actuation and the gear's play (the builders' keyword options).
-
-    The defaults are today's plant: no delay, no inductance, no current limit, no play.
+    """The steering motor's actuation and the gear's play, as the cart's parts declare them
+    (:class:`wmr_mj.hardware.Actuation`, :class:`wmr_mj.hardware.Transmission`), with what only the model
+    adds: the motor side's inertia inside the play. The defaults are today's plant.
     """
 
-    actuation_delay_s: float = 0.0  # s, a whole number of physics steps
-    inductance_H: float = 0.0  # H, the armature inductance L_a (0: the current is algebraic)
-    current_limit_A: float | None = None  # A, the driver's current limit (None: none)
-    backlash_rad: float = 0.0  # rad at the steering axis, half-width b of the play
+    actuation: Actuation = Actuation()
+    transmission: Transmission = Transmission()
     motor_armature_kgm2: float = MOTOR_ARMATURE  # kg m^2 at the steering axis, motor side (with play)
 
     @property
+    def has_play(self) -> bool:
+        return not self.transmission.is_ideal
+
+    @property
     def delay_steps(self) -> int:
-        return int(round(self.actuation_delay_s / TIMESTEP))
+        return int(round(self.actuation.delay / TIMESTEP))
 
     def comment(self) -> str:
         """The non-default options, for the scene's comment ('' for today's plant)."""
-        default = _DriveTrain()
-        changed = [f"{name}={getattr(self, name)!r}" for name in (
-            "actuation_delay_s", "inductance_H", "current_limit_A", "backlash_rad")
-            if getattr(self, name) != getattr(default, name)]
-        if changed and self.backlash_rad > 0:
+        options = {**self.actuation.model_options(), **self.transmission.model_options()}
+        changed = [f"{name}={value!r}" for name, value in options.items() if value != _IDEAL_OPTIONS[name]]
+        if changed and self.has_play:
             changed.append(f"motor_armature_kgm2={self.motor_armature_kgm2!r}")
         return ", ".join(changed)
 
 
-def _finite_at_least_zero(name: str, value: float, unit: str) -> float:
-    if not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
-        raise ParameterError(f"{name} must be a finite number >= 0 {unit}, got {value!r}")
-    return float(value)
+#: The builders' actuation and play keywords at today's plant (what an ideal part leaves out).
+_IDEAL_OPTIONS = {"actuation_delay_s": 0.0, "inductance_H": 0.0, "current_limit_A": None, "backlash_rad": 0.0}
 
 
 def _drive_train(*, actuation_delay_s: float = 0.0, inductance_H: float = 0.0, current_limit_A: float | None = None,
                  backlash_rad: float = 0.0, motor_armature_kgm2: float = MOTOR_ARMATURE) -> _DriveTrain:
-    """The checked options; bad values raise ParameterError naming the option and what is accepted."""
-    delay = _finite_at_least_zero("actuation_delay_s", actuation_delay_s, "s")
-    steps = delay / TIMESTEP
+    """The builders' keywords as the parts (each part checks its own values, the message naming the keyword),
+    and what the model alone requires: a delay of whole physics steps, inertia on the motor side of a play."""
+    actuation = Actuation.from_model_options(actuation_delay_s=actuation_delay_s, inductance_H=inductance_H,
+                                             current_limit_A=current_limit_A)
+    steps = actuation.delay / TIMESTEP
     # 1e-9 of a step: 0.003 / 0.001 = 2.9999999999999996 is three steps, 0.0025 is not
     if abs(steps - round(steps)) > 1e-9:
-        raise ParameterError(f"actuation_delay_s = {delay!r} s is not a whole number of physics steps of "
+        raise ParameterError(f"actuation_delay_s = {actuation.delay!r} s is not a whole number of physics steps of "
                              f"{TIMESTEP!r} s (MuJoCo reads a delayed ctrl at whole steps); give a multiple of it")
-    inductance = _finite_at_least_zero("inductance_H", inductance_H, "H")
-    if current_limit_A is not None:
-        limit = _finite_at_least_zero("current_limit_A", current_limit_A, "A (or None for no limit)")
-        if limit == 0:
-            raise ParameterError("current_limit_A must be > 0 A (or None for no limit), got 0")
-    backlash = _finite_at_least_zero("backlash_rad", backlash_rad, "rad")
-    armature = _finite_at_least_zero("motor_armature_kgm2", motor_armature_kgm2, "kg m^2")
-    if backlash > 0 and armature == 0:
+    transmission = Transmission.from_model_options(backlash_rad=backlash_rad)
+    armature = motor_armature_kgm2
+    if isinstance(armature, bool) or not isinstance(armature, (int, float)) or not math.isfinite(armature) \
+            or armature < 0:
+        raise ParameterError(f"motor_armature_kgm2 must be a finite number >= 0 kg m^2, got {armature!r}")
+    if not transmission.is_ideal and armature == 0:
         raise ParameterError("motor_armature_kgm2 must be > 0 kg m^2 with backlash_rad > 0 (the motor side "
                              "of the play needs inertia)")
-    return _DriveTrain(actuation_delay_s=delay, inductance_H=inductance, current_limit_A=current_limit_A,
-                       backlash_rad=backlash, motor_armature_kgm2=armature)
+    return _DriveTrain(actuation=actuation, transmission=transmission, motor_armature_kgm2=float(armature))
 
 
 _HINGE = mujoco.mjtJoint.mjJNT_HINGE
@@ -333,7 +332,7 @@ def robot_spec(params: C80Parameters = C80, *, steering_friction: str = "stictio
     chassis = _add_chassis(spec, p)
     _add_drive_unit(spec, chassis, p)
     _add_steering_unit(spec, chassis, p)
-    if drive.backlash_rad > 0:
+    if drive.has_play:
         _add_gear_play(spec, chassis, p, drive)
     _add_actuators(spec, p, drive)
     _add_sensors(spec, drive)
@@ -401,7 +400,8 @@ def _add_gear_play(spec: mujoco.MjSpec, chassis: mujoco.MjsBody, p: C80Parameter
     _inertial(shaft, mass=_SHAFT_MASS, inertia=(_SHAFT_INERTIA, _SHAFT_INERTIA, _SHAFT_INERTIA))
     shaft.add_joint(name=MOTOR_JOINT, type=_HINGE, axis=[0.0, 0.0, 1.0],
                     armature=round_sig(drive.motor_armature_kgm2))
-    play = spec.add_tendon(name=GEAR_PLAY_TENDON, range=_r((-drive.backlash_rad, drive.backlash_rad)))
+    b = drive.transmission.backlash
+    play = spec.add_tendon(name=GEAR_PLAY_TENDON, range=_r((-b, b)))
     play.solref_limit = list(GEAR_PLAY_SOLREF)
     play.solimp_limit = list(GEAR_PLAY_SOLIMP)
     play.wrap_joint(STEERING_JOINT, 1.0)
@@ -420,13 +420,14 @@ def _add_actuators(spec: mujoco.MjSpec, p: C80Parameters, drive: _DriveTrain) ->
     differential.wrap_joint("rear_left_spin", 0.5)
     differential.wrap_joint("rear_right_spin", 0.5)
 
-    target = MOTOR_JOINT if drive.backlash_rad > 0 else STEERING_JOINT
+    target = MOTOR_JOINT if drive.has_play else STEERING_JOINT
     motor = spec.add_actuator(name="steering_motor", target=target, trntype=mujoco.mjtTrn.mjTRN_JOINT)
     electrical: dict[str, list[float]] = {}
-    if drive.inductance_H > 0:
-        electrical["inductance"] = [round_sig(drive.inductance_H), 0.0]
-    if drive.current_limit_A is not None:
-        electrical["saturation"] = [0.0, round_sig(drive.current_limit_A), 0.0]
+    actuation = drive.actuation
+    if actuation.inductance > 0:
+        electrical["inductance"] = [round_sig(actuation.inductance), 0.0]
+    if actuation.current_limit is not None:
+        electrical["saturation"] = [0.0, round_sig(actuation.current_limit), 0.0]
     motor.set_to_dcmotor(motorconst=_r((p.k_i, p.k_b)), resistance=round_sig(p.R_a), **electrical)
     if drive.delay_steps > 0:
         # the ring buffer holds exactly the delay: MuJoCo reads ctrl at time - delay (zoh)
@@ -449,7 +450,7 @@ def _add_sensors(spec: mujoco.MjSpec, drive: _DriveTrain) -> None:
     joint the motor acts on) and ``steer_motor_angle`` is added last.
     """
     sens, obj_t = mujoco.mjtSensor, mujoco.mjtObj
-    motor_joint = MOTOR_JOINT if drive.backlash_rad > 0 else STEERING_JOINT
+    motor_joint = MOTOR_JOINT if drive.has_play else STEERING_JOINT
     for name, kind, objtype, obj in (
         ("steer_angle", sens.mjSENS_JOINTPOS, obj_t.mjOBJ_JOINT, "steer"),
         ("steer_rate", sens.mjSENS_JOINTVEL, obj_t.mjOBJ_JOINT, "steer"),
@@ -461,7 +462,7 @@ def _add_sensors(spec: mujoco.MjSpec, drive: _DriveTrain) -> None:
         ("A_vel", sens.mjSENS_FRAMELINVEL, obj_t.mjOBJ_SITE, "A"),
     ):
         spec.add_sensor(name=name, type=kind, objtype=objtype, objname=obj)
-    if drive.backlash_rad > 0:
+    if drive.has_play:
         spec.add_sensor(name="steer_motor_angle", type=sens.mjSENS_JOINTPOS, objtype=obj_t.mjOBJ_JOINT,
                         objname=MOTOR_JOINT)
 
@@ -470,7 +471,7 @@ def _add_home_key(spec: mujoco.MjSpec, p: C80Parameters, drive: _DriveTrain) -> 
     """The ``home`` key: rolling straight ahead at V_A, the drive commanding i1 V_A / r2."""
     # qpos order: free joint (7), rear_left, rear_right, steer, front_left, front_right[, steer_motor]
     w2, w3 = p.V_A / p.r2, p.V_A / p.r3
-    extra = (0.0,) if drive.backlash_rad > 0 else ()
+    extra = (0.0,) if drive.has_play else ()
     spec.add_key(name="home",
                  qpos=_r((0.0, 0.0, p.r2, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0) + extra),
                  qvel=_r((p.V_A, 0.0, 0.0, 0.0, 0.0, 0.0, w2, w2, 0.0, w3, w3) + extra),

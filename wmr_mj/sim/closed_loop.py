@@ -59,6 +59,7 @@ from wmr_mj.sim.engine import (
     run_engine,
 )
 from wmr_mj.sim.log_header import LogHeader
+from wmr_mj.sim.measured_errors import with_measured_errors
 from wmr_mj.sim.parts import RunParts, control_substeps, resolve_run
 from wmr_mj.sim.summary import RunSummary
 
@@ -423,6 +424,7 @@ def run_parts(parts: RunParts, *, logger_factory: Callable[..., Any] | None = No
         # the tracker's declared bounds, measured on the reference the law received
         certificate = with_measured(certificate, within_declared(done, outer.declared_bounds(
             reference_bounds_of(config, reference)), tracker=outer.name))
+    certificate = with_measured_errors(certificate, config, params, done, period=period)  # sensing's bounds, measured
     after = done["t"] >= settle_s
     at = path_sample_index(k, period)
     saturated = int(np.count_nonzero(done["voltage"] != done["voltage_cmd"]))  # NaN included: 0 V applied

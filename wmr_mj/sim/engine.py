@@ -53,6 +53,7 @@ import mujoco
 import numpy as np
 
 from wmr_mj.errors import ParameterError, UnknownNameError, WmrMjError
+from wmr_mj.hardware.cart import CART_PARTS
 from wmr_mj.hardware.sensing import P_GEAR_RATIO, SensingChain
 from wmr_mj.params import C80Parameters
 from wmr_mj.sim import compiled_law
@@ -90,17 +91,14 @@ def load_fields(params: C80Parameters, **plant_options: Any) -> dict[str, np.nda
 
 def plant_options(config: Any) -> dict[str, Any]:
     """The plant-law keywords the config carries (compile_model and Plant take them): the steering friction
-    and tyre contact laws, and where the cart is not ideal its actuation (MuJoCo's actuator delay, the
-    dcmotor's inductance and current limit) and its gear's play (:mod:`wmr_mj.plant.mjcf`); an ideal cart adds
-    no keyword, so its model is today's."""
+    and tyre contact laws, and each cart part's own ``model_options()`` (:mod:`wmr_mj.hardware.coverage`: the
+    actuation's delay, inductance and current limit, the gear's play; the sensor none); an ideal part adds no
+    keyword, so an ideal cart's model is today's."""
     options = {name: getattr(config, name) for name in _PLANT_OPTIONS if hasattr(config, name)}
-    actuation = getattr(config, "actuation", None)
-    if actuation is not None and not actuation.is_ideal:
-        options.update(actuation_delay_s=actuation.delay, inductance_H=actuation.inductance,
-                       current_limit_A=actuation.current_limit)
-    transmission = getattr(config, "transmission", None)
-    if transmission is not None and not transmission.is_ideal:
-        options.update(backlash_rad=transmission.backlash)
+    for name in CART_PARTS:  # each part declares its own model change ({} where ideal)
+        part = getattr(config, name, None)
+        if part is not None:
+            options.update(part.model_options())
     return options
 
 
