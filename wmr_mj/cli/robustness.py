@@ -349,8 +349,18 @@ def _assumption_lines(cert, fmt) -> list[str]:
 
 
 def _certificate_table(cert, config, paper) -> str:
-    if cert.region == "box":
+    """The text report of ``cert``, chosen by its region's type: section 4's table, or a law's box claim's."""
+    from wmr_mj.analysis.regions import BoxRegion, SmallGainRegion
+
+    if isinstance(cert.region, BoxRegion):
         return _claim_table(cert)
+    if not isinstance(cert.region, SmallGainRegion):
+        raise TypeError(f"no text report for a claim whose region is a {type(cert.region).__name__}")
+    return _small_gain_table(cert, config, paper)
+
+
+def _small_gain_table(cert, config, paper) -> str:
+    """The text report of section 4's certificate: its inputs, gammas, deltas and terms, and every assumption."""
     inp = cert.inputs
     box, est, ref = inp["box"], inp["estimate"], inp["reference"]
 
