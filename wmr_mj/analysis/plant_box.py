@@ -127,7 +127,7 @@ def hull(a: tuple[float, float], *values: float) -> tuple[float, float]:
     return min(a[0], *values), max(a[1], *values)
 
 
-@functools.lru_cache(maxsize=32)
+@functools.lru_cache(maxsize=64)  # the two caches it replaces held 32 each
 def derived_box(params: C80Parameters, m1_range: tuple[float, float], m1_inertia: str,
                 ranges: tuple[tuple[str, tuple[float, float]], ...], model: str = "nonholonomic") -> ParameterBox:
     """The box of ``params.coefficients(model)`` over m1 in ``m1_range`` and the ranged parameters.

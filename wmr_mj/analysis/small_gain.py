@@ -156,7 +156,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Protocol
 
 from wmr_mj._util.checks import finite_number as _number
 from wmr_mj.analysis.claim import fixed_point, shared_assumptions
@@ -700,7 +700,29 @@ class _Setting:
     stated: tuple[Assumption, ...]
 
 
-def _certificate(path: _Exact | _Measured, setting: _Setting) -> Certificate:
+class _Path(Protocol):
+    """One way to the bound (:class:`_Exact`, :class:`_Measured`); ``at`` is its terms at E_max = x."""
+
+    @property
+    def bound(self) -> _Bound: ...
+
+    @property
+    def friction_width(self) -> float: ...
+
+    def solve(self) -> tuple[float, int, str]: ...
+
+    def at(self, x: float) -> Any: ...
+
+    def voltage_max(self, at: Any, E_max: float, Edot_max: float) -> float: ...
+
+    def own_assumptions(self, at: Any, valid: bool, reason: str) -> tuple[Assumption, ...]: ...
+
+    def record(self, at: Any, E_max: float, Edot_max: float) -> dict[str, Any] | None: ...
+
+    def measurement_term(self, at: Any) -> float: ...
+
+
+def _certificate(path: _Path, setting: _Setting) -> Certificate:
     """The certificate of either path (exact or measured): the fixed point, the corner (4.21), the law's
     voltage, the assumptions, and the terms of delta1, each written once."""
     bound = path.bound
@@ -709,10 +731,10 @@ def _certificate(path: _Exact | _Measured, setting: _Setting) -> Certificate:
     at = path.at(E_max if valid else 0.0)
     alpha_max = bound.a0 + E_max if valid else math.inf
     Edot_max = bound.g2 * at.delta1 / (1.0 - at.condition) if valid else math.inf
-    voltage_max = path.voltage_max(at, E_max, Edot_max) if valid else math.inf  # type: ignore[arg-type]
+    voltage_max = path.voltage_max(at, E_max, Edot_max) if valid else math.inf
     assumptions = _assumptions(cond=at.condition, valid=valid, alpha_max=alpha_max, reason=reason,
                                iterations=iterations, voltage_max=voltage_max, setting=setting,
-                               own=path.own_assumptions(at, valid, reason))  # type: ignore[arg-type]
+                               own=path.own_assumptions(at, valid, reason))
     P_lo, corners = bound.P_corners[0], bound.P_corners
     terms = SmallGainTerms(
         friction_term=max(bound.phi_at(p) / p for p in corners), gyro_term=bound.dG * bound.a0d / at.c2 / P_lo,
@@ -720,13 +742,13 @@ def _certificate(path: _Exact | _Measured, setting: _Setting) -> Certificate:
         C_V_term=bound.dC * bound.a0d / P_lo, gyro_Edot_term=bound.dG / at.c2 / P_lo,
         dead_band=bound.plant.box.F[1] / (bound.estimate.P * bound.kp),
         disturbance_term=max(bound.dist_at(p) / p for p in corners) if bound.plant.disturbance else 0.0,
-        measurement_term=path.measurement_term(at),  # type: ignore[arg-type]
+        measurement_term=path.measurement_term(at),
         kp=bound.kp, kd=bound.kd, friction_sign=bound.friction_sign, friction_width=path.friction_width)
     inputs = SmallGainInputs(plant=bound.plant, estimate=bound.estimate, compensation=setting.compensation,
                              reference=setting.reference, limits=setting.limits,
                              control_period=setting.control_period, initial_error=setting.initial_error,
                              friction_amplitude_phi=bound.phi,
-                             measurement=path.record(at, E_max, Edot_max))  # type: ignore[arg-type]
+                             measurement=path.record(at, E_max, Edot_max))
     region = SmallGainRegion(gamma1=bound.g1, gamma2=bound.g2, delta1=at.delta1, delta2=at.delta2,
                              delta3=at.delta3, E_max=E_max, Edot_max=Edot_max)
     return Certificate(region=region, valid=valid, assumptions=assumptions, alpha_max=alpha_max,
