@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 import math
+import pickle
 import sys
 from dataclasses import dataclass
 from pathlib import Path
@@ -149,6 +150,8 @@ def test_a_run_carries_its_claims_by_name():
         claims["x"] = law  # type: ignore[index]
     with pytest.raises(TypeError, match="must be a Certificate"):
         claim_set(law={"E_max": 0.1})  # type: ignore[arg-type]
+    again = pickle.loads(pickle.dumps(claims))  # a batch sends a run's parts to its workers
+    assert dict(again) == dict(claims) and again[LAW_CLAIM].inputs.to_dict() == law.inputs.to_dict()
     assert Claim is Certificate
 
 

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import functools
 import math
-import types
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from typing import Any, Literal, Protocol, get_args
@@ -324,24 +323,44 @@ class Certificate:
 #: The claim type (section 4's certificate and a law's own claim alike).
 Claim = Certificate
 
-#: The claims a run is judged by, by name: the law's own (:data:`LAW_CLAIM`), and any further analysis
-#: (a sampled-data certificate) as one more entry.
-Claims = Mapping[str, Certificate]
-
 #: The name of the run's law's own claim in :data:`Claims` (section 4's certificate, or a box claim).
 LAW_CLAIM = "law"
 
 
-def claim_set(**claims: Certificate | None) -> Claims:
-    """A read-only mapping of the claims given (None: that analysis states none, left out).
+class Claims(Mapping[str, Certificate]):
+    """The claims a run is judged by, by name, read-only (and picklable, for a batch's workers): the law's
+    own under :data:`LAW_CLAIM`, any further analysis (a sampled-data certificate) as one more entry.
 
     Raises:
         TypeError: a value that is not a :class:`Certificate`.
     """
-    for name, c in claims.items():
-        if c is not None and not isinstance(c, Certificate):
-            raise TypeError(f"claim {name!r} must be a Certificate, got {type(c).__name__}")
-    return types.MappingProxyType({k: c for k, c in claims.items() if c is not None})
+
+    def __init__(self, claims: Mapping[str, Certificate] | None = None) -> None:
+        for name, c in (claims or {}).items():
+            if not isinstance(c, Certificate):
+                raise TypeError(f"claim {name!r} must be a Certificate, got {type(c).__name__}")
+        self._claims: dict[str, Certificate] = dict(claims or {})
+
+    def __getitem__(self, name: str) -> Certificate:
+        return self._claims[name]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._claims)
+
+    def __len__(self) -> int:
+        return len(self._claims)
+
+    def __repr__(self) -> str:
+        return f"Claims({self._claims!r})"
+
+
+def claim_set(**claims: Certificate | None) -> Claims:
+    """:class:`Claims` of the claims given by name (None: that analysis states none, left out).
+
+    Raises:
+        TypeError: a value that is not a :class:`Certificate`.
+    """
+    return Claims({k: c for k, c in claims.items() if c is not None})
 
 
 def _clean_inputs(obj: Any) -> Any:
