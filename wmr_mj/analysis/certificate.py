@@ -6,7 +6,7 @@ The pieces live in modules of their own, lowest first:
   and the :class:`BoxRegion` of a law's own claim;
 * :mod:`wmr_mj.analysis.claim_types`: :class:`Assumption`, :class:`Certificate` (the claim type, also
   :data:`Claim`: a region, its assumptions, section 4's :class:`SmallGainTerms`, :class:`ClaimInputs`),
-  :func:`judge` and :class:`CertificateJudgement`, :data:`Claims` (a run's claims by name);
+  :func:`judge` and :class:`CertificateJudgement`, :class:`Claims` (a run's claims by name);
 * :mod:`wmr_mj.analysis.plant_box`: :class:`PlantBox`, :class:`PlantLimits`, the plant's K and gyro bands,
   the derived box of a run's ranges and the bound on F/P over its corners;
 * :mod:`wmr_mj.analysis.claim`: what a run gives a claim (:class:`~wmr_mj.analysis.claim.ClaimContext`),

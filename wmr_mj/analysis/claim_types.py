@@ -4,7 +4,7 @@ Every claim a run is judged by, section 4's certificate (:mod:`wmr_mj.analysis.s
 own (:func:`wmr_mj.analysis.claim.box_claim`) alike, is a :class:`Certificate` (also named
 :data:`Claim`): a :class:`~wmr_mj.analysis.regions.Region` object, its :class:`Assumption` records, section
 4's :class:`SmallGainTerms` where it has them, and its :class:`ClaimInputs`. :func:`judge` gives the
-run's verdict against it; a run may carry several claims by name (:data:`Claims`, :func:`claim_set`).
+run's verdict against it; a run may carry several claims by name (:class:`Claims`, :func:`claim_set`).
 
 Usage::
 
@@ -323,7 +323,7 @@ class Certificate:
 #: The claim type (section 4's certificate and a law's own claim alike).
 Claim = Certificate
 
-#: The name of the run's law's own claim in :data:`Claims` (section 4's certificate, or a box claim).
+#: The name of the run's law's own claim in :class:`Claims` (section 4's certificate, or a box claim).
 LAW_CLAIM = "law"
 
 
