@@ -18,8 +18,10 @@ section-4 certificate:
 
 The computed-torque and PD laws claim the section-4 certificate
 (:func:`wmr_mj.analysis.certificate.certify`). A law with a simpler guarantee, such as a
-sliding-mode law's boundary layer |E| <= phi/lambda, states it with :func:`box_claim`: the region
-|E| <= E_max, |E'| <= Edot_max, with its own assumptions beside the run's.
+sliding-mode law's boundary layer |E| <= phi/lambda, states it with :func:`box_claim`: a
+:class:`~wmr_mj.analysis.regions.BoxRegion` |E| <= E_max, |E'| <= Edot_max, with its own assumptions
+beside the run's. Both share this module's :func:`fixed_point` (the reachable angle) and the four
+assumptions of :func:`shared_assumptions`, each worded by the claim that states it.
 
 Usage::
 
