@@ -11,6 +11,7 @@ from pathlib import Path
 import pytest
 from test_cli_errors import _one_error_line, _tree
 
+from wmr_mj.analysis.regions import BoxRegion
 from wmr_mj.cli.app import main
 from wmr_mj.params import C80
 from wmr_mj.sim.certify import certificate_for
@@ -38,7 +39,7 @@ def test_robustness_certificate_prints_a_law_s_own_claim(controller, capsys):
     assert main(["robustness", "--certificate", "--preset", "certified", "--controller", controller]) == 0
     text = capsys.readouterr().out
     cert = _python_certificate(controller)
-    assert cert is not None and cert.region == "box"
+    assert cert is not None and isinstance(cert.region, BoxRegion)
     # the printed E_max (4 significant digits) is the one certificate_for computes in Python
     printed = float(re.search(r"\|E\| <= ([0-9.e+-]+) rad", _printed(text, "claim")).group(1))
     assert printed == float(f"{cert.E_max:.4g}")

@@ -18,6 +18,7 @@ from reduced_zoh import Plant, simulate_zoh
 from controllers.sliding_mode import SlidingMode
 from wmr_mj.analysis.certificate import PlantBox, PlantLimits
 from wmr_mj.analysis.claim import ClaimContext
+from wmr_mj.analysis.regions import BoxRegion
 from wmr_mj.analysis.robustness import ParameterBox
 from wmr_mj.params import C80
 from wmr_mj.plant.reduced import SteeringModel
@@ -60,7 +61,7 @@ def test_claim_on_its_context_is_the_boundary_layer():
     ref = _reference(12.0)
     law = SlidingMode(ESTIMATE, lam=5.0, phi=0.2, k=3.0, eta=0.2)
     cert = law.claim(_context(ref))
-    assert cert.region == "box" and cert.claimant == "sliding-mode"
+    assert isinstance(cert.region, BoxRegion) and cert.claimant == "sliding-mode"
     assert cert.E_max == pytest.approx(0.2 / 5.0) and cert.Edot_max == pytest.approx(0.4)
     assert cert.certified, cert.unmet
     # D by hand: |P-P^| max|a_r''| + |C~| max|a'| + max(F_max, F^) + |K~| S + |Gam~| max|a'|/c^2

@@ -18,8 +18,10 @@ section-4 certificate:
 
 The computed-torque and PD laws claim the section-4 certificate
 (:func:`wmr_mj.analysis.certificate.certify`). A law with a simpler guarantee, such as a
-sliding-mode law's boundary layer |E| <= phi/lambda, states it with :func:`box_claim`: the region
-|E| <= E_max, |E'| <= Edot_max, with its own assumptions beside the run's.
+sliding-mode law's boundary layer |E| <= phi/lambda, states it with :func:`box_claim`: a
+:class:`~wmr_mj.analysis.regions.BoxRegion` |E| <= E_max, |E'| <= Edot_max, with its own assumptions
+beside the run's. Both share this module's :func:`fixed_point` (the reachable angle) and the four
+assumptions of :func:`shared_assumptions`, each worded by the claim that states it.
 
 Usage::
 
@@ -32,18 +34,26 @@ Usage::
 
 from __future__ import annotations
 
+import dataclasses
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, NamedTuple
 
-from wmr_mj.analysis.certificate import Assumption, Certificate, PlantBox, PlantLimits
+from wmr_mj.analysis.claim_types import Assumption, Certificate, ClaimInputs
 from wmr_mj.analysis.measurement import MEASUREMENT_COVERED, MeasurementErrors, coverage_assumption_fields
+from wmr_mj.analysis.plant_box import PlantBox, PlantLimits
+from wmr_mj.analysis.regions import BoxRegion
 from wmr_mj.errors import ParameterError
 from wmr_mj.params import C80Parameters
 from wmr_mj.reference.bounds import ReferenceBounds
 
-__all__ = ["ClaimContext", "box_claim", "run_assumptions", "with_measured", "covers_measurement"]
+__all__ = ["ClaimContext", "box_claim", "run_assumptions", "RunAssumptions", "shared_assumptions", "fixed_point",
+           "with_measured", "covers_measurement", "INITIAL_TOLERANCE"]
+
+#: The tolerance on |E(0)|, |E'(0)| of the assumption 'zero initial error' (the reference's rounding at t = 0).
+INITIAL_TOLERANCE = 1e-9
+_FIXED_POINT_ITERATIONS = 10000
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -82,37 +92,100 @@ class ClaimContext:
             raise ParameterError(f"measurement must be a MeasurementErrors, got {type(self.measurement).__name__}")
 
 
-def run_assumptions(*, alpha_max: float, voltage_max: float, context: ClaimContext,
-                    initial_tolerance: float = 1e-9) -> tuple[Assumption, ...]:
-    """The assumptions every claim of a bounded |E| shares, checked: the reachable angle below pi/2
-    (``alpha_max`` = max|alpha0| + E_max [rad]), inside the steering stops, the law's voltage within
-    the supply (``voltage_max`` [V], the claim's bound on |u|), zero initial error (within
-    ``initial_tolerance``, the reference's rounding at t = 0)."""
-    limits = context.limits
-    E0, Ed0 = context.initial_error
+class RunAssumptions(NamedTuple):
+    """The four assumptions every claim of a bounded |E| shares (:func:`shared_assumptions`), by name."""
+
+    reachable: Assumption
+    stops: Assumption
+    supply: Assumption
+    initial: Assumption
+
+
+def shared_assumptions(*, alpha_max: float, voltage_max: float, limits: PlantLimits,
+                       initial_error: tuple[float, float], initial_tolerance: float = INITIAL_TOLERANCE,
+                       angle_equation: str = "alpha_max = max|alpha0| + E_max < pi/2",
+                       angle_met: bool | None = None, angle_note: str = "",
+                       supply_equation: str = "the law's |u| bound <= voltage_limit",
+                       initial_equation: str = "E(0) = E'(0) = 0") -> RunAssumptions:
+    """The reachable angle, the steering stops, the supply and the zero initial error, checked; written once.
+
+    Args:
+        alpha_max: max|alpha0| + E_max [rad], the reachable angle.
+        voltage_max: the claim's bound on the law's |u| [V].
+        limits: the plant's steering stops [rad] and supply [V].
+        initial_error: (E(0) [rad], E'(0) [rad/s]).
+        initial_tolerance: the tolerance on them [rad, rad/s].
+        angle_equation, supply_equation, initial_equation: how the claim words each (section 4 names its
+            fixed point, its voltage bound and (4.17)); angle_met: whether the angle's bound exists
+            (None: alpha_max < pi/2); angle_note: its note.
+
+    Returns:
+        RunAssumptions: the four, each an :class:`Assumption`.
+    """
+    E0, Ed0 = initial_error
     init = max(abs(E0), abs(Ed0))
-    return (
-        Assumption("reachable angle", "alpha_max = max|alpha0| + E_max < pi/2", alpha_max < 0.5 * math.pi,
-                   alpha_max, 0.5 * math.pi, ""),
+    return RunAssumptions(
+        Assumption("reachable angle", angle_equation, alpha_max < 0.5 * math.pi if angle_met is None else angle_met,
+                   alpha_max, 0.5 * math.pi, angle_note),
         Assumption("inside the steering stops", "max|alpha0| + E_max < steering_range",
                    alpha_max < limits.steering_range, alpha_max, limits.steering_range,
                    "the stop's torque is not in the model"),
-        Assumption("within the supply", "the law's |u| bound <= voltage_limit", voltage_max <= limits.voltage_limit,
+        Assumption("within the supply", supply_equation, voltage_max <= limits.voltage_limit,
                    voltage_max, limits.voltage_limit, "the analysis has no saturation"),
-        Assumption("zero initial error", "E(0) = E'(0) = 0", init <= initial_tolerance, init, initial_tolerance,
+        Assumption("zero initial error", initial_equation, init <= initial_tolerance, init, initial_tolerance,
                    f"E(0) = {E0:g} rad, E'(0) = {Ed0:g} rad/s"),
     )
+
+
+def run_assumptions(*, alpha_max: float, voltage_max: float, context: ClaimContext,
+                    initial_tolerance: float = INITIAL_TOLERANCE) -> tuple[Assumption, ...]:
+    """The assumptions every claim of a bounded |E| shares, checked: the reachable angle below pi/2
+    (``alpha_max`` = max|alpha0| + E_max [rad]), inside the steering stops, the law's voltage within
+    the supply (``voltage_max`` [V], the claim's bound on |u|), zero initial error (within
+    ``initial_tolerance``, the reference's rounding at t = 0). :func:`shared_assumptions` on the context."""
+    return tuple(shared_assumptions(alpha_max=alpha_max, voltage_max=voltage_max, limits=context.limits,
+                                    initial_error=context.initial_error, initial_tolerance=initial_tolerance))
+
+
+def fixed_point(phi: Callable[[float], float], alpha0_max: float, *,
+                max_iterations: int = _FIXED_POINT_ITERATIONS) -> tuple[float, int, str]:
+    """Least x >= 0 with x = phi(x), alpha = alpha0_max + x staying in (-pi/2, pi/2).
+
+    phi(x) is the bound at alpha_max = alpha0_max + x (increasing; inf where (4.23)
+    fails). Returns (x*, iterations, reason); x* = inf with the reason when the
+    iteration leaves (-pi/2, pi/2), (4.23) fails on the way, the fixed point is tangent
+    (phi(x) >= x just above it), or it does not settle.
+    """
+    x = 0.0
+    for k in range(1, max_iterations + 1):
+        if alpha0_max + x >= 0.5 * math.pi:
+            return math.inf, k, (f"no fixed point: the bound on |alpha| = max|alpha0| + E_max reaches pi/2 "
+                                 f"(iterate E_max = {x:.4g} rad), where sin/cos^3 and 1/cos^2 are unbounded")
+        nxt = phi(x)
+        if not math.isfinite(nxt):
+            return math.inf, k, (f"no fixed point: (4.23) fails at alpha_max = {alpha0_max + x:.4g} rad "
+                                 f"(iterate E_max = {x:.4g} rad)")
+        if nxt <= x * (1.0 + 1e-13) + 1e-300:
+            x = max(x, nxt)
+            break
+        x = nxt
+    else:
+        return math.inf, max_iterations, f"no fixed point: E_max did not settle in {max_iterations} iterations"
+    h = max(1e-6 * x, 1e-12)
+    if alpha0_max + x + h < 0.5 * math.pi and not phi(x + h) < x + h:
+        return math.inf, k, f"tangent fixed point at E_max = {x:.4g} rad: the bound does not confine the error"
+    return x, k, ""
 
 
 def box_claim(*, claimant: str, E_max: float, Edot_max: float = math.inf, context: ClaimContext, alpha_max: float,
               voltage_max: float, own: Sequence[Assumption] = (), reason: str = "",
               inputs: Mapping[str, Any] | None = None) -> Certificate:
-    """A claim |E| <= E_max [rad] and |E'| <= Edot_max [rad/s] (inf: |E| alone) as a certificate.
+    """A claim |E| <= E_max [rad] and |E'| <= Edot_max [rad/s] (inf: |E| alone): a :class:`BoxRegion`.
 
     Its assumptions: :func:`run_assumptions` (reachable angle, stops, supply, initial error), then
     the claim's ``own`` (e.g. a gain above an uncertainty bound), then the run's
     (``context.stated``). ``valid`` is False (E_max inf) where E_max is not a finite number >= 0 or
-    the reachable angle reaches pi/2.
+    the reachable angle reaches pi/2. ``inputs``: the law's own record (its JSON ``inputs``).
 
     Raises:
         ParameterError: an assumption that is not an :class:`Assumption`.
@@ -127,17 +200,13 @@ def box_claim(*, claimant: str, E_max: float, Edot_max: float = math.inf, contex
         reason = reason or "no finite bound"
     assumptions = (*run_assumptions(alpha_max=alpha_max, voltage_max=voltage_max, context=context), *own,
                    *context.stated)
-    nan = math.nan
-    return Certificate(E_max=E_max, Edot_max=Edot_max, condition=nan, valid=valid, assumptions=assumptions,
-                       gamma1=nan, gamma2=nan, delta1=nan, delta2=nan, delta3=nan, alpha_max=alpha_max,
-                       voltage_max=voltage_max, friction_term=nan, gyro_term=nan, reason=reason,
-                       inputs=dict(inputs or {}), region="box", claimant=claimant, friction_sign="none")
+    return Certificate(region=BoxRegion(E_max=E_max, Edot_max=Edot_max), valid=valid, assumptions=assumptions,
+                       alpha_max=alpha_max, voltage_max=voltage_max, reason=reason,
+                       inputs=ClaimInputs(law=dict(inputs or {})), claimant=claimant)
 
 
 def with_measured(cert: Certificate, assumption: Assumption) -> Certificate:
     """``cert`` with ``assumption``, measured on the run, in place of the one of the same name (else appended)."""
-    import dataclasses
-
     kept = tuple(a for a in cert.assumptions if a.name != assumption.name)
     return dataclasses.replace(cert, assumptions=(*kept, assumption))
 
@@ -149,8 +218,6 @@ def covers_measurement(cert: Certificate, measurement: MeasurementErrors) -> Cer
     measurement only, so the run is uncertified."""
     if measurement.is_exact or any(a.name == MEASUREMENT_COVERED for a in cert.assumptions):
         return cert
-    import dataclasses
-
     fields = coverage_assumption_fields(measurement, cert.claimant)
     fields.update(met=False, value=1.0, note=(f"{cert.claimant or 'the claim'} states nothing about sensing or "
                                               "actuation: it covers exact measurement only"))

@@ -349,10 +349,23 @@ def _assumption_lines(cert, fmt) -> list[str]:
 
 
 def _certificate_table(cert, config, paper) -> str:
-    if cert.region == "box":
+    """The text report of ``cert``, chosen by its region's type: section 4's table, or a law's box claim's."""
+    from wmr_mj.analysis.regions import BoxRegion, SmallGainRegion
+
+    if isinstance(cert.region, BoxRegion):
         return _claim_table(cert)
-    inp = cert.inputs
-    box, est, ref = inp["box"], inp["estimate"], inp["reference"]
+    if not isinstance(cert.region, SmallGainRegion):
+        raise TypeError(f"no text report for a claim whose region is a {type(cert.region).__name__}")
+    return _small_gain_table(cert, config, paper)
+
+
+def _small_gain_table(cert, config, paper) -> str:
+    """The text report of section 4's certificate: its inputs, gammas, deltas and terms, and every assumption."""
+    import dataclasses
+
+    inp = cert.inputs  # the run's record (controller, model, box rule) by key; section 4's inputs typed
+    law = inp.law
+    box, ref = law.plant.box, law.reference
 
     def fmt(x) -> str:
         return "unbounded" if x is None or not math.isfinite(x) else f"{x:.4g}"
@@ -364,15 +377,16 @@ def _certificate_table(cert, config, paper) -> str:
     rows = [
         ("controller", f"{inp['controller']} ({inp['model']} model), K_P = {cert.kp:g}, K_D = {cert.kd:g} "
                        f"({cert.as_dict()['regime']}), Coulomb sign {sign}"),
-        ("plant box P, C_V", f"{span(box['P'])} V s^2/rad, {span(box['C_V'])} V s/rad"),
-        ("plant box F, K", f"{span(box['F'])} V, {span(box['K'])} V"),
-        ("plant gyro, V_A", f"{span(inp['gyro'])} V s/m, {span(inp['V_A'])} m/s"),
+        ("plant box P, C_V", f"{span(box.P)} V s^2/rad, {span(box.C_V)} V s/rad"),
+        ("plant box F, K", f"{span(box.F)} V, {span(box.K)} V"),
+        ("plant gyro, V_A", f"{span(law.plant.gyro)} V s/m, {span(law.plant.V_A)} m/s"),
         ("box rule", f"{inp['box_rule']}, m1 {inp['m1_range'][0]:g}-{inp['m1_range'][1]:g} kg"
                      + "".join(f", {k} {lo:g}-{hi:g}" for k, (lo, hi) in inp["box_ranges"].items())
                      + f"; plant m1 = {inp['plant_m1']:g} kg"),
-        ("estimate", ", ".join(f"{k}^={v:.4g}" for k, v in est.items())),
-        ("reference", f"max|a0| {ref['alpha0_max']:.4g} rad, max|a0'| {ref['alpha0_dot_max']:.4g} rad/s, "
-                      f"max|a0''| {ref['alpha0_ddot_max']:.4g} rad/s^2"),
+        ("estimate", ", ".join(f"{f.name}^={getattr(law.estimate, f.name):.4g}"
+                               for f in dataclasses.fields(law.estimate))),
+        ("reference", f"max|a0| {ref.alpha_max:.4g} rad, max|a0'| {ref.alpha_dot_max:.4g} rad/s, "
+                      f"max|a0''| {ref.alpha_ddot_max:.4g} rad/s^2"),
         ("gamma1, gamma2 (4.14)", f"{cert.gamma1:.4g}, {cert.gamma2:.4g}"),
         ("delta1 (4.18) [rad/s^2]", f"{fmt(cert.delta1)} = friction {cert.friction_term:.4g} "
                                     f"+ K~ {cert.K_term:.3g} + gyro {cert.gyro_term:.3g} + P~ {cert.P_term:.3g} "

@@ -14,7 +14,6 @@ Usage::
 from __future__ import annotations
 
 import dataclasses
-import itertools
 import math
 from collections.abc import Mapping
 from typing import Any
@@ -29,13 +28,14 @@ from wmr_mj.analysis.certificate import (
     Certificate,
     PlantBox,
     PlantLimits,
-    _hull,
     derived_box,
     friction_over_P_max,
     replace_inputs,
 )
 from wmr_mj.analysis.claim import ClaimContext, covers_measurement
 from wmr_mj.analysis.measurement import MeasurementErrors
+from wmr_mj.analysis.plant_box import F_OVER_P_NOT_MONOTONE, box_corners
+from wmr_mj.analysis.plant_box import hull as _hull
 from wmr_mj.analysis.robustness import ParameterBox
 from wmr_mj.analysis.verdicts import OUTSIDE_THE_BOX
 from wmr_mj.errors import ParameterError
@@ -363,17 +363,12 @@ def disturbance_over_P_max(d_max: float, params: C80Parameters, plant: C80Parame
 
     d_V/P = (R_a d/(k_i i2)) / ((R_a/k_i) 2D/i2) = d/(2D): R_a, k_i, i2 cancel and 2D, the steering's
     inertia, does not depend on m1 or any other parameter but the geometry and masses of
-    :data:`wmr_mj.analysis.certificate._F_OVER_P_NOT_MONOTONE`; with one of those ranged, None.
+    :data:`wmr_mj.analysis.plant_box.F_OVER_P_NOT_MONOTONE`; with one of those ranged, None.
     """
-    from wmr_mj.analysis.certificate import _F_OVER_P_NOT_MONOTONE
-    from wmr_mj.params import with_params
-
-    if any(name in _F_OVER_P_NOT_MONOTONE for name, _ in ranges):
+    if any(name in F_OVER_P_NOT_MONOTONE for name, _ in ranges):
         return None
-    axes = [("m1", m1_range), *ranges]
     worst = plant.steering_torque_voltage(d_max) / plant.coefficients("nonholonomic").P
-    for corner in itertools.product(*(span for _, span in axes)):
-        p = with_params(params, m1_inertia=m1_inertia, **dict(zip((n for n, _ in axes), corner)))
+    for p in box_corners(params, m1_range, m1_inertia, ranges):
         worst = max(worst, p.steering_torque_voltage(d_max) / p.coefficients("nonholonomic").P)
     return worst
 

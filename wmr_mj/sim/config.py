@@ -412,24 +412,14 @@ def analysis_box(config: RunConfig, params: C80Parameters = C80):
     """The parameter box of the analysis: the paper's (5.1), or derived from ``params`` over
     the config's m1 range (and box ranges) with the model the controller's source stands on
     ('nonholonomic' for nonholonomic and identified, 'paper' otherwise)."""
+    from wmr_mj.analysis.plant_box import derived_box
     from wmr_mj.analysis.robustness import ParameterBox
 
     if config.box == "paper":
         return ParameterBox.paper()
     box_model = "nonholonomic" if config.model in ("nonholonomic", "identified") else "paper"
-    return _derived_box(params, as_pair(config.m1_range), box_model, config.m1_inertia,
-                        tuple((k, as_pair(v)) for k, v in config.box_ranges.items()))
-
-
-@functools.lru_cache(maxsize=32)
-def _derived_box(params: C80Parameters, m1_range: tuple[float, float], box_model: str, m1_inertia: str,
-                 ranges: tuple[tuple[str, tuple[float, float]], ...]):
-    """The derived box of :func:`analysis_box`, cached: every run of a sweep or a comparison over a box of
-    several ranged parameters asks for the same one (its corners cost 0.4 s for the full box)."""
-    from wmr_mj.analysis.robustness import ParameterBox
-
-    return ParameterBox.from_parameters(params, m1_range=m1_range, model=box_model, m1_inertia=m1_inertia,
-                                        ranges=dict(ranges) or None)
+    return derived_box(params, as_pair(config.m1_range), config.m1_inertia,
+                       tuple((k, as_pair(v)) for k, v in config.box_ranges.items()), model=box_model)
 
 
 def analysis_for(config: RunConfig, reference, params: C80Parameters = C80, *, estimate=None):
