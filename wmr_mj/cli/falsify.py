@@ -225,12 +225,13 @@ def run(args: argparse.Namespace) -> int:
     base, box = _base_and_box(args)
     spec = FalsifySpec(base=base, box=box, objective=objective, budget=args.budget, seed=args.seed,
                        population=args.population, method=args.method, requirement=args.require)
-    check_runnable(base)  # a duration too short for the path: one line, before any output or search
+    parts = check_runnable(base)  # a duration too short for the path: one line, before any output or search
     out = check_output_path(args.out or f"logs/falsify-{time.strftime('%Y%m%d-%H%M%S')}", kind="dir", option="--out")
     with progress_bar(2 * spec.budget, desc="falsify", unit="runs") as bar:
         result = falsify(spec, chunk=args.chunk, nthread=args.nthread, scheduler=args.scheduler,
                          progress=counter_callback(bar),  # evaluations.csv after every generation: Ctrl-C keeps them
-                         checkpoint=lambda partial: write_text_atomic(out / "evaluations.csv", _table(partial)))
+                         checkpoint=lambda partial: write_text_atomic(out / "evaluations.csv", _table(partial)),
+                         parts=parts)
     log_path = out / "worst.mcap"
     config = worst_config(result)
     logged = run_logged(config, str(log_path))

@@ -421,30 +421,38 @@ def format_report(s: RunSummary) -> str:
 _ESTIMATES = ("paper", "nonholonomic")
 
 
-def no_estimate_note(config) -> str | None:
+def no_estimate_note(parts: Any) -> str | None:
     """One line where a built-in law's claim holds under none of the estimates :data:`_ESTIMATES` at the
     run's other settings (gains, box, path): which assumptions fail under each; None where it can hold,
-    states no claim, or the law is not built in."""
+    states no claim, or the law is not built in.
+
+    Args:
+        parts: the run resolved (:func:`wmr_mj.sim.parts.resolve_run`): its own claim is read, not computed
+            again; the law on the other estimate is built once, and its claim computed once. A RunConfig is
+            resolved here first.
+    """
     from controllers.registry import is_builtin
     from wmr_mj.hardware.cart import is_ideal_cart
-    from wmr_mj.params import C80
-    from wmr_mj.plant.mjcf import TIMESTEP
-    from wmr_mj.sim.certify import certificate_for
-    from wmr_mj.sim.config import build_reference, controller_for, estimate_parameters
+    from wmr_mj.sim.certify import claim_on_estimate
+    from wmr_mj.sim.config import RunConfig
     from wmr_mj.sim.designs import CERTIFIED
+    from wmr_mj.sim.parts import resolve_run
 
+    if isinstance(parts, RunConfig):
+        parts = resolve_run(parts)
+    config = parts.config
     if not is_builtin(config.controller) or config.model not in _ESTIMATES:
         return None
-    period = config.control_period or TIMESTEP
-    n = int(round(config.duration / period))
-    reference, _ = build_reference(config.path, estimate_parameters(C80), dt=period, duration=n * period)
+    if parts.claim is None or parts.claim.certified:
+        return None
+    claims = {model: parts.claim if model == config.model else claim_on_estimate(parts, model)
+              for model in _ESTIMATES}
     unmet = {}
-    for model in _ESTIMATES:
-        cert = certificate_for(config.replace(model=model), reference)
+    for model, cert in claims.items():
         if cert is None or cert.certified:
             return None
         unmet[model] = ", ".join(cert.unmet) or "no finite bound"
-    label = controller_for(config, estimate_parameters(C80)).label()
+    label = parts.controller.label()
     hint = ""
     if is_ideal_cart(config) and config.replace(**CERTIFIED.config_changes()) != config:
         hint = "; --preset certified is a computed-torque design whose claim holds"
@@ -463,7 +471,8 @@ def run(args: argparse.Namespace) -> int:
     from wmr_mj._util.memory import require_run_memory
     from wmr_mj.cli._common import print_json
     from wmr_mj.plant.mjcf import TIMESTEP
-    from wmr_mj.sim.closed_loop import run_closed_loop
+    from wmr_mj.sim.closed_loop import run_parts
+    from wmr_mj.sim.parts import resolve_run
 
     # refuse what cannot work before anything runs (an identification for --model identified)
     require_run_memory(duration_s=args.duration, control_period_s=args.control_period or TIMESTEP)
@@ -481,11 +490,12 @@ def run(args: argparse.Namespace) -> int:
         factory = functools.partial(RunLogger, path, options=LogOptions(log_every=args.log_every, background=True))
     from wmr_mj.logs.writer import terminate_as_interrupt
 
-    note = no_estimate_note(config)
+    parts = resolve_run(config)  # the run's law, reference and claim, built once
+    note = no_estimate_note(parts)
     if note:
         print(f"wmr-mj: note: {note}", file=sys.stderr)
     with terminate_as_interrupt():
-        result = run_closed_loop(config, logger_factory=factory, progress=args.progress)
+        result = run_parts(parts, logger_factory=factory, progress=args.progress)
     if result.law_note:
         from wmr_mj.sim.config import plugin_source
 

@@ -1,0 +1,68 @@
+"""One run, one resolution: ``wmr-mj run`` builds each law once and computes each claim once.
+
+The counter wraps each law class's constructor and its ``claim`` (a deep copy does not call the
+constructor, so only a build counts), keyed by the law's class and its estimate's model source: a run of
+the paper's design builds the computed-torque law on the paper's model once; where the run's note asks
+what the law would claim on the other estimate (``no_estimate_note``), that other law is built once too.
+"""
+
+from __future__ import annotations
+
+import collections
+from pathlib import Path
+
+import pytest
+
+from controllers.adaptive import AdaptiveComputedTorque
+from controllers.computed_torque import ComputedTorque, PDController
+from controllers.registry import resolve
+from controllers.sliding_mode import SlidingMode
+from wmr_mj.cli.app import main
+
+REPO = Path(__file__).resolve().parents[1]
+MY_PID = f"{REPO / 'examples' / 'my_pid.py'}:MyPID"
+
+
+def _key(law) -> tuple[str, str | None]:
+    model = getattr(law, "model", None)
+    return type(law).__name__, getattr(model, "name", None)
+
+
+@pytest.fixture
+def counted(monkeypatch):
+    """(builds, claims): Counters of (law class, model source) filled by every law built and claim computed."""
+    builds: collections.Counter = collections.Counter()
+    claims: collections.Counter = collections.Counter()
+    classes = [ComputedTorque, PDController, SlidingMode, AdaptiveComputedTorque, resolve(MY_PID)[0]]
+    for cls in classes:
+        def init(self, *args, __init=cls.__init__, __cls=cls, **kwargs):
+            __init(self, *args, **kwargs)
+            if type(self) is __cls:
+                builds[_key(self)] += 1
+
+        monkeypatch.setattr(cls, "__init__", init)
+        if "claim" in vars(cls):
+            def claim(self, context, __claim=cls.claim):
+                claims[_key(self)] += 1
+                return __claim(self, context)
+
+            monkeypatch.setattr(cls, "claim", claim)
+    return builds, claims
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("options", [
+    [],  # the paper's design
+    ["--preset", "certified"],
+    ["--controller", "sliding-mode"],
+    ["--controller", "adaptive-computed-torque"],
+    ["--controller", "pd"],
+    ["--controller", MY_PID],
+], ids=["paper", "certified", "sliding-mode", "adaptive", "pd", "plug-in"])
+def test_a_run_builds_each_law_once_and_computes_each_claim_once(counted, options, capsys):
+    builds, claims = counted
+    assert main(["run", "--no-log", "--duration", "10", "--json", *options]) in (0, 3)
+    assert builds, "no law was built: the counter missed the run's law"
+    assert set(builds.values()) == {1}, f"a law built more than once: {dict(builds)}"
+    assert set(claims.values()) <= {1}, f"a claim computed more than once: {dict(claims)}"
+    assert set(claims) <= set(builds), f"a claim of a law never built: {dict(claims)}"
