@@ -66,3 +66,28 @@ def test_a_run_builds_each_law_once_and_computes_each_claim_once(counted, option
     assert set(builds.values()) == {1}, f"a law built more than once: {dict(builds)}"
     assert set(claims.values()) <= {1}, f"a claim computed more than once: {dict(claims)}"
     assert set(claims) <= set(builds), f"a claim of a law never built: {dict(claims)}"
+
+
+def test_a_plugin_is_imported_and_hashed_once_per_config(monkeypatch):
+    """A plug-in's source is hashed once when its config is built: as_dict, controller_name and resolving the
+    run read what was found, and the record stays the one a fresh resolution gives."""
+    import controllers.registry as registry
+    from wmr_mj.sim.config import RunConfig, controller_name, controller_source
+    from wmr_mj.sim.parts import resolve_run
+
+    hashed: list[type] = []
+    real = registry.source_hash
+
+    def counting(cls):
+        hashed.append(cls)
+        return real(cls)
+
+    monkeypatch.setattr(registry, "source_hash", counting)
+    config = RunConfig(controller=MY_PID, controller_params={"ki": 20.0}, duration=10.0)
+    first = config.as_dict()
+    assert len(hashed) == 1
+    assert config.as_dict() == first and controller_name(config) == "my-pid"
+    resolve_run(config)
+    assert len(hashed) == 1, f"hashed again: {hashed}"
+    _, fresh = resolve(MY_PID, {"ki": 20.0})
+    assert first["controller_plugin"] == fresh.as_dict() == controller_source(config)
