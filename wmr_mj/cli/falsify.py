@@ -79,15 +79,18 @@ def _objective(args: argparse.Namespace) -> str:
 
 
 def reproduce_command(config, params: dict[str, float], args: argparse.Namespace, *,
-                      signals_file: str | None = None, path_file: str | None = None) -> str:
+                      signals_file: str | None = None, path_file: str | None = None,
+                      law_settings: frozenset[str] | None = None) -> str:
     """A ``wmr-mj run`` line that repeats the worst run (parameters at full precision; its signals,
     when it has some, from ``signals_file``, and its searched path from ``path_file``, where they
     were written exactly)."""
     import shlex
 
-    from wmr_mj.sim.config import controller_and_settings, estimate_parameters
+    read = law_settings  # only the settings the law reads: the resolved run's (RunParts.law_settings)
+    if read is None:
+        from wmr_mj.sim.config import controller_and_settings, estimate_parameters
 
-    read = controller_and_settings(config, estimate_parameters())[1]  # only the settings the law reads
+        read = controller_and_settings(config, estimate_parameters())[1]
     parts = ["wmr-mj run", *([f"--preset {args.preset}"] if args.preset else []),
              f"--controller {shlex.quote(str(config.controller))}",
              *(f"--{name.replace('_', '-')} {value}" for name, value in (
@@ -255,7 +258,8 @@ def run(args: argparse.Namespace) -> int:
         summary["path_file"] = path_file
     summary.update({
         "reproduced": logged.sup_E == worst.sup_E,  # the serial re-run gives the batch's bits
-        "reproduce": reproduce_command(config, worst.params, args, signals_file=signals_file, path_file=path_file),
+        "reproduce": reproduce_command(config, worst.params, args, signals_file=signals_file, path_file=path_file,
+                                       law_settings=parts.law_settings),
         "reference_bounds": None if base.reference_bounds is None else base.reference_bounds.as_dict(),
         "uncertainty": args.uncertainty,
         "folder": str(out),
