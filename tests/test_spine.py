@@ -91,3 +91,51 @@ def test_a_plugin_is_imported_and_hashed_once_per_config(monkeypatch):
     assert len(hashed) == 1, f"hashed again: {hashed}"
     _, fresh = resolve(MY_PID, {"ki": 20.0})
     assert first["controller_plugin"] == fresh.as_dict() == controller_source(config)
+
+
+class _Reads:
+    """A RunConfig that records which of its fields are read (and hands them out)."""
+
+    def __init__(self, config) -> None:
+        object.__setattr__(self, "_config", config)
+        object.__setattr__(self, "read", set())
+
+    def __getattr__(self, name):
+        self.read.add(name)
+        return getattr(self._config, name)
+
+
+#: what the run's summary and log record of the config (its labels and the record itself): read below
+#: resolve_run to be written out, never to build anything
+RECORDED = {"model", "kp", "kd", "path", "as_dict"}
+
+
+@pytest.mark.slow
+def test_below_resolve_run_the_config_is_only_recorded():
+    """run_parts reads the typed parts (sensing, signals, reference bounds, route, ...) and no field of the
+    config but the labels it records; the run's numbers are the same as run_closed_loop's."""
+    import dataclasses
+
+    import numpy as np
+
+    from wmr_mj.sim.closed_loop import run_closed_loop, run_parts
+    from wmr_mj.sim.config import RunConfig
+    from wmr_mj.sim.designs import CERTIFIED
+    from wmr_mj.sim.parts import resolve_run
+
+    config = RunConfig(**CERTIFIED.config_changes(), path="lane-change", duration=5.0, sensing="magnetic-12bit-axis",
+                       signals={"disturbance": {"kind": "step", "amplitude": 0.5, "t1": 1.0},
+                                "loads": [{"kind": "step", "t": 2.0, "m1": 700.0}]},
+                       reference_bounds="paper", correction=True)
+    parts = resolve_run(config)
+    spy = _Reads(config)
+    seen = run_parts(dataclasses.replace(parts, config=spy), progress=False)
+    assert spy.read <= RECORDED, f"read below resolve_run: {sorted(spy.read - RECORDED)}"
+    plain = run_closed_loop(config, progress=False)
+    timing = ("wall_s", "realtime_factor")  # the two runs' clocks, the only keys that differ
+
+    def numbers(result):
+        return {k: v for k, v in result.summary.to_dict().items() if k not in timing}
+
+    assert numbers(seen) == numbers(plain)
+    assert all(np.array_equal(seen.rows[k], plain.rows[k], equal_nan=True) for k in plain.rows)
