@@ -156,7 +156,7 @@ def test_each_law_s_default_estimate_is_its_own_and_the_paper_default_is_unchang
 
 
 def test_a_built_in_whose_claim_holds_under_no_estimate_says_so_in_one_line(capsys):
-    from wmr_mj.cli.run import no_estimate_note
+    from wmr_mj.sim.spec import no_estimate_note
 
     note = no_estimate_note(RunConfig(controller="pd"))
     assert note is not None and "holds under no estimate" in note and "(4.23) small gain" in note

@@ -79,15 +79,18 @@ def _objective(args: argparse.Namespace) -> str:
 
 
 def reproduce_command(config, params: dict[str, float], args: argparse.Namespace, *,
-                      signals_file: str | None = None, path_file: str | None = None) -> str:
+                      signals_file: str | None = None, path_file: str | None = None,
+                      law_settings: frozenset[str] | None = None) -> str:
     """A ``wmr-mj run`` line that repeats the worst run (parameters at full precision; its signals,
     when it has some, from ``signals_file``, and its searched path from ``path_file``, where they
     were written exactly)."""
     import shlex
 
-    from wmr_mj.sim.config import controller_and_settings, estimate_parameters
+    read = law_settings  # only the settings the law reads: the resolved run's (RunParts.law_settings)
+    if read is None:
+        from wmr_mj.sim.config import controller_and_settings, estimate_parameters
 
-    read = controller_and_settings(config, estimate_parameters())[1]  # only the settings the law reads
+        read = controller_and_settings(config, estimate_parameters())[1]
     parts = ["wmr-mj run", *([f"--preset {args.preset}"] if args.preset else []),
              f"--controller {shlex.quote(str(config.controller))}",
              *(f"--{name.replace('_', '-')} {value}" for name, value in (
@@ -225,12 +228,13 @@ def run(args: argparse.Namespace) -> int:
     base, box = _base_and_box(args)
     spec = FalsifySpec(base=base, box=box, objective=objective, budget=args.budget, seed=args.seed,
                        population=args.population, method=args.method, requirement=args.require)
-    check_runnable(base)  # a duration too short for the path: one line, before any output or search
+    parts = check_runnable(base)  # a duration too short for the path: one line, before any output or search
     out = check_output_path(args.out or f"logs/falsify-{time.strftime('%Y%m%d-%H%M%S')}", kind="dir", option="--out")
     with progress_bar(2 * spec.budget, desc="falsify", unit="runs") as bar:
         result = falsify(spec, chunk=args.chunk, nthread=args.nthread, scheduler=args.scheduler,
                          progress=counter_callback(bar),  # evaluations.csv after every generation: Ctrl-C keeps them
-                         checkpoint=lambda partial: write_text_atomic(out / "evaluations.csv", _table(partial)))
+                         checkpoint=lambda partial: write_text_atomic(out / "evaluations.csv", _table(partial)),
+                         parts=parts)
     log_path = out / "worst.mcap"
     config = worst_config(result)
     logged = run_logged(config, str(log_path))
@@ -254,7 +258,8 @@ def run(args: argparse.Namespace) -> int:
         summary["path_file"] = path_file
     summary.update({
         "reproduced": logged.sup_E == worst.sup_E,  # the serial re-run gives the batch's bits
-        "reproduce": reproduce_command(config, worst.params, args, signals_file=signals_file, path_file=path_file),
+        "reproduce": reproduce_command(config, worst.params, args, signals_file=signals_file, path_file=path_file,
+                                       law_settings=parts.law_settings),
         "reference_bounds": None if base.reference_bounds is None else base.reference_bounds.as_dict(),
         "uncertainty": args.uncertainty,
         "folder": str(out),

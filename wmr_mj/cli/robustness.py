@@ -422,28 +422,19 @@ def run_certificate(args: argparse.Namespace) -> int:
     as_json = bool(args.json or inner.json)
 
     from wmr_mj.cli.run import config_from_args
-    from wmr_mj.params import C80
-    from wmr_mj.plant.mjcf import TIMESTEP
-    from wmr_mj.sim.certify import certificate_for
-    from wmr_mj.sim.config import analysis_for, build_reference, controller_for, estimate_of, estimate_parameters
+    from wmr_mj.sim.parts import resolve_run
 
     m1_range, ranges = _box_ranges(inner)
     inner.m1_range = m1_range
     extra = {} if inner.d_max is None else {"signals": {"d_max": inner.d_max}}
     config = config_from_args(inner, m1=inner.m1, **extra)
     config = config.replace(m1_range=m1_range, box_ranges=ranges)
-    period = config.control_period or TIMESTEP
-    n = int(round(config.duration / period))
-    estimate = estimate_parameters(C80)
-    reference, _ = build_reference(config.path, estimate, dt=period, duration=n * period)
-    cert = certificate_for(config, reference, params=C80)
+    parts = resolve_run(config)  # the law, its reference and its claim, built once
+    cert = parts.claim
     if cert is None:
-        from wmr_mj.errors import ParameterError
-        from wmr_mj.sim.config import controller_name
-
-        raise ParameterError(f"controller {controller_name(config)!r} states no claim: there is no certificate to "
+        raise ParameterError(f"controller {parts.controller_name!r} states no claim: there is no certificate to "
                              "print; judge its runs by requirements (wmr-mj run --require ...)")
-    paper = analysis_for(config, reference, estimate, estimate=estimate_of(controller_for(config, estimate)))
+    paper = parts.analysis
     if as_json:
         out = cert.as_dict()
         out["paper_region"] = {"E_max": paper.E_max if paper.stable else None,

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import math
 from typing import TYPE_CHECKING, Any
 
 from wmr_mj.cli._common import box_ranges_from_args, parse_assignments, positive_float, positive_int
@@ -131,113 +130,32 @@ def hardware_from_args(args: argparse.Namespace) -> dict[str, Any]:
 
 
 def config_from_args(args: argparse.Namespace, **extra):
-    """A RunConfig from the shared options (raises WmrMjError on bad input)."""
-    from controllers import gains_from_omega_r
+    """A RunConfig from the shared options (raises WmrMjError on bad input): the law's options merged with the
+    preset by :func:`wmr_mj.sim.spec.law_fields`, the rest parsed here."""
+    from controllers.registry import parse_params
     from wmr_mj.errors import ParameterError
     from wmr_mj.sim.config import RunConfig
-    from wmr_mj.sim.designs import preset
+    from wmr_mj.sim.spec import LawChoice, law_fields
 
-    design = preset("paper" if args.preset is None else args.preset)
-    if args.omega_r is not None and (args.kp is not None or args.kd is not None):
-        raise ParameterError("give either --omega-r or --kp/--kd, not both")
-    if args.omega_r is not None:
-        kp, kd = gains_from_omega_r(args.omega_r)
-    else:
-        kp = design.kp if args.kp is None else args.kp
-        kd = design.kd if args.kd is None else args.kd
-    controller = design.controller if args.controller is None else args.controller
-    model = args.model
-    if model is None and (args.preset is not None or args.controller is None):
-        model = design.model  # else None: the law's own default (RunConfig resolves it)
-    friction_sign = design.friction_sign if args.friction_sign is None else args.friction_sign
-    friction_width = design.friction_width if args.friction_width is None else args.friction_width
-    if not math.isfinite(friction_width) or friction_width < 0:
-        raise ParameterError(f"--friction-width {friction_width} must be finite and >= 0 (rad/s)")
-    identified = args.identified
-    if model == "identified" and identified is None:
-        from wmr_mj.params import C80
-        from wmr_mj.plant.identify import identify_plant
-
-        identified = identify_plant(C80, duration=30.0, seed=0).as_dict()
-    coefficients = parse_assignments(args.coef) if args.coef else None
+    tracker = getattr(args, "tracker", None)
+    if bool(getattr(args, "correction", False)) and tracker not in (None, "stanley-at-C"):
+        raise ParameterError(f"--correction is the tracker stanley-at-C; give it or --tracker {tracker}, not both")
+    choice = LawChoice(preset=args.preset, controller=args.controller,
+                       controller_params=parse_params(getattr(args, "controller_param", None)), model=args.model,
+                       kp=args.kp, kd=args.kd, omega_r=args.omega_r, friction_sign=args.friction_sign,
+                       friction_width=args.friction_width, identified=args.identified,
+                       coefficients=parse_assignments(args.coef) if args.coef else None)
     signals = signals_from_args(args)
     if signals is not None:
         extra.setdefault("signals", signals)
-    from controllers.registry import parse_params
-
-    controller_params = parse_params(getattr(args, "controller_param", None))
-    tracker = getattr(args, "tracker", None)
     tracker_params = parse_params(getattr(args, "tracker_param", None), option="--tracker-param")
-    if bool(getattr(args, "correction", False)) and tracker not in (None, "stanley-at-C"):
-        raise ParameterError(f"--correction is the tracker stanley-at-C; give it or --tracker {tracker}, not both")
-    settings: dict[str, Any] = {"model": model, "kp": kp, "kd": kd, "friction_sign": friction_sign,
-                                "friction_width": friction_width}
-    controller_params = _law_options(args, controller, controller_params, settings, design)
-    model, kp, kd = settings["model"], settings["kp"], settings["kd"]
-    friction_sign, friction_width = settings["friction_sign"], settings["friction_width"]
-    return RunConfig(controller=controller, controller_params=controller_params, tracker=tracker,
-                     tracker_params=tracker_params, model=model, duration=args.duration,
-                     control_period=args.control_period, kp=kp, kd=kd, friction_sign=friction_sign,
-                     friction_width=friction_width, path=args.path,
-                     plant_overrides=parse_assignments(args.param), m1_inertia=args.m1_inertia,
-                     identified=identified, coefficients=coefficients, box=args.box,
+    return RunConfig(**law_fields(choice), tracker=tracker, tracker_params=tracker_params, duration=args.duration,
+                     control_period=args.control_period, path=args.path,
+                     plant_overrides=parse_assignments(args.param), m1_inertia=args.m1_inertia, box=args.box,
                      m1_range=tuple(args.m1_range), steering_friction=args.steering_friction,
                      tyre_contact=args.tyre_contact, box_ranges=box_ranges_from_args(args),
                      correction=bool(getattr(args, "correction", False)),
                      reference_bounds=getattr(args, "reference_bounds", None), **hardware_from_args(args), **extra)
-
-
-#: the run options that configure a steering law, and the RunConfig fields they set
-_LAW_OPTIONS = {"--model": ("model",), "--kp": ("kp",), "--kd": ("kd",), "--omega-r": ("kp", "kd"),
-                "--friction-sign": ("friction_sign",), "--friction-width": ("friction_width",)}
-
-
-def _law_options(args: argparse.Namespace, controller: str, params: dict, settings: dict, design) -> dict:
-    """The explicit law options (--model, --kp, --kd, --omega-r, --friction-sign, --friction-width) of a law
-    other than computed-torque: each goes to the law as the parameter of that name where it declares one
-    (its constructor or from_context: moved from ``settings`` into the returned parameters, ``settings``
-    keeping the preset's value), stays a RunConfig setting where its build reads it from the context
-    (``BuildContext``: model, kp, kd), and is refused otherwise. A preset's own values are never refused.
-
-    Raises:
-        ParameterError: an option the law neither declares nor reads (one line naming what it takes), or
-            one given both as an option and as --controller-param.
-    """
-    from controllers.computed_torque import CONTROLLER_NAMES
-    from wmr_mj.errors import ParameterError
-    from wmr_mj.params import C80
-    from wmr_mj.sim.config import RunConfig, controller_and_settings, declared_parameters, estimate_parameters
-
-    given = {option: fields for option, fields in _LAW_OPTIONS.items()
-             if getattr(args, option[2:].replace("-", "_"), None) is not None}
-    if not given or controller == "computed-torque":
-        return params
-    if controller in CONTROLLER_NAMES:  # pd: fields, as computed-torque, but no Coulomb compensation
-        declared: frozenset[str] = frozenset()
-        reads = frozenset({"model", "kp", "kd"})
-    else:
-        declared = declared_parameters(controller) - {"model"}  # a model is the context's, never a parameter
-        preset_values = {k: getattr(design, k) for k in settings}
-        probe = RunConfig(controller=controller, controller_params=params, model=preset_values["model"]
-                          if preset_values["model"] != "identified" else "paper", kp=design.kp, kd=design.kd)
-        reads = controller_and_settings(probe, estimate_parameters(C80))[1]
-    out = dict(params)
-    for option, fields in given.items():
-        passed = [f for f in fields if f in declared]
-        if passed and len(passed) == len(fields):
-            for f in fields:
-                if f in out:
-                    raise ParameterError(f"{option} and --controller-param {f}=... both set {f}; give one")
-                out[f] = settings[f]
-                settings[f] = getattr(design, f)  # the RunConfig field the law does not read keeps the preset's
-            continue
-        if all(f in reads for f in fields):
-            continue
-        takes = sorted(declared - {"self"})
-        raise ParameterError(
-            f"{option} does not apply to controller {controller!r}: it reads no {'/'.join(fields)}; give its own "
-            f"parameters with --controller-param NAME=VALUE (it takes: {', '.join(takes) or 'none'})")
-    return out
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -417,44 +335,6 @@ def format_report(s: RunSummary) -> str:
     return "\n".join(lines)
 
 
-#: the model sources whose estimate needs no data (identified and explicit need the user's)
-_ESTIMATES = ("paper", "nonholonomic")
-
-
-def no_estimate_note(config) -> str | None:
-    """One line where a built-in law's claim holds under none of the estimates :data:`_ESTIMATES` at the
-    run's other settings (gains, box, path): which assumptions fail under each; None where it can hold,
-    states no claim, or the law is not built in."""
-    from controllers.registry import is_builtin
-    from wmr_mj.hardware.cart import is_ideal_cart
-    from wmr_mj.params import C80
-    from wmr_mj.plant.mjcf import TIMESTEP
-    from wmr_mj.sim.certify import certificate_for
-    from wmr_mj.sim.config import build_reference, controller_for, estimate_parameters
-    from wmr_mj.sim.designs import CERTIFIED
-
-    if not is_builtin(config.controller) or config.model not in _ESTIMATES:
-        return None
-    period = config.control_period or TIMESTEP
-    n = int(round(config.duration / period))
-    reference, _ = build_reference(config.path, estimate_parameters(C80), dt=period, duration=n * period)
-    unmet = {}
-    for model in _ESTIMATES:
-        cert = certificate_for(config.replace(model=model), reference)
-        if cert is None or cert.certified:
-            return None
-        unmet[model] = ", ".join(cert.unmet) or "no finite bound"
-    label = controller_for(config, estimate_parameters(C80)).label()
-    hint = ""
-    if is_ideal_cart(config) and config.replace(**CERTIFIED.config_changes()) != config:
-        hint = "; --preset certified is a computed-torque design whose claim holds"
-    elif not is_ideal_cart(config):
-        hint = " on this cart (its sensing, actuation or play: see the assumptions not met)"
-    return (f"the claim of controller {config.controller!r} ({label}) holds under no estimate at these settings (" +
-            "; ".join(f"{m} model: {u} not met" for m, u in unmet.items()) +
-            "): its runs are uncertified whatever they do" + hint)
-
-
 def run(args: argparse.Namespace) -> int:
     import functools
     import sys
@@ -463,7 +343,9 @@ def run(args: argparse.Namespace) -> int:
     from wmr_mj._util.memory import require_run_memory
     from wmr_mj.cli._common import print_json
     from wmr_mj.plant.mjcf import TIMESTEP
-    from wmr_mj.sim.closed_loop import run_closed_loop
+    from wmr_mj.sim.closed_loop import run_parts
+    from wmr_mj.sim.parts import resolve_run
+    from wmr_mj.sim.spec import no_estimate_note
 
     # refuse what cannot work before anything runs (an identification for --model identified)
     require_run_memory(duration_s=args.duration, control_period_s=args.control_period or TIMESTEP)
@@ -481,11 +363,12 @@ def run(args: argparse.Namespace) -> int:
         factory = functools.partial(RunLogger, path, options=LogOptions(log_every=args.log_every, background=True))
     from wmr_mj.logs.writer import terminate_as_interrupt
 
-    note = no_estimate_note(config)
+    parts = resolve_run(config)  # the run's law, reference and claim, built once
+    note = no_estimate_note(parts)
     if note:
         print(f"wmr-mj: note: {note}", file=sys.stderr)
     with terminate_as_interrupt():
-        result = run_closed_loop(config, logger_factory=factory, progress=args.progress)
+        result = run_parts(parts, logger_factory=factory, progress=args.progress)
     if result.law_note:
         from wmr_mj.sim.config import plugin_source
 

@@ -64,7 +64,8 @@ def run(args: argparse.Namespace) -> int:
     base = config_from_args(args)
     from wmr_mj.sim.parts import resolve_run
 
-    resolve_run(base)  # what the runs would raise (a law's claim() that raises): one line, before any output
+    # what the runs would raise (a law's claim() that raises): one line, before any output
+    base_parts = resolve_run(base)
     requirements = tuple(r.text for r in requirements_from_args(args, args.control_period or TIMESTEP))
     spec = SweepSpec(n=args.n, seed=args.seed, sampling=args.sampling, m1_range=tuple(args.m1_range),
                      ranges=ranges, base=base, requirements=requirements)
@@ -106,9 +107,9 @@ def run(args: argparse.Namespace) -> int:
         print_json(summary)
         return status
     fmt = lambda x: "n/a" if x is None else f"{x:.3f}"  # noqa: E731
-    from wmr_mj.sim.config import controller_for, estimate_of, estimate_parameters
+    from wmr_mj.sim.config import estimate_of
 
-    law = controller_for(base, estimate_parameters())
+    law = base_parts.controller
     label = law.label()
     print(f"{runs.n} runs ({label}, m1 over "
           f"{args.m1_range[0]:g}-{args.m1_range[1]:g} kg, {args.sampling}, seed {args.seed}):")

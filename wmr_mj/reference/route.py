@@ -69,7 +69,8 @@ from wmr_mj.params import C80Parameters
 from wmr_mj.reference.paths import Path, Reference, Segment, SegmentKind, _s5_int, make_reference
 
 __all__ = ["Route", "ROUTES_DIR", "route_names", "load_route", "parse_route", "route_from_path",
-           "is_route_spec", "route_reference", "RouteProgress", "route_progress"]
+           "is_route_spec", "route_reference", "RouteProgress", "route_progress",
+           "route_length"]
 
 #: Routes shipped with the package, selectable by name (the file's stem).
 ROUTES_DIR = DATA_DIR / "routes"
@@ -503,6 +504,13 @@ class RouteProgress:
     def finished(self) -> bool:
         return self.driven_m >= self.length_m - FINISHED_TOL_M
 
+    @classmethod
+    def along(cls, length_m: float, reference: Any, duration: float) -> RouteProgress:
+        """The progress of a run of ``duration`` [s] with ``reference`` on a route of ``length_m`` [m]."""
+        s = np.asarray(reference.s, float)
+        driven = float(np.interp(float(duration), np.asarray(reference.t, float), s)) - float(s[0])
+        return cls(length_m=float(length_m), driven_m=driven)
+
     def to_dict(self) -> dict[str, Any]:
         """The summary keys route_length_m, route_driven_m, route_finished."""
         return {"route_length_m": self.length_m, "route_driven_m": self.driven_m, "route_finished": self.finished}
@@ -512,8 +520,12 @@ def route_progress(spec: str, reference: Any, duration: float) -> RouteProgress 
     """The :class:`RouteProgress` of a run of ``duration`` s on the route ``spec`` with ``reference``
     (built by ``route_reference``); None when ``spec`` names no route (a named path, built to fill
     the duration)."""
+    length_m = route_length(spec)
+    return None if length_m is None else RouteProgress.along(length_m, reference, duration)
+
+
+def route_length(spec: str) -> float | None:
+    """The length [m] of the route ``spec`` (one lap of a closed route); None when it names no route."""
     if not isinstance(spec, str) or not is_route_spec(spec):
         return None
-    s = np.asarray(reference.s, float)
-    driven = float(np.interp(float(duration), np.asarray(reference.t, float), s)) - float(s[0])
-    return RouteProgress(length_m=float(load_route(spec).path.length), driven_m=driven)
+    return float(load_route(spec).path.length)

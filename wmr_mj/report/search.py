@@ -45,7 +45,6 @@ from wmr_mj.report.settings import (
     certificate_summary,
     loud,
     max_at,
-    reference_of,
     stage_progress,
 )
 from wmr_mj.sim.designs import CERTIFIED, LADDER, PAPER, Design
@@ -198,14 +197,15 @@ def _result(plan: SearchPlan, spec, runs: Sequence[Mapping[str, Any]], worst: Ma
 
 
 def run_search(plan: SearchPlan, settings: ValidateSettings, folder: Path, st: Stages,
-               rungs: Sequence[Mapping[str, Any]], reference) -> dict[str, Any]:
+               rungs: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
     """One search: read back when search-<key>/search.json matches its spec, else run it,
     re-run its worst run with an MCAP log (worst.mcap: is the serial run's sup|E| the
-    batch's?) and write evaluations.csv and search.json."""
+    batch's?) and write evaluations.csv and search.json; its certificate is the base run's claim
+    (:func:`wmr_mj.sim.parts.resolve_run`)."""
     from wmr_mj._util.files import write_json_atomic, write_text_atomic
     from wmr_mj.logs.writer import run_logged
-    from wmr_mj.sim.certify import certificate_for
     from wmr_mj.sim.falsify import OBJECTIVE_LABELS
+    from wmr_mj.sim.parts import resolve_run
 
     spec = _search_spec(plan, settings)
     out = folder / f"search-{plan.key}"
@@ -222,7 +222,7 @@ def run_search(plan: SearchPlan, settings: ValidateSettings, folder: Path, st: S
     if worst:
         logged = run_logged(spec.config([worst["params"][n] for n in spec.names]), str(out / "worst.mcap"))
     result = _result(plan, spec, runs, worst, bool(worst and logged is not None and logged.sup_E == worst["sup_E"]),
-                     certificate_for(spec.base, reference), out, folder)
+                     resolve_run(spec.base).claim, out, folder)
     _compare(result, plan, rungs, folder)
     write_text_atomic(out / "evaluations.csv", _evaluations_csv(spec.names, runs))
     write_json_atomic(out / "search.json", result)
@@ -238,5 +238,4 @@ def _num(x: Any) -> str:
 def search_stage(settings: ValidateSettings, folder: Path, st: Stages, rungs: Sequence[Mapping[str, Any]]
                  ) -> list[dict[str, Any]]:
     """Every search of :func:`search_plans`, in order ([] when the search is disabled)."""
-    reference = reference_of(settings)
-    return [run_search(plan, settings, folder, st, rungs, reference) for plan in search_plans(settings)]
+    return [run_search(plan, settings, folder, st, rungs) for plan in search_plans(settings)]

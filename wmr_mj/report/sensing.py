@@ -29,7 +29,7 @@ import numpy as np
 
 from wmr_mj._util.progress import Stages
 from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE, unmet_assumptions
-from wmr_mj.report.settings import ValidateSettings, reference_of
+from wmr_mj.report.settings import ValidateSettings
 
 __all__ = ["REALISTIC_SENSING", "SETTLED_WINDOW_S", "sensing_stage", "voltage_activity", "settled_plateau"]
 
@@ -69,10 +69,12 @@ def settled_plateau(E: np.ndarray, control_period: float, window_s: float = SETT
             "window_s": n * control_period}
 
 
-def _one_run(config, name: str, ideal_E_max: float | None) -> dict[str, Any]:
-    from wmr_mj.sim.closed_loop import run_closed_loop
+def _one_run(parts, name: str, ideal_E_max: float | None) -> dict[str, Any]:
+    """The run of ``parts`` (resolved: :func:`wmr_mj.sim.parts.resolve_run`) under the sensing called ``name``."""
+    from wmr_mj.sim.closed_loop import run_parts
 
-    run = run_closed_loop(config, progress=False)
+    config = parts.config
+    run = run_parts(parts, progress=False)
     s = run.summary
     cert = s.to_dict().get("certificate") or {}
     period = 1e-3 if config.control_period is None else config.control_period
@@ -84,11 +86,10 @@ def _one_run(config, name: str, ideal_E_max: float | None) -> dict[str, Any]:
             "max_abs_voltage": float(np.max(np.abs(run.rows["voltage"]))) if len(run.rows["voltage"]) else None}
 
 
-def _dead_band_prediction(config, reference) -> dict[str, float]:
-    """F^ / (P^ K_P) [rad] from the certified design's certificate (its estimate's F and P, its K_P)."""
-    from wmr_mj.sim.certify import certificate_for
-
-    cert = certificate_for(config, reference)
+def _dead_band_prediction(parts) -> dict[str, float]:
+    """F^ / (P^ K_P) [rad] from the certified design's certificate (its estimate's F and P, its K_P): the claim
+    of its run resolved (``parts``, :func:`wmr_mj.sim.parts.resolve_run`)."""
+    cert = parts.claim
     if cert is None:  # the certified design's computed-torque law always states one
         raise RuntimeError("the certified design states no certificate")
     est = cert.inputs["estimate"]
@@ -107,13 +108,19 @@ def sensing_stage(settings: ValidateSettings, st: Stages, *,
         [rad]), ``runs`` (one per sensing, 'ideal' first: see the module docstring), ``certified_outside``.
     """
     from wmr_mj.sim.designs import CERTIFIED
+    from wmr_mj.sim.parts import resolve_run
 
     m1 = float(settings.m1_range[1])
     st.start("sensing", f"the certified design on realistic sensing ({', '.join(presets)}; m1 = {m1:g} kg, "
                         f"{settings.duration:g} s each)")
     base = settings.config(CERTIFIED).replace(m1=m1)
-    prediction = _dead_band_prediction(base, reference_of(settings))
-    runs = [_one_run(base.replace(sensing=name), name, prediction["ideal_E_max"]) for name in ("ideal", *presets)]
+    base_parts = resolve_run(base)
+    prediction = _dead_band_prediction(base_parts)
+    runs = []
+    for name in ("ideal", *presets):
+        config = base.replace(sensing=name)
+        parts = base_parts if config == base else resolve_run(config)  # the base run resolved once
+        runs.append(_one_run(parts, name, prediction["ideal_E_max"]))
     n_out = sum(r["verdict"] == CERTIFIED_OUTSIDE for r in runs)
     st.done(", ".join(f"{r['sensing']}: {r['verdict']}, TV u {r['tv_voltage']:.3g} V/s" for r in runs))
     return {"m1": m1, "design": CERTIFIED.label, "duration": settings.duration, **prediction, "runs": runs,

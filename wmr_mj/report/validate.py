@@ -51,7 +51,6 @@ from wmr_mj.report.settings import (
     reference_of,
     stage_progress,
 )
-from wmr_mj.sim.config import RunConfig
 from wmr_mj.sim.designs import CERTIFIED, LADDER, PAPER, Design, DesignLike
 
 __all__ = [
@@ -104,12 +103,10 @@ def _change_text(before: DesignLike, after: DesignLike) -> str:
     return "; ".join(parts)
 
 
-def _paper_region(config: RunConfig, reference) -> dict[str, Any]:
-    """The paper's claim for ``config``: the region (4.21)-(4.23) its runs are judged by."""
-    from wmr_mj.sim.config import analysis_for, controller_for, estimate_of
-
-    analysis = analysis_for(config, reference, C80, estimate=estimate_of(controller_for(config, C80)))
-    d = analysis.as_dict()
+def _paper_region(parts: Any) -> dict[str, Any]:
+    """The paper's claim for a resolved run (:class:`wmr_mj.sim.parts.RunParts`): the region (4.21)-(4.23)
+    its runs are judged by."""
+    d = parts.analysis.as_dict()
     return {k: d[k] for k in ("E_max", "Edot_max", "condition", "stable", "vertices")}
 
 
@@ -147,13 +144,16 @@ def friction_stage(settings: ValidateSettings, st: Stages) -> dict[str, dict[str
 
 
 # --------------------------------------------------------------------------- stage 3: the ladder
-def run_rung(settings: ValidateSettings, k: int, design: DesignLike, folder: Path, st: Stages, reference,
-             before: Design | None) -> dict[str, Any]:
-    """Sweep one rung over m1 (resumable in ladder-<k>-<name>/) and summarise it."""
-    from wmr_mj.sim.certify import certificate_for
+def run_rung(settings: ValidateSettings, k: int, design: DesignLike, folder: Path, st: Stages,
+             before: Design | None, *, parts: Any = None) -> dict[str, Any]:
+    """Sweep one rung over m1 (resumable in ladder-<k>-<name>/) and summarise it; its certificate and the
+    paper's region are the base run's (``settings.config(design)``), resolved once: ``parts``
+    (:func:`wmr_mj.sim.parts.resolve_run`), resolved here where None."""
+    from wmr_mj.sim.parts import resolve_run
     from wmr_mj.sim.sweep import SweepSpec, read_results, run_sweep
 
     base = settings.config(design)
+    parts = resolve_run(base) if parts is None else parts
     spec = SweepSpec(n=settings.n, seed=settings.seed, sampling=settings.sampling,
                      m1_range=as_pair(settings.m1_range), ranges=settings.ranges, base=base)
     sweep_dir = folder / f"ladder-{k}-{design.name}"
@@ -164,8 +164,8 @@ def run_rung(settings: ValidateSettings, k: int, design: DesignLike, folder: Pat
     rung.update(index=k, name=design.name, label=design.label, design=design.describe(),
                 config=design.config_changes(), changed=[] if before is None else ladder_changes(before, design),
                 change="" if before is None else _change_text(before, design),
-                certificate=certificate_summary(certificate_for(base, reference)),
-                paper_region=_paper_region(base, reference),
+                certificate=certificate_summary(parts.claim),
+                paper_region=_paper_region(parts),
                 runs_csv=(sweep_dir / "runs.csv").relative_to(folder).as_posix())
     paper = ("" if rung["paper_inside"] is None
              else f", {rung['paper_inside']}/{rung['n']} inside the paper's claim")
@@ -175,10 +175,9 @@ def run_rung(settings: ValidateSettings, k: int, design: DesignLike, folder: Pat
 
 def ladder_stage(settings: ValidateSettings, folder: Path, st: Stages) -> list[dict[str, Any]]:
     """Every rung of :data:`LADDER`, in order (see :func:`run_rung`)."""
-    reference = reference_of(settings)
     rungs = []
     for k, design in enumerate(LADDER, start=1):
-        rungs.append(run_rung(settings, k, design, folder, st, reference, LADDER[k - 2] if k > 1 else None))
+        rungs.append(run_rung(settings, k, design, folder, st, LADDER[k - 2] if k > 1 else None))
     return rungs
 
 
@@ -187,8 +186,7 @@ def correction_stage(settings: ValidateSettings, folder: Path, st: Stages) -> di
     (:data:`wmr_mj.sim.designs.CORRECTION_RUNG`; summary.json's ``correction_rung``)."""
     from wmr_mj.sim.designs import CERTIFIED, CORRECTION_RUNG
 
-    rung = run_rung(settings, len(LADDER) + 1, CORRECTION_RUNG, folder, st, reference_of(settings),
-                    CERTIFIED)
+    rung = run_rung(settings, len(LADDER) + 1, CORRECTION_RUNG, folder, st, CERTIFIED)
     rung.update(changed=["correction"], change="Cartesian correction at C (outer loop on alpha0, "
                                               "controllers/tracking.py)")
     return rung
@@ -198,15 +196,17 @@ def designs_stage(settings: ValidateSettings, folder: Path, st: Stages, *, first
     """``validate --design TOKEN``: each design of the user's (a plug-in law, a tracker, other gains; a token
     as ``wmr-mj compare`` takes it) judged beside the ladder: its rung (:func:`run_rung`: the same m1 sweep,
     its verdicts against its own claim) and its nominal run (summary.json's ``designs``)."""
-    from wmr_mj.sim.closed_loop import run_closed_loop
+    from wmr_mj.sim.closed_loop import run_parts
     from wmr_mj.sim.designs import TokenDesign
+    from wmr_mj.sim.parts import resolve_run
 
     out = []
     for k, token in enumerate(settings.designs, start=first_index):
         design = TokenDesign(token)
-        rung = run_rung(settings, k, design, folder, st, reference_of(settings), None)
+        parts = resolve_run(settings.config(design))  # the rung's claim and its nominal run: one resolution
+        rung = run_rung(settings, k, design, folder, st, None, parts=parts)
         st.start(f"design-{k}", f"nominal run of {token} at m1 = {settings.nominal_m1:g} kg")
-        nominal = run_closed_loop(settings.config(design), progress=False)
+        nominal = run_parts(parts, progress=False)
         st.done(f"sup|E| = {nominal.summary.sup_E:.3g} rad, {nominal.summary.verdict}")
         law = "no-claim: judged by requirements only" if nominal.summary.verdict == "no-claim" else ""
         rung.update(token=token, change="a design of the user's (validate --design)" + (f"; {law}" if law else ""),

@@ -482,9 +482,10 @@ def _summaries(configs: Sequence[RunConfig], plants: Sequence[C80Parameters], st
     # C's projections are NumPy work that releases the GIL: judged on the batch's threads, each run alone
     with concurrent.futures.ThreadPoolExecutor(max(1, min(run.threads, nsim))) as pool:
         paths = list(pool.map(path_of, range(nsim)))
-    from wmr_mj.reference.route import route_progress
+    from wmr_mj.reference.route import RouteProgress
 
-    progress = route_progress(configs[0].path, reference, n * substeps * TIMESTEP)  # one path: one progress
+    progress = (None if parts.route_length_m is None  # one path: one progress
+                else RouteProgress.along(parts.route_length_m, reference, n * substeps * TIMESTEP))
     reports = []
     for i, (c, p) in enumerate(zip(configs, plants)):
         certificate = certificates[i]

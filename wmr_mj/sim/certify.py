@@ -49,7 +49,8 @@ from wmr_mj.sim.config import (
     tracker_for,
 )
 
-__all__ = ["certificate_for", "certificate_of", "identified_spread", "box_spans", "outside_the_box", "reference_within"]
+__all__ = ["certificate_for", "certificate_of", "claim_on_estimate", "identified_spread",
+           "box_spans", "outside_the_box", "reference_within"]
 
 
 def identified_spread(identified: Any) -> dict[str, tuple[float, float]]:
@@ -184,6 +185,22 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
                           plant=plant_parameters(config, params), controller=controller_for(config, estimate_params),
                           tracker=tracker_for(config, estimate_params), k_band=k_band, gyro_band=gyro_band,
                           measurement=measurement)
+
+
+def claim_on_estimate(parts: Any, model: str) -> Certificate | None:
+    """The claim the run's law would state on another estimate: the law of ``parts`` (a resolved run,
+    :class:`wmr_mj.sim.parts.RunParts`) built on the model source ``model`` (one new law, built once), its
+    claim computed on the run's reference, plant, belief and tracker.
+
+    Raises:
+        WmrMjError: what the law on that estimate cannot build or claim.
+    """
+    from wmr_mj.sim.config import controller_and_settings
+
+    config = parts.config.replace(model=model)
+    controller, _ = controller_and_settings(config, parts.estimate)
+    return certificate_of(config, parts.reference, base=parts.base, estimate=parts.estimate, plant=parts.plant,
+                          controller=controller, tracker=parts.tracker)
 
 
 def measurement_errors_of(config: Any, plant: C80Parameters) -> MeasurementErrors:

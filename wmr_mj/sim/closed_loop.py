@@ -48,14 +48,12 @@ from wmr_mj.sim.config import (
     build_reference,
     controller_name,
     estimate_parameters,
-    reference_bounds_of,
 )
 from wmr_mj.sim.engine import (
     ROW_FIELDS,
     ControllerFailure,
     Schedule,
     batch_model,
-    load_fields,
     run_engine,
 )
 from wmr_mj.sim.log_header import LogHeader
@@ -328,27 +326,6 @@ def _drift_of(E: np.ndarray, final_alpha_dot: float, period: float) -> Drift:
                  final_alpha_dot=final_alpha_dot)
 
 
-def _signal_inputs(config: RunConfig, params: C80Parameters, options: dict[str, Any], n: int, period: float):
-    """(disturbance torque per control step [N m] or None, [(control step, load fields)]) of config.signals.
-
-    A load change at time t is applied at the first control step at or after t.
-    """
-    signals = getattr(config, "signals", None)
-    if signals is None:
-        return None, []
-    from wmr_mj.params import with_params
-
-    disturbance = None
-    if signals.disturbance is not None:
-        disturbance = signals.disturbance.samples(np.arange(n) * period)
-    loads = []
-    for t, m1 in signals.load_steps(params.m1):
-        k = int(np.ceil(t / period - 1e-9))
-        if k < n:
-            loads.append((k, load_fields(with_params(params, m1_inertia=config.m1_inertia, m1=m1), **options)))
-    return disturbance, loads
-
-
 def run_closed_loop(
     config: RunConfig = RunConfig(),
     *,
@@ -400,15 +377,15 @@ def run_parts(parts: RunParts, *, logger_factory: Callable[..., Any] | None = No
             bounds=({"E_max": certificate.E_max, "Edot_max": certificate.Edot_max} if certificate is not None
                     else {"E_max": math.inf, "Edot_max": math.inf}),
             reference_path=np.asarray(reference.C_xy)[::max(1, len(reference.C_xy) // 2000)],
-            path_errors=_PathRows(reference, period), sensed=not config.sensing.is_ideal))
+            path_errors=_PathRows(reference, period), sensed=not parts.sensing.is_ideal))
 
-    disturbance, loads = _signal_inputs(config, params, options, n, period)
+    disturbance, loads = parts.disturbance, list(parts.loads)
     on_block = None if logger is None else logger.write_block
     bar = progress_bar(n, desc="run", unit="step", unit_scale=True, enabled=progress)
     try:
         schedule = Schedule(reference=(a0_all, a0d_all, a0dd_all), n=n, substeps=substeps, period=period,
                             disturbance=disturbance, loads=loads, tracker=outer, path_reference=reference,
-                            sensing=config.sensing)
+                            sensing=parts.sensing)
         run = run_engine(params=params, controller=controller, options=options, model=plain, schedule=schedule,
                          law=law, on_block=on_block, on_progress=bar.update)
     finally:
@@ -422,9 +399,11 @@ def run_parts(parts: RunParts, *, logger_factory: Callable[..., Any] | None = No
         raise KeyboardInterrupt  # nothing simulated: nothing to report
     if outer is not None and certificate is not None:
         # the tracker's declared bounds, measured on the reference the law received
-        certificate = with_measured(certificate, within_declared(done, outer.declared_bounds(
-            reference_bounds_of(config, reference)), tracker=outer.name))
-    certificate = with_measured_errors(certificate, config, params, done, period=period)  # sensing's bounds, measured
+        certificate = with_measured(certificate, within_declared(done, outer.declared_bounds(parts.reference_bounds),
+                                                                 tracker=outer.name))
+    # the sensing's error bounds the claim assumed, measured on what the law read
+    certificate = with_measured_errors(certificate, sensing=parts.sensing, measurement=parts.measurement, rows=done,
+                                       period=period)
     after = done["t"] >= settle_s
     at = path_sample_index(k, period)
     saturated = int(np.count_nonzero(done["voltage"] != done["voltage_cmd"]))  # NaN included: 0 V applied
@@ -446,9 +425,11 @@ def run_parts(parts: RunParts, *, logger_factory: Callable[..., Any] | None = No
     summary = dataclasses.replace(summary, mujoco_warnings=run.warnings, failure=run.failure,
                                   paper_law=parts.paper_law, law_settings=parts.law_settings,
                                   analysis=analysis.as_dict(), controller_config=controller.describe())
-    from wmr_mj.reference.route import route_progress
+    if parts.route_length_m is not None:
+        from wmr_mj.reference.route import RouteProgress
 
-    summary = dataclasses.replace(summary, route=route_progress(config.path, reference, summary.duration))
+        summary = dataclasses.replace(summary, route=RouteProgress.along(parts.route_length_m, reference,
+                                                                         summary.duration))
     if logger is not None:
         logger.close(summary.to_dict(), status=status)
     path_samples = None

@@ -339,21 +339,23 @@ def compare(designs: Sequence[Design], suite: Suite, *, scenarios: Sequence[str]
     steps = sum(int(r.summary.get("steps") or 0) for r in runs)
     for i, d in enumerate(designs):
         mine = [r for r in runs if r.design == d.label]
-        adversary = None
+        adversary = claim = None
         if specs:
-            from wmr_mj.sim.falsify import falsify
+            from wmr_mj.sim.falsify import check_runnable, falsify
 
+            parts = check_runnable(specs[i].base)  # the adversary's base run, resolved once: its claim is the row's
+            claim = parts.claim
             adversary = falsify(specs[i], nthread=nthread, scheduler=scheduler,
-                                progress=lambda k, n: None)
+                                progress=lambda k, n: None, parts=parts)
             steps += sum(int(e.summary.get("steps") or 0) for e in [*adversary.search, *adversary.random])
             tick(2 * budget)
-        rows.append(_row(d, mine, adversary, specs[i] if specs else None))
+        rows.append(_row(d, mine, adversary, claim))
     return CompareResult(suite=suite, scenarios=chosen, rows=tuple(rows), runs=runs, budget=budget, seed=seed,
                          versions=versions(), wall_s=time.perf_counter() - wall0, steps=steps)
 
 
-def _row(design: Design, runs: Sequence[ScenarioRun], adversary: Any, spec: Any) -> DesignRow:
-    """A design's line from its scenario runs and the adversary's result."""
+def _row(design: Design, runs: Sequence[ScenarioRun], adversary: Any, cert: Any) -> DesignRow:
+    """A design's line from its scenario runs and the adversary's result (``cert``: the claim of its base run)."""
     passed = total = 0
     least, least_at = None, ""
     for r in runs:
@@ -368,13 +370,6 @@ def _row(design: Design, runs: Sequence[ScenarioRun], adversary: Any, spec: Any)
     claim_E_max = worst = random_worst = worst_sup_E = tightness = None
     falsified, runs_to, random_runs_to, where = False, None, None, {}
     if adversary is not None:
-        from wmr_mj.sim.certify import certificate_for
-        from wmr_mj.sim.config import build_reference, estimate_parameters
-
-        base = spec.base
-        period = TIMESTEP if base.control_period is None else base.control_period
-        reference, _ = build_reference(base.path, estimate_parameters(), dt=period, duration=base.duration)
-        cert = certificate_for(base, reference)
         if cert is not None and cert.valid:
             claim_E_max = float(cert.E_max)
         evals = list(adversary.search) + list(adversary.random)

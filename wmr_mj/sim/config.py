@@ -109,12 +109,21 @@ class RunConfig:
     sensing: Any = None
     actuation: Any = None
     transmission: Any = None
+    # the plug-ins found once (kind -> PluginSource, kind + "_class" -> the class): imported and hashed when the
+    # config is checked or first asked, never again for as_dict, controller_name or the run's build
+    _plugins: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
+
+    def __getstate__(self) -> dict[str, Any]:
+        state = dict(self.__dict__)
+        state["_plugins"] = {}  # a plug-in's class is found again where the copy is used (a file's module by path)
+        return state
 
     def __post_init__(self) -> None:
         _check_plugin(self, "controller")
         _check_plugin(self, "tracker")
         if self.model is None:
-            object.__setattr__(self, "model", default_model(self.controller, self.controller_params))
+            object.__setattr__(self, "model", default_model(self.controller, self.controller_params,
+                                                            cls=self._plugins.get("controller_class")))
         if self.model not in MODEL_SOURCES:
             raise UnknownNameError("model source", str(self.model), MODEL_SOURCES)
         if self.friction_sign not in FRICTION_SIGNS:
@@ -152,6 +161,7 @@ class RunConfig:
 
     def as_dict(self) -> dict[str, Any]:
         d = dataclasses.asdict(self)
+        del d["_plugins"]
         if self.signals is None:
             del d["signals"]  # a run without signals keeps the keys it always had
         else:
@@ -211,7 +221,6 @@ def _check_plugin(config: RunConfig, kind: str) -> None:
     """A controller (or tracker) that can be built: a name resolves (a plug-in's file and class are found,
     else one line naming them), an object is a law (or tracker), parameters only where a plug-in takes them."""
     from controllers.base import SteeringController
-    from controllers.registry import resolve
     from controllers.tracking import PathTracker
 
     given, params = getattr(config, kind), getattr(config, f"{kind}_params")
@@ -231,7 +240,7 @@ def _check_plugin(config: RunConfig, kind: str) -> None:
                 raise ParameterError(f"controller {given!r} takes its settings as RunConfig fields (kp, kd, model, "
                                      f"friction_sign, friction_width), not controller_params {sorted(params)}")
             return
-        resolve(given, params, kind=kind)  # a missing file, class or method: one line, before any run
+        _resolved(config, kind)  # a missing file, class or method: one line, before any run
         return
     if isinstance(given, base):
         if params:
@@ -246,14 +255,33 @@ def _check_plugin(config: RunConfig, kind: str) -> None:
 def plugin_source(config: RunConfig, kind: str = "controller"):
     """Where the run's controller (or tracker) comes from (:class:`controllers.registry.PluginSource`),
     as its log records it; None for the computed-torque and PD laws built from the config's fields and
-    for no tracker."""
-    from controllers.registry import PluginSource, resolve, source_hash
-
+    for no tracker. Found once per config (a plug-in imported and its source hashed once)."""
     given = getattr(config, kind)
     if given is None or (kind == "controller" and isinstance(given, str) and given in CONTROLLER_NAMES):
         return None
     if isinstance(given, str):
-        return resolve(given, getattr(config, f"{kind}_params"), kind=kind)[1]
+        return _resolved(config, kind)[1]
+    if kind not in config._plugins:
+        config._plugins[kind] = _instance_source(given, kind)
+    return config._plugins[kind]
+
+
+def _resolved(config: RunConfig, kind: str) -> tuple[type, Any]:
+    """(class, PluginSource) of the config's plug-in given by name, resolved (imported, its source hashed) on
+    the first call and kept in the config."""
+    from controllers.registry import resolve
+
+    if f"{kind}_class" not in config._plugins:
+        cls, source = resolve(getattr(config, kind), getattr(config, f"{kind}_params"), kind=kind)
+        config._plugins[f"{kind}_class"], config._plugins[kind] = cls, source
+    return config._plugins[f"{kind}_class"], config._plugins[kind]
+
+
+def _instance_source(given: Any, kind: str):
+    """The PluginSource of a law (or tracker) given as an object or a factory."""
+    from controllers.base import describe_params
+    from controllers.registry import PluginSource, source_hash
+
     if callable(given) and not hasattr(given, "describe"):
         given = given()  # a factory (a class or a function): what it builds names the plug-in
     cls = type(given)
@@ -261,24 +289,21 @@ def plugin_source(config: RunConfig, kind: str = "controller"):
     params = {}
     if callable(describe):
         params = {k: v for k, v in describe().items() if k not in (kind, "law")}
-    from controllers.base import describe_params
-
     return PluginSource(spec=f"{cls.__module__}:{cls.__qualname__}", name=str(getattr(given, "name", cls.__name__)),
                         origin="instance", import_path=f"{cls.__module__}:{cls.__qualname__}",
                         params=describe_params(params), source_sha256=source_hash(cls))
 
 
-def default_model(controller: Any, params: Mapping[str, Any] | None = None) -> str:
+def default_model(controller: Any, params: Mapping[str, Any] | None = None, *, cls: type | None = None) -> str:
     """The model source a law runs with where the run names none: its class's ``default_model``
     (:attr:`controllers.base.SteeringController.default_model`); 'paper' for computed-torque, pd and a
-    factory (its class is known only once built)."""
+    factory (its class is known only once built). ``cls``: the plug-in's class, already found."""
     from controllers.base import SteeringController
     from controllers.registry import resolve
 
-    cls: Any = None
-    if isinstance(controller, str):
-        cls = None if controller in CONTROLLER_NAMES else resolve(controller, params, kind="controller")[0]
-    elif isinstance(controller, SteeringController):
+    if cls is None and isinstance(controller, str) and controller not in CONTROLLER_NAMES:
+        cls = resolve(controller, params, kind="controller")[0]
+    elif cls is None and isinstance(controller, SteeringController):
         cls = type(controller)
     model = getattr(cls, "default_model", "paper")
     if model not in MODEL_SOURCES:
@@ -529,7 +554,8 @@ def _plugin_for(config: RunConfig, params: C80Parameters, kind: str, given: Any,
     if isinstance(given, base):
         return copy.deepcopy(given)
     if isinstance(given, str):
-        cls, _ = resolve(given, plugin_params, kind=kind)
+        cls = _resolved(config, kind)[0] if given == getattr(config, kind) else resolve(given, plugin_params,
+                                                                                         kind=kind)[0]
         if model is None:
             model = model_from_source(str(config.model), params=params, identified=config.identified,
                                       coefficients=config.coefficients)

@@ -166,19 +166,19 @@ def objective_value(summary: Mapping[str, Any], objective: str) -> float | None:
     return summary.get("E_ratio")
 
 
-def check_objective_applies(config: Any, objective: str) -> None:
-    """Refuse, before any run, an objective that says nothing of the run's controller: the certificate's
-    ratio for a law that states no claim, the paper's for a law that is not the paper's.
+def check_objective_applies(law: Any, objective: str) -> None:
+    """Refuse, before any run, an objective that says nothing of the run's controller (``law``, the resolved
+    run's: :attr:`wmr_mj.sim.parts.RunParts.controller`): the certificate's ratio for a law that states no
+    claim, the paper's for a law that is not the paper's.
 
     Raises:
         ParameterError: naming the controller and the objectives that apply.
     """
     from controllers import SteeringController
-    from wmr_mj.sim.config import controller_for, estimate_of, estimate_parameters
+    from wmr_mj.sim.config import estimate_of
 
     if objective not in ("certificate", "paper"):
         return
-    law = controller_for(config, estimate_parameters())
     if objective == "certificate" and type(law).claim is SteeringController.claim:
         raise ParameterError(f"controller {law.name!r} states no claim, so there is no certificate to search "
                              "against: falsify a requirement (--require STL) or maximise sup|E| (--objective sup-E)")
@@ -907,8 +907,10 @@ class FalsifyResult:
 
 def falsify(spec: FalsifySpec, *, chunk: int = 128, nthread: int = 0, scheduler: str | None = None,
             progress: Callable[[int, int], None] | None = None,
-            checkpoint: Callable[[FalsifyResult], object] | None = None) -> FalsifyResult:
+            checkpoint: Callable[[FalsifyResult], object] | None = None, parts: Any = None) -> FalsifyResult:
     """Search ``spec.box`` for the worst run, then spend as many runs on a random sample.
+
+    ``parts``: ``spec.base`` already resolved (:func:`check_runnable`); None: resolved here.
 
     Each generation runs as one batch (locally in chunks of ``chunk`` on ``nthread``
     threads, or on the Dask ``scheduler``). progress(done, total) counts finished runs of
@@ -917,7 +919,8 @@ def falsify(spec: FalsifySpec, *, chunk: int = 128, nthread: int = 0, scheduler:
     """
     from wmr_mj.sim.sweep import connect, run_configs
 
-    check_objective_applies(spec.base, spec.objective)
+    parts = check_runnable(spec.base) if parts is None else parts  # a bad duration or path: one line, here
+    check_objective_applies(parts.controller, spec.objective)
     client = connect(scheduler) if scheduler is not None else None
     evaluations: dict[str, list[Evaluation]] = {"search": [], "random": []}
     total = 2 * spec.budget  # refined once the search has run
@@ -962,7 +965,6 @@ def falsify(spec: FalsifySpec, *, chunk: int = 128, nthread: int = 0, scheduler:
         generations += 1
         return generations - 1
 
-    check_runnable(spec.base)  # a bad duration or path fails here, in one line, not inside the optimiser
     try:
         search_worst(evaluator("search", next_generation), spec.bounds, budget=spec.budget, seed=spec.seed,
                      population=spec.population_size, method=spec.method)
@@ -976,14 +978,18 @@ def falsify(spec: FalsifySpec, *, chunk: int = 128, nthread: int = 0, scheduler:
                          objective_source=objective_source(first, spec.objective))
 
 
-def check_runnable(base: RunConfig) -> None:
+def check_runnable(base: RunConfig) -> Any:
     """Raise what the first batch would raise for ``base`` (a duration too short for the path,
     a control period that does not fit), before any search starts: the reference every
     evaluation shares depends on the base configuration only (path, duration, period), and a law's
-    claim() that raises or returns what is not a claim (:func:`wmr_mj.sim.certify.certificate_of`)."""
+    claim() that raises or returns what is not a claim (:func:`wmr_mj.sim.certify.certificate_of`).
+
+    Returns:
+        RunParts: ``base`` resolved (:func:`wmr_mj.sim.parts.resolve_run`), for :func:`falsify`'s ``parts``.
+    """
     from wmr_mj.sim.parts import resolve_run
 
-    resolve_run(base)
+    return resolve_run(base)
 
 
 def worst_config(result: FalsifyResult) -> RunConfig:

@@ -11,7 +11,8 @@ the largest error of what the law read and adds it to the claim as the measured 
 Usage::
 
     from wmr_mj.sim.measured_errors import with_measured_errors
-    certificate = with_measured_errors(certificate, config, plant, rows, period=0.001)
+    certificate = with_measured_errors(certificate, sensing=parts.sensing, measurement=parts.measurement,
+                                       rows=rows, period=parts.period)
 
 A run whose law reads the true state (ideal sensing: no ``alpha_measured`` rows) gains nothing: its error
 is 0 by construction, and its JSON keeps the keys it had.
@@ -26,7 +27,7 @@ import numpy as np
 from wmr_mj.analysis.certificate import Assumption, Certificate
 from wmr_mj.analysis.claim import with_measured
 from wmr_mj.analysis.measurement import MeasurementErrors
-from wmr_mj.params import C80Parameters
+from wmr_mj.hardware import Sensing
 
 __all__ = ["MEASURED_ERRORS", "measured_errors", "with_measured_errors"]
 
@@ -104,27 +105,21 @@ def measured_errors_assumption(rows: Any, measurement: MeasurementErrors, *, del
                       kind="checked")
 
 
-def with_measured_errors(certificate: Certificate | None, config: Any, plant: C80Parameters, rows: Any, *,
-                         period: float) -> Certificate | None:
+def with_measured_errors(certificate: Certificate | None, *, sensing: Sensing, measurement: MeasurementErrors,
+                         rows: Any, period: float) -> Certificate | None:
     """``certificate`` with :data:`MEASURED_ERRORS` measured on ``rows``, where the run was sensed and its
     claim's sensing was covered; else ``certificate`` itself (an ideal sensor, no claim, or an error model
     already refused by the assumption 'sensing and actuation covered').
 
     Args:
         certificate: the run's claim, or None.
-        config: the run's config (``sensing``, ``actuation``, ``transmission``).
-        plant: the run's plant parameters (i2, R_a).
+        sensing: the run's sensing (:class:`wmr_mj.hardware.Sensing`).
+        measurement: the error bounds the claim assumed (``RunParts.measurement``).
         rows: the run's rows (:data:`wmr_mj.sim.engine.SENSED_ROW_FIELDS` among them where sensed).
         period: T, s, the control period.
     """
-    if certificate is None or config.sensing.is_ideal or "alpha_measured" not in rows:
+    if certificate is None or sensing.is_ideal or "alpha_measured" not in rows or not measurement.covered:
         return certificate
-    from wmr_mj.sim.certify import measurement_errors_of
-
-    measurement = measurement_errors_of(config, plant)
-    if not measurement.covered:
-        return certificate
-    sensing = config.sensing
     assumption = measured_errors_assumption(rows, measurement, delay_steps=sensing.delay_steps(period),
                                             velocity_bounded=sensing.velocity in ("exact", "tachometer"))
     return with_measured(certificate, assumption)

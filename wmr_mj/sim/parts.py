@@ -18,8 +18,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 from controllers import PathTracker, SteeringController
 from wmr_mj.analysis.certificate import Certificate
+from wmr_mj.analysis.measurement import MeasurementErrors
 from wmr_mj.errors import ParameterError
 from wmr_mj.hardware import Actuation, Sensing, Transmission
 from wmr_mj.params import C80, C80Parameters
@@ -33,10 +36,11 @@ from wmr_mj.sim.config import (
     estimate_of,
     estimate_parameters,
     plant_parameters,
+    reference_bounds_of,
     tracker_for,
 )
 
-__all__ = ["RunParts", "resolve_run", "control_substeps"]
+__all__ = ["RunParts", "resolve_run", "control_substeps", "signal_inputs"]
 
 
 def control_substeps(config: RunConfig, timestep: float = TIMESTEP) -> int:
@@ -74,6 +78,15 @@ class RunParts:
         claim: the law's own claim (a Certificate), None where it states none.
         paper_law: the law is the paper's family (computed torque, PD): the paper's region applies to it.
         law_settings: the RunConfig settings the law reads (``controller_and_settings``: model, kp, kd, ...).
+        sensing, actuation, transmission: the cart as it is built (:mod:`wmr_mj.hardware`; ideal by default).
+        reference_bounds: the reference bounds the claims are computed for
+            (:class:`wmr_mj.reference.bounds.ReferenceBounds`): the declared ones, else the run's own reference's.
+        signals: the run's signals (:class:`wmr_mj.sim.signals.Signals`), None without.
+        disturbance: the disturbance torque at each control step [N m], None without one.
+        loads: (control step, the plant's MuJoCo fields from then on) of each load change, in time order.
+        route_length_m: the length of the route C follows [m] (one lap of a closed one); None on a named path.
+        measurement: the error bounds on what the law reads, from the cart's parts
+            (:func:`wmr_mj.sim.certify.measurement_errors_of`; exact on an ideal cart).
     """
 
     config: RunConfig
@@ -96,6 +109,12 @@ class RunParts:
     sensing: Sensing = Sensing()
     actuation: Actuation = Actuation()
     transmission: Transmission = Transmission()
+    reference_bounds: Any = None
+    signals: Any = None
+    disturbance: np.ndarray | None = None
+    loads: tuple[tuple[int, Any], ...] = ()
+    route_length_m: float | None = None
+    measurement: MeasurementErrors = MeasurementErrors.exact()
 
 
 def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
@@ -104,7 +123,8 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
     Raises:
         WmrMjError: what the config cannot build (a plug-in, a path too short, a period that does not fit).
     """
-    from wmr_mj.sim.certify import certificate_of
+    from wmr_mj.reference.route import route_length
+    from wmr_mj.sim.certify import certificate_of, measurement_errors_of
     from wmr_mj.sim.engine import plant_options
 
     plant = plant_parameters(config, base)
@@ -119,9 +139,43 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
     analysis = analysis_for(config, reference, estimate, estimate=paper_estimate)
     claim = certificate_of(config, reference, base=base, estimate=estimate, plant=plant,
                            controller=controller, tracker=tracker)
+    options = plant_options(config)
+    disturbance, loads = signal_inputs(config.signals, plant, options, n=n, period=period,
+                                       m1_inertia=config.m1_inertia)
     return RunParts(config=config, base=base, plant=plant, estimate=estimate, controller=controller,
                     controller_name=controller_name(config), tracker=tracker, reference=reference,
-                    settle_s=settle_s, substeps=substeps, period=period, n=n, options=plant_options(config),
+                    settle_s=settle_s, substeps=substeps, period=period, n=n, options=options,
                     analysis=analysis, claim=claim, paper_law=paper_estimate is not None,
                     law_settings=law_settings, sensing=config.sensing, actuation=config.actuation,
-                    transmission=config.transmission)
+                    transmission=config.transmission, reference_bounds=reference_bounds_of(config, reference),
+                    signals=config.signals, disturbance=disturbance, loads=loads,
+                    route_length_m=route_length(config.path), measurement=measurement_errors_of(config, plant))
+
+
+def signal_inputs(signals: Any, plant: C80Parameters, options: dict[str, Any], *, n: int, period: float,
+                  m1_inertia: str) -> tuple[np.ndarray | None, tuple[tuple[int, Any], ...]]:
+    """What the run's signals (:class:`wmr_mj.sim.signals.Signals`, None: none) do to its plant, on its grid.
+
+    A load change at time t is applied at the first control step at or after t.
+
+    Args:
+        plant: the plant's parameters before any load change; options: its laws (``plant_options``).
+        n: control steps; period: the control period [s]; m1_inertia: how m1 changes the chassis inertia.
+
+    Returns:
+        (the disturbance torque at each control step [N m] or None, ((control step, load fields), ...)).
+    """
+    if signals is None:
+        return None, ()
+    from wmr_mj.params import with_params
+    from wmr_mj.sim.engine import load_fields
+
+    disturbance = None
+    if signals.disturbance is not None:
+        disturbance = signals.disturbance.samples(np.arange(n) * period)
+    loads = []
+    for t, m1 in signals.load_steps(plant.m1):
+        k = int(np.ceil(t / period - 1e-9))
+        if k < n:
+            loads.append((k, load_fields(with_params(plant, m1_inertia=m1_inertia, m1=m1), **options)))
+    return disturbance, tuple(loads)

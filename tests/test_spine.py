@@ -1,0 +1,141 @@
+"""One run, one resolution: ``wmr-mj run`` builds each law once and computes each claim once.
+
+The counter wraps each law class's constructor and its ``claim`` (a deep copy does not call the
+constructor, so only a build counts), keyed by the law's class and its estimate's model source: a run of
+the paper's design builds the computed-torque law on the paper's model once; where the run's note asks
+what the law would claim on the other estimate (``no_estimate_note``), that other law is built once too.
+"""
+
+from __future__ import annotations
+
+import collections
+from pathlib import Path
+
+import pytest
+
+from controllers.adaptive import AdaptiveComputedTorque
+from controllers.computed_torque import ComputedTorque, PDController
+from controllers.registry import resolve
+from controllers.sliding_mode import SlidingMode
+from wmr_mj.cli.app import main
+
+REPO = Path(__file__).resolve().parents[1]
+MY_PID = f"{REPO / 'examples' / 'my_pid.py'}:MyPID"
+
+
+def _key(law) -> tuple[str, str | None]:
+    model = getattr(law, "model", None)
+    return type(law).__name__, getattr(model, "name", None)
+
+
+@pytest.fixture
+def counted(monkeypatch):
+    """(builds, claims): Counters of (law class, model source) filled by every law built and claim computed."""
+    builds: collections.Counter = collections.Counter()
+    claims: collections.Counter = collections.Counter()
+    classes = [ComputedTorque, PDController, SlidingMode, AdaptiveComputedTorque, resolve(MY_PID)[0]]
+    for cls in classes:
+        def init(self, *args, __init=cls.__init__, __cls=cls, **kwargs):
+            __init(self, *args, **kwargs)
+            if type(self) is __cls:
+                builds[_key(self)] += 1
+
+        monkeypatch.setattr(cls, "__init__", init)
+        if "claim" in vars(cls):
+            def claim(self, context, __claim=cls.claim):
+                claims[_key(self)] += 1
+                return __claim(self, context)
+
+            monkeypatch.setattr(cls, "claim", claim)
+    return builds, claims
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("options", [
+    [],  # the paper's design
+    ["--preset", "certified"],
+    ["--controller", "sliding-mode"],
+    ["--controller", "adaptive-computed-torque"],
+    ["--controller", "pd"],
+    ["--controller", MY_PID],
+], ids=["paper", "certified", "sliding-mode", "adaptive", "pd", "plug-in"])
+def test_a_run_builds_each_law_once_and_computes_each_claim_once(counted, options, capsys):
+    builds, claims = counted
+    assert main(["run", "--no-log", "--duration", "10", "--json", *options]) in (0, 3)
+    assert builds, "no law was built: the counter missed the run's law"
+    assert set(builds.values()) == {1}, f"a law built more than once: {dict(builds)}"
+    assert set(claims.values()) <= {1}, f"a claim computed more than once: {dict(claims)}"
+    assert set(claims) <= set(builds), f"a claim of a law never built: {dict(claims)}"
+
+
+def test_a_plugin_is_imported_and_hashed_once_per_config(monkeypatch):
+    """A plug-in's source is hashed once when its config is built: as_dict, controller_name and resolving the
+    run read what was found, and the record stays the one a fresh resolution gives."""
+    import controllers.registry as registry
+    from wmr_mj.sim.config import RunConfig, controller_name, controller_source
+    from wmr_mj.sim.parts import resolve_run
+
+    hashed: list[type] = []
+    real = registry.source_hash
+
+    def counting(cls):
+        hashed.append(cls)
+        return real(cls)
+
+    monkeypatch.setattr(registry, "source_hash", counting)
+    config = RunConfig(controller=MY_PID, controller_params={"ki": 20.0}, duration=10.0)
+    first = config.as_dict()
+    assert len(hashed) == 1
+    assert config.as_dict() == first and controller_name(config) == "my-pid"
+    resolve_run(config)
+    assert len(hashed) == 1, f"hashed again: {hashed}"
+    _, fresh = resolve(MY_PID, {"ki": 20.0})
+    assert first["controller_plugin"] == fresh.as_dict() == controller_source(config)
+
+
+class _Reads:
+    """A RunConfig that records which of its fields are read (and hands them out)."""
+
+    def __init__(self, config) -> None:
+        object.__setattr__(self, "_config", config)
+        object.__setattr__(self, "read", set())
+
+    def __getattr__(self, name):
+        self.read.add(name)
+        return getattr(self._config, name)
+
+
+#: what the run's summary and log record of the config (its labels and the record itself): read below
+#: resolve_run to be written out, never to build anything
+RECORDED = {"model", "kp", "kd", "path", "as_dict"}
+
+
+@pytest.mark.slow
+def test_below_resolve_run_the_config_is_only_recorded():
+    """run_parts reads the typed parts (sensing, signals, reference bounds, route, ...) and no field of the
+    config but the labels it records; the run's numbers are the same as run_closed_loop's."""
+    import dataclasses
+
+    import numpy as np
+
+    from wmr_mj.sim.closed_loop import run_closed_loop, run_parts
+    from wmr_mj.sim.config import RunConfig
+    from wmr_mj.sim.designs import CERTIFIED
+    from wmr_mj.sim.parts import resolve_run
+
+    config = RunConfig(**CERTIFIED.config_changes(), path="lane-change", duration=5.0, sensing="magnetic-12bit-axis",
+                       signals={"disturbance": {"kind": "step", "amplitude": 0.5, "t1": 1.0},
+                                "loads": [{"kind": "step", "t": 2.0, "m1": 700.0}]},
+                       reference_bounds="paper", correction=True)
+    parts = resolve_run(config)
+    spy = _Reads(config)
+    seen = run_parts(dataclasses.replace(parts, config=spy), progress=False)
+    assert spy.read <= RECORDED, f"read below resolve_run: {sorted(spy.read - RECORDED)}"
+    plain = run_closed_loop(config, progress=False)
+    timing = ("wall_s", "realtime_factor")  # the two runs' clocks, the only keys that differ
+
+    def numbers(result):
+        return {k: v for k, v in result.summary.to_dict().items() if k not in timing}
+
+    assert numbers(seen) == numbers(plain)
+    assert all(np.array_equal(seen.rows[k], plain.rows[k], equal_nan=True) for k in plain.rows)
