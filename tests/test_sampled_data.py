@@ -160,21 +160,35 @@ def test_between_samples_bound_holds_for_the_worst_sampled_sequences():
 
 @pytest.mark.parametrize("velocity, tau", [("exact", None), ("difference", None), ("filtered", 0.002)])
 def test_state_space_impulse_response_is_the_plain_loops(velocity, tau):
-    """C A^k B (+ D at k = 0) of the augmented loop equals the plain loop's response to a unit angle error
-    and a unit velocity noise, step by step (rounding only)."""
+    """C A^k B (+ D at k = 0) of the augmented loop equals the plain loop's response to a unit angle error,
+    a unit velocity noise and a unit w held over the first period (w_held), step by step (rounding only)."""
     loop = sampled_loop(kp=KP, kd=KD, control_period=T, velocity=velocity, filter_tau=tau, sensing_delay=2,
                         actuation_delay=3)
     n = 200
-    for col in range(2):
-        x, got = loop.B[:, col].copy(), [loop.D[:, col]]
+    unit, zero = np.zeros(n), np.zeros(n)
+    unit[0] = 1.0
+    columns = ((loop.B[:, 0], loop.D[:, 0], {"e": unit}), (loop.B[:, 1], loop.D[:, 1], {"e": zero, "nv": unit}),
+               (loop.w_held, np.zeros(3), {"e": zero, "w": unit}))
+    for b, d, inputs in columns:
+        x, got = b.copy(), [d]
         for _ in range(n - 1):
             got.append(loop.C @ x)
             x = loop.A @ x
-        unit = np.zeros(n)
-        unit[0] = 1.0
-        plain = plain_loop(unit if col == 0 else np.zeros(n), velocity=velocity, tau=tau, d_s=2, d_a=3,
-                           nv=unit if col == 1 else None)
-        np.testing.assert_allclose(np.array(got), np.column_stack(plain), rtol=1e-9, atol=1e-9)
+        plain = plain_loop(inputs.pop("e"), velocity=velocity, tau=tau, d_s=2, d_a=3, **inputs)
+        np.testing.assert_allclose(np.array(got), np.column_stack(plain), rtol=1e-9, atol=1e-12)
+
+
+def test_hold_is_scipys_zoh_discretisation():
+    """The plant's step (exact alpha', no delay: A = Phi - Gamma K) against scipy.signal.cont2discrete's ZOH
+    of E'' = -u, for two periods."""
+    from scipy.signal import cont2discrete
+
+    for period in (1e-3, 0.05):
+        Phi, Gamma, *_ = cont2discrete((np.array([[0.0, 1.0], [0.0, 0.0]]), np.array([[0.0], [-1.0]]),
+                                        np.eye(2), np.zeros((2, 1))), period, method="zoh")
+        loop = sampled_loop(kp=KP, kd=KD, control_period=period)
+        np.testing.assert_allclose(loop.A, Phi + Gamma @ np.array([[KP, KD]]), rtol=1e-12, atol=1e-15)
+        np.testing.assert_allclose(loop.w_held, -Gamma[:, 0], rtol=1e-12)
 
 
 # --- closed forms: mismatch.md's table and the continuous limit -------------------------------------------
