@@ -5,7 +5,7 @@ The top level is the library's public API, enough for a notebook::
     import wmr_mj as wm
 
     result = wm.run_closed_loop(wm.RunConfig(**wm.CERTIFIED.config_changes(), m1=700.0))
-    result.summary["verdict"]
+    result.summary.verdict  # 'certified-inside': the summary is a frozen record, read by attribute
 
 The parameter set and the errors are imported at once; everything else (the simulation, sweeps,
 the search, logs, the certificate) on first use (PEP 562), because ``controllers`` imports

@@ -106,6 +106,7 @@ from wmr_mj.sim.config import RunConfig
 __all__ = [
     "OBJECTIVES",
     "METHODS",
+    "METHOD_LABELS",
     "covering_design",
     "OBJECTIVE_LABELS",
     "FalsifySpec",
@@ -130,6 +131,10 @@ OBJECTIVES = ("certificate", "paper", "sup-E", "requirement")
 #: Search methods (module docstring): the portfolio (default: vertices, CMA-ES, a local CMA-ES), CMA-ES alone,
 #: vertices or a Latin hypercube then a Nelder-Mead polish, differential evolution.
 METHODS = ("portfolio", "cma", "vertices-polish", "lhs-polish", "de")
+#: What each method does, in a few words (the legend of the search's history plot); a test keeps each
+#: label true to the search :func:`search_worst` dispatches the method to.
+METHOD_LABELS = {"portfolio": "vertices, then CMA-ES", "cma": "CMA-ES", "vertices-polish": "vertices, then Nelder-Mead",
+                 "lhs-polish": "Latin hypercube, then Nelder-Mead", "de": "differential evolution"}
 OBJECTIVE_LABELS = {"certificate": "sup|E|/E_max of the certificate", "paper": "sup|E|/E_max of the paper's region",
                     "sup-E": "sup|E| [rad]", "requirement": "-robustness of the requirement (> 0: falsified)"}
 MIN_POPULATION = 5  # scipy's differential evolution needs at least 5 members
