@@ -37,6 +37,7 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from wmr_mj.analysis.certificate import VERDICTS
+from wmr_mj.analysis.verdicts import WITHIN_THE_SUPPLY
 from wmr_mj.params import COEFFICIENT_MODELS, COEFFICIENT_NAMES
 from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS
 
@@ -359,7 +360,7 @@ def _search_bound_sentence(s: Mapping[str, Any], summary: Mapping[str, Any]) -> 
     names = ", ".join(s.get("names") or s["box"])
     if cert.get("certified"):
         head = f"Over the full box ({names}) the certificate holds: |E| <= {_fmt(cert.get('E_max'), '.4g')} rad."
-    elif cert.get("valid") and cert.get("unmet") == ["within the supply"]:
+    elif cert.get("valid") and cert.get("unmet") == [WITHIN_THE_SUPPLY]:
         head = (f"Over the full box ({names}) the certified design has no certificate: its bound |E| <= "
                 f"{_fmt(cert.get('E_max'), '.4g')} rad needs {_fmt(cert.get('voltage_max'), '.4g')} V, more than the "
                 f"{_fmt(cert.get('voltage_limit'), 'g')} V supply.")
