@@ -192,3 +192,25 @@ def test_the_supply_assumption_is_named_by_its_constant():
     summary = run_closed_loop(RunConfig(**CERTIFIED.config_changes()), progress=False).summary.to_dict()
     supply = [a for a in summary["certificate"]["assumptions"] if "voltage_limit" in a["equation"]]
     assert [a["name"] for a in supply] == [WITHIN_THE_SUPPLY]
+
+
+def test_validate_summary_round_trips_and_is_read_by_attribute():
+    import json
+    from pathlib import Path
+
+    from wmr_mj.report.results import Rung, ValidateSummary
+
+    d = json.loads((Path(__file__).parent / "data" / "validate_summary.json").read_text())
+    s = ValidateSummary.from_dict(d)
+    assert s.to_dict() == d and ValidateSummary.from_dict(s.to_dict()).to_dict() == d
+    first, last = s.ladder[0], s.ladder[-1]
+    assert (first.n, first.index, last.passes) == (d["ladder"][0]["n"], 1, d["ladder"][-1]["passes"])
+    assert s.certified_rule.omega_r_design == d["certified_rule"]["omega_r_design"]
+    assert "designs" not in s.to_dict() and "token" not in last.to_dict()
+    # a user's design (validate --design) is a rung with its token, nominal run and paper_law; the JSON says so
+    design = Rung.from_dict({**d["ladder"][-1], "index": 7, "token": "sliding-mode", "nominal": {"sup_E": 0.01},
+                             "paper_law": False})
+    with_design = ValidateSummary.from_dict({**d, "designs": [design.to_dict()]})
+    assert with_design.designs[0].paper_law is False and with_design.to_dict()["designs"][0]["token"] == "sliding-mode"
+    assert ValidateSummary.from_dict(with_design.to_dict()).to_dict() == with_design.to_dict()
+

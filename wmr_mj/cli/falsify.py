@@ -336,7 +336,7 @@ def _how_text(spec, result, report: FalsifyReport) -> str:
         cma = (f"CMA-ES from the box's centre ({len(result.search) - len(first)} runs, {report.population} per "
                "generation)")
         if first:
-            cma = _portfolio_phases_text(spec, first, report.population)
+            cma = _portfolio_phases_text(spec, first, int(report.population or 0))  # CMA-ES: always set
         how = f"{kind} ({len(first)} runs), then {cma}" if first else cma
     else:
         first = [e for e in result.search if e.generation == 0]

@@ -29,10 +29,12 @@ Usage::
     from wmr_mj.report.text import format_headline
     summary = run_validate(ValidateSettings(n=8, search_budget=10), "logs/my-validate")
     print(format_headline(summary))
+    summary.ladder[-1].passes, summary.ladder[-1].n  # read by attribute (summary.json: summary.to_dict())
 """
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import time
 from collections.abc import Mapping, Sequence
@@ -43,6 +45,7 @@ from wmr_mj._util.checks import as_pair
 from wmr_mj._util.files import software_versions
 from wmr_mj._util.progress import Stages
 from wmr_mj.params import C80
+from wmr_mj.report.results import CertifiedRule, PathSummary, Rung, ValidateSummary
 from wmr_mj.report.settings import (
     LADDER_GROUPS,
     ValidateSettings,
@@ -148,7 +151,7 @@ def friction_stage(settings: ValidateSettings, st: Stages) -> dict[str, dict[str
 
 # --------------------------------------------------------------------------- stage 3: the ladder
 def run_rung(settings: ValidateSettings, k: int, design: DesignLike, folder: Path, st: Stages, reference,
-             before: Design | None) -> dict[str, Any]:
+             before: Design | None) -> Rung:
     """Sweep one rung over m1 (resumable in ladder-<k>-<name>/) and summarise it."""
     from wmr_mj.sim.certify import certificate_for
     from wmr_mj.sim.sweep import SweepSpec, read_results, run_sweep
@@ -160,20 +163,19 @@ def run_rung(settings: ValidateSettings, k: int, design: DesignLike, folder: Pat
     st.start(f"ladder-{k}", f"rung {k} ({design.label}): {settings.n} runs of {settings.duration:g} s over m1 "
                             f"{settings.m1_range[0]:g}-{settings.m1_range[1]:g} kg ({settings.sampling})")
     run_sweep(spec, out_dir=sweep_dir, nthread=settings.nthread, progress=stage_progress(st))
-    rung = summarise_rung(read_results(sweep_dir / "runs.csv"))
-    rung.update(index=k, name=design.name, label=design.label, design=design.describe(),
-                config=design.config_changes(), changed=[] if before is None else ladder_changes(before, design),
+    rung = Rung(**summarise_rung(read_results(sweep_dir / "runs.csv")),
+                index=k, name=design.name, label=design.label, design=design.describe(),
+                config=design.config_changes(), changed=() if before is None else tuple(ladder_changes(before, design)),
                 change="" if before is None else _change_text(before, design),
                 certificate=certificate_summary(certificate_for(base, reference)),
                 paper_region=_paper_region(base, reference),
                 runs_csv=(sweep_dir / "runs.csv").relative_to(folder).as_posix())
-    paper = ("" if rung["paper_inside"] is None
-             else f", {rung['paper_inside']}/{rung['n']} inside the paper's claim")
-    st.done(f"{rung['passes']}/{rung['n']} certified-inside{paper}" + loud(rung["certified_outside"], f"rung {k}"))
+    paper = "" if rung.paper_inside is None else f", {rung.paper_inside}/{rung.n} inside the paper's claim"
+    st.done(f"{rung.passes}/{rung.n} certified-inside{paper}" + loud(rung.certified_outside, f"rung {k}"))
     return rung
 
 
-def ladder_stage(settings: ValidateSettings, folder: Path, st: Stages) -> list[dict[str, Any]]:
+def ladder_stage(settings: ValidateSettings, folder: Path, st: Stages) -> list[Rung]:
     """Every rung of :data:`LADDER`, in order (see :func:`run_rung`)."""
     reference = reference_of(settings)
     rungs = []
@@ -182,19 +184,18 @@ def ladder_stage(settings: ValidateSettings, folder: Path, st: Stages) -> list[d
     return rungs
 
 
-def correction_stage(settings: ValidateSettings, folder: Path, st: Stages) -> dict[str, Any]:
+def correction_stage(settings: ValidateSettings, folder: Path, st: Stages) -> Rung:
     """The rung after the ladder: the certified design with the Cartesian correction at C
     (:data:`wmr_mj.sim.designs.CORRECTION_RUNG`; summary.json's ``correction_rung``)."""
     from wmr_mj.sim.designs import CERTIFIED, CORRECTION_RUNG
 
     rung = run_rung(settings, len(LADDER) + 1, CORRECTION_RUNG, folder, st, reference_of(settings),
                     CERTIFIED)
-    rung.update(changed=["correction"], change="Cartesian correction at C (outer loop on alpha0, "
-                                              "controllers/tracking.py)")
-    return rung
+    return dataclasses.replace(rung, changed=("correction",),
+                               change="Cartesian correction at C (outer loop on alpha0, controllers/tracking.py)")
 
 
-def designs_stage(settings: ValidateSettings, folder: Path, st: Stages, *, first_index: int) -> list[dict[str, Any]]:
+def designs_stage(settings: ValidateSettings, folder: Path, st: Stages, *, first_index: int) -> list[Rung]:
     """``validate --design TOKEN``: each design of the user's (a plug-in law, a tracker, other gains; a token
     as ``wmr-mj compare`` takes it) judged beside the ladder: its rung (:func:`run_rung`: the same m1 sweep,
     its verdicts against its own claim) and its nominal run (summary.json's ``designs``)."""
@@ -209,9 +210,9 @@ def designs_stage(settings: ValidateSettings, folder: Path, st: Stages, *, first
         nominal = run_closed_loop(settings.config(design), progress=False)
         st.done(f"sup|E| = {nominal.summary.sup_E:.3g} rad, {nominal.summary.verdict}")
         law = "no-claim: judged by requirements only" if nominal.summary.verdict == "no-claim" else ""
-        rung.update(token=token, change="a design of the user's (validate --design)" + (f"; {law}" if law else ""),
-                    nominal=_nominal_summary(nominal), paper_law=nominal.summary.paper_law)
-        out.append(rung)
+        out.append(dataclasses.replace(
+            rung, token=token, change="a design of the user's (validate --design)" + (f"; {law}" if law else ""),
+            nominal=_nominal_summary(nominal), paper_law=nominal.summary.paper_law))
     return out
 
 
@@ -240,15 +241,17 @@ def _nominal_summary(run) -> dict[str, Any]:
 
 
 # --------------------------------------------------------------------------- stage 7: the report
-def write_report(summary: dict[str, Any], folder: Path) -> None:
-    """summary.csv, index.md, index.html and summary.json (last), each written atomically."""
+def write_report(summary: ValidateSummary | Mapping[str, Any], folder: Path) -> None:
+    """summary.csv, index.md, index.html and summary.json (last, ``summary.to_dict()``), each written atomically
+    (``summary``: the summary, or its JSON read back)."""
     from wmr_mj._util.files import write_json_atomic, write_text_atomic
     from wmr_mj.report.text import render_html, render_markdown, summary_csv
 
+    summary = ValidateSummary.of(summary)
     write_text_atomic(folder / "summary.csv", summary_csv(summary))
     write_text_atomic(folder / "index.md", render_markdown(summary))
     write_text_atomic(folder / "index.html", render_html(summary))
-    write_json_atomic(folder / "summary.json", summary)
+    write_json_atomic(folder / "summary.json", summary.to_dict())
 
 
 def write_pointer(folder: str | os.PathLike) -> Path:
@@ -286,7 +289,7 @@ def _remove(path: Path) -> None:
         shutil.rmtree(path)
 
 
-def _path_summary(settings: ValidateSettings) -> dict[str, Any]:
+def _path_summary(settings: ValidateSettings) -> PathSummary:
     """The runs' path of C: its name and, on the paper circle, the circle's radius [m] from the
     reference's final curvature (the verdict's 'its 1 m circle')."""
     import numpy as np
@@ -295,10 +298,10 @@ def _path_summary(settings: ValidateSettings) -> dict[str, Any]:
     if settings.path == "paper-circle":
         kappa = float(np.asarray(reference_of(settings).kappa)[-1])
         radius = 1.0 / abs(kappa) if kappa else None
-    return {"name": settings.path, "circle_radius": radius}
+    return PathSummary(name=settings.path, circle_radius=radius)
 
 
-def _certified_rule() -> dict[str, Any]:
+def _certified_rule() -> CertifiedRule:
     """The certified design's rule as designs.py writes it, and the omega_r it gives now."""
     import re
 
@@ -307,16 +310,16 @@ def _certified_rule() -> dict[str, Any]:
     doc = designs.__doc__ or ""
     rule = doc.split("``certified``:", 1)[-1].split("The ladder", 1)[0]
     rule = re.sub(r":\w+:`([^`]*)`", r"\1", rule).replace("``", "")
-    return {"text": " ".join(rule.split()), "error_spec": designs.ERROR_SPEC, "omega_r_grid_step":
-            designs.OMEGA_R_GRID[1] - designs.OMEGA_R_GRID[0], "omega_r_rule": designs.certified_omega_r(),
-            "omega_r_design": CERTIFIED.kd}
+    return CertifiedRule(text=" ".join(rule.split()), error_spec=designs.ERROR_SPEC,
+                         omega_r_grid_step=designs.OMEGA_R_GRID[1] - designs.OMEGA_R_GRID[0],
+                         omega_r_rule=designs.certified_omega_r(), omega_r_design=CERTIFIED.kd)
 
 
 def run_validate(settings: ValidateSettings, out_dir: str | os.PathLike, *, log: bool = True,
-                 stream=None, tty: bool | None = None) -> dict[str, Any]:
+                 stream=None, tty: bool | None = None) -> ValidateSummary:
     """Run the validation into ``out_dir`` (created; sweeps and searches resume there).
 
-    Returns the summary (what summary.json holds). Stage lines go to ``stream`` (default
+    Returns the summary, read by attribute (summary.json is its ``to_dict()``). Stage lines go to ``stream`` (default
     stderr) when ``log``; ``tty`` forces or suppresses the live counter.
     """
     from wmr_mj.report.figures import figures_stage
@@ -338,21 +341,17 @@ def run_validate(settings: ValidateSettings, out_dir: str | os.PathLike, *, log:
     sensing = sensing_stage(settings, st)
     figures, fig7 = figures_stage(settings, folder, st, rungs, searches, nominal)
     st.start("report", "summary.json, summary.csv, index.md, index.html")
-    summary: dict[str, Any] = {
-        "folder": str(folder), "created": time.strftime("%Y-%m-%d %H:%M:%S %z"), "settings": settings.as_dict(),
-        "seed": settings.seed, "ladder": rungs, "certified_rule": _certified_rule(), "searches": searches,
-        "nominal": {name: _nominal_summary(run) for name, run in nominal.items()}, "friction": friction,
-        "identification": identification, "paper_example": fig7, "figures": figures,
-        "correction_rung": corrected, "path": _path_summary(settings),
-        **({"designs": designs} if designs else {}),
-        "certified_outside": sum(r["certified_outside"] for r in [*rungs, *designs]) + corrected["certified_outside"]
+    summary = ValidateSummary(
+        folder=str(folder), created=time.strftime("%Y-%m-%d %H:%M:%S %z"), settings=settings.as_dict(),
+        seed=settings.seed, ladder=tuple(rungs), certified_rule=_certified_rule(), searches=tuple(searches),
+        nominal={name: _nominal_summary(run) for name, run in nominal.items()}, friction=friction,
+        identification=identification, paper_example=fig7, figures=figures,
+        correction_rung=corrected, path=_path_summary(settings), designs=tuple(designs),
+        certified_outside=sum(r.certified_outside for r in [*rungs, *designs]) + corrected.certified_outside
         + sum(s["verdicts"]["certified-outside"] for s in searches) + sensing["certified_outside"],
-        "sensing": sensing,
-        "versions": software_versions(),
-    }
-    summary["findings"] = findings(summary)
-    summary["timings_s"] = dict(st.timings)
-    summary["wall_s"] = time.perf_counter() - wall0
+        sensing=sensing, versions=software_versions())
+    summary = dataclasses.replace(summary, findings=tuple(findings(summary)))
+    summary = dataclasses.replace(summary, timings_s=dict(st.timings), wall_s=time.perf_counter() - wall0)
     write_report(summary, folder)
     st.done()
     return summary
