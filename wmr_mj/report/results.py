@@ -36,9 +36,13 @@ class Rung(Record):
     sup|E'| [rad/s], ratios [-], m1 [kg], cross-track [m]); then the design's place and words.
 
     Attributes:
-        index: the rung's number, 1-based; name, label: the design's; design: its description.
-        config: the RunConfig fields the design sets; changed: the groups changed from the rung before;
-            change: the change in words ("" on the first rung).
+        index: the rung's number, 1-based.
+        name: the design's name.
+        label: the design's label.
+        design: the design's description.
+        config: the RunConfig fields the design sets.
+        changed: the groups changed from the rung before.
+        change: the change in words ("" on the first rung).
         certificate: the rung's certificate (``wmr_mj.report.settings.certificate_summary``: a mapping).
         paper_region: the paper's claim for the rung ({E_max, Edot_max, condition, stable, vertices}).
         runs_csv: the rung's runs.csv, relative to the report folder.
@@ -116,23 +120,28 @@ class ValidateSummary(Record):
     """What ``wmr-mj validate`` found: summary.json, read by attribute.
 
     Attributes:
-        folder: the report's folder; created: when (local time, with its offset).
-        settings: the settings (``ValidateSettings.as_dict()``); seed: theirs.
+        folder: the report's folder.
+        created: when (local time, with its offset).
+        settings: the settings (``ValidateSettings.as_dict()``).
+        seed: the settings' seed.
         ladder: the rungs from the paper's design to the certified design, in order.
         certified_rule: how the certified design was chosen.
         searches: the worst-case searches (:mod:`wmr_mj.report.search`'s mappings), in order.
         nominal: the paper's and the certified design's run at the nominal m1, by name (mappings).
         friction: the steering joint's measured friction law, by friction model (mappings).
         identification: the plant identified at the nominal m1 (a mapping, with its verdict).
-        paper_example: the section-5 example of the paper (Fig. 7); figures: stem -> the files written.
+        paper_example: the section-5 example of the paper (Fig. 7).
+        figures: stem -> the files written.
         correction_rung: the certified design with the Cartesian correction; None in reports before it.
         path: the runs' path of C; None in reports before it.
         designs: the user's designs (``validate --design``), each as a rung; () when none (no ``designs`` key).
         certified_outside: certified-outside runs of every rung, design, search and sensing run.
         sensing: the certified design on realistic sensing (:mod:`wmr_mj.report.sensing`); None in reports
             before it (no ``sensing`` key).
-        versions: the software's; findings: the report's findings, in sentences.
-        timings_s: each stage's wall time [s]; wall_s: the whole validation's [s].
+        versions: the software's.
+        findings: the report's findings, in sentences.
+        timings_s: each stage's wall time [s].
+        wall_s: the whole validation's wall time [s].
     """
 
     _records = {"ladder": Rung, "certified_rule": CertifiedRule, "correction_rung": Rung, "path": PathSummary,

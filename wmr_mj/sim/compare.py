@@ -276,12 +276,15 @@ class CompareReport(Record):
     """A comparison as compare.json holds it, read by attribute (:meth:`CompareResult.report`).
 
     Attributes:
-        suite: the suite's JSON (``Suite.as_dict()``); versions: the software's.
-        budget: the adversary's simulations per design; seed: its seed.
+        suite: the suite's JSON (``Suite.as_dict()``).
+        versions: the software's.
+        budget: the adversary's simulations per design.
+        seed: the adversary's seed.
         scenarios: the ids of the scenarios run.
         rows: one per design, in order.
         claims_broken: the designs one of whose runs breaks its claim, in order.
-        wall_s: the comparison's wall time [s]; steps: physics steps simulated.
+        wall_s: the comparison's wall time [s].
+        steps: physics steps simulated.
     """
 
     _records = {"rows": DesignRow}

@@ -826,7 +826,8 @@ class BrokenRun(Record):
         phase: "search" or "random".
         run: its place in its phase, 1-based.
         params: every ranged parameter of the run, full precision.
-        sup_E: its sup|E| [rad]; sup_Edot: its sup|E'| [rad/s].
+        sup_E: its sup|E| [rad].
+        sup_Edot: its sup|E'| [rad/s].
         E_max: the certificate's E_max [rad]; None where it has none.
         ratio: sup|E|/E_max [-]; None where undefined.
         count: the certified-outside runs of both phases.
@@ -878,15 +879,21 @@ class FalsifyReport(Record):
     command adds its files, cart and reproduce line), from :meth:`FalsifyResult.report`.
 
     Attributes:
-        objective: one of :data:`OBJECTIVES`; objective_label: its words (:data:`OBJECTIVE_LABELS`).
+        objective: one of :data:`OBJECTIVES`.
+        objective_label: its words (:data:`OBJECTIVE_LABELS`).
         objective_source: where the objective's bound comes from (:func:`objective_source`).
-        budget: the search's simulations asked; evaluations: those run.
-        seed, method, population (members per generation; None for the polish methods), generations.
+        budget: the search's simulations asked.
+        evaluations: the search's simulations run.
+        seed: the search's seed.
+        method: one of :data:`METHODS`.
+        population: members per generation; None for the polish methods.
+        generations: the search's generations.
         requirement: the STL requirement of the objective 'requirement'; None otherwise.
         falsified: :attr:`FalsifyResult.falsified`.
         claim_broken: the run that breaks the claim most; None when none does.
         box: each ranged parameter -> (lo, hi).
-        worst: the search's worst run; tightness: where the objective is the certificate's ratio, else None.
+        worst: the search's worst run.
+        tightness: how tight the certificate is, where the objective is its ratio; else None.
         random: the random sample's worst run.
         log: the MCAP log of the worst run's re-run; None where not written.
     """

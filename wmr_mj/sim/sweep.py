@@ -530,7 +530,8 @@ class BrokenSweepRun(Record):
     Attributes:
         run: the run's index in the sweep; None where its row has none.
         params: m1 [kg] and each ranged parameter of the run.
-        sup_E: its sup|E| [rad]; sup_Edot: its sup|E'| [rad/s].
+        sup_E: its sup|E| [rad].
+        sup_Edot: its sup|E'| [rad/s].
         E_max: the certificate's E_max [rad]; None where the row has none.
         ratio: sup|E|/E_max of the certificate [-]; None where undefined.
         count: the sweep's certified-outside runs.
