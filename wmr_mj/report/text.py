@@ -19,6 +19,11 @@ A ``certified-outside`` run (a bug or a modelling gap) is announced in a banner 
 the verdict, above the details, wherever it appears (the verdict's certified-design line names
 its own). ``uncertified-*`` runs are never counted as a pass.
 
+Each public function takes the :class:`~wmr_mj.report.results.ValidateSummary` that ``run_validate``
+returns, or a summary.json read back (a mapping, read through ``ValidateSummary.of``), and reads the
+summary and its rungs by attribute; the sections other modules write (certificates, searches, sensing,
+friction, identification) are read as the mappings they are.
+
 Usage::
 
     import json
