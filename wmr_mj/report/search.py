@@ -39,7 +39,6 @@ import numpy as np
 from wmr_mj._util.checks import as_pair
 from wmr_mj._util.progress import Stages
 from wmr_mj.params import uncertainty_ranges
-from wmr_mj.report.results import Rung
 from wmr_mj.report.settings import (
     FULL_BOX_FACTOR,
     ValidateSettings,
@@ -152,7 +151,7 @@ def _evaluations_csv(names: Sequence[str], runs: Sequence[Mapping[str, Any]]) ->
     return buf.getvalue()
 
 
-def _compare(result: dict[str, Any], plan: SearchPlan, rungs: Sequence[Rung], folder: Path) -> None:
+def _compare(result: dict[str, Any], plan: SearchPlan, rungs: Sequence[Mapping[str, Any]], folder: Path) -> None:
     """Add the Monte-Carlo worst of the plan's rung (read from its runs.csv) beside the search's."""
     from wmr_mj.sim.sweep import read_results
 
@@ -160,10 +159,10 @@ def _compare(result: dict[str, Any], plan: SearchPlan, rungs: Sequence[Rung], fo
         result["mc"] = None
         return
     rung = rungs[plan.mc_rung - 1]
-    value, m1 = max_at(read_results(folder / rung.runs_csv), plan.mc_column)
+    value, m1 = max_at(read_results(folder / rung["runs_csv"]), plan.mc_column)
     worst = (result["worst"] or {}).get("objective")
-    result["mc"] = {"rung": plan.mc_rung, "n": rung.n, "column": plan.mc_column, "worst_objective": value,
-                    "worst_m1": m1, "runs_csv": rung.runs_csv}
+    result["mc"] = {"rung": plan.mc_rung, "n": rung["n"], "column": plan.mc_column, "worst_objective": value,
+                    "worst_m1": m1, "runs_csv": rung["runs_csv"]}
     result["search_at_least_mc"] = None if worst is None or value is None else bool(worst >= value)
 
 
@@ -199,7 +198,7 @@ def _result(plan: SearchPlan, spec, runs: Sequence[Mapping[str, Any]], worst: Ma
 
 
 def run_search(plan: SearchPlan, settings: ValidateSettings, folder: Path, st: Stages,
-               rungs: Sequence[Rung], reference) -> dict[str, Any]:
+               rungs: Sequence[Mapping[str, Any]], reference) -> dict[str, Any]:
     """One search: read back when search-<key>/search.json matches its spec, else run it,
     re-run its worst run with an MCAP log (worst.mcap: is the serial run's sup|E| the
     batch's?) and write evaluations.csv and search.json."""
@@ -236,7 +235,7 @@ def _num(x: Any) -> str:
     return "n/a" if x is None else f"{x:.4g}"
 
 
-def search_stage(settings: ValidateSettings, folder: Path, st: Stages, rungs: Sequence[Rung]
+def search_stage(settings: ValidateSettings, folder: Path, st: Stages, rungs: Sequence[Mapping[str, Any]]
                  ) -> list[dict[str, Any]]:
     """Every search of :func:`search_plans`, in order ([] when the search is disabled)."""
     reference = reference_of(settings)

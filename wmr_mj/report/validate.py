@@ -151,7 +151,7 @@ def friction_stage(settings: ValidateSettings, st: Stages) -> dict[str, dict[str
 
 # --------------------------------------------------------------------------- stage 3: the ladder
 def run_rung(settings: ValidateSettings, k: int, design: DesignLike, folder: Path, st: Stages, reference,
-             before: Design | None) -> Rung:
+             before: Design | None) -> dict[str, Any]:
     """Sweep one rung over m1 (resumable in ladder-<k>-<name>/) and summarise it."""
     from wmr_mj.sim.certify import certificate_for
     from wmr_mj.sim.sweep import SweepSpec, read_results, run_sweep
@@ -163,19 +163,20 @@ def run_rung(settings: ValidateSettings, k: int, design: DesignLike, folder: Pat
     st.start(f"ladder-{k}", f"rung {k} ({design.label}): {settings.n} runs of {settings.duration:g} s over m1 "
                             f"{settings.m1_range[0]:g}-{settings.m1_range[1]:g} kg ({settings.sampling})")
     run_sweep(spec, out_dir=sweep_dir, nthread=settings.nthread, progress=stage_progress(st))
-    rung = Rung(**summarise_rung(read_results(sweep_dir / "runs.csv")),
-                index=k, name=design.name, label=design.label, design=design.describe(),
-                config=design.config_changes(), changed=() if before is None else tuple(ladder_changes(before, design)),
+    rung = summarise_rung(read_results(sweep_dir / "runs.csv"))
+    rung.update(index=k, name=design.name, label=design.label, design=design.describe(),
+                config=design.config_changes(), changed=[] if before is None else ladder_changes(before, design),
                 change="" if before is None else _change_text(before, design),
                 certificate=certificate_summary(certificate_for(base, reference)),
                 paper_region=_paper_region(base, reference),
                 runs_csv=(sweep_dir / "runs.csv").relative_to(folder).as_posix())
-    paper = "" if rung.paper_inside is None else f", {rung.paper_inside}/{rung.n} inside the paper's claim"
-    st.done(f"{rung.passes}/{rung.n} certified-inside{paper}" + loud(rung.certified_outside, f"rung {k}"))
+    paper = ("" if rung["paper_inside"] is None
+             else f", {rung['paper_inside']}/{rung['n']} inside the paper's claim")
+    st.done(f"{rung['passes']}/{rung['n']} certified-inside{paper}" + loud(rung["certified_outside"], f"rung {k}"))
     return rung
 
 
-def ladder_stage(settings: ValidateSettings, folder: Path, st: Stages) -> list[Rung]:
+def ladder_stage(settings: ValidateSettings, folder: Path, st: Stages) -> list[dict[str, Any]]:
     """Every rung of :data:`LADDER`, in order (see :func:`run_rung`)."""
     reference = reference_of(settings)
     rungs = []
@@ -184,18 +185,19 @@ def ladder_stage(settings: ValidateSettings, folder: Path, st: Stages) -> list[R
     return rungs
 
 
-def correction_stage(settings: ValidateSettings, folder: Path, st: Stages) -> Rung:
+def correction_stage(settings: ValidateSettings, folder: Path, st: Stages) -> dict[str, Any]:
     """The rung after the ladder: the certified design with the Cartesian correction at C
     (:data:`wmr_mj.sim.designs.CORRECTION_RUNG`; summary.json's ``correction_rung``)."""
     from wmr_mj.sim.designs import CERTIFIED, CORRECTION_RUNG
 
     rung = run_rung(settings, len(LADDER) + 1, CORRECTION_RUNG, folder, st, reference_of(settings),
                     CERTIFIED)
-    return dataclasses.replace(rung, changed=("correction",),
-                               change="Cartesian correction at C (outer loop on alpha0, controllers/tracking.py)")
+    rung.update(changed=["correction"], change="Cartesian correction at C (outer loop on alpha0, "
+                                              "controllers/tracking.py)")
+    return rung
 
 
-def designs_stage(settings: ValidateSettings, folder: Path, st: Stages, *, first_index: int) -> list[Rung]:
+def designs_stage(settings: ValidateSettings, folder: Path, st: Stages, *, first_index: int) -> list[dict[str, Any]]:
     """``validate --design TOKEN``: each design of the user's (a plug-in law, a tracker, other gains; a token
     as ``wmr-mj compare`` takes it) judged beside the ladder: its rung (:func:`run_rung`: the same m1 sweep,
     its verdicts against its own claim) and its nominal run (summary.json's ``designs``)."""
@@ -210,9 +212,9 @@ def designs_stage(settings: ValidateSettings, folder: Path, st: Stages, *, first
         nominal = run_closed_loop(settings.config(design), progress=False)
         st.done(f"sup|E| = {nominal.summary.sup_E:.3g} rad, {nominal.summary.verdict}")
         law = "no-claim: judged by requirements only" if nominal.summary.verdict == "no-claim" else ""
-        out.append(dataclasses.replace(
-            rung, token=token, change="a design of the user's (validate --design)" + (f"; {law}" if law else ""),
-            nominal=_nominal_summary(nominal), paper_law=nominal.summary.paper_law))
+        rung.update(token=token, change="a design of the user's (validate --design)" + (f"; {law}" if law else ""),
+                    nominal=_nominal_summary(nominal), paper_law=nominal.summary.paper_law)
+        out.append(rung)
     return out
 
 
@@ -333,10 +335,12 @@ def run_validate(settings: ValidateSettings, out_dir: str | os.PathLike, *, log:
     st = Stages("validate", stream=stream, enabled=log, tty=tty)
     identification = identify_stage(settings, folder, st)
     friction = friction_stage(settings, st)
-    rungs = ladder_stage(settings, folder, st)
-    corrected = correction_stage(settings, folder, st)
-    designs = designs_stage(settings, folder, st, first_index=len(LADDER) + 2)
-    searches = search_stage(settings, folder, st, rungs)
+    # the stages build each rung's JSON (run_rung); the summary holds them typed, read by attribute
+    ladder = ladder_stage(settings, folder, st)
+    rungs = [Rung.from_dict(r) for r in ladder]
+    corrected = Rung.from_dict(correction_stage(settings, folder, st))
+    designs = [Rung.from_dict(r) for r in designs_stage(settings, folder, st, first_index=len(LADDER) + 2)]
+    searches = search_stage(settings, folder, st, ladder)  # the search stage reads the rungs' JSON
     nominal = nominal_stage(settings, st)
     sensing = sensing_stage(settings, st)
     figures, fig7 = figures_stage(settings, folder, st, rungs, searches, nominal)
