@@ -5,7 +5,7 @@ The top level is the library's public API, enough for a notebook::
     import wmr_mj as wm
 
     result = wm.run_closed_loop(wm.RunConfig(**wm.CERTIFIED.config_changes(), m1=700.0))
-    result.summary["verdict"]
+    result.summary.verdict  # 'certified-inside': the summary is a frozen record, read by attribute
 
 The parameter set and the errors are imported at once; everything else (the simulation, sweeps,
 the search, logs, the certificate) on first use (PEP 562), because ``controllers`` imports
@@ -37,17 +37,18 @@ from ._version import __version__ as __version__
 if TYPE_CHECKING:
     from wmr_mj.logs.reader import load_log
     from wmr_mj.logs.writer import LogOptions, RunLogger
+    from wmr_mj.report.results import ValidateSummary
     from wmr_mj.sim.certify import certificate_for
     from wmr_mj.sim.closed_loop import RunResult, run_closed_loop
-    from wmr_mj.sim.compare import compare
+    from wmr_mj.sim.compare import CompareResult, compare
     from wmr_mj.sim.config import RunConfig, controller_for
     from wmr_mj.sim.designs import CERTIFIED, PAPER, PRESETS, preset
-    from wmr_mj.sim.falsify import FalsifySpec, falsify
+    from wmr_mj.sim.falsify import FalsifyReport, FalsifyResult, FalsifySpec, falsify
     from wmr_mj.sim.log_header import LogHeader
     from wmr_mj.sim.parts import RunParts, resolve_run
     from wmr_mj.sim.signals import Disturbance, LoadChange, Signals
     from wmr_mj.sim.suite import load_suite
-    from wmr_mj.sim.sweep import SweepSpec, run_sweep
+    from wmr_mj.sim.sweep import SweepSpec, SweepSummary, run_sweep
 
 #: name -> the module that defines it, imported on first access
 _LAZY: dict[str, str] = {
@@ -58,8 +59,12 @@ _LAZY: dict[str, str] = {
     "certificate_for": "wmr_mj.sim.certify",
     "SweepSpec": "wmr_mj.sim.sweep",
     "run_sweep": "wmr_mj.sim.sweep",
+    "SweepSummary": "wmr_mj.sim.sweep",
     "FalsifySpec": "wmr_mj.sim.falsify",
     "falsify": "wmr_mj.sim.falsify",
+    "FalsifyResult": "wmr_mj.sim.falsify",
+    "FalsifyReport": "wmr_mj.sim.falsify",
+    "ValidateSummary": "wmr_mj.report.results",
     "PAPER": "wmr_mj.sim.designs",
     "CERTIFIED": "wmr_mj.sim.designs",
     "PRESETS": "wmr_mj.sim.designs",
@@ -75,6 +80,7 @@ _LAZY: dict[str, str] = {
     "RunParts": "wmr_mj.sim.parts",
     "load_suite": "wmr_mj.sim.suite",
     "compare": "wmr_mj.sim.compare",
+    "CompareResult": "wmr_mj.sim.compare",
 }
 
 __all__ = [
@@ -107,14 +113,20 @@ __all__ = [
     "CERTIFIED",
     "PRESETS",
     "preset",
-    # many runs and the search for the worst
+    # many runs and the search for the worst, and what they add up to (frozen, read by attribute; to_dict/from_dict)
     "SweepSpec",
     "run_sweep",
+    "SweepSummary",
     "FalsifySpec",
     "falsify",
+    "FalsifyResult",
+    "FalsifyReport",
     # one yardstick for every controller
     "load_suite",
     "compare",
+    "CompareResult",
+    # the headline validation's summary (wmr-mj validate; summary.json is its to_dict())
+    "ValidateSummary",
     # logs
     "RunLogger",
     "LogHeader",

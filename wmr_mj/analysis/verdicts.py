@@ -34,6 +34,7 @@ from wmr_mj.analysis.measurement import DELAY_FIXED_POINT, MEASUREMENT_COVERED
 
 __all__ = [
     "CART_ASSUMPTIONS",
+    "WITHIN_THE_SUPPLY",
     "VERDICTS",
     "PASS",
     "NO_CLAIM",
@@ -223,6 +224,9 @@ def certified_outside_banner(where: str = "") -> str:
 #: The assumptions about the cart (sensing, actuation, play) whose value and limit say little alone (1 vs 0:
 #: not covered): an unmet one carries its note (why: what has no derived bound) wherever it is listed.
 CART_ASSUMPTIONS = (MEASUREMENT_COVERED, DELAY_FIXED_POINT)
+#: The assumption that the law's voltage stays within the supply (section 4's certificate and the box claim
+#: both make it under this name; the report says why a certificate fails when only it is unmet).
+WITHIN_THE_SUPPLY = "within the supply"
 
 
 def unmet_assumptions(certificate: Mapping[str, Any] | None) -> list[dict[str, Any]]:

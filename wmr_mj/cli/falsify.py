@@ -4,8 +4,12 @@ from __future__ import annotations
 
 import argparse
 import json
+from typing import TYPE_CHECKING
 
 from wmr_mj.cli._common import positive_int
+
+if TYPE_CHECKING:
+    from wmr_mj.sim.falsify import FalsifyReport
 
 _AGAINST = ("certificate", "paper")
 _OBJECTIVE_KINDS = ("ratio", "sup-E")
@@ -239,7 +243,8 @@ def run(args: argparse.Namespace) -> int:
     config = worst_config(result)
     logged = run_logged(config, str(log_path))
     worst = result.worst
-    summary = result.as_dict(log=str(log_path))
+    report = result.report(log=str(log_path))
+    summary = report.to_dict()  # the JSON (falsify.json, --json), with the files and the cart added below
     from wmr_mj.cli._common import add_controller_source
     from wmr_mj.hardware import cart_dict
 
@@ -271,7 +276,7 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print_json(summary)
         return exit_status(summary)
-    names, how = ", ".join(spec.names), _how_text(spec, result, summary)
+    names, how = ", ".join(spec.names), _how_text(spec, result, report)
     print(f"worst-case search over {len(spec.names)} parameter(s) ({names}; box {args.uncertainty}): {how}, "
           f"seed {spec.seed}")
     print(f"objective: {OBJECTIVE_LABELS[objective]}  [{result.objective_source}]")
@@ -280,9 +285,9 @@ def run(args: argparse.Namespace) -> int:
           f"(sup|E| = {worst.sup_E:.6g} rad, sup|E'| = {worst.sup_Edot:.6g} rad/s, {worst.verdict})")
     rw = result.random_worst
     print(f"random : worst objective {fmt(rw.objective)} in {len(result.random)} runs (Latin hypercube, same seed)")
-    print("".join(f"{line}\n" for line in claim_lines(summary)), end="")
-    if summary["tightness"] is not None:
-        print(f"tightness: {summary['tightness']['text']}")
+    print("".join(f"{line}\n" for line in claim_lines(report)), end="")
+    if report.tightness is not None:
+        print(f"tightness: {report.tightness.text}")
     if spec.objective == "requirement":
         first_s = next((e.index + 1 for e in result.search if e.objective is not None and e.objective > 0), None)
         first_r = next((e.index + 1 for e in result.random if e.objective is not None and e.objective > 0), None)
@@ -325,19 +330,18 @@ def _bounds_line(b) -> str:
             "reference within them)")
 
 
-def _how_text(spec, result, summary: dict) -> str:
+def _how_text(spec, result, report: FalsifyReport) -> str:
     """How the search spent its runs, for falsify's first line."""
     if spec.method == "de":
-        how = (f"differential evolution, {summary['population']} per generation x {summary['generations']} "
-               "generations")
+        how = f"differential evolution, {report.population} per generation x {report.generations} generations"
     elif spec.method in ("portfolio", "cma"):
         first = [e for e in result.search if e.generation == 0] if spec.method == "portfolio" else []
         kind = ("all vertices" if len(first) == 2 ** len(spec.names) else
                 "a fractional-factorial covering of the vertices")
-        cma = (f"CMA-ES from the box's centre ({len(result.search) - len(first)} runs, {summary['population']} per "
+        cma = (f"CMA-ES from the box's centre ({len(result.search) - len(first)} runs, {report.population} per "
                "generation)")
         if first:
-            cma = _portfolio_phases_text(spec, first, summary["population"])
+            cma = _portfolio_phases_text(spec, first, int(report.population or 0))  # CMA-ES: always set
         how = f"{kind} ({len(first)} runs), then {cma}" if first else cma
     else:
         first = [e for e in result.search if e.generation == 0]
@@ -358,22 +362,22 @@ def exit_status(summary: dict) -> int:
     return CLAIM_BROKEN_EXIT if summary["falsified"] else 0
 
 
-def claim_lines(summary: dict) -> list[str]:
+def claim_lines(report: FalsifyReport) -> list[str]:
     """Beside the verdict: the banner and the run that broke the claim (where one did), and the worst
     run's unmet assumptions (name, value vs limit)."""
     from wmr_mj.analysis.verdicts import certified_outside_banner, format_unmet
 
     lines = []
-    broken = summary.get("claim_broken")
+    broken = report.claim_broken
     if broken is not None:
-        where = (f"{broken['count']} run(s) break the claim; the worst, {broken['phase']} run {broken['run']} "
-                 f"(sup|E| = {broken['sup_E']:.6g} rad, {broken['ratio']:.3g} times E_max = "
-                 f"{broken['E_max']:.4g} rad)")
+        where = (f"{broken.count} run(s) break the claim; the worst, {broken.phase} run {broken.run} "
+                 f"(sup|E| = {broken.sup_E:.6g} rad, {broken.ratio:.3g} times E_max = {broken.E_max:.4g} rad)")
         lines += [certified_outside_banner(where),
-                  "broken by: " + ", ".join(f"{k} = {v!r}" for k, v in broken["params"].items())]
-    unmet = summary["worst"].get("unmet")
+                  "broken by: " + ", ".join(f"{k} = {v!r}" for k, v in broken.params.items())]
+    unmet = report.worst.unmet
     if unmet:
-        lines.append(f"worst run {summary['worst']['verdict']}: assumptions not met: {format_unmet(unmet)}")
+        lines.append(f"worst run {report.worst.verdict}: assumptions not met: "
+                     f"{format_unmet(a.to_dict() for a in unmet)}")
     return lines
 
 

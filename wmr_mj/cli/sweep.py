@@ -156,11 +156,11 @@ def claim_lines(runs: SweepSummary) -> list[str]:
     b = runs.claim_broken
     if b is not None:
         lines += [certified_outside_banner(
-            f"{b['count']} of {runs.n} run(s) break the claim; the worst, run {b['run']} (sup|E| = "
-            f"{b['sup_E']:.6g} rad, {b['ratio']:.3g} times E_max = {b['E_max']:.4g} rad; see runs.csv)"),
-            "broken by: " + ", ".join(f"{k} = {v!r}" for k, v in b["params"].items())]
+            f"{b.count} of {runs.n} run(s) break the claim; the worst, run {b.run} (sup|E| = "
+            f"{b.sup_E:.6g} rad, {b.ratio:.3g} times E_max = {b.E_max:.4g} rad; see runs.csv)"),
+            "broken by: " + ", ".join(f"{k} = {v!r}" for k, v in b.params.items())]
     if runs.unmet:
-        lines.append("assumptions not met: " + "; ".join(f"{format_unmet([a])} in {a['runs']}/{runs.n} runs"
+        lines.append("assumptions not met: " + "; ".join(f"{format_unmet([a.to_dict()])} in {a.runs}/{runs.n} runs"
                                                          for a in runs.unmet))
     return lines
 

@@ -26,17 +26,18 @@ import numpy as np
 
 from wmr_mj._util.progress import Stages
 from wmr_mj.params import C80
+from wmr_mj.report.results import Rung
 from wmr_mj.report.settings import ValidateSettings
 
 __all__ = ["figures_stage", "travelled_paths"]
 
 
-def _rung_figure(rung: Mapping[str, Any], folder: Path):
+def _rung_figure(rung: Rung, folder: Path):
     from wmr_mj.report import plots
     from wmr_mj.sim.sweep import read_results
 
-    rows = read_results(folder / rung["runs_csv"])
-    cert, paper = rung["certificate"], rung["paper_region"]
+    rows = read_results(folder / rung.runs_csv)
+    cert, paper = rung.certificate, rung.paper_region
     regions = [plots.Region(f"certificate: |E| <= {cert['E_max']:.3g} rad, |E'| <= {cert['Edot_max']:.3g} rad/s",
                             [tuple(v) for v in cert["vertices"]], gid=plots.CERTIFICATE_GID)] if cert["valid"] else []
     if paper["vertices"]:
@@ -46,7 +47,7 @@ def _rung_figure(rung: Mapping[str, Any], folder: Path):
     note = None if cert["valid"] else "no certificate:\n" + _wrap(cert["reason"] or ", ".join(cert["unmet"]), 48)
     return plots.figure_verdict_plane([r["sup_E"] for r in rows], [r["sup_Edot"] for r in rows],
                                       [r["verdict"] for r in rows], regions, note=note,
-                                      title=f"rung {rung['index']}: {rung['design']}")
+                                      title=f"rung {rung.index}: {rung.design}")
 
 
 def _wrap(text: str, width: int) -> str:
@@ -71,7 +72,7 @@ def _history_figures(nominal: Mapping[str, Any]) -> dict[str, Any]:
     return figs
 
 
-def _search_figure(searches: Sequence[Mapping[str, Any]], rungs: Sequence[Mapping[str, Any]]):
+def _search_figure(searches: Sequence[Mapping[str, Any]], rungs: Sequence[Rung]):
     from wmr_mj.report import plots
 
     histories = []
@@ -82,7 +83,7 @@ def _search_figure(searches: Sequence[Mapping[str, Any]], rungs: Sequence[Mappin
             title=f"{s['design']} design, {s['box_name']} box ({len(s['box'])} parameter(s))",
             ylabel=s["objective_label"], values=s["values"], mc_worst=mc.get("worst_objective"),
             mc_label=f"Monte Carlo, rung {mc.get('rung')} ({mc.get('n')} runs)",
-            bound=1.0 if ratio else rungs[-1]["certificate"].get("E_max"),
+            bound=1.0 if ratio else rungs[-1].certificate.get("E_max"),
             bound_label="region boundary" if ratio else "E_max of the m1-box certificate"))
     return plots.figure_search_history(histories, title="worst-case search (differential evolution)")
 
@@ -101,7 +102,7 @@ def travelled_paths(nominal: Mapping[str, Any]) -> list[tuple[str, np.ndarray]]:
     return out
 
 
-def figures_stage(settings: ValidateSettings, folder: Path, st: Stages, rungs: Sequence[Mapping[str, Any]],
+def figures_stage(settings: ValidateSettings, folder: Path, st: Stages, rungs: Sequence[Rung],
                   searches: Sequence[Mapping[str, Any]], nominal: Mapping[str, Any]
                   ) -> tuple[dict[str, list[str]], dict[str, Any]]:
     """Write every figure (PNG + SVG) into figures/: ({stem: [relative paths]}, Fig. 7's numbers)."""
@@ -110,10 +111,10 @@ def figures_stage(settings: ValidateSettings, folder: Path, st: Stages, rungs: S
 
     st.start("figures", "figures (PNG + SVG)")
     figs: dict[str, Any] = {"ladder": plots.figure_ladder(
-        [f"{r['index']}. {r['label']}" for r in rungs], [r["verdicts"] for r in rungs],
-        [r["paper_inside"] for r in rungs], title=f"Verdicts per rung, {settings.n} runs over m1 each")}
+        [f"{r.index}. {r.label}" for r in rungs], [r.verdicts for r in rungs],
+        [r.paper_inside for r in rungs], title=f"Verdicts per rung, {settings.n} runs over m1 each")}
     for rung in rungs:
-        figs[f"rung_{rung['index']}_{rung['name']}"] = _rung_figure(rung, folder)
+        figs[f"rung_{rung.index}_{rung.name}"] = _rung_figure(rung, folder)
     figs.update(_history_figures(nominal))
     if searches:
         figs["search_history"] = _search_figure(searches, rungs)

@@ -806,10 +806,10 @@ def close_all(figures: Iterable[Figure]) -> None:
 def falsify_history(result: FalsifyResult):
     """The search's history: each run's objective in evaluation order, and the running worst
     of the search and of the random sample (same budget)."""
-    from wmr_mj.sim.falsify import OBJECTIVE_LABELS
+    from wmr_mj.sim.falsify import METHOD_LABELS, OBJECTIVE_LABELS
 
     fig, ax = new_figure(6.0, 3.6)
-    search_label = "differential evolution" if result.spec.method == "de" else "vertices, then Nelder-Mead"
+    search_label = METHOD_LABELS[result.spec.method]
     for evals, color, label in ((result.search, "C3", search_label),
                                 (result.random, "0.45", "random (Latin hypercube)")):
         x = np.arange(1, len(evals) + 1)

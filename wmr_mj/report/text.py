@@ -19,6 +19,11 @@ A ``certified-outside`` run (a bug or a modelling gap) is announced in a banner 
 the verdict, above the details, wherever it appears (the verdict's certified-design line names
 its own). ``uncertified-*`` runs are never counted as a pass.
 
+Each public function takes the :class:`~wmr_mj.report.results.ValidateSummary` that ``run_validate``
+returns, or a summary.json read back (a mapping, read through ``ValidateSummary.of``), and reads the
+summary and its rungs by attribute; the sections other modules write (certificates, searches, sensing,
+friction, identification) are read as the mappings they are.
+
 Usage::
 
     import json
@@ -37,8 +42,13 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from wmr_mj.analysis.certificate import VERDICTS
+from wmr_mj.analysis.verdicts import WITHIN_THE_SUPPLY
 from wmr_mj.params import COEFFICIENT_MODELS, COEFFICIENT_NAMES
 from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS
+from wmr_mj.report.results import Rung, ValidateSummary
+
+#: a summary as run_validate returns it, or its JSON read back (summary.json); each public function takes either
+Summary = ValidateSummary | Mapping[str, Any]
 
 __all__ = [
     "document",
@@ -117,29 +127,30 @@ def _cert_cell(cert: Mapping[str, Any]) -> str:
 
 
 # --------------------------------------------------------------------------- the verdict: five lines
-def _path_text(summary: Mapping[str, Any]) -> str:
+def _path_text(summary: ValidateSummary) -> str:
     """'its 1 m circle' on the paper circle (radius from the run's reference), else 'its path'."""
-    radius = (summary.get("path") or {}).get("circle_radius")
+    radius = None if summary.path is None else summary.path.circle_radius
     return f"its {_fmt(radius, '.3g')} m circle" if radius else "its path"
 
 
-def _paper_verdict(summary: Mapping[str, Any]) -> str:
-    rung = summary["ladder"][0]
-    n, inside, pr = rung["n"], rung["paper_inside"], rung["paper_region"]
+def _paper_verdict(summary: ValidateSummary) -> str:
+    rung = summary.ladder[0]
+    # rung 1 is the paper's own law, always judged by the paper's region (None: no run of it was)
+    n, inside, pr = rung.n, 0 if rung.paper_inside is None else rung.paper_inside, rung.paper_region
     answer = "Yes" if inside == n else "No"
-    ratio = rung["worst_paper_ratio"]
+    ratio = rung.worst_paper_ratio
     parts = [f"{n - inside}/{n} runs leave the paper's region" if inside < n else f"{n}/{n} runs stay inside it"]
-    cross = rung.get("worst_path_cross_track")
+    cross = rung.worst_path_cross_track
     if cross is not None:
         parts.append(f"C leaves {_path_text(summary)} by up to {_fmt(cross, '.3g')} m")
-    parts.append(f"{rung['hit_stop']}/{n} runs reach the steering stop")
-    parts.append(f"worst sup|E| = {_fmt(rung['worst_sup_E'], '.3g')} rad, {_fmt(ratio, '.3g')} times the paper's "
+    parts.append(f"{rung.hit_stop}/{n} runs reach the steering stop")
+    parts.append(f"worst sup|E| = {_fmt(rung.worst_sup_E, '.3g')} rad, {_fmt(ratio, '.3g')} times the paper's "
                  f"E_max = {_fmt(pr['E_max'], '.3g')} rad")
-    return f"The paper's design ({rung['design']}): {answer}. " + "; ".join(parts) + "."
+    return f"The paper's design ({rung.design}): {answer}. " + "; ".join(parts) + "."
 
 
-def _why_verdict(summary: Mapping[str, Any]) -> str:
-    first, last = summary["ladder"][0]["certificate"], summary["ladder"][-1]["certificate"]
+def _why_verdict(summary: ValidateSummary) -> str:
+    first, last = summary.ladder[0].certificate, summary.ladder[-1].certificate
     if first.get("certified"):
         head = (f"Why: redone for the plant actually simulated, the paper's analysis certifies the paper's design "
                 f"only to |E| <= {_fmt(first.get('E_max'), '.3g')} rad")
@@ -154,55 +165,56 @@ def _why_verdict(summary: Mapping[str, Any]) -> str:
     return f"{head}; {tail}."
 
 
-def _certified_verdict(summary: Mapping[str, Any]) -> str:
-    rung = summary["ladder"][-1]
-    n, cert, passes = rung["n"], rung["certificate"], rung["passes"]
-    head = f"The certified design (rung {rung['index']}: {rung['design']})"
-    cross = rung.get("worst_path_cross_track")
+def _certified_verdict(summary: ValidateSummary) -> str:
+    rung = summary.ladder[-1]
+    n, cert, passes = rung.n, rung.certificate, rung.passes
+    head = f"The certified design (rung {rung.index}: {rung.design})"
+    cross = rung.worst_path_cross_track
     keeps = f" keeps C within {_fmt(cross, '.3g')} m of {_path_text(summary)}" if cross is not None else ""
     if not cert.get("certified"):
         return (f"{head}{keeps}, but has NO certificate here: {passes}/{n} runs certified-inside; worst sup|E| = "
-                f"{_fmt(rung['worst_sup_E'], '.3g')} rad.")
+                f"{_fmt(rung.worst_sup_E, '.3g')} rad.")
     text = (f"{head}{keeps}: {passes}/{n} runs certified-inside (|E| <= {_fmt(cert.get('E_max'), '.3g')} rad); "
-            f"worst sup|E| = {_fmt(rung['worst_sup_E'], '.3g')} rad = "
-            f"{_fmt(rung['worst_certificate_ratio'], '.3f')} of its certificate")
-    if rung["certified_outside"]:
-        return text + f"; !!! {rung['certified_outside']}/{n} CERTIFIED-OUTSIDE: a bug or a modelling gap !!!"
+            f"worst sup|E| = {_fmt(rung.worst_sup_E, '.3g')} rad = "
+            f"{_fmt(rung.worst_certificate_ratio, '.3f')} of its certificate")
+    if rung.certified_outside:
+        return text + f"; !!! {rung.certified_outside}/{n} CERTIFIED-OUTSIDE: a bug or a modelling gap !!!"
     return text + "."
 
 
-def verdict_lines(summary: Mapping[str, Any]) -> list[str]:
+def verdict_lines(summary: Summary) -> list[str]:
     """The five-line verdict that opens stdout, index.md and index.html: the question, the answer
     for the paper's design, why, the answer for the certified design, where the report is. Every
     number from ``summary`` (rung 1 and the last rung of the ladder, the settings, the folder)."""
-    s = summary["settings"]
+    summary = ValidateSummary.of(summary)
+    s = summary.settings
     lo, hi = s["m1_range"]
     question = (f"Question: does the paper's robustness region hold for the C80 under m1 in {lo:g}-{hi:g} kg? "
-                f"({summary['ladder'][0]['n']} MuJoCo runs per design on {_path_words(s)}, {s['duration']:g} s each)")
-    report = (f"Report: {summary['folder']}/index.html (also index.md, summary.json); the details follow: (a) the "
+                f"({summary.ladder[0].n} MuJoCo runs per design on {_path_words(s)}, {s['duration']:g} s each)")
+    report = (f"Report: {summary.folder}/index.html (also index.md, summary.json); the details follow: (a) the "
               "paper's design, (b) the ladder between the designs, (c) the certified design, (d) the friction law, "
               "(e) the certified design on realistic sensing.")
     return [question, _paper_verdict(summary), _why_verdict(summary), _certified_verdict(summary), report]
 
 
 # --------------------------------------------------------------------------- (a) the paper's design
-def paper_design_lines(summary: Mapping[str, Any]) -> list[str]:
-    rung = summary["ladder"][0]
-    n, pr, cert = rung["n"], rung["paper_region"], rung["certificate"]
-    lines = [f"Design: {rung['design']}, {n} runs over m1 {rung['m1_min']:.0f}-{rung['m1_max']:.0f} kg.",
+def paper_design_lines(summary: Summary) -> list[str]:
+    rung = ValidateSummary.of(summary).ladder[0]
+    n, pr, cert = rung.n, rung.paper_region, rung.certificate
+    lines = [f"Design: {rung.design}, {n} runs over m1 {rung.m1_min:.0f}-{rung.m1_max:.0f} kg.",
              f"Against the paper's claim (|E| <= {_fmt(pr['E_max'])} rad, |E'| <= {_fmt(pr['Edot_max'])} rad/s, "
-             f"(4.23) = {_fmt(pr['condition'], '.4g')}): {rung['paper_inside']}/{n} runs inside; worst sup|E|/E_max "
-             f"= {_fmt(rung['worst_paper_ratio'])} (m1 = {_fmt(rung['worst_paper_ratio_m1'], '.0f')} kg), worst "
-             f"sup|E| = {_fmt(rung['worst_sup_E'])} rad."]
+             f"(4.23) = {_fmt(pr['condition'], '.4g')}): {rung.paper_inside}/{n} runs inside; worst sup|E|/E_max "
+             f"= {_fmt(rung.worst_paper_ratio)} (m1 = {_fmt(rung.worst_paper_ratio_m1, '.0f')} kg), worst "
+             f"sup|E| = {_fmt(rung.worst_sup_E)} rad."]
     if cert.get("certified"):
         lines.append(f"Against its own certificate (|E| <= {_fmt(cert['E_max'])} rad): "
-                     f"{rung['passes']}/{n} certified-inside.")
+                     f"{rung.passes}/{n} certified-inside.")
     else:
         lines.append("Against its own certificate: there is none. " + _why_no_certificate(cert))
-    lines.append(f"Verdicts: {_counts(rung['verdicts'])}; only certified-inside is a pass: "
-                 f"{rung['passes']}/{n} pass.")
-    lines.append(f"Runs that reached the steering stop: {rung['hit_stop']}/{n}; runs whose |E| is still growing "
-                 f"at the end: {rung['growing']}/{n}.")
+    lines.append(f"Verdicts: {_counts(rung.verdicts)}; only certified-inside is a pass: "
+                 f"{rung.passes}/{n} pass.")
+    lines.append(f"Runs that reached the steering stop: {rung.hit_stop}/{n}; runs whose |E| is still growing "
+                 f"at the end: {rung.growing}/{n}.")
     return lines
 
 
@@ -211,18 +223,23 @@ LADDER_COLUMNS = ("rung", "design", "change", "certificate", "cert-in", "CERT-OU
                   "paper in", "worst sup|E| rad", "sup|E|/E_max", "stop", "growing", "cross-track m")
 
 
-def ladder_rows(summary: Mapping[str, Any]) -> list[list[str]]:
+def _all_rungs(summary: ValidateSummary) -> list[Rung]:
+    """The ladder's rungs, then the correction rung (where the report has it), then the user's designs."""
+    extra = [summary.correction_rung] if summary.correction_rung is not None else []
+    return [*summary.ladder, *extra, *summary.designs]
+
+
+def ladder_rows(summary: Summary) -> list[list[str]]:
     out = []
-    extra = ([summary["correction_rung"]] if summary.get("correction_rung") else []) + list(summary.get("designs", []))
-    for r in [*summary["ladder"], *extra]:
-        v, n = r["verdicts"], r["n"]
-        out.append([str(r["index"]), r["label"], r["change"] or "-", _cert_cell(r["certificate"]),
+    for r in _all_rungs(ValidateSummary.of(summary)):
+        v, n = r.verdicts, r.n
+        out.append([str(r.index), r.label, r.change or "-", _cert_cell(r.certificate),
                     f"{v['certified-inside']}/{n}",
                     f"{v['certified-outside']}/{n}" + (" !!!" if v["certified-outside"] else ""),
                     f"{v['uncertified-inside']}/{n}", f"{v['uncertified-outside']}/{n}",
-                    f"{r['paper_inside']}/{n}" if r.get("paper_law", True) else "n/a",
-                    _fmt(r["worst_sup_E"]), _fmt(r["worst_certificate_ratio"], ".3f"), f"{r['hit_stop']}/{n}",
-                    f"{r['growing']}/{n}", _fmt(r.get("worst_path_cross_track"), ".3g")])
+                    f"{r.paper_inside}/{n}" if r.paper_law else "n/a",
+                    _fmt(r.worst_sup_E), _fmt(r.worst_certificate_ratio, ".3f"), f"{r.hit_stop}/{n}",
+                    f"{r.growing}/{n}", _fmt(r.worst_path_cross_track, ".3g")])
     return out
 
 
@@ -236,21 +253,22 @@ def assumption_rows(cert: Mapping[str, Any]) -> list[list[str]]:
             for a in cert.get("assumptions", [])]
 
 
-def _rule_line(summary: Mapping[str, Any], brief: bool) -> str:
-    rule = summary["certified_rule"]
-    now = (f"it gives omega_r = {_fmt(rule['omega_r_rule'], 'g')} rad/s now (designs.certified_omega_r, certificates "
-           f"only); the design uses {_fmt(rule['omega_r_design'], 'g')}.")
+def _rule_line(summary: ValidateSummary, brief: bool) -> str:
+    rule = summary.certified_rule
+    now = (f"it gives omega_r = {_fmt(rule.omega_r_rule, 'g')} rad/s now (designs.certified_omega_r, certificates "
+           f"only); the design uses {_fmt(rule.omega_r_design, 'g')}.")
     if brief:
         return (f"Rule, written before any run (wmr_mj/sim/designs.py): the smallest omega_r on a "
-                f"{_fmt(rule['omega_r_grid_step'], 'g')} rad/s grid whose certificate over the m1 box is valid with "
-                f"E_max <= {_fmt(rule['error_spec'], 'g')} rad; " + now)
-    return f"Rule, written before any run (wmr_mj/sim/designs.py): {rule['text']} Now " + now
+                f"{_fmt(rule.omega_r_grid_step, 'g')} rad/s grid whose certificate over the m1 box is valid with "
+                f"E_max <= {_fmt(rule.error_spec, 'g')} rad; " + now)
+    return f"Rule, written before any run (wmr_mj/sim/designs.py): {rule.text} Now " + now
 
 
-def certified_lines(summary: Mapping[str, Any], *, brief: bool = False) -> list[str]:
-    rung = summary["ladder"][-1]
-    cert, n = rung["certificate"], rung["n"]
-    lines = [f"Design: {rung['design']} (rung {rung['index']}).", _rule_line(summary, brief)]
+def certified_lines(summary: Summary, *, brief: bool = False) -> list[str]:
+    summary = ValidateSummary.of(summary)
+    rung = summary.ladder[-1]
+    cert, n = rung.certificate, rung.n
+    lines = [f"Design: {rung.design} (rung {rung.index}).", _rule_line(summary, brief)]
     if cert.get("certified"):
         lines.append(f"Certificate: |E| <= {_fmt(cert['E_max'], '.4g')} rad, |E'| <= "
                      f"{_fmt(cert['Edot_max'], '.4g')} rad/s, at most {_fmt(cert['voltage_max'])} V of the "
@@ -259,10 +277,10 @@ def certified_lines(summary: Mapping[str, Any], *, brief: bool = False) -> list[
                      "assumptions met (table below).")
     else:
         lines.append("Certificate: NOT valid. " + _why_no_certificate(cert))
-    lines.append(f"Runs: {rung['passes']}/{n} certified-inside ({_counts(rung['verdicts'])}); worst sup|E| = "
-                 f"{_fmt(rung['worst_sup_E'], '.4g')} rad = {_fmt(rung['worst_certificate_ratio'], '.3f')} of E_max "
-                 f"(m1 = {_fmt(rung['worst_certificate_ratio_m1'], '.0f')} kg); {rung['growing']}/{n} with |E| still "
-                 f"growing, {rung['hit_stop']}/{n} at the stop.")
+    lines.append(f"Runs: {rung.passes}/{n} certified-inside ({_counts(rung.verdicts)}); worst sup|E| = "
+                 f"{_fmt(rung.worst_sup_E, '.4g')} rad = {_fmt(rung.worst_certificate_ratio, '.3f')} of E_max "
+                 f"(m1 = {_fmt(rung.worst_certificate_ratio_m1, '.0f')} kg); {rung.growing}/{n} with |E| still "
+                 f"growing, {rung.hit_stop}/{n} at the stop.")
     lines += search_lines(summary)
     return lines
 
@@ -277,12 +295,13 @@ def _params_text(params: Mapping[str, float], names: Sequence[str] = ()) -> str:
     return ", ".join(f"{k} = {params[k]:.4g}" for k in order)
 
 
-def search_rows(summary: Mapping[str, Any]) -> list[list[str]]:
+def search_rows(summary: Summary) -> list[list[str]]:
+    summary = ValidateSummary.of(summary)
     out = []
-    for s in summary["searches"]:
+    for s in summary.searches:
         w, mc = s.get("worst") or {}, s.get("mc") or {}
         ratio = s["objective"] != "sup-E"
-        m1_cert = summary["ladder"][-1]["certificate"]
+        m1_cert = summary.ladder[-1].certificate
         bound = "1 (region boundary)" if ratio else f"{_fmt(m1_cert.get('E_max'), '.4g')} rad (m1-box certificate)"
         v = s["verdicts"]
         out.append([s["title"], s["objective_label"], str(s["evaluations"]), _fmt(w.get("objective"), ".4g"),
@@ -293,9 +312,10 @@ def search_rows(summary: Mapping[str, Any]) -> list[list[str]]:
     return out
 
 
-def search_lines(summary: Mapping[str, Any]) -> list[str]:
+def search_lines(summary: Summary) -> list[str]:
     """The search beside the Monte-Carlo worst and the certificate, in sentences."""
-    searches = summary.get("searches") or []
+    summary = ValidateSummary.of(summary)
+    searches = summary.searches
     if not searches:
         return ["Worst-case search: not run (--search-budget 0)."]
     lines = [_tightness_line(s) for s in searches if s["objective"] == "certificate" and (s.get("worst") or {})
@@ -336,7 +356,7 @@ def _versus(search: float | None, mc: float | None) -> str:
             "Monte-Carlo sample")
 
 
-def _search_bound_sentence(s: Mapping[str, Any], summary: Mapping[str, Any]) -> str:
+def _search_bound_sentence(s: Mapping[str, Any], summary: ValidateSummary) -> str:
     w, cert = s.get("worst") or {}, s["certificate"]
     worst_ratio = max(x for x in (w.get("objective"), (s.get("mc") or {}).get("worst_objective"), -math.inf)
                       if x is not None)
@@ -345,9 +365,9 @@ def _search_bound_sentence(s: Mapping[str, Any], summary: Mapping[str, Any]) -> 
                  f"holds at its worst, at {worst_ratio:.3g} of its bound")
         text = (f"The paper's claim {where}; the design has "
                 f"{'a certificate' if cert.get('certified') else 'no certificate'} to compare with.")
-        rung = summary["ladder"][(s.get("mc") or {}).get("rung", 1) - 1]
-        if rung["hit_stop"] and cert.get("alpha0_max") is not None and cert.get("steering_range") is not None:
-            text += (f" {rung['hit_stop']}/{rung['n']} runs of rung {rung['index']} reached the steering stop, which "
+        rung = summary.ladder[(s.get("mc") or {}).get("rung", 1) - 1]
+        if rung.hit_stop and cert.get("alpha0_max") is not None and cert.get("steering_range") is not None:
+            text += (f" {rung.hit_stop}/{rung.n} runs of rung {rung.index} reached the steering stop, which "
                      f"caps sup|E| near max|alpha0| + stop = {cert['alpha0_max'] + cert['steering_range']:.4g} rad.")
         return text
     if s["objective"] == "certificate":
@@ -355,11 +375,11 @@ def _search_bound_sentence(s: Mapping[str, Any], summary: Mapping[str, Any]) -> 
         return (f"Tightness: the largest error found is {worst_ratio:.3f} of the certificate's E_max = "
                 f"{_fmt(cert.get('E_max'), '.4g')} rad: the certificate is {slack:.2f} times the worst case found"
                 + ("." if worst_ratio <= 1 else " -- OUTSIDE the certificate (see the banner)."))
-    m1_cert = summary["ladder"][-1]["certificate"]
+    m1_cert = summary.ladder[-1].certificate
     names = ", ".join(s.get("names") or s["box"])
     if cert.get("certified"):
         head = f"Over the full box ({names}) the certificate holds: |E| <= {_fmt(cert.get('E_max'), '.4g')} rad."
-    elif cert.get("valid") and cert.get("unmet") == ["within the supply"]:
+    elif cert.get("valid") and cert.get("unmet") == [WITHIN_THE_SUPPLY]:
         head = (f"Over the full box ({names}) the certified design has no certificate: its bound |E| <= "
                 f"{_fmt(cert.get('E_max'), '.4g')} rad needs {_fmt(cert.get('voltage_max'), '.4g')} V, more than the "
                 f"{_fmt(cert.get('voltage_limit'), 'g')} V supply.")
@@ -381,16 +401,16 @@ FRICTION_COLUMNS = ("plant law", "F (2.13) V", "break-away V", "creep at 0.5 F r
                     "rate at 1.3 F rad/s", "(2.13) predicts", "holds below break-away")
 
 
-def _friction_laws(summary: Mapping[str, Any]) -> list[tuple[str, Mapping[str, Any]]]:
+def _friction_laws(summary: ValidateSummary) -> list[tuple[str, Mapping[str, Any]]]:
     """The measured laws in the report's order (stiction first), whatever the mapping's order."""
-    laws = summary["friction"]
+    laws = summary.friction
     return [(n, laws[n]) for n in STEERING_FRICTION_MODELS if n in laws] + [
         (n, v) for n, v in laws.items() if n not in STEERING_FRICTION_MODELS]
 
 
-def friction_rows(summary: Mapping[str, Any]) -> list[list[str]]:
+def friction_rows(summary: Summary) -> list[list[str]]:
     out = []
-    for name, law in _friction_laws(summary):
+    for name, law in _friction_laws(ValidateSummary.of(summary)):
         creep, slide = law["creep_rates"], law["slide_rates"]
         out.append([name, _fmt(law["friction_voltage"], ".4g"),
                     f"{_fmt(law['breakaway_voltage'], '.4g')} (+-{_fmt(law['breakaway_resolution'], '.1g')})",
@@ -402,8 +422,8 @@ def friction_rows(summary: Mapping[str, Any]) -> list[list[str]]:
 IDENT_COLUMNS = ("coef", "identified", "+-", "paper", "diff", "nonholonomic", "diff", "unit")
 
 
-def identification_rows(summary: Mapping[str, Any]) -> list[list[str]]:
-    ident = summary["identification"]
+def identification_rows(summary: Summary) -> list[list[str]]:
+    ident = ValidateSummary.of(summary).identification
     se = ident.get("diagnostics", {}).get("std_error", {})
     out = []
     for k in COEFFICIENT_NAMES:
@@ -421,12 +441,12 @@ SENSING_COLUMNS = ("sensing", "verdict", "its E_max rad", "sup|E|/E_max (exact)"
                    "TV u V/s", "max |u| V", "unmet (value vs limit)")
 
 
-def sensing_rows(summary: Mapping[str, Any]) -> list[list[str]]:
+def sensing_rows(summary: Summary) -> list[list[str]]:
     """One row per run of summary.json's ``sensing`` (:mod:`wmr_mj.report.sensing`)."""
     from wmr_mj.analysis.verdicts import format_unmet
 
     out = []
-    for r in summary["sensing"]["runs"]:
+    for r in (ValidateSummary.of(summary).sensing or {}).get("runs", []):
         plateau = r["settled_E"]
         name = r["sensing"] if r["label"] == r["sensing"] else f"{r['sensing']} ({r['label']})"
         out.append([name, r["verdict"], _fmt(r["certificate_E_max"], ".3g", "none"),
@@ -436,9 +456,10 @@ def sensing_rows(summary: Mapping[str, Any]) -> list[list[str]]:
     return out
 
 
-def sensing_blocks(summary: Mapping[str, Any]) -> list[Block]:
+def sensing_blocks(summary: Summary) -> list[Block]:
     """Section (e), where the report has it (reports written before it have no ``sensing``)."""
-    sec = summary.get("sensing")
+    summary = ValidateSummary.of(summary)
+    sec = summary.sensing
     if not sec:
         return []
     return [("h2", f"(e) The certified design on realistic sensing (m1 = {sec['m1']:g} kg, {sec['duration']:g} s)"),
@@ -468,21 +489,21 @@ def sensing_finding(section: Mapping[str, Any]) -> str:
 
 
 # --------------------------------------------------------------------------- (g) findings
-def _rung_finding(before: Mapping[str, Any], r: Mapping[str, Any]) -> str:
+def _rung_finding(before: Rung, r: Rung) -> str:
     def step(key: str, fmt: str = "d") -> str:
-        a, b = before[key], r[key]
+        a, b = getattr(before, key), getattr(r, key)
         return f"{_fmt(a, fmt) if fmt != 'd' else a} -> {_fmt(b, fmt) if fmt != 'd' else b}"
 
-    cb, ca = before["certificate"], r["certificate"]
+    cb, ca = before.certificate, r.certificate
     cert = ("certificate: " + ("none" if not cb.get("certified") else f"E_max {_fmt(cb['E_max'])} rad") + " -> "
             + ("none" if not ca.get("certified") else f"E_max {_fmt(ca['E_max'], '.4g')} rad, all assumptions met"))
-    paper = "" if r["paper_inside"] is None else f", inside the paper's claim {step('paper_inside')}"
-    return (f"Rung {r['index']} ({r['change']}): certified-inside {step('passes')}{paper}, "
-            f"at the stop {step('hit_stop')}, |E| growing {step('growing')} of {r['n']}; "
+    paper = "" if r.paper_inside is None else f", inside the paper's claim {step('paper_inside')}"
+    return (f"Rung {r.index} ({r.change}): certified-inside {step('passes')}{paper}, "
+            f"at the stop {step('hit_stop')}, |E| growing {step('growing')} of {r.n}; "
             f"worst sup|E| {step('worst_sup_E', '.3g')} rad; {cert}.")
 
 
-def _friction_finding(summary: Mapping[str, Any]) -> list[str]:
+def _friction_finding(summary: ValidateSummary) -> list[str]:
     out = []
     for name, law in _friction_laws(summary):
         creep = ", ".join(f"{_fmt(v, '.2g')} rad/s at {k} F" for k, v in law["creep_rates"].items())
@@ -495,8 +516,8 @@ def _friction_finding(summary: Mapping[str, Any]) -> list[str]:
     return out
 
 
-def _identification_finding(summary: Mapping[str, Any]) -> list[str]:
-    ident = summary["identification"]
+def _identification_finding(summary: ValidateSummary) -> list[str]:
+    ident = summary.identification
     idv, se = ident["identified"], ident.get("diagnostics", {}).get("std_error", {})
     pp, nh = ident["predicted"]["paper"], ident["predicted"]["nonholonomic"]
     ratio = _div(idv["K"], pp["K"])
@@ -510,8 +531,8 @@ def _identification_finding(summary: Mapping[str, Any]) -> list[str]:
             f"{nh['gyro']:.3g} V s/m; the paper's model and its analysis (4.17)-(4.23) have no such term."]
 
 
-def _paper_view_finding(summary: Mapping[str, Any]) -> list[str]:
-    ex = summary.get("paper_example")
+def _paper_view_finding(summary: ValidateSummary) -> list[str]:
+    ex = summary.paper_example
     if not ex:
         return []
     red = "; ".join(f"{r['case']}: sup|E| = {r['sup_E']:.3g} rad, sup|E'| = {r['sup_Edot']:.3g} rad/s"
@@ -523,8 +544,8 @@ def _paper_view_finding(summary: Mapping[str, Any]) -> list[str]:
             "the MuJoCo plant is the rung-1 design at m1 = 650 kg."]
 
 
-def _search_findings(summary: Mapping[str, Any]) -> list[str]:
-    searches = summary.get("searches") or []
+def _search_findings(summary: ValidateSummary) -> list[str]:
+    searches = summary.searches
     if not searches:
         return ["No worst-case search was run (--search-budget 0)."]
     parts = []
@@ -543,47 +564,50 @@ def _search_findings(summary: Mapping[str, Any]) -> list[str]:
     return out
 
 
-def findings(summary: Mapping[str, Any]) -> list[str]:
+def findings(summary: Summary) -> list[str]:
     """Plain-language statements of what this run shows, every number from ``summary``."""
-    ladder = summary["ladder"]
+    summary = ValidateSummary.of(summary)
+    ladder = summary.ladder
     first, last = ladder[0], ladder[-1]
-    out = [f"The paper's design keeps {first['paper_inside']}/{first['n']} runs inside the paper's claim and has no "
-           f"valid certificate ({', '.join(first['certificate']['unmet']) or 'none unmet'}), so none of its runs is "
-           f"a pass." if not first["certificate"].get("certified") else
-           f"The paper's design: {first['passes']}/{first['n']} certified-inside."]
+    out = [f"The paper's design keeps {first.paper_inside}/{first.n} runs inside the paper's claim and has no "
+           f"valid certificate ({', '.join(first.certificate['unmet']) or 'none unmet'}), so none of its runs is "
+           f"a pass." if not first.certificate.get("certified") else
+           f"The paper's design: {first.passes}/{first.n} certified-inside."]
     out += [_rung_finding(a, b) for a, b in zip(ladder, ladder[1:])]
-    out.append(f"The certified design ({last['design']}): {last['passes']}/{last['n']} runs certified-inside, worst "
-               f"sup|E| = {_fmt(last['worst_sup_E'], '.4g')} rad against E_max = "
-               f"{_fmt(last['certificate'].get('E_max'), '.4g')} rad.")
+    out.append(f"The certified design ({last.design}): {last.passes}/{last.n} runs certified-inside, worst "
+               f"sup|E| = {_fmt(last.worst_sup_E, '.4g')} rad against E_max = "
+               f"{_fmt(last.certificate.get('E_max'), '.4g')} rad.")
     out += _search_findings(summary)
     out += _friction_finding(summary) + _identification_finding(summary) + _paper_view_finding(summary)
-    if summary.get("sensing"):
-        out.append(sensing_finding(summary["sensing"]))
-    n_out = summary.get("certified_outside", 0)
+    if summary.sensing:
+        out.append(sensing_finding(summary.sensing))
+    n_out = summary.certified_outside
     out.append("No run of this report is certified-outside." if not n_out else
                f"!!! {n_out} run(s) are CERTIFIED-OUTSIDE: a bug or a modelling gap; report it. !!!")
     return out
 
 
 # --------------------------------------------------------------------------- the document
-def banner(summary: Mapping[str, Any]) -> list[Block]:
-    n = summary.get("certified_outside", 0)
+def banner(summary: Summary) -> list[Block]:
+    summary = ValidateSummary.of(summary)
+    n = summary.certified_outside
     if not n:
         return []
-    where = [f"rung {r['index']} ({r['certified_outside']})" for r in summary["ladder"] if r["certified_outside"]]
-    where += [f"search {s['key']} ({s['verdicts']['certified-outside']})" for s in summary.get("searches") or []
+    where = [f"rung {r.index} ({r.certified_outside})" for r in summary.ladder if r.certified_outside]
+    where += [f"search {s['key']} ({s['verdicts']['certified-outside']})" for s in summary.searches
               if s["verdicts"]["certified-outside"]]
-    if (summary.get("sensing") or {}).get("certified_outside"):
-        where.append(f"realistic sensing ({summary['sensing']['certified_outside']})")
+    if (summary.sensing or {}).get("certified_outside"):
+        where.append(f"realistic sensing ({(summary.sensing or {})['certified_outside']})")
     return [("loud", f"!!! CERTIFIED-OUTSIDE: {n} run(s) ({', '.join(where)}) are outside a certificate whose "
                      "assumptions all hold. This is a bug or a modelling gap: report it. !!!")]
 
 
-def answer_blocks(summary: Mapping[str, Any], *, brief: bool = False, with_banner: bool = True) -> list[Block]:
+def answer_blocks(summary: Summary, *, brief: bool = False, with_banner: bool = True) -> list[Block]:
     """Sections (a)-(d), after the certified-outside banner (``with_banner``); ``brief``
     (stdout): the rule in one sentence and the assumptions without their equations."""
-    rung = summary["ladder"][-1]
-    assumptions = assumption_rows(rung["certificate"])
+    summary = ValidateSummary.of(summary)
+    rung = summary.ladder[-1]
+    assumptions = assumption_rows(rung.certificate)
     header: tuple[str, ...] = ASSUMPTION_COLUMNS
     if brief:
         header, assumptions = tuple(c for c in header if c != "equation"), [r[:1] + r[2:] for r in assumptions]
@@ -602,9 +626,9 @@ def answer_blocks(summary: Mapping[str, Any], *, brief: bool = False, with_banne
         ("h3", "Its certificate, every assumption"),
         ("table", header, assumptions),
         *([("h3", "Worst-case search vs Monte Carlo vs certificate"), ("table", SEARCH_COLUMNS, search_rows(summary))]
-          if summary.get("searches") else []),
+          if summary.searches else []),
         ("h2", "(d) The plant's measured friction law (steering joint, m1 = "
-               f"{summary['settings']['nominal_m1']:g} kg, constant voltages from the home keyframe)"),
+               f"{summary.settings['nominal_m1']:g} kg, constant voltages from the home keyframe)"),
         ("table", FRICTION_COLUMNS, friction_rows(summary)),
         *sensing_blocks(summary),
     ]
@@ -616,8 +640,9 @@ def _path_words(settings: Mapping[str, Any]) -> str:
     return "the paper circle" if path == "paper-circle" else f"the path {path}"
 
 
-def _settings_line(summary: Mapping[str, Any]) -> str:
-    s = summary["settings"]
+def _settings_line(summary: Summary) -> str:
+    # only the settings are read: a mapping that holds just them will do (tests give one)
+    s = summary.settings if isinstance(summary, ValidateSummary) else summary["settings"]
     box = s.get("uncertainty", "m1")
     search = (f"search budget {s['search_budget']} runs per {box}-box search" if s["search_budget"] else "no search")
     others = "" if box == "m1" else " and the rest of the full uncertainty box (wmr_mj/params.py)"
@@ -637,10 +662,10 @@ def _cart_words(settings: Mapping[str, Any]) -> str:
                    for i, (name, cls) in enumerate(parts))
 
 
-def fig4_caption(summary: Mapping[str, Any]) -> str:
+def fig4_caption(summary: Summary) -> str:
     """The caption of Fig. 4 under the answer."""
     return (f"Fig. 4: C's desired path and the paths C travelled under the paper's design and the certified design "
-            f"(MuJoCo plant, m1 = {summary['settings']['nominal_m1']:g} kg)")
+            f"(MuJoCo plant, m1 = {ValidateSummary.of(summary).settings['nominal_m1']:g} kg)")
 
 FIGURE_GROUPS = (
     ("The ladder", [("verdict counts per rung", "ladder")]),
@@ -656,51 +681,52 @@ FIGURE_GROUPS = (
 )
 
 
-def _figure_blocks(summary: Mapping[str, Any]) -> list[Block]:
-    figs = summary["figures"]
+def _figure_blocks(summary: ValidateSummary) -> list[Block]:
+    figs = summary.figures
     out: list[Block] = []
     for heading, items in FIGURE_GROUPS:
         if items is None:
-            items = [(f"rung {r['index']}: {r['label']}", f"rung_{r['index']}_{r['name']}") for r in summary["ladder"]]
+            items = [(f"rung {r.index}: {r.label}", f"rung_{r.index}_{r.name}") for r in summary.ladder]
         items = [(c, s) for c, s in items if s in figs]
         if items:
             out += [("h3", heading), ("figures", items)]
     return out
 
 
-def _files(summary: Mapping[str, Any]) -> list[tuple[str, str]]:
+def _files(summary: ValidateSummary) -> list[tuple[str, str]]:
     out = [("summary.json", "every number of this report"), ("summary.csv", "one row per rung"),
            ("identified.json", "the identification")]
-    out += [(r["runs_csv"], f"per-run results of rung {r['index']} ({r['label']})") for r in summary["ladder"]]
-    for s in summary.get("searches") or []:
+    out += [(r.runs_csv, f"per-run results of rung {r.index} ({r.label})") for r in summary.ladder]
+    for s in summary.searches:
         out.append((s["evaluations_csv"], f"every run of the search '{s['key']}'"))
         if s.get("log"):
             out.append((s["log"], f"the worst run of the search '{s['key']}' (wmr-mj replay opens it)"))
     return out
 
 
-def document(summary: Mapping[str, Any]) -> list[Block]:
+def document(summary: Summary) -> list[Block]:
     """The whole report as blocks, the answer first."""
-    ident = summary["identification"]
-    lead = [("lead", fig4_caption(summary), "fig4_trajectory")] if "fig4_trajectory" in summary["figures"] else []
+    summary = ValidateSummary.of(summary)
+    ident = summary.identification
+    lead = [("lead", fig4_caption(summary), "fig4_trajectory")] if "fig4_trajectory" in summary.figures else []
     return [
         ("answer", verdict_lines(summary)),
         *banner(summary),
         *lead,
         ("h1", "wmr-mj validate: does the paper's steering controller keep its promise on the MuJoCo C80?"),
-        ("p", f"{summary['created']} - {_settings_line(summary)}."),
+        ("p", f"{summary.created} - {_settings_line(summary)}."),
         *answer_blocks(summary, with_banner=False),
         ("h2", f"(f) Identification (m1 = {ident['m1']:g} kg, {ident['duration']:g} s excitation)"),
         ("table", IDENT_COLUMNS, identification_rows(summary)),
         ("p", "diff = (identified - predicted) / |predicted|."),
         ("h2", "(g) Findings"),
-        ("ul", summary["findings"]),
+        ("ul", list(summary.findings)),
         ("h2", "Figures"),
         *_figure_blocks(summary),
         ("h2", "Files"),
         ("files", _files(summary)),
         ("h2", "Software"),
-        ("p", ", ".join(f"{k} {v}" for k, v in summary["versions"].items())),
+        ("p", ", ".join(f"{k} {v}" for k, v in summary.versions.items())),
     ]
 
 
@@ -713,8 +739,9 @@ def _text_table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> list[st
     return lines
 
 
-def format_headline(summary: Mapping[str, Any]) -> str:
+def format_headline(summary: Summary) -> str:
     """The answer as text (what ``wmr-mj validate`` prints on stdout)."""
+    summary = ValidateSummary.of(summary)
     out = [*verdict_lines(summary)]
     out += [line for b in banner(summary) for line in ("", b[1])]
     out += ["", f"wmr-mj validate - {_settings_line(summary)}"]
@@ -739,11 +766,12 @@ def _md_table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
     return "\n".join(lines + ["| " + " | ".join(r) + " |" for r in esc[1:]])
 
 
-def _fig_path(summary: Mapping[str, Any], stem: str, ext: str) -> str:
-    return next((p for p in summary["figures"][stem] if p.endswith("." + ext)), summary["figures"][stem][0])
+def _fig_path(summary: ValidateSummary, stem: str, ext: str) -> str:
+    return next((p for p in summary.figures[stem] if p.endswith("." + ext)), summary.figures[stem][0])
 
 
-def render_markdown(summary: Mapping[str, Any]) -> str:
+def render_markdown(summary: Summary) -> str:
+    summary = ValidateSummary.of(summary)
     out: list[str] = []
     for block in document(summary):
         kind = block[0]
@@ -785,7 +813,7 @@ def _html_table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
     return f"<table><thead><tr>{h}</tr></thead><tbody>{body}</tbody></table>"
 
 
-def _html_block(block: Block, summary: Mapping[str, Any]) -> str:
+def _html_block(block: Block, summary: ValidateSummary) -> str:
     e = html.escape
     kind = block[0]
     if kind in ("h1", "h2", "h3"):
@@ -817,7 +845,8 @@ def _html_block(block: Block, summary: Mapping[str, Any]) -> str:
     raise ValueError(f"unknown block kind {kind!r}")
 
 
-def render_html(summary: Mapping[str, Any]) -> str:
+def render_html(summary: Summary) -> str:
+    summary = ValidateSummary.of(summary)
     parts = ["<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>", "<title>wmr-mj validate</title>",
              f"<style>{_CSS}</style></head><body>"]
     parts += [_html_block(b, summary) for b in document(summary)]
@@ -831,18 +860,17 @@ SUMMARY_CSV_COLUMNS = ("rung", "name", "design", "certificate_valid", "certifica
                        "worst_path_cross_track")
 
 
-def summary_csv(summary: Mapping[str, Any]) -> str:
+def summary_csv(summary: Summary) -> str:
     """summary.csv: one row per rung (floats round-trip: repr)."""
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(SUMMARY_CSV_COLUMNS)
-    extra = ([summary["correction_rung"]] if summary.get("correction_rung") else []) + list(summary.get("designs", []))
-    for r in [*summary["ladder"], *extra]:
-        c = r["certificate"]
-        row = [r["index"], r["name"], r["design"], c["certified"], c.get("E_max"), c.get("Edot_max"),
-               c.get("voltage_max"), " ".join(x.replace(" ", "_") for x in c["unmet"]), r["n"],
-               *(r["verdicts"][v] for v in VERDICTS),
-               r["paper_inside"], r["worst_sup_E"], r["worst_certificate_ratio"], r["worst_paper_ratio"],
-               r["hit_stop"], r["growing"], r["runs_csv"], r.get("worst_path_cross_track")]
+    for r in _all_rungs(ValidateSummary.of(summary)):
+        c = r.certificate
+        row = [r.index, r.name, r.design, c["certified"], c.get("E_max"), c.get("Edot_max"),
+               c.get("voltage_max"), " ".join(x.replace(" ", "_") for x in c["unmet"]), r.n,
+               *(r.verdicts[v] for v in VERDICTS),
+               r.paper_inside, r.worst_sup_E, r.worst_certificate_ratio, r.worst_paper_ratio,
+               r.hit_stop, r.growing, r.runs_csv, r.worst_path_cross_track]
         w.writerow(["" if x is None else (repr(x) if isinstance(x, float) else x) for x in row])
     return buf.getvalue()

@@ -29,10 +29,12 @@ Usage::
     from wmr_mj.report.text import format_headline
     summary = run_validate(ValidateSettings(n=8, search_budget=10), "logs/my-validate")
     print(format_headline(summary))
+    summary.ladder[-1].passes, summary.ladder[-1].n  # read by attribute (summary.json: summary.to_dict())
 """
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import time
 from collections.abc import Mapping, Sequence
@@ -43,6 +45,7 @@ from wmr_mj._util.checks import as_pair
 from wmr_mj._util.files import software_versions
 from wmr_mj._util.progress import Stages
 from wmr_mj.params import C80
+from wmr_mj.report.results import CertifiedRule, PathSummary, Rung, ValidateSummary
 from wmr_mj.report.settings import (
     LADDER_GROUPS,
     ValidateSettings,
@@ -240,15 +243,17 @@ def _nominal_summary(run) -> dict[str, Any]:
 
 
 # --------------------------------------------------------------------------- stage 7: the report
-def write_report(summary: dict[str, Any], folder: Path) -> None:
-    """summary.csv, index.md, index.html and summary.json (last), each written atomically."""
+def write_report(summary: ValidateSummary | Mapping[str, Any], folder: Path) -> None:
+    """summary.csv, index.md, index.html and summary.json (last, ``summary.to_dict()``), each written atomically
+    (``summary``: the summary, or its JSON read back)."""
     from wmr_mj._util.files import write_json_atomic, write_text_atomic
     from wmr_mj.report.text import render_html, render_markdown, summary_csv
 
+    summary = ValidateSummary.of(summary)
     write_text_atomic(folder / "summary.csv", summary_csv(summary))
     write_text_atomic(folder / "index.md", render_markdown(summary))
     write_text_atomic(folder / "index.html", render_html(summary))
-    write_json_atomic(folder / "summary.json", summary)
+    write_json_atomic(folder / "summary.json", summary.to_dict())
 
 
 def write_pointer(folder: str | os.PathLike) -> Path:
@@ -286,7 +291,7 @@ def _remove(path: Path) -> None:
         shutil.rmtree(path)
 
 
-def _path_summary(settings: ValidateSettings) -> dict[str, Any]:
+def _path_summary(settings: ValidateSettings) -> PathSummary:
     """The runs' path of C: its name and, on the paper circle, the circle's radius [m] from the
     reference's final curvature (the verdict's 'its 1 m circle')."""
     import numpy as np
@@ -295,10 +300,10 @@ def _path_summary(settings: ValidateSettings) -> dict[str, Any]:
     if settings.path == "paper-circle":
         kappa = float(np.asarray(reference_of(settings).kappa)[-1])
         radius = 1.0 / abs(kappa) if kappa else None
-    return {"name": settings.path, "circle_radius": radius}
+    return PathSummary(name=settings.path, circle_radius=radius)
 
 
-def _certified_rule() -> dict[str, Any]:
+def _certified_rule() -> CertifiedRule:
     """The certified design's rule as designs.py writes it, and the omega_r it gives now."""
     import re
 
@@ -307,16 +312,16 @@ def _certified_rule() -> dict[str, Any]:
     doc = designs.__doc__ or ""
     rule = doc.split("``certified``:", 1)[-1].split("The ladder", 1)[0]
     rule = re.sub(r":\w+:`([^`]*)`", r"\1", rule).replace("``", "")
-    return {"text": " ".join(rule.split()), "error_spec": designs.ERROR_SPEC, "omega_r_grid_step":
-            designs.OMEGA_R_GRID[1] - designs.OMEGA_R_GRID[0], "omega_r_rule": designs.certified_omega_r(),
-            "omega_r_design": CERTIFIED.kd}
+    return CertifiedRule(text=" ".join(rule.split()), error_spec=designs.ERROR_SPEC,
+                         omega_r_grid_step=designs.OMEGA_R_GRID[1] - designs.OMEGA_R_GRID[0],
+                         omega_r_rule=designs.certified_omega_r(), omega_r_design=CERTIFIED.kd)
 
 
 def run_validate(settings: ValidateSettings, out_dir: str | os.PathLike, *, log: bool = True,
-                 stream=None, tty: bool | None = None) -> dict[str, Any]:
+                 stream=None, tty: bool | None = None) -> ValidateSummary:
     """Run the validation into ``out_dir`` (created; sweeps and searches resume there).
 
-    Returns the summary (what summary.json holds). Stage lines go to ``stream`` (default
+    Returns the summary, read by attribute (summary.json is its ``to_dict()``). Stage lines go to ``stream`` (default
     stderr) when ``log``; ``tty`` forces or suppresses the live counter.
     """
     from wmr_mj.report.figures import figures_stage
@@ -330,29 +335,27 @@ def run_validate(settings: ValidateSettings, out_dir: str | os.PathLike, *, log:
     st = Stages("validate", stream=stream, enabled=log, tty=tty)
     identification = identify_stage(settings, folder, st)
     friction = friction_stage(settings, st)
-    rungs = ladder_stage(settings, folder, st)
-    corrected = correction_stage(settings, folder, st)
-    designs = designs_stage(settings, folder, st, first_index=len(LADDER) + 2)
-    searches = search_stage(settings, folder, st, rungs)
+    # the stages build each rung's JSON (run_rung); the summary holds them typed, read by attribute
+    ladder = ladder_stage(settings, folder, st)
+    rungs = [Rung.from_dict(r) for r in ladder]
+    corrected = Rung.from_dict(correction_stage(settings, folder, st))
+    designs = [Rung.from_dict(r) for r in designs_stage(settings, folder, st, first_index=len(LADDER) + 2)]
+    searches = search_stage(settings, folder, st, ladder)  # the search stage reads the rungs' JSON
     nominal = nominal_stage(settings, st)
     sensing = sensing_stage(settings, st)
     figures, fig7 = figures_stage(settings, folder, st, rungs, searches, nominal)
     st.start("report", "summary.json, summary.csv, index.md, index.html")
-    summary: dict[str, Any] = {
-        "folder": str(folder), "created": time.strftime("%Y-%m-%d %H:%M:%S %z"), "settings": settings.as_dict(),
-        "seed": settings.seed, "ladder": rungs, "certified_rule": _certified_rule(), "searches": searches,
-        "nominal": {name: _nominal_summary(run) for name, run in nominal.items()}, "friction": friction,
-        "identification": identification, "paper_example": fig7, "figures": figures,
-        "correction_rung": corrected, "path": _path_summary(settings),
-        **({"designs": designs} if designs else {}),
-        "certified_outside": sum(r["certified_outside"] for r in [*rungs, *designs]) + corrected["certified_outside"]
+    summary = ValidateSummary(
+        folder=str(folder), created=time.strftime("%Y-%m-%d %H:%M:%S %z"), settings=settings.as_dict(),
+        seed=settings.seed, ladder=tuple(rungs), certified_rule=_certified_rule(), searches=tuple(searches),
+        nominal={name: _nominal_summary(run) for name, run in nominal.items()}, friction=friction,
+        identification=identification, paper_example=fig7, figures=figures,
+        correction_rung=corrected, path=_path_summary(settings), designs=tuple(designs),
+        certified_outside=sum(r.certified_outside for r in [*rungs, *designs]) + corrected.certified_outside
         + sum(s["verdicts"]["certified-outside"] for s in searches) + sensing["certified_outside"],
-        "sensing": sensing,
-        "versions": software_versions(),
-    }
-    summary["findings"] = findings(summary)
-    summary["timings_s"] = dict(st.timings)
-    summary["wall_s"] = time.perf_counter() - wall0
+        sensing=sensing, versions=software_versions())
+    summary = dataclasses.replace(summary, findings=tuple(findings(summary)))
+    summary = dataclasses.replace(summary, timings_s=dict(st.timings), wall_s=time.perf_counter() - wall0)
     write_report(summary, folder)
     st.done()
     return summary

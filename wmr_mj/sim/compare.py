@@ -45,10 +45,11 @@ from wmr_mj.sim.config import (
     controller_name,
     controller_source,
 )
+from wmr_mj.sim.records import Record, plain
 from wmr_mj.sim.suite import Scenario, Suite, versions
 
-__all__ = ["Design", "design_from_token", "ScenarioRun", "DesignRow", "CompareResult", "compare", "run_scenario",
-           "adversary_spec"]
+__all__ = ["Design", "design_from_token", "ScenarioRun", "DesignRow", "CompareResult", "CompareReport", "compare",
+           "run_scenario", "adversary_spec"]
 
 
 @dataclass(frozen=True)
@@ -181,7 +182,7 @@ def adversary_spec(design: Design, suite: Suite, *, budget: int, seed: int, meth
 
 
 @dataclass(frozen=True)
-class DesignRow:
+class DesignRow(Record):
     """A design's line of the comparison (every figure over the suite's scenarios, then the adversary's)."""
 
     label: str
@@ -223,16 +224,14 @@ class DesignRow:
     # form); a scenario that names its own cart runs with that one. {}: ideal (as_dict then has no "cart")
     cart: Mapping[str, Any] = field(default_factory=dict)
 
-    def as_dict(self) -> dict[str, Any]:
-        from dataclasses import asdict
-
-        out = asdict(self)
-        out["adversary_where"] = dict(self.adversary_where)
-        out["controller_source"] = None if self.controller_source is None else dict(self.controller_source)
-        out["unmet"] = [dict(a) for a in self.unmet]
+    def to_dict(self) -> dict[str, Any]:
+        """The row's JSON (compare.json's ``rows``): every field, in order (:meth:`from_dict` reads it back)."""
+        out = super().to_dict()
         if not self.cart:
             del out["cart"]  # a comparison on the ideal cart keeps the keys it always had
         return out
+
+    as_dict = to_dict  # the name of earlier versions (wmr_mj.report.compare calls it)
 
 
 @dataclass(frozen=True)
@@ -259,11 +258,46 @@ class CompareResult:
         """The designs one of whose runs (a scenario's or the adversary's) breaks its claim, in order."""
         return [r.label for r in self.rows if r.claim_broken is not None]
 
-    def as_dict(self) -> dict[str, Any]:
-        return {"suite": self.suite.as_dict(), "versions": dict(self.versions), "budget": self.budget,
-                "seed": self.seed, "scenarios": [s.id for s in self.scenarios],
-                "rows": [r.as_dict() for r in self.rows], "claims_broken": self.claims_broken,
-                "wall_s": self.wall_s, "steps": self.steps}
+    def report(self) -> CompareReport:
+        """What the comparison found, as compare.json holds it, typed (the suite as its JSON, scenarios by id)."""
+        return CompareReport(suite=self.suite.as_dict(), versions=dict(self.versions), budget=self.budget,
+                             seed=self.seed, scenarios=tuple(s.id for s in self.scenarios), rows=self.rows,
+                             claims_broken=tuple(self.claims_broken), wall_s=self.wall_s, steps=self.steps)
+
+    def to_dict(self) -> dict[str, Any]:
+        """compare.json's object (``wmr-mj compare --json`` without its files): :meth:`report`'s JSON."""
+        return self.report().to_dict()
+
+    as_dict = to_dict  # the name of earlier versions (wmr_mj.report.compare calls it)
+
+
+@dataclass(frozen=True, kw_only=True)
+class CompareReport(Record):
+    """A comparison as compare.json holds it, read by attribute (:meth:`CompareResult.report`).
+
+    Attributes:
+        suite: the suite's JSON (``Suite.as_dict()``).
+        versions: the software's.
+        budget: the adversary's simulations per design.
+        seed: the adversary's seed.
+        scenarios: the ids of the scenarios run.
+        rows: one per design, in order.
+        claims_broken: the designs one of whose runs breaks its claim, in order.
+        wall_s: the comparison's wall time [s].
+        steps: physics steps simulated.
+    """
+
+    _records = {"rows": DesignRow}
+
+    suite: Mapping[str, Any]
+    versions: Mapping[str, str]
+    budget: int
+    seed: int
+    scenarios: tuple[str, ...]
+    rows: tuple[DesignRow, ...]
+    claims_broken: tuple[str, ...]
+    wall_s: float
+    steps: int
 
 
 def compare(designs: Sequence[Design], suite: Suite, *, scenarios: Sequence[str] = (), budget: int = 32,
@@ -415,7 +449,8 @@ def _claim_broken(runs: Sequence[ScenarioRun], adversary: Any) -> dict[str, Any]
             cert = r.summary.get("certificate") or {}
             found.append({"where": "scenario", "scenario": r.scenario, "params": {"m1": r.summary.get("m1")},
                           "sup_E": r.summary.get("sup_E"), "E_max": cert.get("E_max"), "ratio": cert.get("E_ratio")})
-    broken = None if adversary is None else adversary.claim_broken
+    # falsify's BrokenRun as the JSON this row writes (a mapping: compare's report reads it so)
+    broken = None if adversary is None else plain(adversary.claim_broken)
     if broken is not None:
         found.append({"where": f"adversary {broken['phase']} run {broken['run']}", "scenario": None,
                       "params": broken["params"], "sup_E": broken["sup_E"], "E_max": broken["E_max"],

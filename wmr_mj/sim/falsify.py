@@ -102,14 +102,21 @@ from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE, VERDICTS
 from wmr_mj.errors import ParameterError, UnknownNameError, WmrMjError
 from wmr_mj.params import parameter_names
 from wmr_mj.sim.config import RunConfig
+from wmr_mj.sim.records import Record, UnmetAssumption
 
 __all__ = [
     "OBJECTIVES",
     "METHODS",
+    "METHOD_LABELS",
     "covering_design",
     "OBJECTIVE_LABELS",
     "FalsifySpec",
     "FalsifyResult",
+    "FalsifyReport",
+    "WorstRun",
+    "RandomWorst",
+    "Tightness",
+    "BrokenRun",
     "Evaluation",
     "Trace",
     "objective_value",
@@ -130,6 +137,10 @@ OBJECTIVES = ("certificate", "paper", "sup-E", "requirement")
 #: Search methods (module docstring): the portfolio (default: vertices, CMA-ES, a local CMA-ES), CMA-ES alone,
 #: vertices or a Latin hypercube then a Nelder-Mead polish, differential evolution.
 METHODS = ("portfolio", "cma", "vertices-polish", "lhs-polish", "de")
+#: What each method does, in a few words (the legend of the search's history plot); a test keeps each
+#: label true to the search :func:`search_worst` dispatches the method to.
+METHOD_LABELS = {"portfolio": "vertices, then CMA-ES", "cma": "CMA-ES", "vertices-polish": "vertices, then Nelder-Mead",
+                 "lhs-polish": "Latin hypercube, then Nelder-Mead", "de": "differential evolution"}
 OBJECTIVE_LABELS = {"certificate": "sup|E|/E_max of the certificate", "paper": "sup|E|/E_max of the paper's region",
                     "sup-E": "sup|E| [rad]", "requirement": "-robustness of the requirement (> 0: falsified)"}
 MIN_POPULATION = 5  # scipy's differential evolution needs at least 5 members
@@ -788,8 +799,135 @@ class Evaluation:
         return _verdict(self.summary)
 
 
-@dataclass
+@dataclass(frozen=True, kw_only=True)
+class Tightness(Record):
+    """How tight the certificate is (:attr:`FalsifyResult.tightness`).
+
+    Attributes:
+        ratio: the worst objective found, sup|E|/E_max of the certificate [-] (a lower bound on the worst case).
+        factor: 1/ratio, how many times the worst case found the certificate is (inf where ratio <= 0).
+        found_sup_E: the worst run's sup|E| [rad].
+        E_max: the certificate's E_max [rad] (an upper bound); None where the run has none.
+        text: the sentence ``wmr-mj falsify`` prints.
+    """
+
+    ratio: float | None
+    factor: float
+    found_sup_E: float
+    E_max: float | None
+    text: str
+
+
+@dataclass(frozen=True, kw_only=True)
+class BrokenRun(Record):
+    """The run of a search that breaks the law's claim most (:attr:`FalsifyResult.claim_broken`).
+
+    Attributes:
+        phase: "search" or "random".
+        run: its place in its phase, 1-based.
+        params: every ranged parameter of the run, full precision.
+        sup_E: its sup|E| [rad].
+        sup_Edot: its sup|E'| [rad/s].
+        E_max: the certificate's E_max [rad]; None where it has none.
+        ratio: sup|E|/E_max [-]; None where undefined.
+        count: the certified-outside runs of both phases.
+    """
+
+    phase: str
+    run: int
+    params: Mapping[str, float]
+    sup_E: float
+    sup_Edot: float
+    E_max: float | None
+    ratio: float | None
+    count: int
+
+
+@dataclass(frozen=True, kw_only=True)
+class WorstRun(Record):
+    """The search's worst run (``falsify --json``'s ``worst``): its parameters, objective, sup|E| [rad],
+    sup|E'| [rad/s], verdict, generation and index (0-based in the search), and the claim's assumptions it
+    does not meet."""
+
+    _records = {"unmet": UnmetAssumption}
+
+    params: Mapping[str, float]
+    objective: float | None
+    sup_E: float
+    sup_Edot: float
+    verdict: str
+    generation: int
+    index: int
+    unmet: tuple[UnmetAssumption, ...]
+
+
+@dataclass(frozen=True, kw_only=True)
+class RandomWorst(Record):
+    """The random sample's worst run (``falsify --json``'s ``random``): its objective and parameters, the
+    sample's size, the run's sup|E| [rad] and verdict."""
+
+    worst_objective: float | None
+    worst_params: Mapping[str, float]
+    evaluations: int
+    sup_E: float
+    verdict: str
+
+
+@dataclass(frozen=True, kw_only=True)
+class FalsifyReport(Record):
+    """What a search found, read by attribute: ``wmr-mj falsify --json``'s object (:meth:`to_dict`, before the
+    command adds its files, cart and reproduce line), from :meth:`FalsifyResult.report`.
+
+    Attributes:
+        objective: one of :data:`OBJECTIVES`.
+        objective_label: its words (:data:`OBJECTIVE_LABELS`).
+        objective_source: where the objective's bound comes from (:func:`objective_source`).
+        budget: the search's simulations asked.
+        evaluations: the search's simulations run.
+        seed: the search's seed.
+        method: one of :data:`METHODS`.
+        population: members per generation; None for the polish methods.
+        generations: the search's generations.
+        requirement: the STL requirement of the objective 'requirement'; None otherwise.
+        falsified: :attr:`FalsifyResult.falsified`.
+        claim_broken: the run that breaks the claim most; None when none does.
+        box: each ranged parameter -> (lo, hi).
+        worst: the search's worst run.
+        tightness: how tight the certificate is, where the objective is its ratio; else None.
+        random: the random sample's worst run.
+        log: the MCAP log of the worst run's re-run; None where not written.
+    """
+
+    _records = {"claim_broken": BrokenRun, "worst": WorstRun, "tightness": Tightness, "random": RandomWorst}
+
+    objective: str
+    objective_label: str
+    objective_source: str
+    budget: int
+    evaluations: int
+    seed: int
+    method: str
+    population: int | None
+    generations: int
+    requirement: str | None
+    falsified: bool | None
+    claim_broken: BrokenRun | None
+    box: Mapping[str, tuple[float, float]]
+    worst: WorstRun
+    tightness: Tightness | None
+    random: RandomWorst
+    log: str | None = None
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> FalsifyReport:
+        report = super().from_dict(d)
+        return dataclasses.replace(report, box={k: (float(lo), float(hi)) for k, (lo, hi) in report.box.items()})
+
+
+@dataclass(frozen=True)
 class FalsifyResult:
+    """Every run of a search and of its random sample (:func:`falsify`); :meth:`report` is what they add up to."""
+
     spec: FalsifySpec
     search: list[Evaluation]
     random: list[Evaluation]
@@ -820,7 +958,7 @@ class FalsifyResult:
         return 1 + max((e.generation for e in self.search), default=-1)
 
     @property
-    def tightness(self) -> dict[str, Any] | None:
+    def tightness(self) -> Tightness | None:
         """How tight the certificate is, where the objective is its ratio sup|E|/E_max: the worst
         found (a lower bound on the worst case: a run reached it) beside the certificate's E_max (an
         upper bound), their ratio X and 1/X, and the sentence falsify prints. None for other objectives."""
@@ -840,15 +978,14 @@ class FalsifyResult:
         else:
             text = (f"the worst found is {x:.4g} of the certificate's bound: the certificate is {factor:.3g} times "
                     f"the worst case found (sup|E| >= {w.sup_E:.4g} rad found, <= {bound} rad certified)")
-        return {"ratio": x, "factor": factor, "found_sup_E": w.sup_E,
-                "E_max": None if e_max is None else float(e_max), "text": text}
+        return Tightness(ratio=x, factor=factor, found_sup_E=w.sup_E, E_max=None if e_max is None else float(e_max),
+                         text=text)
 
     @property
-    def claim_broken(self) -> dict[str, Any] | None:
+    def claim_broken(self) -> BrokenRun | None:
         """The run (of the search or the random sample) that breaks the law's claim most, whatever the
         objective: the ``certified-outside`` run of the largest sup|E|/E_max (the first of equals, the
-        search's first), as {phase, run (1-based in its phase), params, sup_E [rad], sup_Edot [rad/s],
-        E_max [rad], ratio, count (certified-outside runs of both phases)}; None when no run breaks it."""
+        search's first); None when no run breaks it."""
         broken = [e for e in (*self.search, *self.random) if e.verdict == CERTIFIED_OUTSIDE]
         if not broken:
             return None
@@ -859,9 +996,9 @@ class FalsifyResult:
 
         e = max(broken, key=ratio)  # max keeps the first of equals
         e_max = (e.summary.get("certificate") or {}).get("E_max")
-        return {"phase": e.phase, "run": e.index + 1, "params": dict(e.params), "sup_E": e.sup_E,
-                "sup_Edot": e.sup_Edot, "E_max": None if e_max is None else float(e_max),
-                "ratio": None if ratio(e) == -math.inf else ratio(e), "count": len(broken)}
+        return BrokenRun(phase=e.phase, run=e.index + 1, params=dict(e.params), sup_E=e.sup_E, sup_Edot=e.sup_Edot,
+                         E_max=None if e_max is None else float(e_max),
+                         ratio=None if ratio(e) == -math.inf else ratio(e), count=len(broken))
 
     @property
     def falsified(self) -> bool | None:
@@ -876,33 +1013,32 @@ class FalsifyResult:
         judged = any(e.verdict in VERDICTS for e in (*self.search, *self.random))
         return False if judged else None
 
-    def as_dict(self, *, log: str | None = None) -> dict[str, Any]:
-        """The ``wmr-mj falsify --json`` object."""
+    def report(self, *, log: str | None = None) -> FalsifyReport:
+        """What the search found, typed (``log``: the worst run's MCAP log, where written)."""
         from wmr_mj.analysis.verdicts import unmet_assumptions
 
         w, r = self.worst, self.random_worst
-        return {
-            "objective": self.spec.objective,
-            "objective_label": OBJECTIVE_LABELS[self.spec.objective],
-            "objective_source": self.objective_source,
-            "budget": self.spec.budget,
-            "evaluations": len(self.search),
-            "seed": self.spec.seed,
-            "method": self.spec.method,
-            "population": self.spec.population_size,
-            "generations": self.generations,
-            "requirement": self.spec.requirement,
-            "falsified": self.falsified,
-            "claim_broken": self.claim_broken,
-            "box": {k: [float(lo), float(hi)] for k, (lo, hi) in self.spec.box.items()},
-            "worst": {"params": dict(w.params), "objective": w.objective, "sup_E": w.sup_E, "sup_Edot": w.sup_Edot,
-                      "verdict": w.verdict, "generation": w.generation, "index": w.index,
-                      "unmet": unmet_assumptions(w.summary.get("certificate"))},
-            "tightness": self.tightness,
-            "random": {"worst_objective": r.objective, "worst_params": dict(r.params), "evaluations": len(self.random),
-                       "sup_E": r.sup_E, "verdict": r.verdict},
-            "log": log,
-        }
+        return FalsifyReport(
+            objective=self.spec.objective, objective_label=OBJECTIVE_LABELS[self.spec.objective],
+            objective_source=self.objective_source, budget=self.spec.budget, evaluations=len(self.search),
+            seed=self.spec.seed, method=self.spec.method, population=self.spec.population_size,
+            generations=self.generations, requirement=self.spec.requirement, falsified=self.falsified,
+            claim_broken=self.claim_broken,
+            box={k: (float(lo), float(hi)) for k, (lo, hi) in self.spec.box.items()},
+            worst=WorstRun(params=dict(w.params), objective=w.objective, sup_E=w.sup_E, sup_Edot=w.sup_Edot,
+                           verdict=w.verdict, generation=w.generation, index=w.index,
+                           unmet=tuple(UnmetAssumption.from_dict(a)
+                                       for a in unmet_assumptions(w.summary.get("certificate")))),
+            tightness=self.tightness,
+            random=RandomWorst(worst_objective=r.objective, worst_params=dict(r.params), evaluations=len(self.random),
+                               sup_E=r.sup_E, verdict=r.verdict),
+            log=log)
+
+    def to_dict(self, *, log: str | None = None) -> dict[str, Any]:
+        """The ``wmr-mj falsify --json`` object (:meth:`report`'s JSON)."""
+        return self.report(log=log).to_dict()
+
+    as_dict = to_dict  # the name of earlier versions (tests and scripts call it)
 
 
 def falsify(spec: FalsifySpec, *, chunk: int = 128, nthread: int = 0, scheduler: str | None = None,

@@ -42,6 +42,7 @@ from wmr_mj.errors import ParameterError, SchedulerError, UnknownNameError
 from wmr_mj.params import M1_RANGE, parameter_names
 from wmr_mj.sim.batch import run_batch
 from wmr_mj.sim.config import RunConfig, config_from_dict
+from wmr_mj.sim.records import Record, UnmetAssumption
 from wmr_mj.sim.summary import RunSummary
 
 __all__ = [
@@ -56,6 +57,7 @@ __all__ = [
     "flat_row",
     "max_at",
     "Worst",
+    "BrokenSweepRun",
     "SweepSummary",
     "config_from_dict",
     "connect",
@@ -474,7 +476,7 @@ def max_at(rows: Sequence[Mapping[str, Any]], column: str) -> tuple[float | None
 
 
 @dataclass(frozen=True)
-class Worst:
+class Worst(Record):
     """The largest value of one quantity over a sweep's runs, and where.
 
     Attributes:
@@ -487,7 +489,7 @@ class Worst:
 
 
 @dataclass(frozen=True)
-class RequirementSweep:
+class RequirementSweep(Record):
     """One STL requirement over a sweep's runs (``wmr-mj sweep --require``).
 
     Attributes:
@@ -520,13 +522,31 @@ class RequirementSweep:
                    satisfied=sum(v >= 0.0 for v, _ in values), violated=sum(v < 0.0 for v, _ in values),
                    undefined=len(rows) - len(values))
 
-    def to_dict(self) -> dict[str, Any]:
-        return {"requirement": self.requirement, "min_robustness": self.min_robustness,
-                "run": self.run, "m1": self.m1, "satisfied": self.satisfied, "violated": self.violated,
-                "undefined": self.undefined}
+
+@dataclass(frozen=True, kw_only=True)
+class BrokenSweepRun(Record):
+    """The run of a sweep that breaks the law's claim most (:attr:`SweepSummary.claim_broken`).
+
+    Attributes:
+        run: the run's index in the sweep; None where its row has none.
+        params: m1 [kg] and each ranged parameter of the run.
+        sup_E: its sup|E| [rad].
+        sup_Edot: its sup|E'| [rad/s].
+        E_max: the certificate's E_max [rad]; None where the row has none.
+        ratio: sup|E|/E_max of the certificate [-]; None where undefined.
+        count: the sweep's certified-outside runs.
+    """
+
+    run: int | None
+    params: Mapping[str, float]
+    sup_E: float
+    sup_Edot: float
+    E_max: float | None
+    ratio: float | None
+    count: int
 
 
-def _claim_broken(rows: Sequence[Mapping[str, Any]], names: Sequence[str]) -> dict[str, Any] | None:
+def _claim_broken(rows: Sequence[Mapping[str, Any]], names: Sequence[str]) -> BrokenSweepRun | None:
     """SweepSummary.claim_broken of ``rows``: the certified-outside run of the largest cert_E_ratio."""
     from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE
 
@@ -538,28 +558,30 @@ def _claim_broken(rows: Sequence[Mapping[str, Any]], names: Sequence[str]) -> di
         return -math.inf if r.get("cert_E_ratio") is None else float(r["cert_E_ratio"])
 
     r = max(broken, key=ratio)  # max keeps the first of equals
-    return {"run": int(r["run"]) if r.get("run") is not None else None,
-            "params": {n: float(r[n]) for n in names if r.get(n) is not None}, "sup_E": float(r["sup_E"]),
-            "sup_Edot": float(r["sup_Edot"]),
-            "E_max": None if r.get("cert_E_max") is None else float(r["cert_E_max"]),
-            "ratio": None if ratio(r) == -math.inf else ratio(r), "count": len(broken)}
+    return BrokenSweepRun(run=int(r["run"]) if r.get("run") is not None else None,
+                          params={n: float(r[n]) for n in names if r.get(n) is not None}, sup_E=float(r["sup_E"]),
+                          sup_Edot=float(r["sup_Edot"]),
+                          E_max=None if r.get("cert_E_max") is None else float(r["cert_E_max"]),
+                          ratio=None if ratio(r) == -math.inf else ratio(r), count=len(broken))
 
 
-def _unmet_over(rows: Sequence[Mapping[str, Any]]) -> tuple[dict[str, Any], ...]:
+def _unmet_over(rows: Sequence[Mapping[str, Any]]) -> tuple[UnmetAssumption, ...]:
     """SweepSummary.unmet of ``rows``: each unmet assumption once, its first run's value and limit, and
     the number of runs that do not meet it."""
     from wmr_mj.analysis.verdicts import count_unmet, unmet_assumptions
 
     certificates = (r.get("certificate") for r in rows)
-    return tuple(count_unmet(unmet_assumptions(c if isinstance(c, Mapping) else None) for c in certificates))
+    counted = count_unmet(unmet_assumptions(c if isinstance(c, Mapping) else None) for c in certificates)
+    return tuple(UnmetAssumption.from_dict(a) for a in counted)
 
 
 @dataclass(frozen=True)
-class SweepSummary:
+class SweepSummary(Record):
     """What a sweep's runs add up to: the one aggregator of ``wmr-mj sweep`` and validate's rungs.
 
     :meth:`of` reads rows of runs.csv (or of :func:`run_sweep`, which carry the same columns);
-    :meth:`sweep_dict` writes ``wmr-mj sweep --json``'s keys, :meth:`rung_dict` validate's.
+    :meth:`sweep_dict` writes ``wmr-mj sweep --json``'s keys, :meth:`rung_dict` validate's;
+    :meth:`to_dict` every field and :meth:`from_dict` reads it back (:class:`wmr_mj.sim.records.Record`).
 
     Attributes:
         n: number of runs.
@@ -587,13 +609,15 @@ class SweepSummary:
         path_verdicts: the count of each path verdict ('within-bound', 'beyond-bound', 'no-guarantee').
         requirements: each STL requirement over the runs.
         claim_broken: the ``certified-outside`` run of the largest sup|E|/E_max (the first of equals), the
-            run that breaks the law's claim most, as {run, params (m1 [kg] and each ranged parameter),
-            sup_E [rad], sup_Edot [rad/s], E_max [rad], ratio, count (certified-outside runs)}; None when
-            no run breaks it.
-        unmet: the claim's assumptions not met in some run, as {name, value, limit, runs}: value and
-            limit of the first such run (the assumption's units), runs: how many; from rows that carry
-            their certificate (a resumed sweep's rows, read from runs.csv, do not).
+            run that breaks the law's claim most; None when no run breaks it.
+        unmet: the claim's assumptions not met in some run: value and limit of the first such run (the
+            assumption's units), runs: how many; from rows that carry their certificate (a resumed sweep's
+            rows, read from runs.csv, do not).
     """
+
+    _records = {"sup_E": Worst, "sup_Edot": Worst, "certificate_E_ratio": Worst, "certificate_Edot_ratio": Worst,
+                "paper_E_ratio": Worst, "paper_Edot_ratio": Worst, "path_cross_track": Worst,
+                "requirements": RequirementSweep, "claim_broken": BrokenSweepRun, "unmet": UnmetAssumption}
 
     n: int
     verdicts: Mapping[str, int]
@@ -618,8 +642,8 @@ class SweepSummary:
     path_cross_track: Worst = Worst(None, None)
     path_verdicts: Mapping[str, int] | None = None
     requirements: tuple[RequirementSweep, ...] = ()
-    claim_broken: Mapping[str, Any] | None = None
-    unmet: tuple[Mapping[str, Any], ...] = ()
+    claim_broken: BrokenSweepRun | None = None
+    unmet: tuple[UnmetAssumption, ...] = ()
 
     @classmethod
     def of(cls, rows: Sequence[Mapping[str, Any]], requirements: Sequence[str] = (), *,
@@ -709,8 +733,8 @@ class SweepSummary:
             **({"requirements": [{**r.to_dict(), "column": requirement_column(i)}
                                  for i, r in enumerate(self.requirements)]} if self.requirements else {}),
             # a broken claim, whatever else the sweep measured (None: no run is certified-outside)
-            "claim_broken": None if self.claim_broken is None else dict(self.claim_broken),
-            "unmet": [dict(a) for a in self.unmet],
+            "claim_broken": None if self.claim_broken is None else self.claim_broken.to_dict(),
+            "unmet": [a.to_dict() for a in self.unmet],
         }
         # the paper's region under names that say so (the unprefixed keys above: deprecated, kept one version)
         out.update({new: out[old] for old, new in SWEEP_KEYS_DEPRECATED.items()})
