@@ -8,24 +8,13 @@ import sys
 from pathlib import Path
 
 import pytest
+from helpers import files_under, one_error_line
 
 from wmr_mj._util.files import check_output_path
 from wmr_mj.cli.app import main
 from wmr_mj.errors import NotEnoughMemoryError, OutputPathError
 
 REPO = Path(__file__).resolve().parents[1]
-
-
-def _one_error_line(capsys) -> str:
-    err = capsys.readouterr().err
-    lines = err.strip().splitlines()
-    assert len(lines) == 1, err
-    assert lines[0].startswith("wmr-mj: error: ") and "Traceback" not in err
-    return lines[0]
-
-
-def _tree(folder: Path) -> list[str]:
-    return sorted(p.relative_to(folder).as_posix() for p in folder.rglob("*"))
 
 
 # a regular file where a folder is needed: fails for root too (permissions would not)
@@ -39,25 +28,25 @@ def _tree(folder: Path) -> list[str]:
 def test_unwritable_output_path_is_one_line(tmp_path, capsys, argv):
     blocker = tmp_path / "a-file"
     blocker.write_text("in the way\n")
-    before = _tree(tmp_path)
+    before = files_under(tmp_path)
     code = main([a.format(blocker=blocker) for a in argv])
-    line = _one_error_line(capsys)
+    line = one_error_line(capsys)
     assert code == 2
     assert "--out" in line and str(blocker) in line and "not a folder" in line, line
-    assert _tree(tmp_path) == before  # no partial file or folder
+    assert files_under(tmp_path) == before  # no partial file or folder
     assert blocker.read_text() == "in the way\n"
 
 
 def test_output_path_that_is_a_folder(tmp_path, capsys):
     assert main(["identify", "--duration", "1", "--out", str(tmp_path)]) == 2
-    assert "is a folder" in _one_error_line(capsys)
-    assert _tree(tmp_path) == []
+    assert "is a folder" in one_error_line(capsys)
+    assert files_under(tmp_path) == []
 
 
 @pytest.mark.skipif(not Path("/proc/self").is_dir(), reason="needs Linux /proc (a folder no one can write)")
 def test_folder_that_cannot_be_created(capsys):
     assert main(["run", "--duration", "10", "--out", "/proc/wmr-mj-test/run.mcap"]) == 2
-    line = _one_error_line(capsys)
+    line = one_error_line(capsys)
     assert "cannot create the folder /proc/wmr-mj-test" in line, line
     assert not Path("/proc/wmr-mj-test").exists()
 
@@ -67,7 +56,7 @@ def test_check_output_path_accepts_new_folders_and_leaves_nothing(tmp_path):
     assert check_output_path(tmp_path / "c" / "d", kind="dir") == tmp_path / "c" / "d"
     (tmp_path / "e").mkdir()
     assert check_output_path(tmp_path / "e", kind="dir") == tmp_path / "e"  # an existing folder resumes
-    assert _tree(tmp_path) == ["e"]  # no probe, no folder made by the check
+    assert files_under(tmp_path) == ["e"]  # no probe, no folder made by the check
 
 
 def test_check_output_path_removes_the_folders_it_made_on_failure(tmp_path, monkeypatch):
@@ -79,7 +68,7 @@ def test_check_output_path_removes_the_folders_it_made_on_failure(tmp_path, monk
     monkeypatch.setattr(tempfile, "mkstemp", full_disk)
     with pytest.raises(OutputPathError, match=r"--out .*cannot create a file in .*No space left on device"):
         check_output_path(tmp_path / "new" / "deeper" / "x.json", kind="file", option="--out")
-    assert _tree(tmp_path) == []
+    assert files_under(tmp_path) == []
 
 
 def test_huge_run_is_refused_up_front():
@@ -123,8 +112,8 @@ def test_available_memory_is_plausible():
 
 def test_bad_input_after_a_good_output_path_leaves_nothing(tmp_path, capsys):
     assert main(["sweep", "--n", "1", "--path", "no-such-path", "--out", str(tmp_path / "new" / "sweep")]) == 2
-    assert "no-such-path" in _one_error_line(capsys)
-    assert _tree(tmp_path) == []
+    assert "no-such-path" in one_error_line(capsys)
+    assert files_under(tmp_path) == []
 
 
 def test_a_gl_backend_that_cannot_load_is_one_line():
@@ -157,5 +146,5 @@ def test_a_gl_backend_that_cannot_load_is_one_line():
 ], ids=["bounds-key", "bounds-value", "knots", "signal-field", "no-disturbance", "no-load", "sweep-require"])
 def test_bad_search_spaces_and_bounds_are_one_line_exit_2(tmp_path, capsys, argv, names):
     code = main([*argv, "--duration", "10", *(["--out", str(tmp_path / "o")] if argv[0] != "run" else [])])
-    line = _one_error_line(capsys)
+    line = one_error_line(capsys)
     assert code == 2 and names in line, line

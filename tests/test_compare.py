@@ -7,7 +7,7 @@ import json
 from pathlib import Path
 
 import pytest
-from test_cli_errors import _one_error_line
+from helpers import one_error_line
 
 from wmr_mj.cli.app import main
 from wmr_mj.errors import ParameterError, UnknownNameError
@@ -100,7 +100,7 @@ def test_compare_gives_the_single_runs_numbers_to_the_bit(tmp_path):
 def test_bad_compare_input_is_one_line_and_exit_2(tmp_path, capsys, argv, words):
     out = tmp_path / "out"
     assert main([*argv, "--out", str(out)]) == 2
-    line = _one_error_line(capsys)
+    line = one_error_line(capsys)
     for w in words:
         assert w in line, line
     assert not out.exists()

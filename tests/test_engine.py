@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 import pytest
+from helpers import StopAfter3000Rows
 from reference_loop import reference_run
 
 from wmr_mj.sim.closed_loop import ROW_FIELDS, run_closed_loop
@@ -105,18 +106,12 @@ def test_a_block_with_a_warning_is_stepped_again_with_the_python_law(monkeypatch
 @pytest.mark.parametrize("background", [False, True])
 def test_an_interrupted_logged_run_leaves_a_finished_log_of_its_rows(tmp_path, background):
     from wmr_mj.logs.reader import load_log
-    from wmr_mj.logs.writer import LogOptions, RunLogger
+    from wmr_mj.logs.writer import LogOptions
 
     path = tmp_path / "run.mcap"
 
-    class StopAfter(RunLogger):  # Ctrl-C after the third simulated second
-        def write_block(self, block):
-            super().write_block(block)
-            if self.rows >= 3000:
-                raise KeyboardInterrupt
-
     result = run_closed_loop(RunConfig(duration=12.0), progress=False,
-                             logger_factory=lambda header: StopAfter(path, header,
+                             logger_factory=lambda header: StopAfter3000Rows(path, header,
                                                                            options=LogOptions(background=background)))
     assert result.status == "interrupted" and len(result.rows["t"]) == 3000
     log = load_log(path)

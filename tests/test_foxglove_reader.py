@@ -8,40 +8,21 @@ JSON.parse, from the schemas stored in the file. Needs node and the pinned packa
 
 from __future__ import annotations
 
-import json
-import shutil
-import subprocess
-from pathlib import Path
-
 import mujoco
 import numpy as np
 import pytest
-from test_mcaplog import TEST_MJCF, synthetic_run
+from helpers import TEST_MJCF, foxglove_read, synthetic_run
 
 from wmr_mj.logs.foxglove import qmul, qrot
 from wmr_mj.logs.reader import load_log
 
 pytestmark = pytest.mark.npm  # Foxglove's reader from npm: `make test-fast` leaves it out
 
-CHECK = Path(__file__).parent / "foxglove_reader" / "check.mjs"
-
-
-def _foxglove_read(path: Path) -> dict:
-    node = shutil.which("node")
-    if node is None:
-        pytest.skip("node is not installed")
-    if not (CHECK.parent / "node_modules" / "@mcap" / "core").is_dir():
-        pytest.skip("Foxglove's reader packages are not installed: npm ci --prefix tests/foxglove_reader")
-    proc = subprocess.run([node, str(CHECK), str(path)], capture_output=True, text=True, timeout=120)
-    assert proc.returncode == 0, proc.stderr
-    return json.loads(proc.stdout)
-
-
 @pytest.mark.parametrize("compression", ["lz4", "zstd"])
 def test_foxglove_reader_decodes_every_channel(tmp_path, compression):
     path = tmp_path / f"{compression}.mcap"
     rows = synthetic_run(path, 0.5, block_rows=250, compression=compression, bounds={"E_max": 0.25, "Edot_max": 1.5})
-    fox = _foxglove_read(path)
+    fox = foxglove_read(path)
     log = load_log(path)
     assert set(fox["topics"]) == set(log.topics)
     for topic, entry in fox["topics"].items():

@@ -9,7 +9,7 @@ import json
 import math
 
 import pytest
-from test_cli_errors import _one_error_line
+from helpers import one_error_line
 
 from wmr_mj.analysis.measurement import MEASUREMENT_COVERED
 from wmr_mj.analysis.verdicts import format_unmet, unmet_assumptions
@@ -86,14 +86,14 @@ def test_an_uncovered_cart_says_why_where_unmet_assumptions_are_printed(capsys):
         "backlash-word", "negative-inductance", "actuation-off-grid"])
 def test_bad_cart_is_one_line_and_exit_2(capsys, argv, words):
     assert main(["run", "--duration", "6", "--no-log", *argv]) == 2
-    line = _one_error_line(capsys)
+    line = one_error_line(capsys)
     assert all(w in line for w in words), line
 
 
 def test_a_sensing_delay_off_a_coarser_control_period_is_refused(capsys):
     # 3 ms is 1.5 periods of a 2 ms control period: the sensing runs at the law's period
     assert main(["run", "--duration", "6", "--no-log", "--control-period", "0.002", "--sensing", "delay=0.003"]) == 2
-    assert "0.003" in _one_error_line(capsys)
+    assert "0.003" in one_error_line(capsys)
 
 
 @pytest.mark.parametrize("argv, words", [
@@ -106,7 +106,7 @@ def test_a_sensing_delay_off_a_coarser_control_period_is_refused(capsys):
 ], ids=["sweep-unknown-axis", "sweep-negative", "falsify-unknown-axis", "filter-without-filtered"])
 def test_bad_hardware_axes_are_one_line_and_exit_2(tmp_path, capsys, argv, words):
     assert main([*argv, *SHORT, "--out", str(tmp_path / "out")]) == 2
-    line = _one_error_line(capsys)
+    line = one_error_line(capsys)
     assert all(w in line for w in words), line
 
 
@@ -200,7 +200,7 @@ def test_robustness_certificate_and_validate_take_the_cart(capsys):
     assert settings.as_dict()["sensing"]["encoder_ticks"] == 4096 and "actuation" not in settings.as_dict()
     assert not {"sensing", "actuation", "transmission"} & set(ValidateSettings().as_dict())
     assert main(["validate", "--n", "1", "--sensing", "delay=0.0007"]) == 2
-    assert "0.0007" in _one_error_line(capsys)
+    assert "0.0007" in one_error_line(capsys)
     assert math.isclose(Sensing.from_spec("delay=0.002").delay, 0.002)
 
 

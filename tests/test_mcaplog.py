@@ -23,6 +23,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pytest
+from helpers import CONFIG, ROW_KEYS, TEST_MJCF, chunk_spans, ros2_decoded, synthetic_block, synthetic_run
 
 from wmr_mj.errors import LogError, ParameterError
 from wmr_mj.logs import logformat
@@ -30,130 +31,12 @@ from wmr_mj.logs.logformat import foxglove_schema
 from wmr_mj.logs.reader import load_log
 from wmr_mj.logs.writer import LogHeader, LogOptions, RunLogger, terminate_as_interrupt
 
-TEST_MJCF = """
-<mujoco model="c80_test">
-  <option timestep="0.001" integrator="implicitfast"/>
-  <worldbody>
-    <light pos="0 0 4" dir="0 0 -1"/>
-    <geom name="floor" type="plane" size="0 0 0.1" rgba=".8 .8 .8 1"/>
-    <body name="chassis" pos="0 0 0.2">
-      <freejoint name="chassis_free"/>
-      <geom type="box" size="0.6 0.3 0.05" pos="0.3 0 0.1" rgba="0.2 0.4 0.8 1" mass="50"/>
-      <geom type="sphere" size="0.05" pos="0.8 0 0.2" rgba="1 1 0 1" mass="0.1"/>
-      <geom type="ellipsoid" size="0.1 0.05 0.03" pos="0 0 0.2" rgba="0 1 0 1" mass="0.1"/>
-      <body name="drive_unit">
-        <geom type="box" size="0.04 0.3 0.03" rgba=".3 .3 .3 1" mass="5"/>
-        <body name="rear_left_wheel" pos="0 0.35 -0.05">
-          <joint name="rear_left_spin" type="hinge" axis="0 1 0" damping="0.01"/>
-          <geom type="cylinder" size="0.15 0.04" euler="90 0 0" rgba=".1 .1 .1 1" mass="2"/>
-        </body>
-        <body name="rear_right_wheel" pos="0 -0.35 -0.05">
-          <joint name="rear_right_spin" type="hinge" axis="0 1 0" damping="0.01"/>
-          <geom type="cylinder" size="0.15 0.04" euler="90 0 0" rgba=".1 .1 .1 1" mass="2"/>
-        </body>
-      </body>
-      <body name="steering_unit" pos="0.612 0 0">
-        <joint name="steer" type="hinge" axis="0 0 1" range="-0.9 0.9" damping="0.5"/>
-        <geom type="capsule" size="0.03 0.2" euler="90 0 0" rgba=".6 .2 .2 1" mass="3"/>
-        <body name="front_left_wheel" pos="0 0.25 -0.1">
-          <joint name="front_left_spin" type="hinge" axis="0 1 0"/>
-          <geom type="cylinder" size="0.1 0.03" euler="90 0 0" rgba=".1 .1 .1 1" mass="1"/>
-        </body>
-        <body name="front_right_wheel" pos="0 -0.25 -0.1">
-          <joint name="front_right_spin" type="hinge" axis="0 1 0"/>
-          <geom type="cylinder" size="0.1 0.03" euler="90 0 0" rgba=".1 .1 .1 1" mass="1"/>
-        </body>
-      </body>
-    </body>
-  </worldbody>
-  <actuator>
-    <motor name="steer_motor" joint="steer" gear="1" ctrlrange="-20 20"/>
-    <motor name="drive_left" joint="rear_left_spin" gear="1"/>
-    <motor name="drive_right" joint="rear_right_spin" gear="1"/>
-  </actuator>
-</mujoco>
-"""
-
-ROW_KEYS = (
-    "t", "alpha", "alpha_dot", "alpha0", "alpha0_dot", "alpha0_ddot", "E", "E_dot", "voltage_cmd",
-    "voltage", "current", "steer_torque", "A_pos", "C_pos", "heading", "qpos", "qvel", "ctrl",
-)  # fmt: skip
-CONFIG = {"seed": 7, "controller": "test", "settle_s": 0.5, "E_max": 0.5, "Edot_max": 2.0, "gains": {"kp": 6.0}}
-
-
-def synthetic_run(path, seconds=1.0, *, block_rows=1000, log_every=1, substeps=1, nan_at=None,
-                  tamper_at=None, summary=None, bounds=None, **options):  # fmt: skip
-    """Simulate TEST_MJCF under a simple steering law and log it; returns the rows logged."""
-    m = mujoco.MjModel.from_xml_string(TEST_MJCF)
-    d = mujoco.MjData(m)
-    spec = mujoco.mjtState.mjSTATE_INTEGRATION
-    s0 = np.empty(mujoco.mj_stateSize(m, spec))
-    mujoco.mj_getState(m, d, s0, spec)
-    jid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, "steer")
-    qa, va = m.jnt_qposadr[jid], m.jnt_dofadr[jid]
-    cb = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "steering_unit")
-    ab = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "drive_unit")
-    n = int(round(seconds / (m.opt.timestep * substeps)))
-    ref = np.column_stack([np.linspace(0, 2, 50), 0.2 * np.sin(np.linspace(0, 3, 50))])
-    header = LogHeader(mjcf_xml=TEST_MJCF, config=CONFIG, parameters={"m1": 650.0, "voltage_limit": 20.0},
-                       initial_state=s0, timestep=m.opt.timestep, control_substeps=substeps, reference_path=ref,
-                       bounds=bounds)
-    log = RunLogger(path, header, options=LogOptions(log_every=log_every, **options))
-    rows = {k: [] for k in ROW_KEYS}
-    out = {k: [] for k in ROW_KEYS}
-    for k in range(n):
-        t = d.time
-        a0, a0d = 0.3 * np.sin(2 * t), 0.6 * np.cos(2 * t)
-        u = 40 * (a0 - d.qpos[qa]) - 2 * d.qvel[va]
-        ctrl = np.array([np.clip(u, -20, 20), 1.0, 1.0])
-        row = {
-            "t": t, "alpha": d.qpos[qa], "alpha_dot": d.qvel[va], "alpha0": a0, "alpha0_dot": a0d,
-            "alpha0_ddot": -1.2 * np.sin(2 * t), "E": a0 - d.qpos[qa], "E_dot": a0d - d.qvel[va],
-            "voltage_cmd": u, "voltage": np.clip(u, -20, 20), "current": 0.1 * u, "steer_torque": ctrl[0],
-            "A_pos": d.xpos[ab][:2].copy(), "C_pos": d.xpos[cb][:2].copy(),
-            "heading": 2 * np.arctan2(d.qpos[6], d.qpos[3]), "qpos": d.qpos.copy(), "qvel": d.qvel.copy(), "ctrl": ctrl,
-        }  # fmt: skip
-        if nan_at is not None and k == nan_at:
-            row["E"] = np.nan
-            row["voltage"] = np.inf
-            row["qpos"][0] = np.nan  # a NaN pose: /tf leaves the row out, /sim/state keeps it
-        if tamper_at is not None and k == tamper_at:
-            row["qpos"][2] += 1e-12
-        for key in ROW_KEYS:
-            rows[key].append(row[key])
-        d.ctrl[:] = ctrl
-        for _ in range(substeps):
-            mujoco.mj_step(m, d)
-        if len(rows["t"]) == block_rows or k == n - 1:
-            blk = {key: np.array(v) for key, v in rows.items()}
-            for key in ROW_KEYS:
-                out[key].append(blk[key])
-            log.write_block(blk)
-            rows = {key: [] for key in ROW_KEYS}
-    log.close(summary if summary is not None else {"sup_abs_E": 0.1, "nan": float("nan")})
-    return {k: np.concatenate(v) for k, v in out.items()}
-
-
-
 
 @pytest.fixture(scope="module")
 def logged(tmp_path_factory):
     path = tmp_path_factory.mktemp("log") / "run.mcap"
     rows = synthetic_run(path, 1.2, block_rows=500, nan_at=700, bounds={"E_max": 0.25, "Edot_max": math.inf})
     return path, rows
-
-
-def _decoded(path, topics):
-    """{topic: [(log_time, message)]} decoded by mcap-ros2-support, a CDR decoder independent of ours."""
-    decoder = pytest.importorskip("mcap_ros2.decoder")
-    from mcap.reader import make_reader
-
-    out = {t: [] for t in topics}
-    with open(path, "rb") as f:
-        reader = make_reader(f, decoder_factories=[decoder.DecoderFactory()])
-        for _, channel, message, msg in reader.iter_decoded_messages(topics=topics):
-            out[channel.topic].append((message.log_time, msg))
-    return out
 
 
 def test_round_trip_arrays(logged):
@@ -233,7 +116,7 @@ def test_official_mcap_reader_and_schemas(logged):
 def test_cdr_channels_decode_with_an_independent_decoder(logged):
     path, rows = logged
     log = load_log(path)
-    dec = _decoded(path, ["/signals", "/sim/state", "/steering", "/bounds"])
+    dec = ros2_decoded(path, ["/signals", "/sim/state", "/steering", "/bounds"])
     state = dec["/sim/state"]
     assert [(t, m.rows) for t, m in state] == [(0, 1000), (1_000_000_000, 200)]
     qpos = np.concatenate([np.reshape(m.qpos, (m.rows, m.nq)) for _, m in state])
@@ -262,7 +145,7 @@ def _compose(transforms):
 
 def test_tf_matches_mujoco_kinematics(logged):
     path, rows = logged
-    msgs = dict(_decoded(path, ["/tf"])["/tf"])
+    msgs = dict(ros2_decoded(path, ["/tf"])["/tf"])
     m = mujoco.MjModel.from_xml_string(TEST_MJCF)
     d = mujoco.MjData(m)
     for k in (0, 340, 1180):
@@ -318,7 +201,7 @@ def test_foxglove_layout_names_what_the_log_has(logged):
         topic, field = value.split(".", 1)
         assert field in log.channel(topic), value
     (three_d,) = [v for k, v in layout["configById"].items() if k.startswith("3D!")]
-    frames = {x.child_frame_id for x in _decoded(path, ["/tf"])["/tf"][0][1].transforms}
+    frames = {x.child_frame_id for x in ros2_decoded(path, ["/tf"])["/tf"][0][1].transforms}
     assert three_d["followTf"] in frames and three_d["topics"]["/scene"]["visible"]
 
 
@@ -388,26 +271,14 @@ def test_each_block_is_on_disk(tmp_path):
     log = RunLogger(path, LogHeader(mjcf_xml=TEST_MJCF, config={}, parameters={}, initial_state=s0, timestep=0.001,
                                     control_substeps=1))
     for b in range(3):
-        log.write_block(_block(m, 1000, b))
+        log.write_block(synthetic_block(m, 1000, b))
         partial = load_log(path)
         assert partial.truncated and partial.summary is None
         assert partial.rows == 1000 * (b + 1)
     log.close({}, status="completed")
     assert not load_log(path).truncated
     with pytest.raises(LogError, match="after close"):
-        log.write_block(_block(m, 10, 0))
-
-
-def _block(m, n, b):
-    t = (np.arange(n) + b * n) * 1e-3
-    blk = {k: np.sin(t + i) for i, k in enumerate(ROW_KEYS) if k not in ("A_pos", "C_pos", "qpos", "qvel", "ctrl")}
-    blk["t"] = t
-    blk["A_pos"] = np.column_stack([t, 0 * t])
-    blk["C_pos"] = np.column_stack([t + 0.6, 0 * t])
-    blk["qpos"] = np.tile(m.qpos0, (n, 1))
-    blk["qvel"] = np.zeros((n, m.nv))
-    blk["ctrl"] = np.zeros((n, m.nu))
-    return blk
+        log.write_block(synthetic_block(m, 10, 0))
 
 
 def test_bad_blocks_and_options_are_refused(tmp_path):
@@ -421,7 +292,7 @@ def test_bad_blocks_and_options_are_refused(tmp_path):
     with pytest.raises(ParameterError, match="initial_state"):
         RunLogger(tmp_path / "x.mcap", dataclasses.replace(header, initial_state=s0[:-1]))
     with RunLogger(tmp_path / "x.mcap", header) as log:
-        blk = _block(m, 10, 0)
+        blk = synthetic_block(m, 10, 0)
         with pytest.raises(ParameterError, match="lacks qvel"):
             log.write_block({k: v for k, v in blk.items() if k != "qvel"})
         with pytest.raises(ParameterError, match=r"block\['qpos'\] has shape"):
@@ -448,7 +319,7 @@ def test_context_manager_closes_on_error(tmp_path):
     with pytest.raises(ZeroDivisionError):
         with RunLogger(path, LogHeader(mjcf_xml=TEST_MJCF, config={}, parameters={}, initial_state=s0,
                                        timestep=0.001, control_substeps=1)) as log:
-            log.write_block(_block(m, 200, 0))
+            log.write_block(synthetic_block(m, 200, 0))
             raise ZeroDivisionError("division by zero")
     log2 = load_log(path)
     assert log2.status == "error" and not log2.truncated and log2.rows == 200
@@ -509,17 +380,10 @@ def test_run_log_with_a_channel_of_unknown_schema(tmp_path):
         load_log(path)
 
 
-def _chunk_spans(path):
-    from mcap.reader import make_reader
-
-    with open(path, "rb") as f:
-        return [(ci.chunk_start_offset, ci.chunk_length) for ci in make_reader(f).get_summary().chunk_indexes]
-
-
 def test_corrupted_chunk(tmp_path):
     path = _write_small(tmp_path)
     data = bytearray(path.read_bytes())
-    spans = _chunk_spans(path)
+    spans = chunk_spans(path)
     rng = np.random.default_rng(3)
     for i, (start, length) in enumerate(spans[1::2]):  # packed and Foxglove chunks alike
         bad = bytearray(data)
@@ -578,7 +442,7 @@ _LOOP = textwrap.dedent(
     import sys, time
     import numpy as np, mujoco
     sys.path.insert(0, {tests!r})
-    from test_mcaplog import TEST_MJCF, _block
+    from helpers import TEST_MJCF, synthetic_block
     from wmr_mj.logs.writer import LogHeader, RunLogger, terminate_as_interrupt
     m = mujoco.MjModel.from_xml_string(TEST_MJCF)
     s0 = np.empty(mujoco.mj_stateSize(m, mujoco.mjtState.mjSTATE_INTEGRATION))
@@ -589,7 +453,7 @@ _LOOP = textwrap.dedent(
         with terminate_as_interrupt(), RunLogger({path!r}, header) as log:
             b = 0
             while True:
-                log.write_block(_block(m, 1000, b))
+                log.write_block(synthetic_block(m, 1000, b))
                 b += 1
                 print("block", b, flush=True)
                 time.sleep(0.05)
@@ -677,7 +541,7 @@ def test_bulk_messages_are_the_messages_added_one_by_one(tmp_path):
         if not bulk:
             log._bulk = None
         for b in range(3):
-            log.write_block(_block(m, 1000 if b < 2 else 437, b))
+            log.write_block(synthetic_block(m, 1000 if b < 2 else 437, b))
         log.close({"sup_E": 0.01})
 
     def messages(path):
@@ -717,9 +581,9 @@ def test_a_background_writer_writes_the_same_file_a_second_behind_at_most(tmp_pa
         log = RunLogger(path, LogHeader(mjcf_xml=TEST_MJCF, config={}, parameters={}, initial_state=s0,
                                         timestep=0.001, control_substeps=1, bounds={"E_max": 0.1, "Edot_max": 0.2}),
                         options=LogOptions(background=background))
-        buffer = _block(m, 1000, 0)
+        buffer = synthetic_block(m, 1000, 0)
         for b in range(4):
-            block = _block(m, 1000, b)
+            block = synthetic_block(m, 1000, b)
             for k, v in block.items():  # the runner reuses its buffers: the writer must have copied them
                 buffer[k][...] = v
             log.write_block(buffer)

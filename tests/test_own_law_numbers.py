@@ -8,7 +8,7 @@ import argparse
 import json
 
 import pytest
-from test_cli_errors import _one_error_line
+from helpers import one_error_line
 
 from wmr_mj.cli.app import main
 
@@ -49,7 +49,7 @@ def laws(tmp_path):
 def test_an_option_the_law_does_not_read_is_refused_in_one_line(laws, tmp_path, capsys, option):
     out = tmp_path / "out.mcap"
     assert main(["run", "--controller", f"{laws}:OwnGain", *option, *RUN, "--out", str(out)]) == 2
-    line = _one_error_line(capsys)
+    line = one_error_line(capsys)
     assert f"{option[0]} does not apply to controller" in line and "--controller-param" in line, line
     assert "it takes: k" in line, line  # what the law does take
     assert not out.exists()  # refused before any run
@@ -74,13 +74,13 @@ def test_a_law_that_declares_kp_receives_the_cli_kp(laws, capsys):
     # given both ways: one line
     assert main(["run", "--controller", f"{laws}:TakesKp", "--kp", "3", "--controller-param", "kp=4", *RUN,
                  "--no-log"]) == 2
-    assert "both set kp" in _one_error_line(capsys)
+    assert "both set kp" in one_error_line(capsys)
 
 
 def test_the_built_in_laws_take_only_what_they_read(capsys):
     # sliding-mode stands on the run's model (from_context reads it) and has no K_P
     assert main(["run", "--controller", "sliding-mode", "--kp", "50", *RUN, "--no-log"]) == 2
-    assert "--kp does not apply to controller 'sliding-mode'" in _one_error_line(capsys)
+    assert "--kp does not apply to controller 'sliding-mode'" in one_error_line(capsys)
     # the adaptive law declares kd and friction_width: they are its parameters
     assert main(["run", "--controller", "adaptive-computed-torque", "--kd", "12", "--friction-width", "0.03",
                  "--model", "nonholonomic", *RUN, "--no-log", "--json"]) == 0
@@ -89,7 +89,7 @@ def test_the_built_in_laws_take_only_what_they_read(capsys):
     assert report["model"] == "nonholonomic" and report["kp"] is None and report["kd"] is None
     # PD has no Coulomb compensation
     assert main(["run", "--controller", "pd", "--friction-sign", "none", *RUN, "--no-log"]) == 2
-    assert "--friction-sign does not apply to controller 'pd'" in _one_error_line(capsys)
+    assert "--friction-sign does not apply to controller 'pd'" in one_error_line(capsys)
 
 
 def test_a_plug_in_run_carries_no_paper_region_and_no_other_law_s_gains(laws, tmp_path, capsys):

@@ -183,7 +183,7 @@ def test_replay_reports_the_path_of_c(tmp_path, capsys):
 
 
 def test_replay_without_a_path_says_why(tmp_path, capsys):
-    from test_mcaplog import synthetic_run
+    from helpers import synthetic_run
 
     from wmr_mj.cli.app import main
 

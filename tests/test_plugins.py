@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_cli_errors import _one_error_line
+from helpers import one_error_line
 
 from controllers.registry import PluginSource, parse_params, resolve
 from wmr_mj.analysis.verdicts import NO_CLAIM, is_pass
@@ -101,7 +101,7 @@ def test_a_bad_plug_in_is_one_line_and_exit_2_before_any_run(law_file, tmp_path,
     spec = spec.format(dir=tmp_path, file=law_file)
     out = tmp_path / "out.mcap"
     assert main(["run", "--controller", spec, "--duration", "10", "--out", str(out)]) == 2
-    line = _one_error_line(capsys)
+    line = one_error_line(capsys)
     for w in words:
         assert w in line, line
     assert not out.exists()  # refused before any run
@@ -114,7 +114,7 @@ def test_a_bad_plug_in_is_one_line_and_exit_2_before_any_run(law_file, tmp_path,
 def test_a_bad_controller_param_is_one_line(law_file, capsys, param, words):
     assert main(["run", "--controller", f"{law_file}:Law", "--controller-param", param, "--duration", "10",
                  "--no-log"]) == 2
-    line = _one_error_line(capsys)
+    line = one_error_line(capsys)
     for w in words:
         assert w in line, line
 
@@ -175,7 +175,7 @@ def test_a_law_that_fails_at_its_first_step_is_one_line_and_exit_2(law_file, cap
     with pytest.raises(ControllerFailure, match="one voltage"):  # nothing simulated: nothing to judge
         run_closed_loop(RunConfig(controller=f"{law_file}:TwoVoltages", duration=10.0), progress=False)
     assert main(["run", "--controller", f"{law_file}:TwoVoltages", "--duration", "10", "--no-log"]) == 2
-    line = _one_error_line(capsys)
+    line = one_error_line(capsys)
     assert "'two-voltages' returned list" in line and "t = 0 s" in line, line
 
 
@@ -211,11 +211,11 @@ def test_the_example_plug_in_through_run_sweep_falsify_require_and_replay(tmp_pa
     # the same folder with another law is refused, not resumed
     assert main(["sweep", "--controller", spec, "--controller-param", "ki=30", "--n", "2", "--duration", "10",
                  "--out", str(sweep_dir)]) == 2
-    assert "holds the runs of another controller" in _one_error_line(capsys)
+    assert "holds the runs of another controller" in one_error_line(capsys)
     # falsify: the certificate's ratio says nothing of a law without a claim; a requirement does
     assert main(["falsify", "--controller", spec, "--budget", "8", "--duration", "10", "--out",
                  str(tmp_path / "f0")]) == 2
-    assert "states no claim" in _one_error_line(capsys)
+    assert "states no claim" in one_error_line(capsys)
     assert main(["falsify", "--controller", spec, "--controller-param", "ki=20", "--budget", "8", "--duration", "10",
                  "--out", str(tmp_path / "f1"), "--require", "always[5,10](abs(E) <= 0.01)", "--json"]) == 3
     fals = json.loads(capsys.readouterr().out)  # exit 3: the requirement falsified (sup|E| > 0.01 rad)
@@ -293,5 +293,5 @@ def test_a_tracker_of_ones_own_runs_named_as_itself_and_replays(tmp_path, capsys
     # a bad tracker parameter: one line, exit 2, before any run
     assert main(["run", "--tracker", f"{path}:GentleStanley", "--tracker-param", "k_x=1", "--duration", "10",
                  "--no-log"]) == 2
-    line = _one_error_line(capsys)
+    line = one_error_line(capsys)
     assert "tracker" in line and "accepted: k_e" in line

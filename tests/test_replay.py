@@ -9,7 +9,7 @@ import sys
 
 import numpy as np
 import pytest
-from test_mcaplog import _chunk_spans, synthetic_run
+from helpers import StopAfter3000Rows, chunk_spans, synthetic_run
 
 from wmr_mj.cli.app import main
 
@@ -89,7 +89,7 @@ def test_video_renders_or_says_why(logs, capsys):
 
 def test_truncated_log_replays(logs, capsys):
     data = logs["honest"].read_bytes()
-    start, length = _chunk_spans(logs["honest"])[-3]
+    start, length = chunk_spans(logs["honest"])[-3]
     cut = logs["dir"] / "cut.mcap"
     cut.write_bytes(data[: start + length // 2])
     code, out, _ = _run(capsys, cut)
@@ -108,7 +108,7 @@ def test_bad_input_exit_2_one_line(logs, capsys, monkeypatch, case):
         path.write_bytes(b"PK\x03\x04 definitely not an MCAP file" * 10)
     elif case == "corrupt_chunk":
         data = bytearray(logs["honest"].read_bytes())
-        start, length = _chunk_spans(logs["honest"])[2]
+        start, length = chunk_spans(logs["honest"])[2]
         for k in range(8):
             data[start + length - 20 - k] ^= 0xA5
         path.write_bytes(bytes(data))
@@ -150,19 +150,12 @@ def test_real_run_replays_bit_for_bit(tmp_path, capsys):
     """The closed-loop runner's own log (C80 plant, paper circle, interrupted after 3 s) verifies."""
     from wmr_mj.logs.reader import load_log
     from wmr_mj.logs.replay import summarize, verify
-    from wmr_mj.logs.writer import RunLogger
     from wmr_mj.sim.closed_loop import run_closed_loop
     from wmr_mj.sim.config import RunConfig
 
     path = tmp_path / "run.mcap"
 
-    class StopAfter(RunLogger):  # Ctrl-C after the third simulated second
-        def write_block(self, block):
-            super().write_block(block)
-            if self.rows >= 3000:
-                raise KeyboardInterrupt
-
-    result = run_closed_loop(RunConfig(duration=12.0), logger_factory=lambda header: StopAfter(path, header),
+    result = run_closed_loop(RunConfig(duration=12.0), logger_factory=lambda header: StopAfter3000Rows(path, header),
                              progress=False)
     assert result.status == "interrupted"
     log = load_log(path)

@@ -15,7 +15,7 @@ import json
 import mujoco
 import numpy as np
 import pytest
-from test_mcaplog import _chunk_spans, _decoded
+from helpers import StopAfter3000Rows, chunk_spans, foxglove_read, ros2_decoded
 
 from wmr_mj.cli.app import main
 from wmr_mj.errors import ParameterError
@@ -87,7 +87,7 @@ def test_the_log_holds_what_the_law_read_beside_the_true_state(sensed):
     assert log.signals["alpha"].tobytes() == rows["alpha"].tobytes()
     assert np.count_nonzero(ms["alpha_measured"] != log.signals["alpha"]) > 0.99 * len(ms["t"])
     # Foxglove's plot channel: every plot_every-th row (100 Hz of 1 kHz), decoded by an independent decoder
-    dec = _decoded(path, ["/measured", "/steering/measured"])
+    dec = ros2_decoded(path, ["/measured", "/steering/measured"])
     plot = dec["/steering/measured"]
     assert len(plot) == 600
     assert np.array_equal([m.alpha for _, m in plot], rows["alpha_measured"][::10])
@@ -257,13 +257,7 @@ def test_actuation_and_backlash_the_header_model_is_the_one_simulated(tmp_path):
 def test_an_interrupted_sensed_run_leaves_a_readable_log_that_verifies(tmp_path):
     path = tmp_path / "stopped.mcap"
 
-    class StopAfter(RunLogger):  # Ctrl-C after the third simulated second
-        def write_block(self, block):
-            super().write_block(block)
-            if self.rows >= 3000:
-                raise KeyboardInterrupt
-
-    result = _run(SENSED.replace(duration=12.0), path, StopAfter)
+    result = _run(SENSED.replace(duration=12.0), path, StopAfter3000Rows)
     assert result.status == "interrupted"
     log = load_log(path)
     assert log.status == "interrupted" and not log.truncated and log.rows == 3000
@@ -272,7 +266,7 @@ def test_an_interrupted_sensed_run_leaves_a_readable_log_that_verifies(tmp_path)
     assert ver["identical"] and ver["measured"]["rows"] == 3000
     # the file cut inside its last chunks (a killed run) still reads, its measured rows a prefix of the run's
     data = path.read_bytes()
-    start, length = _chunk_spans(path)[-3]
+    start, length = chunk_spans(path)[-3]
     cut = tmp_path / "cut.mcap"
     cut.write_bytes(data[: start + length // 2])
     short = load_log(cut)
@@ -310,10 +304,9 @@ def test_hardware_labels_of_a_config_wmr_mj_does_not_accept():
 
 @pytest.mark.npm  # Foxglove's reader from npm (tests/foxglove_reader): skipped where it is not installed
 def test_foxglove_reader_decodes_the_sensed_channels(sensed):
-    from test_foxglove_reader import _foxglove_read
 
     path, result = sensed
-    fox = _foxglove_read(path)
+    fox = foxglove_read(path)
     log = load_log(path)
     assert set(fox["topics"]) == set(log.topics)
     for topic, entry in fox["topics"].items():
