@@ -71,8 +71,8 @@ def _certify_flat(*, box, gyro, V_A, P_hat, C_V_hat, F_hat, K_hat, gyro_hat, V_A
 
 
 @pytest.fixture(scope="module")
-def circle():
-    return build_reference("paper-circle", C80, dt=1e-3, duration=35.0)[0]
+def circle(paper_reference):
+    return paper_reference
 
 
 # ----------------------------------------------------------------- friction term by mode

@@ -26,7 +26,7 @@ from wmr_mj.errors import ParameterError
 from wmr_mj.plant.reduced import steering_model
 from wmr_mj.reference.bounds import ReferenceBounds
 from wmr_mj.sim.certify import certificate_for
-from wmr_mj.sim.config import RunConfig, build_reference
+from wmr_mj.sim.config import RunConfig
 
 EXACT = MeasurementErrors.exact()
 DELTA_12BIT = 2.0 * math.pi / 4096  # one tick of a 12-bit encoder on the steering axis [rad]
@@ -34,8 +34,8 @@ DELTA_12BIT = 2.0 * math.pi / 4096  # one tick of a 12-bit encoder on the steeri
 
 # ----------------------------------------------------------------------------- fixtures
 @pytest.fixture(scope="module")
-def circle():
-    return build_reference("paper-circle", C80, dt=1e-3, duration=35.0)[0]
+def circle(paper_reference):
+    return paper_reference
 
 
 def _configs():

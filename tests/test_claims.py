@@ -9,7 +9,7 @@ import re
 from pathlib import Path
 
 import pytest
-from test_cli_errors import _one_error_line, _tree
+from helpers import files_under, one_error_line
 
 from wmr_mj.analysis.regions import BoxRegion
 from wmr_mj.cli.app import main
@@ -61,7 +61,7 @@ def test_robustness_certificate_json_of_a_law_s_own_claim(controller, capsys):
 
 def test_robustness_certificate_of_a_law_without_a_claim_is_one_line(capsys):
     assert main(["robustness", "--certificate", "--controller", "adaptive-computed-torque"]) == 2
-    assert "states no claim" in _one_error_line(capsys)
+    assert "states no claim" in one_error_line(capsys)
 
 
 @pytest.mark.parametrize("cls, name, error", [
@@ -72,19 +72,19 @@ def test_a_broken_claim_is_one_line_and_exit_2_before_any_step(command, cls, nam
     argv = [command, "--controller", f"{LAWS}:{cls}", "--path", "lane-change", "--duration", "4"]
     argv += ["--out", str(tmp_path / "out")] + (["--n", "2"] if command == "sweep" else [])
     assert main(argv) == 2
-    line = _one_error_line(capsys)
+    line = one_error_line(capsys)
     assert error in line and f"controller {name!r}" in line
-    assert _tree(tmp_path) == []  # no log, no sweep folder: refused before any step
+    assert files_under(tmp_path) == []  # no log, no sweep folder: refused before any step
 
 
 def test_a_broken_claim_is_refused_by_compare_and_falsify(tmp_path, capsys):
     spec = f"{LAWS}:ClaimDividesByZero"
     assert main(["compare", spec, "--budget", "0", "--scenarios", "lane*", "--out", str(tmp_path / "c")]) == 2
-    assert "claim() raised ZeroDivisionError" in _one_error_line(capsys)
+    assert "claim() raised ZeroDivisionError" in one_error_line(capsys)
     assert main(["falsify", "--controller", spec, "--budget", "8", "--path", "lane-change", "--duration", "4",
                  "--out", str(tmp_path / "f")]) == 2
-    assert "claim() raised ZeroDivisionError" in _one_error_line(capsys)
-    assert _tree(tmp_path) == []
+    assert "claim() raised ZeroDivisionError" in one_error_line(capsys)
+    assert files_under(tmp_path) == []
 
 
 # --------------------------------------------------------------------------- provenance in every JSON
@@ -133,7 +133,7 @@ def _run_config(argv: list[str]) -> RunConfig:
     return config_from_args(args, m1=args.m1)
 
 
-def test_each_law_s_default_estimate_is_its_own_and_the_paper_default_is_unchanged():
+def test_each_law_s_default_estimate_is_its_own_and_the_paper_default_is_unchanged(paper_reference):
     # the paper's design: RunConfig(), run with no option, run --controller computed-torque, compare's token
     from wmr_mj.sim.designs import PAPER, design_changes
 
@@ -149,7 +149,7 @@ def test_each_law_s_default_estimate_is_its_own_and_the_paper_default_is_unchang
     assert _run_config(["--controller", "sliding-mode", "--model", "paper"]).model == "paper"
     assert _run_config(["--preset", "paper", "--controller", "sliding-mode"]).model == "paper"  # the preset's
     # under its default estimate the claim holds on the paper circle; under the paper's (K^ = 5.33 V) it cannot
-    reference, _ = build_reference("paper-circle", C80, dt=1e-3, duration=35.0)
+    reference = paper_reference
     assert certificate_for(smc, reference).certified
     under_paper = certificate_for(smc.replace(model="paper"), reference)
     assert "switching gain above the uncertainty" in under_paper.unmet

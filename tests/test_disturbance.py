@@ -116,14 +116,14 @@ def test_no_disturbance_leaves_the_certificate_as_it_was():
     assert math.isclose(b.delta1 - a.delta1, 1e-3 / 0.385, rel_tol=1e-9)
 
 
-def test_disturbance_term_over_an_R_a_box_is_d_max_over_the_steering_inertia():
+def test_disturbance_term_over_an_R_a_box_is_d_max_over_the_steering_inertia(paper_reference):
     """d_V/P = d/(2D): R_a cancels, so over R_a 1.0-1.3 the term stays d_max/(2D), not d_V(1.3)/P(1.0)."""
     from wmr_mj.sim.certify import certificate_for
-    from wmr_mj.sim.config import RunConfig, build_reference
+    from wmr_mj.sim.config import RunConfig
     from wmr_mj.sim.designs import CERTIFIED
 
     base = RunConfig(**CERTIFIED.config_changes(), box_ranges={"R_a": (1.0, 1.3)})
-    reference = build_reference(base.path, C80, dt=1e-3, duration=35.0)[0]
+    reference = paper_reference  # base.path, 1 ms, 35 s
     plain = certificate_for(base, reference)
     cert = certificate_for(base.replace(signals={"d_max": 1.0}), reference)
     two_D = 2.0 * C80.kinetic_energy_coefficients()["D"]

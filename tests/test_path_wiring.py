@@ -64,8 +64,9 @@ def test_batch_path_errors_equal_the_single_runs(law):
         assert b.path_verdict == single.path_verdict
 
 
-def test_runs_csv_columns_and_sweep_summary():
-    s = run_closed_loop(BASE, progress=False).summary
+def test_runs_csv_columns_and_sweep_summary(certified_run_10s):
+    assert certified_run_10s.config == BASE  # run_closed_loop(BASE), run once for the session
+    s = certified_run_10s.summary
     row = flat_row({**s.to_dict(), "run": 0})
     for col in ("path_cross_track_max", "path_along_track_final", "path_heading_error_max", "path_verdict",
                 "path_cross_track_bound"):

@@ -8,7 +8,7 @@ import json
 
 import pytest
 
-from wmr_mj.sim.closed_loop import RunConfig, run_closed_loop
+from wmr_mj.sim.closed_loop import RunConfig
 from wmr_mj.sim.sweep import RESULT_COLUMNS, flat_row
 
 # the keys `wmr-mj run --json` wrote before the summary was typed (less "log", which the command adds)
@@ -30,9 +30,10 @@ CERTIFICATE_KEYS = {"C_V_term", "E_max", "E_ratio", "Edot_max", "Edot_ratio", "K
 
 
 @pytest.fixture(scope="module")
-def summary():
-    return run_closed_loop(RunConfig(model="nonholonomic", kp=100.0, kd=20.0, friction_width=0.01, duration=10.0),
-                           progress=False).summary
+def summary(certified_run_10s):
+    config = RunConfig(model="nonholonomic", kp=100.0, kd=20.0, friction_width=0.01, duration=10.0)
+    assert certified_run_10s.config == config  # the certified design, 10 s: the session's run
+    return certified_run_10s.summary
 
 
 def test_the_json_keeps_every_key(summary):

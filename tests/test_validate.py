@@ -148,7 +148,7 @@ def test_ladder_changes_and_summarise_rung_units():
 
 
 @pytest.mark.slow
-def test_the_search_beside_the_monte_carlo_worst_and_the_certificate(validated):
+def test_the_search_beside_the_monte_carlo_worst_and_the_certificate(validated, paper_reference):
     from wmr_mj.logs.reader import load_log
 
     folder, _, _ = validated
@@ -174,15 +174,14 @@ def test_the_search_beside_the_monte_carlo_worst_and_the_certificate(validated):
     full = searches["certified-full"]
     assert set(full["box"]) == {"m1", "mu", "ground_friction", "R_a", "V_A"}
     # the full-box certificate is the one certificate_for gives for that box, and the runs' verdicts follow it
-    from wmr_mj import C80
     from wmr_mj.params import uncertainty_ranges
     from wmr_mj.sim.certify import certificate_for
-    from wmr_mj.sim.config import RunConfig, build_reference
+    from wmr_mj.sim.config import RunConfig
     from wmr_mj.sim.designs import CERTIFIED
 
     extra = {k: v for k, v in uncertainty_ranges("full").items() if k != "m1"}
     cfg = RunConfig(**CERTIFIED.config_changes(), duration=35.0, box_ranges=extra)
-    again = certificate_for(cfg, build_reference(cfg.path, C80, dt=1e-3, duration=35.0)[0])
+    again = certificate_for(cfg, paper_reference)  # cfg.path, 1 ms, 35 s
     assert full["certificate"]["E_max"] == pytest.approx(again.E_max, rel=1e-12)
     assert full["certificate"]["unmet"] == list(again.unmet)
     certified = not again.unmet
