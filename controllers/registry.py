@@ -133,7 +133,7 @@ def source_hash(cls: type) -> str | None:
     """SHA-256 of the file that defines ``cls``; None where it has none (built in C, made in a REPL)."""
     try:
         path = inspect.getsourcefile(cls)
-    except TypeError:
+    except (TypeError, OSError):  # built in C; a class of a __main__ without a file (a REPL, python -c)
         return None
     if path is None or not Path(path).is_file():
         return None
