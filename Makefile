@@ -31,12 +31,18 @@ $(FOXGLOVE_READER): tests/foxglove_reader/package-lock.json
 
 foxglove-reader: $(FOXGLOVE_READER)
 
-test: lint $(FOXGLOVE_READER)
-	$(PY) -m pytest
+# the suite in PYTEST_WORKERS processes (pytest-xdist, the test extra), one for each of CI's 2 cores; a test
+# file stays on one worker (--dist loadfile), so a module's fixture runs once; session fixtures (tests/conftest.py)
+# run once per worker. PYTEST_WORKERS=0 runs it in this process. Times: docs/guides/development.md
+PYTEST_WORKERS ?= 2
+XDIST := -n $(PYTEST_WORKERS) --dist loadfile
 
-# the quick loop while editing: no lint, no test marked slow, wheel, npm or browser (431 tests, 40 s of CPU)
+test: lint $(FOXGLOVE_READER)
+	$(PY) -m pytest $(XDIST)
+
+# the quick loop while editing: no lint, no test marked slow, wheel, npm or browser (897 tests, 90 s of CPU)
 test-fast: $(STAMP)
-	$(PY) -m pytest -m "not slow and not wheel and not npm and not browser"
+	$(PY) -m pytest $(XDIST) -m "not slow and not wheel and not npm and not browser"
 
 # the documentation site into site/ (docs/, mkdocs.yml); --strict: a warning is an error
 docs: $(STAMP)
