@@ -16,10 +16,6 @@ from wmr_mj.errors import NotEnoughMemoryError, OutputPathError
 
 REPO = Path(__file__).resolve().parents[1]
 
-# the name test files written before tests/helpers.py import from here (main's test_replay_trust.py);
-# import one_error_line from helpers instead: this alias goes once none is left
-_one_error_line = one_error_line
-
 
 # a regular file where a folder is needed: fails for root too (permissions would not)
 @pytest.mark.parametrize("argv", [

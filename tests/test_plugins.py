@@ -225,7 +225,7 @@ def test_the_example_plug_in_through_run_sweep_falsify_require_and_replay(tmp_pa
     # a changed source: replay refuses it in one line, before importing it (tests/test_replay_trust.py)
     example.write_text(example.read_text() + "\n# changed\n")
     assert main(["replay", str(log), "--verify"]) == 2
-    line = _one_error_line(capsys)
+    line = one_error_line(capsys)
     assert str(example.resolve()) in line and "has changed since it ran" in line and "SHA-256" in line
 
 

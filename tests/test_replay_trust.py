@@ -20,7 +20,7 @@ from pathlib import Path
 from types import SimpleNamespace
 
 import pytest
-from test_cli_errors import _one_error_line
+from helpers import one_error_line
 
 from controllers.registry import locate_source
 from wmr_mj.cli.app import main
@@ -102,7 +102,7 @@ def test_a_changed_file_is_refused_before_it_runs(file_run, capsys, monkeypatch)
     _forget(_file_module(law), monkeypatch=monkeypatch)
     marker.unlink(missing_ok=True)
     assert main(["replay", str(file_run["log"]), "--verify"]) == 2
-    line = _one_error_line(capsys)
+    line = one_error_line(capsys)
     assert str(law.resolve()) in line and "has changed since it ran" in line
     assert f"the record's {file_run['sha'][:12]}..." in line and f"SHA-256 is {_sha(law)[:12]}..." in line
     assert not marker.exists()  # never executed
@@ -116,7 +116,7 @@ def test_a_deleted_file_is_refused(file_run, capsys, monkeypatch):
     marker.unlink(missing_ok=True)
     try:
         assert main(["replay", str(file_run["log"]), "--verify"]) == 2
-        line = _one_error_line(capsys)
+        line = one_error_line(capsys)
         assert str(law.resolve()) in line and "is gone" in line
         assert f"the record's SHA-256 {file_run['sha'][:12]}..., found: no file" in line
         assert not marker.exists()
@@ -177,7 +177,7 @@ def test_a_changed_module_plug_in_is_refused_before_its_package_runs(package, tm
     package["init_marker"].unlink()
     package["law_marker"].unlink()
     assert main(["replay", str(log), "--verify"]) == 2
-    line = _one_error_line(capsys)
+    line = one_error_line(capsys)
     assert str(law) in line and f"the record's {recorded[:12]}..." in line and f"{_sha(law)[:12]}..." in line
     assert not package["init_marker"].exists() and not package["law_marker"].exists()
     # restored: said (with the __init__ that runs first), imported, verified
