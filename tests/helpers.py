@@ -10,11 +10,12 @@ The runs that many files repeat are session fixtures in ``tests/conftest.py``, n
 
 Usage::
 
-    from helpers import one_error_line
+    from helpers import files_under, one_error_line
 
-    def test_bad_input(capsys):
-        assert main(["run", "--m1", "-1"]) == 2
-        assert "m1" in one_error_line(capsys)
+    def test_an_unknown_path_is_one_line(tmp_path, capsys):
+        assert main(["sweep", "--n", "1", "--path", "no-such-path", "--out", str(tmp_path / "sweep")]) == 2
+        assert "no-such-path" in one_error_line(capsys)
+        assert files_under(tmp_path) == []
 """
 
 from __future__ import annotations
