@@ -114,8 +114,8 @@ def test_steps_out_of_turn_are_refused():
 @pytest.mark.parametrize("kind", ["uniform", "gaussian"])
 def test_noise_has_its_mean_and_standard_deviation_and_the_uniform_bound(kind):
     n, magnitude = 200_000, 5e-4
-    sensing = Sensing(noise_kind=kind, noise_alpha=magnitude, velocity="tachometer",
-                      velocity_noise_kind=kind, velocity_noise_alpha_dot=2 * magnitude, seed=11)
+    sensing = Sensing(noise_kind=kind, noise=magnitude, velocity="tachometer",
+                      velocity_noise_kind=kind, velocity_noise=2 * magnitude, seed=11)
     chain = _chain(sensing, n)
     for noise, m in ((chain.alpha_noise, magnitude), (chain.alpha_dot_noise, 2 * magnitude)):
         sigma = m / math.sqrt(3) if kind == "uniform" else m
@@ -135,8 +135,8 @@ def test_noise_has_its_mean_and_standard_deviation_and_the_uniform_bound(kind):
 
 
 def test_noise_is_drawn_in_the_documented_order():
-    s = Sensing(noise_kind="uniform", noise_alpha=1e-3, velocity_noise_kind="gaussian",
-                velocity_noise_alpha_dot=0.02, seed=5)
+    s = Sensing(noise_kind="uniform", noise=1e-3, velocity_noise_kind="gaussian",
+                velocity_noise=0.02, seed=5)
     chain = _chain(s, 1000)
     rng = np.random.default_rng(5)
     assert np.array_equal(chain.alpha_noise, rng.uniform(-1e-3, 1e-3, 1000))
@@ -189,7 +189,7 @@ def test_filter_step_response_is_one_minus_a_to_the_k():
     ("preset=no-such-encoder,delay=0.001", UnknownNameError, "valid sensing presets: ideal, incremental-500-motor"),
     ("noise=uniform", ParameterError, "noise = 'uniform' is not accepted; accepted: 'none', 'uniform:BOUND'"),
     ("noise=laplace:0.1", ParameterError, "noise = 'laplace:0.1' is not accepted"),
-    ("noise=uniform:-0.1", ParameterError, "noise_alpha = -0.1 rad is not accepted"),
+    ("noise=uniform:-0.1", ParameterError, "noise = -0.1 rad is not accepted"),
     ("velocity=kalman", UnknownNameError, "unknown sensing velocity value 'kalman'; valid sensing velocity values: "
                                           "difference, exact, filtered, tachometer"),
     ("velocity=filtered", ParameterError, "velocity=filtered needs filter_tau"),
@@ -218,7 +218,7 @@ def test_a_delay_that_is_not_a_whole_number_of_periods_names_both():
 def test_the_issues_string_a_mapping_and_files_give_one_sensing(tmp_path):
     text = "encoder_ticks=4096,encoder_side=axis,velocity=difference,delay=0.005,noise=uniform:0.0005,seed=3"
     s = Sensing.from_spec(text)
-    assert (s.encoder_ticks, s.encoder_side, s.velocity, s.delay, s.noise_kind, s.noise_alpha, s.seed) == (
+    assert (s.encoder_ticks, s.encoder_side, s.velocity, s.delay, s.noise_kind, s.noise, s.seed) == (
         4096, "axis", "difference", 0.005, "uniform", 0.0005, 3)
     (tmp_path / "s.json").write_text(json.dumps(s.as_dict()))
     (tmp_path / "s.toml").write_text('encoder_ticks = 4096\nvelocity = "difference"\ndelay = 0.005\n'
@@ -232,7 +232,7 @@ def test_the_issues_string_a_mapping_and_files_give_one_sensing(tmp_path):
 def test_ideal_is_the_default_and_passes_its_inputs_to_the_bit():
     assert Sensing() == Sensing.from_spec(None) == Sensing.from_spec("ideal") == sensing_preset("ideal")
     assert Sensing().is_ideal and Sensing().label() == "ideal"
-    assert Sensing(noise_kind="gaussian", noise_alpha=0.0).is_ideal  # a zero noise is no noise
+    assert Sensing(noise_kind="gaussian", noise=0.0).is_ideal  # a zero noise is no noise
     for not_ideal in ("encoder_ticks=4096", "encoder_side=motor", "velocity=difference", "delay=0.001",
                       "noise=uniform:0.001", "velocity_noise=gaussian:0.1"):
         assert not Sensing.from_spec(not_ideal).is_ideal, not_ideal
@@ -321,7 +321,7 @@ def test_bounds_closed_forms_and_gaussian_is_not_covered():
     m = measurement_error_bounds(Sensing.from_spec("incremental-500-motor"), control_period=T, gear_ratio=I2,
                                  backlash=0.001)
     assert m.alpha_error_max == pytest.approx(2 * math.pi / 2000 / I2 + 0.001, rel=1e-8)
-    g = measurement_error_bounds(Sensing(noise_kind="gaussian", noise_alpha=1e-4), control_period=T, gear_ratio=I2)
+    g = measurement_error_bounds(Sensing(noise_kind="gaussian", noise=1e-4), control_period=T, gear_ratio=I2)
     assert not g.covered and g.why_not == "Gaussian noise has no bound" and g.alpha_error_max == math.inf
 
 

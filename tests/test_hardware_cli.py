@@ -113,15 +113,15 @@ def test_bad_hardware_axes_are_one_line_and_exit_2(tmp_path, capsys, argv, words
 def test_hardware_axes_round_to_what_a_run_can_have():
     base = RunConfig(control_period=0.002)
     cfg = with_hardware(base, {"sensing.delay": 0.0051, "actuation.delay": 0.0026, "sensing.encoder_bits": 11.6,
-                               "transmission.backlash": 0.002, "sensing.noise_alpha": 0.001})
+                               "transmission.backlash": 0.002, "sensing.noise": 0.001})
     assert cfg.sensing.delay == 3 * 0.002  # 2.55 periods of 2 ms -> 3 (nearest)
     assert cfg.actuation.delay == 3 * 0.001  # 2.6 physics steps -> 3
     assert cfg.sensing.encoder_ticks == 4096  # 11.6 bits -> 12 -> 2**12 ticks
-    assert (cfg.sensing.noise_kind, cfg.sensing.noise_alpha) == ("uniform", 0.001)  # the kind where none was set
+    assert (cfg.sensing.noise_kind, cfg.sensing.noise) == ("uniform", 0.001)  # the kind where none was set
     assert cfg.transmission.backlash == 0.002
     assert with_hardware(base, {"sensing.encoder_ticks": 1000.5}).sensing.encoder_ticks == 1000  # ties to even
     gauss = RunConfig(sensing="noise=gaussian:0.0001")
-    assert with_hardware(gauss, {"sensing.noise_alpha": 0.0003}).sensing.noise_kind == "gaussian"  # the base's kind
+    assert with_hardware(gauss, {"sensing.noise": 0.0003}).sensing.noise_kind == "gaussian"  # the base's kind
     plain = RunConfig(m1=700.0)
     assert config_for(plain, ["m1"], [700.0]) == plain  # no hardware axis: the config as before
     with pytest.raises(UnknownNameError, match="sensing.delay"):

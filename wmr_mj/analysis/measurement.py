@@ -17,7 +17,7 @@ Usage::
     exact = MeasurementErrors.exact()                       # today's: every number unchanged
     encoder = MeasurementErrors(alpha_error_max=2 * math.pi / 4096 / 2, alpha_dot_error_max=1.5, delay_s=0.0)
     late = MeasurementErrors(alpha_error_max=0.0, alpha_dot_error_max=0.0, delay_s=0.005)
-    gauss = MeasurementErrors(0.0, 0.0, 0.0, covered=False, why_not="Gaussian noise on alpha has no bound")
+    gauss = MeasurementErrors(math.inf, 0.0, 0.0, covered=False, why_not="Gaussian noise on alpha has no bound")
 """
 
 from __future__ import annotations
@@ -51,7 +51,8 @@ class MeasurementErrors:
 
     Attributes:
         alpha_error_max: sup |alpha_m - alpha| [rad], >= 0 (quantisation Delta/2 or Delta, a
-            uniform noise bound, a backlash half-width with the encoder on the far side).
+            uniform noise bound, a backlash half-width with the encoder on the far side); math.inf where
+            the error has no bound (Gaussian noise), with ``covered`` False.
         alpha_dot_error_max: sup |alpha_m' - alpha'| [rad/s], >= 0 (a differenced velocity's error
             and lag, a filter's lag, a tachometer's noise bound).
         delay_s: the delay [s] >= 0 between the state and the voltage it produces (sensing plus
@@ -73,6 +74,8 @@ class MeasurementErrors:
 
     def __post_init__(self) -> None:
         for name in ("alpha_error_max", "alpha_dot_error_max", "delay_s"):
+            if name != "delay_s" and self.covered is False and getattr(self, name) == math.inf:
+                continue  # an error with no bound (Gaussian noise) is infinite, and never covered
             object.__setattr__(self, name, finite_number(name, getattr(self, name), minimum=0.0))
         if not isinstance(self.covered, bool):
             raise ParameterError(f"covered = {self.covered!r} is not accepted: True or False")

@@ -570,7 +570,8 @@ class _Measured:
         A_m = A + eps_a
         inf = math.inf
         if A >= 0.5 * math.pi or A_m >= 0.5 * math.pi:
-            return _MeasuredAt(inf, inf, inf, inf, inf, inf, 0.0, A_m, eps_a, inf, inf, inf,
+            exact = b.at(min(A, 0.5 * math.pi))  # the true angle's terms, finite: an invalid certificate shows them
+            return _MeasuredAt(inf, inf, inf, inf, exact.delta1, exact.S, exact.c2, A_m, eps_a, inf, inf, inf,
                                f"the measured angle reaches pi/2 (max|alpha0| + E_max + e_alpha = {A_m:.4g} rad)")
         exact = b.at(A)
         est, P_lo = b.estimate, b.P_corners[0]

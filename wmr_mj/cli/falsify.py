@@ -33,8 +33,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "load0.t, ..., d_max (a ranged amplitude without --d-max declares the box's largest); "
                         "and the cart's axes, searched but not in the certificate's box (each run's claim covers its "
                         "own cart): sensing.delay (whole control periods), sensing.encoder_ticks (whole ticks), "
-                        "sensing.encoder_bits (2**round(bits) ticks), sensing.noise_alpha, "
-                        "sensing.velocity_noise_alpha_dot, sensing.filter_tau, actuation.delay (whole 1 ms steps), "
+                        "sensing.encoder_bits (2**round(bits) ticks), sensing.noise, "
+                        "sensing.velocity_noise, sensing.filter_tau, actuation.delay (whole 1 ms steps), "
                         "actuation.inductance, actuation.current_limit, transmission.backlash")
     p.add_argument("--path-knots", type=int, default=0, metavar="N",
                    help="search C's path too: N curvature knots (path.k1..path.kN, each within +-kappa_max of the "

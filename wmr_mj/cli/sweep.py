@@ -29,7 +29,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "hardware axis of the cart, drawn per run but not in the certificate's box (each run's claim "
                         "covers its own cart): sensing.delay (rounded to whole control periods), "
                         "sensing.encoder_ticks (rounded to whole ticks), sensing.encoder_bits (2**round(bits) "
-                        "ticks), sensing.noise_alpha, sensing.velocity_noise_alpha_dot, sensing.filter_tau, "
+                        "ticks), sensing.noise, sensing.velocity_noise, sensing.filter_tau, "
                         "actuation.delay (whole 1 ms steps), actuation.inductance, actuation.current_limit, "
                         "transmission.backlash; runs.csv records the value each run used")
     p.add_argument("--out", metavar="DIR", help="output folder (default logs/sweep-<time>); rerun to resume")

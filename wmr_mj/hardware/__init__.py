@@ -23,7 +23,7 @@ and one mapping).
 from __future__ import annotations
 
 from wmr_mj.hardware.actuation import Actuation
-from wmr_mj.hardware.cart import CART_PARTS, cart_dict, cart_line, is_ideal_cart
+from wmr_mj.hardware.cart import CART_PARTS, cart_dict, cart_line, check_cart, is_ideal_cart
 from wmr_mj.hardware.coverage import Coverage
 from wmr_mj.hardware.presets import (
     SENSING_PRESET_SOURCES,
@@ -62,4 +62,5 @@ __all__ = [
     "cart_dict",
     "cart_line",
     "is_ideal_cart",
+    "check_cart",
 ]

@@ -71,6 +71,7 @@ from wmr_mj.hardware.spec import (
     field_converters,
     parse_spec,
     to_float,
+    to_int,
     whole_periods,
 )
 
@@ -104,6 +105,9 @@ _SIDE_CODES = {"axis": 0, "motor": 1}
 _ROUNDING_CODES = {"round": 0, "floor": 1}
 _VELOCITY_CODES = {"exact": 0, "tachometer": 1, "difference": 2, "filtered": 3}
 _NOISE_FORMS = "'none', 'uniform:BOUND' or 'gaussian:SIGMA'"
+#: The finest encoder accepted, in bits: 2**48 ticks keep angle x ticks / (2 pi) below 2**53 (where a double
+#: holds every integer) for a motor-shaft angle up to 2**53 / 2**48 x 2 pi = 201 rad (i2 = 60: 3.3 rad of steering).
+MAX_ENCODER_BITS = 48
 
 
 def _check_choice(key: str, value: object, choices: tuple[str, ...]) -> None:
@@ -143,23 +147,25 @@ class Sensing:
     velocity: VelocityEstimate = "exact"  # how alpha' is obtained
     filter_tau: float | None = None  # s, the low-pass time constant tau_f of velocity='filtered'
     noise_kind: NoiseKind = "none"  # noise added to the quantised alpha
-    noise_alpha: float = 0.0  # rad: the bound B (uniform on [-B, B)) or the standard deviation (gaussian)
+    noise: float = 0.0  # rad: the bound B (uniform on [-B, B)) or the standard deviation (gaussian)
     velocity_noise_kind: NoiseKind = "none"  # noise added to the measured alpha'
-    velocity_noise_alpha_dot: float = 0.0  # rad/s: its bound or standard deviation
+    velocity_noise: float = 0.0  # rad/s: its bound or standard deviation
     delay: float = 0.0  # s, the sensing delay, a whole number of control periods when run
     seed: int = 0  # numpy.random.default_rng seed of the noise
 
     def __post_init__(self) -> None:
         ticks = self.encoder_ticks
-        if ticks is not None and (isinstance(ticks, bool) or not isinstance(ticks, int) or ticks < 1):
-            raise ParameterError(f"sensing: encoder_ticks = {ticks!r} is not accepted; an integer >= 1 (ticks per "
-                                 "revolution) or none (the exact angle) is required")
+        if ticks is not None and (isinstance(ticks, bool) or not isinstance(ticks, int)
+                                  or not 1 <= ticks <= 2 ** MAX_ENCODER_BITS):
+            raise ParameterError(f"sensing: encoder_ticks = {ticks!r} is not accepted; an integer >= 1 and <= "
+                                 f"2**{MAX_ENCODER_BITS} (ticks per revolution; the step rounds angle x ticks / 2 pi "
+                                 "in doubles, exact below 2**53) or none (the exact angle) is required")
         _check_choice("encoder_side", self.encoder_side, get_args(EncoderSide))
         _check_choice("encoder_rounding", self.encoder_rounding, get_args(EncoderRounding))
         _check_choice("velocity", self.velocity, get_args(VelocityEstimate))
         self._check_filter()
-        for kind_key, mag_key, unit in (("noise_kind", "noise_alpha", "rad"),
-                                        ("velocity_noise_kind", "velocity_noise_alpha_dot", "rad/s")):
+        for kind_key, mag_key, unit in (("noise_kind", "noise", "rad"),
+                                        ("velocity_noise_kind", "velocity_noise", "rad/s")):
             m = _check_noise(kind_key, getattr(self, kind_key), mag_key, getattr(self, mag_key), unit)
             object.__setattr__(self, mag_key, m)
             if m == 0.0:
@@ -223,11 +229,11 @@ class Sensing:
 
     def noise_bound(self) -> float:
         """(c) |noise on alpha| <= this, rad: 0 (none), B (uniform on [-B, B)), inf (Gaussian: no bound)."""
-        return {"none": 0.0, "uniform": self.noise_alpha, "gaussian": math.inf}[self.noise_kind]
+        return {"none": 0.0, "uniform": self.noise, "gaussian": math.inf}[self.noise_kind]
 
     def velocity_noise_bound(self) -> float:
         """(d) |noise on alpha'| <= this, rad/s: 0, its bound B, or inf (Gaussian)."""
-        return {"none": 0.0, "uniform": self.velocity_noise_alpha_dot,
+        return {"none": 0.0, "uniform": self.velocity_noise,
                 "gaussian": math.inf}[self.velocity_noise_kind]
 
     def estimate_bound(self, control_period: float, *, angle_spread: float) -> tuple[float, float]:
@@ -244,9 +250,11 @@ class Sensing:
         return dot_error, control_period / 2.0 + (self.filter_tau or 0.0)  # filter_tau is set for 'filtered' only
 
     @property
-    def encoder_on_motor(self) -> bool:
-        """True where an encoder reads the motor shaft (the gear's play then lies between it and alpha)."""
-        return self.encoder_side == "motor" and self.encoder_ticks is not None
+    def reads_motor_side(self) -> bool:
+        """True where the sensor reads the motor shaft, through an encoder or exactly (``encoder_side='motor'``,
+        ``encoder_ticks`` any): the gear's play then lies between the reading and alpha. The side, not the
+        ticks, says where the play sits."""
+        return self.encoder_side == "motor"
 
     def model_options(self) -> dict[str, Any]:
         """The model keywords this part sets: none (the sensor runs in the control callback, not the model)."""
@@ -254,26 +262,26 @@ class Sensing:
 
     def coverage(self, *, control_period: float, gear_ratio: float, play: float = 0.0) -> Coverage:
         """The stages' bounds summed (:func:`measurement_error_bounds`), as a :class:`Coverage`; not covered
-        where a noise is Gaussian (its bounds then 0 here, the reason in ``why_not``).
+        where a noise is Gaussian: the error it enters is then unbounded, math.inf (a claim that reads only
+        the numbers cannot cover it), the reason in ``why_not``.
 
         Args:
             control_period: T, s (> 0).
             gear_ratio: i2 (> 0).
-            play: rad at the steering axis, what the gear's play adds where the encoder is on the motor side.
+            play: rad at the steering axis, what the gear's play adds where the sensor reads the motor side.
         """
         bounds = measurement_error_bounds(self, control_period=control_period, gear_ratio=gear_ratio, backlash=play)
-        if not bounds.covered:
-            return Coverage(delay=bounds.delay, why_not=(str(bounds.why_not),))
         return Coverage(alpha_error=bounds.alpha_error_max, alpha_dot_error=bounds.alpha_dot_error_max,
-                        delay=bounds.delay, lag=bounds.alpha_dot_lag)
+                        delay=bounds.delay, lag=bounds.alpha_dot_lag,
+                        why_not=() if bounds.covered else (str(bounds.why_not),))
 
     def as_dict(self) -> dict[str, Any]:
         """The spec form (JSON-ready; :meth:`from_spec` reads it back to an equal Sensing)."""
         return {"encoder_ticks": self.encoder_ticks, "encoder_side": self.encoder_side,
                 "encoder_rounding": self.encoder_rounding, "velocity": self.velocity,
                 "filter_tau": self.filter_tau,
-                "noise": _noise_text(self.noise_kind, self.noise_alpha),
-                "velocity_noise": _noise_text(self.velocity_noise_kind, self.velocity_noise_alpha_dot),
+                "noise": _noise_text(self.noise_kind, self.noise),
+                "velocity_noise": _noise_text(self.velocity_noise_kind, self.velocity_noise),
                 "delay": self.delay, "seed": self.seed}
 
     def label(self) -> str:
@@ -288,9 +296,9 @@ class Sensing:
         parts.append(f"alpha' {self.velocity}"
                      + (f" tau_f {self.filter_tau * 1e3:g} ms" if self.filter_tau is not None else ""))
         if self.noise_kind != "none":
-            parts.append(f"noise {self.noise_kind} {self.noise_alpha:g} rad")
+            parts.append(f"noise {self.noise_kind} {self.noise:g} rad")
         if self.velocity_noise_kind != "none":
-            parts.append(f"alpha' noise {self.velocity_noise_kind} {self.velocity_noise_alpha_dot:g} rad/s")
+            parts.append(f"alpha' noise {self.velocity_noise_kind} {self.velocity_noise:g} rad/s")
         if self.delay:
             parts.append(f"delay {self.delay * 1e3:g} ms")
         if self.noise_kind != "none" or self.velocity_noise_kind != "none":
@@ -326,14 +334,27 @@ def _noise_key(kind_field: str, magnitude_field: str, unit: str) -> Converter:
     return convert
 
 
+def _encoder_bits(what: str, key: str, value: object) -> dict[str, object]:
+    """``encoder_bits=B``: an encoder of 2**B ticks per revolution (B an integer >= 0; the ticks' range is the
+    part's)."""
+    bits = to_int(what, key, value)
+    if not 0 <= bits <= MAX_ENCODER_BITS:
+        raise ParameterError(f"{what}: {key} = {value!r} is not accepted; an integer number of bits from 0 to "
+                             f"{MAX_ENCODER_BITS} is required (encoder_ticks = 2**bits)")
+    return {"encoder_ticks": 2 ** bits}
+
+
 _SPEC_KEYS: dict[str, Converter] = {
-    **field_converters(Sensing, exclude=("noise_kind", "noise_alpha", "velocity_noise_kind",
-                                         "velocity_noise_alpha_dot")),
-    "noise": _noise_key("noise_kind", "noise_alpha", "rad"),
-    "velocity_noise": _noise_key("velocity_noise_kind", "velocity_noise_alpha_dot", "rad/s"),
+    **field_converters(Sensing, exclude=("noise_kind", "noise", "velocity_noise_kind",
+                                         "velocity_noise")),
+    "encoder_bits": _encoder_bits,
+    "noise": _noise_key("noise_kind", "noise", "rad"),
+    "velocity_noise": _noise_key("velocity_noise_kind", "velocity_noise", "rad/s"),
 }
-#: The keys of the spec form, in :meth:`Sensing.as_dict`'s order.
-SENSING_SPEC_KEYS: tuple[str, ...] = tuple(Sensing().as_dict())
+#: The keys of the spec form, in :meth:`Sensing.as_dict`'s order, with ``encoder_bits`` (a second way to give
+#: ``encoder_ticks``: 2**bits) after ``encoder_ticks``.
+SENSING_SPEC_KEYS: tuple[str, ...] = tuple(k for key in Sensing().as_dict()
+                                           for k in ((key, "encoder_bits") if key == "encoder_ticks" else (key,)))
 assert set(SENSING_SPEC_KEYS) == set(_SPEC_KEYS)  # the two lists are one list
 
 _PRESET_CACHE: dict[str, Sensing] = {}
@@ -414,8 +435,8 @@ class SensingChain:
         self.parameters = p
         self.parameters.flags.writeable = False
         rng = np.random.default_rng(sensing.seed)
-        self.alpha_noise = _draw(rng, sensing.noise_kind, sensing.noise_alpha, n_steps)
-        self.alpha_dot_noise = _draw(rng, sensing.velocity_noise_kind, sensing.velocity_noise_alpha_dot, n_steps)
+        self.alpha_noise = _draw(rng, sensing.noise_kind, sensing.noise, n_steps)
+        self.alpha_dot_noise = _draw(rng, sensing.velocity_noise_kind, sensing.velocity_noise, n_steps)
         self.state = np.zeros(STATE_HEADER + 3 * (d + 1))
         # the step reads these as Python numbers (IEEE doubles, the same operations as numpy's, faster)
         self._ticks_per_rad = float(p[P_TICKS_PER_RAD])

@@ -11,13 +11,15 @@ Usage::
     a = parse_spec("actuation.toml", Actuation, what="actuation", keys=keys)
 
 A converter takes ``(what, key, value)`` and returns the dataclass fields it sets (a key may set several:
-``noise=uniform:0.0005`` sets ``noise_kind`` and ``noise_alpha``). The dataclass's ``__post_init__`` checks
+``noise=uniform:0.0005`` sets ``noise_kind`` and ``noise``). The dataclass's ``__post_init__`` checks
 ranges, so a part built directly is checked the same way. The key ``preset`` (where presets exist) names
-the part the other keys change: ``preset=magnetic-12bit-axis,delay=0.005``.
+the part the other keys change, a preset or a file: ``preset=magnetic-12bit-axis,delay=0.005``,
+``preset=my-encoder.toml,delay=0.003`` (a file's own ``preset`` names a preset, not another file).
 
 Every bad input raises one line naming the culprit and what is accepted: :class:`UnknownNameError` for an
 unknown key or preset, :class:`ParameterError` for a value that is not of its key's type, a key given twice,
-an unreadable file.
+two keys that set the same field (``encoder_bits`` and ``encoder_ticks``), an unreadable file, or a file that
+sets no key (an empty file is refused, never read as the ideal part).
 """
 
 from __future__ import annotations
@@ -189,13 +191,25 @@ def _read_file(path: Path, what: str) -> Mapping[str, Any]:
     return data
 
 
+def _read_spec_file(path: Path, what: str, accepted: list[str]) -> Mapping[str, Any]:
+    """A file's table, refused where it sets no key: an empty file is a mistake, not the ideal part."""
+    data = _read_file(path, what)
+    if not data:
+        raise ParameterError(f"{what}: {str(path)!r} sets no key; a file sets at least one of {', '.join(accepted)}")
+    return data
+
+
+def _is_file_name(value: object) -> bool:
+    return isinstance(value, os.PathLike) or (isinstance(value, str) and value.strip().lower().endswith(_FILE_SUFFIXES))
+
+
 def _as_mapping(spec: str | Mapping[str, Any] | os.PathLike[str], what: str, accepted: list[str],
                 presets: Mapping[str, Any]) -> Mapping[str, Any]:
     """The spec as a mapping of keys to raw values; a preset name becomes ``{'preset': name}``."""
     if isinstance(spec, Mapping):
         return spec
     if isinstance(spec, os.PathLike):
-        return _read_file(Path(spec), what)
+        return _read_spec_file(Path(spec), what, accepted)
     if not isinstance(spec, str):
         raise ParameterError(f"{what}: {spec!r} is not a specification; a KEY=VALUE,... string, a mapping, a "
                              ".json/.toml file or a preset name is accepted")
@@ -203,7 +217,7 @@ def _as_mapping(spec: str | Mapping[str, Any] | os.PathLike[str], what: str, acc
     if "=" in text:
         return _split_pairs(text, what, accepted)
     if text.lower().endswith(_FILE_SUFFIXES):
-        return _read_file(Path(text), what)
+        return _read_spec_file(Path(text), what, accepted)
     if text in presets:
         return {"preset": text}
     forms = ["<KEY=VALUE,...>", "<file .json/.toml>"]
@@ -216,19 +230,21 @@ def parse_spec(spec: SpecSource, cls: type[T], *, what: str, keys: Mapping[str, 
 
     Args:
         spec: None (the dataclass's defaults); a preset name; ``"KEY=VALUE,KEY=VALUE"``; a mapping (values
-            typed or strings); a path or a file name ending in ``.json`` or ``.toml`` holding one table.
+            typed or strings); a path or a file name ending in ``.json`` or ``.toml`` holding one table that
+            sets at least one key.
         cls: the frozen dataclass to build; its ``__post_init__`` checks the ranges.
         what: the part's name in messages ('sensing', 'actuation').
         keys: accepted key -> converter (:func:`field_converters`, plus keys that set several fields).
-        presets: name -> instance; the key ``preset`` picks the base that the other keys change.
+        presets: name -> instance; the key ``preset`` picks the base that the other keys change: one of these,
+            or (outside a file) a ``.json``/``.toml`` file.
 
     Returns:
         The instance.
 
     Raises:
         UnknownNameError: an unknown key, preset or choice (the message lists the accepted ones).
-        ParameterError: a malformed string, a value of the wrong type, a field set twice, an unreadable file,
-            or a range the part refuses.
+        ParameterError: a malformed string, a value of the wrong type, a field set twice (by one key given
+            twice or by two keys), an unreadable file or one that sets no key, or a range the part refuses.
     """
     presets = presets or {}
     accepted = [*keys, *(["preset"] if presets else [])]
@@ -237,20 +253,37 @@ def parse_spec(spec: SpecSource, cls: type[T], *, what: str, keys: Mapping[str, 
     raw = _as_mapping(spec, what, accepted, presets)
     base: T = cls()
     fields: dict[str, object] = {}
+    set_by: dict[str, str] = {}  # field -> the key that set it
     for key, value in raw.items():
         if key == "preset" and presets:
-            name = value if isinstance(value, str) else repr(value)
-            if name not in presets:
-                raise UnknownNameError(f"{what} preset", name, presets)
-            base = presets[name]
+            base = _preset_base(value, cls, what=what, keys=keys, presets=presets, in_file=_is_file_name(spec))
             continue
         if key not in keys:
-            raise UnknownNameError(f"{what} key", str(key), accepted)
+            error = UnknownNameError(f"{what} key", str(key), accepted)
+            if _is_file_name(spec):  # name the file too: its keys are not on the command line
+                error.args = (f"{error.args[0]} (in {str(spec)!r})",)
+            raise error
         for name, converted in keys[key](what, key, value).items():
             if name in fields:
-                raise ParameterError(f"{what}: {name} is set twice (by {key!r} and an earlier key)")
-            fields[name] = converted
+                raise ParameterError(f"{what}: {set_by[name]!r} and {key!r} both set {name}; give one of them")
+            fields[name], set_by[name] = converted, key
     return dataclasses.replace(base, **fields)  # type: ignore[type-var]
+
+
+def _preset_base(value: object, cls: type[T], *, what: str, keys: Mapping[str, Converter],
+                 presets: Mapping[str, T], in_file: bool) -> T:
+    """The part that ``preset=VALUE`` names: a preset, or a .json/.toml file (which the other keys then
+    change, as they change a preset). A file's own ``preset`` names a preset, not another file (no chain)."""
+    if _is_file_name(value) and not in_file:
+        return parse_spec(value if isinstance(value, os.PathLike) else str(value).strip(), cls, what=what,
+                          keys=keys, presets=presets)
+    if _is_file_name(value):
+        raise ParameterError(f"{what}: a file's preset = {str(value)!r} names another file; a file's preset names "
+                             f"one of the presets {', '.join(presets)}")
+    name = value if isinstance(value, str) else repr(value)
+    if name not in presets:
+        raise UnknownNameError(f"{what} preset", name, presets)
+    return presets[name]
 
 
 def spec_string(spec: Mapping[str, object]) -> str:

@@ -77,7 +77,8 @@ class Transmission:
         would add to an encoder on the motor side (b; 0 on the axis), which the sensing's bounds carry.
 
         Args:
-            encoder_on_motor: True where the sensor reads the motor shaft through an encoder (the play then
+            encoder_on_motor: True where the sensor reads the motor shaft, through an encoder or exactly
+                (:attr:`Sensing.reads_motor_side <wmr_mj.hardware.sensing.Sensing.reads_motor_side>`; the play then
                 lies between the measured angle and alpha).
         """
         if self.is_ideal:

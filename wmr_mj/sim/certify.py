@@ -228,7 +228,7 @@ def measurement_errors_of(config: Any, plant: C80Parameters) -> MeasurementError
     period = config.control_period if config.control_period is not None else TIMESTEP
     # each part declares its coverage (wmr_mj.hardware.coverage); the play's rigid-stop b enters the sensor's
     # bounds where the encoder reads the motor shaft
-    play = transmission.coverage(encoder_on_motor=sensing.encoder_on_motor)
+    play = transmission.coverage(encoder_on_motor=sensing.reads_motor_side)
     sensed = sensing.coverage(control_period=period, gear_ratio=plant.i2, play=play.alpha_error)
     driven = actuation.coverage(R_a=plant.R_a)
     why = sensed.why_not + play.why_not + driven.why_not

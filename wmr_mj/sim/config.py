@@ -208,13 +208,15 @@ def _check_hardware(config: RunConfig) -> None:
     Raises:
         ParameterError, UnknownNameError: a malformed spec, a bad value, a delay the grid cannot represent.
     """
-    from wmr_mj.hardware import Actuation, Sensing, Transmission
+    from wmr_mj.hardware import Actuation, Sensing, Transmission, check_cart, is_ideal_cart
 
     for name, cls in (("sensing", Sensing), ("actuation", Actuation), ("transmission", Transmission)):
         given = getattr(config, name)
         object.__setattr__(config, name, given if isinstance(given, cls) else cls.from_spec(given))
     config.sensing.delay_steps(TIMESTEP if config.control_period is None else config.control_period)
     config.actuation.delay_steps(TIMESTEP)
+    if not is_ideal_cart(config):  # the limits that need the plant and the duration (hardware.cart.check_cart)
+        check_cart(config, plant_parameters(config))
 
 
 def _check_plugin(config: RunConfig, kind: str) -> None:

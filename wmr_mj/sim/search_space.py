@@ -60,8 +60,8 @@ HARDWARE_AXES = {
     "sensing.delay": "s, rounded to the nearest whole number of control periods",
     "sensing.encoder_ticks": "ticks per revolution, rounded to the nearest integer (ties to even), >= 1",
     "sensing.encoder_bits": "bits: 2**round(bits) ticks per revolution (a draw over 10:14 gives 10, ..., 14 bits)",
-    "sensing.noise_alpha": "rad, the noise on alpha: the base's kind (uniform where it has none), this bound or sigma",
-    "sensing.velocity_noise_alpha_dot": "rad/s, the noise on alpha': the base's kind (uniform where none)",
+    "sensing.noise": "rad, the noise on alpha: the base's kind (uniform where it has none), this bound or sigma",
+    "sensing.velocity_noise": "rad/s, the noise on alpha': the base's kind (uniform where none)",
     "sensing.filter_tau": "s, the low-pass time constant (the base's velocity must be filtered)",
     "actuation.delay": "s, rounded to the nearest whole number of 1 ms physics steps",
     "actuation.inductance": "H, the armature inductance",
@@ -128,8 +128,8 @@ def with_hardware(base: RunConfig, values: Mapping[str, float]) -> RunConfig:
             changes[part]["encoder_ticks"] = int(v)
         elif name == "sensing.encoder_bits":
             changes[part]["encoder_ticks"] = 2 ** int(v)
-        elif name in ("sensing.noise_alpha", "sensing.velocity_noise_alpha_dot"):
-            kind = "noise_kind" if key == "noise_alpha" else "velocity_noise_kind"
+        elif name in ("sensing.noise", "sensing.velocity_noise"):
+            kind = "noise_kind" if key == "noise" else "velocity_noise_kind"
             changes[part][kind] = "uniform" if getattr(base.sensing, kind) == "none" else getattr(base.sensing, kind)
             changes[part][key] = v
         else:
@@ -148,7 +148,10 @@ def check_hardware_range(base: RunConfig, name: str, lo: float, hi: float) -> No
         raise ParameterError(f"range of {name} = {lo!r}:{hi!r} is not accepted: finite 0 <= LO <= HI "
                              f"({HARDWARE_AXES.get(name, 'a hardware axis')})")
     for end in (lo, hi):
-        with_hardware(base, {name: end})
+        try:
+            with_hardware(base, {name: end})
+        except ParameterError as exc:  # the part's refusal, named by the range's end that drew it
+            raise ParameterError(f"range of {name} = {lo!r}:{hi!r}: at {end!r}, {exc}") from None
 
 
 def axis_names_text() -> str:
