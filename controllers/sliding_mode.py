@@ -301,7 +301,9 @@ class SlidingMode(SteeringController):
         if not math.isfinite(unc.total) or A_m >= 0.5 * math.pi:
             return MeasuredLayer(layer=math.inf, D=math.inf, e_alpha=e_a, e_alpha_dot=math.inf, rho=math.inf,
                                  alpha_m=A_m, voltage_max=math.inf, uncertainty=unc,
-                                 reason=f"the measured angle reaches pi/2 (alpha_max + e_alpha = {A_m:.4g} rad)")
+                                 reason=(f"the measured angle reaches pi/2 (alpha_max + e_alpha = {A_m:.4g} rad)"
+                                         if math.isfinite(A_m) else "the measured angle's error e_alpha is unbounded "
+                                         "(no bound derived)"))
         c2_m = math.cos(A_m) ** 2
         c_v = m.P * lam + abs(m.C_V) + abs(self._gyro_V) / c2_m  # V per rad/s of the law's velocity error
         c_a = abs(m.K) * sin_cos3_slope(A_m) + abs(self._gyro_V) * inv_cos2_slope(A_m) * rate  # V per rad

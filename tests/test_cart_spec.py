@@ -319,6 +319,18 @@ def test_a_gaussian_run_prints_no_inf_and_its_json_writes_null(capsys):
     assert not any(word in printed.split() for word in ("inf", "inf,", "-inf", "nan"))
 
 
+@pytest.mark.parametrize("controller", ["computed-torque", "sliding-mode"])
+def test_robustness_prints_an_unbounded_error_as_unbounded_not_inf(capsys, controller):
+    """Before, the Gaussian cart printed 'alpha_error_max 0'; its error is now infinite, and shown as such."""
+    assert main(["robustness", "--certificate", "--controller", controller, "--sensing", "noise=gaussian:0.0005"]) == 0
+    printed = capsys.readouterr().out
+    assert "e_alpha is unbounded (no bound derived)" in printed
+    words = printed.replace(",", " ").split()
+    assert "inf" not in words and "nan" not in words, printed
+    if controller == "sliding-mode":
+        assert "alpha_error_max unbounded" in printed
+
+
 # ---- 9. the play's coverage follows the sensor's side, with or without ticks
 
 

@@ -572,7 +572,9 @@ class _Measured:
         if A >= 0.5 * math.pi or A_m >= 0.5 * math.pi:
             exact = b.at(min(A, 0.5 * math.pi))  # the true angle's terms, finite: an invalid certificate shows them
             return _MeasuredAt(inf, inf, inf, inf, exact.delta1, exact.S, exact.c2, A_m, eps_a, inf, inf, inf,
-                               f"the measured angle reaches pi/2 (max|alpha0| + E_max + e_alpha = {A_m:.4g} rad)")
+                               (f"the measured angle reaches pi/2 (max|alpha0| + E_max + e_alpha = {A_m:.4g} rad)"
+                                if math.isfinite(A_m) else "the measured angle's error e_alpha is unbounded (no bound "
+                                "derived)"))
         exact = b.at(A)
         est, P_lo = b.estimate, b.P_corners[0]
         c2_m = math.cos(A_m) ** 2

@@ -300,8 +300,8 @@ def _claim_table(cert) -> str:
     def fmt(x) -> str:
         return "unbounded" if x is None or not math.isfinite(x) else f"{x:.4g}"
 
-    def scalar(v) -> str:
-        return f"{v:.4g}" if isinstance(v, float) else str(v)
+    def scalar(v) -> str:  # an unbounded input (a Gaussian noise's error, math.inf) reads 'unbounded', not inf
+        return fmt(v) if isinstance(v, float) else str(v)
 
     own = {k: v for k, v in inp.items() if k not in _CLAIM_RUN_INPUTS and not isinstance(v, (dict, list, tuple))}
     nested = {k: v for k, v in inp.items() if k not in _CLAIM_RUN_INPUTS and isinstance(v, dict)}
