@@ -33,7 +33,9 @@ class Actuation:
     """Delay, armature inductance and current limit of the steering motor; the default is ideal.
 
     Raises:
-        ParameterError: a negative delay or inductance, a current limit that is not > 0.
+        ParameterError: a negative delay or inductance, a current limit that is not > 0. The limits that need the
+            plant and the run (L_a/R_a <= 0.1 s, a delay shorter than the run) are
+            :func:`wmr_mj.hardware.cart.check_cart`'s.
     """
 
     delay: float = 0.0  # s, from the law's output to the motor's terminals

@@ -132,12 +132,16 @@ class Sensing:
     """How the law sees the steering angle alpha and its rate alpha'. The default is exact (``is_ideal``).
 
     Built directly (``Sensing(encoder_ticks=4096, velocity="difference")``) or from a spec
-    (:meth:`from_spec`); either way checked here. A noise of magnitude 0 is stored as no noise.
+    (:meth:`from_spec`); either way checked here. A noise of magnitude 0 is stored as no noise. Each quantity has
+    one name in Python, a spec, a file and an axis (``noise``: ``Sensing(noise_kind="uniform", noise=5e-4)``,
+    ``noise=uniform:0.0005``, ``sensing.noise``); the encoder's resolution has a second spec form,
+    ``encoder_bits`` (2**bits ticks).
 
     Raises:
-        ParameterError: zero or negative ticks, a negative delay or noise magnitude, a filter time constant
-            that is missing (``velocity='filtered'``), not > 0, or given for another velocity estimate, a
-            negative seed.
+        ParameterError: zero, negative or more than 2**48 ticks, a negative delay or noise magnitude, a filter
+            time constant that is missing (``velocity='filtered'``), not > 0, or given for another velocity
+            estimate, a negative seed. The limits that need the plant and the run (a delay against the duration,
+            a reading against the steering stops) are :func:`wmr_mj.hardware.cart.check_cart`'s.
         UnknownNameError: an unknown side, rounding, velocity estimate or noise kind.
     """
 
@@ -308,8 +312,10 @@ class Sensing:
     @classmethod
     def from_spec(cls, spec: SpecSource) -> Sensing:
         """A Sensing from ``"KEY=VALUE,..."`` (keys :data:`SENSING_SPEC_KEYS`, noise as 'none',
-        'uniform:BOUND' or 'gaussian:SIGMA'), a mapping of the same, a ``.json``/``.toml`` file, a preset name
-        (:func:`~wmr_mj.hardware.presets.sensing_preset_names`), or None (ideal).
+        'uniform:BOUND' or 'gaussian:SIGMA'), a mapping of the same, a ``.json``/``.toml`` file (which sets at
+        least one key), a preset name (:func:`~wmr_mj.hardware.presets.sensing_preset_names`), a preset or a file
+        with changes (``preset=magnetic-14bit-axis,delay=0.003``, ``preset=my.toml,delay=0.003``), or None
+        (ideal).
 
         Raises:
             UnknownNameError: an unknown key, preset or choice.

@@ -37,7 +37,8 @@ class Transmission:
     """The gear between the motor and the steering axis; the default has no play.
 
     Raises:
-        ParameterError: a negative or non-finite backlash.
+        ParameterError: a negative or non-finite backlash. Play as wide as the steering stops or wider is refused
+            where the plant is known (:func:`wmr_mj.hardware.cart.check_cart`).
     """
 
     backlash: float = 0.0  # rad at the steering axis: the half-width b of the play (the gap is 2 b)
