@@ -115,8 +115,9 @@ def check_cart(config: Any, parameters: Any) -> None:
     if tau_e > MAX_ELECTRICAL_TIME_CONSTANT_S:
         raise ParameterError(f"actuation: inductance = {actuation.inductance:g} H is not accepted: its electrical time "
                              f"constant L_a/R_a = {tau_e:.3g} s (R_a = {R_a:g} Ohm) exceeds "
-                             f"{MAX_ELECTRICAL_TIME_CONSTANT_S:g} s, ten times the largest in DC motor datasheets "
-                             f"(0.1-10 ms); accepted: inductance <= {MAX_ELECTRICAL_TIME_CONSTANT_S * R_a:g} H")
+                             f"{MAX_ELECTRICAL_TIME_CONSTANT_S:g} s, ten times the top of the range DC motor "
+                             f"datasheets give (about 0.1-10 ms); accepted: inductance <= "
+                             f"{MAX_ELECTRICAL_TIME_CONSTANT_S * R_a:g} H (R_a = {R_a:g} Ohm)")
 
 
 def _check_reading(sensing: Any, *, gear_ratio: float, stops: float) -> None:
