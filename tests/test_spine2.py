@@ -8,6 +8,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from wmr_mj.analysis.claim_types import LAW_CLAIM, Claims, judge
 from wmr_mj.analysis.regions import BoxRegion
@@ -68,3 +69,152 @@ def test_a_second_claim_is_one_more_entry_judged_as_the_law_claim_without_moving
     assert judged.inside == (sup_E <= E_max)
     assert judged.E_ratio == sup_E / E_max and judged.Edot_ratio == 0.0
     assert judged.region_ratio == sup_E / E_max and math.isfinite(judged.region_ratio)
+
+
+# --------------------------------------------------------------------------- the reproduce line parses back
+#: `wmr-mj run` command lines, each a config the reproduce line must build again: a preset, a plug-in with
+#: parameters, a sensed cart, trackers, ranged values (the --uncertainty box with --range added and replaced),
+#: signals, a control period, plant overrides, a law's own estimate with a preset's unread settings
+RUN_LINES = {
+    "preset": ["--preset", "certified"],
+    "plug-in": ["--controller", "examples/my_pid.py:MyPID", "--controller-param", "ki=20",
+                "--controller-param", "P_hat=0.39", "--path", "lane-change", "--duration", "12.5"],
+    "sensed-cart": ["--preset", "certified", "--sensing", "magnetic-14bit-axis", "--actuation",
+                    "delay=0.002,inductance=0.0005,current_limit=20", "--backlash", "0.0015"],
+    "tracker": ["--controller", "sliding-mode", "--tracker", "pure-pursuit", "--tracker-param", "lookahead=0.7",
+                "--path", "lane-change", "--reference-bounds", "paper"],
+    "correction": ["--preset", "certified", "--correction", "--path", "lane-change", "--m1", "712.25"],
+    "ranged": ["--preset", "certified", "--uncertainty", "full", "--range", "R_a=1.0:1.4", "--range",
+               "l3=0.14:0.15", "--m1-range", "500", "800", "--m1", "720.125"],
+    "ranged-m1-box": ["--range", "mu=0.013:0.03", "--box", "derived", "--m1-inertia", "scale"],
+    "signals": ["--preset", "certified", "--disturbance", "kind=step,amplitude=1,t1=5", "--d-max", "1.5",
+                "--control-period", "0.002", "--param", "mu=0.02", "--steering-friction", "soft",
+                "--tyre-contact", "soft"],
+    "own-estimate": ["--preset", "certified", "--controller", "sliding-mode"],
+    "omega-r": ["--omega-r", "4.5", "--friction-sign", "reference", "--friction-width", "0.02"],
+}
+
+
+def _run_config(argv):
+    from wmr_mj.cli.app import build_parser
+    from wmr_mj.cli.run import config_from_args
+
+    args = build_parser().parse_args(["run", *argv])
+    return config_from_args(args, m1=args.m1), args
+
+
+@pytest.mark.parametrize("argv", list(RUN_LINES.values()), ids=list(RUN_LINES))
+def test_the_reproduce_line_parses_back_into_the_same_config(argv):
+    import shlex
+
+    from wmr_mj.cli.falsify import reproduce_command
+
+    config, args = _run_config(argv)
+    line = reproduce_command(config, {}, args, law_settings=resolve_run(config).law_settings)
+    words = shlex.split(line)
+    assert words[:2] == ["wmr-mj", "run"], line
+    again, _ = _run_config(words[2:])
+    assert again.as_dict() == config.as_dict(), line
+    assert reproduce_command(again, {}, args) == line  # a fixed point: the line of the line is the line
+
+
+def test_the_reproduce_line_writes_what_falsify_wrote():
+    """The table writes the options in the order falsify's hand-written line did, so its JSON keeps its text."""
+    from wmr_mj.cli.falsify import reproduce_command
+
+    config, args = _run_config(["--preset", "certified", "--uncertainty", "full", "--duration", "15",
+                                "--m1", "692.3300677526303", "--param", "mu=0.02054295349737046"])
+    assert reproduce_command(config, {}, args) == (
+        "wmr-mj run --preset certified --controller computed-torque --model nonholonomic --kp 100.0 --kd 20.0 "
+        "--friction-sign measured --friction-width 0.01 --path paper-circle --duration 15.0 --m1 692.3300677526303 "
+        "--param mu=0.02054295349737046 --steering-friction stiction --tyre-contact stiff --m1-inertia payload "
+        "--box derived --m1-range 550.0 750.0 --uncertainty full")
+
+
+def test_every_run_option_is_in_the_table_and_the_table_is_the_parser():
+    """The run command's parser has each row of the table (its flag, default and help), and every option of
+    `wmr-mj run` that sets a RunConfig field is a row."""
+    import argparse
+
+    from wmr_mj.cli.run import add_require_option, add_run_options, add_signal_options
+    from wmr_mj.cli.run_options import run_options
+
+    p = argparse.ArgumentParser()
+    add_run_options(p)
+    add_signal_options(p)
+    add_require_option(p)
+    actions = {a.option_strings[0]: a for a in p._actions if a.option_strings}
+    rows = {r.flag: r for r in run_options()}
+    for flag, row in rows.items():
+        if row.group == "command":
+            assert flag not in actions  # each command adds its own (--m1, --range)
+            continue
+        if "default" in row.settings:
+            assert actions[flag].default == row.settings["default"], flag
+        assert actions[flag].help and actions[flag].help == (row.help() if callable(row.help) else row.help)
+    assert set(actions) - {"-h"} <= set(rows)
+
+
+# --------------------------------------------------------------------------- one rule for --range
+#: (--range item, the one line every command gives): names refused by the one rule, whatever the command
+REFUSED = [
+    ("m1=600:700", "give m1's range with --m1-range LO HI, not --range m1=..."),
+    ("nope=1:2", "unknown parameter 'nope'; valid parameters: "),
+    ("mu=0.03:0.01", "--range 'mu=0.03:0.01': the range of mu is empty or inverted; LO < HI is required"),
+    ("mu=abc", "--range 'mu=abc' is not NAME=LO:HI (e.g. --range mu=0.015:0.02)"),
+    ("mu=0:inf", "--range 'mu=0:inf': LO and HI must be finite numbers"),
+]
+
+#: each command with --range, as a user types it (refused before any run)
+COMMANDS = {
+    "run": ["run", "--no-log", "--duration", "10"],
+    "sweep": ["sweep", "--n", "2", "--duration", "10"],
+    "falsify": ["falsify", "--budget", "10", "--duration", "10"],
+    "robustness": ["robustness", "--box", "derived"],
+    "robustness --certificate": ["robustness", "--certificate"],
+}
+
+
+@pytest.mark.parametrize("command", list(COMMANDS))
+@pytest.mark.parametrize(("item", "line"), REFUSED, ids=[r[0] for r in REFUSED])
+def test_every_command_refuses_the_same_range_names_with_the_same_line(command, item, line, capsys, tmp_path):
+    from wmr_mj.cli.app import main
+
+    argv = [*COMMANDS[command], "--range", item]
+    if command in ("sweep", "falsify"):
+        argv += ["--out", str(tmp_path / "out")]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(f"wmr-mj: error: {line}"), err
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("command", list(COMMANDS))
+def test_every_command_reads_a_plant_range_the_same_way(command):
+    """A plant parameter (R_a) replaces the range the --uncertainty box gives it, and adds one it has not (l3),
+    in every command, by the one parser; the kinds a command does not vary are refused by name."""
+    from wmr_mj.cli.options import RANGE_ACCEPTS, RANGE_KINDS, parse_ranges
+
+    key = command.split()[0]
+    items = ["R_a=1.0:1.4", "l3=0.14:0.15"]
+    ranges = parse_ranges(items, command=key, accepts=RANGE_ACCEPTS[key])
+    assert ranges.plant == {"R_a": (1.0, 1.4), "l3": (0.14, 0.15)}
+    from wmr_mj.errors import ParameterError
+
+    for name, kind in (("sensing.delay", "cart"), ("disturbance.amplitude", "signal"), ("path.k1", "path")):
+        if kind in RANGE_ACCEPTS[key]:
+            assert getattr(parse_ranges([f"{name}=0:1"], command=key, accepts=RANGE_ACCEPTS[key]), kind) == {
+                name: (0.0, 1.0)}
+        else:
+            with pytest.raises(ParameterError, match=f"--range {name}: {key} does not vary "
+                                                     f"{RANGE_KINDS[kind].split(' (')[0]}"):
+                parse_ranges([f"{name}=0:1"], command=key, accepts=RANGE_ACCEPTS[key])
+
+
+def test_the_box_of_a_run_has_its_range():
+    """`wmr-mj run --range` (written by falsify's reproduce line) puts the range in the run's analysis box."""
+    config, _ = _run_config(["--preset", "certified", "--uncertainty", "full", "--range", "R_a=1.0:1.4"])
+    from wmr_mj.params import uncertainty_ranges
+
+    full = {k: v for k, v in uncertainty_ranges("full").items() if k != "m1"}
+    assert dict(config.box_ranges) == {**full, "R_a": (1.0, 1.4)}
