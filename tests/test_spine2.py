@@ -218,3 +218,26 @@ def test_the_box_of_a_run_has_its_range():
 
     full = {k: v for k, v in uncertainty_ranges("full").items() if k != "m1"}
     assert dict(config.box_ranges) == {**full, "R_a": (1.0, 1.4)}
+
+
+@pytest.mark.slow
+def test_falsify_reproduce_line_runs_and_gives_the_worst_run_bits(tmp_path, capsys):
+    """End to end, with a ranged plant parameter (the old line's --range was refused by `wmr-mj run`): the
+    reproduce line runs, and its run's sup|E| and claim are the search's worst run's, to the bit."""
+    import json
+    import shlex
+
+    from wmr_mj.cli.app import main
+
+    assert main(["falsify", "--preset", "certified", "--path", "lane-change", "--duration", "3", "--uncertainty",
+                 "m1", "--range", "R_a=1.0:1.3", "--budget", "10", "--nthread", "1", "--out", str(tmp_path / "f"),
+                 "--json"]) in (0, 3)
+    found = json.loads(capsys.readouterr().out)
+    words = shlex.split(found["reproduce"])
+    assert words[:2] == ["wmr-mj", "run"] and "--range" in words, found["reproduce"]
+    assert main([*words[1:], "--no-log", "--json"]) in (0, 3)
+    run = json.loads(capsys.readouterr().out)
+    assert run["sup_E"] == found["worst"]["sup_E"] and run["sup_Edot"] == found["worst"]["sup_Edot"]
+    assert run["verdict"] == found["worst"]["verdict"]
+    assert run["certificate"]["unmet"] == found["worst"]["unmet"]
+    assert run["certificate"]["inputs"]["box_ranges"] == {"R_a": [1.0, 1.3]}  # the claim covers the searched box
