@@ -22,6 +22,8 @@ from __future__ import annotations
 
 import argparse
 
+from wmr_mj.cli.options import add_json, add_out, add_seed, add_threads
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     from wmr_mj.cli._common import CLAIM_BROKEN_EXIT
@@ -41,12 +43,12 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="only the scenarios whose id matches (shell pattern, e.g. 'circle/*'; repeatable)")
     p.add_argument("--budget", type=int, default=32,
                    help="the adversary's simulations per design, and as many random ones (default 32; 0: none)")
-    p.add_argument("--seed", type=int, default=0, help="the adversary's seed, the same for every design (default 0)")
+    add_seed(p, help="the adversary's seed, the same for every design (default 0)")
     p.add_argument("--method", default=None, help="the adversary's search method (default: falsify's)")
-    p.add_argument("--nthread", type=int, default=0, help="threads (default 0: every core)")
+    add_threads(p, help="threads (default 0: every core)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="run on a Dask cluster (e.g. tcp://127.0.0.1:8786)")
-    p.add_argument("--out", metavar="DIR", help="output folder (default logs/compare-<time>)")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_out(p, help="output folder (default logs/compare-<time>)")
+    add_json(p, help="print one JSON object")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                    help="progress bar (default: only on a terminal)")
     from wmr_mj.cli.run import add_hardware_options

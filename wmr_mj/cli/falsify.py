@@ -7,6 +7,7 @@ import json
 from typing import TYPE_CHECKING
 
 from wmr_mj.cli._common import positive_int
+from wmr_mj.cli.options import add_json, add_out, add_seed, add_threads
 
 if TYPE_CHECKING:
     from wmr_mj.sim.falsify import FalsifyReport
@@ -60,12 +61,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--population", type=int, default=None,
                    help="members per generation: CMA-ES's (default 4 + 3 ln d) or differential evolution's "
                         "(default: 10 per parameter, at most budget/8, at least 5)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the search and of the random sample (default 0)")
+    add_seed(p, help="seed of the search and of the random sample (default 0)")
     p.add_argument("--chunk", type=positive_int, default=128, help="simulations per batch (default 128)")
-    p.add_argument("--nthread", type=int, default=0, help="threads of the batch (default 0: all cores)")
+    add_threads(p, help="threads of the batch (default 0: all cores)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="run the batches on a Dask cluster (e.g. tcp://127.0.0.1:8786)")
-    p.add_argument("--out", metavar="DIR", help="output folder (default logs/falsify-<time>)")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_out(p, help="output folder (default logs/falsify-<time>)")
+    add_json(p, help="print one JSON object")
     add_signal_options(p)
     p.set_defaults(func=run)
 
@@ -85,71 +86,21 @@ def _objective(args: argparse.Namespace) -> str:
 def reproduce_command(config, params: dict[str, float], args: argparse.Namespace, *,
                       signals_file: str | None = None, path_file: str | None = None,
                       law_settings: frozenset[str] | None = None) -> str:
-    """A ``wmr-mj run`` line that repeats the worst run (parameters at full precision; its signals,
-    when it has some, from ``signals_file``, and its searched path from ``path_file``, where they
-    were written exactly)."""
-    import shlex
+    """A ``wmr-mj run`` line that repeats the worst run ``config``, written by the table of run options
+    (:func:`wmr_mj.cli.run_options.command_line`: each option writes back the field it sets, parameters at full
+    precision; its signals, when it has some, from ``signals_file``, and its searched path from ``path_file``,
+    where they were written exactly). ``params``: the worst run's searched values (already in ``config``)."""
+    from wmr_mj.cli.run_options import Replay, command_line
 
     read = law_settings  # only the settings the law reads: the resolved run's (RunParts.law_settings)
     if read is None:
         from wmr_mj.sim.config import controller_and_settings, estimate_parameters
 
         read = controller_and_settings(config, estimate_parameters())[1]
-    parts = ["wmr-mj run", *([f"--preset {args.preset}"] if args.preset else []),
-             f"--controller {shlex.quote(str(config.controller))}",
-             *(f"--{name.replace('_', '-')} {value}" for name, value in (
-                 ("model", config.model), ("kp", repr(config.kp)), ("kd", repr(config.kd)),
-                 ("friction_sign", config.friction_sign), ("friction_width", repr(config.friction_width)))
-               if name in read),
-             f"--path {shlex.quote(path_file or config.path)}", f"--duration {config.duration!r}",
-             f"--m1 {config.m1!r}"]
-    if args.identified:
-        parts.append(f"--identified {args.identified}")
-    for name, value in (config.coefficients or {}).items():
-        parts.append(f"--coef {name}={value!r}")
-    if config.control_period is not None:
-        parts.append(f"--control-period {config.control_period!r}")
-    for name, value in config.plant_overrides.items():
-        parts.append(f"--param {name}={value!r}")
-    for option in ("steering_friction", "tyre_contact"):
-        if hasattr(config, option):
-            parts.append(f"--{option.replace('_', '-')} {getattr(config, option)}")
-    if getattr(args, "require", None):
-        parts.append(f"--require {shlex.quote(args.require)}")
-    parts += [f"--m1-inertia {config.m1_inertia}", f"--box {config.box}",
-              f"--m1-range {config.m1_range[0]!r} {config.m1_range[1]!r}", f"--uncertainty {args.uncertainty}"]
-    parts += [f"--range {shlex.quote(item)}" for item in getattr(args, "range", None) or []]  # the same box
-    if getattr(config, "correction", False):
-        parts.append("--correction")
-    for kind in ("controller", "tracker"):
-        if kind == "tracker" and isinstance(config.tracker, str):
-            parts.append(f"--tracker {shlex.quote(config.tracker)}")
-        for name, value in getattr(config, f"{kind}_params").items():
-            parts.append(f"--{kind}-param {shlex.quote(f'{name}={json.dumps(value)}')}")
-    if config.signals is not None:
-        parts.append(f"--signals {shlex.quote(signals_file or json.dumps(config.signals.as_dict()))}")
-    if config.reference_bounds is not None:
-        bounds = ",".join(f"{k}={v!r}" for k, v in config.reference_bounds.as_dict().items())
-        parts.append(f"--reference-bounds {bounds}")
-    parts += _cart_options(config)
-    return " ".join(parts)
-
-
-def _cart_options(config) -> list[str]:
-    """--sensing, --actuation, --backlash of ``config``'s cart (the parts that are not ideal), every field
-    written out at full precision, so that ``wmr-mj run`` builds the same parts."""
-    import shlex
-
-    from wmr_mj.hardware.spec import spec_string
-
-    out = []
-    for option, part in (("--sensing", config.sensing), ("--actuation", config.actuation)):
-        if not part.is_ideal:
-            spec = {k: repr(v) if isinstance(v, float) else v for k, v in part.as_dict().items()}
-            out.append(f"{option} {shlex.quote(spec_string(spec))}")
-    if not config.transmission.is_ideal:
-        out.append(f"--backlash {config.transmission.backlash!r}")
-    return out
+    require = getattr(args, "require", None) or ()
+    return command_line(config, Replay(preset=args.preset, law_settings=frozenset(read), path_file=path_file,
+                                       signals_file=signals_file,
+                                       require=(require,) if isinstance(require, str) else tuple(require)))
 
 
 def _portfolio_phases_text(spec, first, population: int) -> str:
@@ -194,15 +145,13 @@ def _base_and_box(args: argparse.Namespace):
     Raises:
         ParameterError: a bad --path-knots or range (one line).
     """
-    from wmr_mj.cli._common import box_ranges_from_args, parse_range
+    from wmr_mj.cli._common import box_ranges_from_args
+    from wmr_mj.cli.options import command_ranges
     from wmr_mj.cli.run import config_from_args
     from wmr_mj.errors import ParameterError
-    from wmr_mj.sim.search_space import hardware_axis, path_axis, signal_axis
+    from wmr_mj.sim.search_space import path_axis
 
-    parsed = [(item, parse_range(item)) for item in args.range or []]
-    searched = dict(span for _, span in parsed
-                    if signal_axis(span[0]) or path_axis(span[0]) or hardware_axis(span[0]))
-    args.range = [item for item, (name, _) in parsed if name not in searched]
+    searched = command_ranges(args, "falsify").searched  # the one rule of --range; the plant's go to the box
     if args.path_knots < 0:
         raise ParameterError(f"--path-knots {args.path_knots} is not accepted: a number of knots >= 0")
     if (args.path_knots or any(path_axis(n) for n in searched)) and args.reference_bounds is None:

@@ -11,12 +11,13 @@ from __future__ import annotations
 import argparse
 
 from wmr_mj.cli._common import positive_float
+from wmr_mj.cli.options import add_out
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("figures", help="regenerate the paper's Figs. 4-7 (PNG and SVG, headless)",
                        description=__doc__.split("\n\n")[1] if __doc__ else None)
-    p.add_argument("--out", metavar="DIR", help="output folder (default logs/figures-<timestamp>/)")
+    add_out(p, help="output folder (default logs/figures-<timestamp>/)")
     p.add_argument("--duration", type=positive_float, default=35.0,
                    help="length of the paper circle run, s (default 35; >= ~10 s reaches the circle)")
     p.set_defaults(func=run)

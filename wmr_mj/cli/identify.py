@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from wmr_mj.cli._common import parse_assignments, positive_float
+from wmr_mj.cli.options import add_json, add_out, add_seed
 from wmr_mj.params import M1_NOMINAL
 
 
@@ -12,10 +13,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("identify", help="excite the plant's steering and fit P, C_V, F, K, gyro by least squares")
     p.add_argument("--m1", type=positive_float, default=M1_NOMINAL, help="chassis mass of the plant, kg (default 650)")
     p.add_argument("--duration", type=positive_float, default=60.0, help="excitation length, s (default 60)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the excitation signal (default 0)")
+    add_seed(p, help="seed of the excitation signal (default 0)")
     p.add_argument("--param", action="append", metavar="NAME=VALUE", help="override a plant parameter (repeatable)")
-    p.add_argument("--out", metavar="PATH", help="also write the result as JSON (used by --model identified)")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_out(p, metavar="PATH", help="also write the result as JSON (used by --model identified)")
+    add_json(p, help="print one JSON object")
     p.set_defaults(func=run)
 
 

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import argparse
 
+from wmr_mj.cli.options import add_json
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("model", help="write/check the MJCF files generated from the C80 parameter set")
@@ -16,7 +18,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "card: write models/README.md; image: render models/c80.png (the scene at its home "
                         "keyframe, offscreen: EGL or OSMesa)")
     p.add_argument("--param", action="append", metavar="NAME=VALUE", help="override a parameter (repeatable)")
-    p.add_argument("--json", action="store_true", help="with 'params', 'slip' or 'friction': print one JSON object")
+    add_json(p, help="with 'params', 'slip' or 'friction': print one JSON object")
     p.set_defaults(func=run)
 
 

@@ -27,6 +27,7 @@ import sys
 from typing import Any
 
 from wmr_mj.cli._common import positive_float, positive_int, print_json
+from wmr_mj.cli.options import add_json
 
 
 def register(subparsers: Any) -> None:
@@ -36,7 +37,7 @@ def register(subparsers: Any) -> None:
         description="summarise, plot, verify (bit for bit) or render a wmr-mj run log (MCAP)",
     )
     p.add_argument("log", metavar="LOG", help="MCAP run log written by `wmr-mj run`")
-    p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
+    add_json(p, help="print the summary as one JSON object")
     p.add_argument("--plot", metavar="PATH.png",
                    help="write a figure: E, E', voltage over time and the (|E|,|E'|) plane")
     p.add_argument("--verify", action="store_true",

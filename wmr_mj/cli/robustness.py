@@ -16,7 +16,8 @@ from __future__ import annotations
 import argparse
 import math
 
-from wmr_mj.cli._common import parse_assignments, parse_range, positive_float
+from wmr_mj.cli._common import parse_assignments, positive_float
+from wmr_mj.cli.options import add_json
 from wmr_mj.params import COEFFICIENT_MODELS, M1_NOMINAL, M1_RANGE, PAPER_KD, PAPER_KP
 
 
@@ -98,7 +99,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--alpha-ddot", type=_nonneg_float, default=None, help="||alpha0''|| [rad/s^2] (default 0.4)")
     p.add_argument("--alpha-dot", type=_nonneg_float, default=None, help="||alpha0'|| [rad/s] (default 0.23)")
     p.add_argument("--sin-cos3", type=_nonneg_float, default=None, help="||sin/cos^3|| (default 1.24)")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_json(p, help="print one JSON object")
     p.add_argument(
         "--certificate",
         nargs=argparse.REMAINDER,
@@ -168,19 +169,11 @@ def _box(args: argparse.Namespace):
         if used:
             raise ParameterError(f"{', '.join(used)} only apply to --box derived (got --box paper)")
         return ParameterBox.paper(), "paper (5.1)"
+    from wmr_mj.cli.options import command_ranges
     from wmr_mj.params import C80
 
-    ranges: dict[str, tuple[float, float]] = {}
-    for item in args.range or []:
-        name, span = parse_range(item)
-        if name in ranges:
-            raise ParameterError(f"--range {name} given twice; give each parameter once")
-        ranges[name] = span
-    if "m1" in ranges and args.m1_range is not None:
-        raise ParameterError("m1 given by both --m1-range and --range m1=LO:HI; give it once")
+    ranges = command_ranges(args, "robustness").plant  # m1's range is --m1-range (the one rule of --range)
     m1_range = tuple(args.m1_range) if args.m1_range is not None else M1_RANGE
-    if "m1" in ranges:
-        m1_range = ranges.pop("m1")
     model = args.model or "paper"
     box = ParameterBox.from_parameters(C80, m1_range=m1_range, ranges=ranges, model=model)
     spans = [f"m1 {m1_range[0]:g}-{m1_range[1]:g} kg"] + [f"{n} {lo:g}-{hi:g}" for n, (lo, hi) in ranges.items()]
@@ -265,30 +258,22 @@ def certificate_parser() -> argparse.ArgumentParser:
                        help="a named uncertainty box of wmr_mj.params: m1 (the paper's 550-750 kg) or full "
                        "(m1, mu, ground_friction, R_a, V_A); --m1-range and --range override its entries")
     if "--json" not in taken:
-        p.add_argument("--json", action="store_true", help="print one JSON object")
+        add_json(p, help="print one JSON object")
     return p
 
 
 def _box_ranges(args: argparse.Namespace) -> tuple[tuple[float, float], dict[str, tuple[float, float]]]:
-    """(m1_range, other ranges) from --uncertainty, --m1-range and --range."""
+    """(m1_range, other ranges) from --uncertainty, --m1-range and --range (read by the one rule of every
+    command, :func:`wmr_mj.cli.options.parse_ranges`: m1's range is --m1-range)."""
     from wmr_mj._util.checks import as_pair
-    from wmr_mj.errors import ParameterError
+    from wmr_mj.cli.options import command_ranges
     from wmr_mj.params import M1_RANGE, uncertainty_ranges
 
     ranges = uncertainty_ranges(args.uncertainty) if getattr(args, "uncertainty", None) else {}
     m1_range = ranges.pop("m1", M1_RANGE)
     if tuple(args.m1_range) != tuple(M1_RANGE):
         m1_range = tuple(args.m1_range)
-    seen: set[str] = set()
-    for item in getattr(args, "range", None) or []:
-        name, span = parse_range(item)
-        if name in seen:
-            raise ParameterError(f"--range {name} given twice; give each parameter once")
-        seen.add(name)
-        if name == "m1":
-            m1_range = span
-        else:
-            ranges[name] = span
+    ranges.update(command_ranges(args, "robustness").plant)
     return as_pair(m1_range), ranges
 
 

@@ -6,6 +6,7 @@ import argparse
 from typing import TYPE_CHECKING, Any
 
 from wmr_mj.cli._common import box_ranges_from_args, parse_assignments, positive_float, positive_int
+from wmr_mj.cli.options import add_json, add_out
 from wmr_mj.params import M1_NOMINAL
 
 if TYPE_CHECKING:
@@ -13,105 +14,25 @@ if TYPE_CHECKING:
 
 
 def add_run_options(p: argparse.ArgumentParser) -> None:
-    """Options shared by ``run`` and ``sweep`` (the closed-loop configuration)."""
-    from controllers.computed_torque import FRICTION_SIGNS, MODEL_SOURCES
-    from controllers.registry import controller_names, tracker_names
-    from wmr_mj.params import M1_RANGE
-    from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS, TYRE_CONTACT_MODELS
-    from wmr_mj.sim.config import PATH_NAMES
-    from wmr_mj.sim.designs import PRESET_NAMES
+    """Options shared by ``run``, ``sweep``, ``falsify`` and ``robustness --certificate`` (the closed-loop
+    configuration): the 'run' rows of the table of run options (:func:`wmr_mj.cli.run_options.run_options`,
+    which also writes a config back as its ``wmr-mj run`` line), then the cart's (:func:`add_hardware_options`)."""
+    from wmr_mj.cli.run_options import add_options
 
-    p.add_argument("--preset", default=None,
-                   help=f"controller design: one of {', '.join(PRESET_NAMES)} (default paper: paper model, K_P = 6, "
-                        "K_D = 9, exact sign; certified: see wmr_mj/sim/designs.py); explicit options override it. "
-                        "With --controller and no --preset, the law's estimate is its own default model (as "
-                        "RunConfig(controller=NAME) and wmr-mj compare NAME: non-holonomic for sliding-mode)")
-    p.add_argument("--controller", default=None, metavar="NAME|FILE.py:Class|module:Class",
-                   help=f"the steering law: one of {', '.join(controller_names())}, a class in a file of your own "
-                        "(FILE.py:Class), or of an importable module (module:Class) (default: the preset's; see "
-                        "controllers/base.py)")
-    p.add_argument("--controller-param", action="append", metavar="NAME=VALUE", default=None,
-                   help="a parameter of a --controller given by name or file (repeatable; VALUE read as JSON where "
-                        "it parses, e.g. lam=5, else as text)")
-    p.add_argument("--tracker", default=None, metavar="NAME|FILE.py:Class|module:Class",
-                   help=f"a path tracker, the outer loop on C that writes alpha0: one of {', '.join(tracker_names())}, "
-                        "FILE.py:Class or module:Class (default: none, the path's own alpha0; see "
-                        "controllers/tracking.py)")
-    p.add_argument("--tracker-param", action="append", metavar="NAME=VALUE", default=None,
-                   help="a parameter of the --tracker (repeatable)")
-    p.add_argument("--model", default=None,
-                   help=f"model source of the estimate: one of {', '.join(MODEL_SOURCES)} (default: the preset's)")
-    p.add_argument("--identified", metavar="PATH",
-                   help="JSON from `wmr-mj identify --out` for --model identified "
-                        "(default: identify the nominal plant now)")
-    p.add_argument("--coef", action="append", metavar="NAME=VALUE",
-                   help="coefficient for --model explicit (P, C_V, F, K, gyro)")
-    p.add_argument("--duration", type=positive_float, default=35.0, help="simulated time, s (default 35)")
-    p.add_argument("--control-period", type=positive_float, default=None,
-                   help="controller period, s, a multiple of the 1 ms physics step (default: every step)")
-    p.add_argument("--kp", type=positive_float, default=None, help="K_P, 1/s^2 (default: the preset's)")
-    p.add_argument("--kd", type=positive_float, default=None, help="K_D, 1/s (default: the preset's)")
-    p.add_argument("--omega-r", type=positive_float, default=None,
-                   help="gains by (3.6): K_P = omega_r^2/4, K_D = omega_r")
-    p.add_argument("--friction-sign", default=None,
-                   help=f"Coulomb compensation sign: one of {', '.join(FRICTION_SIGNS)} (default: the preset's)")
-    p.add_argument("--friction-width", type=float, default=None,
-                   help="smoothing of that sign, rad/s: x/sqrt(x^2+w^2) (0: exact sign; default: the preset's)")
-    p.add_argument("--path", default="paper-circle", metavar="NAME|FILE",
-                   help=f"reference path of point C: one of {', '.join(PATH_NAMES)}, a packaged route "
-                        "(agv-loop), or a route file (.toml/.json: segments or waypoints; see "
-                        "wmr_mj/reference/route.py)")
-    p.add_argument("--param", action="append", metavar="NAME=VALUE", help="override a plant parameter (repeatable)")
-    p.add_argument("--steering-friction", default="stiction",
-                   help=f"plant's steering friction law: one of {', '.join(STEERING_FRICTION_MODELS)} (default "
-                        "stiction: holds below break-away; soft: MuJoCo's default frictionloss, creeps at mrad/s)")
-    p.add_argument("--tyre-contact", default="stiff",
-                   help=f"plant's tyre-floor contacts: one of {', '.join(TYRE_CONTACT_MODELS)} (default stiff; "
-                        "soft: MuJoCo's default solref, see models/README.md)")
-    p.add_argument("--m1-inertia", default="payload", choices=("payload", "scale"),
-                   help="m1 changes as a compact payload at the CoM (default) or scales the chassis inertia")
-    p.add_argument("--box", default="derived", help="parameter box of the analysis: derived (from the parameter set "
-                                                     "over --m1-range) or paper (5.1)")
-    p.add_argument("--m1-range", nargs=2, type=positive_float, metavar=("LO", "HI"), default=M1_RANGE,
-                   help="m1 range of the analysis box, kg (default 550 750)")
-    p.add_argument("--reference-bounds", metavar="paper|KEY=VALUE,...", default=None,
-                   help="declared bounds on the reference alpha0: 'paper' ((5.1): alpha0' 0.23 rad/s, alpha0'' 0.4 "
-                        "rad/s^2, sin/cos^3 1.24) or alpha_dot_max=..,alpha_ddot_max=..,alpha_max=.. (others: the "
-                        "paper's). The certificate then covers every reference within them, and the run's own "
-                        "reference is checked against them (default: the certificate is for this path alone)")
-    p.add_argument("--correction", action="store_true",
-                   help="Cartesian correction: an outer loop at C (Stanley-like, from C's cross-track and heading "
-                        "errors) corrects alpha0 within declared rate and acceleration limits, which the "
-                        "certificate then assumes (controllers/tracking.py)")
-    from wmr_mj.params import UNCERTAINTY_NAMES
-
-    p.add_argument("--uncertainty", default=None,
-                   help=f"uncertainty box: one of {', '.join(UNCERTAINTY_NAMES)} (m1: the paper's 550-750 kg, "
-                        "the default of run and sweep; full: also steering and tyre friction, R_a and V_A, the "
-                        "default of falsify; sources in wmr_mj/params.py). A run draws nothing: the box is what "
-                        "its analysis covers; m1's range is --m1-range")
+    add_options(p, "run")
     add_hardware_options(p)
 
 
 def add_hardware_options(p: argparse.ArgumentParser) -> None:
     """--sensing, --actuation, --backlash: the cart as it is built (wmr_mj.hardware), RunConfig's sensing,
     actuation and transmission (``run``, ``sweep``, ``falsify``, ``robustness --certificate``, ``compare``,
-    ``validate``). Each is parsed by its part: bad values raise one line (exit status 2)."""
-    from wmr_mj.hardware import SENSING_SPEC_KEYS, sensing_preset_names
+    ``validate``): the 'cart' rows of the table of run options. Each is parsed by its part: bad values raise
+    one line (exit status 2)."""
+    from wmr_mj.cli.run_options import add_options
 
     g = p.add_argument_group("the cart as it is built (wmr_mj/hardware; default ideal: the exact alpha and alpha', "
                              "no delay, no inductance, no play); shown in every summary and JSON where not ideal")
-    g.add_argument("--sensing", metavar="KEY=VALUE,...|PRESET|FILE", default=None,
-                   help="the steering sensor between the plant and the law: a preset "
-                        f"({', '.join(sensing_preset_names())}), KEY=VALUE pairs ({', '.join(SENSING_SPEC_KEYS)}, "
-                        "preset; e.g. encoder_ticks=4096,velocity=difference,delay=0.005,noise=uniform:0.0005,seed=3; "
-                        "the delay a whole number of "
-                        "control periods) or a .json/.toml file of the same")
-    g.add_argument("--actuation", metavar="KEY=VALUE,...|FILE", default=None,
-                   help="the motor's actuation: delay (s, whole 1 ms physics steps), inductance (H), current_limit "
-                        "(A), e.g. delay=0.002,inductance=0.0005,current_limit=20, or a .json/.toml file")
-    g.add_argument("--backlash", metavar="RAD", default=None,
-                   help="the gear's play: half-width b >= 0, rad at the steering axis (e.g. 0.002)")
+    add_options(g, "cart")
 
 
 def hardware_from_args(args: argparse.Namespace) -> dict[str, Any]:
@@ -173,41 +94,35 @@ def register(sub: argparse._SubParsersAction) -> None:
                     "engine evaluates the Python law, with the same numbers, and says so on stderr.")
     add_run_options(p)
     p.add_argument("--m1", type=positive_float, default=M1_NOMINAL, help="plant chassis mass, kg (default 650)")
-    p.add_argument("--out", metavar="PATH", help="MCAP log path (default logs/run-<time>-<model>-m<m1>.mcap)")
+    p.add_argument("--range", action="append", metavar="NAME=LO:HI",
+                   help="another ranged plant parameter of the analysis box (repeatable; it adds the parameter to "
+                        "the --uncertainty box or replaces its range, e.g. R_a=1.0:1.3); a run draws nothing")
+    add_out(p, metavar="PATH", help="MCAP log path (default logs/run-<time>-<model>-m<m1>.mcap)")
     p.add_argument("--no-log", action="store_true", help="do not write an MCAP log")
     p.add_argument("--log-every", type=positive_int, default=1, help="log signals every k-th control step (default 1)")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                    help="progress bar (default: only on a terminal)")
     add_require_option(p)
-    p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_json(p)
     add_signal_options(p)
     p.set_defaults(func=run)
 
 
 def add_signal_options(p: argparse.ArgumentParser) -> None:
-    """--signals, --disturbance, --load, --d-max (``run``, ``sweep``, ``falsify``; see signals_from_args)."""
+    """--signals, --disturbance, --load, --d-max (``run``, ``sweep``, ``falsify``; see signals_from_args): the
+    'signals' rows of the table of run options."""
+    from wmr_mj.cli.run_options import add_options
+
     g = p.add_argument_group("signals on the plant during the run (wmr_mj/sim/signals.py); reported under "
                              "'signals' in --json, which --signals takes back to reproduce the run to the bit")
-    g.add_argument("--signals", metavar="FILE|JSON",
-                   help="a .json file or JSON text: {\"disturbance\": {...}, \"d_max\": N m, \"loads\": [...]}")
-    g.add_argument("--disturbance", metavar="KEY=VALUE,...",
-                   help="torque on the steering joint, N m: kind=constant|step|pulse|noise,amplitude=A "
-                        "[,t1=S][,t2=S][,bandwidth=HZ,seed=N for noise], e.g. kind=step,amplitude=1,t1=5")
-    g.add_argument("--load", action="append", metavar="KEY=VALUE,...",
-                   help="chassis mass change (repeatable, in time order): t=S,m1=KG (a step) or "
-                        "kind=ramp,t1=S,t2=S,m1=KG[,every=S]")
-    g.add_argument("--d-max", type=float, default=None, metavar="NM",
-                   help="disturbance bound the certificate declares, N m (default: the disturbance's amplitude)")
+    add_options(g, "signals")
 
 
 def add_require_option(p: argparse.ArgumentParser) -> None:
-    from wmr_mj.analysis.requirements import PRESETS, SIGNALS
+    """--require STL (repeatable; ``run``, ``sweep``): the 'require' row of the table of run options."""
+    from wmr_mj.cli.run_options import add_options
 
-    p.add_argument("--require", action="append", metavar="STL",
-                   help="a requirement in Signal Temporal Logic, monitored by rtamt on the run's signals "
-                        f"({', '.join(SIGNALS)}; time bounds in s), e.g. 'always[8,35](abs(E) <= 0.05)', or a "
-                        f"preset: {', '.join(PRESETS)} (the certificate's or the paper's |E|, |E'| bounds for the "
-                        "whole run); repeatable. Its robustness (> 0: held with that margin) is reported")
+    add_options(p, "require")
 
 
 def requirements_from_args(args: argparse.Namespace, period: float) -> list:

@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from wmr_mj.cli._common import CLAIM_BROKEN_EXIT, positive_int
+from wmr_mj.cli.options import add_json, add_out, add_seed, add_threads
 
 if TYPE_CHECKING:
     from wmr_mj.sim.sweep import SweepSummary
@@ -22,7 +23,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                               "law's claim (a banner names the run; summary.json's claim_broken); 2 bad input")
     add_run_options(p)
     p.add_argument("--n", type=int, default=200, help="number of runs (default 200)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the draw (default 0)")
+    add_seed(p, help="seed of the draw (default 0)")
     p.add_argument("--sampling", default="lhs", help="uniform, lhs (Latin hypercube, default) or grid")
     p.add_argument("--range", action="append", metavar="NAME=LO:HI",
                    help="draw another plant parameter over a range too (repeatable); the box includes it. Or a "
@@ -32,13 +33,13 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "ticks), sensing.noise, sensing.velocity_noise, sensing.filter_tau, "
                         "actuation.delay (whole 1 ms steps), actuation.inductance, actuation.current_limit, "
                         "transmission.backlash; runs.csv records the value each run used")
-    p.add_argument("--out", metavar="DIR", help="output folder (default logs/sweep-<time>); rerun to resume")
+    add_out(p, help="output folder (default logs/sweep-<time>); rerun to resume")
     p.add_argument("--chunk", type=positive_int, default=128, help="simulations per batch (default 128)")
-    p.add_argument("--nthread", type=int, default=0, help="threads of the batch (default 0: all cores)")
+    add_threads(p, help="threads of the batch (default 0: all cores)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="run the chunks on a Dask cluster (e.g. tcp://127.0.0.1:8786)")
     p.add_argument("--log", action="store_true",
                    help="also write an MCAP log per run (re-run one by one; bit-identical)")
-    p.add_argument("--json", action="store_true", help="print one summary JSON object")
+    add_json(p, help="print one summary JSON object")
     add_require_option(p)
     add_signal_options(p)
     p.set_defaults(func=run)

@@ -21,6 +21,7 @@ from __future__ import annotations
 import argparse
 
 from wmr_mj.cli._common import int_at_least, positive_float, positive_int
+from wmr_mj.cli.options import add_json, add_out, add_seed, add_threads
 
 _nonneg_int = int_at_least(0)
 
@@ -34,8 +35,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                        description=__doc__.split("\n\n")[1] if __doc__ else None)
     p.add_argument("--n", type=positive_int, default=DEFAULT_N,
                    help=f"runs per rung of the ladder (default {DEFAULT_N}; --n 100 for the full counts)")
-    p.add_argument("--seed", type=_nonneg_int, default=0,
-                   help="seed of the m1 samples, the searches and the identification (default 0)")
+    add_seed(p, help="seed of the m1 samples, the searches and the identification (default 0)")
     p.add_argument("--sampling", choices=SAMPLINGS, default="lhs", help="sampling of m1 (default lhs)")
     p.add_argument("--duration", type=positive_float, default=DEFAULT_DURATION,
                    help=f"simulated time per run, s (default {DEFAULT_DURATION:g}; >= ~10 s reaches the circle)")
@@ -54,10 +54,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="a design of your own, judged beside the ladder (its rung and its nominal run): a preset, "
                         "a law's name, FILE.py:Class or module:Class, with ,key=value settings as for wmr-mj "
                         "compare, e.g. 'sliding-mode' or 'my_law.py:MyLaw,k=2' (repeatable)")
-    p.add_argument("--nthread", type=_nonneg_int, default=0, help="simulation threads (default 0: all CPUs)")
-    p.add_argument("--out", metavar="DIR",
-                   help="report folder (default logs/validate-<timestamp>/; an existing folder resumes its sweeps)")
-    p.add_argument("--json", action="store_true", help="print the summary object (summary.json) on stdout")
+    add_threads(p, help="simulation threads (default 0: all CPUs)")
+    add_out(p, help="report folder (default logs/validate-<timestamp>/; an existing folder resumes its sweeps)")
+    add_json(p, help="print the summary object (summary.json) on stdout")
     from wmr_mj.cli.run import add_hardware_options
 
     add_hardware_options(p)  # the cart of every run of the report (summary.json's settings record it)

@@ -37,6 +37,7 @@ from controllers.tracking import within_declared
 from wmr_mj._util.memory import require_run_memory
 from wmr_mj._util.progress import progress_bar
 from wmr_mj.analysis.claim import with_measured
+from wmr_mj.analysis.claim_types import LAW_CLAIM, CertificateJudgement, judge
 from wmr_mj.analysis.path_bound import PathBound, PathVerdict
 from wmr_mj.analysis.path_error import PathErrors, PathErrorSeries
 from wmr_mj.analysis.verdicts import Drift
@@ -82,6 +83,9 @@ class RunResult:
     # (control steps, C's cross-track [m] there) of the path verdict's samples (path_sample_index), where all
     # are finite: what requirement_rows interpolates between
     path_samples: tuple[np.ndarray, np.ndarray] | None = None
+    # every claim of the run (RunParts.claims), with what the run measured of it, judged against its sup|E|,
+    # sup|E'|, by name; the law's (LAW_CLAIM) is summary.certificate. Empty where the law failed.
+    claims: Mapping[str, CertificateJudgement] = dataclasses.field(default_factory=dict)
 
 
 def requirement_rows(result: RunResult, requirements: Sequence[Any], *, base: C80Parameters = C80
@@ -356,7 +360,7 @@ def run_parts(parts: RunParts, *, logger_factory: Callable[..., Any] | None = No
     """:func:`run_closed_loop` of a config already resolved (:func:`wmr_mj.sim.parts.resolve_run`)."""
     config, params, controller, outer = parts.config, parts.plant, parts.controller, parts.tracker
     dt, substeps, period, n = TIMESTEP, parts.substeps, parts.period, parts.n
-    reference, settle_s, analysis, certificate = parts.reference, parts.settle_s, parts.analysis, parts.claim
+    reference, settle_s, analysis = parts.reference, parts.settle_s, parts.analysis
     a0_all, a0d_all, a0dd_all = reference.alpha0, reference.alpha0_dot, reference.alpha0_ddot
     if len(a0_all) < n:
         raise ParameterError(f"reference shorter than the run: {len(a0_all)} < {n} samples")
@@ -374,7 +378,7 @@ def run_parts(parts: RunParts, *, logger_factory: Callable[..., Any] | None = No
         logger = logger_factory(LogHeader(
             mjcf_xml=scene_xml(params, **options), config=config.as_dict(), parameters=params.as_dict(),
             initial_state=state, timestep=dt, control_substeps=substeps, model=m,
-            bounds=({"E_max": certificate.E_max, "Edot_max": certificate.Edot_max} if certificate is not None
+            bounds=({"E_max": parts.claim.E_max, "Edot_max": parts.claim.Edot_max} if parts.claim is not None
                     else {"E_max": math.inf, "Edot_max": math.inf}),
             reference_path=np.asarray(reference.C_xy)[::max(1, len(reference.C_xy) // 2000)],
             path_errors=_PathRows(reference, period), sensed=not parts.sensing.is_ideal))
@@ -397,13 +401,8 @@ def run_parts(parts: RunParts, *, logger_factory: Callable[..., Any] | None = No
                 logger.close({"status": "failed", "failure": run.failure}, status="failed")
             raise ControllerFailure(run.failure)  # nothing simulated: nothing to judge
         raise KeyboardInterrupt  # nothing simulated: nothing to report
-    if outer is not None and certificate is not None:
-        # the tracker's declared bounds, measured on the reference the law received
-        certificate = with_measured(certificate, within_declared(done, outer.declared_bounds(parts.reference_bounds),
-                                                                 tracker=outer.name))
-    # the sensing's error bounds the claim assumed, measured on what the law read
-    certificate = with_measured_errors(certificate, sensing=parts.sensing, measurement=parts.measurement, rows=done,
-                                       period=period)
+    claims = _measured_claims(parts, done)
+    certificate = claims.get(LAW_CLAIM)  # the run's verdict is the law's claim's
     after = done["t"] >= settle_s
     at = path_sample_index(k, period)
     saturated = int(np.count_nonzero(done["voltage"] != done["voltage_cmd"]))  # NaN included: 0 V applied
@@ -435,8 +434,25 @@ def run_parts(parts: RunParts, *, logger_factory: Callable[..., Any] | None = No
     path_samples = None
     if path is not None and path.series is not None and path.series.t.size == at.size:  # every sample finite
         path_samples = (at, path.series.cross_track)
+    judged = {} if run.failure is not None else {
+        name: summary.certificate if name == LAW_CLAIM and summary.certificate is not None
+        else judge(cert, summary.sup_E, summary.sup_Edot) for name, cert in claims.items()}
     return RunResult(config=config, rows=done, summary=summary, status=status, law=run.law, law_note=run.law_note,
-                     C_xy=run.C_xy, cpu_s=run.cpu_s, reference=reference, path_samples=path_samples)
+                     C_xy=run.C_xy, cpu_s=run.cpu_s, reference=reference, path_samples=path_samples, claims=judged)
+
+
+def _measured_claims(parts: RunParts, rows: Mapping[str, np.ndarray]) -> dict[str, Any]:
+    """Each of the run's claims (``parts.claims``, by name) with what the run measured of its assumptions: the
+    tracker's declared bounds on the reference the law received, and the sensing's error bounds on what the
+    law read (:func:`with_measured_errors`)."""
+    out = {}
+    for name, cert in parts.claims.items():
+        if parts.tracker is not None:
+            cert = with_measured(cert, within_declared(rows, parts.tracker.declared_bounds(parts.reference_bounds),
+                                                       tracker=parts.tracker.name))
+        out[name] = with_measured_errors(cert, sensing=parts.sensing, measurement=parts.measurement, rows=rows,
+                                         period=parts.period)
+    return out
 
 
 def run_on_reduced_model(

@@ -11,6 +11,7 @@ Usage::
     from wmr_mj.sim.parts import resolve_run
     parts = resolve_run(RunConfig(controller="sliding-mode", model="nonholonomic"))
     parts.controller.name, parts.claim.E_max, parts.n, parts.period
+    parts.claims[LAW_CLAIM]      # the same claim, by name: a further analysis is one more entry
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ import numpy as np
 
 from controllers import PathTracker, SteeringController
 from wmr_mj.analysis.certificate import Certificate
+from wmr_mj.analysis.claim_types import LAW_CLAIM, Claims, claim_set
 from wmr_mj.analysis.measurement import MeasurementErrors
 from wmr_mj.errors import ParameterError
 from wmr_mj.hardware import Actuation, Sensing, Transmission
@@ -75,7 +77,10 @@ class RunParts:
         substeps: physics steps per control step; period: the control period [s]; n: control steps.
         options: the plant's laws (steering friction, tyre contact).
         analysis: the paper's analysis for the run's box, gains and reference bounds.
-        claim: the law's own claim (a Certificate), None where it states none.
+        claims: the claims the run is judged by, by name (:class:`~wmr_mj.analysis.claim_types.Claims`): the
+            law's own under :data:`~wmr_mj.analysis.claim_types.LAW_CLAIM` (absent where it states none); a
+            further analysis is one more entry, measured and judged by ``run_parts`` as the law's is. The
+            run's verdict is the law's claim's (:attr:`claim`).
         paper_law: the law is the paper's family (computed torque, PD): the paper's region applies to it.
         law_settings: the RunConfig settings the law reads (``controller_and_settings``: model, kp, kd, ...).
         sensing, actuation, transmission: the cart as it is built (:mod:`wmr_mj.hardware`; ideal by default).
@@ -103,7 +108,7 @@ class RunParts:
     n: int
     options: dict[str, Any]
     analysis: Any
-    claim: Certificate | None
+    claims: Claims
     paper_law: bool = True
     law_settings: frozenset[str] | None = None
     sensing: Sensing = Sensing()
@@ -115,6 +120,12 @@ class RunParts:
     loads: tuple[tuple[int, Any], ...] = ()
     route_length_m: float | None = None
     measurement: MeasurementErrors = MeasurementErrors.exact()
+
+    @property
+    def claim(self) -> Certificate | None:
+        """The law's own claim (``claims[LAW_CLAIM]``), None where it states none: the run's verdict is
+        judged against it."""
+        return self.claims.get(LAW_CLAIM)
 
 
 def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
@@ -137,7 +148,7 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
     reference, settle_s = build_reference(config.path, estimate, dt=period, duration=n * period)
     paper_estimate = estimate_of(controller)  # None: not the paper's law, whose region then says nothing of it
     analysis = analysis_for(config, reference, estimate, estimate=paper_estimate)
-    claim = certificate_of(config, reference, base=base, estimate=estimate, plant=plant,
+    law_claim = certificate_of(config, reference, base=base, estimate=estimate, plant=plant,
                            controller=controller, tracker=tracker)
     options = plant_options(config)
     disturbance, loads = signal_inputs(config.signals, plant, options, n=n, period=period,
@@ -145,10 +156,11 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
     return RunParts(config=config, base=base, plant=plant, estimate=estimate, controller=controller,
                     controller_name=controller_name(config), tracker=tracker, reference=reference,
                     settle_s=settle_s, substeps=substeps, period=period, n=n, options=options,
-                    analysis=analysis, claim=claim, paper_law=paper_estimate is not None,
-                    law_settings=law_settings, sensing=config.sensing, actuation=config.actuation,
-                    transmission=config.transmission, reference_bounds=reference_bounds_of(config, reference),
-                    signals=config.signals, disturbance=disturbance, loads=loads,
+                    analysis=analysis, claims=claim_set(**{LAW_CLAIM: law_claim}),
+                    paper_law=paper_estimate is not None, law_settings=law_settings, sensing=config.sensing,
+                    actuation=config.actuation, transmission=config.transmission,
+                    reference_bounds=reference_bounds_of(config, reference), signals=config.signals,
+                    disturbance=disturbance, loads=loads,
                     route_length_m=route_length(config.path), measurement=measurement_errors_of(config, plant))
 
 
