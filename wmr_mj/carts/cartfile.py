@@ -2,9 +2,10 @@
 
 The C80 is ``c80.toml`` beside this module (shipped with the package); :mod:`wmr_mj.params` builds the C80
 parameter set from it. A file is checked against ``cart.schema.json`` (:mod:`wmr_mj.carts.schema`), then
-against the rules a schema cannot say: l3 below the wheelbase l1, each range's lo below its hi, the newest
-changelog line beginning with the version. Every failure is one line naming the file, the key, the value,
-its unit and what is accepted (:class:`wmr_mj.errors.ParameterError`; the CLI exits with status 2).
+against the rules a schema cannot say: l3 below the wheelbase l1, k_b equal to k_i (one flux in SI units, and
+MuJoCo's dcmotor has one motor constant: it would silently use their geometric mean), each range's lo below
+its hi, the newest changelog line beginning with the version. Every failure is one line naming the file, the
+key, the value, its unit and what is accepted (:class:`wmr_mj.errors.ParameterError`; the CLI exits with 2).
 
 The file's layout (``c80.toml`` is the example to copy)::
 
@@ -52,6 +53,8 @@ CARTS_DIR = Path(__file__).resolve().parent
 #: The sections holding the parameters, in the file's order (the schema's 'required' keys minus the others).
 PARAMETER_SECTIONS: tuple[str, ...] = tuple(
     key for key in load_schema()["required"] if key not in ("name", "version", "changelog", "uncertainty", "defaults"))
+#: How far k_b may differ from k_i, relative: a rounding, not a second constant (see _check_rules).
+MOTOR_CONSTANT_RTOL = 1e-9
 #: The keys of the [defaults] section: the default sensing, actuation and play of a run on the cart.
 DEFAULT_KEYS: tuple[str, ...] = tuple(load_schema()["properties"]["defaults"]["required"])
 
@@ -128,6 +131,11 @@ def _check_rules(document: Mapping[str, Any]) -> None:
     if not l3 < l1:
         raise ParameterError(f"chassis.l3.value = {l3!r} m is not accepted; accepted: a number below the wheelbase "
                              f"chassis.l1.value = {l1!r} m (the centre of mass lies between the axles)")
+    k_i, k_b = document["motor"]["k_i"]["value"], document["motor"]["k_b"]["value"]
+    if abs(k_b - k_i) > MOTOR_CONSTANT_RTOL * abs(k_i):
+        raise ParameterError(f"motor.k_b.value = {k_b!r} V s/rad is not accepted; accepted: equal to motor.k_i.value = "
+                             f"{k_i!r} N m/A (in SI units the back-EMF and torque constants are one flux; MuJoCo's "
+                             "dcmotor has one constant and would use their geometric mean)")
     for box, ranges in document["uncertainty"].items():
         for name, entry in ranges.items():
             lo, hi = entry["range"]

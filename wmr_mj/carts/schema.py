@@ -27,7 +27,7 @@ from typing import Any
 
 from wmr_mj.errors import ParameterError
 
-__all__ = ["SCHEMA_PATH", "SUPPORTED_KEYWORDS", "load_schema", "check_against_schema", "resolve"]
+__all__ = ["SCHEMA_PATH", "SUPPORTED_KEYWORDS", "load_schema", "check_against_schema", "resolve", "schema_table"]
 
 #: The cart file's JSON Schema (draft 2020-12), shipped beside the carts.
 SCHEMA_PATH = Path(__file__).resolve().parent / "cart.schema.json"
@@ -119,9 +119,10 @@ def _check_object(value: dict, schema: Mapping[str, Any], root: Mapping[str, Any
                                      f"{_section(path)}: " + ", ".join(properties))
     unit_schema = properties.get("unit", {})
     unit = unit_schema.get("const", "") if isinstance(unit_schema, Mapping) else ""
-    for key, item in value.items():
+    # the unit first: a value written in degrees is refused for its unit, not shown as radians
+    for key in sorted(value, key=lambda k: k != "unit"):
         if key in properties:
-            check_against_schema(item, properties[key], root=root, path=(*path, key), unit=unit)
+            check_against_schema(value[key], properties[key], root=root, path=(*path, key), unit=unit)
 
 
 def _check_array(value: list, schema: Mapping[str, Any], root: Mapping[str, Any],
@@ -170,7 +171,8 @@ def check_against_schema(value: Any, schema: Mapping[str, Any], *, root: Mapping
 
     Raises:
         ParameterError: the first violation, in one line naming the key, the value, its unit and what is
-            accepted. Keys are checked in the file's order; a missing key before an unknown one.
+            accepted. Keys are checked in the file's order (a table's unit before its value); a missing key
+            before an unknown one.
     """
     root = schema if root is None else root
     schema = resolve(schema, root)
@@ -181,3 +183,36 @@ def check_against_schema(value: Any, schema: Mapping[str, Any], *, root: Mapping
         _check_array(value, schema, root, path, unit)
     else:
         _check_scalar(value, schema, path, unit)
+
+
+def _accepted_value(value_schema: Mapping[str, Any]) -> str:
+    if value_schema.get("type") == "number":
+        return _accepted_number(value_schema, "")
+    return "a non-empty string" if value_schema.get("minLength") else "a string"
+
+
+def schema_table(schema: Mapping[str, Any] | None = None) -> str:
+    """The cart file's keys as a Markdown table (key, unit, accepted, what), rendered from the schema: the
+    documentation's table (``docs/reference/cart.md``), kept equal to a fresh rendering by a test."""
+    root = load_schema() if schema is None else schema
+    rows = ["| key | unit | accepted | what |", "|---|---|---|---|"]
+    for key in ("name", "version", "changelog"):
+        entry = root["properties"][key]
+        accepted = f"a string matching `{entry['pattern']}`" if "pattern" in entry else (
+            "an array of strings, at least one" if entry["type"] == "array" else "a non-empty string")
+        rows.append(f"| `{key}` | | {accepted} | {entry['description']} |")
+    for section, section_schema in root["properties"].items():
+        if section in ("name", "version", "changelog"):
+            continue
+        for name, sub in section_schema["properties"].items():
+            entry = resolve(sub, root)
+            props = entry.get("properties", {})
+            unit = props.get("unit", {}).get("const", "")
+            if "value" in props:
+                accepted = _accepted_value(props["value"])
+            else:  # an uncertainty box: parameter -> range
+                required = ", ".join(entry.get("required", ()))
+                accepted = (f"a table of `NAME = {{range = [lo, hi], unit, source}}`, lo < hi, each bound accepted as "
+                            f"NAME's value; requires {required}")
+            rows.append(f"| `{section}.{name}` | {unit} | {accepted} | {entry.get('description', '')} |")
+    return "\n".join(rows) + "\n"
