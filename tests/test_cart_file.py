@@ -325,16 +325,17 @@ def test_scaled_cart_coefficients_follow_the_closed_form_scaling(tmp_path):
 
 
 # -- cart check ---------------------------------------------------------------------------------------------
-@pytest.mark.slow
-def test_cart_check_passes_on_the_c80(capsys):
-    assert main(["cart", "check", "c80"]) == 0
+# about 1 s each on the 2-core machine (1 s stepped, 20 s identified): not 'slow'
+@pytest.mark.parametrize("name", cart_names())
+def test_every_shipped_cart_passes_cart_check(name, capsys):
+    cart = load_cart(name)
+    assert main(["cart", "check", name]) == 0
     out = capsys.readouterr().out.splitlines()
-    assert out[0].startswith(f"cart C80 1.0.0 ({CARTS_DIR / 'c80.toml'}): passes: ")
+    assert out[0].startswith(f"cart {cart.name} {cart.version} ({CARTS_DIR / f'{name}.toml'}): passes: ")
     assert "no MuJoCo warning" in out[0]
     assert out[2].startswith("steps: 1000 steps (1 s)") and "0 MuJoCo warnings" in out[2]
 
 
-@pytest.mark.slow
 def test_cart_check_passes_on_a_scaled_cart_json(tmp_path, capsys):
     """The identification follows the file, not the C80: the scaled cart's implied P is 2.5 times the C80's."""
     path = _write(tmp_path, _scaled_document())
@@ -348,7 +349,6 @@ def test_cart_check_passes_on_a_scaled_cart_json(tmp_path, capsys):
         assert abs(row["identified"] - row["implied"]) <= row["allowed"], name
 
 
-@pytest.mark.slow
 def test_cart_check_fails_where_mujoco_warns(tmp_path, capsys):
     """A 1 GV supply on a 1 uOhm armature: the random voltages make the steering's acceleration blow up."""
     document = _c80_document()
