@@ -88,6 +88,9 @@ def _section(path: tuple[str | int, ...]) -> str:
 
 def _check_type(value: Any, schema: Mapping[str, Any], path: tuple[str | int, ...], unit: str) -> None:
     kind = schema.get("type")
+    if kind is not None and kind not in _TYPE_WORDS:
+        raise ParameterError(f"cart schema: type {kind!r} at {_where(path)} is not supported; supported: "
+                             + ", ".join(_TYPE_WORDS))
     ok = {
         None: True,
         "object": isinstance(value, dict),

@@ -8,7 +8,15 @@ from __future__ import annotations
 
 import mujoco
 
-from wmr_mj.params import C80, COEFFICIENT_NAMES, M1_RANGE, PARAMETER_SOURCES, C80Parameters, with_params
+from wmr_mj.params import (
+    C80,
+    C80_CART,
+    COEFFICIENT_NAMES,
+    M1_RANGE,
+    PARAMETER_SOURCES,
+    C80Parameters,
+    with_params,
+)
 from wmr_mj.plant.friction import (
     HOLD_RATE,
     FrictionLaw,
@@ -28,13 +36,8 @@ from wmr_mj.plant.mjcf import (
 
 __all__ = ["render_model_card"]
 
-_UNITS = {
-    "V_A": "m/s", "g": "m/s^2", "m1": "kg", "chassis_length": "m", "chassis_width": "m", "chassis_height": "m",
-    "chassis_inertia_mass": "kg", "l1": "m", "l2": "m", "l3": "m", "l4": "m", "rear_axle_mass": "kg",
-    "rear_wheel_mass": "kg", "r2": "m", "rear_wheel_width": "m", "i1": "-", "front_axle_mass": "kg",
-    "front_wheel_mass": "kg", "r3": "m", "front_wheel_width": "m", "R_a": "Ohm", "k_i": "N m/A", "k_b": "V s/rad",
-    "i2": "-", "voltage_limit": "V", "steering_range": "rad", "mu": "-", "f2": "m", "f3": "m", "ground_friction": "-",
-}
+#: Each parameter's unit, as its cart file states it.
+_UNITS = C80_CART.units
 _PAPER_INTERVALS = {"P": (0.37, 0.4), "C_V": (4.73, 4.81), "F": (1.5, 1.53), "K": (5.29, 5.38)}
 
 
