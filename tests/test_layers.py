@@ -6,7 +6,8 @@ with ``ast`` and walks all ``import`` and ``from ... import`` nodes. The layers,
 ====  ==========================================  =====================================================
 rank  modules                                     what
 ====  ==========================================  =====================================================
-0     wmr_mj.errors, params, _version, _util      errors, the parameter set, files, memory, progress
+0     wmr_mj.errors, params, carts, _version,     errors, the parameter set and its cart files, files,
+      _util                                       memory, progress
 1     wmr_mj.hardware                             sensing, actuation, transmission: typed parts, presets
 2     wmr_mj.plant                                MJCF model, derivation, reduced models, friction, identification
 3     wmr_mj.reference                            paths of C and alpha0(t)
@@ -27,7 +28,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 LAYERS: tuple[tuple[str, ...], ...] = (
-    ("wmr_mj.errors", "wmr_mj.params", "wmr_mj._version", "wmr_mj._util"),
+    ("wmr_mj.errors", "wmr_mj.params", "wmr_mj.carts", "wmr_mj._version", "wmr_mj._util"),
     ("wmr_mj.hardware",),
     ("wmr_mj.plant",),
     ("wmr_mj.reference",),

@@ -6,6 +6,10 @@ plausible compact cart chosen so that the paper's own formulas (2.3), (2.7) and
 (2.13) reproduce its numerical example (5.1); each field says where its value
 comes from. All quantities are SI: m, kg, s, rad, V, A, Ohm, N m.
 
+Every number and source of the C80 is read from its cart file, ``wmr_mj/carts/c80.toml``
+(:data:`C80_CART`): the parameter set's defaults, the m1 range and the uncertainty boxes. The
+dataclass below fixes the fields, their order and the formulas; the file fixes the values.
+
 Geometry (top view, x forward, y left, z up)::
 
     A      rear-axle midpoint (point of the drive unit b); V_A is its speed
@@ -32,11 +36,14 @@ import math
 from dataclasses import dataclass, fields
 from typing import Any, Literal, get_args
 
+from wmr_mj.carts import CartFile, load_cart
 from wmr_mj.errors import ParameterError, UnknownNameError
 
 __all__ = [
     "C80Parameters",
     "C80",
+    "C80_CART",
+    "parameters_of_cart",
     "Coefficients",
     "COEFFICIENT_NAMES",
     "CoefficientModel",
@@ -53,33 +60,22 @@ __all__ = [
     "uncertainty_ranges",
 ]
 
-# The paper's design and uncertainty (5.1): written here once, imported everywhere else.
+#: The C80's cart file: the one source of every number below (values, sources, ranges).
+C80_CART: CartFile = load_cart("c80")
+_C80_VALUES = C80_CART.parameters
+
+# The paper's design (5.1), a controller's gains and not a fact of the cart: written here once.
 PAPER_KP = 6.0  # K_P of (5.1), 1/s^2
 PAPER_KD = 9.0  # K_D of (5.1), 1/s
-M1_NOMINAL = 650.0  # kg, the centre of (5.1)'s 550-750 kg
-M1_RANGE = (550.0, 750.0)  # kg, (5.1)
+M1_NOMINAL = _C80_VALUES["m1"]  # kg, the centre of (5.1)'s 550-750 kg: the C80's m1
+M1_RANGE: tuple[float, float] = C80_CART.uncertainty["m1"]["m1"]  # kg, (5.1)
 
 # Uncertainty boxes for model-mismatch experiments: parameter name -> (lo, hi) in its
 # SI unit. 'm1' is the paper's; 'full' adds what a real C80 also varies in.
-_UNCERTAINTY: dict[str, dict[str, tuple[float, float]]] = {
-    "m1": {"m1": M1_RANGE},
-    "full": {
-        "m1": M1_RANGE,
-        "mu": (0.0129, 0.0215),
-        "ground_friction": (0.6, 1.0),
-        "R_a": (1.0, 1.3),
-        "V_A": (0.15, 0.25),
-    },
-}
+_UNCERTAINTY: dict[str, dict[str, tuple[float, float]]] = {box: dict(r) for box, r in C80_CART.uncertainty.items()}
 UNCERTAINTY_NAMES = tuple(_UNCERTAINTY)
 #: Where each range of the 'full' box comes from.
-UNCERTAINTY_SOURCES: dict[str, str] = {
-    "m1": "(5.1): chassis mass 550-750 kg",
-    "mu": "chosen: steering Coulomb coefficient +-25% around 0.0172 (lubrication, wear and load spread of a king-pin bearing)",
-    "ground_friction": "chosen: tyre-floor friction 0.6 (dusty or damp concrete) to 1.0 (dry rubber on concrete)",
-    "R_a": "chosen: armature resistance 1.0-1.3 Ohm, copper at +0.39 %/K from 20 C to about 95 C winding temperature",
-    "V_A": "chosen: forward speed 0.15-0.25 m/s, +-25% around (5.1)'s 0.2 m/s (drive speed loop, wheel wear)",
-}
+UNCERTAINTY_SOURCES: dict[str, str] = dict(C80_CART.uncertainty_sources["full"])
 
 
 def uncertainty_ranges(name: str) -> dict[str, tuple[float, float]]:
@@ -87,41 +83,6 @@ def uncertainty_ranges(name: str) -> dict[str, tuple[float, float]]:
     if name not in _UNCERTAINTY:
         raise UnknownNameError("uncertainty box name", name, UNCERTAINTY_NAMES)
     return dict(_UNCERTAINTY[name])
-
-# One line per field: where its value comes from.
-PARAMETER_SOURCES: dict[str, str] = {
-    "V_A": "(5.1): the experiment's forward speed of point A, 0.2 m/s",
-    "g": "standard gravity",
-    "m1": "(5.1): chassis (unit a) mass, nominal 650 kg = centre of the 550-750 kg range",
-    "chassis_length": "chosen: 1.75 m platform; with chassis_width gives I_z1 = 205 kg m^2 so that K(650 kg) = 5.33 V, the centre of (5.1)'s (5.29, 5.38)",
-    "chassis_width": "chosen: 0.85 m platform (see chassis_length)",
-    "chassis_height": "chosen: 0.30 m platform depth (roll/pitch inertia only)",
-    "chassis_inertia_mass": "chosen: the chassis inertia is that of a uniform box of 650 kg; m1 beyond it is a compact payload at the chassis centre of mass (the paper's (2.3) keeps I_z1 fixed while m1 varies)",
-    "l1": "chosen: 0.612 m wheelbase, so that C (the pivot) on the R = 1 m circle needs alpha = 0.659 rad and sin/cos^3 = 1.24 as in (5.1)",
-    "l2": "chosen: 0.30 m rear half-track",
-    "l3": "chosen: 0.142 m from A to the chassis centre of mass, so that m1 over 550-750 kg spans K over (5.29, 5.38) as in (5.1)",
-    "l4": "chosen: 0.25 m front half-track (pivot to front wheel centre)",
-    "rear_axle_mass": "chosen: 40 kg rear beam, differential and drive motor (unit b without wheels)",
-    "rear_wheel_mass": "chosen: 10 kg per rear wheel (solid rubber tyre on steel hub)",
-    "r2": "chosen: 0.15 m rear wheel radius",
-    "rear_wheel_width": "chosen: 0.08 m rear wheel width (inertia only)",
-    "i1": "chosen: 20:1 drive gear (not used by the steering analysis)",
-    "front_axle_mass": "chosen: 14 kg front beam with the steering gear; with the wheels gives P = 0.385 V s^2/rad, inside (5.1)'s (0.37, 0.4)",
-    "front_wheel_mass": "chosen: 8 kg per front wheel",
-    "r3": "chosen: 0.10 m front wheel radius",
-    "front_wheel_width": "chosen: 0.06 m front wheel width (inertia only)",
-    "R_a": "chosen: 1.0 Ohm armature resistance of a 24 V, ~250 W permanent-magnet motor",
-    "k_i": "chosen: 0.0795 N m/A = C_V / i2, with C_V = 4.77 V s/rad, the centre of (5.1)'s (4.73, 4.81)",
-    "k_b": "chosen: 0.0795 V s/rad, equal to k_i in SI units",
-    "i2": "chosen: 60:1 steering gear",
-    "voltage_limit": "chosen: 24 V supply of the steering motor",
-    "steering_range": "chosen: +-0.9 rad mechanical stops, beyond the 0.66 rad the 1 m circle needs",
-    "mu": "chosen: 0.0172 Coulomb friction coefficient of the steering, so that F(650 kg) = 1.52 V lies in (5.1)'s (1.5, 1.53)",
-    "f2": "chosen: 0.5 mm rolling-resistance arm of the rear wheels (2.5); acts on the drive only",
-    "f3": "chosen: 0.5 mm rolling-resistance arm of the front wheels (2.5); acts on the drive only",
-    "ground_friction": "chosen: 1.0 tyre-floor friction coefficient (rubber on concrete)",
-}
-
 
 @dataclass(frozen=True)
 class Coefficients:
@@ -153,44 +114,45 @@ COEFFICIENT_MODELS: tuple[str, ...] = get_args(CoefficientModel)
 
 @dataclass(frozen=True, kw_only=True)
 class C80Parameters:
-    """Physical parameters of the C80 cart (SI units). See PARAMETER_SOURCES."""
+    """Physical parameters of the C80 cart (SI units). The defaults are the C80's, read from its cart file
+    (``wmr_mj/carts/c80.toml``); see PARAMETER_SOURCES."""
 
-    V_A: float = 0.2
-    g: float = 9.81
+    V_A: float = _C80_VALUES["V_A"]
+    g: float = _C80_VALUES["g"]
     # unit a: chassis
-    m1: float = 650.0
-    chassis_length: float = 1.75
-    chassis_width: float = 0.85
-    chassis_height: float = 0.30
-    chassis_inertia_mass: float = 650.0
+    m1: float = _C80_VALUES["m1"]
+    chassis_length: float = _C80_VALUES["chassis_length"]
+    chassis_width: float = _C80_VALUES["chassis_width"]
+    chassis_height: float = _C80_VALUES["chassis_height"]
+    chassis_inertia_mass: float = _C80_VALUES["chassis_inertia_mass"]
     # geometry
-    l1: float = 0.612
-    l2: float = 0.30
-    l3: float = 0.142
-    l4: float = 0.25
+    l1: float = _C80_VALUES["l1"]
+    l2: float = _C80_VALUES["l2"]
+    l3: float = _C80_VALUES["l3"]
+    l4: float = _C80_VALUES["l4"]
     # unit b: rear drive
-    rear_axle_mass: float = 40.0
-    rear_wheel_mass: float = 10.0
-    r2: float = 0.15
-    rear_wheel_width: float = 0.08
-    i1: float = 20.0
+    rear_axle_mass: float = _C80_VALUES["rear_axle_mass"]
+    rear_wheel_mass: float = _C80_VALUES["rear_wheel_mass"]
+    r2: float = _C80_VALUES["r2"]
+    rear_wheel_width: float = _C80_VALUES["rear_wheel_width"]
+    i1: float = _C80_VALUES["i1"]
     # unit c: front steering
-    front_axle_mass: float = 14.0
-    front_wheel_mass: float = 8.0
-    r3: float = 0.10
-    front_wheel_width: float = 0.06
+    front_axle_mass: float = _C80_VALUES["front_axle_mass"]
+    front_wheel_mass: float = _C80_VALUES["front_wheel_mass"]
+    r3: float = _C80_VALUES["r3"]
+    front_wheel_width: float = _C80_VALUES["front_wheel_width"]
     # steering motor (2.9)-(2.10)
-    R_a: float = 1.0
-    k_i: float = 0.0795
-    k_b: float = 0.0795
-    i2: float = 60.0
-    voltage_limit: float = 24.0
-    steering_range: float = 0.9
+    R_a: float = _C80_VALUES["R_a"]
+    k_i: float = _C80_VALUES["k_i"]
+    k_b: float = _C80_VALUES["k_b"]
+    i2: float = _C80_VALUES["i2"]
+    voltage_limit: float = _C80_VALUES["voltage_limit"]
+    steering_range: float = _C80_VALUES["steering_range"]
     # friction (2.5)
-    mu: float = 0.0172
-    f2: float = 0.0005
-    f3: float = 0.0005
-    ground_friction: float = 1.0
+    mu: float = _C80_VALUES["mu"]
+    f2: float = _C80_VALUES["f2"]
+    f3: float = _C80_VALUES["f3"]
+    ground_friction: float = _C80_VALUES["ground_friction"]
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -372,6 +334,28 @@ C80 = C80Parameters()
 
 def parameter_names() -> tuple[str, ...]:
     return tuple(f.name for f in fields(C80Parameters))
+
+
+#: One line per field: where its value comes from (the C80 cart file's sources, in the fields' order).
+PARAMETER_SOURCES: dict[str, str] = {name: C80_CART.sources[name] for name in parameter_names()}
+
+
+def parameters_of_cart(cart: CartFile) -> C80Parameters:
+    """The parameter set of a checked cart file (:func:`wmr_mj.carts.load_cart`).
+
+    Raises:
+        ParameterError: the file's keys are not the parameter set's fields, or a value the parameter set
+            refuses (the message names the file).
+    """
+    names = parameter_names()
+    if set(cart.parameters) != set(names):
+        odd = sorted(set(cart.parameters) ^ set(names))
+        raise ParameterError(f"cart file {str(cart.path)!r}: its parameters differ from the parameter set's in "
+                             f"{', '.join(odd)}; accepted: exactly {', '.join(names)}")
+    try:
+        return C80Parameters(**{name: cart.parameters[name] for name in names})
+    except ParameterError as exc:
+        raise ParameterError(f"cart file {str(cart.path)!r}: {exc}") from None
 
 
 def with_params(base: C80Parameters = C80, /, *, m1_inertia: str = "payload", **changes: Any) -> C80Parameters:

@@ -18,7 +18,8 @@ from collections.abc import Sequence
 
 from wmr_mj.errors import WmrMjError
 
-COMMANDS = ("identify", "robustness", "run", "replay", "sweep", "falsify", "compare", "validate", "figures", "model")
+COMMANDS = ("identify", "robustness", "run", "replay", "sweep", "falsify", "compare", "validate", "figures", "model",
+            "cart")
 
 
 class _OneLineParser(argparse.ArgumentParser):

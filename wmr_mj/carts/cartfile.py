@@ -1,0 +1,190 @@
+"""A cart file: a front-steered cart's parameters in SI units, each with its source, read from TOML.
+
+The C80 is ``c80.toml`` beside this module (shipped with the package); :mod:`wmr_mj.params` builds the C80
+parameter set from it. A file is checked against ``cart.schema.json`` (:mod:`wmr_mj.carts.schema`), then
+against the rules a schema cannot say: l3 below the wheelbase l1, k_b equal to k_i (one flux in SI units, and
+MuJoCo's dcmotor has one motor constant: it would silently use their geometric mean), each range's lo below
+its hi, the newest changelog line beginning with the version. Every failure is one line naming the file, the
+key, the value, its unit and what is accepted (:class:`wmr_mj.errors.ParameterError`; the CLI exits with 2).
+
+The file's layout (``c80.toml`` is the example to copy)::
+
+    name = "C80"
+    version = "1.0.0"
+    changelog = ["1.0.0 (2026-11-27): ..."]          # newest first, each line beginning with its version
+    [chassis.l1]                                      # one table per parameter, in its section
+    value = 0.612
+    unit = "m"                                        # must be the schema's SI unit: a check, not a conversion
+    source = "chosen: 0.612 m wheelbase, ..."
+    [uncertainty.full.mu]                             # the boxes: 'm1' (the paper's) and 'full'
+    range = [0.0129, 0.0215]
+    unit = "-"
+    source = "..."
+    [defaults.sensing]                                # the default sensing, actuation and play
+    value = "ideal"
+    source = "..."
+
+Usage::
+
+    from wmr_mj.carts import load_cart
+
+    cart = load_cart("c80")                  # a shipped cart by name, or a path to a .toml file
+    cart.parameters["l1"], cart.units["l1"], cart.sources["l1"]     # 0.612, 'm', 'chosen: ...'
+    cart.uncertainty["full"]["mu"]           # (0.0129, 0.0215)
+"""
+
+from __future__ import annotations
+
+import os
+import tomllib
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any
+
+from wmr_mj.carts.schema import check_against_schema, load_schema
+from wmr_mj.errors import ParameterError
+
+__all__ = ["CARTS_DIR", "CartFile", "cart_names", "cart_path", "load_cart", "PARAMETER_SECTIONS", "DEFAULT_KEYS"]
+
+#: The shipped carts (``NAME.toml``), inside the package: found from any folder and by an installed wheel.
+CARTS_DIR = Path(__file__).resolve().parent
+#: The sections holding the parameters, in the file's order (the schema's 'required' keys minus the others).
+PARAMETER_SECTIONS: tuple[str, ...] = tuple(
+    key for key in load_schema()["required"] if key not in ("name", "version", "changelog", "uncertainty", "defaults"))
+#: How far k_b may differ from k_i, relative: a rounding, not a second constant (see _check_rules).
+MOTOR_CONSTANT_RTOL = 1e-9
+#: The keys of the [defaults] section: the default sensing, actuation and play of a run on the cart.
+DEFAULT_KEYS: tuple[str, ...] = tuple(load_schema()["properties"]["defaults"]["required"])
+
+
+def _frozen(mapping: Mapping[str, Any]) -> Mapping[str, Any]:
+    return MappingProxyType(dict(mapping))
+
+
+@dataclass(frozen=True)
+class CartFile:
+    """A checked cart file. Parameters are floats in SI units, by name (the C80Parameters field names).
+
+    Attributes:
+        name, version: the file's name and version (MAJOR.MINOR.PATCH).
+        changelog: one line per version, newest first.
+        path: the file read.
+        parameters: parameter name -> value in its SI unit, in the file's section order.
+        units: parameter name -> unit ('m', 'kg', 'rad', '-' for a ratio, ...).
+        sources: parameter name -> where its value comes from.
+        sections: section name -> its parameters' names.
+        uncertainty: box name ('m1', 'full') -> parameter name -> (lo, hi) in its unit.
+        uncertainty_sources: box name -> parameter name -> where the range comes from.
+        defaults: 'sensing', 'actuation' (a preset name or KEY=VALUE spec), 'backlash' (rad) -> value.
+        default_sources: the same keys -> where the default comes from.
+    """
+
+    name: str
+    version: str
+    changelog: tuple[str, ...]
+    path: Path
+    parameters: Mapping[str, float]
+    units: Mapping[str, str]
+    sources: Mapping[str, str]
+    sections: Mapping[str, tuple[str, ...]]
+    uncertainty: Mapping[str, Mapping[str, tuple[float, float]]]
+    uncertainty_sources: Mapping[str, Mapping[str, str]]
+    defaults: Mapping[str, Any]
+    default_sources: Mapping[str, str]
+
+
+def cart_names() -> tuple[str, ...]:
+    """The shipped carts' names (``NAME.toml`` in :data:`CARTS_DIR`), sorted."""
+    return tuple(sorted(p.stem for p in CARTS_DIR.glob("*.toml")))
+
+
+def cart_path(source: str | os.PathLike[str]) -> Path:
+    """The file ``source`` names: a path to a file, or the name of a shipped cart ('c80').
+
+    Raises:
+        ParameterError: neither an existing file nor a shipped cart's name.
+    """
+    path = Path(source)
+    if path.is_file():
+        return path
+    if isinstance(source, str) and source in cart_names():
+        return CARTS_DIR / f"{source}.toml"
+    raise ParameterError(f"cart {str(source)!r} is neither a file nor a shipped cart; accepted: a path to a .toml "
+                         f"cart file or one of {', '.join(cart_names())}")
+
+
+def _read(path: Path) -> dict[str, Any]:
+    try:
+        with path.open("rb") as f:
+            return tomllib.load(f)
+    except OSError as exc:
+        raise ParameterError(f"cart file {str(path)!r} cannot be read: {exc.strerror or exc}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ParameterError(f"cart file {str(path)!r} is not valid TOML: {exc}") from None
+
+
+def _check_rules(document: Mapping[str, Any]) -> None:
+    """The rules the schema cannot say; raises ParameterError (without the file's name)."""
+    l1, l3 = document["chassis"]["l1"]["value"], document["chassis"]["l3"]["value"]
+    if not l3 < l1:
+        raise ParameterError(f"chassis.l3.value = {l3!r} m is not accepted; accepted: a number below the wheelbase "
+                             f"chassis.l1.value = {l1!r} m (the centre of mass lies between the axles)")
+    k_i, k_b = document["motor"]["k_i"]["value"], document["motor"]["k_b"]["value"]
+    if abs(k_b - k_i) > MOTOR_CONSTANT_RTOL * abs(k_i):
+        raise ParameterError(f"motor.k_b.value = {k_b!r} V s/rad is not accepted; accepted: equal to motor.k_i.value = "
+                             f"{k_i!r} N m/A (in SI units the back-EMF and torque constants are one flux; MuJoCo's "
+                             "dcmotor has one constant and would use their geometric mean)")
+    for box, ranges in document["uncertainty"].items():
+        for name, entry in ranges.items():
+            lo, hi = entry["range"]
+            if not lo < hi:
+                raise ParameterError(f"uncertainty.{box}.{name}.range = {entry['range']!r} {entry['unit']} is not "
+                                     "accepted; accepted: [lo, hi] with lo < hi")
+    version, newest = document["version"], document["changelog"][0]
+    if not newest.startswith(version):
+        raise ParameterError(f"changelog[0] = {newest!r} is not accepted; accepted: the newest line first, beginning "
+                             f"with the version {version!r}")
+
+
+def _cart_of(document: Mapping[str, Any], path: Path) -> CartFile:
+    sections = {s: tuple(document[s]) for s in PARAMETER_SECTIONS}
+    entries = {name: document[s][name] for s, names in sections.items() for name in names}
+    boxes = document["uncertainty"]
+    return CartFile(
+        name=document["name"], version=document["version"], changelog=tuple(document["changelog"]), path=path,
+        parameters=_frozen({n: float(e["value"]) for n, e in entries.items()}),
+        units=_frozen({n: e["unit"] for n, e in entries.items()}),
+        sources=_frozen({n: e["source"] for n, e in entries.items()}),
+        sections=_frozen(sections),
+        uncertainty=_frozen({box: _frozen({n: (float(e["range"][0]), float(e["range"][1])) for n, e in r.items()})
+                             for box, r in boxes.items()}),
+        uncertainty_sources=_frozen({box: _frozen({n: e["source"] for n, e in r.items()}) for box, r in boxes.items()}),
+        defaults=_frozen({k: (float(e["value"]) if "unit" in e else e["value"])
+                          for k, e in document["defaults"].items()}),
+        default_sources=_frozen({k: e["source"] for k, e in document["defaults"].items()}),
+    )
+
+
+def load_cart(source: str | os.PathLike[str]) -> CartFile:
+    """Read and check a cart file.
+
+    Args:
+        source: a path to a TOML cart file, or a shipped cart's name (:func:`cart_names`).
+
+    Returns:
+        The checked :class:`CartFile`.
+
+    Raises:
+        ParameterError: a missing or unreadable file, invalid TOML, or a violation of the schema or of the
+            rules beside it: one line naming the file, the key, the value, its unit and what is accepted.
+    """
+    path = cart_path(source)
+    document = _read(path)
+    try:
+        check_against_schema(document, load_schema())
+        _check_rules(document)
+    except ParameterError as exc:
+        raise ParameterError(f"cart file {str(path)!r}: {exc}") from None
+    return _cart_of(document, path)
