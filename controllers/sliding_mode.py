@@ -36,7 +36,9 @@ Sampling. The law is held over each control period T; the argument above is cont
 claim states the check that one period moves s by a small part of the layer: with
 |P s'| <= D + k, the change of s over T is at most T (D + k)/P_min, required
 <= :data:`SAMPLING_FRACTION` phi, and the layer's gain k/phi must not overshoot the layer in one
-period (T k/(P_min phi) <= 1). These are a stated margin, not a sampled-data proof; the tests
+period (T k/(P_min phi) <= 1). Under measurement errors or a delay the same check is named for
+what it measures, :data:`MEASURED_STEP`: D grows by the law's measured-input terms, T does not.
+These are a stated margin, not a sampled-data proof; the tests
 (tests/test_sliding_mode.py) check the bound on a zero-order-hold simulation.
 
 Usage::
@@ -67,10 +69,14 @@ from wmr_mj.analysis.measurement import (
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.plant.reduced import SteeringModel
 
-__all__ = ["SlidingMode", "Uncertainty", "MeasuredLayer", "SAMPLING_FRACTION", "SLIDING_FRICTION_SIGNS"]
+__all__ = ["SlidingMode", "Uncertainty", "MeasuredLayer", "SAMPLING_FRACTION", "SLIDING_FRICTION_SIGNS",
+           "MEASURED_STEP"]
 
 #: The largest change of s over one control period, as a fraction of the layer phi.
 SAMPLING_FRACTION = 0.1
+#: Name of the sampling check under measurement errors and a delay: what it measures, the step
+#: T (D + k)/P_min of s over one period, grows with D (its measured-input and delay terms) while T stays.
+MEASURED_STEP = "step of s per period with the measured errors"
 #: The Coulomb compensation's sign: the measured a' (as computed-torque's default) or none.
 SLIDING_FRICTION_SIGNS = ("measured", "none")
 _LAYER_ITERATIONS = 10000
@@ -372,10 +378,11 @@ class SlidingMode(SteeringController):
                        bool(math.isfinite(D) and self.k >= D + self.eta), D + self.eta, self.k,
                        f"D = {D:.4g} V with e_alpha = {lay.e_alpha:.4g} rad, e_alpha' = {lay.e_alpha_dot:.4g} rad/s, "
                        f"delay {meas.delay_s:g} s; k = {self.k:g} V, eta = {self.eta:g} V", kind="checked"),
-            Assumption("control period", f"T (D + k)/P_min <= {SAMPLING_FRACTION:g} phi and T k/(P_min phi) <= 1 "
-                       "(continuous-time analysis; a margin, not a sampled-data proof)",
+            Assumption(MEASURED_STEP, f"T (D + k)/P_min <= {SAMPLING_FRACTION:g} phi with D grown by the law's "
+                       "measured-input and delay terms, and T k/(P_min phi) <= 1 (continuous-time analysis; a margin, "
+                       "not a sampled-data proof)",
                        bool(ds <= SAMPLING_FRACTION * self.phi and layer_gain <= 1.0), ds / self.phi,
-                       SAMPLING_FRACTION, f"T = {T:g} s, T k/(P_min phi) = {layer_gain:.4g}", kind="checked"),
+                       SAMPLING_FRACTION, self._step_note(T, ds, D, unc, layer_gain), kind="checked"),
             Assumption(**coverage_assumption_fields(meas, self.name)),
         ]
         if meas.delay_s > 0.0:
@@ -394,6 +401,12 @@ class SlidingMode(SteeringController):
                                  "uncertainty_V": unc.as_dict() if unc is not None else None,
                                  "estimate": self.model.coefficients.as_dict(),
                                  "friction_sign": self.friction_sign, "friction_width": self.friction_width})
+
+    def _step_note(self, T: float, ds: float, D: float, unc: Uncertainty | None, layer_gain: float) -> str:
+        """The note of :data:`MEASURED_STEP`: what moved (D, by the measured errors), the period that did not."""
+        ideal = f" ({unc.total:.4g} V without the measured-input and delay terms)" if unc is not None else ""
+        return (f"the step of s per period T (D + k)/P_min = {ds:.4g} rad/s against phi = {self.phi:g} rad/s, with "
+                f"D = {D:.4g} V{ideal}; T = {T:g} s; T k/(P_min phi) = {layer_gain:.4g}")
 
     def describe(self) -> dict:
         return {"controller": self.name, "model": self.model.name, "lam": self.lam, "phi": self.phi, "k": self.k,

@@ -41,6 +41,7 @@ __all__ = [
     "CertificateJudgement",
     "judge",
     "finite_or_none",
+    "MeasurementCause",
 ]
 
 #: A run's verdict against its certificate; only 'certified-inside' is a pass.
@@ -78,6 +79,40 @@ class Assumption:
 
 
 @dataclass(frozen=True, kw_only=True)
+class MeasurementCause:
+    """The measurement errors a section-4 certificate assumed, and which of them keeps its fixed point from
+    closing (:func:`wmr_mj.analysis.small_gain.certify` with a ``measurement`` that is not exact).
+
+    Attributes:
+        e_a: the bound on |alpha_m - alpha| the claim assumed [rad] (inf: none derived).
+        e_v: the bound on |alpha_m' - alpha'| [rad/s].
+        tau: the delay [s] (sensing plus actuation; a differenced velocity's T/2 lag is counted by the sensing).
+        E_max_without: for each error that is not 0, ('e_a', 'e_v' or 'tau', E_max [rad] with it set to 0
+            and the others kept; inf: still no fixed point); empty when the certificate has a fixed point.
+        E_max_exact: E_max with no measurement error at all [rad] (inf: no fixed point without them either);
+            None when the certificate has a fixed point.
+    """
+
+    e_a: float
+    e_v: float
+    tau: float
+    E_max_without: tuple[tuple[str, float], ...] = ()
+    E_max_exact: float | None = None
+
+    @property
+    def binding(self) -> tuple[str, ...]:
+        """The errors each of which alone keeps the fixed point from closing: set to 0, it closes."""
+        return tuple(name for name, E in self.E_max_without if math.isfinite(E))
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready (inf -> None): e_a [rad], e_v [rad/s], tau [s], binding, E_max_without, E_max_exact."""
+        return {"e_a": finite_or_none(self.e_a), "e_v": finite_or_none(self.e_v), "tau": finite_or_none(self.tau),
+                "binding": list(self.binding),
+                "E_max_without": {name: finite_or_none(E) for name, E in self.E_max_without},
+                "E_max_exact": None if self.E_max_exact is None else finite_or_none(self.E_max_exact)}
+
+
+@dataclass(frozen=True, kw_only=True)
 class SmallGainTerms:
     """Section 4's breakdown of delta1 and the law it is for (:func:`wmr_mj.analysis.small_gain.certify`).
 
@@ -90,6 +125,12 @@ class SmallGainTerms:
         kp [1/s^2], kd [1/s]: the law's gains.
         friction_sign: the law's Coulomb sign ('measured', 'reference', 'none'); friction_width [rad/s]:
             its smoothing.
+        delta1_parts: every term of delta1 [rad/s^2] as (name, value), at the plant corner P where delta1 is
+            reached, so that they add up to delta1 (to rounding); the measurement's terms, with a delay's loop
+            gain 1/(1 - tau c_v) as the part it adds. Not in :meth:`Certificate.as_dict` (whose keys stay as
+            they were); ``robustness --certificate`` prints and writes them.
+        measurement_cause: the measurement errors assumed and which binds (:class:`MeasurementCause`); None
+            for a law that reads the true state at once.
     """
 
     friction_term: float
@@ -105,6 +146,8 @@ class SmallGainTerms:
     kd: float = 0.0
     friction_sign: str = "measured"
     friction_width: float = 0.0
+    delta1_parts: tuple[tuple[str, float], ...] = ()
+    measurement_cause: MeasurementCause | None = None
 
 
 #: What the JSON has always written for a claim without section 4's terms (a law's box claim): these

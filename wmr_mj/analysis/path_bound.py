@@ -33,10 +33,14 @@ The assumptions are listed in each :class:`PathBound`; transients (E' != 0: the 
 circle, a curvature change) and offsets that vary with time (one at the lap frequency moves
 C's circle lap after lap) are not covered: they need their own term.
 
+Only a certificate that holds (valid, every assumption met) bounds |E|: :func:`guaranteed_E_max` gives
+its E_max, or None with the reason (a certificate whose assumptions fail gives no path guarantee).
+
 Usage::
 
-    from wmr_mj.analysis.path_bound import path_bound, path_verdict
-    bound = path_bound(reference, E_max=cert.E_max, settle_s=settle_s)
+    from wmr_mj.analysis.path_bound import guaranteed_E_max, path_bound, path_verdict
+    E_max, why_not = guaranteed_E_max(E_max=cert.E_max, valid=cert.valid, unmet=cert.unmet)
+    bound = path_bound(reference, E_max=E_max, settle_s=settle_s)
     bound.cross_track_bound, bound.reason, bound.assumptions
     path_verdict(errors, bound).verdict    # 'within-bound', 'beyond-bound' or 'no-guarantee'
 """
@@ -65,6 +69,7 @@ __all__ = [
     "line_bound",
     "path_bound",
     "path_verdict",
+    "guaranteed_E_max",
     "straight_line_drift",
 ]
 
@@ -141,6 +146,29 @@ class PathBound:
         d["assumptions"] = list(self.assumptions)
         d["radius_range"] = None if self.radius_range is None else list(self.radius_range)
         return d
+
+
+def guaranteed_E_max(*, E_max: float | None, valid: bool, unmet: Any = ()) -> tuple[float | None, str]:
+    """The steering-error bound a path bound may rest on: the certificate's E_max when it holds.
+
+    A certificate that is not valid has no bound; one whose assumptions are not all met has a number that
+    is no guarantee, so neither bounds C's path.
+
+    Args:
+        E_max: the certificate's bound on |E| [rad] (None or inf: none).
+        valid: the certificate's bound exists (its fixed point was found).
+        unmet: the names of its assumptions that are not met (empty: it holds).
+
+    Returns:
+        (E_max [rad] or None, why a finite E_max is no bound: '' when E_max is returned or there is none).
+    """
+    names = [str(n) for n in unmet or ()]
+    if not valid or E_max is None or not math.isfinite(float(E_max)):
+        return None, ""  # the path bound's own reason says it: "there is no bound on the steering error |E|"
+    if names:
+        return None, (f"the certificate's |E| <= {float(E_max):.4g} rad does not hold: its assumptions are not met "
+                      f"({', '.join(names)}), so it bounds nothing")
+    return float(E_max), ""
 
 
 def _check_E(E_max: Any) -> float | None:

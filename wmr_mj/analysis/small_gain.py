@@ -154,13 +154,13 @@ Usage::
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
 
 from wmr_mj._util.checks import finite_number as _number
 from wmr_mj.analysis.claim import fixed_point, shared_assumptions
-from wmr_mj.analysis.claim_types import Assumption, Certificate, ClaimInputs, SmallGainTerms
+from wmr_mj.analysis.claim_types import Assumption, Certificate, ClaimInputs, MeasurementCause, SmallGainTerms
 from wmr_mj.analysis.measurement import (
     DELAY_FIXED_POINT,
     MeasurementErrors,
@@ -189,6 +189,8 @@ __all__ = [
 
 #: The control period may use at most this fraction of the loop's delay margin.
 CONTROL_PERIOD_FRACTION = 0.1
+#: The measurement errors by the names the printout gives them, and their MeasurementErrors fields.
+_ERRORS = (("e_a", "alpha_error_max"), ("e_v", "alpha_dot_error_max"), ("tau", "delay_s"))
 
 
 # --------------------------------------------------------------------------- pieces
@@ -489,6 +491,27 @@ class _Bound:
         cond = self.g1 * self.delta2 + self.g2 * delta3
         return _AtAngle(delta1=delta1, delta2=self.delta2, delta3=delta3, condition=cond, S=S, c2=c2)
 
+    def parts_at(self, S: float, c2: float, phi_at: Callable[[float], float],
+                 ff: float = 0.0) -> tuple[tuple[str, float], ...]:
+        """delta1's terms [rad/s^2] at the P corner where it is reached, so that they add up to it.
+
+        Args:
+            S: sin/cos^3 at the angle bound [-]. c2: cos^2 there [-].
+            phi_at: the friction term [V] at P (the measured path's may count a wrong sign).
+            ff: the delayed feedforward's term [V] (0 without a delay).
+
+        Returns:
+            ((name, value [rad/s^2]), ...): friction, P~, K~, C_V~, gyro, then the disturbance and the
+            delayed reference where they are not 0.
+        """
+        rest = self.dK * S + self.dC * self.a0d + self.dG * self.a0d / c2
+        dist = self.dist_at if self.plant.disturbance else (lambda p: 0.0)
+        p = max(self.P_corners, key=lambda p: (abs(p - self.P_ff) * self.a0dd + phi_at(p) + rest + ff + dist(p)) / p)
+        parts = [("friction", phi_at(p) / p), ("P~", abs(p - self.P_ff) * self.a0dd / p), ("K~", self.dK * S / p),
+                 ("C_V~", self.dC * self.a0d / p), ("gyro", self.dG * self.a0d / c2 / p)]
+        parts += [(name, v / p) for name, v in (("disturbance", dist(p)), ("delayed reference", ff)) if v]
+        return tuple(parts)
+
     def E_max_at(self, x: float) -> float:
         """The bound on |E| [rad] at alpha_max = max|alpha0| + x: Phi(x) of the fixed point."""
         b = self.at(self.a0 + x)
@@ -653,6 +676,39 @@ class _Measured:
         """The measurement's part of delta1 [rad/s^2]."""
         return at.delta1 - at.delta1_exact
 
+    def delta1_parts(self, at: _MeasuredAt) -> tuple[tuple[str, float], ...]:
+        """Every term of delta1 [rad/s^2] (:meth:`at`'s sum, term by term); () where it is not finite."""
+        if at.failure or not math.isfinite(at.delta1):
+            return ()
+        b, m = self.bound, self.measurement
+        tau = m.delay_s
+        flip = b.friction_sign == "measured" and (m.alpha_dot_error_max > 0.0 or tau > 0.0)
+        ff = 2.0 * b.P_ff * b.a0dd if tau > 0.0 else 0.0
+        inner = [*b.parts_at(at.S, at.c2, lambda p: self._phi_at(p, flip), ff),
+                 ("angle error e_a", at.c_a * m.alpha_error_max),
+                 ("velocity error e_v", at.c_v * m.alpha_dot_error_max)]
+        if tau > 0.0:
+            inner.append(("delay tau", at.c_a * tau * b.a0d + at.c_v * tau * b.a0dd))
+            inner.append(("delay loop 1/(1 - tau c_v)", at.rho / (1.0 - at.rho) * math.fsum(v for _, v in inner)))
+        return tuple(inner)
+
+    def cause(self, valid: bool) -> MeasurementCause:
+        """The errors assumed and, without a fixed point, the fixed point re-solved with each set to 0 alone
+        and with none of them: which error binds."""
+        m = self.measurement
+        if valid:
+            return MeasurementCause(e_a=m.alpha_error_max, e_v=m.alpha_dot_error_max, tau=m.delay_s)
+        without = []
+        for name, field_name in _ERRORS:
+            if getattr(m, field_name) != 0.0:
+                zeroed = MeasurementErrors(**{**m.as_dict(), field_name: 0.0})
+                path: _Path = (_Exact(self.bound, self.friction_width) if zeroed.is_exact
+                               else _Measured(self.bound, zeroed, self.friction_width))
+                without.append((name, path.solve()[0]))
+        exact = _Exact(self.bound, self.friction_width).solve()[0]
+        return MeasurementCause(e_a=m.alpha_error_max, e_v=m.alpha_dot_error_max, tau=m.delay_s,
+                                E_max_without=tuple(without), E_max_exact=exact)
+
 
 @dataclass(frozen=True)
 class _Exact:
@@ -689,6 +745,14 @@ class _Exact:
     def measurement_term(at: _AtAngle) -> float:
         return 0.0
 
+    def delta1_parts(self, at: _AtAngle) -> tuple[tuple[str, float], ...]:
+        """Every term of delta1 [rad/s^2] at the corner where it is reached."""
+        return self.bound.parts_at(at.S, at.c2, self.bound.phi_at)
+
+    @staticmethod
+    def cause(valid: bool) -> None:
+        return None
+
 
 @dataclass(frozen=True)
 class _Setting:
@@ -724,6 +788,10 @@ class _Path(Protocol):
 
     def measurement_term(self, at: Any) -> float: ...
 
+    def delta1_parts(self, at: Any) -> tuple[tuple[str, float], ...]: ...
+
+    def cause(self, valid: bool) -> MeasurementCause | None: ...
+
 
 def _certificate(path: _Path, setting: _Setting) -> Certificate:
     """The certificate of either path (exact or measured): the fixed point, the corner (4.21), the law's
@@ -746,7 +814,8 @@ def _certificate(path: _Path, setting: _Setting) -> Certificate:
         dead_band=bound.plant.box.F[1] / (bound.estimate.P * bound.kp),
         disturbance_term=max(bound.dist_at(p) / p for p in corners) if bound.plant.disturbance else 0.0,
         measurement_term=path.measurement_term(at),
-        kp=bound.kp, kd=bound.kd, friction_sign=bound.friction_sign, friction_width=path.friction_width)
+        kp=bound.kp, kd=bound.kd, friction_sign=bound.friction_sign, friction_width=path.friction_width,
+        delta1_parts=path.delta1_parts(at), measurement_cause=path.cause(valid))
     inputs = SmallGainInputs(plant=bound.plant, estimate=bound.estimate, compensation=setting.compensation,
                              reference=setting.reference, limits=setting.limits,
                              control_period=setting.control_period, initial_error=setting.initial_error,

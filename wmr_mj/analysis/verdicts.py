@@ -30,6 +30,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from wmr_mj.analysis.certificate import VERDICTS, Certificate, CertificateJudgement, judge
+from wmr_mj.analysis.claim_types import MeasurementCause
 from wmr_mj.analysis.measurement import DELAY_FIXED_POINT, MEASUREMENT_COVERED
 
 __all__ = [
@@ -56,6 +57,8 @@ __all__ = [
     "unmet_assumptions",
     "count_unmet",
     "format_unmet",
+    "format_measurement_cause",
+    "format_delta1_parts",
 ]
 
 PASS = "certified-inside"
@@ -292,18 +295,24 @@ def format_verdict(summary: Mapping[str, Any]) -> list[str]:
     if verdict == CERTIFIED_OUTSIDE:
         lines.append(certified_outside_banner())
     ratio = cert.get("E_ratio")
+    no_region = cert.get("valid") is False  # no bound: the run is neither inside nor outside of anything
     lines.append(f"verdict: {verdict.upper()}"
                  + ("" if ratio is None else f"  (tightness sup|E|/E_max = {ratio:.3f})")
-                 + ("" if is_pass(verdict) else "  -- not a pass"))
+                 + ("" if is_pass(verdict) else "  -- not a pass")
+                 + (": no certificate, so no region to be inside or outside of" if no_region else ""))
     unmet = [a for a in cert.get("assumptions", []) if not a.get("met")]
     if unmet:
         lines.append("certificate NOT valid; assumptions not met: " + format_unmet(unmet))
     for a in unmet:
         if str(a.get("name", "")).startswith(OUTSIDE_THE_BOX):
             lines.append(f"plant outside the box: {a.get('equation', '')} fails; {a.get('note', '')}")
-    lines.append(f"certificate:   |E| <= {_num(cert.get('E_max'))} rad, |E'| <= {_num(cert.get('Edot_max'))} rad/s"
-                 f", (4.23) = {_num(cert.get('condition'), '.4f')}, run "
-                 f"{'inside' if cert.get('inside') else 'OUTSIDE'}")
+    if no_region:
+        lines.append(f"certificate:   no certificate ({cert.get('reason') or 'no finite bound'}); the run's "
+                     f"sup|E| = {_num(summary.get('sup_E'))} rad is judged against no region")
+    else:
+        lines.append(f"certificate:   |E| <= {_num(cert.get('E_max'))} rad, |E'| <= {_num(cert.get('Edot_max'))} "
+                     f"rad/s, (4.23) = {_num(cert.get('condition'), '.4f')}, run "
+                     f"{'inside' if cert.get('inside') else 'OUTSIDE'}")
     if summary.get("paper_claim_applies") is False:
         lines.append(f"paper's claim: {PAPER_CLAIM_NOT_APPLICABLE}")
     else:
@@ -315,3 +324,43 @@ def format_verdict(summary: Mapping[str, Any]) -> list[str]:
                      f"{'STILL GROWING' if dr.get('growing') else 'not growing'} over the last "
                      f"{_num(dr.get('window_s'), 'g')} s")
     return lines
+
+
+def format_measurement_cause(cause: MeasurementCause) -> str:
+    """One line: the measurement errors a certificate assumed and, without a fixed point, the one that binds.
+
+    Args:
+        cause: the certificate's :class:`~wmr_mj.analysis.claim_types.MeasurementCause`
+            (``certificate.terms.measurement_cause``).
+
+    Returns:
+        e.g. "measurement errors assumed: |e_a| <= 0.000767 rad, |e_v| <= 1.534 rad/s, tau = 0.0005 s; the
+        fixed point fails by e_v: with e_v = 0 (the others kept) E_max = 0.09648 rad".
+    """
+    text = (f"measurement errors assumed: |e_a| <= {_num(cause.e_a, '.4g')} rad, |e_v| <= {_num(cause.e_v, '.4g')} "
+            f"rad/s, tau = {_num(cause.tau, '.4g')} s")
+    if cause.E_max_exact is None:
+        return text
+    if not math.isfinite(cause.E_max_exact):
+        return text + ("; the fixed point fails without any measurement error too: the law and the plant box "
+                       "alone have none")
+    binding = cause.binding
+    if not binding:
+        return text + ("; the fixed point fails by the errors together: with any one of them set to 0 it still "
+                       f"fails, with none of them E_max = {cause.E_max_exact:.4g} rad")
+    without = dict(cause.E_max_without)
+    each = "; ".join(f"with {name} = 0 (the others kept) E_max = {without[name]:.4g} rad" for name in binding)
+    return text + f"; the fixed point fails by {' or '.join(binding)}: {each}"
+
+
+def format_delta1_parts(delta1: float, parts: Iterable[tuple[str, float]]) -> str:
+    """'delta1 = name value + ...' with every term, which add up to delta1 (to rounding).
+
+    Args:
+        delta1: the certificate's delta1 [rad/s^2].
+        parts: its terms as (name, value [rad/s^2]) (``certificate.terms.delta1_parts``); empty: unbounded.
+    """
+    terms = list(parts)
+    if not terms or not math.isfinite(delta1):
+        return f"{_num(delta1, '.4g') if math.isfinite(delta1) else 'unbounded'} (no finite breakdown)"
+    return f"{delta1:.6g} = " + " + ".join(f"{name} {value:.6g}" for name, value in terms)

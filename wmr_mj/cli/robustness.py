@@ -348,6 +348,8 @@ def _small_gain_table(cert, config, paper) -> str:
     """The text report of section 4's certificate: its inputs, gammas, deltas and terms, and every assumption."""
     import dataclasses
 
+    from wmr_mj.analysis.verdicts import format_delta1_parts, format_measurement_cause
+
     inp = cert.inputs  # the run's record (controller, model, box rule) by key; section 4's inputs typed
     law = inp.law
     box, ref = law.plant.box, law.reference
@@ -373,11 +375,8 @@ def _small_gain_table(cert, config, paper) -> str:
         ("reference", f"max|a0| {ref.alpha_max:.4g} rad, max|a0'| {ref.alpha_dot_max:.4g} rad/s, "
                       f"max|a0''| {ref.alpha_ddot_max:.4g} rad/s^2"),
         ("gamma1, gamma2 (4.14)", f"{cert.gamma1:.4g}, {cert.gamma2:.4g}"),
-        ("delta1 (4.18) [rad/s^2]", f"{fmt(cert.delta1)} = friction {cert.friction_term:.4g} "
-                                    f"+ K~ {cert.K_term:.3g} + gyro {cert.gyro_term:.3g} + P~ {cert.P_term:.3g} "
-                                    f"+ C_V~ {cert.C_V_term:.3g}"
-                                    + (f" + disturbance {cert.disturbance_term:.4g}" if cert.disturbance_term else "")
-                                    + " (at P_min)"),
+        ("delta1 (4.18) [rad/s^2]", format_delta1_parts(cert.delta1, cert.terms.delta1_parts)
+                                    + " (every term, at the P corner where delta1 is reached)"),
         ("delta2, delta3", f"{fmt(cert.delta2)} (of ||E||), {fmt(cert.delta3)} "
                            f"(of ||E'||; gyro {cert.gyro_Edot_term:.3g})"),
         ("condition (4.23)", fmt(cert.condition)),
@@ -388,10 +387,29 @@ def _small_gain_table(cert, config, paper) -> str:
         ("the paper's claim", f"E_max {fmt(paper.E_max)} rad, Edot_max {fmt(paper.Edot_max)} rad/s, "
                               f"(4.23) {fmt(paper.condition)} (wmr_mj.analysis.robustness, as the paper bounds it)"),
     ]
+    cause = cert.terms.measurement_cause
+    if cause is not None:  # what the law reads instead of the truth, and which error keeps the fixed point open
+        rows.insert(rows.index(next(r for r in rows if r[0].startswith("delta1"))),
+                    ("measurement", format_measurement_cause(cause)))
     width = max(len(k) for k, _ in rows)
     lines = ["Certificate for the controller as run on the plant as simulated (section 4 redone)"]
     lines += [f"  {k:<{width}}  {v}" for k, v in rows]
     return "\n".join(lines + _assumption_lines(cert, fmt))
+
+
+def certificate_breakdown(cert) -> dict:
+    """The JSON keys section 4's certificate adds beside :meth:`Certificate.as_dict`: ``delta1_parts``
+    ({term: rad/s^2}, adding up to delta1) and, with measurement errors, ``measurement_errors``
+    (:meth:`~wmr_mj.analysis.claim_types.MeasurementCause.to_dict`); {} for a claim without section 4's terms."""
+    from wmr_mj.analysis.claim_types import finite_or_none
+
+    terms = cert.terms
+    if terms is None:
+        return {}
+    out: dict = {"delta1_parts": {name: finite_or_none(v) for name, v in terms.delta1_parts}}
+    if terms.measurement_cause is not None:
+        out["measurement_errors"] = terms.measurement_cause.to_dict()
+    return out
 
 
 def run_certificate(args: argparse.Namespace) -> int:
@@ -426,6 +444,7 @@ def run_certificate(args: argparse.Namespace) -> int:
                                "Edot_max": paper.Edot_max if paper.stable else None,
                                "condition": paper.condition, "stable": bool(paper.stable)}
         out["config"] = config.as_dict()
+        out.update(certificate_breakdown(cert))
         print_json(out)
         return 0
     print(_certificate_table(cert, config, paper))

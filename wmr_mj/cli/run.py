@@ -196,9 +196,17 @@ def default_log_path(config) -> str:
     return f"logs/run-{stamp}-{config.model}-m{config.m1:g}.mcap"
 
 
+def measurement_cause(s: RunSummary):
+    """The measurement errors the run's section-4 certificate assumed, and which binds
+    (:class:`~wmr_mj.analysis.claim_types.MeasurementCause`); None on an ideal cart or for another claim."""
+    judged = s.certificate
+    terms = None if judged is None else judged.certificate.terms
+    return None if terms is None else terms.measurement_cause
+
+
 def format_report(s: RunSummary) -> str:
     """Human-readable run report of the summary ``s``."""
-    from wmr_mj.analysis.verdicts import format_verdict
+    from wmr_mj.analysis.verdicts import format_measurement_cause, format_verdict
 
     def ratio(x):
         return "n/a" if x is None else f"{x:.3f}"
@@ -222,9 +230,14 @@ def format_report(s: RunSummary) -> str:
     # a run that ended before the entry transient did has no samples after it: n/a, not the empty sup's 0
     settled = s.duration > s.settle_s
     paper = (lambda bound, r: f" {bound:12.5g} {ratio(r):>8s}") if s.paper_law else (lambda bound, r: "")
+    verdict = format_verdict(s.to_dict())
+    cause = measurement_cause(s)
+    if cause is not None:  # beside the certificate's line: what it assumed the law reads, and what binds
+        at = next((i + 1 for i, line in enumerate(verdict) if line.startswith("certificate:")), len(verdict))
+        verdict.insert(at, format_measurement_cause(cause))
     lines = [
         f"{who}, {s.duration:g} s, {s.steps} steps in {s.wall_s:.2f} s{rate}",
-        *format_verdict(s.to_dict()),
+        *verdict,
         f"{'':22s} {'whole run':>12s} {after:>12s} {'certificate':>12s} {'ratio':>8s}"
         + (f" {'paper':>12s} {'ratio':>8s}" if s.paper_law else ""),
         f"{'sup|E|   [rad]':22s} {s.sup_E:12.5g} {num(s.sup_E_settled if settled else None):>12s} "
@@ -312,6 +325,9 @@ def run(args: argparse.Namespace) -> int:
                                                     result.summary.to_dict(),
                                                     period=period)]
     report = {**result.summary.to_dict(), "log": path, **({"requirements": judged} if judged else {})}
+    cause = measurement_cause(result.summary)
+    if cause is not None:  # the errors the claim assumed, and which keeps its fixed point open (an ideal cart: none)
+        report["measurement_errors"] = cause.to_dict()
     if config.signals is not None:
         report["signals"] = config.signals.as_dict()  # every parameter: --signals takes it back
     from wmr_mj.cli._common import add_controller_source

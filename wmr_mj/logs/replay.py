@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -105,7 +105,7 @@ def path_of_log(log: RunLog, settle_s: float | None = None) -> LogPath:
     """C's Cartesian errors in ``log``: the desired path rebuilt as the run built it (its path, the
     controller's parameter set, its control period and duration), C's logged positions and the
     chassis heading. Never raises for a log without them: ``reason`` says why."""
-    from wmr_mj.analysis.path_bound import path_bound, path_verdict
+    from wmr_mj.analysis.path_bound import guaranteed_E_max, path_bound, path_verdict
     from wmr_mj.analysis.path_error import path_error_series, summarize_series
     from wmr_mj.params import C80
     from wmr_mj.sim.config import build_reference, estimate_parameters
@@ -130,7 +130,11 @@ def path_of_log(log: RunLog, settle_s: float | None = None) -> LogPath:
         return LogPath(reason=f"C's desired path cannot be rebuilt ({exc})")
     errors = summarize_series(series, settle_s)
     cert = (log.summary or {}).get("certificate")
-    E_max = _number(cert.get("E_max")) if isinstance(cert, dict) and cert.get("valid") else None
+    E_max, why_not = None, ""
+    if isinstance(cert, dict):  # a certificate whose assumptions fail bounds no path (guaranteed_E_max)
+        unmet = [a.get("name") for a in cert.get("assumptions") or [] if not a.get("met")]
+        E_max, why_not = guaranteed_E_max(E_max=_number(cert.get("E_max")) if cert.get("valid") else None,
+                                          valid=bool(cert.get("valid")), unmet=unmet)
     try:
         stops = _number(log.parameters.get("steering_range"))
     except LogError:
@@ -139,6 +143,8 @@ def path_of_log(log: RunLog, settle_s: float | None = None) -> LogPath:
         bound = path_bound(reference, E_max, settle_s=settle_s, max_angle=stops)
     except WmrMjError:
         bound = path_bound(reference, E_max, max_angle=stops)
+    if why_not:
+        bound = replace(bound, reason=f"{bound.reason}: {why_not}")
     return LogPath(reference=reference, series=series, errors=errors, bound=bound,
                    verdict=path_verdict(errors, bound))
 

@@ -285,12 +285,13 @@ def judge_path(reference, t: np.ndarray, C_xy: np.ndarray, heading: np.ndarray, 
 
     reference: the run's Reference; t, C_xy (m, 2), heading: C's samples (the control steps of
     :func:`path_sample_index`, from the engine's rows and ``EngineRun.C_xy``, or the batch's);
-    the bound from the certificate's E_max when it is valid (else no bound), judged from
+    the bound from the certificate's E_max when it holds (valid, every assumption met: else no bound, and
+    the bound's reason says why; :func:`~wmr_mj.analysis.path_bound.guaranteed_E_max`), judged from
     ``settle_s`` on (from the start where the reference ends before it). None when no sample
     is finite (a diverged run): nothing to project. ``corrected``: the run had the Cartesian
     correction (position feedback at C); the bound and verdict say that no bound is proven for it.
     """
-    from wmr_mj.analysis.path_bound import path_bound, path_verdict
+    from wmr_mj.analysis.path_bound import guaranteed_E_max, path_bound, path_verdict
     from wmr_mj.analysis.path_error import path_error_series, summarize_series
 
     tt, X, h = np.asarray(t, float), np.asarray(C_xy, float), np.asarray(heading, float)
@@ -299,11 +300,14 @@ def judge_path(reference, t: np.ndarray, C_xy: np.ndarray, heading: np.ndarray, 
         return None
     series = path_error_series(reference, tt[ok], X[ok], h[ok])
     errors = summarize_series(series, settle_s)  # path_errors(...), with the series kept
-    E_max = certificate.E_max if certificate is not None and certificate.valid else None
+    E_max, why_not = (None, "") if certificate is None else guaranteed_E_max(
+        E_max=certificate.E_max, valid=certificate.valid, unmet=certificate.unmet)
     try:
         bound = path_bound(reference, E_max, settle_s=settle_s, max_angle=steering_range)
     except WmrMjError:  # the reference ends before settle_s
         bound = path_bound(reference, E_max, max_angle=steering_range)
+    if why_not:
+        bound = dataclasses.replace(bound, reason=f"{bound.reason}: {why_not}")
     verdict = path_verdict(errors, bound)
     if corrected:
         note = ("; with the Cartesian correction C's position is fed back, but no bound on C's path is proven "
