@@ -49,7 +49,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -70,6 +70,7 @@ __all__ = [
     "path_bound",
     "path_verdict",
     "guaranteed_E_max",
+    "without_guarantee",
     "straight_line_drift",
 ]
 
@@ -148,6 +149,10 @@ class PathBound:
         return d
 
 
+#: How a path bound without a bound on |E| says so.
+_NO_E_BOUND = "there is no bound on the steering error |E|"
+
+
 def guaranteed_E_max(*, E_max: float | None, valid: bool, unmet: Any = ()) -> tuple[float | None, str]:
     """The steering-error bound a path bound may rest on: the certificate's E_max when it holds.
 
@@ -164,11 +169,24 @@ def guaranteed_E_max(*, E_max: float | None, valid: bool, unmet: Any = ()) -> tu
     """
     names = [str(n) for n in unmet or ()]
     if not valid or E_max is None or not math.isfinite(float(E_max)):
-        return None, ""  # the path bound's own reason says it: "there is no bound on the steering error |E|"
+        return None, ""  # the path bound's own reason says it (_NO_E_BOUND)
     if names:
-        return None, (f"the certificate's |E| <= {float(E_max):.4g} rad does not hold: its assumptions are not met "
-                      f"({', '.join(names)}), so it bounds nothing")
+        return None, f"the certificate's |E| <= {float(E_max):.4g} rad does not hold: {', '.join(names)} not met"
     return float(E_max), ""
+
+
+def without_guarantee(bound: PathBound, why: str) -> PathBound:
+    """``bound`` (computed with no E_max) with its reason saying why the certificate's E_max was not used.
+
+    Args:
+        bound: a :class:`PathBound` of :func:`path_bound` with E_max None.
+        why: :func:`guaranteed_E_max`'s reason ('' leaves the bound as it is).
+    """
+    if not why:
+        return bound
+    reason = (bound.reason.replace(_NO_E_BOUND, f"{_NO_E_BOUND} ({why})", 1) if _NO_E_BOUND in bound.reason
+              else f"{bound.reason} ({why})")
+    return replace(bound, reason=reason)
 
 
 def _check_E(E_max: Any) -> float | None:
@@ -197,7 +215,7 @@ def circle_bound(radius: float, E_max: float | None, *, l1: float = C80.l1, V_A:
     a0 = steady_angle(R, l1)
     E = _check_E(E_max)
     if E is None:
-        return _no_bound("circle", "there is no bound on the steering error |E|", radius=R, alpha0=a0,
+        return _no_bound("circle", _NO_E_BOUND, radius=R, alpha0=a0,
                          settle_s=settle_s)
     lo, hi = a0 - E, a0 + E
     if max_angle is not None:
@@ -241,7 +259,7 @@ def line_bound(E_max: float | None, *, l1: float = C80.l1, V_A: float = C80.V_A,
     """On a straight line: no Cartesian guarantee; the drift rates an offset E_max [rad] gives."""
     E = _check_E(E_max)
     if E is None:
-        return _no_bound("line", "there is no bound on the steering error |E|", settle_s=settle_s)
+        return _no_bound("line", _NO_E_BOUND, settle_s=settle_s)
     rate = V_A * math.tan(E) / l1 if E < 0.5 * math.pi else math.inf
     side = V_A * math.tan(E) if E < 0.5 * math.pi else math.inf
     return PathBound(
@@ -294,7 +312,7 @@ def path_bound(reference: Any, E_max: float | None, *, settle_s: float | None = 
            + (", with straights" if straight else "") + "); the steady circle bound does not apply, and "
            "straights and transitions give no bound without position feedback")
     if E is None:
-        why = "there is no bound on the steering error |E|; " + why
+        why = f"{_NO_E_BOUND}; " + why
     return PathBound(kind="none", cross_track_bound=None, reason=f"no Cartesian guarantee: {why}",
                      assumptions=(_NO_SLIP, _NO_FEEDBACK), E_max=E, heading_rate_max=rate, settle_s=settle_s)
 

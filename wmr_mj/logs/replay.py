@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -105,7 +105,7 @@ def path_of_log(log: RunLog, settle_s: float | None = None) -> LogPath:
     """C's Cartesian errors in ``log``: the desired path rebuilt as the run built it (its path, the
     controller's parameter set, its control period and duration), C's logged positions and the
     chassis heading. Never raises for a log without them: ``reason`` says why."""
-    from wmr_mj.analysis.path_bound import guaranteed_E_max, path_bound, path_verdict
+    from wmr_mj.analysis.path_bound import guaranteed_E_max, path_bound, path_verdict, without_guarantee
     from wmr_mj.analysis.path_error import path_error_series, summarize_series
     from wmr_mj.params import C80
     from wmr_mj.sim.config import build_reference, estimate_parameters
@@ -143,8 +143,7 @@ def path_of_log(log: RunLog, settle_s: float | None = None) -> LogPath:
         bound = path_bound(reference, E_max, settle_s=settle_s, max_angle=stops)
     except WmrMjError:
         bound = path_bound(reference, E_max, max_angle=stops)
-    if why_not:
-        bound = replace(bound, reason=f"{bound.reason}: {why_not}")
+    bound = without_guarantee(bound, why_not)
     return LogPath(reference=reference, series=series, errors=errors, bound=bound,
                    verdict=path_verdict(errors, bound))
 

@@ -291,7 +291,7 @@ def judge_path(reference, t: np.ndarray, C_xy: np.ndarray, heading: np.ndarray, 
     is finite (a diverged run): nothing to project. ``corrected``: the run had the Cartesian
     correction (position feedback at C); the bound and verdict say that no bound is proven for it.
     """
-    from wmr_mj.analysis.path_bound import guaranteed_E_max, path_bound, path_verdict
+    from wmr_mj.analysis.path_bound import guaranteed_E_max, path_bound, path_verdict, without_guarantee
     from wmr_mj.analysis.path_error import path_error_series, summarize_series
 
     tt, X, h = np.asarray(t, float), np.asarray(C_xy, float), np.asarray(heading, float)
@@ -306,8 +306,7 @@ def judge_path(reference, t: np.ndarray, C_xy: np.ndarray, heading: np.ndarray, 
         bound = path_bound(reference, E_max, settle_s=settle_s, max_angle=steering_range)
     except WmrMjError:  # the reference ends before settle_s
         bound = path_bound(reference, E_max, max_angle=steering_range)
-    if why_not:
-        bound = dataclasses.replace(bound, reason=f"{bound.reason}: {why_not}")
+    bound = without_guarantee(bound, why_not)
     verdict = path_verdict(errors, bound)
     if corrected:
         note = ("; with the Cartesian correction C's position is fed back, but no bound on C's path is proven "
