@@ -176,11 +176,13 @@ class SampledDataInputs:
 
 
 def damped_loop(*, kp: float, kd: float, c_hat: float, control_period: float, cart: SampledCart) -> SampledLoop:
-    """The sampled loop of E'' = -u[k - d_a] - c^ E'[k] + w with u = K_P E^ + (K_D - c^) E^'.
+    """The sampled loop of E'' = -u[k - d_a] - c^ E'(t) + w with u = K_P E^ + (K_D - c^) E^', to second order in c^ T.
 
     :func:`~wmr_mj.analysis.sampled_data.sampled_loop` with the derivative gain K_D - c^ (the law's back-EMF
-    compensation C_V^ alpha_m' = C_V^ (alpha0' - E^') reads the same estimate), then the plant's back-EMF, held
-    at the sample: over a period E gains -T^2/2 c^ E'[k] and E' gains -T c^ E'[k] (the rest of -c^ E'(t) is in w).
+    compensation C_V^ alpha_m' = C_V^ (alpha0' - E^') reads the same estimate), then the plant's back-EMF over the
+    period: with s = t - t_k and u_a the held command, -c^ E'(t) = -c^ E'[k] + c^ s (u_a + c^ E'[k]) + rho(t),
+    |rho| <= c^^2 s^2/2 sup|E''| + c^ s sup|w| (left in the disturbance), so over one period
+    E gains -(T^2/2 - c^ T^3/6)(u_a + c^ E'[k]) and E' gains -(T - c^ T^2/2)(u_a + c^ E'[k]).
 
     Raises:
         ParameterError: K_D - c^ <= 0 (the sampled servo then has no damping of its own), as sampled_loop.
@@ -191,12 +193,23 @@ def damped_loop(*, kp: float, kd: float, c_hat: float, control_period: float, ca
     loop = sampled_loop(kp=kp, kd=kd_loop, control_period=control_period, velocity=cart.velocity,
                         filter_tau=cart.filter_tau, sensing_delay=cart.sensing_delay,
                         actuation_delay=cart.actuation_delay)
-    T = control_period
-    A = np.array(loop.A)
-    A[0, 1] -= 0.5 * T * T * c_hat
-    A[1, 1] -= T * c_hat
-    A.flags.writeable = False
-    return dataclasses.replace(loop, A=A)
+    T, n = control_period, loop.n_states
+    applied = np.zeros(n + 2)  # u[k - d_a] over (state, e, n_v)
+    if cart.actuation_delay:
+        applied[n - 1] = 1.0  # the last of the command's shift register
+    else:
+        applied[:n], applied[n:] = loop.C[2], loop.D[2]
+    drive = applied.copy()
+    drive[1] += c_hat  # u_a + c^ E'[k]
+    rows = np.zeros((2, n + 2))
+    rows[0, 0], rows[0, 1], rows[1, 1] = 1.0, T, 1.0
+    rows[0] -= (0.5 * T * T - c_hat * T ** 3 / 6.0) * drive
+    rows[1] -= (T - 0.5 * c_hat * T * T) * drive
+    A, B = np.array(loop.A), np.array(loop.B)
+    A[:2], B[:2] = rows[:, :n], rows[:, n:]
+    for x in (A, B):
+        x.flags.writeable = False
+    return dataclasses.replace(loop, A=A, B=B)
 
 
 def _initial_transient(loop: SampledLoop, cart: SampledCart, radius: float) -> np.ndarray:
@@ -313,9 +326,17 @@ def _solve_at(bound: _Bound, lin: _Linear, cart: SampledCart, T: float, c_hat: f
     delta_u = max(abs(m) for m in b.mis.values())
     delta_c = max(abs(c_hat - cv / p) for cv in (C_V_lo, C_V_hi) for p in corners)
     k_y = delta_c + b.dG / (c2 * P_lo)
-    k_A = c_hat * T + gam * lag / c2m
+    k_A = gam * lag / c2m  # the gyro compensation's age times sup|E''|
     (gE, gV, gU), (ME, MV, MU) = lin.g, lin.M
-    loop_gain = delta_u * gU + k_y * gV + (k_y * T + k_A) * (gU + c_hat * gV + 1.0)
+    # unknowns: W = sup|w| (the remainder), Wt = sup|w + rho| (what the loop is driven by), A2 = sup|E''|
+    q = 1.0 / (1.0 - c_hat * T)
+    h = 0.5 * c_hat * c_hat * T * T
+    K = k_y * T + k_A
+    a_W = W0 + delta_u * MU + k_y * MV + K * q * (MU + c_hat * MV)
+    b_W = delta_u * gU + k_y * gV + K * q * (gU + c_hat * gV)
+    r_W = 1.0 + c_hat * T + h * q
+    inner = K * q
+    loop_gain = (h * q * (gU + c_hat * gV) + r_W * b_W / (1.0 - inner)) if inner < 1.0 else math.inf
     terms = SampledDataTerms(
         gain_E_w=gE, gain_Edot_w=gV, gain_u_w=gU, gain_E_angle=float(lin.gains.gains[0, 1]),
         gain_E_velocity=float(lin.gains.gains[0, 4]), angle_channel=lin.angle_channel,
@@ -326,9 +347,10 @@ def _solve_at(bound: _Bound, lin: _Linear, cart: SampledCart, T: float, c_hat: f
     if not loop_gain < 1.0:
         return _Solved(x, y, inf, inf, inf, eps_a, inf, A_m, terms,
                        f"the sampled small gain fails: loop gain {loop_gain:.4g} >= 1")
-    W = (W0 + delta_u * MU + k_y * MV + (k_y * T + k_A) * (MU + c_hat * MV)) / (1.0 - loop_gain)
-    Es, Ys, U = ME + gE * W, MV + gV * W, MU + gU * W
-    A2 = U + c_hat * Ys + W
+    Wt = (r_W * a_W / (1.0 - inner) + h * q * (MU + c_hat * MV)) / (1.0 - loop_gain)
+    W = (a_W + b_W * Wt) / (1.0 - inner)
+    Es, Ys, U = ME + gE * Wt, MV + gV * Wt, MU + gU * Wt
+    A2 = q * (U + c_hat * Ys + W)
     y_new = Ys + T * A2
     x_new = Es + T * Ys + 0.5 * T * T * A2
     eps_v = cart.velocity_error + lag * (b.a0dd + A2)
