@@ -156,3 +156,8 @@ def test_a_run_on_the_12_bit_encoder_is_certified_inside():
     assert judged.certificate.claimant == SAMPLED_DATA
     # the 12-bit cart's stiction dead band, about F/(P^ K_P) = 0.039 rad (mismatch.md), is reached: not vacuous
     assert 0.2 < judged.E_ratio < 1.0
+
+
+def test_gaussian_noise_has_no_bound():
+    cert = _certify(_cart(Sensing(encoder_ticks=4096, noise_kind="gaussian", noise_alpha=0.001)))
+    assert not cert.valid and "Gaussian" in cert.reason

@@ -411,6 +411,10 @@ def sampled_certificate(*, plant: PlantBox, estimate: Estimate, gains: Gains, re
         raise ParameterError(f"control_period = {control_period!r} s is not accepted; a period > 0 s is required")
     bound = _Bound.of(plant, estimate, gains, reference, compensation, reference.alpha_max)
     c_hat = estimate.C_V / estimate.P
+    if not all(math.isfinite(v) for v in (cart.angle_error, cart.velocity_noise, cart.velocity_error,
+                                           cart.velocity_lag)):
+        return _invalid("a measurement error has no finite bound (Gaussian noise): no sampled-data bound", T, cart,
+                        bound, c_hat, limits, initial_error, stated, reference)
     try:
         lin = _linear(bound, cart, T, c_hat)
     except ParameterError as exc:
