@@ -45,6 +45,7 @@ from wmr_mj.analysis.sampled_data import PeakGains, SampledLoop, _norm_bound, _R
 from wmr_mj.analysis.small_gain import Compensation, Estimate, Gains, _Bound
 from wmr_mj.errors import ParameterError
 from wmr_mj.hardware.sensing import Sensing, measurement_error_bounds
+from wmr_mj.hardware.spec import whole_periods
 from wmr_mj.reference.bounds import ReferenceBounds
 
 __all__ = ["SAMPLED_DATA", "SampledCart", "SampledDataTerms", "SampledDataInputs", "sampled_certificate",
@@ -92,8 +93,6 @@ class SampledCart:
         Raises:
             ParameterError: a delay that is not a whole number of control periods.
         """
-        from wmr_mj.hardware.spec import whole_periods
-
         b = measurement_error_bounds(sensing, control_period=control_period, gear_ratio=gear_ratio, backlash=play)
         return cls(velocity=str(sensing.velocity), filter_tau=sensing.filter_tau,
                    sensing_delay=sensing.delay_steps(control_period),
