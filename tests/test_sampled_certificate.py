@@ -159,5 +159,18 @@ def test_a_run_on_the_12_bit_encoder_is_certified_inside():
 
 
 def test_gaussian_noise_has_no_bound():
-    cert = _certify(_cart(Sensing(encoder_ticks=4096, noise_kind="gaussian", noise_alpha=0.001)))
+    cert = _certify(_cart(Sensing(encoder_ticks=4096, noise_kind="gaussian", noise=0.001)))
     assert not cert.valid and "Gaussian" in cert.reason
+
+
+def test_the_printout_names_the_certificate_taken():
+    """A run judged by the sampled-data certificate says so, with what section 4 gave beside it; a run judged
+    by section 4's keeps its (4.23) line."""
+    from wmr_mj.analysis.verdicts import _which_certificate
+
+    sampled = {"condition": None, "inputs": {"certificate": "sampled-data", "certificates": {
+        "section-4": {"E_max": None, "reason": "no fixed point"}, "sampled-data": {"E_max": 0.1}}}}
+    assert _which_certificate(sampled) == "the sampled-data certificate (section 4's: none: no fixed point)"
+    bounded = {"inputs": {"certificate": "sampled-data", "certificates": {"section-4": {"E_max": 0.25}}}}
+    assert _which_certificate(bounded) == "the sampled-data certificate (section 4's: |E| <= 0.25 rad)"
+    assert _which_certificate({"condition": 0.5, "inputs": {}}).startswith("(4.23) = 0.5")

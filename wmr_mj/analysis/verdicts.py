@@ -263,6 +263,19 @@ def count_unmet(per_run: Iterable[Iterable[Mapping[str, Any]]]) -> list[dict[str
     return list(seen.values())
 
 
+def _which_certificate(cert: dict) -> str:
+    """Which analysis gave the run's certificate: section 4's condition (4.23), or, where a cart that is not
+    ideal gave the sampled-data certificate the smaller bound (:func:`wmr_mj.sim.certify.certificate_of`), its
+    name beside what section 4 gave."""
+    inputs = cert.get("inputs") or {}
+    if inputs.get("certificate") != "sampled-data":
+        return f"(4.23) = {_num(cert.get('condition'), '.4f')}"
+    other = (inputs.get("certificates") or {}).get("section-4") or {}
+    section4 = (f"|E| <= {_num(other.get('E_max'))} rad" if other.get("E_max") is not None
+                else f"none: {other.get('reason') or 'no finite bound'}")
+    return f"the sampled-data certificate (section 4's: {section4})"
+
+
 def format_unmet(unmet: Iterable[Mapping[str, Any]]) -> str:
     """'name (value vs limit); ...' of unmet assumptions ({name, value, limit}: :func:`unmet_assumptions`); an
     assumption about the cart (:data:`CART_ASSUMPTIONS`) with its note, 'name (value vs limit: note)'."""
@@ -311,8 +324,7 @@ def format_verdict(summary: Mapping[str, Any]) -> list[str]:
                      f"sup|E| = {_num(summary.get('sup_E'))} rad is judged against no region")
     else:
         lines.append(f"certificate:   |E| <= {_num(cert.get('E_max'))} rad, |E'| <= {_num(cert.get('Edot_max'))} "
-                     f"rad/s, (4.23) = {_num(cert.get('condition'), '.4f')}, run "
-                     f"{'inside' if cert.get('inside') else 'OUTSIDE'}")
+                     f"rad/s, {_which_certificate(cert)}, run {'inside' if cert.get('inside') else 'OUTSIDE'}")
     if summary.get("paper_claim_applies") is False:
         lines.append(f"paper's claim: {PAPER_CLAIM_NOT_APPLICABLE}")
     else:

@@ -309,7 +309,7 @@ def _with_sampled_data(cert: Certificate, config: Any, controller: Any, context:
     sign = controller.friction_sign
     estimate = Estimate(P=c.P, C_V=c.C_V, F=0.0 if sign == "none" else c.F, K=c.K, gyro=c.gyro,
                         V_A=controller.model.V_A)
-    play = config.transmission.backlash if config.sensing.encoder_on_motor else 0.0
+    play = config.transmission.backlash if config.sensing.reads_motor_side else 0.0
     try:
         cart = SampledCart.of(config.sensing, control_period=context.control_period, gear_ratio=plant.i2, play=play,
                               actuation_delay_s=config.actuation.delay, measurement=context.measurement)
