@@ -30,11 +30,11 @@ def _plot(fig: Any) -> ResultPlot:
 
 
 def run_bounds(summary: Any) -> tuple[float | None, float | None, str]:
-    """(E_max [rad], E'_max [rad/s], whose): the certificate's where the run is certified, else the paper's
-    claim where it has one (as validate's time histories)."""
+    """(E_max [rad], E'_max [rad/s], whose): the certificate's where it bounds E (said "uncertified" where an
+    assumption is not met), else the paper's claim where the run has one, else none."""
     judged = summary.certificate
-    if judged is not None and judged.certified:
-        return judged.E_max, judged.Edot_max, "certificate"
+    if judged is not None and judged.E_max is not None:
+        return judged.E_max, judged.Edot_max, "certificate" if judged.certified else "certificate, uncertified"
     if summary.paper_region is not None:
         return summary.E_max, summary.Edot_max, "paper's claim"
     return None, None, ""
