@@ -81,11 +81,11 @@ def _finite(x: float | None) -> float | None:
 
 def plot_sweep(result: Any) -> ResultPlot:
     """A sweep (``SweepResult``): sup|E| of every run against each ranged parameter (one panel each, the
-    value each run used), coloured by verdict, with the certificate's E_max dashed."""
+    value each run used), coloured by verdict, with the certificate's E_max: one dashed line where every run
+    has the same, else each run's as a dash at its value (a ranged cart's axis changes the claim)."""
     names = result.spec.names
     fig, axes = plots.new_figure(3.6 * len(names) + 0.6, 3.4, 1, len(names), sharey=True)
     axes = tuple(np.atleast_1d(axes))
-    e_max = _finite(result.summary.certificate_E_max)
     units = parameter_units(names)
     for ax, name in zip(axes, names):
         groups: dict[str, list[Any]] = {}
@@ -97,8 +97,13 @@ def plot_sweep(result: Any) -> ResultPlot:
             if runs:
                 ax.scatter([float(r[name]) for r in runs], [float(r["sup_E"]) for r in runs], s=14, color=colour,
                            label=verdict, zorder=3)
-        if e_max is not None:
-            ax.axhline(e_max, color="#1b4f72", ls="--", lw=1.0, label=f"certificate's E_max = {e_max:.3g} rad")
+        bounds = [(float(r[name]), float(r["cert_E_max"])) for r in result.rows if _finite(r.get("cert_E_max"))]
+        if bounds and all(b == bounds[0][1] for _, b in bounds):  # one certificate for every run: one line
+            ax.axhline(bounds[0][1], color="#1b4f72", ls="--", lw=1.0,
+                       label=f"certificate's E_max = {bounds[0][1]:.3g} rad")
+        elif bounds:  # each run's cart has its own claim (a cart's axis ranged): each run's bound, a dash
+            ax.scatter(*zip(*bounds), marker="_", s=160, color="#1b4f72", label="certificate's E_max, each run's",
+                       zorder=2)
         ax.set_xlabel(run_column(name, units))
     axes[0].set_ylabel("sup |E| [rad]")
     axes[-1].legend(loc="best", fontsize=6.5)
