@@ -29,7 +29,8 @@ import numpy as np
 from wmr_mj.errors import WmrMjError
 
 __all__ = ["NOTEBOOK_INSTALL", "require_pandas", "ROW_UNITS", "row_column", "RUN_COLUMNS", "run_column", "ResultPlot",
-           "PLOT_BACKEND", "plot", "rows_frame", "runs_frame", "records_frame", "html_lines", "verdict_counts_text"]
+           "PLOT_BACKEND", "plot", "rows_frame", "runs_frame", "records_frame", "compare_frame", "validate_frame",
+           "html_lines", "verdict_counts_text", "number", "run_html", "falsify_html", "compare_html", "validate_html"]
 
 #: what to run for the tables and the notebook (pyproject's optional extra)
 NOTEBOOK_INSTALL = "pip install 'wmr-mj[notebook]'"
@@ -177,8 +178,12 @@ def records_frame(records: Sequence[Mapping[str, Any]]) -> Any:
 
 
 def _scalar(value: Any) -> Any:
-    """A table's cell: numbers and words as they are, None as NaN's stand-in (None), a mapping or a sequence
-    never (a table holds no Python reprs): those are the caller's to flatten."""
+    """A table's cell: a number, a word, a flag or None (pandas makes None NaN in a column of numbers); never
+    a mapping or a sequence, whose Python repr a table would hold: those are the caller's to flatten.
+
+    Raises:
+        TypeError: a mapping or a sequence.
+    """
     if isinstance(value, Mapping | list | tuple):
         raise TypeError(f"a table cell must be a scalar, not {type(value).__name__}")
     return value
