@@ -95,7 +95,7 @@ suite = wm.load_suite("standard-v1")
 if QUICK:
     suite = dataclasses.replace(suite, duration=DURATION)
 designs = [wm.design_from_token(token, suite) for token in ("certified", "my_pid.py:MyPID,ki=10")]
-comparison = wm.compare(designs, suite, scenarios=["circle/nominal/none"], budget=0 if QUICK else 8)
+comparison = wm.compare(designs, suite, scenarios=["circle/nominal/none"], budget=0 if QUICK else 16)
 comparison.to_pandas()[["design", "scenario", "verdict", "sup_E [rad]", "rms_voltage [V]", "cross_track_max [m]"]]
 
 # %%
