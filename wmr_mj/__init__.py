@@ -5,9 +5,10 @@ The top level is the library's public API, enough for a notebook::
     import wmr_mj as wm
 
     result = wm.run_closed_loop(wm.RunConfig(**wm.CERTIFIED.config_changes(), m1=700.0))
-    result.summary.verdict  # 'certified-inside': the summary is a frozen record, read by attribute
-    result.to_pandas()      # one row per control step, columns with units (pip install 'wmr-mj[notebook]')
     result.plot().figure    # E, E' and the voltage between their bounds, C's path (docs/guides/notebook.md)
+    result.summary.verdict  # 'certified-inside': the summary is a frozen record, read by attribute
+
+``result.to_pandas()`` is its rows, one per control step, with units (``pip install 'wmr-mj[notebook]'``).
 
 The parameter set and the errors are imported at once; everything else (the simulation, sweeps,
 the search, logs, the certificate) on first use (PEP 562), because ``controllers`` imports
