@@ -11,7 +11,7 @@ STAMP := $(VENV)/.installed
 $(STAMP): pyproject.toml setup.py wmr_mj/sim/_compiled_law.c wmr_mj/analysis/_nearest_chord.c
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
-	$(PY) -m pip install -q -e '.[test,dask,video,docs,fast]'
+	$(PY) -m pip install -q -e '.[test,dask,video,docs,fast,notebook]'
 	touch $(STAMP)
 
 venv: $(STAMP)

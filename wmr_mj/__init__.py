@@ -5,7 +5,10 @@ The top level is the library's public API, enough for a notebook::
     import wmr_mj as wm
 
     result = wm.run_closed_loop(wm.RunConfig(**wm.CERTIFIED.config_changes(), m1=700.0))
+    result.plot().figure    # E, E' and the voltage between their bounds, C's path (docs/guides/notebook.md)
     result.summary.verdict  # 'certified-inside': the summary is a frozen record, read by attribute
+
+``result.to_pandas()`` is its rows, one per control step, with units (``pip install 'wmr-mj[notebook]'``).
 
 The parameter set and the errors are imported at once; everything else (the simulation, sweeps,
 the search, logs, the certificate) on first use (PEP 562), because ``controllers`` imports
@@ -40,15 +43,17 @@ if TYPE_CHECKING:
     from wmr_mj.report.results import ValidateSummary
     from wmr_mj.sim.certify import certificate_for
     from wmr_mj.sim.closed_loop import RunResult, run_closed_loop
-    from wmr_mj.sim.compare import CompareResult, compare
+    from wmr_mj.sim.compare import CompareReport, CompareResult, Design, DesignRow, compare, design_from_token
     from wmr_mj.sim.config import RunConfig, controller_for
     from wmr_mj.sim.designs import CERTIFIED, PAPER, PRESETS, preset
     from wmr_mj.sim.falsify import FalsifyReport, FalsifyResult, FalsifySpec, falsify
     from wmr_mj.sim.log_header import LogHeader
+    from wmr_mj.sim.notebook import ResultPlot
     from wmr_mj.sim.parts import RunParts, resolve_run
     from wmr_mj.sim.signals import Disturbance, LoadChange, Signals
     from wmr_mj.sim.suite import load_suite
     from wmr_mj.sim.sweep import SweepSpec, SweepSummary, run_sweep
+    from wmr_mj.sim.sweep_result import SweepResult, sweep
 
 #: name -> the module that defines it, imported on first access
 _LAZY: dict[str, str] = {
@@ -60,6 +65,8 @@ _LAZY: dict[str, str] = {
     "SweepSpec": "wmr_mj.sim.sweep",
     "run_sweep": "wmr_mj.sim.sweep",
     "SweepSummary": "wmr_mj.sim.sweep",
+    "sweep": "wmr_mj.sim.sweep_result",
+    "SweepResult": "wmr_mj.sim.sweep_result",
     "FalsifySpec": "wmr_mj.sim.falsify",
     "falsify": "wmr_mj.sim.falsify",
     "FalsifyResult": "wmr_mj.sim.falsify",
@@ -81,6 +88,11 @@ _LAZY: dict[str, str] = {
     "load_suite": "wmr_mj.sim.suite",
     "compare": "wmr_mj.sim.compare",
     "CompareResult": "wmr_mj.sim.compare",
+    "CompareReport": "wmr_mj.sim.compare",
+    "DesignRow": "wmr_mj.sim.compare",
+    "Design": "wmr_mj.sim.compare",
+    "design_from_token": "wmr_mj.sim.compare",
+    "ResultPlot": "wmr_mj.sim.notebook",
 }
 
 __all__ = [
@@ -117,6 +129,8 @@ __all__ = [
     "SweepSpec",
     "run_sweep",
     "SweepSummary",
+    "sweep",
+    "SweepResult",
     "FalsifySpec",
     "falsify",
     "FalsifyResult",
@@ -125,6 +139,12 @@ __all__ = [
     "load_suite",
     "compare",
     "CompareResult",
+    "CompareReport",
+    "DesignRow",
+    "Design",
+    "design_from_token",
+    # a result in a notebook: .to_pandas() (pip install 'wmr-mj[notebook]'), .plot() -> ResultPlot, _repr_html_
+    "ResultPlot",
     # the headline validation's summary (wmr-mj validate; summary.json is its to_dict())
     "ValidateSummary",
     # logs

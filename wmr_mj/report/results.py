@@ -184,3 +184,31 @@ class ValidateSummary(Record):
     def of(cls, summary: ValidateSummary | Mapping[str, Any]) -> ValidateSummary:
         """``summary`` itself, or the summary of its JSON (a summary.json read back)."""
         return summary if isinstance(summary, ValidateSummary) else cls.from_dict(summary)
+
+    # -- in a notebook (wmr_mj.sim.notebook): one row per rung, the ladder's figure, the verdict in a few lines
+    @property
+    def rungs(self) -> tuple[Rung, ...]:
+        """The ladder, the correction rung where there is one, then the user's designs."""
+        return (*self.ladder, *((self.correction_rung,) if self.correction_rung else ()), *self.designs)
+
+    def to_pandas(self) -> Any:
+        """One row per rung (:attr:`rungs`): its runs, each verdict's count, the certificate's bounds, the worst
+        sup|E| (and its m1), the worst ratios, effort, m1's range; units in the column names.
+
+        Raises:
+            WmrMjError: pandas is not installed (``pip install 'wmr-mj[notebook]'``).
+        """
+        from wmr_mj.sim import notebook
+
+        return notebook.validate_frame(self.rungs)
+
+    def plot(self) -> Any:
+        """The verdicts of each rung (the report's ladder figure), as a :class:`wmr_mj.sim.notebook.ResultPlot`."""
+        from wmr_mj.report.notebook import plot_validate
+
+        return plot_validate(self)
+
+    def _repr_html_(self) -> str:
+        from wmr_mj.sim import notebook
+
+        return notebook.validate_html(self)

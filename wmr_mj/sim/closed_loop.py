@@ -87,6 +87,31 @@ class RunResult:
     # sup|E'|, by name; the law's (LAW_CLAIM) is summary.certificate. Empty where the law failed.
     claims: Mapping[str, CertificateJudgement] = dataclasses.field(default_factory=dict)
 
+    # -- in a notebook (wmr_mj.sim.notebook): the rows as a table, the figure, the verdict in a few lines
+    def to_pandas(self) -> Any:
+        """The rows as a wide DataFrame: one row per control step, each column named with its unit (``t [s]``,
+        ``E [rad]``, ``E_dot [rad/s]``, ``voltage [V]``, ``alpha_measured [rad]`` where sensed, C's ``C_x [m]``,
+        ``C_y [m]``: :data:`wmr_mj.sim.notebook.ROW_UNITS`).
+
+        Raises:
+            WmrMjError: pandas is not installed (``pip install 'wmr-mj[notebook]'``).
+        """
+        from wmr_mj.sim import notebook
+
+        return notebook.rows_frame(self.rows, self.C_xy)
+
+    def plot(self, **options: Any) -> Any:
+        """E and E' between the certificate's bounds, the voltage between the supply limits, and C's path
+        (a :class:`wmr_mj.sim.notebook.ResultPlot`: ``.figure``, ``.axes``)."""
+        from wmr_mj.sim import notebook
+
+        return notebook.plot(self, "run", **options)
+
+    def _repr_html_(self) -> str:
+        from wmr_mj.sim import notebook
+
+        return notebook.run_html(self.summary)
+
 
 def requirement_rows(result: RunResult, requirements: Sequence[Any], *, base: C80Parameters = C80
                      ) -> Mapping[str, np.ndarray]:

@@ -270,6 +270,31 @@ class CompareResult:
 
     as_dict = to_dict  # the name of earlier versions (wmr_mj.report.compare calls it)
 
+    # -- in a notebook (wmr_mj.sim.notebook): one row per design and scenario, the table's figure, a few lines
+    def to_pandas(self) -> Any:
+        """One row per design and scenario, plain columns (no mapping in a cell): the run's verdict, sup|E|,
+        the certificate's E_max, each requirement's robustness and whether it held, effort and C's path;
+        then the design's adversary (the same on each of its rows).
+
+        Raises:
+            WmrMjError: pandas is not installed (``pip install 'wmr-mj[notebook]'``).
+        """
+        from wmr_mj.sim import notebook
+
+        return notebook.compare_frame(self.runs, self.rows)
+
+    def plot(self, **options: Any) -> Any:
+        """The comparison's figure (compare.png: the requirement checks held, effort against C's path), as a
+        :class:`wmr_mj.sim.notebook.ResultPlot`."""
+        from wmr_mj.sim import notebook
+
+        return notebook.plot(self, "compare", **options)
+
+    def _repr_html_(self) -> str:
+        from wmr_mj.sim import notebook
+
+        return notebook.compare_html(self.rows, self.claims_broken)
+
 
 @dataclass(frozen=True, kw_only=True)
 class CompareReport(Record):

@@ -1038,6 +1038,38 @@ class FalsifyResult:
         """The ``wmr-mj falsify --json`` object (:meth:`report`'s JSON)."""
         return self.report(log=log).to_dict()
 
+    # -- in a notebook (wmr_mj.sim.notebook): every run as a table, the search beside random, a few lines
+    def to_pandas(self) -> Any:
+        """One row per run, the search's then the random sample's: ``phase``, ``index``, ``generation``, the
+        values the run used (each ranged parameter, with units), ``objective``, then the run's verdict, sup|E|,
+        the certificate's bounds (``certificate_E_max [rad]``) and the paper's claim as a sweep's table.
+
+        Raises:
+            WmrMjError: pandas is not installed (``pip install 'wmr-mj[notebook]'``).
+        """
+        from wmr_mj.sim import notebook
+        from wmr_mj.sim.sweep import flat_row
+        from wmr_mj.sim.sweep_result import parameter_units
+
+        names = self.spec.names
+        rows = [{"phase": e.phase, "index": e.index, "generation": e.generation, **e.params,
+                 "objective": e.objective, **{k: v for k, v in flat_row(e.summary).items() if k not in e.params}}
+                for e in (*self.search, *self.random)]
+        return notebook.runs_frame(rows, parameters=names, units=parameter_units(names),
+                                   first=("phase", "index", "generation", "objective"))
+
+    def plot(self, **options: Any) -> Any:
+        """The search beside random: each run's objective and the running worst of each
+        (a :class:`wmr_mj.sim.notebook.ResultPlot`)."""
+        from wmr_mj.sim import notebook
+
+        return notebook.plot(self, "falsify", **options)
+
+    def _repr_html_(self) -> str:
+        from wmr_mj.sim import notebook
+
+        return notebook.falsify_html(self.report())
+
     as_dict = to_dict  # the name of earlier versions (tests and scripts call it)
 
 

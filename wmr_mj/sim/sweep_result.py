@@ -1,0 +1,100 @@
+"""A sweep as one typed result: its spec, every run's row and what they add up to, for a notebook.
+
+:func:`wmr_mj.sim.sweep.run_sweep` returns the runs' rows (runs.csv's columns, a list of mappings), as the
+CLI and validate read them; :func:`sweep` runs the same sweep and keeps the rows beside their
+:class:`~wmr_mj.sim.sweep.SweepSummary`, with a table (:meth:`SweepResult.to_pandas`), a figure
+(:meth:`SweepResult.plot`) and a few lines for a notebook. It writes nothing that ``run_sweep`` does not.
+
+Usage::
+
+    import wmr_mj as wm
+
+    result = wm.sweep(wm.SweepSpec(n=16, ranges={"sensing.delay": (0.0, 0.02)}, base=wm.RunConfig(duration=5.0)))
+    result.summary.passes, result.to_pandas()["sup_E [rad]"].max()
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from wmr_mj.sim.sweep import SweepSpec, SweepSummary, run_sweep
+
+__all__ = ["SweepResult", "sweep", "parameter_units"]
+
+
+def parameter_units(names: tuple[str, ...]) -> dict[str, str]:
+    """Each ranged parameter -> its unit (m1 in kg, a cart axis as ``HARDWARE_AXES`` says); others none."""
+    from wmr_mj.sim.search_space import HARDWARE_AXES
+
+    units = {"m1": "kg"}
+    for name in names:
+        text = HARDWARE_AXES.get(name)
+        if text:
+            units[name] = text.split(",")[0].split(":")[0].strip()
+    return units
+
+
+@dataclass(frozen=True)
+class SweepResult:
+    """Every run of a sweep and what they add up to (:func:`sweep`).
+
+    Attributes:
+        spec: the sweep.
+        rows: each run's row, in run order (runs.csv's columns: :func:`wmr_mj.sim.sweep.flat_row`).
+        summary: what the runs add up to.
+    """
+
+    spec: SweepSpec
+    rows: tuple[Mapping[str, Any], ...]
+    summary: SweepSummary
+
+    def to_pandas(self) -> Any:
+        """One row per run: the values each run used (m1 and every ranged parameter, with units), its verdict,
+        sup|E|, sup|E'|, the certificate's bounds and ratios (``certificate_E_max [rad]``), the paper's claim
+        (``paper_E_max [rad]``), effort and C's path (:data:`wmr_mj.sim.notebook.RUN_COLUMNS`).
+
+        Raises:
+            WmrMjError: pandas is not installed (``pip install 'wmr-mj[notebook]'``).
+        """
+        from wmr_mj.sim import notebook
+
+        return notebook.runs_frame(self.rows, parameters=self.spec.names, units=parameter_units(self.spec.names))
+
+    def plot(self, **options: Any) -> Any:
+        """sup|E| of every run against each ranged parameter, one panel each, with the certificate's E_max
+        (:class:`wmr_mj.sim.notebook.ResultPlot`)."""
+        from wmr_mj.sim import notebook
+
+        return notebook.plot(self, "sweep", **options)
+
+    def _repr_html_(self) -> str:
+        from wmr_mj.sim import notebook
+
+        s = self.summary
+        lines = [f"{s.n} runs over {', '.join(self.spec.names)}: {notebook.verdict_counts_text(s.verdicts)}",
+                 f"worst sup|E| {notebook.number(s.sup_E.value, 'rad')}; certificate's E_max "
+                 f"{notebook.number(s.certificate_E_max, 'rad')}; worst sup|E|/E_max "
+                 f"{notebook.number(s.certificate_E_ratio.value)}",
+                 f"mean time at the voltage limit {notebook.number(100 * s.mean_saturated_fraction, spec='.3g')} %"]
+        verdict = ("CERTIFIED-OUTSIDE in some run" if s.certified_outside else
+                   f"{s.passes}/{s.n} certified-inside")
+        return notebook.html_lines("sweep", verdict, lines)
+
+
+def sweep(spec: SweepSpec, *, out_dir: str | os.PathLike | None = None, chunk: int = 128, nthread: int = 0,
+          scheduler: str | None = None, progress: Callable[[float, int], None] | None = None) -> SweepResult:
+    """:func:`wmr_mj.sim.sweep.run_sweep` (the same runs, the same files with ``out_dir``), typed.
+
+    Args:
+        spec: the sweep.
+        out_dir, chunk, nthread, scheduler, progress: as :func:`~wmr_mj.sim.sweep.run_sweep`.
+
+    Returns:
+        SweepResult: the rows and their :class:`~wmr_mj.sim.sweep.SweepSummary`.
+    """
+    rows = run_sweep(spec, out_dir=out_dir, chunk=chunk, nthread=nthread, scheduler=scheduler, progress=progress)
+    summary = SweepSummary.of(rows, spec.requirements, names=spec.names)
+    return SweepResult(spec=spec, rows=tuple(rows), summary=summary)
