@@ -25,7 +25,8 @@ Usage::
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping
+import re
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -246,18 +247,59 @@ def unmet_assumptions(certificate: Mapping[str, Any] | None) -> list[dict[str, A
 
 def count_unmet(per_run: Iterable[Iterable[Mapping[str, Any]]]) -> list[dict[str, Any]]:
     """Each assumption unmet in some run, once, in the order first met: {name, value, limit} of the first
-    run that does not meet it and ``runs``, how many do not.
+    run that does not meet it, ``runs``, how many do not, and, where the runs' finite values differ,
+    ``value_range`` [lo, hi] over them (the assumption's units). A cart assumption's ``note`` quotes the
+    range over the runs of each number that differs between their notes (``b = 0.001-0.01 rad``), so that
+    no aggregate quotes one run's value as the runs'.
 
     Args:
         per_run: each run's unmet assumptions ({name, value, limit}: :func:`unmet_assumptions`).
     """
     seen: dict[str, dict[str, Any]] = {}
+    values: dict[str, list[float]] = {}
+    notes: dict[str, list[str]] = {}
     for unmet in per_run:
         for a in unmet:
-            first = {"name": str(a["name"]), "value": a.get("value"), "limit": a.get("limit"),
+            name = str(a["name"])
+            first = {"name": name, "value": a.get("value"), "limit": a.get("limit"),
                      **({"note": a["note"]} if a.get("note") and a["name"] in CART_ASSUMPTIONS else {}), "runs": 0}
-            seen.setdefault(str(a["name"]), first)["runs"] += 1
+            seen.setdefault(name, first)["runs"] += 1
+            value = a.get("value")
+            if isinstance(value, (int, float)) and math.isfinite(value):
+                values.setdefault(name, []).append(float(value))
+            if a.get("note") and name in CART_ASSUMPTIONS:
+                notes.setdefault(name, []).append(str(a["note"]))
+    for name, entry in seen.items():
+        finite = values.get(name, [])
+        if finite and min(finite) != max(finite):
+            entry["value_range"] = [min(finite), max(finite)]
+        if "note" in entry:
+            entry["note"] = merged_note(notes[name])
     return list(seen.values())
+
+
+_NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
+
+
+def merged_note(notes: Sequence[str]) -> str:
+    """One note for many runs' notes of one assumption: where they are the same text but for their numbers,
+    each number that differs becomes its range over the runs, 'LO-HI' (as the notes write them); where their
+    words differ, the first note and how many others differ.
+
+    Args:
+        notes: the runs' notes, in run order (at least one).
+    """
+    skeletons = {tuple(_NUMBER.split(n)) for n in notes}
+    if len(skeletons) > 1:
+        others = len(set(notes)) - 1
+        return f"{notes[0]} (in the first such run; {others} other note(s) over the runs)"
+    (skeleton,) = skeletons
+    columns = list(zip(*(_NUMBER.findall(n) for n in notes)))
+    pieces = [skeleton[0]]
+    for texts, tail in zip(columns, skeleton[1:]):
+        lo, hi = min(texts, key=float), max(texts, key=float)
+        pieces += [lo if float(lo) == float(hi) else f"{lo}-{hi}", tail]
+    return "".join(pieces)
 
 
 def format_unmet(unmet: Iterable[Mapping[str, Any]]) -> str:
@@ -266,8 +308,11 @@ def format_unmet(unmet: Iterable[Mapping[str, Any]]) -> str:
     def why(a: Mapping[str, Any]) -> str:
         return f": {a['note']}" if a.get("note") and a.get("name") in CART_ASSUMPTIONS else ""
 
-    return "; ".join(f"{a['name']} ({_num(a.get('value'), '.4g')} vs {_num(a.get('limit'), '.4g')}{why(a)})"
-                     for a in unmet)
+    def value(a: Mapping[str, Any]) -> str:
+        span = a.get("value_range")  # over the runs (count_unmet), where their values differ
+        return (f"{_num(span[0], '.4g')}-{_num(span[1], '.4g')}" if span else _num(a.get("value"), ".4g"))
+
+    return "; ".join(f"{a['name']} ({value(a)} vs {_num(a.get('limit'), '.4g')}{why(a)})" for a in unmet)
 
 
 def format_verdict(summary: Mapping[str, Any]) -> list[str]:

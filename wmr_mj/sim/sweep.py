@@ -53,6 +53,9 @@ __all__ = [
     "SAMPLINGS",
     "RESULT_COLUMNS",
     "read_results",
+    "read_runs",
+    "csv_number",
+    "CSV_SIGNIFICANT_DIGITS",
     "run_configs",
     "flat_row",
     "max_at",
@@ -204,7 +207,8 @@ class SweepSpec:
         return hashlib.sha256(json.dumps(obj, sort_keys=True, default=str).encode()).hexdigest()[:16]
 
 
-#: sweep summary keys of the paper's region, deprecated (kept for one version), and their new names
+#: the paper's deprecated aliases of a sweep summary, which sit under its ``paper`` key (never at the top
+#: level, where a reader took them for the certificate's), and the top-level keys of the same numbers
 SWEEP_KEYS_DEPRECATED = {"inside": "paper_inside", "outside": "paper_outside", "worst_E_ratio": "worst_paper_E_ratio",
                          "worst_Edot_ratio": "worst_paper_Edot_ratio", "E_max": "paper_E_max",
                          "Edot_max": "paper_Edot_max"}
@@ -329,9 +333,21 @@ def run_configs(configs: Sequence[RunConfig], *, chunk: int = 128, nthread: int 
     return reports
 
 
+#: significant digits of a number in a CSV table (runs.csv, falsify's evaluations.csv): 0.009 where the float
+#: is 0.009000000000000001. Full precision is kept in the JSON (summary.json, :data:`PRECISE_ROWS`).
+CSV_SIGNIFICANT_DIGITS = 12
+#: the sweep folder's file of every runs.csv row at full precision (JSON: floats round-trip exactly), which
+#: a resumed sweep and validate's rungs read (:func:`read_runs`), so that no number they report is rounded
+PRECISE_ROWS = "runs-full-precision.json"
+
+
+def _columns(extra: Sequence[str], tail: Sequence[str] = ()) -> list[str]:
+    return list(RESULT_COLUMNS[:2]) + list(extra) + list(RESULT_COLUMNS[2:]) + list(tail)
+
+
 def _csv_text(rows: list[dict[str, Any]], extra: Sequence[str], tail: Sequence[str] = ()) -> str:
     buf = io.StringIO()
-    cols = list(RESULT_COLUMNS[:2]) + list(extra) + list(RESULT_COLUMNS[2:]) + list(tail)
+    cols = _columns(extra, tail)
     w = csv.DictWriter(buf, fieldnames=cols, extrasaction="ignore", lineterminator="\n")
     w.writeheader()
     for r in sorted(rows, key=lambda r: r["run"]):
@@ -339,19 +355,44 @@ def _csv_text(rows: list[dict[str, Any]], extra: Sequence[str], tail: Sequence[s
     return buf.getvalue()
 
 
+def csv_number(value: float) -> str:
+    """CSV text of a float: rounded to :data:`CSV_SIGNIFICANT_DIGITS` significant digits, then the shortest
+    text of that float (repr): '0.009' for 0.009000000000000001, 'nan', 'inf'."""
+    return repr(float(f"{float(value):.{CSV_SIGNIFICANT_DIGITS}g}"))
+
+
 def _cell(value: Any) -> Any:
-    """CSV text of a value: floats round-trip exactly (repr), None is empty."""
+    """CSV text of a value: floats to :data:`CSV_SIGNIFICANT_DIGITS` digits (:func:`csv_number`), None is empty."""
     if value is None:
         return ""
     if isinstance(value, (bool, np.bool_)):
         return str(bool(value))
     if isinstance(value, (float, np.floating)):
-        return repr(float(value))
+        return csv_number(value)
     return value
 
 
+def _precise(value: Any) -> Any:
+    """A runs.csv cell at full precision, typed as :func:`read_results` parses the cell (numbers as float)."""
+    if value is None or isinstance(value, (bool, np.bool_)):
+        return None if value is None else bool(value)
+    if isinstance(value, (int, float, np.integer, np.floating)):
+        return float(value)
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        return value
+
+
+def _precise_rows(rows: list[dict[str, Any]], extra: Sequence[str], tail: Sequence[str] = ()) -> list[dict]:
+    cols = _columns(extra, tail)
+    return [{k: int(r["run"]) if k == "run" else _precise(r.get(k)) for k in cols}
+            for r in sorted(rows, key=lambda r: r["run"])]
+
+
 def read_results(path: str | os.PathLike) -> list[dict[str, Any]]:
-    """Rows of a sweep's runs.csv, numbers parsed."""
+    """Rows of a sweep's runs.csv, numbers parsed (as the CSV holds them: :data:`CSV_SIGNIFICANT_DIGITS`
+    digits; :func:`read_runs` reads a folder's rows at full precision)."""
     out = []
     with open(path, newline="") as f:
         for row in csv.DictReader(f):
@@ -368,6 +409,21 @@ def read_results(path: str | os.PathLike) -> list[dict[str, Any]]:
                         parsed[k] = v
             out.append(parsed)
     return out
+
+
+def read_runs(folder: str | os.PathLike) -> list[dict[str, Any]]:
+    """Rows of a sweep folder's runs.csv, each at full precision where :data:`PRECISE_ROWS` holds its run
+    (written before runs.csv after every chunk, so it holds every run the CSV does; a folder written before
+    that file: the CSV's rows), typed as :func:`read_results` types them."""
+    rows = read_results(Path(folder) / "runs.csv")
+    path = Path(folder) / PRECISE_ROWS
+    if not path.is_file():
+        return rows
+    try:
+        precise = {int(r["run"]): r for r in json.loads(path.read_text())}
+    except (json.JSONDecodeError, KeyError, TypeError, ValueError):
+        return rows  # unreadable: the CSV's rows, as before that file existed
+    return [dict(precise.get(int(r["run"]), r)) for r in rows]
 
 
 def connect(scheduler: str):
@@ -420,7 +476,7 @@ def run_sweep(spec: SweepSpec, *, out_dir: str | os.PathLike | None = None, chun
             except json.JSONDecodeError:
                 state = {}
             if state.get("fingerprint") == fp:
-                for r in read_results(csv_path):
+                for r in read_runs(out):
                     done[int(r["run"])] = r
             elif (other := _other_law(state, spec)) and read_results(csv_path):
                 # another law's runs are never taken for this one's, nor written over
@@ -435,7 +491,10 @@ def run_sweep(spec: SweepSpec, *, out_dir: str | os.PathLike | None = None, chun
         for r in reports:
             done[r["run"]] = flat_row(r)
         if out is not None:
-            write_text_atomic(out / "runs.csv", _csv_text(list(done.values()), extra, spec.requirement_columns))
+            rows = list(done.values())
+            # NaN and inf as Python's json writes them: read back as the same floats (json_safe would null them)
+            write_text_atomic(out / PRECISE_ROWS, json.dumps(_precise_rows(rows, extra, spec.requirement_columns)))
+            write_text_atomic(out / "runs.csv", _csv_text(rows, extra, spec.requirement_columns))
         if progress is not None:
             progress(len(done), spec.n)
 
@@ -712,14 +771,14 @@ class SweepSummary(Record):
             "certificate_E_max": self.certificate_E_max,
             "certificate_Edot_max": self.certificate_Edot_max,
             "drift_growing": self.growing,
-            "inside": self.paper_inside,
-            "outside": None if self.paper_inside is None else self.n - self.paper_inside,
-            "worst_E_ratio": self.paper_E_ratio.value,
-            "worst_Edot_ratio": self.paper_Edot_ratio.value,
+            "paper_inside": self.paper_inside,
+            "paper_outside": None if self.paper_inside is None else self.n - self.paper_inside,
+            "worst_paper_E_ratio": self.paper_E_ratio.value,
+            "worst_paper_Edot_ratio": self.paper_Edot_ratio.value,
             "worst_sup_E": self.sup_E.value,
             "worst_sup_Edot": self.sup_Edot.value,
-            "E_max": self.paper_E_max,
-            "Edot_max": self.paper_Edot_max,
+            "paper_E_max": self.paper_E_max,
+            "paper_Edot_max": self.paper_Edot_max,
             "hit_steering_stop": self.hit_stop,
             "steps": self.steps,
             "wall_s": wall_s,
@@ -736,9 +795,8 @@ class SweepSummary(Record):
             "claim_broken": None if self.claim_broken is None else self.claim_broken.to_dict(),
             "unmet": [a.to_dict() for a in self.unmet],
         }
-        # the paper's region under names that say so (the unprefixed keys above: deprecated, kept one version)
-        out.update({new: out[old] for old, new in SWEEP_KEYS_DEPRECATED.items()})
-        out["deprecated_keys"] = dict(SWEEP_KEYS_DEPRECATED)
+        # the paper's deprecated aliases, under ``paper`` only: at the top level they read as the certificate's
+        out["paper"] = {old: out[new] for old, new in SWEEP_KEYS_DEPRECATED.items()}
         if self.paper_inside is None:
             out["paper_claim_applies"] = False
             out["not_applicable"] = {"paper_inside": "the paper's region is for its computed-torque law "
