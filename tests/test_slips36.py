@@ -103,3 +103,81 @@ def test_the_unmet_record_round_trips_its_range():
     a = UnmetAssumption.from_dict({"name": "x", "value": 1.0, "limit": 0.5, "runs": 2, "value_range": [1.0, 2.0]})
     assert a.value_range == (1.0, 2.0) and a.to_dict()["value_range"] == [1.0, 2.0]
     assert "value_range" not in UnmetAssumption(name="x", value=1.0, limit=0.5).to_dict()
+
+
+# -- 2: falsify records the value each run used --------------------------------------------------
+
+def test_falsify_records_the_encoder_bits_each_run_used(tmp_path):
+    """A search over sensing.encoder_bits proposes fractional bits; the run has 2**round(bits) ticks, and the
+    JSON, the evaluations and evaluations.csv record those whole bits (as sweep's runs.csv does)."""
+    from wmr_mj.sim.designs import CERTIFIED
+    from wmr_mj.sim.falsify import FalsifySpec, falsify, worst_config
+
+    base = RunConfig(**CERTIFIED.config_changes(), duration=9.0, sensing="magnetic-12bit-axis")
+    spec = FalsifySpec(base=base, box={"sensing.encoder_bits": (10.6, 13.4)}, objective="sup-E", budget=5,
+                       method="vertices-polish", seed=1)
+    assert spec.recorded_values([11.533]) == {"sensing.encoder_bits": 12.0}
+    assert spec.config([11.533]).sensing.encoder_ticks == 4096
+    result = falsify(spec, nthread=1)
+    for e in (*result.search, *result.random):
+        bits = e.params["sensing.encoder_bits"]
+        assert bits == round(e.point[0]) and bits.is_integer()  # the run's, not the proposed point
+        assert spec.config(e.point).sensing.encoder_ticks == 2 ** int(bits)
+    assert any(e.point[0] != e.params["sensing.encoder_bits"] for e in result.random)  # the sample is fractional
+    assert worst_config(result).sensing.encoder_ticks == 2 ** int(result.worst.params["sensing.encoder_bits"])
+    assert result.report().worst.params["sensing.encoder_bits"] == result.worst.params["sensing.encoder_bits"]
+
+    from wmr_mj.cli.falsify import _table
+
+    rows = list(csv.DictReader(_table(result).splitlines()))
+    assert {float(r["sensing.encoder_bits"]) for r in rows} <= {11.0, 12.0, 13.0}
+
+
+# -- 3: an objective undefined for every run, refused before any step -----------------------------
+
+def test_falsify_refuses_an_objective_undefined_for_every_run_before_any_step(tmp_path, capsys):
+    from wmr_mj.cli.app import main
+
+    out = tmp_path / "f"
+    code = main(["falsify", "--preset", "certified", "--sensing", "magnetic-12bit-axis", "--budget", "8",
+                 "--duration", "10", "--out", str(out)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1, err
+    assert "undefined for every run" in err[0] and "--objective sup-E" in err[0]
+    assert not out.exists()  # nothing written, nothing stepped
+
+
+def test_a_box_that_reaches_the_certificate_is_not_refused_up_front():
+    """Where a run's certificate may differ from the base's (a cart axis, its limits), the base's says nothing of
+    every run's: no refusal before the runs."""
+    from wmr_mj.sim.falsify import shares_the_base_certificate
+
+    ideal = RunConfig()
+    sensed = RunConfig(sensing="magnetic-12bit-axis")
+    assert shares_the_base_certificate(ideal, ["m1", "mu", "R_a", "i2"])
+    assert not shares_the_base_certificate(ideal, ["m1", "sensing.delay"])
+    assert not shares_the_base_certificate(ideal, ["m1", "voltage_limit"])
+    assert shares_the_base_certificate(sensed, ["m1", "R_a"]) and not shares_the_base_certificate(sensed, ["i2"])
+
+
+# -- 4: falsify warns of runs its objective leaves blank ------------------------------------------
+
+def _evaluations(phase: str, objectives: list[float | None]):
+    from wmr_mj.sim.falsify import Evaluation
+
+    return [Evaluation(phase=phase, index=i, generation=0, params={"m1": 600.0 + i}, objective=v,
+                       summary={"sup_E": 0.01 * (i + 1), "sup_Edot": 0.1}) for i, v in enumerate(objectives)]
+
+
+def test_falsify_warns_how_many_runs_have_no_certificate_objective():
+    from wmr_mj.sim.falsify import FalsifyResult, FalsifySpec, undefined_objective_warning
+
+    spec = FalsifySpec(box={"m1": (600.0, 700.0)}, budget=16)
+    blank = FalsifyResult(spec=spec, search=_evaluations("search", [None] * 11 + [0.5] * 5),
+                          random=_evaluations("random", [0.2, None]), objective_source="certificate.E_ratio")
+    text = undefined_objective_warning(blank)
+    assert text is not None and text.startswith("WARNING: 11 of 16 search runs, 1 of 2 random runs")
+    assert "sup|E|/E_max of the certificate" in text and "--objective sup-E" in text
+    full = FalsifyResult(spec=spec, search=_evaluations("search", [0.1, 0.2]),
+                         random=_evaluations("random", [0.3]), objective_source="certificate.E_ratio")
+    assert undefined_objective_warning(full) is None

@@ -368,7 +368,7 @@ def _cell(value: Any) -> Any:
     if isinstance(value, (bool, np.bool_)):
         return str(bool(value))
     if isinstance(value, (float, np.floating)):
-        return csv_number(value)
+        return csv_number(float(value))
     return value
 
 
