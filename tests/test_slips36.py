@@ -181,3 +181,55 @@ def test_falsify_warns_how_many_runs_have_no_certificate_objective():
     full = FalsifyResult(spec=spec, search=_evaluations("search", [0.1, 0.2]),
                          random=_evaluations("random", [0.3]), objective_source="certificate.E_ratio")
     assert undefined_objective_warning(full) is None
+
+
+# -- 9: a drift test that does not fire on a settled run ------------------------------------------
+
+def _drift_of_signal(E, period: float = 0.001):
+    from wmr_mj.sim.closed_loop import _drift_of
+
+    return _drift_of(E, 0.0, period)
+
+
+def test_a_run_settled_onto_a_larger_plateau_is_not_growing():
+    """|E| rises through the window before the last and settles (to the last bits) early in the last one:
+    the last window's max exceeds the previous one's by 1.8e-4 rad (the old test fired), and yet it is settled."""
+    import numpy as np
+
+    t = np.arange(20000) * 0.001  # 20 s at 1 kHz: windows [10, 15) and [15, 20)
+    E = np.where(t < 14.0, 0.0, 0.005 * (1.0 - np.exp(-(t - 14.0) / 0.3)))
+    E = E + 1e-13 * np.sin(997.0 * t)  # a rounding floor
+    d = _drift_of_signal(E)
+    assert d.E_last_window - d.E_prev_window > 1e-4  # what fired before
+    assert d.growing is False
+
+
+def test_a_genuinely_growing_run_is_growing_and_a_creeping_one_is_not():
+    import numpy as np
+
+    t = np.arange(20000) * 0.001
+    assert _drift_of_signal(1e-4 * t).growing is True  # 100 urad/s to the end: 5x the tolerance's rate
+    assert _drift_of_signal(0.002 + 5e-6 * t).growing is False  # stiction's creep: a few urad/s (model card)
+    growing_oscillation = 0.01 * np.exp(0.1 * t) * np.sin(2 * np.pi * t)  # an unstable mode's envelope
+    assert _drift_of_signal(growing_oscillation).growing is True
+    assert _drift_of_signal(np.full(20000, np.inf)).growing is True  # diverged: never settled
+
+
+def test_the_drift_without_halves_is_the_two_windows_test():
+    from wmr_mj.analysis.verdicts import DRIFT_TOLERANCE, drift
+
+    assert drift(prev_window=0.0, last_window=2 * DRIFT_TOLERANCE, final_alpha_dot=0.0).growing is True
+    assert drift(prev_window=0.0, last_window=2 * DRIFT_TOLERANCE, final_alpha_dot=0.0,
+                 last_halves=(2 * DRIFT_TOLERANCE, 2 * DRIFT_TOLERANCE)).growing is False
+    assert drift(prev_window=0.0, last_window=2 * DRIFT_TOLERANCE, final_alpha_dot=0.0,
+                 last_halves=(0.5 * DRIFT_TOLERANCE, 2 * DRIFT_TOLERANCE)).growing is True
+
+
+def test_the_batch_judges_the_drift_as_the_serial_run():
+    """The batch folds the same halves per block as the serial run reads from its rows: the same Drift."""
+    from wmr_mj.sim.batch import run_batch
+    from wmr_mj.sim.closed_loop import run_closed_loop
+
+    configs = [RunConfig(model="nonholonomic", duration=10.0, m1=m1) for m1 in (560.0, 740.0)]
+    for config, batched in zip(configs, run_batch(configs, nthread=1)):
+        assert batched.drift == run_closed_loop(config, progress=False).summary.drift

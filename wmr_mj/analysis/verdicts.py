@@ -140,20 +140,34 @@ class RunJudgement:
     drift: Drift | None
 
 
-def drift(*, prev_window: float, last_window: float, final_alpha_dot: float) -> Drift:
+def drift(*, prev_window: float, last_window: float, final_alpha_dot: float,
+          last_halves: tuple[float, float] | None = None) -> Drift:
     """The end-of-run drift.
+
+    A run that settles onto a larger steady |E| (a transient that rose through the previous window, then a
+    plateau) has a last window above the previous one, yet is settled: growth counts only where it goes on
+    through the last window itself, its second half above its first by more than half the tolerance (the same
+    rate, :data:`DRIFT_TOLERANCE` per :data:`DRIFT_WINDOW_S`, over half the time). A settled |E| (constant to
+    the last bits) never grows; |E| that rises at that rate or faster to the end does.
 
     Args:
         prev_window: max |E| over the window before the last [rad].
         last_window: max |E| over the last window [rad].
         final_alpha_dot: alpha' at the last control step [rad/s].
+        last_halves: max |E| over the first and the second half of the last window [rad]; None (or a
+            window of one step): the two windows alone judge.
 
     Returns:
-        Drift: growing when the last window exceeds the previous by more than
-        :data:`DRIFT_TOLERANCE`, or either is not finite.
+        Drift: growing when the last window exceeds the previous by more than :data:`DRIFT_TOLERANCE` and
+        (with ``last_halves``) the last window's second half exceeds its first by more than half of it, or
+        when either window is not finite.
     """
     growing = bool(math.isfinite(last_window) and math.isfinite(prev_window)
                    and last_window - prev_window > DRIFT_TOLERANCE)
+    if growing and last_halves is not None:
+        first, second = last_halves
+        growing = bool(not (math.isfinite(first) and math.isfinite(second))
+                       or second - first > 0.5 * DRIFT_TOLERANCE)
     if not (math.isfinite(last_window) and math.isfinite(prev_window)):
         growing = True  # a diverged run is not settled
     return Drift(final_alpha_dot=float(final_alpha_dot), growing=growing, E_last_window=float(last_window),

@@ -110,6 +110,7 @@ class _BatchStats:
     law_nan: np.ndarray = field(init=False)  # the law gave NaN: re-run as a single run
     drift_prev: np.ndarray = field(init=False)  # max |E| over the window before the last (wmr_mj.analysis.verdicts)
     drift_last: np.ndarray = field(init=False)  # max |E| over the last window
+    drift_halves: np.ndarray = field(init=False)  # (nsim, 2) max |E| over the first and second half of the last
     final_alpha_dot: np.ndarray = field(init=False)  # alpha0' - E' of the last control step
     path_samples: int = 0  # control steps at which C is sampled (closed_loop.path_sample_index)
     C_xy: np.ndarray = field(init=False)  # (nsim, path_samples, 2) C's xy there [m]
@@ -123,6 +124,7 @@ class _BatchStats:
         self.saturated, self.warnings = np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64)
         self.left_at, self.final_alpha, self.final_alpha_after_step = (np.full(n, np.nan) for _ in range(3))
         self.drift_prev, self.drift_last = np.zeros(n), np.zeros(n)
+        self.drift_halves = np.zeros((n, 2))
         self.final_alpha_dot = np.full(n, np.nan)
         self.C_xy = np.full((n, self.path_samples, 2), np.nan)
         self.heading = np.full((n, self.path_samples), np.nan)
@@ -305,6 +307,11 @@ def _block_stats(loop: _Loop, stats: _BatchStats, idx: np.ndarray, k0: int, rows
         a, b = max(lo_k - k0, 0), min(hi_k - k0, rows)
         if a < b:
             out[idx] = np.maximum(out[idx], E[a:b].max(axis=0))
+    half = loop.n - w + w // 2  # the last window's halves (wmr_mj.sim.closed_loop._drift_of)
+    for j, (lo_k, hi_k) in enumerate(((loop.n - w, half), (half, loop.n))):
+        a, b = max(lo_k - k0, 0), min(hi_k - k0, rows)
+        if a < b:
+            stats.drift_halves[idx, j] = np.maximum(stats.drift_halves[idx, j], E[a:b].max(axis=0))
 
 
 def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parameters = C80,
@@ -498,7 +505,9 @@ def _summaries(configs: Sequence[RunConfig], plants: Sequence[C80Parameters], st
         r = report(c, measured, analysis=analysis, params=p, certificate=certificate,
                    claims_nothing=certificate is None, name=run.parts.controller_name,
                    drift=drift(prev_window=float(stats.drift_prev[i]), last_window=float(stats.drift_last[i]),
-                               final_alpha_dot=float(stats.final_alpha_dot[i])),
+                               final_alpha_dot=float(stats.final_alpha_dot[i]),
+                               last_halves=((float(stats.drift_halves[i, 0]), float(stats.drift_halves[i, 1]))
+                                            if run.loop.drift_k >= 2 else None)),
                    path=paths[i])
         if stats.law_nan[i] if backend == "numpy" else stats.warnings[i]:
             # NumPy law: NaN from the law, where the serial loop applies 0 V and MuJoCo would zero

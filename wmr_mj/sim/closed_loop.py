@@ -322,8 +322,10 @@ def _drift_of(E: np.ndarray, final_alpha_dot: float, period: float) -> Drift:
 
     k = len(E)
     w = drift_window_steps(k, period)
+    h = k - w + w // 2  # the last window's halves: [k - w, h) and [h, k)
     return drift(prev_window=_sup(E[max(0, k - 2 * w):k - w]), last_window=_sup(E[k - w:]),
-                 final_alpha_dot=final_alpha_dot)
+                 final_alpha_dot=final_alpha_dot,
+                 last_halves=(_sup(E[k - w:h]), _sup(E[h:])) if w >= 2 else None)
 
 
 def run_closed_loop(
