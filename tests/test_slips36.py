@@ -233,3 +233,55 @@ def test_the_batch_judges_the_drift_as_the_serial_run():
     configs = [RunConfig(model="nonholonomic", duration=10.0, m1=m1) for m1 in (560.0, 740.0)]
     for config, batched in zip(configs, run_batch(configs, nthread=1)):
         assert batched.drift == run_closed_loop(config, progress=False).summary.drift
+
+
+# -- 1: a fixed m1 on sweep and falsify ------------------------------------------------------------
+
+def test_a_sweep_with_a_fixed_m1_sweeps_the_delay_alone(tmp_path, capsys):
+    import json
+
+    from wmr_mj.cli.app import main
+
+    out = tmp_path / "s"
+    assert main(["sweep", "--preset", "certified", "--m1", "650", "--range", "sensing.delay=0:0.004", "--n", "3",
+                 "--sampling", "grid", "--duration", "9", "--nthread", "1", "--out", str(out), "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    rows = read_runs(out)
+    assert [r["m1"] for r in rows] == [650.0] * 3  # exactly: a zero-width draw
+    assert [r["sensing.delay"] for r in rows] == [0.0, 0.002, 0.004]  # a 3-point grid over the delay alone
+    assert summary["fixed_m1"] == 650.0 and summary["ranges"]["m1"] == [550.0, 750.0]  # the box stays
+
+
+def test_a_zero_width_m1_range_is_a_fixed_m1(tmp_path, capsys):
+    """--m1-range 650 650 was refused; it is --m1 650 (the certificate's box: the default range)."""
+    from wmr_mj.cli.app import build_parser
+    from wmr_mj.cli.falsify import _base_and_box
+    from wmr_mj.cli.sweep import fixed_m1_from_args
+
+    parser = build_parser()
+    args = parser.parse_args(["sweep", "--m1-range", "650", "650", "--range", "sensing.delay=0:0.01"])
+    assert fixed_m1_from_args(args) == 650.0 and list(args.m1_range) == [550.0, 750.0]
+    spec = SweepSpec(n=4, m1=650.0, ranges={"sensing.delay": (0.0, 0.01)}, base=RunConfig(), sampling="lhs")
+    assert {float(x) for x in spec.bounds[0]} == {650.0}
+    assert spec.fingerprint() != SweepSpec(n=4, ranges={"sensing.delay": (0.0, 0.01)}, base=RunConfig()).fingerprint()
+    args = parser.parse_args(["falsify", "--m1-range", "650", "650", "--uncertainty", "m1", "--range", "mu=0.015:0.02",
+                              "--range", "sensing.delay=0:0.01"])
+    base, box = _base_and_box(args)
+    assert "m1" not in box and set(box) == {"mu", "sensing.delay"} and base.m1 == 650.0
+    args = parser.parse_args(["falsify", "--m1", "700", "--uncertainty", "m1", "--range", "mu=0.015:0.02"])
+    base, box = _base_and_box(args)
+    assert set(box) == {"mu"} and base.m1 == 700.0 and base.m1_range == (550.0, 750.0)
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["sweep", "--m1-range", "900", "900"], "outside the certificate's default box"),
+    (["sweep", "--m1", "600", "--m1-range", "650", "650"], "fix two masses"),
+    (["falsify", "--m1", "650", "--uncertainty", "m1"], "the box is empty"),
+    (["sweep", "--m1", "650", "--sampling", "grid", "--n", "4"], "needs a ranged parameter"),
+])
+def test_fixed_m1_bad_input_is_one_line(tmp_path, capsys, argv, words):
+    from wmr_mj.cli.app import main
+
+    assert main([*argv, "--duration", "9", "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and words in err[0], err

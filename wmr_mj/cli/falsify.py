@@ -26,7 +26,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                               "or of the random sample is certified-outside (it breaks the law's claim), or the "
                               "--require is falsified; 1 the serial re-run of the worst run did not reproduce it; "
                               "2 bad input")
+    from wmr_mj.cli.sweep import add_fixed_m1_option
+
     add_run_options(p)
+    add_fixed_m1_option(p)
     p.add_argument("--range", action="append", metavar="NAME=LO:HI",
                    help="add a plant parameter to the box or replace its range (repeatable); with --disturbance "
                         "or --load, also their parameters: disturbance.amplitude, disturbance.t1, ..., load0.m1, "
@@ -207,13 +210,16 @@ def _base_and_box(args: argparse.Namespace):
         raise ParameterError(f"--path-knots {args.path_knots} is not accepted: a number of knots >= 0")
     if (args.path_knots or any(path_axis(n) for n in searched)) and args.reference_bounds is None:
         args.reference_bounds = "paper"  # every searched path within the bounds its certificate declares
-    base = config_from_args(args)
+    from wmr_mj.cli.sweep import fixed_m1_from_args
+
+    fixed_m1 = fixed_m1_from_args(args)  # --m1 or a zero-width --m1-range: m1 not searched
+    base = config_from_args(args) if fixed_m1 is None else config_from_args(args, m1=fixed_m1)
     if args.path_knots:
         from wmr_mj.reference.knots import KnotSpace
 
         space = KnotSpace(args.path_knots, hold_range=(0.0, 3.0))
         searched = {**space.ranges(base.reference_bounds), **searched}
-    box = {"m1": tuple(args.m1_range), **box_ranges_from_args(args), **searched}
+    box = {**({"m1": tuple(args.m1_range)} if fixed_m1 is None else {}), **box_ranges_from_args(args), **searched}
     return base, box
 
 

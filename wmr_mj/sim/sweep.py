@@ -117,12 +117,14 @@ def _count_path_verdicts(rows: Sequence[Mapping[str, Any]]) -> dict[str, int] | 
 
 @dataclass(frozen=True, kw_only=True)
 class SweepSpec:
-    """n runs of ``base`` with the plant's m1 (and ``ranges``) drawn by ``sampling``."""
+    """n runs of ``base`` with the plant's m1 (and ``ranges``) drawn by ``sampling``; with ``m1``, every run's
+    m1 is that (the other axes swept alone) and ``m1_range`` stays the certificate's box."""
 
     n: int = 200
     seed: int = 0
     sampling: str = "lhs"
     m1_range: tuple[float, float] = M1_RANGE
+    m1: float | None = None  # a fixed m1 [kg]: every run's; None: drawn over m1_range
     ranges: Mapping[str, tuple[float, float]] = field(default_factory=dict)
     base: RunConfig = field(default_factory=RunConfig)
     # STL requirements (formulas or presets, wmr_mj.analysis.requirements) judged on every run: such
@@ -136,6 +138,9 @@ class SweepSpec:
         if self.sampling not in SAMPLINGS:
             raise UnknownNameError("sampling", self.sampling, SAMPLINGS)
         positive_range("m1", *self.m1_range)
+        if self.m1 is not None and (isinstance(self.m1, bool) or not isinstance(self.m1, (int, float))
+                                    or not (math.isfinite(self.m1) and self.m1 > 0)):
+            raise ParameterError(f"m1 = {self.m1!r} is not accepted; a fixed m1 is a finite number of kg > 0")
         from wmr_mj.sim.search_space import HARDWARE_AXES, check_hardware_range, hardware_axis
 
         names = set(parameter_names()) - {"m1"}
@@ -147,10 +152,17 @@ class SweepSpec:
                 raise UnknownNameError("axis name", name, [*sorted(names), *HARDWARE_AXES])
             positive_range(name, lo, hi)
         if self.sampling == "grid":
-            d = 1 + len(self.ranges)
+            d = self.grid_dimensions
+            if d == 0:
+                raise ParameterError("grid sampling with a fixed m1 needs a ranged parameter (--range NAME=LO:HI)")
             k = round(self.n ** (1.0 / d))
             if k**d != self.n:
                 raise ParameterError(f"grid sampling of {d} parameter(s) needs n = k^{d}; n = {self.n} is not")
+
+    @property
+    def grid_dimensions(self) -> int:
+        """The axes a grid spans: the ranged parameters, and m1 unless it is fixed."""
+        return len(self.ranges) + (0 if self.m1 is not None else 1)
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -158,7 +170,8 @@ class SweepSpec:
 
     @property
     def bounds(self) -> np.ndarray:
-        return np.array([self.m1_range, *self.ranges.values()], dtype=float)
+        m1 = self.m1_range if self.m1 is None else (self.m1, self.m1)  # a fixed m1: a zero-width draw
+        return np.array([m1, *self.ranges.values()], dtype=float)
 
     @property
     def hardware_names(self) -> tuple[str, ...]:
@@ -204,6 +217,8 @@ class SweepSpec:
                "ranges": {k: list(v) for k, v in self.ranges.items()}, "base": self.base.as_dict()}
         if self.requirements:  # a sweep without requirements keeps the fingerprint it always had
             obj["requirements"] = list(self.requirements)
+        if self.m1 is not None:  # and one with m1 drawn too
+            obj["m1"] = self.m1
         return hashlib.sha256(json.dumps(obj, sort_keys=True, default=str).encode()).hexdigest()[:16]
 
 
@@ -238,6 +253,12 @@ def draw_samples(spec: SweepSpec) -> np.ndarray:
         unit = rng.random((spec.n, d))
     elif spec.sampling == "lhs":
         unit = latin_hypercube(spec.n, d, rng.spawn(1)[0])  # scipy's qmc draws from a spawned child
+    elif spec.m1 is not None:  # a grid over the ranged axes only; m1's column is fixed
+        g = spec.grid_dimensions
+        k = round(spec.n ** (1.0 / g))
+        axes = [np.linspace(0.0, 1.0, k)] if k > 1 else [np.array([0.5])]
+        grid = np.stack(np.meshgrid(*(axes * g), indexing="ij"), axis=-1).reshape(-1, g)
+        unit = np.hstack([np.zeros((len(grid), 1)), grid])
     else:
         k = round(spec.n ** (1.0 / d))
         axes = [np.linspace(0.0, 1.0, k)] if k > 1 else [np.array([0.5])]
@@ -288,6 +309,8 @@ def spec_to_json(spec: SweepSpec) -> str:
            "ranges": {k: list(v) for k, v in spec.ranges.items()}, "base": base}
     if spec.requirements:
         obj["requirements"] = list(spec.requirements)
+    if spec.m1 is not None:
+        obj["m1"] = spec.m1
     return json.dumps(obj, sort_keys=True)
 
 
@@ -295,7 +318,7 @@ def spec_from_json(text: str) -> SweepSpec:
     obj = json.loads(text)
     return SweepSpec(n=obj["n"], seed=obj["seed"], sampling=obj["sampling"], m1_range=tuple(obj["m1_range"]),
                      ranges={k: tuple(v) for k, v in obj["ranges"].items()}, base=config_from_dict(obj["base"]),
-                     requirements=tuple(obj.get("requirements", ())))
+                     requirements=tuple(obj.get("requirements", ())), m1=obj.get("m1"))
 
 
 def _run_config_chunk(config_dicts: list[dict[str, Any]], nthread: int,
