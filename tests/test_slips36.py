@@ -285,3 +285,70 @@ def test_fixed_m1_bad_input_is_one_line(tmp_path, capsys, argv, words):
     assert main([*argv, "--duration", "9", "--out", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and words in err[0], err
+
+
+# -- 5: effort in every sweep summary, overall and per level of a ranged axis ----------------------
+
+def test_voltage_effort_against_a_plain_loop():
+    import numpy as np
+
+    from wmr_mj.sim.summary import voltage_effort
+
+    u = np.array([0.0, 3.0, -24.0, 24.0, 1.5])
+    peak, sq, tv = 0.0, 0.0, 0.0
+    for k, x in enumerate(u):  # a plain loop, the definitions written out
+        peak, sq = max(peak, abs(x)), sq + x * x
+        tv += abs(x - u[k - 1]) if k else 0.0
+    e = voltage_effort(u, 0.002)
+    assert e.peak_voltage == peak == 24.0
+    assert e.rms_voltage == pytest.approx(math.sqrt(sq / 5), rel=1e-15)  # summation order only
+    assert e.tv_voltage == pytest.approx(tv / (5 * 0.002), rel=1e-15) and tv == 3 + 27 + 48 + 22.5
+
+
+def test_the_batch_measures_the_effort_of_the_serial_run_bit_for_bit(swept):
+    from wmr_mj.sim.closed_loop import run_closed_loop
+
+    _, rows = swept
+    single = run_closed_loop(BASE.replace(m1=rows[1]["m1"]), progress=False).summary.to_dict()
+    for key in ("peak_voltage", "rms_voltage", "tv_voltage", "saturated_fraction"):
+        assert rows[1][key] == single[key], key
+
+
+def test_the_sweep_summary_has_the_effort_overall_and_per_level():
+    """A 2 x 2 grid of (m1, mu): two levels of each axis, two runs at each; the figures are the rows' (a
+    plain computation over them)."""
+    from wmr_mj.cli.sweep import effort_lines
+
+    rows = []
+    for i, (m1, mu) in enumerate([(550.0, 0.01), (550.0, 0.02), (750.0, 0.01), (750.0, 0.02)]):
+        rows.append({"run": i, "m1": m1, "mu": mu, "verdict": "certified-inside", "sup_E": 0.01, "sup_Edot": 0.1,
+                     "left_steering_range": False, "saturated_fraction": i / 10, "peak_voltage": 20.0 + i,
+                     "rms_voltage": 5.0 + i, "tv_voltage": 100.0 * (i + 1)})
+    runs = SweepSummary.of(rows, names=("m1", "mu"))
+    e = runs.effort
+    assert e.runs == 4 and e.mean_saturated_fraction == pytest.approx(0.15, rel=1e-15)  # the sum's rounding
+    assert e.max_saturated_fraction == 0.3
+    assert e.peak_voltage == 23.0 and e.mean_rms_voltage == 6.5 and e.mean_tv_voltage == 250.0
+    assert e.max_tv_voltage == 400.0
+    by = {a.axis: a.levels for a in runs.effort_by_level}
+    assert [lv.value for lv in by["m1"]] == [550.0, 750.0] and [lv.value for lv in by["mu"]] == [0.01, 0.02]
+    assert by["m1"][1].effort.peak_voltage == 23.0 and by["m1"][0].effort.mean_tv_voltage == 150.0
+    assert by["mu"][0].effort.runs == 2 and by["mu"][0].effort.mean_rms_voltage == 6.0  # runs 0 and 2
+    out = runs.sweep_dict(1.0)
+    assert out["effort"]["peak_voltage"] == 23.0
+    assert [lv["value"] for lv in out["effort_by_level"]["mu"]] == [0.01, 0.02]
+    assert SweepSummary.from_dict(runs.to_dict()) == runs
+    lines = effort_lines(runs)
+    assert lines[0].startswith("effort: saturated 15% of the time (at most 30%), peak |u| 23 V")
+    assert any(line.startswith("  mu = 0.02 (2 runs)") for line in lines)
+    # rows without the effort columns (a runs.csv written before them): no effort, no lines
+    old = [{k: v for k, v in r.items() if k not in ("peak_voltage", "rms_voltage", "tv_voltage")} for r in rows]
+    assert SweepSummary.of(old, names=("m1", "mu")).effort is None and effort_lines(SweepSummary.of(old)) == []
+
+
+def test_runs_csv_has_the_effort_columns(swept):
+    folder, rows = swept
+    with open(folder / "runs.csv", newline="") as f:
+        header = next(csv.reader(f))
+    assert {"peak_voltage", "rms_voltage", "tv_voltage"} <= set(header)
+    assert SweepSummary.of(rows).effort.peak_voltage == max(r["peak_voltage"] for r in rows)

@@ -169,6 +169,7 @@ def run(args: argparse.Namespace) -> int:
               f"worst sup|E|/E_max = {fmt(runs.paper_E_ratio.value)}, "
               f"worst sup|E'|/Edot_max = {fmt(runs.paper_Edot_ratio.value)}")
     print(f"{runs.hit_stop} runs hit the steering stop")
+    print("\n".join(effort_lines(runs)))
     if runs.path_verdicts is not None:
         print(f"path of C: worst sup|cross-track| = {runs.path_cross_track.value:.4g} m "
               f"(m1 = {runs.path_cross_track.m1:g} kg); path verdicts: "
@@ -184,6 +185,25 @@ def run(args: argparse.Namespace) -> int:
     print(f"{runs.steps} steps in {wall:.1f} s ({summary['steps_per_s']:.3g} steps/s{backend})")
     print(f"table: {out / 'runs.csv'}\nplot:  {plot_path}")
     return status
+
+
+def effort_lines(runs: SweepSummary) -> list[str]:
+    """What the runs asked of the motor: saturation, peak voltage and voltage activity, overall and per level
+    of each ranged axis that has levels; nothing where the rows have no effort (a runs.csv written before)."""
+    e = runs.effort
+    if e is None:
+        return []
+
+    def text(x) -> str:
+        return (f"saturated {100 * x.mean_saturated_fraction:.3g}% of the time "
+                f"(at most {100 * x.max_saturated_fraction:.3g}%), "
+                f"peak |u| {x.peak_voltage:.4g} V, RMS u {x.mean_rms_voltage:.4g} V, activity "
+                f"{x.mean_tv_voltage:.4g} V/s (at most {x.max_tv_voltage:.4g})")
+
+    lines = [f"effort: {text(e)}"]
+    for axis in runs.effort_by_level:
+        lines += [f"  {axis.axis} = {lv.value:g} ({lv.effort.runs} runs): {text(lv.effort)}" for lv in axis.levels]
+    return lines
 
 
 def claim_lines(runs: SweepSummary) -> list[str]:

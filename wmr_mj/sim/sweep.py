@@ -66,12 +66,17 @@ __all__ = [
     "connect",
     "requirement_column",
     "RequirementSweep",
+    "Effort",
+    "EffortLevel",
+    "AxisEffort",
 ]
 
 SAMPLINGS = ("uniform", "lhs", "grid")
 RESULT_COLUMNS = ("run", "m1", "verdict", "cert_valid", "cert_E_max", "cert_Edot_max", "cert_E_ratio",
                   "cert_Edot_ratio", "cert_inside", "sup_E", "sup_Edot", "sup_E_settled", "sup_Edot_settled",
                   "E_max", "Edot_max", "E_ratio", "Edot_ratio", "inside", "saturated_fraction",
+                  # the applied voltage's effort (wmr_mj.sim.summary.VoltageEffort): [V], [V], [V/s]
+                  "peak_voltage", "rms_voltage", "tv_voltage",
                   "left_steering_range", "final_alpha", "final_alpha_dot", "drift_growing",
                   # C's path (wmr_mj.analysis.path_error, path_bound): [m], [m], [rad], verdict, [m]
                   "path_cross_track_max", "path_along_track_final", "path_heading_error_max", "path_verdict",
@@ -657,6 +662,85 @@ def _unmet_over(rows: Sequence[Mapping[str, Any]]) -> tuple[UnmetAssumption, ...
     return tuple(UnmetAssumption.from_dict(a) for a in counted)
 
 
+#: a ranged axis has levels (and its effort per level) where its runs take at most this many distinct values:
+#: a grid, or a hardware axis rounded to whole periods, ticks or bits; a continuous draw has none
+MAX_EFFORT_LEVELS = 16
+_EFFORT_COLUMNS = ("saturated_fraction", "peak_voltage", "rms_voltage", "tv_voltage")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Effort(Record):
+    """What runs asked of the motor (:attr:`SweepSummary.effort`), from runs.csv's effort columns.
+
+    Attributes:
+        runs: how many runs.
+        mean_saturated_fraction: the mean fraction of control steps at the voltage limit [-].
+        max_saturated_fraction: the largest [-].
+        peak_voltage: the largest |u| of any run [V].
+        mean_rms_voltage: the mean of the runs' RMS u [V].
+        mean_tv_voltage: the mean of the runs' total variation of u per second [V/s] (voltage activity).
+        max_tv_voltage: the largest [V/s].
+    """
+
+    runs: int
+    mean_saturated_fraction: float
+    max_saturated_fraction: float
+    peak_voltage: float
+    mean_rms_voltage: float
+    mean_tv_voltage: float
+    max_tv_voltage: float
+
+    @classmethod
+    def of(cls, rows: Sequence[Mapping[str, Any]]) -> Effort | None:
+        """The effort of ``rows``; None where a row lacks an effort column (a runs.csv written before them)."""
+        if not rows or any(r.get(c) is None for r in rows for c in _EFFORT_COLUMNS):
+            return None
+        col = {c: [float(r[c]) for r in rows] for c in _EFFORT_COLUMNS}
+        return cls(runs=len(rows), mean_saturated_fraction=sum(col["saturated_fraction"]) / len(rows),
+                   max_saturated_fraction=max(col["saturated_fraction"]), peak_voltage=max(col["peak_voltage"]),
+                   mean_rms_voltage=sum(col["rms_voltage"]) / len(rows),
+                   mean_tv_voltage=sum(col["tv_voltage"]) / len(rows), max_tv_voltage=max(col["tv_voltage"]))
+
+
+@dataclass(frozen=True, kw_only=True)
+class EffortLevel(Record):
+    """The effort of the runs at one level of a ranged axis: ``value`` (the axis's units) and their effort."""
+
+    _records = {"effort": Effort}
+
+    value: float
+    effort: Effort
+
+
+@dataclass(frozen=True, kw_only=True)
+class AxisEffort(Record):
+    """The effort per level of one ranged axis (:attr:`SweepSummary.effort_by_level`), levels ascending."""
+
+    _records = {"levels": EffortLevel}
+
+    axis: str
+    levels: tuple[EffortLevel, ...]
+
+
+def _effort_by_level(rows: Sequence[Mapping[str, Any]], names: Sequence[str]) -> tuple[AxisEffort, ...]:
+    """Each ranged axis of ``names`` whose runs take 2 to :data:`MAX_EFFORT_LEVELS` distinct values, some value
+    shared by several runs (a grid of two axes or more, a rounded hardware axis), with the effort of the runs
+    at each value; none where the rows have no effort columns."""
+    out = []
+    for name in names:
+        values = sorted({float(r[name]) for r in rows if r.get(name) is not None})
+        if not 2 <= len(values) <= MAX_EFFORT_LEVELS or len(values) == len(rows):
+            continue  # one level, a continuous draw, or one run per level (runs.csv has each run's)
+        levels = []
+        for v in values:
+            effort = Effort.of([r for r in rows if r.get(name) is not None and float(r[name]) == v])
+            if effort is None:
+                return ()
+            levels.append(EffortLevel(value=v, effort=effort))
+        out.append(AxisEffort(axis=name, levels=tuple(levels)))
+    return tuple(out)
+
+
 @dataclass(frozen=True)
 class SweepSummary(Record):
     """What a sweep's runs add up to: the one aggregator of ``wmr-mj sweep`` and validate's rungs.
@@ -695,11 +779,15 @@ class SweepSummary(Record):
         unmet: the claim's assumptions not met in some run: value and limit of the first such run (the
             assumption's units), runs: how many; from rows that carry their certificate (a resumed sweep's
             rows, read from runs.csv, do not).
+        effort: what the runs asked of the motor: saturation, peak voltage, voltage activity (:class:`Effort`);
+            None where the rows have no effort columns.
+        effort_by_level: the effort per level of each ranged axis with levels (:func:`_effort_by_level`).
     """
 
     _records = {"sup_E": Worst, "sup_Edot": Worst, "certificate_E_ratio": Worst, "certificate_Edot_ratio": Worst,
                 "paper_E_ratio": Worst, "paper_Edot_ratio": Worst, "path_cross_track": Worst,
-                "requirements": RequirementSweep, "claim_broken": BrokenSweepRun, "unmet": UnmetAssumption}
+                "requirements": RequirementSweep, "claim_broken": BrokenSweepRun, "unmet": UnmetAssumption,
+                "effort": Effort, "effort_by_level": AxisEffort}
 
     n: int
     verdicts: Mapping[str, int]
@@ -726,6 +814,8 @@ class SweepSummary(Record):
     requirements: tuple[RequirementSweep, ...] = ()
     claim_broken: BrokenSweepRun | None = None
     unmet: tuple[UnmetAssumption, ...] = ()
+    effort: Effort | None = None
+    effort_by_level: tuple[AxisEffort, ...] = ()
 
     @classmethod
     def of(cls, rows: Sequence[Mapping[str, Any]], requirements: Sequence[str] = (), *,
@@ -770,6 +860,8 @@ class SweepSummary(Record):
             requirements=tuple(RequirementSweep.of(rows, i, text) for i, text in enumerate(requirements)),
             claim_broken=_claim_broken(rows, names),
             unmet=_unmet_over(rows),
+            effort=Effort.of(rows),
+            effort_by_level=_effort_by_level(rows, names),
         )
 
     @property
@@ -817,6 +909,10 @@ class SweepSummary(Record):
             # a broken claim, whatever else the sweep measured (None: no run is certified-outside)
             "claim_broken": None if self.claim_broken is None else self.claim_broken.to_dict(),
             "unmet": [a.to_dict() for a in self.unmet],
+            # what the runs asked of the motor, overall and per level of each ranged axis that has levels
+            "effort": None if self.effort is None else self.effort.to_dict(),
+            "effort_by_level": {a.axis: [{"value": lv.value, **lv.effort.to_dict()} for lv in a.levels]
+                                for a in self.effort_by_level},
         }
         # the paper's deprecated aliases, under ``paper`` only: at the top level they read as the certificate's
         out["paper"] = {old: out[new] for old, new in SWEEP_KEYS_DEPRECATED.items()}
