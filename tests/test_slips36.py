@@ -352,3 +352,45 @@ def test_runs_csv_has_the_effort_columns(swept):
         header = next(csv.reader(f))
     assert {"peak_voltage", "rms_voltage", "tv_voltage"} <= set(header)
     assert SweepSummary.of(rows).effort.peak_voltage == max(r["peak_voltage"] for r in rows)
+
+
+# -- 11: compare's adversary over the cart's axes; a figure that tells designs apart ----------------
+
+def test_the_adversary_searches_the_carts_axes_where_a_scenario_declares_a_non_ideal_cart():
+    from wmr_mj.sim.compare import adversary_spec, design_from_token
+    from wmr_mj.sim.suite import load_suite
+
+    v2 = load_suite("standard-v2")
+    design = design_from_token("certified", v2)
+    hardware = v2.select(["circle/*"])
+    spec = adversary_spec(design, v2, budget=16, seed=0, scenarios=hardware)
+    declared = {"sensing.delay": 0.005, "actuation.inductance": 0.0015, "transmission.backlash": 0.002}
+    for axis, top in declared.items():  # the largest each scenario's [hardware.<name>] declares (standard-v2.toml)
+        assert spec.box[axis] == (0.0, top), axis
+    assert not {"actuation.delay", "sensing.noise_alpha"} & set(spec.box)  # no scenario sets them
+    top = spec.config([spec.box[n][1] for n in spec.names])  # the box's far corner: a cart the run builds
+    assert (top.sensing.delay, top.actuation.inductance, top.transmission.backlash) == (0.005, 0.0015, 0.002)
+    # the ideal scenarios alone, or a suite without hardware: the box is the plant's, the signals', the path's
+    ideal = adversary_spec(design, v2, budget=16, seed=0, scenarios=v2.select(["circle/nominal/none"]))
+    v1 = load_suite("standard-v1")
+    plain = adversary_spec(design_from_token("certified", v1), v1, budget=16, seed=0, scenarios=v1.scenarios)
+    for s in (ideal, plain):
+        assert not any(n.startswith(("sensing.", "actuation.", "transmission.")) for n in s.names)
+    assert set(spec.names) - set(ideal.names) == set(declared)
+
+
+def test_the_compare_figure_draws_each_design_in_its_own_colour_with_a_legend():
+    from types import SimpleNamespace
+
+    from matplotlib.colors import to_hex
+
+    from wmr_mj.report.compare import figure
+
+    rows = tuple(SimpleNamespace(label=name, requirements_passed=k, requirements_total=4, rms_voltage=1.0 + k,
+                                 cross_track_max=0.01 * (k + 1)) for k, name in enumerate(("certified", "pd", "smc")))
+    fig = figure(SimpleNamespace(rows=rows))
+    bars_ax, scatter_ax = fig.axes[:2]
+    bars = [to_hex(p.get_facecolor()) for p in bars_ax.patches]
+    points = [to_hex(c.get_facecolor()[0]) for c in scatter_ax.collections]
+    assert len(set(bars)) == 3 and bars == points  # one colour per design, the same in both panels
+    assert [t.get_text() for t in scatter_ax.get_legend().get_texts()] == ["certified", "pd", "smc"]
