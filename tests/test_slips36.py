@@ -394,3 +394,39 @@ def test_the_compare_figure_draws_each_design_in_its_own_colour_with_a_legend():
     points = [to_hex(c.get_facecolor()[0]) for c in scatter_ax.collections]
     assert len(set(bars)) == 3 and bars == points  # one colour per design, the same in both panels
     assert [t.get_text() for t in scatter_ax.get_legend().get_texts()] == ["certified", "pd", "smc"]
+
+
+# -- 7: a lane change too short to cover the manoeuvre, judged as partial ---------------------------
+
+def test_a_lane_change_cut_short_is_judged_as_partial(capsys):
+    """run --path lane-change --duration 3 printed CERTIFIED-INSIDE covering 0.6 m of the 4.5 m manoeuvre
+    (lead-in 0.5 m + lane change 4 m, wmr_mj/sim/config.py) with nothing said: its verdict says PARTIAL."""
+    from wmr_mj.analysis.verdicts import format_verdict
+    from wmr_mj.cli.app import main
+    from wmr_mj.sim.config import manoeuvre_length
+    from wmr_mj.sim.designs import CERTIFIED
+
+    assert manoeuvre_length("lane-change") == 4.5 and manoeuvre_length("paper-circle") is None
+    assert main(["run", "--preset", "certified", "--path", "lane-change", "--duration", "3", "--no-log"]) == 0
+    verdict = next(line for line in capsys.readouterr().out.splitlines() if line.startswith("verdict:"))
+    assert verdict.startswith("verdict: CERTIFIED-INSIDE") and "PARTIAL" in verdict and "4.5 m" in verdict
+    from wmr_mj.sim.closed_loop import run_closed_loop
+
+    short = run_closed_loop(RunConfig(**CERTIFIED.config_changes(), path="lane-change", duration=3.0),
+                            progress=False).summary.to_dict()
+    # C's reference at V_A = 0.2 m/s (a little faster where it turns): about 0.6 m in 3 s
+    assert short["route_finished"] is False and 0.55 < short["route_driven_m"] < 0.7
+    assert short["route_length_m"] == 4.5
+    whole = run_closed_loop(RunConfig(**CERTIFIED.config_changes(), path="lane-change", duration=24.0),
+                            progress=False).summary.to_dict()
+    assert whole["route_finished"] is True and "PARTIAL" not in " ".join(format_verdict(whole))
+
+
+def test_the_batch_reports_the_same_partial_lane_change():
+    from wmr_mj.sim.batch import run_batch
+    from wmr_mj.sim.closed_loop import run_closed_loop
+
+    configs = [RunConfig(model="nonholonomic", path="lane-change", duration=3.0, m1=m1) for m1 in (600.0, 700.0)]
+    for config, batched in zip(configs, run_batch(configs, nthread=1)):
+        assert batched.route == run_closed_loop(config, progress=False).summary.route
+        assert batched.route is not None and not batched.route.finished

@@ -56,6 +56,7 @@ __all__ = [
     "certified_outside_banner",
     "unmet_assumptions",
     "count_unmet",
+    "partial_text",
     "format_unmet",
 ]
 
@@ -329,6 +330,20 @@ def format_unmet(unmet: Iterable[Mapping[str, Any]]) -> str:
     return "; ".join(f"{a['name']} ({value(a)} vs {_num(a.get('limit'), '.4g')}{why(a)})" for a in unmet)
 
 
+def partial_text(summary: Mapping[str, Any]) -> str:
+    """Beside the verdict of a run whose reference does not cover its route or manoeuvre (``route_finished``
+    False: a lane change cut short by the duration, an open route longer than the run): PARTIAL, how much it
+    covers and what duration covers it; '' otherwise."""
+    if summary.get("route_finished") is not False:
+        return ""
+    driven, length = summary.get("route_driven_m"), summary.get("route_length_m")
+    if not isinstance(driven, (int, float)) or not isinstance(length, (int, float)) or length <= 0:
+        return ""
+    return (f"  -- PARTIAL: the run's reference covers {driven:.3g} m of the {length:.3g} m its path must drive "
+            f"({100 * driven / length:.0f}%), and the verdict that part only: give a longer --duration to judge "
+            "the whole manoeuvre")
+
+
 def format_verdict(summary: Mapping[str, Any]) -> list[str]:
     """Text lines of a judged run summary: the verdict first, then both regions and the drift.
 
@@ -353,7 +368,7 @@ def format_verdict(summary: Mapping[str, Any]) -> list[str]:
     ratio = cert.get("E_ratio")
     lines.append(f"verdict: {verdict.upper()}"
                  + ("" if ratio is None else f"  (tightness sup|E|/E_max = {ratio:.3f})")
-                 + ("" if is_pass(verdict) else "  -- not a pass"))
+                 + ("" if is_pass(verdict) else "  -- not a pass") + partial_text(summary))
     unmet = [a for a in cert.get("assumptions", []) if not a.get("met")]
     if unmet:
         lines.append("certificate NOT valid; assumptions not met: " + format_unmet(unmet))
