@@ -93,8 +93,8 @@ def test_aggregated_unmet_assumptions_give_the_range_over_the_runs():
     # one run, or runs that agree: the value as it is, no range
     single = count_unmet([run(1.2, 0.001), run(1.2, 0.001)])
     assert "value_range" not in single[0] and single[1]["note"].count("b = 0.001 rad") == 1
-    # notes whose words differ: the first, and how many others
-    assert merged_note(["a 1", "b 2", "b 3"]).startswith("a 1 (in the first such run; 2 other note(s)")
+    # notes whose words differ (another reason): each, merged with its like, and how many runs gave it
+    assert merged_note(["a 1", "b 2", "b 3"]) == "a 1 (1 run) | b 2-3 (2 runs)"
 
 
 def test_the_unmet_record_round_trips_its_range():

@@ -297,24 +297,28 @@ _NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
 
 
 def merged_note(notes: Sequence[str]) -> str:
-    """One note for many runs' notes of one assumption: where they are the same text but for their numbers,
-    each number that differs becomes its range over the runs, 'LO-HI' (as the notes write them); where their
-    words differ, the first note and how many others differ.
+    """One note for many runs' notes of one assumption: notes that are the same text but for their numbers are
+    one, each number that differs between them its range over those runs, 'LO-HI' (as the notes write them);
+    notes whose words differ (another reason) are each given so, with how many runs gave it, ' | ' between.
 
     Args:
         notes: the runs' notes, in run order (at least one).
     """
-    skeletons = {tuple(_NUMBER.split(n)) for n in notes}
-    if len(skeletons) > 1:
-        others = len(set(notes)) - 1
-        return f"{notes[0]} (in the first such run; {others} other note(s) over the runs)"
-    (skeleton,) = skeletons
-    columns = list(zip(*(_NUMBER.findall(n) for n in notes)))
-    pieces = [skeleton[0]]
-    for texts, tail in zip(columns, skeleton[1:]):
-        lo, hi = min(texts, key=float), max(texts, key=float)
-        pieces += [lo if float(lo) == float(hi) else f"{lo}-{hi}", tail]
-    return "".join(pieces)
+    groups: dict[tuple[str, ...], list[str]] = {}
+    for note in notes:  # in the order first met
+        groups.setdefault(tuple(_NUMBER.split(note)), []).append(note)
+
+    def merged(skeleton: tuple[str, ...], members: list[str]) -> str:
+        pieces = [skeleton[0]]
+        for texts, tail in zip(zip(*(_NUMBER.findall(n) for n in members)), skeleton[1:]):
+            lo, hi = min(texts, key=float), max(texts, key=float)
+            pieces += [lo if float(lo) == float(hi) else f"{lo}-{hi}", tail]
+        return "".join(pieces)
+
+    if len(groups) == 1:
+        ((skeleton, members),) = groups.items()
+        return merged(skeleton, members)
+    return " | ".join(f"{merged(k, m)} ({len(m)} run{'s' if len(m) > 1 else ''})" for k, m in groups.items())
 
 
 def format_unmet(unmet: Iterable[Mapping[str, Any]]) -> str:
