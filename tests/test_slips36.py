@@ -430,3 +430,18 @@ def test_the_batch_reports_the_same_partial_lane_change():
     for config, batched in zip(configs, run_batch(configs, nthread=1)):
         assert batched.route == run_closed_loop(config, progress=False).summary.route
         assert batched.route is not None and not batched.route.finished
+
+
+def test_a_random_sample_without_the_objective_is_no_error():
+    """falsify --range sensing.delay=0:0.05: one search run had a certificate and no random run; the command
+    said "the objective is undefined for every run" after both phases. The search's worst stands; the random
+    sample's is its largest sup|E|, without an objective."""
+    from wmr_mj.sim.falsify import FalsifyResult, FalsifySpec, undefined_objective_warning
+
+    spec = FalsifySpec(box={"m1": (600.0, 700.0)}, budget=16)
+    result = FalsifyResult(spec=spec, search=_evaluations("search", [None, 0.4, None]),
+                           random=_evaluations("random", [None, None, None]), objective_source="certificate.E_ratio")
+    assert result.worst.objective == 0.4 and result.random_worst.index == 2  # sup_E 0.03, the largest
+    report = result.report()
+    assert report.random.worst_objective is None and report.random.sup_E == 0.03
+    assert undefined_objective_warning(result).startswith("WARNING: 2 of 3 search runs, 3 of 3 random runs")

@@ -1022,6 +1022,11 @@ class FalsifyResult:
 
     @property
     def random_worst(self) -> Evaluation:
+        """The random sample's run of the largest objective; where none of its runs has the objective (each
+        left blank: :func:`undefined_objective_warning` says so), its run of the largest sup|E|, whose
+        objective is None: the search's worst is still the answer, not an error."""
+        if self.random and all(e.objective is None for e in self.random):
+            return max(self.random, key=lambda e: e.sup_E)  # max keeps the first of equals
         return self._worst(self.random)
 
     @property
