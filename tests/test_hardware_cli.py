@@ -147,8 +147,11 @@ def test_sweep_over_the_sensing_delay_records_the_cart_and_the_axis(tmp_path, ca
         delay = float(row["sensing.delay"])
         periods = delay / 0.001
         assert 0.0 <= delay <= 0.01 and abs(periods - round(periods)) < 1e-9  # whole 1 ms periods
-    # a sensed run goes one by one on the engine; the same config alone gives the same bits
-    row = rows[1]
+    # a sensed run goes one by one on the engine; the same config alone gives the same bits (the folder's
+    # rows at full precision: runs.csv rounds to 12 digits)
+    from wmr_mj.sim.sweep import read_runs
+
+    row = read_runs(out)[1]
     single = run_closed_loop(RunConfig(**design_changes("certified"), path="lane-change", duration=6.0,
                                        m1=float(row["m1"]), m1_range=(550.0, 750.0),
                                        sensing=Sensing(encoder_ticks=4096, delay=float(row["sensing.delay"]))),

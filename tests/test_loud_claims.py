@@ -156,5 +156,7 @@ def test_unmet_assumptions_are_counted_once_each_with_the_first_runs_value():
     assert unmet_assumptions(cert) == [{"name": "b", "value": 3.0, "limit": 2.0}]
     assert unmet_assumptions(None) == [] and unmet_assumptions({"E_max": 1.0}) == []
     counted = count_unmet([unmet_assumptions(cert), unmet_assumptions(later), []])
-    assert counted == [{"name": "b", "value": 3.0, "limit": 2.0, "runs": 2}]
-    assert format_unmet(counted) == "b (3 vs 2)" and format_unmet([{"name": "c", "value": None}]) == "c (n/a vs n/a)"
+    # the first run's value, and the range over the runs (issue 36: an aggregate never quotes one run's alone)
+    assert counted == [{"name": "b", "value": 3.0, "limit": 2.0, "runs": 2, "value_range": [3.0, 4.0]}]
+    assert format_unmet(counted) == "b (3-4 vs 2)" and format_unmet([{"name": "c", "value": None}]) == "c (n/a vs n/a)"
+    assert format_unmet(unmet_assumptions(cert)) == "b (3 vs 2)"  # one run's: its value

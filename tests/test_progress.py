@@ -80,5 +80,5 @@ def test_sweep_command_writes_table_summary_and_plot(tmp_path, capsys):
     rows = list(csv.DictReader((out / "runs.csv").open()))
     assert len(rows) == summary["n"] == 2
     inside = sum(float(r["sup_E"]) <= float(r["E_max"]) and float(r["sup_Edot"]) <= float(r["Edot_max"]) for r in rows)
-    assert summary["inside"] == inside and summary["outside"] == 2 - inside
+    assert summary["paper_inside"] == inside and summary["paper_outside"] == 2 - inside
     assert json.loads((out / "summary.json").read_text())["n"] == 2

@@ -22,6 +22,8 @@ PATH_KEYS = {"path_error", "path_bound", "path_verdict"}
 # added with the paper's region under names that say so (the unprefixed ones deprecated, kept)
 PAPER_KEYS = {"paper_E_max", "paper_Edot_max", "paper_condition", "paper_inside", "paper_E_ratio",
               "paper_Edot_ratio", "deprecated_keys"}
+# added with the applied voltage's effort (wmr_mj.sim.summary.VoltageEffort; issue 36)
+EFFORT_KEYS = {"peak_voltage", "rms_voltage", "tv_voltage"}
 CERTIFICATE_KEYS = {"C_V_term", "E_max", "E_ratio", "Edot_max", "Edot_ratio", "K_term", "P_term", "alpha_max",
                     "assumptions", "certified", "condition", "dead_band", "delta1", "delta2", "delta3",
                     "friction_sign", "friction_term", "friction_width", "gamma1", "gamma2", "gyro_Edot_term",
@@ -38,7 +40,7 @@ def summary(certified_run_10s):
 
 def test_the_json_keeps_every_key(summary):
     d = summary.to_dict()
-    assert set(d) == RUN_KEYS | PATH_KEYS | PAPER_KEYS  # new keys added: every key before is kept
+    assert set(d) == RUN_KEYS | PATH_KEYS | PAPER_KEYS | EFFORT_KEYS  # new keys added: every key before is kept
     assert set(d["certificate"]) == CERTIFICATE_KEYS
     assert set(d["paper_region"]) == {"E_max", "Edot_max", "condition", "inside"}
     assert set(d["drift"]) == {"final_alpha_dot", "growing", "E_last_window", "E_prev_window", "window_s",

@@ -17,6 +17,7 @@ from wmr_mj.sim.sweep import (
     draw_samples,
     latin_hypercube,
     read_results,
+    read_runs,
     run_configs,
     run_sweep,
 )
@@ -117,13 +118,13 @@ def test_cli_sweep_json_and_files(tmp_path):
                            "--duration", "10", "--out", str(tmp_path), "--json"],
                           capture_output=True, text=True, check=True)
     obj = json.loads(proc.stdout)
-    for key in ("n", "inside", "outside", "worst_E_ratio", "worst_Edot_ratio", "steps_per_s"):
+    for key in ("n", "paper_inside", "paper_outside", "worst_paper_E_ratio", "worst_paper_Edot_ratio", "steps_per_s"):
         assert key in obj
-    rows = read_results(tmp_path / "runs.csv")
-    assert obj["n"] == 3 and obj["inside"] + obj["outside"] == 3
+    rows = read_runs(tmp_path)  # full precision (runs.csv rounds)
+    assert obj["n"] == 3 and obj["paper_inside"] + obj["paper_outside"] == 3
     assert obj["batch_law"] == ["compiled"]  # the default where the compiled law is built (tests/test_compiled_law.py)
-    assert obj["inside"] == sum(r["inside"] for r in rows)
-    assert obj["worst_E_ratio"] == max(r["E_ratio"] for r in rows)
+    assert obj["paper_inside"] == sum(r["inside"] for r in rows)
+    assert obj["worst_paper_E_ratio"] == max(r["E_ratio"] for r in rows)
     assert (tmp_path / "region.png").stat().st_size > 1000
 
 
@@ -162,7 +163,7 @@ def test_cli_sweep_log_writes_replayable_mcap_per_run(tmp_path):
                            "--duration", "10", "--out", str(tmp_path), "--log", "--json"],
                           capture_output=True, text=True, check=True)
     obj = json.loads(proc.stdout)
-    rows = read_results(tmp_path / "runs.csv")
+    rows = read_runs(tmp_path)  # full precision (runs.csv rounds)
     logs = sorted((tmp_path / "mcap").glob("*.mcap"))
     assert len(logs) == 2 and obj["mcap_dir"] == str(tmp_path / "mcap")
     for path, row in zip(logs, rows):
@@ -185,7 +186,7 @@ def test_certified_design_sweep_over_m1_is_certified_inside_for_every_run(tmp_pa
     assert counts["certified-inside"] == 8, counts
     assert max(r["cert_E_ratio"] for r in rows) < 1.0
     assert min(r["m1"] for r in rows) < 575.0 and max(r["m1"] for r in rows) > 725.0  # the range is covered
-    saved = read_results(tmp_path / "runs.csv")  # the verdict columns survive the CSV
+    saved = read_runs(tmp_path)  # the verdict columns survive the CSV (its numbers: at full precision)
     assert [r["verdict"] for r in saved] == [r["verdict"] for r in rows]
     assert [r["cert_E_ratio"] for r in saved] == [r["cert_E_ratio"] for r in rows]
 
@@ -205,7 +206,7 @@ def test_cli_sweep_reports_each_requirement_and_the_signals(tmp_path, capsys):
         argv += ["--require", text]
     assert main(argv) == 0
     summary = json.loads(capsys.readouterr().out)
-    rows = read_results(tmp_path / "s" / "runs.csv")
+    rows = read_runs(tmp_path / "s")  # full precision (runs.csv rounds)
     assert summary["signals"]["disturbance"] == {"kind": "step", "amplitude": 2.0, "t1": 1.0}
     for i, (text, judged) in enumerate(zip(requirements, summary["requirements"])):
         column = f"requirement_{i + 1}_robustness"

@@ -147,7 +147,9 @@ def test_sweep_summary_is_typed_and_round_trips():
     out = s.sweep_dict(1.0)  # the JSON of wmr-mj sweep, keys as before
     assert out["claim_broken"] == {"run": 1, "params": {"m1": 700.0}, "sup_E": 0.075, "sup_Edot": 0.1,
                                    "E_max": 0.05, "ratio": 1.5, "count": 1}
-    assert out["unmet"] == [{"name": "within the supply", "value": 25.0, "limit": 24.0, "runs": 2}]
+    # the first run's value and the range over the runs (issue 36)
+    assert out["unmet"] == [{"name": "within the supply", "value": 25.0, "limit": 24.0, "runs": 2,
+                             "value_range": [25.0, 26.0]}]
     d = s.to_dict()
     assert d["sup_E"] == {"value": 0.075, "m1": 700.0} and d["batch_law"] == ["compiled"]
     assert SweepSummary.from_dict(d).to_dict() == d

@@ -25,7 +25,8 @@ Usage::
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping
+import re
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -56,6 +57,7 @@ __all__ = [
     "certified_outside_banner",
     "unmet_assumptions",
     "count_unmet",
+    "partial_text",
     "format_unmet",
     "format_measurement_cause",
     "format_delta1_parts",
@@ -142,20 +144,34 @@ class RunJudgement:
     drift: Drift | None
 
 
-def drift(*, prev_window: float, last_window: float, final_alpha_dot: float) -> Drift:
+def drift(*, prev_window: float, last_window: float, final_alpha_dot: float,
+          last_halves: tuple[float, float] | None = None) -> Drift:
     """The end-of-run drift.
+
+    A run that settles onto a larger steady |E| (a transient that rose through the previous window, then a
+    plateau) has a last window above the previous one, yet is settled: growth counts only where it goes on
+    through the last window itself, its second half above its first by more than half the tolerance (the same
+    rate, :data:`DRIFT_TOLERANCE` per :data:`DRIFT_WINDOW_S`, over half the time). A settled |E| (constant to
+    the last bits) never grows; |E| that rises at that rate or faster to the end does.
 
     Args:
         prev_window: max |E| over the window before the last [rad].
         last_window: max |E| over the last window [rad].
         final_alpha_dot: alpha' at the last control step [rad/s].
+        last_halves: max |E| over the first and the second half of the last window [rad]; None (or a
+            window of one step): the two windows alone judge.
 
     Returns:
-        Drift: growing when the last window exceeds the previous by more than
-        :data:`DRIFT_TOLERANCE`, or either is not finite.
+        Drift: growing when the last window exceeds the previous by more than :data:`DRIFT_TOLERANCE` and
+        (with ``last_halves``) the last window's second half exceeds its first by more than half of it, or
+        when either window is not finite.
     """
     growing = bool(math.isfinite(last_window) and math.isfinite(prev_window)
                    and last_window - prev_window > DRIFT_TOLERANCE)
+    if growing and last_halves is not None:
+        first, second = last_halves
+        growing = bool(not (math.isfinite(first) and math.isfinite(second))
+                       or second - first > 0.5 * DRIFT_TOLERANCE)
     if not (math.isfinite(last_window) and math.isfinite(prev_window)):
         growing = True  # a diverged run is not settled
     return Drift(final_alpha_dot=float(final_alpha_dot), growing=growing, E_last_window=float(last_window),
@@ -249,17 +265,34 @@ def unmet_assumptions(certificate: Mapping[str, Any] | None) -> list[dict[str, A
 
 def count_unmet(per_run: Iterable[Iterable[Mapping[str, Any]]]) -> list[dict[str, Any]]:
     """Each assumption unmet in some run, once, in the order first met: {name, value, limit} of the first
-    run that does not meet it and ``runs``, how many do not.
+    run that does not meet it, ``runs``, how many do not, and, where the runs' finite values differ,
+    ``value_range`` [lo, hi] over them (the assumption's units). A cart assumption's ``note`` quotes the
+    range over the runs of each number that differs between their notes (``b = 0.001-0.01 rad``), so that
+    no aggregate quotes one run's value as the runs'.
 
     Args:
         per_run: each run's unmet assumptions ({name, value, limit}: :func:`unmet_assumptions`).
     """
     seen: dict[str, dict[str, Any]] = {}
+    values: dict[str, list[float]] = {}
+    notes: dict[str, list[str]] = {}
     for unmet in per_run:
         for a in unmet:
-            first = {"name": str(a["name"]), "value": a.get("value"), "limit": a.get("limit"),
+            name = str(a["name"])
+            first = {"name": name, "value": a.get("value"), "limit": a.get("limit"),
                      **({"note": a["note"]} if a.get("note") and a["name"] in CART_ASSUMPTIONS else {}), "runs": 0}
-            seen.setdefault(str(a["name"]), first)["runs"] += 1
+            seen.setdefault(name, first)["runs"] += 1
+            value = a.get("value")
+            if isinstance(value, (int, float)) and math.isfinite(value):
+                values.setdefault(name, []).append(float(value))
+            if a.get("note") and name in CART_ASSUMPTIONS:
+                notes.setdefault(name, []).append(str(a["note"]))
+    for name, entry in seen.items():
+        finite = values.get(name, [])
+        if finite and min(finite) != max(finite):
+            entry["value_range"] = [min(finite), max(finite)]
+        if "note" in entry:
+            entry["note"] = merged_note(notes[name])
     return list(seen.values())
 
 
@@ -276,14 +309,59 @@ def _which_certificate(cert: dict) -> str:
     return f"the sampled-data certificate (section 4's: {section4})"
 
 
+_NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
+
+
+def merged_note(notes: Sequence[str]) -> str:
+    """One note for many runs' notes of one assumption: notes that are the same text but for their numbers are
+    one, each number that differs between them its range over those runs, 'LO-HI' (as the notes write them);
+    notes whose words differ (another reason) are each given so, with how many runs gave it, ' | ' between.
+
+    Args:
+        notes: the runs' notes, in run order (at least one).
+    """
+    groups: dict[tuple[str, ...], list[str]] = {}
+    for note in notes:  # in the order first met
+        groups.setdefault(tuple(_NUMBER.split(note)), []).append(note)
+
+    def merged(skeleton: tuple[str, ...], members: list[str]) -> str:
+        pieces = [skeleton[0]]
+        for texts, tail in zip(zip(*(_NUMBER.findall(n) for n in members)), skeleton[1:]):
+            lo, hi = min(texts, key=float), max(texts, key=float)
+            pieces += [lo if float(lo) == float(hi) else f"{lo}-{hi}", tail]
+        return "".join(pieces)
+
+    if len(groups) == 1:
+        ((skeleton, members),) = groups.items()
+        return merged(skeleton, members)
+    return " | ".join(f"{merged(k, m)} ({len(m)} run{'s' if len(m) > 1 else ''})" for k, m in groups.items())
+
+
 def format_unmet(unmet: Iterable[Mapping[str, Any]]) -> str:
     """'name (value vs limit); ...' of unmet assumptions ({name, value, limit}: :func:`unmet_assumptions`); an
     assumption about the cart (:data:`CART_ASSUMPTIONS`) with its note, 'name (value vs limit: note)'."""
     def why(a: Mapping[str, Any]) -> str:
         return f": {a['note']}" if a.get("note") and a.get("name") in CART_ASSUMPTIONS else ""
 
-    return "; ".join(f"{a['name']} ({_num(a.get('value'), '.4g')} vs {_num(a.get('limit'), '.4g')}{why(a)})"
-                     for a in unmet)
+    def value(a: Mapping[str, Any]) -> str:
+        span = a.get("value_range")  # over the runs (count_unmet), where their values differ
+        return (f"{_num(span[0], '.4g')}-{_num(span[1], '.4g')}" if span else _num(a.get("value"), ".4g"))
+
+    return "; ".join(f"{a['name']} ({value(a)} vs {_num(a.get('limit'), '.4g')}{why(a)})" for a in unmet)
+
+
+def partial_text(summary: Mapping[str, Any]) -> str:
+    """Beside the verdict of a run whose reference does not cover its route or manoeuvre (``route_finished``
+    False: a lane change cut short by the duration, an open route longer than the run): PARTIAL, how much it
+    covers and what duration covers it; '' otherwise."""
+    if summary.get("route_finished") is not False:
+        return ""
+    driven, length = summary.get("route_driven_m"), summary.get("route_length_m")
+    if not isinstance(driven, (int, float)) or not isinstance(length, (int, float)) or length <= 0:
+        return ""
+    return (f"  -- PARTIAL: the run's reference covers {driven:.3g} m of the {length:.3g} m its path must drive "
+            f"({100 * driven / length:.0f}%), and the verdict that part only: give a longer --duration to judge "
+            "the whole manoeuvre")
 
 
 def format_verdict(summary: Mapping[str, Any]) -> list[str]:
@@ -311,7 +389,7 @@ def format_verdict(summary: Mapping[str, Any]) -> list[str]:
     no_region = cert.get("valid") is False  # no bound: the run is neither inside nor outside of anything
     lines.append(f"verdict: {verdict.upper()}"
                  + ("" if ratio is None else f"  (tightness sup|E|/E_max = {ratio:.3f})")
-                 + ("" if is_pass(verdict) else "  -- not a pass")
+                 + ("" if is_pass(verdict) else "  -- not a pass") + partial_text(summary)
                  + (": no certificate, so no region to be inside or outside of" if no_region else ""))
     unmet = [a for a in cert.get("assumptions", []) if not a.get("met")]
     if unmet:

@@ -82,7 +82,7 @@ def run(args: argparse.Namespace) -> int:
     if args.budget < 0:
         raise ParameterError(f"--budget {args.budget} is not accepted: a number of runs >= 0")
     suite = load_suite(args.suite)
-    suite.select(args.scenarios or [])  # an unknown scenario: one line, before any run
+    chosen = suite.select(args.scenarios or [])  # an unknown scenario: one line, before any run
     cart = _cart_options(args)
     designs = [design_from_token(t, suite, cart=cart) for t in args.designs]
     labels = [d.label for d in designs]
@@ -91,7 +91,7 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError(f"a design is named twice: {', '.join(twice)}; name each once")
     if args.budget:
         for d in designs:  # a budget below one generation, a requirement or box the design refuses: before any run
-            adversary_spec(d, suite, budget=args.budget, seed=args.seed, method=args.method)
+            adversary_spec(d, suite, budget=args.budget, seed=args.seed, method=args.method, scenarios=chosen)
     out = Path(check_output_path(args.out or f"logs/compare-{time.strftime('%Y%m%d-%H%M%S')}", kind="dir",
                                  option="--out"))
     with progress_bar(1, desc="compare", unit="runs", enabled=args.progress) as bar:

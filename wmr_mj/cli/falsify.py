@@ -27,7 +27,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                               "or of the random sample is certified-outside (it breaks the law's claim), or the "
                               "--require is falsified; 1 the serial re-run of the worst run did not reproduce it; "
                               "2 bad input")
+    from wmr_mj.cli.sweep import add_fixed_m1_option
+
     add_run_options(p)
+    add_fixed_m1_option(p)
     p.add_argument("--range", action="append", metavar="NAME=LO:HI",
                    help="add a plant parameter to the box or replace its range (repeatable); with --disturbance "
                         "or --load, also their parameters: disturbance.amplitude, disturbance.t1, ..., load0.m1, "
@@ -118,7 +121,7 @@ def _portfolio_phases_text(spec, first, population: int) -> str:
     )
 
     lo, hi = spec.bounds[:, 0], spec.bounds[:, 1]
-    corners = np.array([[e.params[n] for n in spec.names] for e in first])
+    corners = np.array([e.point or [e.params[n] for n in spec.names] for e in first])  # as searched, unrounded
     corners = np.where(hi > lo, (corners - lo) / np.where(hi > lo, hi - lo, 1.0), 0.0)
     values = np.array([np.nan if e.objective is None else e.objective for e in first])
     start = screened_start(corners, values)
@@ -156,13 +159,16 @@ def _base_and_box(args: argparse.Namespace):
         raise ParameterError(f"--path-knots {args.path_knots} is not accepted: a number of knots >= 0")
     if (args.path_knots or any(path_axis(n) for n in searched)) and args.reference_bounds is None:
         args.reference_bounds = "paper"  # every searched path within the bounds its certificate declares
-    base = config_from_args(args)
+    from wmr_mj.cli.sweep import fixed_m1_from_args
+
+    fixed_m1 = fixed_m1_from_args(args)  # --m1 or a zero-width --m1-range: m1 not searched
+    base = config_from_args(args) if fixed_m1 is None else config_from_args(args, m1=fixed_m1)
     if args.path_knots:
         from wmr_mj.reference.knots import KnotSpace
 
         space = KnotSpace(args.path_knots, hold_range=(0.0, 3.0))
         searched = {**space.ranges(base.reference_bounds), **searched}
-    box = {"m1": tuple(args.m1_range), **box_ranges_from_args(args), **searched}
+    box = {**({"m1": tuple(args.m1_range)} if fixed_m1 is None else {}), **box_ranges_from_args(args), **searched}
     return base, box
 
 
@@ -182,12 +188,23 @@ def run(args: argparse.Namespace) -> int:
     spec = FalsifySpec(base=base, box=box, objective=objective, budget=args.budget, seed=args.seed,
                        population=args.population, method=args.method, requirement=args.require)
     parts = check_runnable(base)  # a duration too short for the path: one line, before any output or search
+    from wmr_mj.sim.falsify import check_objective_applies, check_objective_defined
+
+    check_objective_applies(parts.controller, spec.objective)  # before the output folder is made
+    check_objective_defined(parts, spec)
     out = check_output_path(args.out or f"logs/falsify-{time.strftime('%Y%m%d-%H%M%S')}", kind="dir", option="--out")
     with progress_bar(2 * spec.budget, desc="falsify", unit="runs") as bar:
         result = falsify(spec, chunk=args.chunk, nthread=args.nthread, scheduler=args.scheduler,
                          progress=counter_callback(bar),  # evaluations.csv after every generation: Ctrl-C keeps them
                          checkpoint=lambda partial: write_text_atomic(out / "evaluations.csv", _table(partial)),
                          parts=parts)
+    from wmr_mj.sim.falsify import undefined_objective_warning
+
+    warning = undefined_objective_warning(result)  # runs left blank by the objective: said, on stderr
+    if warning is not None:
+        import sys
+
+        print(warning, file=sys.stderr, flush=True)
     log_path = out / "worst.mcap"
     config = worst_config(result)
     logged = run_logged(config, str(log_path))
@@ -331,15 +348,19 @@ def claim_lines(report: FalsifyReport) -> list[str]:
 
 
 def _table(result) -> str:
-    """evaluations.csv: every run of both phases, parameters at full precision."""
+    """evaluations.csv: every run of both phases, each parameter as its run used it (a hardware axis rounded as
+    the run had it), numbers to 12 significant digits (falsify.json keeps every bit)."""
     import csv
     import io
+
+    from wmr_mj.sim.sweep import csv_number
 
     names = list(result.spec.names)
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(["phase", "index", "generation", *names, "objective", "sup_E", "sup_Edot", "verdict"])
     for e in (*result.search, *result.random):
-        w.writerow([e.phase, e.index, e.generation, *(repr(e.params[n]) for n in names),
-                    "" if e.objective is None else repr(e.objective), repr(e.sup_E), repr(e.sup_Edot), e.verdict])
+        w.writerow([e.phase, e.index, e.generation, *(csv_number(e.params[n]) for n in names),
+                    "" if e.objective is None else csv_number(e.objective), csv_number(e.sup_E),
+                    csv_number(e.sup_Edot), e.verdict])
     return buf.getvalue()

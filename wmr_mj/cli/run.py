@@ -196,16 +196,31 @@ def default_log_path(config) -> str:
     return f"logs/run-{stamp}-{config.model}-m{config.m1:g}.mcap"
 
 
-def measurement_cause(s: RunSummary):
-    """The measurement errors the run's section-4 certificate assumed, and which binds
-    (:class:`~wmr_mj.analysis.claim_types.MeasurementCause`); None on an ideal cart or for another claim."""
+def measurement_cause(s: RunSummary, measurement: Any = None):
+    """The measurement errors the run's certificate assumed, and which binds
+    (:class:`~wmr_mj.analysis.claim_types.MeasurementCause`); None on an ideal cart or for another claim.
+
+    Args:
+        s: the run's summary.
+        measurement: the run's :class:`~wmr_mj.analysis.measurement.MeasurementErrors` (``RunParts.measurement``):
+            where the claim taken is the sampled-data certificate (it has a bound, so nothing binds), the errors it
+            assumed are these.
+    """
+    from wmr_mj.analysis.claim_types import MeasurementCause
+
     judged = s.certificate
     terms = None if judged is None else judged.certificate.terms
-    return None if terms is None else terms.measurement_cause
+    if terms is not None:
+        return terms.measurement_cause
+    sampled = judged is not None and judged.certificate.inputs.get("certificate") == "sampled-data"
+    if not sampled or measurement is None or measurement.is_exact:
+        return None
+    return MeasurementCause(e_a=measurement.alpha_error_max, e_v=measurement.alpha_dot_error_max,
+                            tau=measurement.delay_s)
 
 
-def format_report(s: RunSummary) -> str:
-    """Human-readable run report of the summary ``s``."""
+def format_report(s: RunSummary, *, measurement: Any = None) -> str:
+    """Human-readable run report of the summary ``s`` (``measurement``: as :func:`measurement_cause` takes it)."""
     from wmr_mj.analysis.verdicts import format_measurement_cause, format_verdict
 
     def ratio(x):
@@ -231,7 +246,7 @@ def format_report(s: RunSummary) -> str:
     settled = s.duration > s.settle_s
     paper = (lambda bound, r: f" {bound:12.5g} {ratio(r):>8s}") if s.paper_law else (lambda bound, r: "")
     verdict = format_verdict(s.to_dict())
-    cause = measurement_cause(s)
+    cause = measurement_cause(s, measurement)
     if cause is not None:  # beside the certificate's line: what it assumed the law reads, and what binds
         at = next((i + 1 for i, line in enumerate(verdict) if line.startswith("certificate:")), len(verdict))
         verdict.insert(at, format_measurement_cause(cause))
@@ -325,7 +340,7 @@ def run(args: argparse.Namespace) -> int:
                                                     result.summary.to_dict(),
                                                     period=period)]
     report = {**result.summary.to_dict(), "log": path, **({"requirements": judged} if judged else {})}
-    cause = measurement_cause(result.summary)
+    cause = measurement_cause(result.summary, parts.measurement)
     if cause is not None:  # the errors the claim assumed, and which keeps its fixed point open (an ideal cart: none)
         report["measurement_errors"] = cause.to_dict()
     if config.signals is not None:
@@ -338,7 +353,7 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print_json(report)
     else:
-        print(format_report(result.summary))
+        print(format_report(result.summary, measurement=parts.measurement))
         if not is_ideal_cart(config):
             print(cart_line(config))
         if judged:

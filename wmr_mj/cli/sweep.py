@@ -22,6 +22,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                        epilog=f"exit status: 0; {CLAIM_BROKEN_EXIT} when a run is certified-outside: it breaks the "
                               "law's claim (a banner names the run; summary.json's claim_broken); 2 bad input")
     add_run_options(p)
+    add_fixed_m1_option(p)
     p.add_argument("--n", type=int, default=200, help="number of runs (default 200)")
     add_seed(p, help="seed of the draw (default 0)")
     p.add_argument("--sampling", default="lhs", help="uniform, lhs (Latin hypercube, default) or grid")
@@ -45,6 +46,40 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
+def add_fixed_m1_option(p: argparse.ArgumentParser) -> None:
+    """sweep's and falsify's --m1: a fixed m1, so that the other axes are swept or searched alone."""
+    from wmr_mj.cli._common import positive_float
+
+    p.add_argument("--m1", type=positive_float, default=None, metavar="KG",
+                   help="fix every run's m1 at KG (the other ranges swept alone; the certificate's box stays "
+                        "--m1-range); a zero-width --m1-range KG KG is the same, the box then the default 550-750 kg")
+
+
+def fixed_m1_from_args(args: argparse.Namespace) -> float | None:
+    """The fixed m1 [kg] of sweep's or falsify's options, None where m1 is drawn or searched: --m1 KG, or a
+    zero-width --m1-range KG KG, which then gives the certificate's box back its default range (a box of one
+    mass is no box: :class:`wmr_mj.sim.config.RunConfig` refuses it), rewriting ``args.m1_range``.
+
+    Raises:
+        ParameterError: a zero-width range outside the default box, or one that differs from --m1.
+    """
+    from wmr_mj.errors import ParameterError
+    from wmr_mj.params import M1_RANGE
+
+    fixed = getattr(args, "m1", None)
+    lo, hi = (float(v) for v in args.m1_range)
+    if lo != hi:
+        return fixed
+    if fixed is not None and fixed != lo:
+        raise ParameterError(f"--m1 {fixed:g} and --m1-range {lo:g} {hi:g} fix two masses; give one")
+    if not M1_RANGE[0] <= lo <= M1_RANGE[1]:
+        raise ParameterError(f"--m1-range {lo:g} {hi:g} fixes m1 at {lo:g} kg, outside the certificate's default "
+                             f"box {M1_RANGE[0]:g}-{M1_RANGE[1]:g} kg: give --m1 {lo:g} with --m1-range LO HI "
+                             "around it")
+    args.m1_range = list(M1_RANGE)
+    return lo
+
+
 def run(args: argparse.Namespace) -> int:
     import functools
     import time
@@ -59,6 +94,7 @@ def run(args: argparse.Namespace) -> int:
 
     if args.n < 1:
         raise ParameterError(f"--n {args.n} is not accepted; the number of runs must be >= 1")
+    fixed_m1 = fixed_m1_from_args(args)  # --m1 or a zero-width --m1-range: m1 not drawn
     # --uncertainty (default m1), then --range: the plant's, then the cart's axes (drawn, not in the box)
     ranges = {**box_ranges_from_args(args), **hardware_ranges_from_args(args)}
     out = check_output_path(args.out or f"logs/sweep-{time.strftime('%Y%m%d-%H%M%S')}", kind="dir", option="--out")
@@ -69,7 +105,7 @@ def run(args: argparse.Namespace) -> int:
     base_parts = resolve_run(base)
     requirements = tuple(r.text for r in requirements_from_args(args, args.control_period or TIMESTEP))
     spec = SweepSpec(n=args.n, seed=args.seed, sampling=args.sampling, m1_range=tuple(args.m1_range),
-                     ranges=ranges, base=base, requirements=requirements)
+                     ranges=ranges, base=base, requirements=requirements, m1=fixed_m1)
     t0 = time.perf_counter()
     with progress_bar(spec.n, desc="sweep", unit="runs", fractional=True) as bar:
         results = run_sweep(spec, out_dir=out, chunk=args.chunk, nthread=args.nthread, scheduler=args.scheduler,
@@ -80,6 +116,8 @@ def run(args: argparse.Namespace) -> int:
     summary.update({"folder": str(out), "model": base.model, "controller": base.controller, "seed": args.seed,
                     "sampling": args.sampling,
                     "ranges": {"m1": list(args.m1_range), **{k: list(v) for k, v in ranges.items()}}})
+    if fixed_m1 is not None:  # every run's m1 (ranges' m1: the certificate's box)
+        summary["fixed_m1"] = fixed_m1
     if base.signals is not None:
         summary["signals"] = base.signals.as_dict()  # every run's, with every parameter
     from wmr_mj.cli._common import add_controller_source
@@ -112,8 +150,9 @@ def run(args: argparse.Namespace) -> int:
 
     law = base_parts.controller
     label = law.label()
-    print(f"{runs.n} runs ({label}, m1 over "
-          f"{args.m1_range[0]:g}-{args.m1_range[1]:g} kg, {args.sampling}, seed {args.seed}):")
+    m1_text = (f"m1 fixed at {fixed_m1:g} kg" if fixed_m1 is not None
+               else f"m1 over {args.m1_range[0]:g}-{args.m1_range[1]:g} kg")
+    print(f"{runs.n} runs ({label}, {m1_text}, {args.sampling}, seed {args.seed}):")
     if not is_ideal_cart(base) or spec.hardware_names:
         drawn = f" (drawn per run: {', '.join(spec.hardware_names)})" if spec.hardware_names else ""
         print(cart_line(base) + drawn)
@@ -131,6 +170,7 @@ def run(args: argparse.Namespace) -> int:
               f"worst sup|E|/E_max = {fmt(runs.paper_E_ratio.value)}, "
               f"worst sup|E'|/Edot_max = {fmt(runs.paper_Edot_ratio.value)}")
     print(f"{runs.hit_stop} runs hit the steering stop")
+    print("\n".join(effort_lines(runs)))
     if runs.path_verdicts is not None:
         print(f"path of C: worst sup|cross-track| = {runs.path_cross_track.value:.4g} m "
               f"(m1 = {runs.path_cross_track.m1:g} kg); path verdicts: "
@@ -146,6 +186,25 @@ def run(args: argparse.Namespace) -> int:
     print(f"{runs.steps} steps in {wall:.1f} s ({summary['steps_per_s']:.3g} steps/s{backend})")
     print(f"table: {out / 'runs.csv'}\nplot:  {plot_path}")
     return status
+
+
+def effort_lines(runs: SweepSummary) -> list[str]:
+    """What the runs asked of the motor: saturation, peak voltage and voltage activity, overall and per level
+    of each ranged axis that has levels; nothing where the rows have no effort (a runs.csv written before)."""
+    e = runs.effort
+    if e is None:
+        return []
+
+    def text(x) -> str:
+        return (f"saturated {100 * x.mean_saturated_fraction:.3g}% of the time "
+                f"(at most {100 * x.max_saturated_fraction:.3g}%), "
+                f"peak |u| {x.peak_voltage:.4g} V, RMS u {x.mean_rms_voltage:.4g} V, activity "
+                f"{x.mean_tv_voltage:.4g} V/s (at most {x.max_tv_voltage:.4g})")
+
+    lines = [f"effort: {text(e)}"]
+    for axis in runs.effort_by_level:
+        lines += [f"  {axis.axis} = {lv.value:g} ({lv.effort.runs} runs): {text(lv.effort)}" for lv in axis.levels]
+    return lines
 
 
 def claim_lines(runs: SweepSummary) -> list[str]:

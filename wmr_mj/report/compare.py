@@ -204,14 +204,15 @@ def figure(result: CompareResult):
     labels = [r.label for r in result.rows]
     held = [r.requirements_passed / r.requirements_total if r.requirements_total else 0.0 for r in result.rows]
     y = range(len(labels))
-    a.barh(list(y), held, color="C2")
+    colours = [f"C{i % 10}" for i in range(len(labels))]  # one per design, the same in both panels
+    a.barh(list(y), held, color=colours)
     a.set_yticks(list(y), labels, fontsize=8)
     a.invert_yaxis()
     a.set_xlim(0, 1)
     a.set_xlabel("fraction of requirement checks held")
     a.set_title("(a) requirements over the suite")
     for i, r in enumerate(result.rows):
-        b.scatter(r.rms_voltage, r.cross_track_max if r.cross_track_max is not None else math.nan, color=f"C{i % 10}",
+        b.scatter(r.rms_voltage, r.cross_track_max if r.cross_track_max is not None else math.nan, color=colours[i],
                   label=r.label)
     b.set_xlabel("RMS voltage [V]")
     b.set_ylabel("worst |cross-track| [m]")

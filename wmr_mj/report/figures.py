@@ -34,9 +34,9 @@ __all__ = ["figures_stage", "travelled_paths"]
 
 def _rung_figure(rung: Rung, folder: Path):
     from wmr_mj.report import plots
-    from wmr_mj.sim.sweep import read_results
+    from wmr_mj.sim.sweep import read_runs
 
-    rows = read_results(folder / rung.runs_csv)
+    rows = read_runs((folder / rung.runs_csv).parent)
     cert, paper = rung.certificate, rung.paper_region
     regions = [plots.Region(f"certificate: |E| <= {cert['E_max']:.3g} rad, |E'| <= {cert['Edot_max']:.3g} rad/s",
                             [tuple(v) for v in cert["vertices"]], gid=plots.CERTIFICATE_GID)] if cert["valid"] else []

@@ -152,13 +152,13 @@ def _evaluations_csv(names: Sequence[str], runs: Sequence[Mapping[str, Any]]) ->
 
 def _compare(result: dict[str, Any], plan: SearchPlan, rungs: Sequence[Mapping[str, Any]], folder: Path) -> None:
     """Add the Monte-Carlo worst of the plan's rung (read from its runs.csv) beside the search's."""
-    from wmr_mj.sim.sweep import read_results
+    from wmr_mj.sim.sweep import read_runs
 
     if plan.mc_rung is None or plan.mc_column is None:
         result["mc"] = None
         return
     rung = rungs[plan.mc_rung - 1]
-    value, m1 = max_at(read_results(folder / rung["runs_csv"]), plan.mc_column)
+    value, m1 = max_at(read_runs((folder / rung["runs_csv"]).parent), plan.mc_column)
     worst = (result["worst"] or {}).get("objective")
     result["mc"] = {"rung": plan.mc_rung, "n": rung["n"], "column": plan.mc_column, "worst_objective": value,
                     "worst_m1": m1, "runs_csv": rung["runs_csv"]}

@@ -153,7 +153,7 @@ def run_rung(settings: ValidateSettings, k: int, design: DesignLike, folder: Pat
     paper's region are the base run's (``settings.config(design)``), resolved once: ``parts``
     (:func:`wmr_mj.sim.parts.resolve_run`), resolved here where None."""
     from wmr_mj.sim.parts import resolve_run
-    from wmr_mj.sim.sweep import SweepSpec, read_results, run_sweep
+    from wmr_mj.sim.sweep import SweepSpec, read_runs, run_sweep
 
     base = settings.config(design)
     parts = resolve_run(base) if parts is None else parts
@@ -163,7 +163,7 @@ def run_rung(settings: ValidateSettings, k: int, design: DesignLike, folder: Pat
     st.start(f"ladder-{k}", f"rung {k} ({design.label}): {settings.n} runs of {settings.duration:g} s over m1 "
                             f"{settings.m1_range[0]:g}-{settings.m1_range[1]:g} kg ({settings.sampling})")
     run_sweep(spec, out_dir=sweep_dir, nthread=settings.nthread, progress=stage_progress(st))
-    rung = summarise_rung(read_results(sweep_dir / "runs.csv"))
+    rung = summarise_rung(read_runs(sweep_dir))  # full precision: runs.csv is rounded
     rung.update(index=k, name=design.name, label=design.label, design=design.describe(),
                 config=design.config_changes(), changed=[] if before is None else ladder_changes(before, design),
                 change="" if before is None else _change_text(before, design),

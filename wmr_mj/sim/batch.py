@@ -65,7 +65,7 @@ from wmr_mj.sim.config import (
 )
 from wmr_mj.sim.engine import LAW_BACKENDS, batch_law_backend, batch_model
 from wmr_mj.sim.parts import RunParts, resolve_run
-from wmr_mj.sim.summary import BatchFigures, RunSummary
+from wmr_mj.sim.summary import BatchFigures, RunSummary, voltage_effort
 
 __all__ = ["run_batch", "shares_one_batch", "batch_model", "batch_law_backend", "LAW_BACKENDS", "thread_count",
            "batch_groups"]
@@ -110,6 +110,9 @@ class _BatchStats:
     law_nan: np.ndarray = field(init=False)  # the law gave NaN: re-run as a single run
     drift_prev: np.ndarray = field(init=False)  # max |E| over the window before the last (wmr_mj.analysis.verdicts)
     drift_last: np.ndarray = field(init=False)  # max |E| over the last window
+    drift_halves: np.ndarray = field(init=False)  # (nsim, 2) max |E| over the first and second half of the last
+    control_steps: int = 0  # the runs' control steps (the rows of ``voltage``)
+    voltage: np.ndarray = field(init=False)  # (control_steps, nsim) the applied voltage [V] (its effort)
     final_alpha_dot: np.ndarray = field(init=False)  # alpha0' - E' of the last control step
     path_samples: int = 0  # control steps at which C is sampled (closed_loop.path_sample_index)
     C_xy: np.ndarray = field(init=False)  # (nsim, path_samples, 2) C's xy there [m]
@@ -123,6 +126,8 @@ class _BatchStats:
         self.saturated, self.warnings = np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64)
         self.left_at, self.final_alpha, self.final_alpha_after_step = (np.full(n, np.nan) for _ in range(3))
         self.drift_prev, self.drift_last = np.zeros(n), np.zeros(n)
+        self.drift_halves = np.zeros((n, 2))
+        self.voltage = np.full((self.control_steps, n), np.nan)
         self.final_alpha_dot = np.full(n, np.nan)
         self.C_xy = np.full((n, self.path_samples, 2), np.nan)
         self.heading = np.full((n, self.path_samples), np.nan)
@@ -295,6 +300,8 @@ def _block_stats(loop: _Loop, stats: _BatchStats, idx: np.ndarray, k0: int, rows
     u = u_buf[:rows]
     # saturated as in the serial loop: the applied voltage differs from the law's (NaN included)
     stats.saturated[idx] += (~((u >= lo) & (u <= hi))).sum(axis=0)
+    # the applied voltage, clipped as the step applied it (its effort: wmr_mj.sim.summary.voltage_effort)
+    stats.voltage[k0:k0 + rows, idx] = np.minimum(np.maximum(u, lo), hi)
     stats.law_nan[idx] |= np.isnan(u).any(axis=0)
     hit = np.abs(a_buf[:rows]) >= range_limit
     first = np.where(hit.any(axis=0), hit.argmax(axis=0), -1)
@@ -305,6 +312,11 @@ def _block_stats(loop: _Loop, stats: _BatchStats, idx: np.ndarray, k0: int, rows
         a, b = max(lo_k - k0, 0), min(hi_k - k0, rows)
         if a < b:
             out[idx] = np.maximum(out[idx], E[a:b].max(axis=0))
+    half = loop.n - w + w // 2  # the last window's halves (wmr_mj.sim.closed_loop._drift_of)
+    for j, (lo_k, hi_k) in enumerate(((loop.n - w, half), (half, loop.n))):
+        a, b = max(lo_k - k0, 0), min(hi_k - k0, rows)
+        if a < b:
+            stats.drift_halves[idx, j] = np.maximum(stats.drift_halves[idx, j], E[a:b].max(axis=0))
 
 
 def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parameters = C80,
@@ -366,7 +378,7 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
                  voltage_limit=np.array([p.voltage_limit for p in plants]),
                  range_limit=np.array([p.steering_range for p in plants]) - 1e-3,
                  path_at=path_at, site_C=model.site("C").id)
-    stats = _BatchStats(nsim, path_samples=len(path_at))
+    stats = _BatchStats(nsim, path_samples=len(path_at), control_steps=n)
     threads = thread_count(nthread, nsim)
     # the compiled law holds no GIL: one batch on every thread
     groups = [(np.arange(nsim), threads)] if backend == "compiled" else batch_groups(nsim, threads)
@@ -494,11 +506,13 @@ def _summaries(configs: Sequence[RunConfig], plants: Sequence[C80Parameters], st
                                saturated_fraction=stats.saturated[i] / n,
                                left_range_at=None if np.isnan(stats.left_at[i]) else float(stats.left_at[i]),
                                final_alpha=stats.final_alpha[i], control_steps=n, steps=n * substeps,
-                               wall_s=wall / nsim)
+                               wall_s=wall / nsim, effort=voltage_effort(stats.voltage[:, i], period))
         r = report(c, measured, analysis=analysis, params=p, certificate=certificate,
                    claims_nothing=certificate is None, name=run.parts.controller_name,
                    drift=drift(prev_window=float(stats.drift_prev[i]), last_window=float(stats.drift_last[i]),
-                               final_alpha_dot=float(stats.final_alpha_dot[i])),
+                               final_alpha_dot=float(stats.final_alpha_dot[i]),
+                               last_halves=((float(stats.drift_halves[i, 0]), float(stats.drift_halves[i, 1]))
+                                            if run.loop.drift_k >= 2 else None)),
                    path=paths[i])
         if stats.law_nan[i] if backend == "numpy" else stats.warnings[i]:
             # NumPy law: NaN from the law, where the serial loop applies 0 V and MuJoCo would zero

@@ -60,7 +60,7 @@ from wmr_mj.sim.engine import (
 from wmr_mj.sim.log_header import LogHeader
 from wmr_mj.sim.measured_errors import with_measured_errors
 from wmr_mj.sim.parts import RunParts, control_substeps, resolve_run
-from wmr_mj.sim.summary import RunSummary
+from wmr_mj.sim.summary import RunSummary, voltage_effort
 
 __all__ = ["RunResult", "RunMeasures", "run_closed_loop", "report", "run_on_reduced_model", "ROW_FIELDS", "judge_path",
            "path_sample_index", "PathJudgement", "PATH_SAMPLE_S"]
@@ -170,6 +170,7 @@ class RunMeasures:
     control_steps: int  # control steps simulated
     steps: int  # physics steps simulated
     wall_s: float  # wall time [s]
+    effort: Any = None  # the applied voltage's (wmr_mj.sim.summary.VoltageEffort); None: not measured
 
 
 def report(config: RunConfig, measured: RunMeasures, *, analysis, params: C80Parameters, certificate=None,
@@ -233,6 +234,7 @@ def report(config: RunConfig, measured: RunMeasures, *, analysis, params: C80Par
         path_error=None if path is None else path.errors,
         path_bound=None if path is None else path.bound,
         path_verdict=None if path is None else path.verdict,
+        effort=m.effort,
     )
 
 
@@ -354,8 +356,10 @@ def _drift_of(E: np.ndarray, final_alpha_dot: float, period: float) -> Drift:
 
     k = len(E)
     w = drift_window_steps(k, period)
+    h = k - w + w // 2  # the last window's halves: [k - w, h) and [h, k)
     return drift(prev_window=_sup(E[max(0, k - 2 * w):k - w]), last_window=_sup(E[k - w:]),
-                 final_alpha_dot=final_alpha_dot)
+                 final_alpha_dot=final_alpha_dot,
+                 last_halves=(_sup(E[k - w:h]), _sup(E[h:])) if w >= 2 else None)
 
 
 def run_closed_loop(
@@ -439,7 +443,8 @@ def run_parts(parts: RunParts, *, logger_factory: Callable[..., Any] | None = No
     measured = RunMeasures(status=status, settle_s=settle_s, sup_E=_sup(done["E"]), sup_Edot=_sup(done["E_dot"]),
                            sup_E_settled=_sup(done["E"][after]), sup_Edot_settled=_sup(done["E_dot"][after]),
                            saturated_fraction=saturated / k, left_range_at=left_range_at,
-                           final_alpha=done["alpha"][-1], control_steps=k, steps=k * substeps, wall_s=wall)
+                           final_alpha=done["alpha"][-1], control_steps=k, steps=k * substeps, wall_s=wall,
+                           effort=voltage_effort(done["voltage"], period))
     path = judge_path(reference, done["t"][at], run.C_xy[at], done["heading"][at], settle_s=settle_s,
                       certificate=certificate, steering_range=params.steering_range, corrected=outer is not None)
     summary = report(config, measured, analysis=analysis, params=params,

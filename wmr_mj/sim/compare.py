@@ -49,7 +49,7 @@ from wmr_mj.sim.records import Record, plain
 from wmr_mj.sim.suite import Scenario, Suite, versions
 
 __all__ = ["Design", "design_from_token", "ScenarioRun", "DesignRow", "CompareResult", "CompareReport", "compare",
-           "run_scenario", "adversary_spec"]
+           "run_scenario", "adversary_spec", "adversary_cart_box", "ADVERSARY_CART_AXES"]
 
 
 @dataclass(frozen=True)
@@ -159,9 +159,39 @@ def _scenario_task(config_dict: Mapping[str, Any], requirements: Mapping[str, st
     return run_scenario(config_from_dict(config_dict), requirements)
 
 
-def adversary_spec(design: Design, suite: Suite, *, budget: int, seed: int, method: str | None = None):
+#: the cart's axes the adversary searches where a compared scenario's cart has them: each zero on an ideal cart,
+#: so that [0, the largest a scenario declares] holds the ideal cart and every scenario's value. An encoder's
+#: resolution is not among them: its shaft and velocity estimate are the scenario's, not one axis; nor is noise
+#: (no suite's hardware declares any, and its kind is the scenario's too).
+ADVERSARY_CART_AXES = {"sensing.delay": ("sensing", "delay"), "actuation.delay": ("actuation", "delay"),
+                       "actuation.inductance": ("actuation", "inductance"),
+                       "transmission.backlash": ("transmission", "backlash")}
+
+
+def adversary_cart_box(base: RunConfig, scenarios: Sequence[Any]) -> dict[str, tuple[float, float]]:
+    """The cart's axes of the adversary's box: each of :data:`ADVERSARY_CART_AXES` that a scenario's cart (one
+    that names hardware, ``[hardware.<name>]``) sets above zero, over [0, the largest such value, or the
+    design's own where larger]; none where no scenario names a non-ideal cart (the box is the plant's).
+
+    Args:
+        base: the adversary's base run (the design's cart).
+        scenarios: the compared scenarios (:meth:`wmr_mj.sim.suite.Suite.select`).
+    """
+    box: dict[str, tuple[float, float]] = {}
+    for axis, (part, key) in ADVERSARY_CART_AXES.items():
+        declared = [float(getattr(getattr(s, part), key)) for s in scenarios
+                    if s.hardware is not None and getattr(s, part) is not None]
+        top = max(declared, default=0.0)
+        if top > 0.0:
+            box[axis] = (0.0, max(top, float(getattr(getattr(base, part), key))))
+    return box
+
+
+def adversary_spec(design: Design, suite: Suite, *, budget: int, seed: int, method: str | None = None,
+                   scenarios: Sequence[Any] = ()):
     """The FalsifySpec of the suite's adversary for ``design``: its plant box, C's knot path within the declared
-    bounds and a disturbance pulse (start, amplitude within +-d_max), against the suite's requirement."""
+    bounds and a disturbance pulse (start, amplitude within +-d_max), against the suite's requirement; and the
+    cart's axes where a compared scenario (``scenarios``) declares a non-ideal cart (:func:`adversary_cart_box`)."""
     from wmr_mj.reference.knots import KnotSpace
     from wmr_mj.sim.falsify import FalsifySpec
 
@@ -176,6 +206,7 @@ def adversary_spec(design: Design, suite: Suite, *, budget: int, seed: int, meth
     if adv.path_knots:
         box.update(KnotSpace(adv.path_knots, hold_range=adv.hold_range).ranges(base.reference_bounds))
     box.update({"disturbance.t1": adv.pulse_t1, "disturbance.amplitude": adv.pulse_amplitude})
+    box.update(adversary_cart_box(base, scenarios))  # searched, each run's claim covering its own cart
     kwargs: dict[str, Any] = {} if method is None else {"method": method}
     return FalsifySpec(base=base, box=box, objective="requirement", budget=budget, seed=seed,
                        requirement=suite.requirements[adv.requirement], **kwargs)
@@ -351,7 +382,8 @@ def compare(designs: Sequence[Design], suite: Suite, *, scenarios: Sequence[str]
     if not designs:
         raise ParameterError("compare needs at least one design")
     chosen = suite.select(scenarios)
-    specs = [adversary_spec(d, suite, budget=budget, seed=seed, method=method) for d in designs] if budget else []
+    specs = ([adversary_spec(d, suite, budget=budget, seed=seed, method=method, scenarios=chosen) for d in designs]
+             if budget else [])
     wall0 = time.perf_counter()
     jobs = [(d, s, s.config(d.config)) for d in designs for s in chosen]
     total = len(jobs) + 2 * budget * len(designs)

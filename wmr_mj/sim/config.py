@@ -408,6 +408,21 @@ def _cached_reference(path: str, file_key: tuple | None, params: C80Parameters, 
     return _build_reference(path, params, dt=dt, duration=duration)
 
 
+#: the named path lane-change: a lead-in line, the lane change (lateral offset over a length), then a line that
+#: fills the duration [m]
+LANE_CHANGE_LEAD_IN_M, LANE_CHANGE_OFFSET_M, LANE_CHANGE_LENGTH_M = 0.5, 0.5, 4.0
+
+
+def manoeuvre_length(path: str) -> float | None:
+    """The length [m] of C's reference a run of the named ``path`` must drive for its verdict to judge the whole
+    manoeuvre: lane-change's lead-in and lane change (the line after it only fills the duration); None for a
+    path that refuses a duration too short for it (paper-circle), a closed one (figure-eight) or a route (whose
+    own length :func:`wmr_mj.reference.route.route_length` gives)."""
+    if path == "lane-change":
+        return LANE_CHANGE_LEAD_IN_M + LANE_CHANGE_LENGTH_M
+    return None
+
+
 def _build_reference(path: str, params: C80Parameters, *, dt: float, duration: float):
     """:func:`build_reference` without the cache."""
     from wmr_mj.reference import paths as ref
@@ -421,7 +436,8 @@ def _build_reference(path: str, params: C80Parameters, *, dt: float, duration: f
     if path == "paper-circle":
         p = ref.paper_circle(params, duration=duration)
     elif path == "lane-change":
-        p = ref.line(0.5) + ref.lane_change(0.5, 4.0) + ref.line(max(duration * params.V_A, 1.0))
+        p = (ref.line(LANE_CHANGE_LEAD_IN_M) + ref.lane_change(LANE_CHANGE_OFFSET_M, LANE_CHANGE_LENGTH_M)
+             + ref.line(max(duration * params.V_A, 1.0)))
     elif path == "figure-eight":
         p = ref.line(0.5) + ref.figure_eight(1.5, laps=max(1, int(duration * params.V_A / 20.0) + 1))
     else:

@@ -198,6 +198,65 @@ def check_objective_applies(law: Any, objective: str) -> None:
                              "falsify a requirement (--require STL) or maximise sup|E| (--objective sup-E)")
 
 
+def shares_the_base_certificate(base: RunConfig, names: Sequence[str]) -> bool:
+    """Whether every run of ``base`` searched over ``names`` is judged by the base's certificate: m1 and plant
+    parameters only (the certificate is over the config's box, whatever the run's plant in it), none of
+    which reaches the certificate otherwise: the plant's limits (voltage_limit, steering_range), the gear
+    ratio i2 where the sensing is not ideal and R_a where the actuation is not (their coverage reads them:
+    :func:`wmr_mj.sim.certify.measurement_errors_of`). The cart's, the signals' and the path's axes give
+    each run its own."""
+    from wmr_mj.sim.search_space import hardware_axis, path_axis, signal_axis
+
+    reaching = {"voltage_limit", "steering_range"}
+    if not base.sensing.is_ideal or not base.transmission.is_ideal:
+        reaching.add("i2")
+    if not base.actuation.is_ideal:
+        reaching.add("R_a")
+    return not any(hardware_axis(n) or signal_axis(n) or path_axis(n) or n in reaching for n in names)
+
+
+def check_objective_defined(parts: Any, spec: FalsifySpec) -> None:
+    """Refuse, before any step, a search whose objective is undefined for every run: the certificate's
+    ratio where the base's certificate has no finite bound and every run shares it
+    (:func:`shares_the_base_certificate`); ``run`` knows this before it steps, and so does falsify.
+
+    Args:
+        parts: ``spec.base`` resolved (:func:`check_runnable`).
+
+    Raises:
+        ParameterError: one line naming why there is no bound and what to search instead.
+    """
+    claim = parts.claim
+    if spec.objective != "certificate" or claim is None or not shares_the_base_certificate(spec.base, spec.names):
+        return
+    if claim.valid and 0.0 < claim.E_max < math.inf and 0.0 < claim.Edot_max:
+        return
+    why = getattr(claim, "reason", None) or ", ".join(claim.unmet) or "no finite bound"
+    raise ParameterError(f"the objective sup|E|/E_max of the certificate is undefined for every run: controller "
+                         f"{parts.controller.name!r} has no certificate over this box ({why}; see wmr-mj robustness "
+                         "--certificate): search --objective sup-E or a requirement (--require STL) instead")
+
+
+def undefined_objective_warning(result: FalsifyResult) -> str | None:
+    """The warning of a search some of whose runs have no objective (left blank, never the worst): how many
+    of each phase, which objective, and what to search where no certificate exists; None when every run
+    has one."""
+    blank = {phase: sum(e.objective is None for e in evals)
+             for phase, evals in (("search", result.search), ("random", result.random))}
+    if not any(blank.values()):
+        return None
+    counts = ", ".join(f"{blank[p]} of {len(evals)} {p} runs" for p, evals in
+                       (("search", result.search), ("random", result.random)) if evals)
+    objective = result.spec.objective
+    text = (f"WARNING: {counts} have no {OBJECTIVE_LABELS[objective]} (left blank: the worst is over the "
+            "others only)")
+    if objective in ("certificate", "paper"):
+        region = "certificate" if objective == "certificate" else "paper's region"
+        text += (f"; a run without a {region} (its bound does not exist for that run) may be the worst: "
+                 "--objective sup-E searches sup|E| on every run")
+    return text
+
+
 def objective_source(summary: Mapping[str, Any], objective: str) -> str:
     """Which field of the summary :func:`objective_value` read, in words (for the report)."""
     if objective == "sup-E":
@@ -767,6 +826,15 @@ class FalsifySpec:
         d = len(self.box)
         return population_size(self.budget, d) if self.method == "de" else cma_population(d)
 
+    def recorded_values(self, point: Sequence[float]) -> dict[str, float]:
+        """Each ranged parameter -> the value its run used (what the search's tables record): as proposed, but a
+        hardware axis rounded as the run has it (:func:`wmr_mj.sim.search_space.hardware_values`)."""
+        from wmr_mj.sim.search_space import hardware_axis, hardware_values
+
+        out = {n: float(v) for n, v in zip(self.names, point)}
+        out.update(hardware_values(self.base, {n: v for n, v in out.items() if hardware_axis(n)}))
+        return out
+
     def config(self, point: Sequence[float]) -> RunConfig:
         """The run at ``point`` (values in ``names`` order): m1, the plant overrides and the signals'
         parameters set (:func:`wmr_mj.sim.search_space.config_for`)."""
@@ -782,9 +850,12 @@ class Evaluation:
     phase: str  # "search" or "random"
     index: int  # in its phase, in evaluation order
     generation: int
-    params: dict[str, float]  # every ranged parameter, full precision
+    # every ranged parameter, full precision, as the run used it: a hardware axis rounded as its run had it
+    # (sensing.encoder_bits = 12.0 where the search proposed 11.533: the run had 4096 ticks)
+    params: dict[str, float]
     objective: float | None
     summary: dict[str, Any]  # the run's report
+    point: tuple[float, ...] = ()  # the point the search proposed (FalsifySpec.names order); () where unknown
 
     @property
     def sup_E(self) -> float:
@@ -951,6 +1022,11 @@ class FalsifyResult:
 
     @property
     def random_worst(self) -> Evaluation:
+        """The random sample's run of the largest objective; where none of its runs has the objective (each
+        left blank: :func:`undefined_objective_warning` says so), its run of the largest sup|E|, whose
+        objective is None: the search's worst is still the answer, not an error."""
+        if self.random and all(e.objective is None for e in self.random):
+            return max(self.random, key=lambda e: e.sup_E)  # max keeps the first of equals
         return self._worst(self.random)
 
     @property
@@ -1089,6 +1165,7 @@ def falsify(spec: FalsifySpec, *, chunk: int = 128, nthread: int = 0, scheduler:
 
     parts = check_runnable(spec.base) if parts is None else parts  # a bad duration or path: one line, here
     check_objective_applies(parts.controller, spec.objective)
+    check_objective_defined(parts, spec)  # undefined for every run: refused before any step
     client = connect(scheduler) if scheduler is not None else None
     evaluations: dict[str, list[Evaluation]] = {"search": [], "random": []}
     total = 2 * spec.budget  # refined once the search has run
@@ -1116,7 +1193,7 @@ def falsify(spec: FalsifySpec, *, chunk: int = 128, nthread: int = 0, scheduler:
                 out[i] = np.nan if value is None else value
                 evaluations[phase].append(Evaluation(
                     phase=phase, index=len(evaluations[phase]), generation=generation,
-                    params={n: float(v) for n, v in zip(spec.names, p)},
+                    params=spec.recorded_values(p), point=tuple(float(v) for v in p),
                     objective=None if value is None else float(value), summary=r))
             if checkpoint is not None:
                 checkpoint(FalsifyResult(spec=spec, search=list(evaluations["search"]),
@@ -1163,4 +1240,4 @@ def check_runnable(base: RunConfig) -> Any:
 def worst_config(result: FalsifyResult) -> RunConfig:
     """The worst run's config, rebuilt from its reported parameters."""
     w = result.worst
-    return result.spec.config([w.params[n] for n in result.spec.names])
+    return result.spec.config(w.point or [w.params[n] for n in result.spec.names])

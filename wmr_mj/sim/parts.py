@@ -37,6 +37,7 @@ from wmr_mj.sim.config import (
     controller_name,
     estimate_of,
     estimate_parameters,
+    manoeuvre_length,
     plant_parameters,
     reference_bounds_of,
     tracker_for,
@@ -89,7 +90,9 @@ class RunParts:
         signals: the run's signals (:class:`wmr_mj.sim.signals.Signals`), None without.
         disturbance: the disturbance torque at each control step [N m], None without one.
         loads: (control step, the plant's MuJoCo fields from then on) of each load change, in time order.
-        route_length_m: the length of the route C follows [m] (one lap of a closed one); None on a named path.
+        route_length_m: the length of the route C follows [m] (one lap of a closed one), or of the manoeuvre a
+            named path must drive to judge it whole (lane-change's: :func:`wmr_mj.sim.config.manoeuvre_length`);
+            None on the other named paths.
         measurement: the error bounds on what the law reads, from the cart's parts
             (:func:`wmr_mj.sim.certify.measurement_errors_of`; exact on an ideal cart).
     """
@@ -161,7 +164,8 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
                     actuation=config.actuation, transmission=config.transmission,
                     reference_bounds=reference_bounds_of(config, reference), signals=config.signals,
                     disturbance=disturbance, loads=loads,
-                    route_length_m=route_length(config.path), measurement=measurement_errors_of(config, plant))
+                    route_length_m=route_length(config.path) or manoeuvre_length(config.path),  # lane-change's
+                    measurement=measurement_errors_of(config, plant))
 
 
 def signal_inputs(signals: Any, plant: C80Parameters, options: dict[str, Any], *, n: int, period: float,

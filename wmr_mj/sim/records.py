@@ -81,6 +81,8 @@ class UnmetAssumption(Record):
         note: why it is not met, for an assumption about the cart (``CART_ASSUMPTIONS``); None otherwise
             (the JSON then has no ``note``).
         runs: how many runs do not meet it, where counted over runs; None for one run's (no ``runs`` key).
+        value_range: (lo, hi) of its finite values over the runs that do not meet it, where counted over
+            runs and they differ; None otherwise (the JSON then has no ``value_range``).
     """
 
     name: str
@@ -88,12 +90,16 @@ class UnmetAssumption(Record):
     limit: float | None
     note: str | None = None
     runs: int | None = None
+    value_range: tuple[float, float] | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        """{name, value, limit} with ``note`` and ``runs`` only where set: the keys the verdicts module writes."""
+        """{name, value, limit} with ``note``, ``runs`` and ``value_range`` only where set: the keys the verdicts
+        module writes."""
         out: dict[str, Any] = {"name": self.name, "value": self.value, "limit": self.limit}
         if self.note is not None:
             out["note"] = self.note
         if self.runs is not None:
             out["runs"] = self.runs
+        if self.value_range is not None:
+            out["value_range"] = list(self.value_range)
         return out

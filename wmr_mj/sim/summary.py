@@ -28,7 +28,8 @@ from wmr_mj.analysis.requirements import RequirementResult
 from wmr_mj.analysis.verdicts import FAILED, NO_CLAIM, Drift, PaperRegion
 from wmr_mj.reference.route import RouteProgress
 
-__all__ = ["RunSummary", "PaperRegion", "Drift", "CertificateJudgement", "Assumption", "BatchFigures",
+__all__ = ["RunSummary", "VoltageEffort", "voltage_effort",
+           "PaperRegion", "Drift", "CertificateJudgement", "Assumption", "BatchFigures",
            "PAPER_KEYS_DEPRECATED", "PAPER_REGION_KEYS", "shown_config"]
 
 
@@ -39,6 +40,38 @@ PAPER_KEYS_DEPRECATED = {"E_max": "paper_E_max", "Edot_max": "paper_Edot_max", "
 
 #: A run summary's keys of the paper's region: null in the summary of a law outside the paper's family.
 PAPER_REGION_KEYS = (*PAPER_KEYS_DEPRECATED, *PAPER_KEYS_DEPRECATED.values(), "stable", "paper_region")
+
+
+@dataclass(frozen=True)
+class VoltageEffort:
+    """What a run asked of its motor: the applied voltage's peak, its RMS and its activity.
+
+    Attributes:
+        peak_voltage: max |u| over the run [V].
+        rms_voltage: the RMS of u [V].
+        tv_voltage: the total variation of u per second, sum |u[k+1] - u[k]| / duration [V/s]: chattering
+            (as ``wmr-mj compare`` and validate's sensing section compute it).
+    """
+
+    peak_voltage: float
+    rms_voltage: float
+    tv_voltage: float
+
+    def to_dict(self) -> dict[str, Any]:
+        """The summary keys peak_voltage, rms_voltage, tv_voltage."""
+        return {"peak_voltage": self.peak_voltage, "rms_voltage": self.rms_voltage, "tv_voltage": self.tv_voltage}
+
+
+def voltage_effort(voltage: Any, control_period: float) -> VoltageEffort:
+    """The effort of the applied voltage ``voltage`` [V] at each control step (a contiguous 1-D array: the
+    serial run's rows and the batch's column give the same bits), ``control_period`` [s] apart."""
+    import numpy as np
+
+    u = np.ascontiguousarray(voltage, dtype=float)
+    if u.size == 0:
+        return VoltageEffort(peak_voltage=math.nan, rms_voltage=math.nan, tv_voltage=0.0)
+    return VoltageEffort(peak_voltage=float(np.max(np.abs(u))), rms_voltage=float(np.sqrt(np.mean(u * u))),
+                         tv_voltage=float(np.sum(np.abs(np.diff(u))) / (u.size * control_period)))
 
 
 @dataclass(frozen=True)
@@ -90,6 +123,8 @@ class RunSummary:
         sup_Edot_settled: sup |E'| after settle_s [rad/s].
         stable: (4.23) of the paper's claim holds.
         saturated_fraction: fraction of the control steps whose voltage was limited [-].
+        effort: the applied voltage's peak [V], RMS [V] and total variation per second [V/s]
+            (:class:`VoltageEffort`); None where the run did not measure it.
         left_steering_range_at_s: when |alpha| first reached the steering stop [s]; None if never.
         final_alpha: alpha at the last control step [rad].
         paper_region: the paper's claim, judged (its E_max, Edot_max, condition, inside).
@@ -152,6 +187,7 @@ class RunSummary:
     # the RunConfig settings (model, kp, kd, ...) the law reads (wmr_mj.sim.config.controller_and_settings);
     # None: all of them (the computed-torque law, and a summary of a caller that did not say)
     law_settings: frozenset[str] | None = None
+    effort: VoltageEffort | None = None  # the applied voltage's peak, RMS and activity; None: not measured
 
     # the paper's claim, read through paper_region (the JSON also writes these at the top level)
     @property
@@ -295,6 +331,8 @@ class RunSummary:
             out["requirements"] = [r.as_dict() for r in self.requirements]
         if self.route is not None:
             out.update(self.route.to_dict())
+        if self.effort is not None:
+            out.update(self.effort.to_dict())
         return out
 
 

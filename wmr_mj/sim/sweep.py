@@ -53,6 +53,9 @@ __all__ = [
     "SAMPLINGS",
     "RESULT_COLUMNS",
     "read_results",
+    "read_runs",
+    "csv_number",
+    "CSV_SIGNIFICANT_DIGITS",
     "run_configs",
     "flat_row",
     "max_at",
@@ -63,12 +66,17 @@ __all__ = [
     "connect",
     "requirement_column",
     "RequirementSweep",
+    "Effort",
+    "EffortLevel",
+    "AxisEffort",
 ]
 
 SAMPLINGS = ("uniform", "lhs", "grid")
 RESULT_COLUMNS = ("run", "m1", "verdict", "cert_valid", "cert_E_max", "cert_Edot_max", "cert_E_ratio",
                   "cert_Edot_ratio", "cert_inside", "sup_E", "sup_Edot", "sup_E_settled", "sup_Edot_settled",
                   "E_max", "Edot_max", "E_ratio", "Edot_ratio", "inside", "saturated_fraction",
+                  # the applied voltage's effort (wmr_mj.sim.summary.VoltageEffort): [V], [V], [V/s]
+                  "peak_voltage", "rms_voltage", "tv_voltage",
                   "left_steering_range", "final_alpha", "final_alpha_dot", "drift_growing",
                   # C's path (wmr_mj.analysis.path_error, path_bound): [m], [m], [rad], verdict, [m]
                   "path_cross_track_max", "path_along_track_final", "path_heading_error_max", "path_verdict",
@@ -114,12 +122,14 @@ def _count_path_verdicts(rows: Sequence[Mapping[str, Any]]) -> dict[str, int] | 
 
 @dataclass(frozen=True, kw_only=True)
 class SweepSpec:
-    """n runs of ``base`` with the plant's m1 (and ``ranges``) drawn by ``sampling``."""
+    """n runs of ``base`` with the plant's m1 (and ``ranges``) drawn by ``sampling``; with ``m1``, every run's
+    m1 is that (the other axes swept alone) and ``m1_range`` stays the certificate's box."""
 
     n: int = 200
     seed: int = 0
     sampling: str = "lhs"
     m1_range: tuple[float, float] = M1_RANGE
+    m1: float | None = None  # a fixed m1 [kg]: every run's; None: drawn over m1_range
     ranges: Mapping[str, tuple[float, float]] = field(default_factory=dict)
     base: RunConfig = field(default_factory=RunConfig)
     # STL requirements (formulas or presets, wmr_mj.analysis.requirements) judged on every run: such
@@ -133,6 +143,9 @@ class SweepSpec:
         if self.sampling not in SAMPLINGS:
             raise UnknownNameError("sampling", self.sampling, SAMPLINGS)
         positive_range("m1", *self.m1_range)
+        if self.m1 is not None and (isinstance(self.m1, bool) or not isinstance(self.m1, (int, float))
+                                    or not (math.isfinite(self.m1) and self.m1 > 0)):
+            raise ParameterError(f"m1 = {self.m1!r} is not accepted; a fixed m1 is a finite number of kg > 0")
         from wmr_mj.sim.search_space import HARDWARE_AXES, check_hardware_range, hardware_axis
 
         names = set(parameter_names()) - {"m1"}
@@ -144,10 +157,17 @@ class SweepSpec:
                 raise UnknownNameError("axis name", name, [*sorted(names), *HARDWARE_AXES])
             positive_range(name, lo, hi)
         if self.sampling == "grid":
-            d = 1 + len(self.ranges)
+            d = self.grid_dimensions
+            if d == 0:
+                raise ParameterError("grid sampling with a fixed m1 needs a ranged parameter (--range NAME=LO:HI)")
             k = round(self.n ** (1.0 / d))
             if k**d != self.n:
                 raise ParameterError(f"grid sampling of {d} parameter(s) needs n = k^{d}; n = {self.n} is not")
+
+    @property
+    def grid_dimensions(self) -> int:
+        """The axes a grid spans: the ranged parameters, and m1 unless it is fixed."""
+        return len(self.ranges) + (0 if self.m1 is not None else 1)
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -155,7 +175,8 @@ class SweepSpec:
 
     @property
     def bounds(self) -> np.ndarray:
-        return np.array([self.m1_range, *self.ranges.values()], dtype=float)
+        m1 = self.m1_range if self.m1 is None else (self.m1, self.m1)  # a fixed m1: a zero-width draw
+        return np.array([m1, *self.ranges.values()], dtype=float)
 
     @property
     def hardware_names(self) -> tuple[str, ...]:
@@ -201,10 +222,13 @@ class SweepSpec:
                "ranges": {k: list(v) for k, v in self.ranges.items()}, "base": self.base.as_dict()}
         if self.requirements:  # a sweep without requirements keeps the fingerprint it always had
             obj["requirements"] = list(self.requirements)
+        if self.m1 is not None:  # and one with m1 drawn too
+            obj["m1"] = self.m1
         return hashlib.sha256(json.dumps(obj, sort_keys=True, default=str).encode()).hexdigest()[:16]
 
 
-#: sweep summary keys of the paper's region, deprecated (kept for one version), and their new names
+#: the paper's deprecated aliases of a sweep summary, which sit under its ``paper`` key (never at the top
+#: level, where a reader took them for the certificate's), and the top-level keys of the same numbers
 SWEEP_KEYS_DEPRECATED = {"inside": "paper_inside", "outside": "paper_outside", "worst_E_ratio": "worst_paper_E_ratio",
                          "worst_Edot_ratio": "worst_paper_Edot_ratio", "E_max": "paper_E_max",
                          "Edot_max": "paper_Edot_max"}
@@ -234,6 +258,12 @@ def draw_samples(spec: SweepSpec) -> np.ndarray:
         unit = rng.random((spec.n, d))
     elif spec.sampling == "lhs":
         unit = latin_hypercube(spec.n, d, rng.spawn(1)[0])  # scipy's qmc draws from a spawned child
+    elif spec.m1 is not None:  # a grid over the ranged axes only; m1's column is fixed
+        g = spec.grid_dimensions
+        k = round(spec.n ** (1.0 / g))
+        axes = [np.linspace(0.0, 1.0, k)] if k > 1 else [np.array([0.5])]
+        grid = np.stack(np.meshgrid(*(axes * g), indexing="ij"), axis=-1).reshape(-1, g)
+        unit = np.hstack([np.zeros((len(grid), 1)), grid])
     else:
         k = round(spec.n ** (1.0 / d))
         axes = [np.linspace(0.0, 1.0, k)] if k > 1 else [np.array([0.5])]
@@ -284,6 +314,8 @@ def spec_to_json(spec: SweepSpec) -> str:
            "ranges": {k: list(v) for k, v in spec.ranges.items()}, "base": base}
     if spec.requirements:
         obj["requirements"] = list(spec.requirements)
+    if spec.m1 is not None:
+        obj["m1"] = spec.m1
     return json.dumps(obj, sort_keys=True)
 
 
@@ -291,7 +323,7 @@ def spec_from_json(text: str) -> SweepSpec:
     obj = json.loads(text)
     return SweepSpec(n=obj["n"], seed=obj["seed"], sampling=obj["sampling"], m1_range=tuple(obj["m1_range"]),
                      ranges={k: tuple(v) for k, v in obj["ranges"].items()}, base=config_from_dict(obj["base"]),
-                     requirements=tuple(obj.get("requirements", ())))
+                     requirements=tuple(obj.get("requirements", ())), m1=obj.get("m1"))
 
 
 def _run_config_chunk(config_dicts: list[dict[str, Any]], nthread: int,
@@ -329,9 +361,21 @@ def run_configs(configs: Sequence[RunConfig], *, chunk: int = 128, nthread: int 
     return reports
 
 
+#: significant digits of a number in a CSV table (runs.csv, falsify's evaluations.csv): 0.009 where the float
+#: is 0.009000000000000001. Full precision is kept in the JSON (summary.json, :data:`PRECISE_ROWS`).
+CSV_SIGNIFICANT_DIGITS = 12
+#: the sweep folder's file of every runs.csv row at full precision (JSON: floats round-trip exactly), which
+#: a resumed sweep and validate's rungs read (:func:`read_runs`), so that no number they report is rounded
+PRECISE_ROWS = "runs-full-precision.json"
+
+
+def _columns(extra: Sequence[str], tail: Sequence[str] = ()) -> list[str]:
+    return list(RESULT_COLUMNS[:2]) + list(extra) + list(RESULT_COLUMNS[2:]) + list(tail)
+
+
 def _csv_text(rows: list[dict[str, Any]], extra: Sequence[str], tail: Sequence[str] = ()) -> str:
     buf = io.StringIO()
-    cols = list(RESULT_COLUMNS[:2]) + list(extra) + list(RESULT_COLUMNS[2:]) + list(tail)
+    cols = _columns(extra, tail)
     w = csv.DictWriter(buf, fieldnames=cols, extrasaction="ignore", lineterminator="\n")
     w.writeheader()
     for r in sorted(rows, key=lambda r: r["run"]):
@@ -339,19 +383,44 @@ def _csv_text(rows: list[dict[str, Any]], extra: Sequence[str], tail: Sequence[s
     return buf.getvalue()
 
 
+def csv_number(value: float) -> str:
+    """CSV text of a float: rounded to :data:`CSV_SIGNIFICANT_DIGITS` significant digits, then the shortest
+    text of that float (repr): '0.009' for 0.009000000000000001, 'nan', 'inf'."""
+    return repr(float(f"{float(value):.{CSV_SIGNIFICANT_DIGITS}g}"))
+
+
 def _cell(value: Any) -> Any:
-    """CSV text of a value: floats round-trip exactly (repr), None is empty."""
+    """CSV text of a value: floats to :data:`CSV_SIGNIFICANT_DIGITS` digits (:func:`csv_number`), None is empty."""
     if value is None:
         return ""
     if isinstance(value, (bool, np.bool_)):
         return str(bool(value))
     if isinstance(value, (float, np.floating)):
-        return repr(float(value))
+        return csv_number(float(value))
     return value
 
 
+def _precise(value: Any) -> Any:
+    """A runs.csv cell at full precision, typed as :func:`read_results` parses the cell (numbers as float)."""
+    if value is None or isinstance(value, (bool, np.bool_)):
+        return None if value is None else bool(value)
+    if isinstance(value, (int, float, np.integer, np.floating)):
+        return float(value)
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        return value
+
+
+def _precise_rows(rows: list[dict[str, Any]], extra: Sequence[str], tail: Sequence[str] = ()) -> list[dict]:
+    cols = _columns(extra, tail)
+    return [{k: int(r["run"]) if k == "run" else _precise(r.get(k)) for k in cols}
+            for r in sorted(rows, key=lambda r: r["run"])]
+
+
 def read_results(path: str | os.PathLike) -> list[dict[str, Any]]:
-    """Rows of a sweep's runs.csv, numbers parsed."""
+    """Rows of a sweep's runs.csv, numbers parsed (as the CSV holds them: :data:`CSV_SIGNIFICANT_DIGITS`
+    digits; :func:`read_runs` reads a folder's rows at full precision)."""
     out = []
     with open(path, newline="") as f:
         for row in csv.DictReader(f):
@@ -368,6 +437,21 @@ def read_results(path: str | os.PathLike) -> list[dict[str, Any]]:
                         parsed[k] = v
             out.append(parsed)
     return out
+
+
+def read_runs(folder: str | os.PathLike) -> list[dict[str, Any]]:
+    """Rows of a sweep folder's runs.csv, each at full precision where :data:`PRECISE_ROWS` holds its run
+    (written before runs.csv after every chunk, so it holds every run the CSV does; a folder written before
+    that file: the CSV's rows), typed as :func:`read_results` types them."""
+    rows = read_results(Path(folder) / "runs.csv")
+    path = Path(folder) / PRECISE_ROWS
+    if not path.is_file():
+        return rows
+    try:
+        precise = {int(r["run"]): r for r in json.loads(path.read_text())}
+    except (json.JSONDecodeError, KeyError, TypeError, ValueError):
+        return rows  # unreadable: the CSV's rows, as before that file existed
+    return [dict(precise.get(int(r["run"]), r)) for r in rows]
 
 
 def connect(scheduler: str):
@@ -420,7 +504,7 @@ def run_sweep(spec: SweepSpec, *, out_dir: str | os.PathLike | None = None, chun
             except json.JSONDecodeError:
                 state = {}
             if state.get("fingerprint") == fp:
-                for r in read_results(csv_path):
+                for r in read_runs(out):
                     done[int(r["run"])] = r
             elif (other := _other_law(state, spec)) and read_results(csv_path):
                 # another law's runs are never taken for this one's, nor written over
@@ -435,7 +519,10 @@ def run_sweep(spec: SweepSpec, *, out_dir: str | os.PathLike | None = None, chun
         for r in reports:
             done[r["run"]] = flat_row(r)
         if out is not None:
-            write_text_atomic(out / "runs.csv", _csv_text(list(done.values()), extra, spec.requirement_columns))
+            rows = list(done.values())
+            # NaN and inf as Python's json writes them: read back as the same floats (json_safe would null them)
+            write_text_atomic(out / PRECISE_ROWS, json.dumps(_precise_rows(rows, extra, spec.requirement_columns)))
+            write_text_atomic(out / "runs.csv", _csv_text(rows, extra, spec.requirement_columns))
         if progress is not None:
             progress(len(done), spec.n)
 
@@ -575,6 +662,85 @@ def _unmet_over(rows: Sequence[Mapping[str, Any]]) -> tuple[UnmetAssumption, ...
     return tuple(UnmetAssumption.from_dict(a) for a in counted)
 
 
+#: a ranged axis has levels (and its effort per level) where its runs take at most this many distinct values:
+#: a grid, or a hardware axis rounded to whole periods, ticks or bits; a continuous draw has none
+MAX_EFFORT_LEVELS = 16
+_EFFORT_COLUMNS = ("saturated_fraction", "peak_voltage", "rms_voltage", "tv_voltage")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Effort(Record):
+    """What runs asked of the motor (:attr:`SweepSummary.effort`), from runs.csv's effort columns.
+
+    Attributes:
+        runs: how many runs.
+        mean_saturated_fraction: the mean fraction of control steps at the voltage limit [-].
+        max_saturated_fraction: the largest [-].
+        peak_voltage: the largest |u| of any run [V].
+        mean_rms_voltage: the mean of the runs' RMS u [V].
+        mean_tv_voltage: the mean of the runs' total variation of u per second [V/s] (voltage activity).
+        max_tv_voltage: the largest [V/s].
+    """
+
+    runs: int
+    mean_saturated_fraction: float
+    max_saturated_fraction: float
+    peak_voltage: float
+    mean_rms_voltage: float
+    mean_tv_voltage: float
+    max_tv_voltage: float
+
+    @classmethod
+    def of(cls, rows: Sequence[Mapping[str, Any]]) -> Effort | None:
+        """The effort of ``rows``; None where a row lacks an effort column (a runs.csv written before them)."""
+        if not rows or any(r.get(c) is None for r in rows for c in _EFFORT_COLUMNS):
+            return None
+        col = {c: [float(r[c]) for r in rows] for c in _EFFORT_COLUMNS}
+        return cls(runs=len(rows), mean_saturated_fraction=sum(col["saturated_fraction"]) / len(rows),
+                   max_saturated_fraction=max(col["saturated_fraction"]), peak_voltage=max(col["peak_voltage"]),
+                   mean_rms_voltage=sum(col["rms_voltage"]) / len(rows),
+                   mean_tv_voltage=sum(col["tv_voltage"]) / len(rows), max_tv_voltage=max(col["tv_voltage"]))
+
+
+@dataclass(frozen=True, kw_only=True)
+class EffortLevel(Record):
+    """The effort of the runs at one level of a ranged axis: ``value`` (the axis's units) and their effort."""
+
+    _records = {"effort": Effort}
+
+    value: float
+    effort: Effort
+
+
+@dataclass(frozen=True, kw_only=True)
+class AxisEffort(Record):
+    """The effort per level of one ranged axis (:attr:`SweepSummary.effort_by_level`), levels ascending."""
+
+    _records = {"levels": EffortLevel}
+
+    axis: str
+    levels: tuple[EffortLevel, ...]
+
+
+def _effort_by_level(rows: Sequence[Mapping[str, Any]], names: Sequence[str]) -> tuple[AxisEffort, ...]:
+    """Each ranged axis of ``names`` whose runs take 2 to :data:`MAX_EFFORT_LEVELS` distinct values, some value
+    shared by several runs (a grid of two axes or more, a rounded hardware axis), with the effort of the runs
+    at each value; none where the rows have no effort columns."""
+    out = []
+    for name in names:
+        values = sorted({float(r[name]) for r in rows if r.get(name) is not None})
+        if not 2 <= len(values) <= MAX_EFFORT_LEVELS or len(values) == len(rows):
+            continue  # one level, a continuous draw, or one run per level (runs.csv has each run's)
+        levels = []
+        for v in values:
+            effort = Effort.of([r for r in rows if r.get(name) is not None and float(r[name]) == v])
+            if effort is None:
+                return ()
+            levels.append(EffortLevel(value=v, effort=effort))
+        out.append(AxisEffort(axis=name, levels=tuple(levels)))
+    return tuple(out)
+
+
 @dataclass(frozen=True)
 class SweepSummary(Record):
     """What a sweep's runs add up to: the one aggregator of ``wmr-mj sweep`` and validate's rungs.
@@ -613,11 +779,15 @@ class SweepSummary(Record):
         unmet: the claim's assumptions not met in some run: value and limit of the first such run (the
             assumption's units), runs: how many; from rows that carry their certificate (a resumed sweep's
             rows, read from runs.csv, do not).
+        effort: what the runs asked of the motor: saturation, peak voltage, voltage activity (:class:`Effort`);
+            None where the rows have no effort columns.
+        effort_by_level: the effort per level of each ranged axis with levels (:func:`_effort_by_level`).
     """
 
     _records = {"sup_E": Worst, "sup_Edot": Worst, "certificate_E_ratio": Worst, "certificate_Edot_ratio": Worst,
                 "paper_E_ratio": Worst, "paper_Edot_ratio": Worst, "path_cross_track": Worst,
-                "requirements": RequirementSweep, "claim_broken": BrokenSweepRun, "unmet": UnmetAssumption}
+                "requirements": RequirementSweep, "claim_broken": BrokenSweepRun, "unmet": UnmetAssumption,
+                "effort": Effort, "effort_by_level": AxisEffort}
 
     n: int
     verdicts: Mapping[str, int]
@@ -644,6 +814,8 @@ class SweepSummary(Record):
     requirements: tuple[RequirementSweep, ...] = ()
     claim_broken: BrokenSweepRun | None = None
     unmet: tuple[UnmetAssumption, ...] = ()
+    effort: Effort | None = None
+    effort_by_level: tuple[AxisEffort, ...] = ()
 
     @classmethod
     def of(cls, rows: Sequence[Mapping[str, Any]], requirements: Sequence[str] = (), *,
@@ -688,6 +860,8 @@ class SweepSummary(Record):
             requirements=tuple(RequirementSweep.of(rows, i, text) for i, text in enumerate(requirements)),
             claim_broken=_claim_broken(rows, names),
             unmet=_unmet_over(rows),
+            effort=Effort.of(rows),
+            effort_by_level=_effort_by_level(rows, names),
         )
 
     @property
@@ -712,14 +886,14 @@ class SweepSummary(Record):
             "certificate_E_max": self.certificate_E_max,
             "certificate_Edot_max": self.certificate_Edot_max,
             "drift_growing": self.growing,
-            "inside": self.paper_inside,
-            "outside": None if self.paper_inside is None else self.n - self.paper_inside,
-            "worst_E_ratio": self.paper_E_ratio.value,
-            "worst_Edot_ratio": self.paper_Edot_ratio.value,
+            "paper_inside": self.paper_inside,
+            "paper_outside": None if self.paper_inside is None else self.n - self.paper_inside,
+            "worst_paper_E_ratio": self.paper_E_ratio.value,
+            "worst_paper_Edot_ratio": self.paper_Edot_ratio.value,
             "worst_sup_E": self.sup_E.value,
             "worst_sup_Edot": self.sup_Edot.value,
-            "E_max": self.paper_E_max,
-            "Edot_max": self.paper_Edot_max,
+            "paper_E_max": self.paper_E_max,
+            "paper_Edot_max": self.paper_Edot_max,
             "hit_steering_stop": self.hit_stop,
             "steps": self.steps,
             "wall_s": wall_s,
@@ -735,10 +909,13 @@ class SweepSummary(Record):
             # a broken claim, whatever else the sweep measured (None: no run is certified-outside)
             "claim_broken": None if self.claim_broken is None else self.claim_broken.to_dict(),
             "unmet": [a.to_dict() for a in self.unmet],
+            # what the runs asked of the motor, overall and per level of each ranged axis that has levels
+            "effort": None if self.effort is None else self.effort.to_dict(),
+            "effort_by_level": {a.axis: [{"value": lv.value, **lv.effort.to_dict()} for lv in a.levels]
+                                for a in self.effort_by_level},
         }
-        # the paper's region under names that say so (the unprefixed keys above: deprecated, kept one version)
-        out.update({new: out[old] for old, new in SWEEP_KEYS_DEPRECATED.items()})
-        out["deprecated_keys"] = dict(SWEEP_KEYS_DEPRECATED)
+        # the paper's deprecated aliases, under ``paper`` only: at the top level they read as the certificate's
+        out["paper"] = {old: out[new] for old, new in SWEEP_KEYS_DEPRECATED.items()}
         if self.paper_inside is None:
             out["paper_claim_applies"] = False
             out["not_applicable"] = {"paper_inside": "the paper's region is for its computed-torque law "
