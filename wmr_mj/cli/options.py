@@ -221,7 +221,14 @@ def box_ranges_from_args(args: argparse.Namespace) -> dict[str, tuple[float, flo
     """
     from wmr_mj.params import uncertainty_ranges
 
-    ranges = {k: v for k, v in uncertainty_ranges(getattr(args, "uncertainty", None) or "m1").items() if k != "m1"}
+    box = getattr(args, "uncertainty", None) or "m1"
+    ranges = {k: v for k, v in uncertainty_ranges(box).items() if k != "m1"}
+    if getattr(args, "cart", None) is not None:  # the cart's own box (--cart)
+        from wmr_mj.carts import load_cart
+
+        boxes = load_cart(args.cart).uncertainty
+        if box in boxes:
+            ranges = {k: v for k, v in boxes[box].items() if k != "m1"}
     ranges.update(command_ranges(args).plant)
     return ranges
 
