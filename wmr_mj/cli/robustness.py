@@ -270,8 +270,15 @@ def _box_ranges(args: argparse.Namespace) -> tuple[tuple[float, float], dict[str
     from wmr_mj.params import M1_RANGE, uncertainty_ranges
 
     ranges = uncertainty_ranges(args.uncertainty) if getattr(args, "uncertainty", None) else {}
-    m1_range = ranges.pop("m1", M1_RANGE)
-    if tuple(args.m1_range) != tuple(M1_RANGE):
+    default_m1 = M1_RANGE
+    if getattr(args, "cart", None) is not None:  # --cart: its boxes
+        from wmr_mj.carts import load_cart
+
+        boxes = load_cart(args.cart).uncertainty
+        default_m1 = boxes["m1"]["m1"]
+        ranges = dict(boxes.get(args.uncertainty, ranges)) if getattr(args, "uncertainty", None) else {}
+    m1_range = ranges.pop("m1", default_m1)
+    if args.m1_range is not M1_RANGE and tuple(args.m1_range) != tuple(M1_RANGE):  # given: it overrides the box's
         m1_range = tuple(args.m1_range)
     ranges.update(command_ranges(args, "robustness").plant)
     return as_pair(m1_range), ranges

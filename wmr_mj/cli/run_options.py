@@ -27,7 +27,7 @@ from typing import Any
 
 from wmr_mj.cli.options import positive_float
 
-__all__ = ["RunOption", "Replay", "run_options", "add_options", "command_line", "GROUPS"]
+__all__ = ["RunOption", "Replay", "run_options", "add_options", "add_option", "command_line", "GROUPS"]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -282,6 +282,12 @@ def add_options(p: argparse.ArgumentParser | Any, group: str) -> None:
     for row in run_options():
         if row.group == group:
             p.add_argument(row.flag, help=row.help() if callable(row.help) else row.help, **row.settings)
+
+
+def add_option(p: argparse.ArgumentParser | Any, flag: str) -> None:
+    """Add the one row ``flag`` of the table to ``p`` (``--cart`` in ``identify`` and ``model``)."""
+    row = next(r for r in run_options() if r.flag == flag)
+    p.add_argument(row.flag, help=row.help() if callable(row.help) else row.help, **row.settings)
 
 
 def command_line(config: Any, replay: Replay, *, command: str = "wmr-mj run") -> str:

@@ -59,6 +59,7 @@ __all__ = [
     "OMEGA_R_GRID",
     "certified_omega_r",
     "certified_design",
+    "on_cart",
     "preset",
 ]
 
@@ -170,6 +171,16 @@ def _certified_on(text: str, path: str) -> Design:
                              f"{OMEGA_R_GRID[0]:g}-{OMEGA_R_GRID[-1]:g} rad/s whose certificate is valid with "
                              f"E_max <= {ERROR_SPEC:g} rad on this cart; give the gains with --kp/--kd or --omega-r")
     return dataclasses.replace(CERTIFIED, kp=w * w / 4.0, kd=w)
+
+
+def on_cart(changes: dict[str, Any], cart: Any) -> dict[str, Any]:
+    """A design's RunConfig fields (``Design.config_changes``) on ``cart``: where they carry the certified design's
+    gains (:data:`CERTIFIED`'s K_P and K_D: the certified preset, the ladder's gains rung, the correction rung), the
+    gains the rule gives on the cart (:func:`certified_design`); the rest as given. None: the C80, unchanged."""
+    if cart is None or (changes.get("kp"), changes.get("kd")) != (CERTIFIED.kp, CERTIFIED.kd):
+        return changes
+    derived = certified_design(cart)
+    return {**changes, "kp": derived.kp, "kd": derived.kd}
 
 
 def certified_omega_r(*, error_spec: float = ERROR_SPEC, grid: tuple[float, ...] = OMEGA_R_GRID,
