@@ -92,7 +92,7 @@ def run(args: argparse.Namespace) -> int:
         return 0
     print(format_headline(summary))
     if settings.cart is not None:
-        print(f"on the cart {settings.cart['name']} {settings.cart['version']} ({settings.cart['path']})")
+        print(f"every run on the cart file {settings.cart['path']}")
     from wmr_mj.hardware import cart_line, is_ideal_cart
 
     if not is_ideal_cart(settings):
