@@ -139,6 +139,21 @@ def test_cart_check_reports_the_certified_design_in_its_second_line(capsys):
     assert f"E_max = {claim.E_max:.4g} rad" in second
 
 
+def test_robustness_box_derived_on_a_cart_is_the_carts_box(capsys):
+    """robustness --box derived --cart: the box spanned by the cart's parameter set over its m1 box, computed
+    here with the closed forms of C80Parameters.coefficients at the box's two m1 ends."""
+    from wmr_mj.params import with_params
+
+    assert main(["robustness", "--box", "derived", "--cart", "c80-re40", "--json"]) == 0
+    box = json.loads(capsys.readouterr().out)["box"]
+    base = base_for(RunConfig(cart="c80-re40"))
+    ends = [with_params(base, m1=m).coefficients("paper") for m in load_cart("c80-re40").uncertainty["m1"]["m1"]]
+    for name in ("P", "C_V", "F", "K"):
+        values = [getattr(c, name) for c in ends]
+        assert box[name] == pytest.approx([min(values), max(values)], rel=1e-12), name  # rel: rounding only
+    assert box["P"][0] != pytest.approx(0.385, rel=0.1)  # not the C80's P
+
+
 # -- logs -----------------------------------------------------------------------------------------------------------
 def test_a_cart_in_a_log_verifies_by_replay(tmp_path, capsys):
     """The log carries the cart file (its config record and the attachment cart.toml, the file's text to the
