@@ -7,7 +7,7 @@ Usage::
 
     from wmr_mj.carts import load_cart, cart_names
 
-    cart_names()                          # ('c80',)
+    cart_names()                          # ('c80', 'c80-re40')
     cart = load_cart("mine.toml")         # one line and ParameterError for a wrong file
 """
 
@@ -19,8 +19,9 @@ from wmr_mj.carts.cartfile import (
     cart_names,
     cart_path,
     load_cart,
+    load_cart_text,
 )
 from wmr_mj.carts.schema import SCHEMA_PATH, load_schema
 
 __all__ = ["CARTS_DIR", "CartFile", "DEFAULT_KEYS", "PARAMETER_SECTIONS", "SCHEMA_PATH", "cart_names", "cart_path",
-           "load_cart", "load_schema"]
+           "load_cart", "load_cart_text", "load_schema"]

@@ -46,7 +46,8 @@ from typing import Any
 from wmr_mj.carts.schema import check_against_schema, load_schema
 from wmr_mj.errors import ParameterError
 
-__all__ = ["CARTS_DIR", "CartFile", "cart_names", "cart_path", "load_cart", "PARAMETER_SECTIONS", "DEFAULT_KEYS"]
+__all__ = ["CARTS_DIR", "CartFile", "cart_names", "cart_path", "load_cart", "load_cart_text", "PARAMETER_SECTIONS",
+           "DEFAULT_KEYS"]
 
 #: The shipped carts (``NAME.toml``), inside the package: found from any folder and by an installed wheel.
 CARTS_DIR = Path(__file__).resolve().parent
@@ -79,6 +80,7 @@ class CartFile:
         uncertainty_sources: box name -> parameter name -> where the range comes from.
         defaults: 'sensing', 'actuation' (a preset name or KEY=VALUE spec), 'backlash' (rad) -> value.
         default_sources: the same keys -> where the default comes from.
+        text: the file's text as read (a run's record and its log carry it; :func:`load_cart_text` reads it back).
     """
 
     name: str
@@ -93,6 +95,15 @@ class CartFile:
     uncertainty_sources: Mapping[str, Mapping[str, str]]
     defaults: Mapping[str, Any]
     default_sources: Mapping[str, str]
+    text: str = ""
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        # the mappings are read-only proxies, which pickle refuses: a copy (a sweep's worker) reads the text again
+        return (_cart_again, (self.text, str(self.path)))
+
+
+def _cart_again(text: str, path: str) -> CartFile:
+    return load_cart_text(text, path=path)
 
 
 def cart_names() -> tuple[str, ...]:
@@ -115,12 +126,18 @@ def cart_path(source: str | os.PathLike[str]) -> Path:
                          f"cart file or one of {', '.join(cart_names())}")
 
 
-def _read(path: Path) -> dict[str, Any]:
+def _read_text(path: Path) -> str:
     try:
-        with path.open("rb") as f:
-            return tomllib.load(f)
+        return path.read_text(encoding="utf-8")
     except OSError as exc:
         raise ParameterError(f"cart file {str(path)!r} cannot be read: {exc.strerror or exc}") from None
+    except UnicodeDecodeError as exc:
+        raise ParameterError(f"cart file {str(path)!r} is not UTF-8 text: {exc}") from None
+
+
+def _parse(text: str, path: Path) -> dict[str, Any]:
+    try:
+        return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ParameterError(f"cart file {str(path)!r} is not valid TOML: {exc}") from None
 
@@ -148,7 +165,7 @@ def _check_rules(document: Mapping[str, Any]) -> None:
                              f"with the version {version!r}")
 
 
-def _cart_of(document: Mapping[str, Any], path: Path) -> CartFile:
+def _cart_of(document: Mapping[str, Any], path: Path, text: str) -> CartFile:
     sections = {s: tuple(document[s]) for s in PARAMETER_SECTIONS}
     entries = {name: document[s][name] for s, names in sections.items() for name in names}
     boxes = document["uncertainty"]
@@ -164,6 +181,7 @@ def _cart_of(document: Mapping[str, Any], path: Path) -> CartFile:
         defaults=_frozen({k: (float(e["value"]) if "unit" in e else e["value"])
                           for k, e in document["defaults"].items()}),
         default_sources=_frozen({k: e["source"] for k, e in document["defaults"].items()}),
+        text=text,
     )
 
 
@@ -181,10 +199,27 @@ def load_cart(source: str | os.PathLike[str]) -> CartFile:
             rules beside it: one line naming the file, the key, the value, its unit and what is accepted.
     """
     path = cart_path(source)
-    document = _read(path)
+    return load_cart_text(_read_text(path), path=path)
+
+
+def load_cart_text(text: str, *, path: str | os.PathLike[str] = "<text>") -> CartFile:
+    """Read and check a cart file's text (as :func:`load_cart` reads a file; a run's record carries the text).
+
+    Args:
+        text: the TOML text of a cart file.
+        path: where it was read from, for the messages and :attr:`CartFile.path`.
+
+    Returns:
+        The checked :class:`CartFile`.
+
+    Raises:
+        ParameterError: invalid TOML, or a violation of the schema or of the rules beside it (one line).
+    """
+    path = Path(path)
+    document = _parse(text, path)
     try:
         check_against_schema(document, load_schema())
         _check_rules(document)
     except ParameterError as exc:
         raise ParameterError(f"cart file {str(path)!r}: {exc}") from None
-    return _cart_of(document, path)
+    return _cart_of(document, path, text)

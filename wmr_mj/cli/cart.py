@@ -1,10 +1,16 @@
-"""``wmr-mj cart check FILE|NAME``: is a cart file sound? The answer in the first line.
+"""``wmr-mj cart check FILE|NAME``: is a cart file sound? The answer in the first line, the certified design's
+certificate on the cart in the second. ``wmr-mj cart card FILE|NAME [--out PATH]``: the cart's model card.
 
 It reads and checks the file against its schema (a wrong file: one line naming the key, the value, its unit
 and what is accepted, exit status 2), builds its default sensing, actuation and play, compiles the generated
 model and steps it for 1 s with random controls (no MuJoCo warning accepted, as Menagerie's test), and
 identifies the reduced model (P, C_V, F, K, gyro) from a simulated excitation against what the file implies
 (:mod:`wmr_mj.plant.cartcheck`). Exit status 0 when every check passes, 1 when one fails.
+
+It also reports the certified design on the cart: the rule of :mod:`wmr_mj.sim.designs` run on the cart's
+parameter set and m1 box (its omega_r, never the C80's), and that design's certificate on the paper circle with the
+cart's default sensing, actuation and play: E_max, the voltage bound against the supply, the assumptions met and
+unmet. This is a report, not a check: a cart whose design cannot be certified still passes ``cart check``.
 """
 
 from __future__ import annotations
@@ -17,16 +23,20 @@ from wmr_mj.cli._common import positive_float
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("cart", help="check a cart file (TOML): schema, compile and step, identification")
-    p.add_argument("action", choices=("check",),
+    p.add_argument("action", choices=("check", "card"),
                    help="check: read the file against its schema, compile and step the generated model for 1 s "
                         "with random controls (no MuJoCo warning), identify P, C_V, F, K, gyro from a simulated "
-                        "excitation and compare them with what the file implies; exit 1 if a check fails")
+                        "excitation and compare them with what the file implies, and report the certified design's "
+                        "certificate on the cart; exit 1 if a check fails. card: write the cart's model card "
+                        "(Markdown, as models/README.md is the C80's; about a minute of measurements)")
     p.add_argument("cart", metavar="FILE|NAME", help="a cart file (.toml, see wmr_mj/carts/c80.toml) or a shipped "
                                                      "cart's name (c80)")
     p.add_argument("--duration", type=positive_float, default=20.0,
                    help="length of the identification's excitation, s (default 20)")
     p.add_argument("--seed", type=int, default=0, help="seed of the random controls and the excitation (default 0)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--out", metavar="PATH", default=None,
+                   help="card: the Markdown file to write (default: logs/<cart file's stem>-card.md)")
     p.set_defaults(func=run)
 
 
@@ -66,10 +76,47 @@ def _answer(cart: Any, steps: Any, ident: Any, ident_error: str | None) -> str:
             "P, C_V, F, K, gyro are those the file implies")
 
 
-def _print_text(cart: Any, parts: dict[str, str], steps: Any, ident: Any, ident_error: str | None) -> None:
+def certified_on_cart(cart: Any) -> dict[str, Any]:
+    """The certified design on ``cart`` (a checked CartFile) and its certificate on the paper circle with the cart's
+    default sensing, actuation and play: omega_r [rad/s], kp, kd, certified, E_max [rad], Edot_max [rad/s],
+    voltage_max [V], voltage_limit [V], met, unmet (assumption names); or omega_r None and 'reason' where the rule
+    finds no omega_r on its grid."""
+    from wmr_mj.errors import ParameterError
+    from wmr_mj.sim.config import RunConfig
+    from wmr_mj.sim.designs import certified_design
+    from wmr_mj.sim.parts import resolve_run
+
+    try:
+        design = certified_design(cart)
+    except ParameterError as exc:
+        return {"omega_r": None, "reason": str(exc)}
+    claim = resolve_run(RunConfig(**design.config_changes(), cart=cart)).claim
+    assert claim is not None  # the computed-torque law always states its certificate
+    return {"omega_r": design.kd, "kp": design.kp, "kd": design.kd, "certified": claim.certified,
+            "E_max": claim.E_max, "Edot_max": claim.Edot_max, "voltage_max": claim.voltage_max,
+            "voltage_limit": float(cart.parameters["voltage_limit"]),
+            "met": [a.name for a in claim.assumptions if a.met], "unmet": list(claim.unmet)}
+
+
+def _certified_line(c: dict[str, Any]) -> str:
+    """The second line: the certified design's certificate on the cart."""
+    if c["omega_r"] is None:
+        return f"certified design: none on this cart ({c['reason']})"
+    head = (f"certified design on this cart: omega_r = {c['omega_r']:g} rad/s (K_P = {c['kp']:g}, K_D = {c['kd']:g}, "
+            "the rule of wmr_mj/sim/designs.py run on the cart): ")
+    numbers = (f"E_max = {c['E_max']:.4g} rad, |E'| <= {c['Edot_max']:.4g} rad/s, |u| <= {c['voltage_max']:.4g} V "
+               f"of the {c['voltage_limit']:g} V supply, on the cart's default sensing")
+    if c["certified"]:
+        return head + f"CERTIFIED, all {len(c['met'])} assumptions met; " + numbers
+    return head + f"NOT certified: {', '.join(c['unmet']) or 'no valid bound'} not met; " + numbers
+
+
+def _print_text(cart: Any, parts: dict[str, str], steps: Any, ident: Any, ident_error: str | None,
+                certified: dict[str, Any]) -> None:
     from wmr_mj.plant.cartcheck import COEFFICIENT_UNITS
 
     print(_answer(cart, steps, ident, ident_error))
+    print(_certified_line(certified))
     print(f"defaults: sensing {parts['sensing']}; actuation {parts['actuation']}; play {parts['backlash']}")
     print(f"steps: {steps.steps} steps ({steps.duration:g} s) of uniform random controls, seed {steps.seed}: "
           f"{sum(steps.warnings.values())} MuJoCo warnings, state {'finite' if steps.finite else 'NOT finite'}")
@@ -95,6 +142,9 @@ def run(args: argparse.Namespace) -> int:
     cart = load_cart(args.cart)
     params = parameters_of_cart(cart)
     parts = _default_parts(cart)
+    if args.action == "card":
+        return _write_card(cart, args.out)
+    certified = certified_on_cart(cart)
     steps = step_with_random_controls(params, seed=args.seed)
     ident, ident_error = None, None
     try:
@@ -106,7 +156,18 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print_json({"answer": answer, "passed": passed, "cart": cart.name, "version": cart.version,
                     "path": str(cart.path), "defaults": parts, "steps": steps.as_dict(),
-                    "identification": None if ident is None else ident.as_dict(), "identification_error": ident_error})
+                    "identification": None if ident is None else ident.as_dict(), "identification_error": ident_error,
+                    "certified_design": certified})
     else:
-        _print_text(cart, parts, steps, ident, ident_error)
+        _print_text(cart, parts, steps, ident, ident_error, certified)
     return 0 if passed else 1
+
+
+def _write_card(cart: Any, out: str | None) -> int:
+    """Write the cart's model card (:func:`wmr_mj.plant.modelcard.render_model_card`) to ``out``."""
+    from wmr_mj._util.files import check_output_path, write_text_atomic
+    from wmr_mj.plant.modelcard import render_model_card
+
+    path = check_output_path(out or f"logs/{cart.path.stem}-card.md", kind="file", option="--out")
+    print(f"wrote {write_text_atomic(path, render_model_card(cart=cart))}")
+    return 0

@@ -64,7 +64,10 @@ def _cart_options(args: argparse.Namespace) -> dict:
 
     parts = hardware_from_args(args)
     given = {"sensing": args.sensing, "actuation": args.actuation, "transmission": args.backlash}
-    return {name: part for name, part in parts.items() if given[name] is not None}
+    out = {name: part for name, part in parts.items() if given[name] is not None}
+    if getattr(args, "cart", None) is not None:
+        out["cart"] = args.cart  # the cart file: every design's parameter set, box and default parts
+    return out
 
 
 def run(args: argparse.Namespace) -> int:

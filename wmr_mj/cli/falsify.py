@@ -167,7 +167,9 @@ def _base_and_box(args: argparse.Namespace):
         from wmr_mj.reference.knots import KnotSpace
 
         space = KnotSpace(args.path_knots, hold_range=(0.0, 3.0))
-        searched = {**space.ranges(base.reference_bounds), **searched}
+        from wmr_mj.sim.config import base_for
+
+        searched = {**space.ranges(base.reference_bounds, base_for(base)), **searched}  # the cart's l1 and stops
     box = {**({"m1": tuple(args.m1_range)} if fixed_m1 is None else {}), **box_ranges_from_args(args), **searched}
     return base, box
 

@@ -11,24 +11,31 @@ from wmr_mj.params import M1_NOMINAL
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("identify", help="excite the plant's steering and fit P, C_V, F, K, gyro by least squares")
-    p.add_argument("--m1", type=positive_float, default=M1_NOMINAL, help="chassis mass of the plant, kg (default 650)")
+    p.add_argument("--m1", type=positive_float, default=M1_NOMINAL,
+                   help="chassis mass of the plant, kg (default: the cart's, 650 on the C80)")
     p.add_argument("--duration", type=positive_float, default=60.0, help="excitation length, s (default 60)")
     add_seed(p, help="seed of the excitation signal (default 0)")
     p.add_argument("--param", action="append", metavar="NAME=VALUE", help="override a plant parameter (repeatable)")
     add_out(p, metavar="PATH", help="also write the result as JSON (used by --model identified)")
     add_json(p, help="print one JSON object")
+    from wmr_mj.cli.run_options import add_option
+
+    add_option(p, "--cart")
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     from wmr_mj._util.files import check_output_path, write_json_atomic
     from wmr_mj.cli._common import print_json
-    from wmr_mj.params import C80, COEFFICIENT_MODELS, COEFFICIENT_NAMES, with_params
+    from wmr_mj.cli.options import cart_parameters
+    from wmr_mj.params import COEFFICIENT_MODELS, COEFFICIENT_NAMES, with_params
     from wmr_mj.plant.identify import identify_plant
 
     if args.out:  # before the identification, which takes a while
         check_output_path(args.out, kind="file", option="--out")
-    params = with_params(C80, m1=args.m1, **parse_assignments(args.param))
+    base = cart_parameters(args)
+    m1 = base.m1 if args.m1 is M1_NOMINAL else args.m1  # --m1 not given: the cart's
+    params = with_params(base, m1=m1, **parse_assignments(args.param))
     result = identify_plant(params, duration=args.duration, seed=args.seed)
     obj = result.as_dict()
     if args.out:

@@ -19,16 +19,25 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "keyframe, offscreen: EGL or OSMesa)")
     p.add_argument("--param", action="append", metavar="NAME=VALUE", help="override a parameter (repeatable)")
     add_json(p, help="with 'params', 'slip' or 'friction': print one JSON object")
+    from wmr_mj.cli.run_options import add_option
+
+    add_option(p, "--cart")  # params, slip, friction on the cart (its card: wmr-mj cart card FILE)
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     from wmr_mj._util.resources import MODELS_IN_CHECKOUT
     from wmr_mj.cli._common import parse_assignments, print_json
-    from wmr_mj.params import C80, COEFFICIENT_NAMES, PARAMETER_SOURCES, with_params
+    from wmr_mj.cli.options import cart_parameters
+    from wmr_mj.params import COEFFICIENT_NAMES, PARAMETER_SOURCES, with_params
     from wmr_mj.plant.mjcf import MODELS_DIR, robot_xml, scene_file_xml, write_model_files
 
-    params = with_params(C80, **parse_assignments(args.param))
+    if getattr(args, "cart", None) is not None and args.action in ("write", "check", "card", "image"):
+        from wmr_mj.errors import ParameterError
+
+        raise ParameterError(f"model {args.action} is for the C80's files in models/; it takes no --cart (a cart's "
+                             "model card: wmr-mj cart card FILE); accepted with --cart: params, slip, friction")
+    params = with_params(cart_parameters(args), **parse_assignments(args.param))
     if args.action == "write":
         for path in write_model_files(params):
             print(f"wrote {path}")
@@ -97,8 +106,13 @@ def run(args: argparse.Namespace) -> int:
         print_json({"parameters": params.as_dict(), "paper": paper.as_dict(), "nonholonomic": nonholonomic.as_dict(),
                     "kinetic_energy": params.kinetic_energy_coefficients()})
         return 0
+    sources = PARAMETER_SOURCES
+    if getattr(args, "cart", None) is not None:
+        from wmr_mj.carts import load_cart
+
+        sources = dict(load_cart(args.cart).sources)
     for name, value in params.as_dict().items():
-        print(f"{name:22s} {value:12.6g}  {PARAMETER_SOURCES[name]}")
+        print(f"{name:22s} {value:12.6g}  {sources[name]}")
     print()
     for key in COEFFICIENT_NAMES:
         print(f"{key:5s} paper {getattr(paper, key):10.5g}   nonholonomic {getattr(nonholonomic, key):10.5g}")

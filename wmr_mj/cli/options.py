@@ -221,7 +221,14 @@ def box_ranges_from_args(args: argparse.Namespace) -> dict[str, tuple[float, flo
     """
     from wmr_mj.params import uncertainty_ranges
 
-    ranges = {k: v for k, v in uncertainty_ranges(getattr(args, "uncertainty", None) or "m1").items() if k != "m1"}
+    box = getattr(args, "uncertainty", None) or "m1"
+    ranges = {k: v for k, v in uncertainty_ranges(box).items() if k != "m1"}
+    if getattr(args, "cart", None) is not None:  # the cart's own box (--cart)
+        from wmr_mj.carts import load_cart
+
+        boxes = load_cart(args.cart).uncertainty
+        if box in boxes:
+            ranges = {k: v for k, v in boxes[box].items() if k != "m1"}
     ranges.update(command_ranges(args).plant)
     return ranges
 
@@ -231,3 +238,18 @@ def hardware_ranges_from_args(args: argparse.Namespace) -> dict[str, tuple[float
     :data:`wmr_mj.sim.search_space.HARDWARE_AXES`), in the order given; each is checked where the sweep
     or the search is built."""
     return command_ranges(args).cart
+
+
+def cart_parameters(args: argparse.Namespace):
+    """The parameter set of ``--cart`` (:class:`wmr_mj.params.C80Parameters`; the C80 where not given).
+
+    Raises:
+        ParameterError: a missing file, an unknown name, a file its schema or rules refuse (one line).
+    """
+    from wmr_mj.params import C80, parameters_of_cart
+
+    if getattr(args, "cart", None) is None:
+        return C80
+    from wmr_mj.carts import load_cart
+
+    return parameters_of_cart(load_cart(args.cart))

@@ -71,6 +71,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         metavar="NAME=LO:HI",
         help="extra C80 parameter range for --box derived (repeatable), e.g. mu=0.015:0.02",
     )
+    p.add_argument("--cart", default=None, metavar="FILE|NAME",
+                   help="for --box derived: the cart whose parameter set and m1 box span it (a cart file or a "
+                        "shipped cart's name; default the C80)")
     p.add_argument(
         "--model",
         choices=COEFFICIENT_MODELS,
@@ -164,8 +167,8 @@ def _box(args: argparse.Namespace):
     from wmr_mj.errors import ParameterError
 
     if args.box == "paper":
-        used = [opt for opt, v in (("--m1-range", args.m1_range), ("--range", args.range), ("--model", args.model))
-                if v]
+        used = [opt for opt, v in (("--m1-range", args.m1_range), ("--range", args.range), ("--model", args.model),
+                                   ("--cart", args.cart)) if v]
         if used:
             raise ParameterError(f"{', '.join(used)} only apply to --box derived (got --box paper)")
         return ParameterBox.paper(), "paper (5.1)"
@@ -173,11 +176,18 @@ def _box(args: argparse.Namespace):
     from wmr_mj.params import C80
 
     ranges = command_ranges(args, "robustness").plant  # m1's range is --m1-range (the one rule of --range)
-    m1_range = tuple(args.m1_range) if args.m1_range is not None else M1_RANGE
+    params, name, default_m1 = C80, "C80", M1_RANGE
+    if args.cart is not None:  # --cart: its parameter set and its m1 box
+        from wmr_mj.carts import load_cart
+        from wmr_mj.params import parameters_of_cart
+
+        cart = load_cart(args.cart)
+        params, name, default_m1 = parameters_of_cart(cart), cart.name, cart.uncertainty["m1"]["m1"]
+    m1_range = tuple(args.m1_range) if args.m1_range is not None else default_m1
     model = args.model or "paper"
-    box = ParameterBox.from_parameters(C80, m1_range=m1_range, ranges=ranges, model=model)
+    box = ParameterBox.from_parameters(params, m1_range=m1_range, ranges=ranges, model=model)
     spans = [f"m1 {m1_range[0]:g}-{m1_range[1]:g} kg"] + [f"{n} {lo:g}-{hi:g}" for n, (lo, hi) in ranges.items()]
-    return box, f"derived from C80 ({model} model; {', '.join(spans)})"
+    return box, f"derived from {name} ({model} model; {', '.join(spans)})"
 
 
 def _analysis_table(args: argparse.Namespace, result, gains: tuple[float, float], box_and_label,
@@ -227,7 +237,7 @@ def _analysis_table(args: argparse.Namespace, result, gains: tuple[float, float]
 _OUTER_OPTIONS = (("--kp", "kp"), ("--kd", "kd"), ("--omega-r", "omega_r"), ("--box", "box"),
                   ("--m1-range", "m1_range"), ("--range", "range"), ("--model", "model"), ("--estimate", "estimate"),
                   ("--reading", "reading"), ("--gammas", "gammas"), ("--alpha-ddot", "alpha_ddot"),
-                  ("--alpha-dot", "alpha_dot"), ("--sin-cos3", "sin_cos3"))
+                  ("--alpha-dot", "alpha_dot"), ("--sin-cos3", "sin_cos3"), ("--cart", "cart"))
 
 
 def certificate_parser() -> argparse.ArgumentParser:
@@ -270,8 +280,15 @@ def _box_ranges(args: argparse.Namespace) -> tuple[tuple[float, float], dict[str
     from wmr_mj.params import M1_RANGE, uncertainty_ranges
 
     ranges = uncertainty_ranges(args.uncertainty) if getattr(args, "uncertainty", None) else {}
-    m1_range = ranges.pop("m1", M1_RANGE)
-    if tuple(args.m1_range) != tuple(M1_RANGE):
+    default_m1 = M1_RANGE
+    if getattr(args, "cart", None) is not None:  # --cart: its boxes
+        from wmr_mj.carts import load_cart
+
+        boxes = load_cart(args.cart).uncertainty
+        default_m1 = boxes["m1"]["m1"]
+        ranges = dict(boxes.get(args.uncertainty, ranges)) if getattr(args, "uncertainty", None) else {}
+    m1_range = ranges.pop("m1", default_m1)
+    if args.m1_range is not M1_RANGE and tuple(args.m1_range) != tuple(M1_RANGE):  # given: it overrides the box's
         m1_range = tuple(args.m1_range)
     ranges.update(command_ranges(args, "robustness").plant)
     return as_pair(m1_range), ranges

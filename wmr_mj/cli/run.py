@@ -45,9 +45,11 @@ def hardware_from_args(args: argparse.Namespace) -> dict[str, Any]:
     """
     from wmr_mj.hardware import Actuation, Sensing, Transmission
 
-    return {"sensing": Sensing.from_spec(getattr(args, "sensing", None)),
-            "actuation": Actuation.from_spec(getattr(args, "actuation", None)),
-            "transmission": Transmission.from_spec(getattr(args, "backlash", None))}
+    # an option not given stays None: the cart's default (RunConfig.cart; ideal on the C80)
+    given: dict[str, tuple[Any, str]] = {"sensing": (Sensing, "sensing"), "actuation": (Actuation, "actuation"),
+                                         "transmission": (Transmission, "backlash")}
+    return {name: None if getattr(args, option, None) is None else cls.from_spec(getattr(args, option))
+            for name, (cls, option) in given.items()}
 
 
 def config_from_args(args: argparse.Namespace, **extra):
@@ -61,7 +63,13 @@ def config_from_args(args: argparse.Namespace, **extra):
     tracker = getattr(args, "tracker", None)
     if bool(getattr(args, "correction", False)) and tracker not in (None, "stanley-at-C"):
         raise ParameterError(f"--correction is the tracker stanley-at-C; give it or --tracker {tracker}, not both")
-    choice = LawChoice(preset=args.preset, controller=args.controller,
+    from wmr_mj.params import M1_RANGE
+
+    # --cart: the cart's parameter set, boxes and defaults; --m1 and --m1-range not given (their defaults, the
+    # very objects): the cart's m1 and m1 box
+    cart = getattr(args, "cart", None)
+    m1_range = getattr(args, "m1_range", M1_RANGE)
+    choice = LawChoice(cart=cart, preset=args.preset, controller=args.controller,
                        controller_params=parse_params(getattr(args, "controller_param", None)), model=args.model,
                        kp=args.kp, kd=args.kd, omega_r=args.omega_r, friction_sign=args.friction_sign,
                        friction_width=args.friction_width, identified=args.identified,
@@ -70,13 +78,18 @@ def config_from_args(args: argparse.Namespace, **extra):
     if signals is not None:
         extra.setdefault("signals", signals)
     tracker_params = parse_params(getattr(args, "tracker_param", None), option="--tracker-param")
-    return RunConfig(**law_fields(choice), tracker=tracker, tracker_params=tracker_params, duration=args.duration,
-                     control_period=args.control_period, path=args.path,
-                     plant_overrides=parse_assignments(args.param), m1_inertia=args.m1_inertia, box=args.box,
-                     m1_range=tuple(args.m1_range), steering_friction=args.steering_friction,
-                     tyre_contact=args.tyre_contact, box_ranges=box_ranges_from_args(args),
-                     correction=bool(getattr(args, "correction", False)),
-                     reference_bounds=getattr(args, "reference_bounds", None), **hardware_from_args(args), **extra)
+    if extra.get("m1", None) is M1_NOMINAL:
+        extra["m1"] = None  # --m1 not given: the cart's nominal m1
+    given_range: Any = None if m1_range is M1_RANGE else tuple(m1_range)  # None: the cart's m1 box
+    config = RunConfig(**law_fields(choice), cart=cart, tracker=tracker, tracker_params=tracker_params,
+                       duration=args.duration, control_period=args.control_period, path=args.path,
+                       plant_overrides=parse_assignments(args.param), m1_inertia=args.m1_inertia, box=args.box,
+                       m1_range=given_range, steering_friction=args.steering_friction,
+                       tyre_contact=args.tyre_contact, box_ranges=box_ranges_from_args(args),
+                       correction=bool(getattr(args, "correction", False)),
+                       reference_bounds=getattr(args, "reference_bounds", None), **hardware_from_args(args), **extra)
+    args.m1_range = config.m1_range  # --m1-range not given: the cart's m1 box, which the commands read from args
+    return config
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -93,7 +106,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                     "compiled law cannot run (no C compiler at install, WMR_MJ_COMPILED_LAW=0) the same "
                     "engine evaluates the Python law, with the same numbers, and says so on stderr.")
     add_run_options(p)
-    p.add_argument("--m1", type=positive_float, default=M1_NOMINAL, help="plant chassis mass, kg (default 650)")
+    p.add_argument("--m1", type=positive_float, default=M1_NOMINAL,
+                   help="plant chassis mass, kg (default: the cart's, 650 on the C80)")
     p.add_argument("--range", action="append", metavar="NAME=LO:HI",
                    help="another ranged plant parameter of the analysis box (repeatable; it adds the parameter to "
                         "the --uncertainty box or replaces its range, e.g. R_a=1.0:1.3); a run draws nothing")

@@ -27,7 +27,7 @@ from typing import Any
 
 from wmr_mj.cli.options import positive_float
 
-__all__ = ["RunOption", "Replay", "run_options", "add_options", "command_line", "GROUPS"]
+__all__ = ["RunOption", "Replay", "run_options", "add_options", "add_option", "command_line", "GROUPS"]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -218,7 +218,7 @@ def _plant_and_outer_rows() -> tuple[RunOption, ...]:
           write=lambda c, r: ["--box", c.box]),
         R(flag="--m1-range", group="run", sets="m1_range",
           settings=dict(nargs=2, type=positive_float, metavar=("LO", "HI"), default=M1_RANGE),
-          help="m1 range of the analysis box, kg (default 550 750)",
+          help="m1 range of the analysis box, kg (default: the cart's m1 box, 550 750 on the C80)",
           write=lambda c, r: ["--m1-range", repr(c.m1_range[0]), repr(c.m1_range[1])]),
         R(flag="--uncertainty", group="run", sets="box_ranges", settings=dict(default=None), help=_uncertainty_help,
           write=_write_uncertainty),
@@ -260,6 +260,9 @@ def _plant_and_outer_rows() -> tuple[RunOption, ...]:
           help="the gear's play: half-width b >= 0, rad at the steering axis (e.g. 0.002)",
           write=_if(lambda c, r: not c.transmission.is_ideal,
                     lambda c, r: ["--backlash", repr(c.transmission.backlash)])),
+        R(flag="--cart", group="cart", sets="cart", settings=dict(metavar="FILE|NAME", default=None),
+          help=_cart_help, write=_if(lambda c, r: c.cart is not None,
+                                     lambda c, r: ["--cart", shlex.quote(c.cart["path"])])),
         # written as kp and kd, or within --signals: read, never written
         R(flag="--omega-r", group="run", sets="", settings=dict(type=positive_float, default=None),
           help="gains by (3.6): K_P = omega_r^2/4, K_D = omega_r"),
@@ -279,6 +282,12 @@ def add_options(p: argparse.ArgumentParser | Any, group: str) -> None:
     for row in run_options():
         if row.group == group:
             p.add_argument(row.flag, help=row.help() if callable(row.help) else row.help, **row.settings)
+
+
+def add_option(p: argparse.ArgumentParser | Any, flag: str) -> None:
+    """Add the one row ``flag`` of the table to ``p`` (``--cart`` in ``identify`` and ``model``)."""
+    row = next(r for r in run_options() if r.flag == flag)
+    p.add_argument(row.flag, help=row.help() if callable(row.help) else row.help, **row.settings)
 
 
 def command_line(config: Any, replay: Replay, *, command: str = "wmr-mj run") -> str:
@@ -370,6 +379,15 @@ def _sensing_help() -> str:
             f"({', '.join(sensing_preset_names())}), KEY=VALUE pairs ({', '.join(SENSING_SPEC_KEYS)}, preset; e.g. "
             "encoder_ticks=4096,velocity=difference,delay=0.005,noise=uniform:0.0005,seed=3; the delay a whole number "
             "of control periods) or a .json/.toml file of the same")
+
+
+def _cart_help() -> str:
+    from wmr_mj.carts import cart_names
+
+    return (f"the cart: a cart file (.toml, see wmr_mj/carts/c80.toml and docs/reference/cart.md) or a shipped cart "
+            f"({', '.join(cart_names())}); it gives the parameter set, the m1 box, the supply and stops, the default "
+            "sensing, actuation and play, and the certified preset's gains (its rule run on the cart) "
+            "(default: c80)")
 
 
 def _require_help() -> str:

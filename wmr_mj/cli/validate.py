@@ -80,7 +80,8 @@ def run(args: argparse.Namespace) -> int:
     settings = ValidateSettings(n=args.n, seed=args.seed, sampling=args.sampling, duration=args.duration,
                                 identify_duration=args.identify_duration, search_budget=args.search_budget,
                                 nthread=args.nthread, uncertainty=args.uncertainty, path=args.path,
-                                designs=tuple(args.design or ()), **hardware_from_args(args))
+                                designs=tuple(args.design or ()), cart=getattr(args, "cart", None),
+                                **hardware_from_args(args))
     out = check_output_path(args.out or default_folder("validate"), kind="dir", option="--out")
     summary = run_validate(settings, out)
     pointer = write_pointer(out)
@@ -90,6 +91,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"validate: total wall time {wall:.1f} s; report {out}/index.html", file=sys.stderr)
         return 0
     print(format_headline(summary))
+    if settings.cart is not None:
+        print(f"every run on the cart file {settings.cart['path']}")
     from wmr_mj.hardware import cart_line, is_ideal_cart
 
     if not is_ideal_cart(settings):

@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -122,7 +123,7 @@ def path_of_log(log: RunLog, settle_s: float | None = None) -> LogPath:
         return LogPath(reason="the log has no control period")
     n = int(round(duration / period))
     try:
-        reference, _ = build_reference(path, estimate_parameters(C80), dt=period, duration=n * period)
+        reference, _ = build_reference(path, estimate_parameters(_base_of(cfg, C80)), dt=period, duration=n * period)
         t, C, h = np.asarray(sig["t"], float), np.asarray(sig["C_pos"], float), np.asarray(sig["heading"], float)
         ok = np.isfinite(t) & np.isfinite(C).all(axis=1) & np.isfinite(h)
         series = path_error_series(reference, t[ok], C[ok], h[ok])
@@ -146,6 +147,18 @@ def path_of_log(log: RunLog, settle_s: float | None = None) -> LogPath:
     bound = without_guarantee(bound, why_not)
     return LogPath(reference=reference, series=series, errors=errors, bound=bound,
                    verdict=path_verdict(errors, bound))
+
+
+def _base_of(cfg: Mapping[str, Any], default: Any) -> Any:
+    """The base parameter set of a logged run: its cart's (the config's "cart" record, the file's text), else
+    ``default`` (the C80)."""
+    cart = cfg.get("cart")
+    if not isinstance(cart, Mapping) or not isinstance(cart.get("text"), str):
+        return default
+    from wmr_mj.carts import load_cart_text
+    from wmr_mj.params import parameters_of_cart
+
+    return parameters_of_cart(load_cart_text(cart["text"], path=str(cart.get("path", "<log>"))))
 
 
 def hardware_labels(config: dict[str, Any] | None) -> dict[str, str]:

@@ -372,6 +372,9 @@ class RunLogger:
         params = json.dumps(json_safe(parameters), indent=2, allow_nan=False).encode()
         w.add_attachment(now, 0, "parameters.json", "application/json", params)
         w.add_attachment(now, 0, "initial_state.npy", "application/x-npy", _npy(init))
+        cart = cfg.get("cart")
+        if isinstance(cart, Mapping) and isinstance(cart.get("text"), str):  # a run on a cart file: the file itself
+            w.add_attachment(now, 0, "cart.toml", "application/toml", cart["text"].encode("utf-8"))
         if reference_path is not None:
             ref = np.asarray(reference_path, dtype=np.float64)
             w.add_attachment(now, 0, "reference_path.npy", "application/x-npy", _npy(ref))

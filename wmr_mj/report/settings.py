@@ -18,7 +18,6 @@ from wmr_mj._util.checks import as_pair, integer_at_least, positive_number
 from wmr_mj._util.progress import Stages
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.hardware.cart import CART_PARTS, cart_dict
-from wmr_mj.params import C80, M1_NOMINAL, M1_RANGE
 from wmr_mj.sim.config import RunConfig, build_reference
 from wmr_mj.sim.designs import DesignLike
 from wmr_mj.sim.sweep import max_at  # noqa: F401  (re-exported: the report reads runs.csv with it)
@@ -68,8 +67,9 @@ class ValidateSettings:
     identify_duration: float = 60.0
     search_budget: int = DEFAULT_SEARCH_BUDGET
     nthread: int = 0
-    m1_range: tuple[float, float] = M1_RANGE
-    nominal_m1: float = M1_NOMINAL
+    # None: the cart's m1 box and nominal m1 (the C80's 550-750 kg and 650 kg), resolved when checked
+    m1_range: tuple[float, float] = None  # type: ignore[assignment]
+    nominal_m1: float = None  # type: ignore[assignment]
     uncertainty: str = "m1"
     path: str = "paper-circle"
     designs: tuple[str, ...] = ()  # designs of the user's, each judged beside the ladder (validate --design)
@@ -78,9 +78,20 @@ class ValidateSettings:
     sensing: Any = None
     actuation: Any = None
     transmission: Any = None
+    # the cart (RunConfig.cart: a shipped cart's name, a .toml file; validate --cart), kept as its record; None: the
+    # C80 (as_dict then has no "cart" key). Its parameter set, boxes and defaults; the certified design's gains are
+    # derived on it by their rule (wmr_mj.sim.designs.on_cart)
+    cart: Any = None
 
     def __post_init__(self) -> None:
         from wmr_mj.sim.sweep import SAMPLINGS
+
+        on_cart = RunConfig(cart=self.cart)  # a missing file, an unknown name: one line, before any run
+        object.__setattr__(self, "cart", on_cart.cart)
+        if self.m1_range is None:
+            object.__setattr__(self, "m1_range", on_cart.m1_range)
+        if self.nominal_m1 is None:
+            object.__setattr__(self, "nominal_m1", on_cart.m1)
 
         integer_at_least("n", self.n, 1, "the number of runs per rung must be an integer >= 1")
         integer_at_least("seed", self.seed, 0, "an integer >= 0 is required")
@@ -100,7 +111,7 @@ class ValidateSettings:
             raise UnknownNameError("uncertainty box name", str(self.uncertainty), UNCERTAINTY_NAMES)
         # a named path or a route file, and the cart (a bad spec, a delay off the grid): refused as a run would
         probe = RunConfig(path=self.path, sensing=self.sensing, actuation=self.actuation,
-                          transmission=self.transmission)
+                          transmission=self.transmission, cart=self.cart)
         for name in ("sensing", "actuation", "transmission"):
             object.__setattr__(self, name, getattr(probe, name))  # the typed part
         from wmr_mj.sim.designs import design_changes
@@ -110,7 +121,7 @@ class ValidateSettings:
 
         for token in self.designs:  # an unknown law, a missing file, a bad setting: refused before any run
             # built once: a parameter the law does not take, a claim() that raises or returns no Certificate
-            resolve_run(RunConfig(**design_changes(token)))
+            resolve_run(RunConfig(**design_changes(token), cart=self.cart))
         if 0 < self.search_budget < self.min_search_budget:
             raise ParameterError(f"search_budget = {self.search_budget} is below one generation of CMA-ES (the "
                                  f"searches' portfolio); give 0 (no search) or an integer >= {self.min_search_budget}")
@@ -132,13 +143,29 @@ class ValidateSettings:
         """The ranged parameters of the uncertainty box other than m1, name -> (lo, hi)."""
         from wmr_mj.params import uncertainty_ranges
 
-        return {k: v for k, v in uncertainty_ranges(self.uncertainty).items() if k != "m1"}
+        box = uncertainty_ranges(self.uncertainty)
+        if self.cart is not None:
+            from wmr_mj.sim.config import cart_file
+
+            box = dict(cart_file(RunConfig(cart=self.cart)).uncertainty.get(self.uncertainty, box))
+        return {k: v for k, v in box.items() if k != "m1"}
+
+    @property
+    def base(self):
+        """The cart's parameter set (:class:`wmr_mj.params.C80Parameters`; the C80 without a cart)."""
+        from wmr_mj.sim.config import base_for
+
+        return base_for(RunConfig(cart=self.cart))
 
     def config(self, design: DesignLike) -> RunConfig:
-        """The run of ``design`` these settings sweep (m1 at nominal; the sweep draws it)."""
-        return RunConfig(**design.config_changes(), duration=self.duration, m1=self.nominal_m1, path=self.path,
-                         m1_range=as_pair(self.m1_range), box_ranges=self.ranges, seed=self.seed,
-                         sensing=self.sensing, actuation=self.actuation, transmission=self.transmission)
+        """The run of ``design`` these settings sweep (m1 at nominal; the sweep draws it), on the cart: the
+        certified design's gains derived on it (:func:`wmr_mj.sim.designs.on_cart`)."""
+        from wmr_mj.sim.designs import on_cart
+
+        return RunConfig(**on_cart(design.config_changes(), self.cart), duration=self.duration, m1=self.nominal_m1,
+                         path=self.path, m1_range=as_pair(self.m1_range), box_ranges=self.ranges, seed=self.seed,
+                         sensing=self.sensing, actuation=self.actuation, transmission=self.transmission,
+                         cart=self.cart)
 
     def as_dict(self) -> dict[str, Any]:
         d = asdict(self)
@@ -150,6 +177,8 @@ class ValidateSettings:
         for name in CART_PARTS:  # likewise: only the parts of the cart that are not ideal
             del d[name]
         d.update(cart_dict(self))
+        if self.cart is None:
+            del d["cart"]  # likewise: the C80's settings as they always were
         return d
 
 
@@ -172,7 +201,7 @@ def certificate_summary(cert: Any) -> dict[str, Any]:
 def reference_of(settings: ValidateSettings):
     """The reference of ``settings.path`` (the paper circle by default) for runs of ``settings.duration``
     on the 1 ms grid."""
-    return build_reference(settings.path, C80, dt=1e-3, duration=settings.duration)[0]
+    return build_reference(settings.path, settings.base, dt=1e-3, duration=settings.duration)[0]
 
 
 

@@ -189,7 +189,9 @@ def verdict_lines(summary: Summary) -> list[str]:
     summary = ValidateSummary.of(summary)
     s = summary.settings
     lo, hi = s["m1_range"]
-    question = (f"Question: does the paper's robustness region hold for the C80 under m1 in {lo:g}-{hi:g} kg? "
+    cart = s.get("cart")  # validate --cart: the cart's name (settings without it: the C80)
+    vehicle = "the C80" if not cart else f"the cart {cart['name']} {cart['version']}"
+    question = (f"Question: does the paper's robustness region hold for {vehicle} under m1 in {lo:g}-{hi:g} kg? "
                 f"({summary.ladder[0].n} MuJoCo runs per design on {_path_words(s)}, {s['duration']:g} s each)")
     report = (f"Report: {summary.folder}/index.html (also index.md, summary.json); the details follow: (a) the "
               "paper's design, (b) the ladder between the designs, (c) the certified design, (d) the friction law, "

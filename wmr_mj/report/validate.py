@@ -44,7 +44,6 @@ from typing import Any
 from wmr_mj._util.checks import as_pair
 from wmr_mj._util.files import software_versions
 from wmr_mj._util.progress import Stages
-from wmr_mj.params import C80
 from wmr_mj.report.results import CertifiedRule, PathSummary, Rung, ValidateSummary
 from wmr_mj.report.settings import (
     LADDER_GROUPS,
@@ -122,7 +121,7 @@ def identify_stage(settings: ValidateSettings, folder: Path, st: Stages) -> dict
 
     st.start("identify", f"identify the plant (m1 = {settings.nominal_m1:g} kg, {settings.identify_duration:g} s "
                          "excitation)")
-    ident = identify_plant(with_params(C80, m1=settings.nominal_m1), duration=settings.identify_duration,
+    ident = identify_plant(with_params(settings.base, m1=settings.nominal_m1), duration=settings.identify_duration,
                            seed=settings.seed)
     out = ident.as_dict()
     write_json_atomic(folder / "identified.json", out)
@@ -139,7 +138,7 @@ def friction_stage(settings: ValidateSettings, st: Stages) -> dict[str, dict[str
     from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS
 
     st.start("friction", "the steering joint's friction law (stiction, soft): constant voltages")
-    plant = with_params(C80, m1=settings.nominal_m1)
+    plant = with_params(settings.base, m1=settings.nominal_m1)
     laws = {name: measure_friction_law(plant, steering_friction=name).as_dict() for name in STEERING_FRICTION_MODELS}
     st.done(", ".join(f"{name}: break-away {law['breakaway_voltage']:.3g} V, "
                       f"{'holds' if law['holds'] else 'creeps'} below it" for name, law in laws.items()))
@@ -303,8 +302,8 @@ def _path_summary(settings: ValidateSettings) -> PathSummary:
     return PathSummary(name=settings.path, circle_radius=radius)
 
 
-def _certified_rule() -> CertifiedRule:
-    """The certified design's rule as designs.py writes it, and the omega_r it gives now."""
+def _certified_rule(cart: Any = None) -> CertifiedRule:
+    """The certified design's rule as designs.py writes it, and the omega_r it gives now on the cart."""
     import re
 
     from wmr_mj.sim import designs
@@ -314,7 +313,8 @@ def _certified_rule() -> CertifiedRule:
     rule = re.sub(r":\w+:`([^`]*)`", r"\1", rule).replace("``", "")
     return CertifiedRule(text=" ".join(rule.split()), error_spec=designs.ERROR_SPEC,
                          omega_r_grid_step=designs.OMEGA_R_GRID[1] - designs.OMEGA_R_GRID[0],
-                         omega_r_rule=designs.certified_omega_r(), omega_r_design=CERTIFIED.kd)
+                         omega_r_rule=designs.certified_omega_r(cart=cart),
+                         omega_r_design=designs.certified_design(cart).kd)
 
 
 def run_validate(settings: ValidateSettings, out_dir: str | os.PathLike, *, log: bool = True,
@@ -347,7 +347,8 @@ def run_validate(settings: ValidateSettings, out_dir: str | os.PathLike, *, log:
     st.start("report", "summary.json, summary.csv, index.md, index.html")
     summary = ValidateSummary(
         folder=str(folder), created=time.strftime("%Y-%m-%d %H:%M:%S %z"), settings=settings.as_dict(),
-        seed=settings.seed, ladder=tuple(rungs), certified_rule=_certified_rule(), searches=tuple(searches),
+        seed=settings.seed, ladder=tuple(rungs), certified_rule=_certified_rule(settings.cart),
+        searches=tuple(searches),
         nominal={name: _nominal_summary(run) for name, run in nominal.items()}, friction=friction,
         identification=identification, paper_example=fig7, figures=figures,
         correction_rung=corrected, path=_path_summary(settings), designs=tuple(designs),

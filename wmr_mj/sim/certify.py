@@ -180,6 +180,9 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
         The controller's claim (``SteeringController.claim``: the section-4 certificate for the
         computed-torque and PD laws) with the run's inputs recorded; None where the law states none.
     """
+    from wmr_mj.sim.config import base_for
+
+    params = base_for(config, params)  # the config's cart, where it names one
     estimate_params = estimate_parameters(params)
     return certificate_of(config, reference, base=params, estimate=estimate_params,
                           plant=plant_parameters(config, params), controller=controller_for(config, estimate_params),

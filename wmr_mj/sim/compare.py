@@ -69,16 +69,22 @@ def design_from_token(token: str, suite: Suite, *, cart: Mapping[str, Any] | Non
         suite: the suite it runs.
         cart: RunConfig's sensing, actuation, transmission for this design (``wmr-mj compare --sensing``, ...;
             each overrides the token's own setting of it): its runs and its adversary's run on that cart,
-            but for a scenario that names its own.
+            but for a scenario that names its own; and ``cart`` (``compare --cart``): the cart file, whose box
+            the design declares and on which the certified design's gains are derived.
 
     Raises:
         UnknownNameError, ParameterError: an unknown preset or law, a bad setting (one line each).
     """
-    from wmr_mj.sim.designs import design_changes
+    from wmr_mj.sim.designs import design_changes, on_cart
 
     box = uncertainty_ranges(suite.adversary.uncertainty)
+    on = (cart or {}).get("cart")  # a cart file (compare --cart): its box, the certified gains derived on it
+    if on is not None:
+        from wmr_mj.sim.config import cart_file
+
+        box = dict(cart_file(RunConfig(cart=on)).uncertainty.get(suite.adversary.uncertainty, box))
     m1_range = box.pop("m1")
-    changes = {**design_changes(token), **(cart or {})}
+    changes = {**on_cart(design_changes(token), on), **(cart or {})}
     config = RunConfig(**changes, m1_range=m1_range, box_ranges=box, duration=suite.duration)
     from wmr_mj.sim.parts import resolve_run
 

@@ -26,7 +26,18 @@ from controllers.computed_torque import CONTROLLER_NAMES, FRICTION_SIGNS, MODEL_
 from wmr_mj._util.checks import as_pair
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.hardware.cart import CART_PARTS, cart_dict
-from wmr_mj.params import C80, M1_NOMINAL, M1_RANGE, PAPER_KD, PAPER_KP, C80Parameters, parameter_names, with_params
+from wmr_mj.params import (
+    C80,
+    C80_CART,
+    M1_NOMINAL,
+    M1_RANGE,
+    PAPER_KD,
+    PAPER_KP,
+    C80Parameters,
+    parameter_names,
+    parameters_of_cart,
+    with_params,
+)
 from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS, TIMESTEP, TYRE_CONTACT_MODELS
 
 __all__ = [
@@ -50,6 +61,8 @@ __all__ = [
     "analysis_box",
     "analysis_for",
     "reference_bounds_of",
+    "base_for",
+    "cart_file",
 ]
 
 PATH_NAMES = ("paper-circle", "lane-change", "figure-eight")
@@ -68,7 +81,8 @@ class RunConfig:
     # once (SteeringController.default_model: 'paper' for computed-torque, pd and a plug-in that names none,
     # 'nonholonomic' for sliding-mode and adaptive-computed-torque)
     model: str | None = None
-    m1: float = M1_NOMINAL  # plant chassis mass, kg
+    # plant chassis mass, kg; None: the cart's nominal m1 (the C80's 650 kg), resolved when the config is checked
+    m1: float = None  # type: ignore[assignment]
     duration: float = 35.0  # s
     control_period: float | None = None  # s; None: every physics step
     kp: float = PAPER_KP
@@ -83,7 +97,8 @@ class RunConfig:
     identified: Any = None  # path or mapping from `wmr-mj identify` for model='identified'
     coefficients: Mapping[str, float] | None = None  # for model='explicit'
     box: str = "derived"  # 'derived' from the parameter set over m1_range, or 'paper' (5.1)
-    m1_range: tuple[float, float] = M1_RANGE
+    # m1 range of the analysis box, kg; None: the cart's m1 box (the C80's 550-750 kg, (5.1)), resolved likewise
+    m1_range: tuple[float, float] = None  # type: ignore[assignment]
     box_ranges: Mapping[str, tuple[float, float]] = field(default_factory=dict)  # other ranged parameters
     seed: int = 0  # recorded; a single run draws nothing at random
     steering_friction: str = "stiction"  # plant's steering friction law: one of STEERING_FRICTION_MODELS
@@ -109,6 +124,11 @@ class RunConfig:
     sensing: Any = None
     actuation: Any = None
     transmission: Any = None
+    # the cart the run is on (wmr_mj.carts): a shipped cart's name, a .toml cart file, a CartFile, or the record
+    # as_dict writes ({"name", "version", "path", "text"}); it gives the base parameter set (geometry, masses,
+    # motor, supply, stops), the m1 box and the default sensing, actuation and play. None, or a cart whose
+    # numbers are the C80's: the C80 (as_dict then has no "cart" key). Kept as that record (the file's text).
+    cart: Any = None
     # the plug-ins found once (kind -> PluginSource, kind + "_class" -> the class): imported and hashed when the
     # config is checked or first asked, never again for as_dict, controller_name or the run's build
     _plugins: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
@@ -119,6 +139,7 @@ class RunConfig:
         return state
 
     def __post_init__(self) -> None:
+        _check_cart(self)
         _check_plugin(self, "controller")
         _check_plugin(self, "tracker")
         if self.model is None:
@@ -185,6 +206,8 @@ class RunConfig:
         for name in CART_PARTS:  # likewise: only the parts of the cart that are not ideal
             del d[name]
         d.update(cart_dict(self))
+        if self.cart is None:
+            del d["cart"]  # likewise: a C80 run's record as it always was
         if self.reference_bounds is None:
             del d["reference_bounds"]  # likewise
         else:
@@ -200,6 +223,75 @@ class RunConfig:
         return dataclasses.replace(self, **changes)
 
 
+def _check_cart(config: RunConfig) -> None:
+    """The config's cart as its record (None for the C80), and m1 and m1_range where not given: the cart's.
+
+    Raises:
+        ParameterError: a missing file, an unknown name, a file its schema or rules refuse (one line).
+    """
+    from wmr_mj.carts import CartFile, load_cart
+
+    given = config.cart
+    cart: CartFile | None
+    if given is None:
+        cart = None
+    elif isinstance(given, CartFile):
+        cart = given
+    elif isinstance(given, Mapping):
+        if not isinstance(given.get("text"), str):
+            raise ParameterError(f"cart = {dict(given)!r} is not accepted: a cart record holds the file's 'text'")
+        cart = _cart_of_text(given["text"], str(given.get("path", "<text>")))
+    elif isinstance(given, (str, os.PathLike)):
+        cart = load_cart(given)
+    else:
+        raise ParameterError(f"cart = {given!r} is not accepted: a shipped cart's name, a .toml cart file or a "
+                             "wmr_mj.carts.CartFile")
+    if cart is not None and _numbers_of(cart) == _numbers_of(C80_CART):
+        cart = None  # the C80's numbers: the C80, and its record unchanged
+    if cart is not None:
+        parameters_of_cart(cart)  # a value the parameter set refuses: one line now
+    record = None if cart is None else {"name": cart.name, "version": cart.version, "path": str(cart.path),
+                                        "text": cart.text}
+    object.__setattr__(config, "cart", record)
+    if config.m1 is None:
+        object.__setattr__(config, "m1", M1_NOMINAL if cart is None else cart.parameters["m1"])
+    if config.m1_range is None:
+        object.__setattr__(config, "m1_range", M1_RANGE if cart is None else cart.uncertainty["m1"]["m1"])
+
+
+def _numbers_of(cart: Any) -> tuple[dict, dict, dict]:
+    """What a run reads of a cart: its parameters, its boxes and its defaults."""
+    return (dict(cart.parameters), {k: dict(v) for k, v in cart.uncertainty.items()}, dict(cart.defaults))
+
+
+@functools.lru_cache(maxsize=8)
+def _cart_of_text(text: str, path: str):
+    from wmr_mj.carts import load_cart_text
+
+    return load_cart_text(text, path=path)
+
+
+def cart_file(config: RunConfig):
+    """The config's cart (:class:`wmr_mj.carts.CartFile`), read from its record; None for the C80."""
+    if config.cart is None:
+        return None
+    return _cart_of_text(config.cart["text"], config.cart["path"])
+
+
+def base_for(config: RunConfig, base: C80Parameters = C80) -> C80Parameters:
+    """The base parameter set of a run: the config's cart's where ``base`` is the default (the C80) and the
+    config names a cart; else ``base``."""
+    cart = cart_file(config)
+    if cart is None or base is not C80:
+        return base
+    return _parameters_of_text(config.cart["text"], config.cart["path"])
+
+
+@functools.lru_cache(maxsize=8)
+def _parameters_of_text(text: str, path: str) -> C80Parameters:
+    return parameters_of_cart(_cart_of_text(text, path))
+
+
 def _check_hardware(config: RunConfig) -> None:
     """The config's sensing, actuation and transmission as their typed parts (:mod:`wmr_mj.hardware`; None:
     ideal), each delay checked against the grid it runs on: the sensing's against the control period, the
@@ -210,8 +302,12 @@ def _check_hardware(config: RunConfig) -> None:
     """
     from wmr_mj.hardware import Actuation, Sensing, Transmission, check_cart, is_ideal_cart
 
+    cart = cart_file(config)
     for name, cls in (("sensing", Sensing), ("actuation", Actuation), ("transmission", Transmission)):
         given = getattr(config, name)
+        if given is None and cart is not None:  # the cart's default sensing, actuation and play
+            default = cart.defaults["backlash" if name == "transmission" else name]
+            given = Transmission(backlash=default) if name == "transmission" else default
         object.__setattr__(config, name, given if isinstance(given, cls) else cls.from_spec(given))
     config.sensing.delay_steps(TIMESTEP if config.control_period is None else config.control_period)
     config.actuation.delay_steps(TIMESTEP)
@@ -370,7 +466,9 @@ def _check_period_fits(control_period: float | None, duration: float) -> None:
 
 
 def plant_parameters(config: RunConfig, base: C80Parameters = C80) -> C80Parameters:
-    """The plant's parameter set: base with m1 and the overrides (mass and inertia consistent)."""
+    """The plant's parameter set: base (the config's cart's where it is the C80, :func:`base_for`) with m1 and the
+    overrides (mass and inertia consistent)."""
+    base = base_for(config, base)
     return with_params(base, m1_inertia=config.m1_inertia, m1=config.m1, **dict(config.plant_overrides))
 
 
@@ -614,7 +712,7 @@ def config_from_dict(obj: Mapping[str, Any]) -> RunConfig:
             or module is gone, or whose source has changed since the record was written (its SHA-256).
     """
     d = dict(obj)
-    d["m1_range"] = tuple(d["m1_range"])
+    d["m1_range"] = tuple(d["m1_range"])  # a record always holds m1 and m1_range, the cart's where not given
     d["box_ranges"] = {k: tuple(v) for k, v in d.get("box_ranges", {}).items()}
     for kind in ("controller", "tracker"):
         record = d.pop(f"{kind}_plugin", None)

@@ -39,6 +39,8 @@ Usage::
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 from dataclasses import dataclass
 from typing import Any, Protocol
 
@@ -56,6 +58,8 @@ __all__ = [
     "ERROR_SPEC",
     "OMEGA_R_GRID",
     "certified_omega_r",
+    "certified_design",
+    "on_cart",
     "preset",
 ]
 
@@ -120,25 +124,81 @@ CORRECTION_RUNG = Design(name="correction", label="+ Cartesian correction", mode
                          friction_width=CERTIFIED.friction_width, correction=True)
 
 
-def preset(name: str) -> Design:
-    """The design called ``name``; unknown names raise UnknownNameError listing the valid ones."""
+def preset(name: str, *, cart: Any = None) -> Design:
+    """The design called ``name``; unknown names raise UnknownNameError listing the valid ones.
+
+    cart: the cart the design is for (anything ``RunConfig(cart=...)`` takes; None: the C80). The paper's
+    design is the paper's gains on any cart; the certified design is derived for the cart by its rule
+    (:func:`certified_design`), never copied from the C80's.
+
+    Raises:
+        UnknownNameError: an unknown name.
+        ParameterError: no omega_r of the rule's grid is certified on the cart.
+    """
     if name not in PRESETS:
         raise UnknownNameError("preset", name, PRESET_NAMES)
+    if name == "certified" and cart is not None:
+        return certified_design(cart)
     return PRESETS[name]
 
 
-def certified_omega_r(*, error_spec: float = ERROR_SPEC, grid: tuple[float, ...] = OMEGA_R_GRID) -> float | None:
-    """The rule of the certified design: the smallest omega_r of ``grid`` whose certificate
-    (non-holonomic model, smoothed sign, paper circle, m1 over 550-750 kg) is valid with
-    E_max <= error_spec. None when no grid point qualifies. No simulation is run."""
-    from wmr_mj.params import C80
-    from wmr_mj.sim.certify import certificate_for
-    from wmr_mj.sim.config import RunConfig, build_reference
+def _cart_record(cart: Any) -> dict[str, Any] | None:
+    """The cart's record as RunConfig keeps it (None: the C80)."""
+    from wmr_mj.sim.config import RunConfig
 
-    reference, _ = build_reference("paper-circle", C80, dt=1e-3, duration=35.0)
+    return RunConfig(cart=cart).cart
+
+
+def certified_design(cart: Any = None) -> Design:
+    """The certified design on ``cart`` (None: the C80, :data:`CERTIFIED`): the rule run on the cart.
+
+    Raises:
+        ParameterError: no omega_r of :data:`OMEGA_R_GRID` gives a valid certificate within
+            :data:`ERROR_SPEC` on the cart (one line naming the cart).
+    """
+    record = _cart_record(cart)
+    if record is None:
+        return CERTIFIED
+    return _certified_on(record["text"], record["path"])
+
+
+@functools.lru_cache(maxsize=8)
+def _certified_on(text: str, path: str) -> Design:
+    record = {"text": text, "path": path}
+    w = certified_omega_r(cart=record)
+    if w is None:
+        raise ParameterError(f"cart file {path!r}: the certified design's rule finds no omega_r in "
+                             f"{OMEGA_R_GRID[0]:g}-{OMEGA_R_GRID[-1]:g} rad/s whose certificate is valid with "
+                             f"E_max <= {ERROR_SPEC:g} rad on this cart; give the gains with --kp/--kd or --omega-r")
+    return dataclasses.replace(CERTIFIED, kp=w * w / 4.0, kd=w)
+
+
+def on_cart(changes: dict[str, Any], cart: Any) -> dict[str, Any]:
+    """A design's RunConfig fields (``Design.config_changes``) on ``cart``: where they carry the certified design's
+    gains (:data:`CERTIFIED`'s K_P and K_D: the certified preset, the ladder's gains rung, the correction rung), the
+    gains the rule gives on the cart (:func:`certified_design`); the rest as given. None: the C80, unchanged."""
+    if cart is None or (changes.get("kp"), changes.get("kd")) != (CERTIFIED.kp, CERTIFIED.kd):
+        return changes
+    derived = certified_design(cart)
+    return {**changes, "kp": derived.kp, "kd": derived.kd}
+
+
+def certified_omega_r(*, error_spec: float = ERROR_SPEC, grid: tuple[float, ...] = OMEGA_R_GRID,
+                      cart: Any = None) -> float | None:
+    """The rule of the certified design: the smallest omega_r of ``grid`` whose certificate
+    (non-holonomic model, smoothed sign, paper circle, m1 over the cart's m1 box: 550-750 kg on the C80)
+    is valid with E_max <= error_spec. None when no grid point qualifies. No simulation is run.
+
+    cart: the cart (anything ``RunConfig(cart=...)`` takes; None: the C80): its parameter set, its m1 box, its
+    stops and supply."""
+    from wmr_mj.sim.certify import certificate_for
+    from wmr_mj.sim.config import RunConfig, base_for, build_reference
+
+    on_cart = RunConfig(cart=cart)
+    reference, _ = build_reference("paper-circle", base_for(on_cart), dt=1e-3, duration=35.0)
     for w in grid:
         config = RunConfig(model=CERTIFIED.model, kp=w * w / 4.0, kd=w, friction_sign=CERTIFIED.friction_sign,
-                           friction_width=CERTIFIED.friction_width)
+                           friction_width=CERTIFIED.friction_width, cart=on_cart.cart)
         cert = certificate_for(config, reference)
         if cert is not None and cert.certified and cert.E_max <= error_spec:
             return w

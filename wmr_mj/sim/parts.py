@@ -32,6 +32,7 @@ from wmr_mj.plant.mjcf import TIMESTEP
 from wmr_mj.sim.config import (
     RunConfig,
     analysis_for,
+    base_for,
     build_reference,
     controller_and_settings,
     controller_name,
@@ -134,6 +135,9 @@ class RunParts:
 def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
     """``config`` resolved once into its parts (:class:`RunParts`).
 
+    base: the base parameter set; where it is the default (the C80) and the config names a cart
+    (``RunConfig.cart``), the cart's (:func:`wmr_mj.sim.config.base_for`).
+
     Raises:
         WmrMjError: what the config cannot build (a plug-in, a path too short, a period that does not fit).
     """
@@ -141,6 +145,7 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
     from wmr_mj.sim.certify import certificate_of, measurement_errors_of
     from wmr_mj.sim.engine import plant_options
 
+    base = base_for(config, base)  # the config's cart, where it names one
     plant = plant_parameters(config, base)
     estimate = estimate_parameters(base)
     controller, law_settings = controller_and_settings(config, estimate)

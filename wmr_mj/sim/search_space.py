@@ -236,7 +236,7 @@ def _knot_route(base: RunConfig, values: dict[str, float]) -> str:
     """The canonical route text of the knot path at ``values`` (path.k<i>, path.hold)."""
     from wmr_mj.reference.knots import knot_path
     from wmr_mj.reference.route import route_from_path
-    from wmr_mj.sim.config import estimate_parameters
+    from wmr_mj.sim.config import base_for, estimate_parameters
 
     if base.reference_bounds is None:
         raise ParameterError("searching C's path (path.k<i>, path.hold) needs declared reference bounds, for which "
@@ -245,5 +245,5 @@ def _knot_route(base: RunConfig, values: dict[str, float]) -> str:
     count = max((int(n[6:]) for n in values if n != "path.hold"), default=0)
     curvatures = [values.get(f"path.k{i + 1}", 0.0) for i in range(count)]
     path = knot_path(curvatures, hold_s=values.get("path.hold", DEFAULT_HOLD_S), bounds=base.reference_bounds,
-                     params=estimate_parameters(), duration=base.duration)
+                     params=estimate_parameters(base_for(base)), duration=base.duration)  # the cart's l1 and stops
     return route_from_path(path, name="knots").text

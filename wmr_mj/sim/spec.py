@@ -40,6 +40,8 @@ class LawChoice:
         identified: ``wmr-mj identify`` output (a path or a mapping) for model 'identified'; None: identify the
             nominal plant now.
         coefficients: the estimate's coefficients for model 'explicit'.
+        cart: the cart the preset is derived for (``RunConfig.cart``; None: the C80): the certified design's
+            rule run on it (:func:`wmr_mj.sim.designs.preset`), the identification done on it.
     """
 
     preset: str | None = None
@@ -53,6 +55,7 @@ class LawChoice:
     friction_width: float | None = None
     identified: Any = None
     coefficients: Mapping[str, float] | None = None
+    cart: Any = None
 
     def given(self) -> dict[str, tuple[str, ...]]:
         """The law options given explicitly (:data:`LAW_OPTIONS`' keys) and the fields each sets."""
@@ -72,7 +75,7 @@ def law_fields(choice: LawChoice) -> dict[str, Any]:
     from controllers import gains_from_omega_r
     from wmr_mj.sim.designs import preset
 
-    design = preset("paper" if choice.preset is None else choice.preset)
+    design = preset("paper" if choice.preset is None else choice.preset, cart=choice.cart)
     if choice.omega_r is not None and (choice.kp is not None or choice.kd is not None):
         raise ParameterError("give either --omega-r or --kp/--kd, not both")
     if choice.omega_r is not None:
@@ -90,10 +93,10 @@ def law_fields(choice: LawChoice) -> dict[str, Any]:
         raise ParameterError(f"--friction-width {friction_width} must be finite and >= 0 (rad/s)")
     identified = choice.identified
     if model == "identified" and identified is None:
-        from wmr_mj.params import C80
         from wmr_mj.plant.identify import identify_plant
+        from wmr_mj.sim.config import RunConfig, base_for
 
-        identified = identify_plant(C80, duration=30.0, seed=0).as_dict()
+        identified = identify_plant(base_for(RunConfig(cart=choice.cart)), duration=30.0, seed=0).as_dict()
     settings: dict[str, Any] = {"model": model, "kp": kp, "kd": kd, "friction_sign": friction_sign,
                                 "friction_width": friction_width}
     params = _route_law_options(choice, controller, dict(choice.controller_params), settings, design)
