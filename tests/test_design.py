@@ -142,3 +142,17 @@ def test_objectives_score_the_certificate():
                if a.kind == "checked" and math.isfinite(a.limit) and a.limit > 0 and math.isfinite(a.value)]
     assert score({"p": cert}, "margin") == -min(margins) and min(margins) > 0
     assert score({"p": None}, "E_max") >= PENALTY
+
+
+def test_filtered_cart_searches_tau_f_and_the_period(tmp_path, capsys):
+    """On a filtered velocity estimate the filter's tau_f and the period are the design's too: the run reads both
+    back from the file, and its certificate is the design's, to the bit."""
+    out = tmp_path / "d.json"
+    rc, printed = _run_json(capsys, ["design", "--sensing", "encoder_ticks=4096,velocity=filtered,filter_tau=0.01",
+                                     "--periods", "0.001,0.002", "--budget", "40", "--out", str(out), "--json"])
+    assert rc == 0
+    s = printed["settings"]
+    assert s["control_period"] in (0.001, 0.002) and s["sensing"]["filter_tau"] != 0.01
+    rc, run = _run_json(capsys, ["run", "--design", str(out), "--duration", "35", "--no-log", "--json"])
+    assert run["sensing"]["filter_tau"] == s["sensing"]["filter_tau"]
+    assert run["certificate"]["E_max"] == printed["E_max"]
