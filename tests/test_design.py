@@ -40,6 +40,7 @@ def _run_json(capsys, argv):
 def test_design_certifies_the_12bit_cart_and_run_reads_it_back(designed, capsys):
     rc, out, printed = designed
     assert rc == 0 and printed["certified"] is True
+    assert printed["run"] == f"wmr-mj run --design {out}"  # the default box and path: nothing more to give
     rc, run = _run_json(capsys, ["run", "--design", str(out), "--m1", "750", "--no-log", "--json"])
     # the run's certificate is the one design printed, to the bit (the same function on the same parts)
     assert run["certificate"]["E_max"] == printed["E_max"] == printed["certificates"]["paper-circle"]["E_max"]

@@ -106,7 +106,7 @@ def run(args: argparse.Namespace) -> int:
     wall = time.perf_counter() - t0
     write_design(result, args.out)
     out = design_dict(result)
-    out.update(file=str(args.out), wall_s=wall)
+    out.update(file=str(args.out), wall_s=wall, run=run_line(args))
     if result.certified and args.check > 0:
         out["check"] = check_design(problem, result, args.check)
     if args.json:
@@ -150,4 +150,26 @@ def _print(result: Any, args: argparse.Namespace, out: dict[str, Any], wall: flo
         c = out["check"]
         print(f"check: {c['n']} runs over the box on {c['path']}: "
               + ", ".join(f"{v} {n}" for v, n in c["verdicts"].items()))
-    print(f"wrote {args.out}: wmr-mj run --design {args.out}")
+    print(f"wrote {args.out}: {run_line(args)}")
+
+
+def run_line(args: argparse.Namespace) -> str:
+    """The ``wmr-mj run`` line of the design on its first path: the file, and the box and run options the
+    design was certified for where they are not run's defaults (the file holds the law and the cart only)."""
+    import shlex
+
+    from wmr_mj.params import M1_RANGE
+
+    words = ["wmr-mj", "run", "--design", shlex.quote(str(args.out))]
+    if args.path:
+        words += ["--path", shlex.quote(args.path[0])]
+    if args.uncertainty is not None:
+        words += ["--uncertainty", args.uncertainty]
+    if tuple(args.m1_range) != tuple(M1_RANGE):
+        words += ["--m1-range", *(repr(float(v)) for v in args.m1_range)]
+    words += [w for item in args.range or [] for w in ("--range", shlex.quote(item))]
+    if args.reference_bounds is not None:
+        words += ["--reference-bounds", shlex.quote(args.reference_bounds)]
+    if args.duration != 35.0:
+        words += ["--duration", repr(args.duration)]
+    return " ".join(words)

@@ -89,6 +89,8 @@ class DesignResult:
         certificates: per path, the certificate ``run`` computes for the design (from ``resolve_run``).
         binding: where nothing certified: the assumption (or reason) unmet at the best point found; '' else.
         evaluations: certificate evaluations spent.
+        box: what the certificates were computed for besides the design (m1_range, box_ranges, box,
+            reference_bounds, duration): the run options a run needs to compute the same certificate.
         objective, seed, periods, paths: the search's.
     """
 
@@ -102,6 +104,7 @@ class DesignResult:
     seed: int = 0
     periods: tuple[float, ...] = ()
     paths: tuple[str, ...] = ()
+    box: Mapping[str, Any] | None = None
 
     @property
     def E_max(self) -> float:
@@ -270,7 +273,11 @@ def _finish(problem: DesignProblem, config: Any, found: float, evaluations: int,
     if value != found:  # the search's certificate is the run's: a difference is a bug, never rounded away
         raise RuntimeError(f"design: the search scored {found!r} but the run's certificate gives {value!r}")
     settings = {name: getattr(config, name) for name in DESIGN_FIELDS}
-    return DesignResult(settings=settings, certified=value < PENALTY, score=value, certificates=certificates,
+    bounds = config.reference_bounds
+    box = {"m1_range": list(config.m1_range), "box_ranges": {k: list(v) for k, v in config.box_ranges.items()},
+           "box": config.box, "reference_bounds": None if bounds is None else bounds.as_dict(),
+           "duration": config.duration}
+    return DesignResult(box=box, settings=settings, certified=value < PENALTY, score=value, certificates=certificates,
                         binding=binding_of(certificates), evaluations=evaluations, objective=problem.objective,
                         seed=problem.seed, periods=periods, paths=problem.paths)
 
@@ -296,7 +303,7 @@ def design_dict(result: DesignResult) -> dict[str, Any]:
     return {"format": FORMAT, "version": 1, "settings": settings, "certified": result.certified,
             "E_max": result.E_max if math.isfinite(result.E_max) else None, "binding": result.binding,
             "certificates": {p: _certificate_dict(c) for p, c in result.certificates.items()},
-            "search": {"objective": result.objective, "score": result.score, "seed": result.seed,
+            "box": result.box, "search": {"objective": result.objective, "score": result.score, "seed": result.seed,
                        "periods": list(result.periods), "paths": list(result.paths),
                        "evaluations": result.evaluations}}
 
