@@ -84,14 +84,15 @@ def test_design_beats_or_equals_the_certified_preset_on_the_cart(designed):
     assert printed["E_max"] <= preset.E_max
 
 
-def test_same_seed_same_design(tmp_path):
+@pytest.mark.parametrize("method", ["cma", "de"])
+def test_same_seed_same_design(method):
     from wmr_mj.hardware import Sensing
     from wmr_mj.sim.config import RunConfig
     from wmr_mj.sim.design_search import DesignProblem, search_design
     from wmr_mj.sim.designs import CERTIFIED
 
     problem = DesignProblem(base=RunConfig(**CERTIFIED.config_changes(), sensing=Sensing.from_spec(CART)),
-                            budget=40, seed=3)
+                            budget=40, seed=3, method=method)
     a, b = search_design(problem), search_design(problem)
     assert a.settings == b.settings and a.score == b.score
 

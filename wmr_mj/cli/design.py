@@ -12,12 +12,13 @@ from wmr_mj.cli.options import add_json, positive_int
 def register(sub: argparse._SubParsersAction) -> None:
     from wmr_mj.cli.run import add_hardware_options
     from wmr_mj.params import M1_RANGE
-    from wmr_mj.sim.design_search import OBJECTIVES
+    from wmr_mj.sim.design_search import METHODS, OBJECTIVES
 
     p = sub.add_parser(
         "design", help="the computed-torque gains, sign width, filter and period a given cart certifies",
-        description="A seeded search (scipy's differential evolution) over omega_n and zeta (K_P = omega_n^2, "
-                    "K_D = 2 zeta omega_n), the Coulomb sign's smoothing width, the velocity filter's tau_f "
+        description="A seeded search (CMA-ES or scipy's differential evolution) over omega_n and zeta "
+                    "(K_P = omega_n^2, K_D = 2 zeta omega_n), the Coulomb sign's smoothing width, the velocity "
+                    "filter's tau_f "
                     "(where --sensing has velocity=filtered) and the control period (--periods), minimising the "
                     "certificate a run computes (the worst over --path) subject to every one of its assumptions "
                     "over the plant box. Writes a design file that `wmr-mj run --design FILE` (and sweep, falsify, "
@@ -40,6 +41,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--objective", default="E_max",
                    help=f"what is minimised: one of {', '.join(OBJECTIVES)} (the worst certified E_max, the worst "
                         "certified voltage, minus the smallest relative margin of the checked assumptions)")
+    p.add_argument("--method", default="cma", choices=METHODS,
+                   help="the optimiser: cma (CMA-ES, the default: the better of the two in bench/bench_design.py) "
+                        "or de (scipy's differential evolution)")
     p.add_argument("--seed", type=int, default=0, help="the optimiser's seed (same seed, same design; default 0)")
     p.add_argument("--budget", type=positive_int, default=600,
                    help="certificate evaluations per period and path, about (default 600)")
@@ -88,7 +92,8 @@ def problem_from_args(args: argparse.Namespace) -> Any:
         raise ParameterError(f"{measurement.why_not}: no certificate can cover it (--sensing, --actuation, "
                              "--backlash); a bounded error is accepted")
     return DesignProblem(base=base, paths=tuple(args.path or ("paper-circle",)), periods=periods,
-                         objective=args.objective, seed=args.seed, budget=args.budget)
+                         objective=args.objective, method=args.method, seed=args.seed,
+                         budget=args.budget)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -139,7 +144,8 @@ def _print(result: Any, args: argparse.Namespace, out: dict[str, Any], wall: flo
               f"{paths}; {result.evaluations} certificates in {wall:.1f} s)")
         return
     tau = s["sensing"].filter_tau
-    print(f"design ({result.objective}, seed {result.seed}, {result.evaluations} certificates in {wall:.1f} s): "
+    print(f"design ({result.objective}, {args.method}, seed {result.seed}, {result.evaluations} certificates in "
+          f"{wall:.1f} s): "
           f"K_P = {s['kp']:.6g} 1/s^2, K_D = {s['kd']:.6g} 1/s (omega_n {math.sqrt(s['kp']):.4g} rad/s, zeta "
           f"{s['kd'] / (2 * math.sqrt(s['kp'])):.3g}), sign width {s['friction_width']:.4g} rad/s, period "
           f"{s['control_period'] * 1e3:g} ms" + (f", tau_f {tau * 1e3:.4g} ms" if tau is not None else ""))
