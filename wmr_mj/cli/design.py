@@ -6,7 +6,7 @@ import argparse
 import math
 from typing import Any
 
-from wmr_mj.cli.options import add_json, positive_int
+from wmr_mj.cli.options import add_json, positive_float, positive_int
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -34,7 +34,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--range", action="append", metavar="NAME=LO:HI", help="another ranged parameter of the box")
     p.add_argument("--reference-bounds", metavar="paper|KEY=VALUE,...", default=None,
                    help="declared reference bounds the certificates cover (default: each path's own)")
-    p.add_argument("--duration", type=float, default=35.0, help="the run's length, s (default 35, run's)")
+    p.add_argument("--duration", type=positive_float, default=35.0, help="the run's length, s (default 35, run's)")
     p.add_argument("--periods", default="0.001", metavar="T1,T2,...",
                    help="control periods to try, s, each a whole number of 1 ms physics steps dividing the run "
                         "(default 0.001)")
