@@ -60,6 +60,8 @@ def config_from_args(args: argparse.Namespace, **extra):
     from wmr_mj.sim.config import RunConfig
     from wmr_mj.sim.spec import LawChoice, law_fields
 
+    if getattr(args, "design", None) is not None:
+        args = with_design_file(args)
     tracker = getattr(args, "tracker", None)
     if bool(getattr(args, "correction", False)) and tracker not in (None, "stanley-at-C"):
         raise ParameterError(f"--correction is the tracker stanley-at-C; give it or --tracker {tracker}, not both")
@@ -90,6 +92,29 @@ def config_from_args(args: argparse.Namespace, **extra):
                        reference_bounds=getattr(args, "reference_bounds", None), **hardware_from_args(args), **extra)
     args.m1_range = config.m1_range  # --m1-range not given: the cart's m1 box, which the commands read from args
     return config
+
+
+def with_design_file(args: argparse.Namespace) -> argparse.Namespace:
+    """``args`` with each option that --design FILE sets and was not given taken from the file
+    (:func:`wmr_mj.sim.design_search.design_file_settings`), as a preset's are; --omega-r keeps the file's gains
+    out.
+
+    Raises:
+        ParameterError: --design with --preset, a file that is not a design file.
+    """
+    from wmr_mj.errors import ParameterError
+    from wmr_mj.sim.design_search import design_file_settings
+
+    if args.preset is not None:
+        raise ParameterError("give --design FILE or --preset, not both (a design file is a preset of its own)")
+    settings = design_file_settings(args.design)
+    if args.omega_r is not None:
+        settings.pop("kp"), settings.pop("kd")
+    merged = argparse.Namespace(**vars(args))
+    for name, value in settings.items():
+        if getattr(merged, name, None) is None:
+            setattr(merged, name, value)
+    return merged
 
 
 def register(sub: argparse._SubParsersAction) -> None:

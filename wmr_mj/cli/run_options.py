@@ -162,6 +162,10 @@ def _law_rows() -> tuple[RunOption, ...]:
     return (
         R(flag="--preset", group="run", sets="", settings=dict(default=None), help=_preset_help,
           write=_if(lambda c, r: r.preset is not None, lambda c, r: ["--preset", str(r.preset)])),
+        # its settings are written by their own rows (the law's, --control-period, the cart's): read, never written
+        R(flag="--design", group="run", sets="", settings=dict(default=None, metavar="FILE"),
+          help="a design file written by `wmr-mj design --out FILE`: its law, gains, control period and cart "
+               "(sensing, actuation, backlash) merged like a preset; explicit options override it"),
         R(flag="--controller", group="run", sets="controller",
           settings=dict(default=None, metavar="NAME|FILE.py:Class|module:Class"), help=_controller_help,
           write=lambda c, r: ["--controller", shlex.quote(str(c.controller))]),

@@ -1,0 +1,78 @@
+"""``wmr-mj design``'s cost: one certificate evaluation, and a whole design.
+
+    .venv/bin/python bench/bench_design.py [--sensing magnetic-12bit-axis] [--repeats 50] [--budget 600]
+                                           [--designs 1] [--seeds 2]
+
+Printed:
+
+  evaluation: the median wall time (and the quartiles) of one point's score as the search computes it
+              (``wmr_mj.sim.design_search._Scorer``: the law built from the point's gains and
+              ``wmr_mj.sim.certify.certificate_of`` on the parts ``resolve_run`` gave once), over ``--repeats``
+              points drawn uniformly in the search space (seeded);
+  design:     for each optimiser (:data:`wmr_mj.sim.design_search.METHODS`) and seed (0 .. ``--seeds`` - 1),
+              the median wall time of ``search_design`` (the paper circle, the 1 ms period, ``--budget``
+              points) over ``--designs`` repeats, with its certified E_max (the same every repeat: the search
+              is seeded): which optimiser finds the smaller certificate at the same budget.
+
+The machine may be shared: the quartiles say how much the load blurs the medians.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import statistics
+import time
+
+
+def main() -> None:
+    import dataclasses
+
+    import numpy as np
+
+    from wmr_mj.hardware import Sensing
+    from wmr_mj.sim.config import RunConfig
+    from wmr_mj.sim.design_search import METHODS, DesignProblem, _Scorer, search_design
+    from wmr_mj.sim.designs import CERTIFIED
+
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--sensing", default="magnetic-12bit-axis")
+    ap.add_argument("--repeats", type=int, default=50)
+    ap.add_argument("--budget", type=int, default=600)
+    ap.add_argument("--designs", type=int, default=1)
+    ap.add_argument("--seeds", type=int, default=2)
+    args = ap.parse_args()
+
+    base = RunConfig(**CERTIFIED.config_changes(), sensing=Sensing.from_spec(args.sensing))
+    problem = DesignProblem(base=base, budget=args.budget)
+    scorer = _Scorer(problem, 0.001)
+    rng = np.random.default_rng(0)
+    lows = [math.log(problem.omega_n[0]), problem.zeta[0], math.log10(problem.width[0])]
+    highs = [math.log(problem.omega_n[1]), problem.zeta[1], math.log10(problem.width[1])]
+    if scorer.filtered:
+        lows.append(math.log(problem.tau_f[0]))
+        highs.append(math.log(problem.tau_f[1]))
+    times = []
+    for _ in range(args.repeats):
+        x = rng.uniform(lows, highs)
+        t0 = time.perf_counter()
+        scorer(x)
+        times.append(time.perf_counter() - t0)
+    q1, med, q3 = statistics.quantiles(times, n=4)
+    print(f"evaluation ({args.sensing}, {args.repeats} points): median {med * 1e3:.1f} ms "
+          f"(quartiles {q1 * 1e3:.1f}-{q3 * 1e3:.1f} ms)")
+    for method in METHODS:
+        for seed in range(args.seeds):
+            walls, e_max, evaluations = [], math.nan, 0
+            for _ in range(args.designs):
+                t0 = time.perf_counter()
+                result = search_design(dataclasses.replace(problem, method=method, seed=seed))
+                walls.append(time.perf_counter() - t0)
+                e_max, evaluations = result.E_max, result.evaluations
+            print(f"design {method} seed {seed} (budget {args.budget}, {evaluations} evaluations, {args.designs} "
+                  f"repeats): median {statistics.median(walls):.1f} s (min {min(walls):.1f}, max "
+                  f"{max(walls):.1f}); certified E_max {e_max:.6g} rad")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,181 @@
+"""``wmr-mj design``: the computed-torque gains a given cart can certify (:mod:`wmr_mj.sim.design_search`)."""
+
+from __future__ import annotations
+
+import argparse
+import math
+from typing import Any
+
+from wmr_mj.cli.options import add_json, positive_float, positive_int
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    from wmr_mj.cli.run import add_hardware_options
+    from wmr_mj.params import M1_RANGE
+    from wmr_mj.sim.design_search import METHODS, OBJECTIVES
+
+    p = sub.add_parser(
+        "design", help="the computed-torque gains, sign width, filter and period a given cart certifies",
+        description="A seeded search (CMA-ES or scipy's differential evolution) over omega_n and zeta "
+                    "(K_P = omega_n^2, K_D = 2 zeta omega_n), the Coulomb sign's smoothing width, the velocity "
+                    "filter's tau_f "
+                    "(where --sensing has velocity=filtered) and the control period (--periods), minimising the "
+                    "certificate a run computes (the worst over --path) subject to every one of its assumptions "
+                    "over the plant box. Writes a design file that `wmr-mj run --design FILE` (and sweep, falsify, "
+                    "robustness --certificate) read back as the same design.",
+        epilog="exit status: 0 a certified design found; 1 none certifies (the binding assumption is named); "
+               "2 bad input")
+    add_hardware_options(p)
+    p.add_argument("--path", action="append", metavar="NAME|FILE",
+                   help="a path every certificate must hold on (repeatable; default paper-circle)")
+    p.add_argument("--uncertainty", default=None, help="the plant box: m1 (default) or full (wmr_mj/params.py)")
+    p.add_argument("--m1-range", nargs=2, type=float, metavar=("LO", "HI"), default=M1_RANGE,
+                   help="m1 range of the box, kg (default 550 750)")
+    p.add_argument("--range", action="append", metavar="NAME=LO:HI", help="another ranged parameter of the box")
+    p.add_argument("--reference-bounds", metavar="paper|KEY=VALUE,...", default=None,
+                   help="declared reference bounds the certificates cover (default: each path's own)")
+    p.add_argument("--duration", type=positive_float, default=35.0, help="the run's length, s (default 35, run's)")
+    p.add_argument("--periods", default="0.001", metavar="T1,T2,...",
+                   help="control periods to try, s, each a whole number of 1 ms physics steps dividing the run "
+                        "(default 0.001)")
+    p.add_argument("--objective", default="E_max",
+                   help=f"what is minimised: one of {', '.join(OBJECTIVES)} (the worst certified E_max, the worst "
+                        "certified voltage, minus the smallest relative margin of the checked assumptions)")
+    p.add_argument("--method", default="cma", choices=METHODS,
+                   help="the optimiser: cma (CMA-ES, the default: the better of the two in bench/bench_design.py) "
+                        "or de (scipy's differential evolution)")
+    p.add_argument("--seed", type=int, default=0, help="the optimiser's seed (same seed, same design; default 0)")
+    p.add_argument("--budget", type=positive_int, default=600,
+                   help="certificate evaluations per period and path, about (default 600)")
+    p.add_argument("--check", type=int, default=0, metavar="N",
+                   help="then sweep N runs over the box at the design and count the verdicts (default 0: none)")
+    p.add_argument("--out", default="design.json", metavar="FILE", help="the design file (default design.json)")
+    add_json(p)
+    p.set_defaults(func=run)
+
+
+def problem_from_args(args: argparse.Namespace) -> Any:
+    """The :class:`~wmr_mj.sim.design_search.DesignProblem` of the options, every input checked first.
+
+    Raises:
+        ParameterError: an empty box, an unknown objective, a period list that is not accepted, a cart no claim
+            covers (one line naming the culprit).
+    """
+    from wmr_mj.cli._common import box_ranges_from_args
+    from wmr_mj.cli.run import hardware_from_args
+    from wmr_mj.errors import ParameterError
+    from wmr_mj.params import C80
+    from wmr_mj.sim.certify import measurement_errors_of
+    from wmr_mj.sim.config import RunConfig
+    from wmr_mj.sim.design_search import OBJECTIVES, DesignProblem, check_periods
+    from wmr_mj.sim.designs import CERTIFIED
+
+    if args.objective not in OBJECTIVES:
+        raise ParameterError(f"--objective {args.objective!r} is not accepted; one of {', '.join(OBJECTIVES)}")
+    lo, hi = (float(v) for v in args.m1_range)
+    if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo <= hi):
+        raise ParameterError(f"--m1-range {lo:g} {hi:g} is an empty box; LO <= HI, both > 0 kg, is accepted")
+    ranges = box_ranges_from_args(args)
+    for name, (a, b) in ranges.items():
+        if not a <= b:
+            raise ParameterError(f"--range {name}={a:g}:{b:g} is an empty box; LO <= HI is accepted")
+    periods_text = [t for t in str(args.periods).split(",") if t.strip()]
+    try:
+        periods = tuple(float(t) for t in periods_text)
+    except ValueError:
+        raise ParameterError(f"--periods {args.periods!r} is not a list of numbers (s), e.g. 0.001,0.002") from None
+    check_periods(periods, args.duration)
+    base = RunConfig(**CERTIFIED.config_changes(), m1_range=(lo, hi), box_ranges=ranges, duration=args.duration,
+                     reference_bounds=args.reference_bounds, **hardware_from_args(args))
+    measurement = measurement_errors_of(base, C80)
+    if not measurement.covered:
+        raise ParameterError(f"{measurement.why_not}: no certificate can cover it (--sensing, --actuation, "
+                             "--backlash); a bounded error is accepted")
+    return DesignProblem(base=base, paths=tuple(args.path or ("paper-circle",)), periods=periods,
+                         objective=args.objective, method=args.method, seed=args.seed,
+                         budget=args.budget)
+
+
+def run(args: argparse.Namespace) -> int:
+    import time
+
+    from wmr_mj.cli._common import print_json
+    from wmr_mj.errors import ParameterError
+    from wmr_mj.sim.design_search import design_dict, search_design, write_design
+
+    if args.check < 0:
+        raise ParameterError(f"--check {args.check} is not accepted; a number of runs >= 0")
+    problem = problem_from_args(args)
+    t0 = time.perf_counter()
+    result = search_design(problem)
+    wall = time.perf_counter() - t0
+    write_design(result, args.out)
+    out = design_dict(result)
+    out.update(file=str(args.out), wall_s=wall, run=run_line(args))
+    if result.certified and args.check > 0:
+        out["check"] = check_design(problem, result, args.check)
+    if args.json:
+        print_json(out)
+    else:
+        _print(result, args, out, wall)
+    return 0 if result.certified else 1
+
+
+def check_design(problem: Any, result: Any, n: int) -> dict[str, Any]:
+    """A sweep of ``n`` runs over the box (m1 and the --range parameters) at the design, on the first path, with
+    the search's seed: its verdict counts."""
+    import dataclasses
+
+    from wmr_mj.sim.design_search import DESIGN_FIELDS
+    from wmr_mj.sim.sweep import SweepSpec, SweepSummary, run_sweep
+
+    base = dataclasses.replace(problem.base, path=problem.paths[0], **{k: result.settings[k] for k in DESIGN_FIELDS})
+    spec = SweepSpec(n=n, seed=problem.seed, sampling="lhs", m1_range=tuple(base.m1_range),
+                     ranges={k: tuple(v) for k, v in base.box_ranges.items()}, base=base)
+    runs = SweepSummary.of(run_sweep(spec), spec.requirements, names=spec.names)
+    return {"n": runs.n, "verdicts": dict(runs.verdicts), "path": base.path}
+
+
+def _print(result: Any, args: argparse.Namespace, out: dict[str, Any], wall: float) -> None:
+    s = result.settings
+    paths = ", ".join(result.paths)
+    if not result.certified:
+        print(f"no gains in the box certify this cart: {result.binding} binds (the best point found, over "
+              f"{paths}; {result.evaluations} certificates in {wall:.1f} s)")
+        return
+    tau = s["sensing"].filter_tau
+    print(f"design ({result.objective}, {args.method}, seed {result.seed}, {result.evaluations} certificates in "
+          f"{wall:.1f} s): "
+          f"K_P = {s['kp']:.6g} 1/s^2, K_D = {s['kd']:.6g} 1/s (omega_n {math.sqrt(s['kp']):.4g} rad/s, zeta "
+          f"{s['kd'] / (2 * math.sqrt(s['kp'])):.3g}), sign width {s['friction_width']:.4g} rad/s, period "
+          f"{s['control_period'] * 1e3:g} ms" + (f", tau_f {tau * 1e3:.4g} ms" if tau is not None else ""))
+    for path, cert in result.certificates.items():
+        print(f"  {path}: certified, E_max {cert.E_max:.6g} rad, voltage {cert.voltage_max:.4g} V "
+              f"({cert.inputs.get('certificate', 'section-4')}; {len(cert.assumptions)} assumptions met)")
+    if "check" in out:
+        c = out["check"]
+        print(f"check: {c['n']} runs over the box on {c['path']}: "
+              + ", ".join(f"{v} {n}" for v, n in c["verdicts"].items()))
+    print(f"wrote {args.out}: {run_line(args)}")
+
+
+def run_line(args: argparse.Namespace) -> str:
+    """The ``wmr-mj run`` line of the design on its first path: the file, and the box and run options the
+    design was certified for where they are not run's defaults (the file holds the law and the cart only)."""
+    import shlex
+
+    from wmr_mj.params import M1_RANGE
+
+    words = ["wmr-mj", "run", "--design", shlex.quote(str(args.out))]
+    if args.path:
+        words += ["--path", shlex.quote(args.path[0])]
+    if args.uncertainty is not None:
+        words += ["--uncertainty", args.uncertainty]
+    if tuple(args.m1_range) != tuple(M1_RANGE):
+        words += ["--m1-range", *(repr(float(v)) for v in args.m1_range)]
+    words += [w for item in args.range or [] for w in ("--range", shlex.quote(item))]
+    if args.reference_bounds is not None:
+        words += ["--reference-bounds", shlex.quote(args.reference_bounds)]
+    if args.duration != 35.0:
+        words += ["--duration", repr(args.duration)]
+    return " ".join(words)

@@ -1,0 +1,386 @@
+"""The gains a given cart can certify: a seeded search over the computed-torque law's parameters whose objective
+is the run's own certificate (``wmr-mj design``).
+
+The search space (for each control period of a given list): the natural frequency omega_n and the damping
+ratio zeta of the error dynamics, K_P = omega_n^2, K_D = 2 zeta omega_n; the Coulomb sign's smoothing width w
+(rad/s); and, where the cart's velocity estimate is ``filtered``, its time constant tau_f (s). The law is the
+certified design's family (computed torque, the non-holonomic model, the measured sign, smoothed).
+
+Each point is scored by :func:`wmr_mj.sim.certify.certificate_of` on the parts a run resolves
+(:func:`wmr_mj.sim.parts.resolve_run`, once per period and path): the certificate of the design is the one
+``wmr-mj run --design FILE`` computes, to the bit, and the found design is checked again through
+``resolve_run`` itself. A point whose certificate is not certified on every path is infeasible: it scores a
+penalty above every feasible point (ranked by how many assumptions it leaves unmet), never a value. The optimiser
+(:data:`METHODS`) is CMA-ES (``cmaes``, seeded) started at the certified preset's point, which it scores first, or
+scipy's differential evolution (seeded, one worker, no gradient polish) with that point in its first population:
+where the point lies in the space the design is never worse than that preset.
+
+Usage::
+
+    from wmr_mj.sim.design_search import DesignProblem, search_design
+    result = search_design(DesignProblem(base=config, paths=("paper-circle",), periods=(0.001,)))
+    result.settings            # {'controller': 'computed-torque', 'kp': ..., 'kd': ..., ...}
+    write_design(result, "design.json"); design_file_settings("design.json")
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import os
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from wmr_mj.errors import ParameterError
+
+__all__ = ["DesignProblem", "DesignResult", "OBJECTIVES", "METHODS", "DESIGN_FIELDS", "search_design",
+           "evaluate_design", "write_design", "read_design", "design_file_settings", "check_periods"]
+
+#: what the search minimises: the worst certified E_max over the paths (rad), the worst certified voltage (V),
+#: or minus the smallest relative margin 1 - value/limit of the certificate's checked assumptions
+OBJECTIVES = ("E_max", "voltage", "margin")
+#: the optimisers: CMA-ES (``cmaes``; the default: at 640 points on the 12-bit cart it found 0.018894 rad on
+#: seeds 0 and 1 where differential evolution found 0.019517 rad, bench/bench_design.py) or scipy's
+#: differential evolution
+METHODS = ("cma", "de")
+#: the RunConfig settings a design file sets (``run --design FILE``), as a preset does
+DESIGN_FIELDS = ("controller", "model", "kp", "kd", "friction_sign", "friction_width", "control_period",
+                 "sensing", "actuation", "transmission")
+#: the file's format tag and version
+FORMAT = "wmr-mj design"
+PENALTY = 1.0e6  # an uncertified point's score: above every feasible one (plus its number of unmet assumptions)
+
+
+@dataclass(frozen=True, kw_only=True)
+class DesignProblem:
+    """What ``wmr-mj design`` searches.
+
+    Attributes:
+        base: the run's configuration: the cart (sensing, actuation, transmission), the plant box (m1_range,
+            box_ranges, box), the duration; the law's fields are the search's.
+        paths: the paths every certificate must hold on (the worst counts).
+        periods: the control periods tried, s (each a whole number of physics steps).
+        objective: one of :data:`OBJECTIVES`.
+        method: one of :data:`METHODS`.
+        seed: the optimiser's seed (same seed, same design).
+        budget: points scored per period, about (each point's certificate on every path): CMA-ES's generations
+            until that many; differential evolution's generations are budget // (popsize * dimensions) - 1, at
+            least 1.
+        omega_n: natural frequency range, rad/s; zeta: damping ratio range; width: the sign's smoothing range,
+            rad/s (searched in log); tau_f: the filter's time constant range, s (searched in log; only where the
+            cart's velocity estimate is filtered).
+    """
+
+    base: Any
+    paths: tuple[str, ...] = ("paper-circle",)
+    periods: tuple[float, ...] = (0.001,)
+    objective: str = "E_max"
+    method: str = "cma"
+    seed: int = 0
+    budget: int = 600
+    omega_n: tuple[float, float] = (2.0, 40.0)
+    zeta: tuple[float, float] = (0.5, 3.0)
+    width: tuple[float, float] = (1.0e-3, 1.0)
+    tau_f: tuple[float, float] = (1.0e-3, 0.2)
+
+
+@dataclass(frozen=True, kw_only=True)
+class DesignResult:
+    """The design found.
+
+    Attributes:
+        settings: the RunConfig fields it sets (:data:`DESIGN_FIELDS`; the cart's parts as objects).
+        certified: every path's certificate is certified.
+        score: the objective at the design (:data:`PENALTY` and above where nothing certified).
+        certificates: per path, the certificate ``run`` computes for the design (from ``resolve_run``).
+        binding: where nothing certified: the assumption (or reason) unmet at the best point found; '' else.
+        evaluations: certificate evaluations spent.
+        box: what the certificates were computed for besides the design (m1_range, box_ranges, box,
+            reference_bounds, duration): the run options a run needs to compute the same certificate.
+        objective, seed, periods, paths: the search's.
+    """
+
+    settings: Mapping[str, Any]
+    certified: bool
+    score: float
+    certificates: Mapping[str, Any]
+    binding: str = ""
+    evaluations: int = 0
+    objective: str = "E_max"
+    seed: int = 0
+    periods: tuple[float, ...] = ()
+    paths: tuple[str, ...] = ()
+    box: Mapping[str, Any] | None = None
+
+    @property
+    def E_max(self) -> float:
+        """The worst E_max over the paths, rad (inf where a certificate has none)."""
+        return max((c.E_max if c is not None and c.valid else math.inf) for c in self.certificates.values())
+
+
+def check_periods(periods: Sequence[float], duration: float) -> tuple[float, ...]:
+    """The period list, each checked: > 0, a whole number of 1 ms physics steps, and a divisor of the run.
+
+    Raises:
+        ParameterError: an empty list or a period that is not accepted (one line naming it).
+    """
+    from wmr_mj.plant.mjcf import TIMESTEP
+
+    out = []
+    for p in periods:
+        p = float(p)
+        steps = p / TIMESTEP
+        if not (math.isfinite(p) and p > 0 and abs(steps - round(steps)) < 1e-9 and round(steps) >= 1):
+            raise ParameterError(f"--periods: {p!r} s is not a whole number of {TIMESTEP:g} s physics steps; "
+                                 "periods such as 0.001,0.002 are accepted")
+        runs = duration / p
+        if abs(runs - round(runs)) > 1e-9 * max(1.0, runs):
+            raise ParameterError(f"--periods: {p!r} s does not divide the run's {duration!r} s; a period that "
+                                 "divides the run and the physics step's multiple is accepted")
+        out.append(p)
+    if not out:
+        raise ParameterError("--periods is empty; one or more periods (s), e.g. 0.001,0.002, are accepted")
+    return tuple(out)
+
+
+def _gains(omega_n: float, zeta: float) -> tuple[float, float]:
+    return omega_n * omega_n, 2.0 * zeta * omega_n
+
+
+class _Scorer:
+    """The certificate of a point on each path, on the parts ``resolve_run`` gives (resolved once per path)."""
+
+    def __init__(self, problem: DesignProblem, period: float):
+        from wmr_mj.sim.parts import resolve_run
+
+        self.problem = problem
+        self.template = dataclasses.replace(problem.base, control_period=period)
+        self.parts = {path: resolve_run(dataclasses.replace(self.template, path=path)) for path in problem.paths}
+        self.filtered = self.template.sensing.velocity == "filtered"
+        self.evaluations = 0
+
+    def config(self, x: Any) -> Any:
+        """The RunConfig of the point x = (log omega_n, zeta, log10 w[, log tau_f]) (a sequence or an array)."""
+        kp, kd = _gains(math.exp(x[0]), float(x[1]))
+        sensing = self.template.sensing
+        if self.filtered:
+            sensing = dataclasses.replace(sensing, filter_tau=math.exp(x[3]))
+        return dataclasses.replace(self.template, kp=kp, kd=kd, friction_width=10.0 ** float(x[2]), sensing=sensing)
+
+    def certificates(self, config: Any) -> dict[str, Any]:
+        from wmr_mj.sim.certify import certificate_of
+        from wmr_mj.sim.config import controller_and_settings
+
+        out = {}
+        for path, parts in self.parts.items():
+            c = dataclasses.replace(config, path=path)
+            controller, _ = controller_and_settings(c, parts.estimate)
+            self.evaluations += 1
+            out[path] = certificate_of(c, parts.reference, base=parts.base, estimate=parts.estimate,
+                                       plant=parts.plant, controller=controller, tracker=parts.tracker)
+        return out
+
+    def __call__(self, x: Any) -> float:
+        return score(self.certificates(self.config(x)), self.problem.objective)
+
+
+def _margin(cert: Any) -> float:
+    """The smallest relative margin 1 - value/limit of the checked assumptions with a finite limit > 0."""
+    margins = [1.0 - a.value / a.limit for a in cert.assumptions
+               if a.kind == "checked" and math.isfinite(a.limit) and a.limit > 0 and math.isfinite(a.value)]
+    return min(margins, default=0.0)
+
+
+def score(certificates: Mapping[str, Any], objective: str) -> float:
+    """The objective over the paths' certificates: the worst one; :data:`PENALTY` plus the unmet assumptions'
+    count where any certificate is missing or not certified."""
+    unmet = 0
+    for cert in certificates.values():
+        if cert is None:
+            unmet += 100
+        elif not cert.certified:
+            unmet += len(cert.unmet) + (0 if cert.valid else 1)
+    if unmet:
+        return PENALTY + unmet
+    certs = list(certificates.values())
+    if objective == "E_max":
+        return max(c.E_max for c in certs)
+    if objective == "voltage":
+        return max(c.voltage_max for c in certs)
+    return -min(_margin(c) for c in certs)
+
+
+def binding_of(certificates: Mapping[str, Any]) -> str:
+    """The first assumption unmet (or the reason there is no bound) over the paths, '' where all certify."""
+    for path, cert in certificates.items():
+        if cert is None:
+            return f"the law states no claim on {path}"
+        if not cert.certified:
+            unmet = cert.unmet
+            return f"the assumption {unmet[0]!r}" if unmet else f"no bound ({cert.reason or 'none derived'})"
+    return ""
+
+
+def _preset_point(scorer: _Scorer, bounds: list[tuple[float, float]]) -> list[float] | None:
+    """The certified preset's point (omega_n 10, zeta 1, w 0.01, the cart's own tau_f) where it is in bounds."""
+    from wmr_mj.sim.designs import CERTIFIED
+
+    omega_n = math.sqrt(CERTIFIED.kp)
+    x = [math.log(omega_n), CERTIFIED.kd / (2.0 * omega_n), math.log10(CERTIFIED.friction_width)]
+    if scorer.filtered:
+        x.append(math.log(scorer.template.sensing.filter_tau))
+    return x if all(lo <= v <= hi for v, (lo, hi) in zip(x, bounds)) else None
+
+
+def search_design(problem: DesignProblem) -> DesignResult:
+    """The design of ``problem`` (:class:`DesignResult`): the best point over the periods, its certificates
+    computed again by ``resolve_run`` (what ``run`` computes for it).
+
+    Raises:
+        ParameterError: an unknown objective or method, a period list that is not accepted.
+    """
+    if problem.objective not in OBJECTIVES:
+        raise ParameterError(f"--objective {problem.objective!r} is not accepted; one of {', '.join(OBJECTIVES)}")
+    if problem.method not in METHODS:
+        raise ParameterError(f"--method {problem.method!r} is not accepted; one of {', '.join(METHODS)}")
+    periods = check_periods(problem.periods, problem.base.duration)
+    best: tuple[float, Any] | None = None
+    evaluations = 0
+    for period in periods:
+        scorer = _Scorer(problem, period)
+        bounds = [(math.log(problem.omega_n[0]), math.log(problem.omega_n[1])), problem.zeta,
+                  (math.log10(problem.width[0]), math.log10(problem.width[1]))]
+        if scorer.filtered:
+            bounds.append((math.log(max(problem.tau_f[0], period)), math.log(problem.tau_f[1])))
+        run = _cma if problem.method == "cma" else _differential_evolution
+        value, x = run(scorer, bounds, problem)
+        evaluations += scorer.evaluations
+        if best is None or value < best[0]:
+            best = (value, scorer.config(x))
+    assert best is not None
+    return _finish(problem, best[1], best[0], evaluations, periods)
+
+
+def _differential_evolution(scorer: _Scorer, bounds: list[tuple[float, float]],
+                            problem: DesignProblem) -> tuple[float, Any]:
+    """scipy's differential evolution (seeded, one worker, no gradient polish), the preset's point in its first
+    population: the best (score, point)."""
+    from scipy.optimize import differential_evolution
+
+    popsize = 10
+    maxiter = max(1, problem.budget // (popsize * len(bounds)) - 1)
+    result = differential_evolution(scorer, bounds, seed=problem.seed, popsize=popsize, maxiter=maxiter,
+                                    polish=False, updating="immediate", workers=1, tol=0.0, init="sobol",
+                                    x0=_preset_point(scorer, bounds))
+    return float(result.fun), result.x
+
+
+def _cma(scorer: _Scorer, bounds: list[tuple[float, float]], problem: DesignProblem) -> tuple[float, Any]:
+    """CMA-ES (``cmaes``, falsify's optimiser: its own seeded generator, bounds kept by resampling), started at
+    the preset's point (scored first) or the box's centre with a step of 0.3 of the narrowest range, ``budget``
+    points: the best (score, point) of every point scored."""
+    import numpy as np
+    from cmaes import CMA
+
+    box = np.array(bounds, dtype=float)
+    x0 = _preset_point(scorer, bounds)
+    mean = np.array(x0) if x0 is not None else box.mean(axis=1)
+    best = (scorer(mean), mean)
+    n = 1
+    opt = CMA(mean=mean, sigma=0.3 * float(np.min(box[:, 1] - box[:, 0])), bounds=box, seed=problem.seed)
+    while n < problem.budget:
+        told = []
+        for _ in range(opt.population_size):
+            x = opt.ask()
+            value = scorer(x)
+            n += 1
+            told.append((x, value))
+            if value < best[0]:
+                best = (value, x)
+        opt.tell(told)
+    return float(best[0]), best[1]
+
+
+def evaluate_design(config: Any, paths: Sequence[str]) -> dict[str, Any]:
+    """Each path's certificate of ``config`` as ``wmr-mj run`` computes it (``resolve_run(...).claim``)."""
+    from wmr_mj.sim.parts import resolve_run
+
+    return {path: resolve_run(dataclasses.replace(config, path=path)).claim for path in paths}
+
+
+def _finish(problem: DesignProblem, config: Any, found: float, evaluations: int,
+            periods: tuple[float, ...]) -> DesignResult:
+    certificates = evaluate_design(config, problem.paths)
+    value = score(certificates, problem.objective)
+    if value != found:  # the search's certificate is the run's: a difference is a bug, never rounded away
+        raise RuntimeError(f"design: the search scored {found!r} but the run's certificate gives {value!r}")
+    settings = {name: getattr(config, name) for name in DESIGN_FIELDS}
+    bounds = config.reference_bounds
+    box = {"m1_range": list(config.m1_range), "box_ranges": {k: list(v) for k, v in config.box_ranges.items()},
+           "box": config.box, "reference_bounds": None if bounds is None else bounds.as_dict(),
+           "duration": config.duration}
+    return DesignResult(box=box, settings=settings, certified=value < PENALTY, score=value, certificates=certificates,
+                        binding=binding_of(certificates), evaluations=evaluations, objective=problem.objective,
+                        seed=problem.seed, periods=periods, paths=problem.paths)
+
+
+def _certificate_dict(cert: Any) -> dict[str, Any] | None:
+    if cert is None:
+        return None
+    inputs = cert.inputs
+    return {"certified": cert.certified, "E_max": cert.E_max if cert.valid else None,
+            "voltage_max": cert.voltage_max if cert.valid else None, "reason": cert.reason,
+            "certificate": inputs.get("certificate", "section-4"),
+            "assumptions": [a.as_dict() for a in cert.assumptions]}
+
+
+def design_dict(result: DesignResult) -> dict[str, Any]:
+    """The design file's content: the settings (the cart's parts as their spec mappings), the certificate of
+    each path, the search."""
+    s = dict(result.settings)
+    settings = {k: s[k] for k in ("controller", "model", "kp", "kd", "friction_sign", "friction_width",
+                                  "control_period")}
+    settings.update(sensing=s["sensing"].as_dict(), actuation=s["actuation"].as_dict(),
+                    backlash=s["transmission"].backlash)
+    return {"format": FORMAT, "version": 1, "settings": settings, "certified": result.certified,
+            "E_max": result.E_max if math.isfinite(result.E_max) else None, "binding": result.binding,
+            "certificates": {p: _certificate_dict(c) for p, c in result.certificates.items()},
+            "box": result.box, "search": {"objective": result.objective, "score": result.score, "seed": result.seed,
+                       "periods": list(result.periods), "paths": list(result.paths),
+                       "evaluations": result.evaluations}}
+
+
+def write_design(result: DesignResult, path: str | os.PathLike) -> None:
+    """Write the design file (JSON; floats at full precision, so ``run --design`` reads the same numbers)."""
+    from wmr_mj._util.files import write_json_atomic
+
+    write_json_atomic(path, design_dict(result))
+
+
+def read_design(path: str | os.PathLike) -> dict[str, Any]:
+    """The design file's content.
+
+    Raises:
+        ParameterError: a file that cannot be read or is not a design file (one line naming it).
+    """
+    try:
+        with open(path, encoding="utf-8") as f:
+            data = json.load(f)
+    except (OSError, ValueError) as exc:
+        raise ParameterError(f"--design {os.fspath(path)!r} cannot be read as a design file: {exc}") from None
+    if not isinstance(data, dict) or data.get("format") != FORMAT or not isinstance(data.get("settings"), dict):
+        raise ParameterError(f"--design {os.fspath(path)!r} is not a design file (one written by `wmr-mj design "
+                             "--out FILE`)")
+    return data
+
+
+def design_file_settings(path: str | os.PathLike) -> dict[str, Any]:
+    """The settings of a design file, as the run options spell them (controller, model, kp, kd, friction_sign,
+    friction_width, control_period, sensing, actuation, backlash): ``run --design FILE`` fills each option not
+    given explicitly from them, as a preset does."""
+    settings = read_design(path)["settings"]
+    return {k: settings.get(k) for k in ("controller", "model", "kp", "kd", "friction_sign", "friction_width",
+                                         "control_period", "sensing", "actuation", "backlash")}
+
