@@ -129,6 +129,9 @@ class SteeringController:
     #: without --model or --preset): one of controllers.computed_torque.MODEL_SOURCES under which the law's
     #: claim can hold at its default parameters
     default_model: str = "paper"
+    #: whether the law reads alpha_dot; a law that estimates alpha' from the angle alone sets False, and only
+    #: such a law runs with ``--sensing velocity=none`` (alpha_dot is then NaN; the run refuses the others)
+    reads_velocity: bool = True
 
     @classmethod
     def from_context(cls, context: BuildContext, **params: Any) -> SteeringController:

@@ -127,6 +127,8 @@ static void sense(const mjtNum* sp, mjtNum* s, long long k, double alpha, double
   double v;
   if (p[P_VELOCITY] <= 1.0) { /* exact, tachometer */
     v = ring[r + 1];
+  } else if (p[P_VELOCITY] == 4.0) { /* none: the law reads the angle only */
+    v = NAN;
   } else {
     v = k == 0 ? 0.0 : (alpha_m - s[S_PREVIOUS_ALPHA]) / p[P_PERIOD];
     if (p[P_VELOCITY] == 3.0) {

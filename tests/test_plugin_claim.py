@@ -1,0 +1,130 @@
+"""A plug-in law's claim on its own linear part (issue 35 item 6): wmr_mj.analysis.sampled_loop_of and
+linear_part_bounds against sampled_data's built-in loop and closed forms, velocity=none's coverage, the
+built-in laws' refusal of it, and examples/observer_law.py's claim on a run."""
+
+import json
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from wmr_mj.analysis import linear_part_bounds, sampled_loop_of
+from wmr_mj.analysis.sampled_data import peak_gains, sampled_loop
+from wmr_mj.errors import ParameterError
+from wmr_mj.hardware import Sensing, SensingChain
+
+T = 0.001
+FIELDS = ("A", "B", "C", "D", "w_position", "w_rate", "w_held")
+NO_STATE = (np.zeros((0, 0)), np.zeros((0, 2)), np.zeros((1, 0)))
+
+
+@pytest.mark.parametrize("velocity,tau", [("exact", None), ("tachometer", None), ("difference", None),
+                                          ("filtered", 0.01)])
+@pytest.mark.parametrize("d_s,d_a", [(0, 0), (3, 0), (0, 2), (2, 3)])
+def test_pure_pd_is_the_built_in_loop_bit_for_bit(velocity, tau, d_s, d_a):
+    built_in = sampled_loop(kp=100.0, kd=20.0, control_period=T, velocity=velocity, filter_tau=tau,
+                            sensing_delay=d_s, actuation_delay=d_a)
+    own = sampled_loop_of((*NO_STATE, [[100.0, 20.0]]), control_period=T, velocity=velocity, filter_tau=tau,
+                          sensing_delay=d_s, actuation_delay=d_a)
+    for name in FIELDS:
+        assert np.array_equal(getattr(built_in, name), getattr(own, name)), name
+
+
+@pytest.mark.parametrize("d_s,d_a", [(0, 0), (3, 2)])
+def test_first_order_estimator_as_a_transfer_function(d_s, d_a):
+    """The chain's filtered difference, written by the law as C(z) = K_P + K_D (1 - a)(z - 1)/(T (z - a)) on the
+    angle alone, is the built-in 'filtered' loop: the same impulse responses (another state order), so the same
+    l1 sums over the same N steps, to rounding (1e-9 relative: sums of 20000 terms of one loop's products)."""
+    tau = 0.01
+    a = math.exp(-T / tau)
+    num = [100.0 * T + 20.0 * (1.0 - a), -100.0 * T * a - 20.0 * (1.0 - a)]
+    own = sampled_loop_of((num, [T, -a * T]), control_period=T, sensing_delay=d_s, actuation_delay=d_a)
+    built_in = sampled_loop(kp=100.0, kd=20.0, control_period=T, velocity="filtered", filter_tau=tau,
+                            sensing_delay=d_s, actuation_delay=d_a)
+    g_own, g_in = peak_gains(own, n_terms=20000), peak_gains(built_in, n_terms=20000)
+    angle = slice(1, 4)  # the three angle sources; the velocity noise enters nothing of the law's
+    np.testing.assert_allclose(g_own.reached[:, angle], g_in.reached[:, angle], rtol=1e-9)
+    np.testing.assert_allclose(g_own.reached[:, 0], g_in.reached[:, 0], rtol=1e-9)  # w
+    assert np.all(g_own.reached[:, 4] == 0.0)
+    np.testing.assert_allclose(np.sort(np.abs(np.linalg.eigvals(own.A)))[-3:],
+                               np.sort(np.abs(np.linalg.eigvals(built_in.A)))[-3:], rtol=1e-9)
+
+
+def test_continuous_first_order_is_discretised_by_zoh():
+    """x' = (E^ - x)/tau, u = K_P E^ + K_D' x: its ZOH at T is x[k+1] = a x + (1 - a) E^, a = exp(-T/tau) (closed
+    form), which the law could write itself; the two loops agree to 1e-15."""
+    tau, kd = 0.02, 5.0
+    cont = sampled_loop_of(([[-1.0 / tau]], [[1.0 / tau]], [[kd]], [[100.0]]), control_period=T, continuous=True)
+    a = math.exp(-T / tau)
+    disc = sampled_loop_of(([[a]], [[1.0 - a]], [[kd]], [[100.0]]), control_period=T)
+    np.testing.assert_allclose(cont.A, disc.A, atol=1e-15)
+    np.testing.assert_allclose(cont.B, disc.B, atol=1e-15)
+
+
+def test_refusals():
+    with pytest.raises(ParameterError, match="velocity is 'exact'"):
+        sampled_loop_of(([1.0], [1.0]), control_period=T, velocity="exact")
+    with pytest.raises(ParameterError, match="proper"):
+        sampled_loop_of(([1.0, 0.0, 0.0], [1.0, 0.5]), control_period=T)
+    with pytest.raises(ParameterError, match="parts"):
+        sampled_loop_of(([1.0],), control_period=T)
+
+
+def test_velocity_none_reads_no_rate_and_is_charged_no_lag():
+    none = Sensing(encoder_ticks=8192, velocity="none", delay=0.003)
+    diff = Sensing(encoder_ticks=8192, velocity="difference", delay=0.003)
+    c_none, c_diff = none.coverage(control_period=T, gear_ratio=60.0), diff.coverage(control_period=T, gear_ratio=60.0)
+    assert c_none.lag == 0.0 and c_diff.lag == T / 2.0  # the difference's T/2, not charged where none is taken
+    assert c_none.alpha_dot_error == 0.0 and c_diff.alpha_dot_error > 2 * math.pi / 8192 / T
+    assert c_none.alpha_error == c_diff.alpha_error and c_none.delay == c_diff.delay == 0.003
+    chain = SensingChain(none, control_period=T, n_steps=5, gear_ratio=60.0)
+    a, ad = chain.run(np.linspace(0.0, 0.01, 5), np.ones(5))
+    assert np.all(np.isnan(ad)) and np.all(np.isfinite(a))
+    with pytest.raises(ParameterError, match="velocity is 'none'"):
+        Sensing(velocity="none", velocity_noise_kind="uniform", velocity_noise=0.1)
+    assert Sensing.from_spec("encoder_bits=13,velocity=none").velocity == "none"
+
+
+def _run(*args):
+    return subprocess.run([sys.executable, "-m", "wmr_mj.cli", "run", *args], capture_output=True, text=True,
+                          timeout=300)
+
+
+def test_built_in_law_refuses_velocity_none_in_one_line():
+    out = _run("--sensing", "encoder_bits=13,velocity=none", "--duration", "10", "--no-log")
+    assert out.returncode == 2
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 1 and "velocity=none" in lines[0] and "computed-torque" in lines[0]
+
+
+def test_linear_part_bounds_on_the_cart():
+    """From the claim's context: the encoder's Delta/2 at the PD's gain, the delay in whole periods."""
+    from wmr_mj.analysis.claim import ClaimContext
+    from wmr_mj.analysis.plant_box import PlantBox, PlantLimits
+    from wmr_mj.analysis.robustness import ParameterBox
+    from wmr_mj.params import C80
+    from wmr_mj.reference.bounds import PAPER_BOUNDS
+
+    sensing = Sensing(encoder_ticks=8192, velocity="difference", delay=0.003)
+    context = ClaimContext(plant=PlantBox(box=ParameterBox.paper(), gyro=(0.0, 0.0), V_A=(0.2, 0.2)),
+                           reference=PAPER_BOUNDS, limits=PlantLimits(steering_range=0.9, voltage_limit=24.0),
+                           control_period=T, initial_error=(0.0, 0.0), estimate=C80, sensing=sensing)
+    b = linear_part_bounds((*NO_STATE, [[100.0, 20.0]]), context=context, between_samples=False)
+    built_in = peak_gains(sampled_loop(kp=100.0, kd=20.0, control_period=T, velocity="difference", sensing_delay=3))
+    q = sensing.encoder_bound(60.0)
+    assert b.by_source["quantisation"][0] == pytest.approx(built_in.gain("E", "quantisation") * q, rel=1e-12)
+    assert b.E_max == pytest.approx(built_in.gain("E", "quantisation") * q, rel=1e-12)
+
+
+@pytest.mark.slow
+def test_observer_example_claim_covers_the_13_bit_3_ms_cart():
+    out = _run("--controller", "examples/observer_law.py:ObserverLaw", "--sensing",
+               "encoder_bits=13,velocity=none,delay=0.003", "--path", "paper-circle", "--m1", "750",
+               "--duration", "10", "--no-log", "--json")
+    assert out.returncode == 0, out.stderr
+    d = json.loads(out.stdout)
+    cert = d["certificate"]
+    assert cert["valid"] and d["verdict"] == "certified-inside", (cert.get("reason"), d["verdict"])
+    assert cert["E_ratio"] < 1.0
