@@ -10,6 +10,11 @@ feed-forward cancels the rest), in current-estimator form at the control period 
     x_pred = Phi x - Gamma v,  Phi = [[1, T], [0, 1]], Gamma = [T^2/2, T]      predict
     u = P_hat (alpha0'' + v) + C_V_hat alpha0'               volts (the viscous term on the reference's rate)
 
+The observer's model lacks what the feed-forward does not cancel (friction at rest, the model's mismatch): a
+constant such acceleration biases its estimate of E' (measured 0.056 rad/s on the circle with the steering
+stuck), which the claim charges with the rest of w below. It logs its estimates beside the rows
+(``signal_names``: rows ``law_E_est``, ``law_Edot_est``, ``law_alpha_dot_est`` and the log's ``/law``).
+
 Its linear part E^ -> v is the state-space model (A_c, B_c, C_c, D_c) of :meth:`ObserverLaw.linear_part`, and
 its claim analyses it with :func:`wmr_mj.analysis.linear_part_bounds` on the run's cart (the encoder, the
 delays), charging everything nonlinear as a disturbance w of E'' = -v + w, bounded over the run's plant box:
@@ -49,6 +54,7 @@ class ObserverLaw(SteeringController):
 
     name = "observer-pd"
     reads_velocity = False  # it reads the angle only: runs with --sensing velocity=none
+    signal_names = ("E_est", "Edot_est", "alpha_dot_est")  # logged beside the rows as law_E_est, ...
 
     def __init__(self, kp: float = 400.0, kd: float = 40.0, observer_pole: float = 150.0, P_hat: float = 0.385,
                  C_V_hat: float = 4.77) -> None:
@@ -78,7 +84,7 @@ class ObserverLaw(SteeringController):
         self.T = float(control_period)
         self.L = self.observer_gain(self.T)
         self.x_pred = np.zeros(2)
-        self.estimate = (0.0, 0.0)
+        self.estimate = (0.0, 0.0, 0.0)
 
     def step(self, t, alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot):
         T = self.T
@@ -88,8 +94,12 @@ class ObserverLaw(SteeringController):
         Edot_est = self.x_pred[1] + self.L[1] * innovation
         v = self.kp * E_est + self.kd * Edot_est
         self.x_pred = np.array([E_est + T * Edot_est - 0.5 * T * T * v, Edot_est - T * v])
-        self.estimate = (E_est, Edot_est)
+        self.estimate = (E_est, Edot_est, alpha0_dot - Edot_est)
         return self.P_hat * (alpha0_ddot + v) + self.C_V_hat * alpha0_dot
+
+    def signals(self):
+        """The observer's estimates of this step: E (rad), E' and alpha' (rad/s), logged beside the rows."""
+        return dict(zip(self.signal_names, self.estimate))
 
     def describe(self):
         return {"controller": self.name, "kp": self.kp, "kd": self.kd, "observer_pole": self.observer_pole,

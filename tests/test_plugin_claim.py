@@ -128,3 +128,56 @@ def test_observer_example_claim_covers_the_13_bit_3_ms_cart():
     cert = d["certificate"]
     assert cert["valid"] and d["verdict"] == "certified-inside", (cert.get("reason"), d["verdict"])
     assert cert["E_ratio"] < 1.0
+
+
+def _observer_module():
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "examples" / "observer_law.py"
+    spec = importlib.util.spec_from_file_location("observer_law_example", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_law_signals_in_the_rows_and_the_log(tmp_path):
+    """The example's observer estimates appear as rows law_NAME and, to the bit, in the log's /law channel; the
+    estimate of E follows the true E (the observer works) though the law read no alpha' (NaN)."""
+    from wmr_mj import RunConfig, load_log, run_closed_loop
+    from wmr_mj.logs.writer import RunLogger
+
+    law = _observer_module().ObserverLaw()
+    out = tmp_path / "observer.mcap"
+    config = RunConfig(controller=law, path="paper-circle", m1=750.0, duration=10.0,
+                       sensing=Sensing.from_spec("encoder_bits=13,velocity=none,delay=0.003"))
+    result = run_closed_loop(config, logger_factory=lambda header: RunLogger(out, header))
+    rows = result.rows
+    assert {"law_E_est", "law_Edot_est", "law_alpha_dot_est"} <= set(rows)
+    assert np.all(np.isnan(rows["alpha_dot_measured"]))
+    # the estimate of E against the truth, from a 13-bit angle 3 ms late: within 1 mrad after 1 s (measured
+    # 0.5 mrad; the estimate of E' is biased by the friction the observer's model E'' = -v lacks, and is not
+    # asserted: the claim charges that mismatch as w)
+    late = rows["t"] > 1.0
+    assert np.max(np.abs(rows["law_E_est"][late] - rows["E"][late])) < 1e-3
+    messages = load_log(out).messages("/law")
+    logged = {k: np.concatenate([np.asarray(m[k], float) for _, m in messages]) for k in ("t", "E_est")}
+    assert np.array_equal(logged["t"], rows["t"]) and np.array_equal(logged["E_est"], rows["law_E_est"])
+
+
+def test_a_law_without_signals_keeps_the_compiled_path_and_its_rows():
+    from wmr_mj import RunConfig, run_closed_loop
+
+    result = run_closed_loop(RunConfig(path="paper-circle", duration=10.0))
+    assert result.law == "compiled" and not any(k.startswith("law_") for k in result.rows)
+
+
+def test_bad_signal_names_are_refused():
+    from wmr_mj.sim.engine import law_signal_names
+
+    class Bad:
+        name = "bad"
+        signal_names = ("a b",)
+
+    with pytest.raises(ParameterError, match="signal_names"):
+        law_signal_names(Bad())
