@@ -56,7 +56,7 @@ class ObserverLaw(SteeringController):
     reads_velocity = False  # it reads the angle only: runs with --sensing velocity=none
     signal_names = ("E_est", "Edot_est", "alpha_dot_est")  # logged beside the rows as law_E_est, ...
 
-    def __init__(self, kp: float = 400.0, kd: float = 40.0, observer_pole: float = 150.0, P_hat: float = 0.385,
+    def __init__(self, kp: float = 1600.0, kd: float = 80.0, observer_pole: float = 300.0, P_hat: float = 0.385,
                  C_V_hat: float = 4.77) -> None:
         self.kp, self.kd, self.observer_pole = float(kp), float(kd), float(observer_pole)
         self.P_hat, self.C_V_hat = float(P_hat), float(C_V_hat)
@@ -147,12 +147,15 @@ def observer_claim(law: ObserverLaw, context):
                  + Gam_max * a0d / c2 + K_abs * S + box.disturbance) / P_lo)
         gain = a_u * gU + a_d * gD
         if not gain < 1.0:
-            return math.inf, math.inf, math.inf, math.inf
+            return math.inf, math.inf, math.inf, gain
         w = (c0 + a_u * U_q + a_d * D_q) / (1.0 - gain)
         return E_q + gE * w, D_q + gD * w, U_q + gU * w, w
 
     E_max, iterations, reason = fixed_point(lambda x: solve(a0 + x)[0], a0)
     E_max, Edot_max, u_max, w = solve(a0 + E_max) if math.isfinite(E_max) else (math.inf,) * 4
+    if not math.isfinite(E_max) and "(4.23)" in reason:  # fixed_point words it for section 4: say which gain
+        reason = (f"no fixed point: the small gain of w's own terms, |1 - P_hat/P| g_u + (C_V + Gam/cos^2)/P g_E' = "
+                  f"{solve(a0)[3]:.4g} >= 1 at alpha_max = {a0:.4g} rad (or beyond, as alpha_max grows)")
     voltage_max = law.P_hat * (a0dd + u_max) + law.C_V_hat * a0d
     own.append(Assumption(MEASUREMENT_COVERED, "the encoder, the delays and the observer in the sampled loop",
                           True, 0.0, 0.0, "linear_part_bounds: quantisation, noise, delays, the reference's shift"))
