@@ -181,3 +181,44 @@ def test_bad_signal_names_are_refused():
 
     with pytest.raises(ParameterError, match="signal_names"):
         law_signal_names(Bad())
+
+
+ANGLE_ONLY_LAW = '''
+from controllers import SteeringController
+
+
+class AngleOnly(SteeringController):
+    """P on the angle with feed-forward; reads no alpha' (the plant's own damping, C_V/P = 12/s, damps it)."""
+
+    name = "angle-only"
+    reads_velocity = False
+
+    def law_parameters(self):
+        return [0.385, 100.0, 4.77]
+
+    @staticmethod
+    def law(p, alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot):
+        return p[0] * (alpha0_ddot + p[1] * (alpha0 - alpha)) + p[2] * alpha0_dot
+'''
+
+
+def test_velocity_none_is_the_same_bits_compiled_and_in_python(tmp_path):
+    """A stateless law of the angle alone runs compiled (numba, the C sensing chain) and in Python with
+    velocity=none: the same rows to the bit, alpha_dot_measured NaN on both paths."""
+    import importlib.util
+
+    from wmr_mj import RunConfig, run_closed_loop
+    from wmr_mj.sim import compiled_law
+
+    if compiled_law.unavailable_reason() is not None or importlib.util.find_spec("numba") is None:
+        pytest.skip("the compiled law or numba is not available")
+    (tmp_path / "angle_only.py").write_text(ANGLE_ONLY_LAW)
+    config = RunConfig(controller=f"{tmp_path / 'angle_only.py'}:AngleOnly", path="paper-circle", duration=10.0,
+                       sensing=Sensing.from_spec("encoder_bits=13,velocity=none,delay=0.003"))
+    compiled = run_closed_loop(config, progress=False, law="compiled")
+    python = run_closed_loop(config, progress=False, law="numpy")
+    assert compiled.law == "compiled" and python.law == "python"
+    assert np.all(np.isnan(compiled.rows["alpha_dot_measured"]))
+    assert compiled.rows.keys() == python.rows.keys()
+    for key in compiled.rows:
+        assert compiled.rows[key].tobytes() == python.rows[key].tobytes(), key
