@@ -11,7 +11,7 @@ feed-forward cancels the rest), in current-estimator form at the control period 
     u = P_hat (alpha0'' + v) + C_V_hat alpha0'               volts (the viscous term on the reference's rate)
 
 The observer's model lacks what the feed-forward does not cancel (friction at rest, the model's mismatch): a
-constant such acceleration biases its estimate of E' (measured 0.056 rad/s on the circle with the steering
+constant such acceleration biases its estimate of E' (measured 0.024 rad/s on the circle with the steering
 stuck), which the claim charges with the rest of w below. It logs its estimates beside the rows
 (``signal_names``: rows ``law_E_est``, ``law_Edot_est``, ``law_alpha_dot_est`` and the log's ``/law``).
 

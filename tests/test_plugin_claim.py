@@ -155,11 +155,12 @@ def test_law_signals_in_the_rows_and_the_log(tmp_path):
     rows = result.rows
     assert {"law_E_est", "law_Edot_est", "law_alpha_dot_est"} <= set(rows)
     assert np.all(np.isnan(rows["alpha_dot_measured"]))
-    # the estimate of E against the truth, from a 13-bit angle 3 ms late: within 1 mrad after 1 s (measured
-    # 0.5 mrad; the estimate of E' is biased by the friction the observer's model E'' = -v lacks, and is not
-    # asserted: the claim charges that mismatch as w)
+    # the estimate of E against the truth after 1 s: within what the reading lacks, the 3 ms delay's shift
+    # (3 ms x max|alpha'|) plus one 13-bit tick (measured 0.84 mrad against 1.47 mrad). The estimate of E' is
+    # biased by the friction the observer's model E'' = -v lacks, and is not asserted: the claim charges it as w
     late = rows["t"] > 1.0
-    assert np.max(np.abs(rows["law_E_est"][late] - rows["E"][late])) < 1e-3
+    reading = 0.003 * np.max(np.abs(rows["alpha_dot"])) + 2.0 * math.pi / 8192
+    assert np.max(np.abs(rows["law_E_est"][late] - rows["E"][late])) < reading
     messages = load_log(out).messages("/law")
     logged = {k: np.concatenate([np.asarray(m[k], float) for _, m in messages]) for k in ("t", "E_est")}
     assert np.array_equal(logged["t"], rows["t"]) and np.array_equal(logged["E_est"], rows["law_E_est"])
