@@ -129,7 +129,8 @@ def sampled_loop_of(controller: LinearModel, *, control_period: float, continuou
             'filtered'), or 'none': the law reads the angle only (one input; the velocity noise then enters
             nothing).
         filter_tau: tau_f, s, for 'filtered' only.
-        sensing_delay, actuation_delay: d_s, d_a, whole control periods (>= 0).
+        sensing_delay: d_s, whole control periods (>= 0): the law reads the state of step k - d_s.
+        actuation_delay: d_a, whole control periods (>= 0): the command of step k acts over step k + d_a.
 
     Returns:
         The :class:`~wmr_mj.analysis.sampled_data.SampledLoop` (kp, kd nan: the gains are the controller's;
