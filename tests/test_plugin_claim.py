@@ -223,3 +223,24 @@ def test_velocity_none_is_the_same_bits_compiled_and_in_python(tmp_path):
     assert compiled.rows.keys() == python.rows.keys()
     for key in compiled.rows:
         assert compiled.rows[key].tobytes() == python.rows[key].tobytes(), key
+
+
+def test_the_claims_context_carries_the_cart():
+    """The run hands the claim its sensing spec, the actuation delay, i2 and the play, beside the summed bounds."""
+    from wmr_mj import Actuation, RunConfig
+    from wmr_mj.sim.parts import resolve_run
+
+    seen = []
+
+    class Spy(_observer_module().ObserverLaw):
+        def claim(self, context):
+            seen.append(context)
+            return None
+
+    sensing = Sensing.from_spec("encoder_bits=13,velocity=none,delay=0.003")
+    parts = resolve_run(RunConfig(controller=Spy(), path="paper-circle", duration=10.0, sensing=sensing,
+                                  actuation=Actuation(delay=0.002)))
+    (context,) = seen
+    assert context.sensing == sensing and context.actuation_delay == 0.002
+    assert context.gear_ratio == parts.plant.i2 and context.play == 0.0
+    assert context.measurement.delay_s == pytest.approx(0.005)  # the summed bounds stay beside it
