@@ -14,6 +14,10 @@ leading batch axis): each is derived from the other, and :meth:`step` calls
 (the default derives it from :meth:`voltage`; a stateful law that has no batch form runs its
 simulations one by one on the engine).
 
+A law may log its own signals beside the rows: it names them in :attr:`signal_names` and returns
+their values of the step just taken from :meth:`signals` (``{"alpha_dot_est": ...}``); the rows
+gain ``law_alpha_dot_est``, and an MCAP log the channel ``/law``.
+
 A law may state a claim (:meth:`claim`): a bound on |E| and |E'| with its assumptions
 (:mod:`wmr_mj.analysis.claim`), which every run of it is judged against. Without one the run
 is judged by its requirements only (``--require``), never as a pass.
@@ -129,6 +133,12 @@ class SteeringController:
     #: without --model or --preset): one of controllers.computed_torque.MODEL_SOURCES under which the law's
     #: claim can hold at its default parameters
     default_model: str = "paper"
+    #: whether the law reads alpha_dot; a law that estimates alpha' from the angle alone sets False, and only
+    #: such a law runs with ``--sensing velocity=none`` (alpha_dot is then NaN; the run refuses the others)
+    reads_velocity: bool = True
+    #: the names of the law's own signals (its alpha' estimate, an observer's state), logged beside the rows as
+    #: ``law_NAME`` (:meth:`signals`); a law that logs any runs in Python on the engine, one call per step
+    signal_names: tuple[str, ...] = ()
 
     @classmethod
     def from_context(cls, context: BuildContext, **params: Any) -> SteeringController:
@@ -172,6 +182,11 @@ class SteeringController:
              alpha0_ddot: float) -> float:
         """One control step at time ``t`` [s]: the voltage to apply [V]; a law with state updates it here."""
         return self.voltage_scalar(alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot)
+
+    def signals(self) -> Mapping[str, float]:
+        """After each :meth:`step`: the law's own signals of that step, a float per name of :attr:`signal_names`
+        (units the law's own), recorded in the rows as ``law_NAME`` and in the log's ``/law`` channel."""
+        return {}
 
     @property
     def stateful(self) -> bool:

@@ -191,7 +191,7 @@ def test_filter_step_response_is_one_minus_a_to_the_k():
     ("noise=laplace:0.1", ParameterError, "noise = 'laplace:0.1' is not accepted"),
     ("noise=uniform:-0.1", ParameterError, "noise = -0.1 rad is not accepted"),
     ("velocity=kalman", UnknownNameError, "unknown sensing velocity value 'kalman'; valid sensing velocity values: "
-                                          "difference, exact, filtered, tachometer"),
+                                          "difference, exact, filtered, none, tachometer"),
     ("velocity=filtered", ParameterError, "velocity=filtered needs filter_tau"),
     ("velocity=filtered,filter_tau=0", ParameterError, "filter_tau = 0.0 s is not accepted"),
     ("filter_tau=0.01", ParameterError, "filter_tau = 0.01 s applies to velocity=filtered only"),

@@ -45,6 +45,7 @@ from wmr_mj.analysis.measurement import MEASUREMENT_COVERED, MeasurementErrors, 
 from wmr_mj.analysis.plant_box import PlantBox, PlantLimits
 from wmr_mj.analysis.regions import BoxRegion
 from wmr_mj.errors import ParameterError
+from wmr_mj.hardware.sensing import Sensing
 from wmr_mj.params import C80Parameters
 from wmr_mj.reference.bounds import ReferenceBounds
 
@@ -75,6 +76,14 @@ class ClaimContext:
         measurement: bounds on what the law reads instead of the true state and its delay
             (:class:`~wmr_mj.analysis.measurement.MeasurementErrors`; default exact, today's runs). A claim
             that does not absorb them must not cover the run: :func:`covers_measurement`.
+        sensing: the sensor itself (:class:`~wmr_mj.hardware.Sensing`: encoder ticks, side, rounding, noise,
+            the velocity estimate, its delay [s]), whose stages ``measurement`` sums; a claim that analyses
+            its own loop reads it (:func:`wmr_mj.analysis.linear_part_bounds`). Default: ideal.
+        actuation_delay: the actuator's delay [s] (:class:`~wmr_mj.hardware.Actuation`), between the law's
+            voltage and the motor.
+        gear_ratio: i2 of the run's plant (a motor-side encoder's step at the axis is 2 pi / (N i2)); None:
+            the estimate's.
+        play: the gear's play b [rad at the axis] (0 without play; never covered today: see ``measurement``).
     """
 
     plant: PlantBox
@@ -86,10 +95,18 @@ class ClaimContext:
     estimate: C80Parameters
     notes: Mapping[str, Any] = field(default_factory=dict)
     measurement: MeasurementErrors = field(default_factory=MeasurementErrors.exact)
+    sensing: Sensing = field(default_factory=Sensing)
+    actuation_delay: float = 0.0
+    gear_ratio: float | None = None
+    play: float = 0.0
 
     def __post_init__(self) -> None:
         if not isinstance(self.measurement, MeasurementErrors):
             raise ParameterError(f"measurement must be a MeasurementErrors, got {type(self.measurement).__name__}")
+        if not isinstance(self.sensing, Sensing):
+            raise ParameterError(f"sensing must be a wmr_mj.hardware.Sensing, got {type(self.sensing).__name__}")
+        if self.gear_ratio is None:
+            object.__setattr__(self, "gear_ratio", float(self.estimate.i2))
 
 
 class RunAssumptions(NamedTuple):

@@ -29,7 +29,9 @@ The pipeline, once per control step k at t_k = k T (T the control period), in th
 (d) **velocity**: ``exact``: the delayed true alpha'; ``tachometer``: the same (its noise is the velocity
     noise); ``difference``: (alpha_m[k] - alpha_m[k-1]) / T, 0 at k = 0; ``filtered``: that difference x_k
     through y_k = a y_{k-1} + (1 - a) x_k, a = exp(-T / tau_f), y_{-1} = 0 (the exact discretisation of
-    1/(tau_f s + 1) for an input held over each period). Then ``alpha'_m[k] = v_k + n_alpha'[k]`` where set.
+    1/(tau_f s + 1) for an input held over each period); ``none``: no velocity is read, alpha'_m[k] is NaN (the
+    law reads the measured angle only and estimates alpha' itself; no velocity noise is accepted). Then
+    ``alpha'_m[k] = v_k + n_alpha'[k]`` where set.
 
 Noise, drawn up front: ``rng = numpy.random.default_rng(seed)``; first the n_steps noise values on alpha
 (``rng.uniform(-B, B, n_steps)`` or ``rng.normal(0.0, sigma, n_steps)``), only where noise on alpha is set;
@@ -46,7 +48,7 @@ step calls no ``exp``. The layouts (index constants of this module):
 - parameters (float64): ``P_TICKS_PER_RAD`` c (0 without an encoder), ``P_GEAR_RATIO`` i2, ``P_PERIOD`` T (s),
   ``P_FILTER_A`` a, ``P_FILTER_ONE_MINUS_A`` 1 - a, ``P_DELAY_STEPS`` d, ``P_ENCODER_SIDE`` (0 axis, 1 motor;
   the angle is quantised where c != 0), ``P_ROUNDING`` (0 rint, 1 floor), ``P_VELOCITY`` (0 exact,
-  1 tachometer, 2 difference, 3 filtered), ``P_ALPHA_NOISE_ON``, ``P_ALPHA_DOT_NOISE_ON`` (0 or 1);
+  1 tachometer, 2 difference, 3 filtered, 4 none), ``P_ALPHA_NOISE_ON``, ``P_ALPHA_DOT_NOISE_ON`` (0 or 1);
   ``N_PARAMETERS`` in all.
 - state (float64, ``STATE_HEADER + 3 (d + 1)``): ``S_NEXT_STEP`` the k the next call must pass,
   ``S_PREVIOUS_ALPHA`` alpha_m[k-1] (rad), ``S_FILTER`` y_{k-1} (rad/s), then the ring: slot j at
@@ -90,7 +92,7 @@ __all__ = [
 
 EncoderSide = Literal["axis", "motor"]
 EncoderRounding = Literal["round", "floor"]
-VelocityEstimate = Literal["exact", "tachometer", "difference", "filtered"]
+VelocityEstimate = Literal["exact", "tachometer", "difference", "filtered", "none"]
 NoiseKind = Literal["none", "uniform", "gaussian"]
 
 # parameter layout (see the module docstring)
@@ -103,7 +105,7 @@ STATE_HEADER = S_RING
 
 _SIDE_CODES = {"axis": 0, "motor": 1}
 _ROUNDING_CODES = {"round": 0, "floor": 1}
-_VELOCITY_CODES = {"exact": 0, "tachometer": 1, "difference": 2, "filtered": 3}
+_VELOCITY_CODES = {"exact": 0, "tachometer": 1, "difference": 2, "filtered": 3, "none": 4}
 _NOISE_FORMS = "'none', 'uniform:BOUND' or 'gaussian:SIGMA'"
 #: The finest encoder accepted, in bits: 2**48 ticks keep angle x ticks / (2 pi) below 2**53 (where a double
 #: holds every integer) for a motor-shaft angle up to 2**53 / 2**48 x 2 pi = 201 rad (i2 = 60: 3.3 rad of steering).
@@ -148,7 +150,7 @@ class Sensing:
     encoder_ticks: int | None = None  # ticks per revolution of the shaft the encoder sits on; None: exact
     encoder_side: EncoderSide = "axis"  # 'motor': on the motor shaft, angle = i2 * alpha (no play)
     encoder_rounding: EncoderRounding = "round"  # 'round': rint (ties to even); 'floor': truncation down
-    velocity: VelocityEstimate = "exact"  # how alpha' is obtained
+    velocity: VelocityEstimate = "exact"  # how alpha' is obtained; 'none': not at all (NaN, the law estimates it)
     filter_tau: float | None = None  # s, the low-pass time constant tau_f of velocity='filtered'
     noise_kind: NoiseKind = "none"  # noise added to the quantised alpha
     noise: float = 0.0  # rad: the bound B (uniform on [-B, B)) or the standard deviation (gaussian)
@@ -174,6 +176,9 @@ class Sensing:
             object.__setattr__(self, mag_key, m)
             if m == 0.0:
                 object.__setattr__(self, kind_key, "none")
+        if self.velocity == "none" and self.velocity_noise_kind != "none":
+            raise ParameterError("sensing: velocity_noise needs a velocity reading; velocity is 'none' (the law reads "
+                                 "the angle only)")
         delay = to_float("sensing", "delay", self.delay)
         if delay < 0.0:
             raise ParameterError(f"sensing: delay = {self.delay!r} s is not accepted; a delay >= 0 s is required")
@@ -243,13 +248,17 @@ class Sensing:
     def estimate_bound(self, control_period: float, *, angle_spread: float) -> tuple[float, float]:
         """(d) the velocity estimate's error bound (rad/s) and its lag (s, times sup|alpha''| in the bound).
 
-        exact and tachometer: the velocity noise's bound, no lag. difference: the angle's error changes by at
-        most ``angle_spread`` (rad) in a period T, so ``angle_spread / T`` plus the velocity noise, with the lag
-        T/2 of a mean over the period; filtered: the same error (the filter's weights are >= 0 and sum to at
-        most 1) and the lag tau_f + T/2 (:func:`measurement_error_bounds`).
+        exact and tachometer: the velocity noise's bound, no lag. none: (0, 0): no alpha' is read (NaN), so no
+        reading's error and no difference's T/2 lag is charged; a law that estimates alpha' itself charges its
+        estimate in its own claim (:func:`wmr_mj.analysis.linear_part_bounds`). difference: the angle's error
+        changes by at most ``angle_spread`` (rad) in a period T, so ``angle_spread / T`` plus the velocity noise,
+        with the lag T/2 of a mean over the period; filtered: the same error (the filter's weights are >= 0 and sum
+        to at most 1) and the lag tau_f + T/2 (:func:`measurement_error_bounds`).
         """
         if self.velocity in ("exact", "tachometer"):
             return self.velocity_noise_bound(), 0.0
+        if self.velocity == "none":
+            return 0.0, 0.0
         dot_error = angle_spread / control_period + self.velocity_noise_bound()
         return dot_error, control_period / 2.0 + (self.filter_tau or 0.0)  # filter_tau is set for 'filtered' only
 
@@ -495,6 +504,8 @@ class SensingChain:
             alpha_m = alpha_m + self.alpha_noise.item(k)
         if self._velocity <= 1:  # exact, tachometer
             v = s.item(r + 1)
+        elif self._velocity == 4:  # none: the law reads the angle only
+            v = math.nan
         else:
             v = 0.0 if k == 0 else (alpha_m - s.item(S_PREVIOUS_ALPHA)) / self.control_period
             if self._velocity == 3:

@@ -78,6 +78,12 @@ STATUSES = ("completed", "interrupted", "error", "failed")  # failed: the law (a
 COMPRESSIONS = ("lz4", "zstd", "none")
 
 
+#: The channel of a law's own signals (JSON, one message per block: {"t": [...], NAME: [...]}, NaN as null), and
+#: the block keys it takes them from (engine.LAW_SIGNAL_PREFIX + NAME); only in the log of a law that logs any.
+LAW_TOPIC = "/law"
+LAW_PREFIX = "law_"
+
+
 def _dumps(obj: Any) -> str:
     return json.dumps(json_safe(obj), allow_nan=False, separators=(",", ":"))
 
@@ -443,6 +449,9 @@ class RunLogger:
             if a.shape != (n,):
                 raise ParameterError(f"block[{k!r}] has shape {a.shape}; {(n,)} is expected")
             clean[k] = a
+        for k in block:  # a law's own signals (rows law_NAME: controllers.SteeringController.signal_names)
+            if k.startswith(LAW_PREFIX):
+                clean[k] = np.array(block[k], np.float64).ravel()
         self._pending.append(clean)
         self._pending_rows += n
         if self._pending_rows * self.dt_row >= self.flush_period_s - 0.5 * self.dt_row:
@@ -451,7 +460,7 @@ class RunLogger:
     def _take_pending(self) -> dict[str, np.ndarray]:
         self._taken_rows += self._pending_rows
         blocks, self._pending, self._pending_rows = self._pending, [], 0
-        keys = (*self._keys, *lf.OPTIONAL_BLOCK_KEYS)
+        keys = (*self._keys, *lf.OPTIONAL_BLOCK_KEYS, *(k for k in blocks[0] if k.startswith(LAW_PREFIX)))
         return blocks[0] if len(blocks) == 1 else {k: np.concatenate([b[k] for b in blocks]) for k in keys}
 
     def flush(self) -> None:
@@ -510,6 +519,12 @@ class RunLogger:
             fields = lf.channel_layouts()["channels"][lf.MEASURED_TOPIC]["fields"]
             measured = {f["name"]: b[f["block"]] for f in fields}
             self._add(lf.MEASURED_TOPIC, int(lt[0]), lf.encode_block(lf.MEASURED_TOPIC, measured))
+        law = [k for k in b if k.startswith(LAW_PREFIX)]
+        if law and LAW_TOPIC not in self._cid:  # registered at its first block: other runs keep their channel ids
+            self._cid[LAW_TOPIC] = cid = self._w.register_channel(LAW_TOPIC, "json", 0, {})
+            self._seq[cid] = 0
+        if law:  # the law's own signals at every control step: one JSON message per block on /law
+            self._add(LAW_TOPIC, int(lt[0]), _dumps({"t": t, **{k[len(LAW_PREFIX):]: b[k] for k in law}}).encode())
         self._w.flush()
         # 2. what Foxglove draws, one message per row
         plot = np.flatnonzero(rows % self.plot_every == 0)

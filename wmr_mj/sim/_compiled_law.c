@@ -88,7 +88,11 @@ enum { P_TICKS_PER_RAD, P_GEAR_RATIO, P_PERIOD, P_FILTER_A, P_FILTER_ONE_MINUS_A
 enum { S_NEXT_STEP, S_PREVIOUS_ALPHA, S_FILTER, S_RING };
 #define SENSE_USERDATA 9 /* the chain's state starts here in userdata */
 
-int wmr_mj_sensing_layout(void) { return 1000 * SENSE_HEADER + 10 * N_PARAMETERS + S_RING; }
+/* the velocity codes sense() knows (exact, tachometer, difference, filtered, none): a library older than a code
+ * the Python chain gives does not match, and the run falls back to the Python law */
+enum { N_VELOCITY_CODES = 5 };
+
+int wmr_mj_sensing_layout(void) { return 100000 * N_VELOCITY_CODES + 1000 * SENSE_HEADER + 10 * N_PARAMETERS + S_RING; }
 
 /* SensingChain.step of wmr_mj/hardware/sensing.py, operation for operation (the same bits) */
 static void sense(const mjtNum* sp, mjtNum* s, long long k, double alpha, double alpha_dot, double motor,
@@ -127,6 +131,8 @@ static void sense(const mjtNum* sp, mjtNum* s, long long k, double alpha, double
   double v;
   if (p[P_VELOCITY] <= 1.0) { /* exact, tachometer */
     v = ring[r + 1];
+  } else if (p[P_VELOCITY] == 4.0) { /* none: the law reads the angle only */
+    v = NAN;
   } else {
     v = k == 0 ? 0.0 : (alpha_m - s[S_PREVIOUS_ALPHA]) / p[P_PERIOD];
     if (p[P_VELOCITY] == 3.0) {

@@ -272,7 +272,8 @@ def certificate_of(config: Any, reference: Any, *, base: C80Parameters, estimate
     context = ClaimContext(plant=plant_box, reference=bounds,
                            limits=PlantLimits(steering_range=plant.steering_range, voltage_limit=plant.voltage_limit),
                            control_period=period, initial_error=initial, stated=stated, estimate=estimate_params,
-                           measurement=measurement)
+                           measurement=measurement, sensing=config.sensing, actuation_delay=config.actuation.delay,
+                           gear_ratio=plant.i2, play=config.transmission.backlash)
     try:
         cert = controller.claim(context)
     except Exception as exc:  # noqa: BLE001  (any error of a law's own claim: one line naming the law, before any step)

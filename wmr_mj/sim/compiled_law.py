@@ -118,10 +118,11 @@ def _library() -> tuple[ctypes.CDLL | None, str | None]:
 
 
 def _sensing_layout() -> int:
-    """The sensing layout's sizes as the C file encodes them (wmr_mj_sensing_layout)."""
-    from wmr_mj.hardware.sensing import N_PARAMETERS, S_RING
+    """The sensing layout's sizes as the C file encodes them (wmr_mj_sensing_layout), and the number of velocity
+    codes it knows (a library built before velocity=none would difference where the chain gives NaN)."""
+    from wmr_mj.hardware.sensing import _VELOCITY_CODES, N_PARAMETERS, S_RING
 
-    return 1000 * len(SENSE_FIELDS) + 10 * N_PARAMETERS + S_RING
+    return 100000 * len(_VELOCITY_CODES) + 1000 * len(SENSE_FIELDS) + 10 * N_PARAMETERS + S_RING
 
 
 def sensing_numeric(chain: Any, *, motor_qpos_adr: int) -> np.ndarray:

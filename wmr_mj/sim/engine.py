@@ -68,6 +68,8 @@ ROW_FIELDS = ("t", "alpha", "alpha_dot", "alpha0", "alpha0_dot", "alpha0_ddot", 
 #: recorded besides where the run has a sensor (wmr_mj.hardware.sensing): what the law read [rad, rad/s];
 #: alpha, alpha_dot, E and E_dot stay the true state's
 SENSED_ROW_FIELDS = ("alpha_measured", "alpha_dot_measured")
+#: the rows' prefix of a law's own signals (``SteeringController.signal_names``: row ``law_NAME`` per name)
+LAW_SIGNAL_PREFIX = "law_"
 
 #: how a run evaluates the law: "compiled" (C, in MuJoCo's control callback), "numpy"
 #: (Python: the vectorised law of a batch, ``voltage_scalar`` of a single run), "auto"
@@ -144,6 +146,22 @@ def batch_law_backend(controller: Any, law: str = "auto") -> str:
     return _backend(controller, law)[0]
 
 
+def law_signal_names(controller: Any) -> tuple[str, ...]:
+    """The names of the signals ``controller`` logs beside the rows (``signal_names``; () for most laws).
+
+    Raises:
+        ParameterError: names that are not a tuple of distinct identifiers.
+    """
+    names = getattr(controller, "signal_names", ())
+    if names == ():
+        return ()
+    if (not isinstance(names, (tuple, list)) or not all(isinstance(x, str) and x.isidentifier() for x in names)
+            or len(set(names)) != len(names)):
+        raise ParameterError(f"controller {getattr(controller, 'name', controller)!r}: signal_names = {names!r} is "
+                             "not accepted; a tuple of distinct identifiers (e.g. ('alpha_dot_est',)) is required")
+    return tuple(names)
+
+
 def _backend(controller: Any, law: str) -> tuple[str, str | None]:
     """(backend, why the compiled law does not run or None)."""
     if law not in LAW_BACKENDS:
@@ -151,6 +169,9 @@ def _backend(controller: Any, law: str) -> tuple[str, str | None]:
     if law == "numpy":
         return "numpy", "the Python law was asked for"
     why = compiled_law.unavailable_reason()
+    if why is None and law_signal_names(controller):
+        why = (f"{type(controller).__name__} logs its own signals (signal_names), which the compiled law does not "
+               "call")
     if why is None and not compiled_law.supports(controller):
         # a plug-in: compiled by numba where it offers a pure law function (compiled_law.external_reason)
         why = compiled_law.external_reason(controller)
@@ -204,7 +225,7 @@ class _Block:
     step's start, ctrl as applied (logs only: without a log they have no rows).
     """
 
-    def __init__(self, count: int, m: mujoco.MjModel, log: bool, sensing: bool = False) -> None:
+    def __init__(self, count: int, m: mujoco.MjModel, log: bool, sensing: bool = False, n_signals: int = 0) -> None:
         self.alpha, self.alpha_dot, self.voltage_cmd, self.voltage, self.force, self.torque, self.heading = (
             np.empty(count) for _ in range(7))
         rows = count if log else 0
@@ -216,6 +237,8 @@ class _Block:
         # what the law read where the run has a sensor (wmr_mj.hardware.sensing); else no rows
         sensed = count if sensing else 0
         self.alpha_measured, self.alpha_dot_measured = np.empty(sensed), np.empty(sensed)
+        # the law's own signals (signal_names), one column each; no rows where it logs none
+        self.law_signals = np.empty((count if n_signals else 0, n_signals))
 
     @classmethod
     def head(cls, block: _Block, count: int) -> _Block:
@@ -337,6 +360,18 @@ def _checked_call(law: Callable[..., Any], t: float, *state: float) -> float:
     return u
 
 
+def _read_signals(signals: Callable[[], Mapping[str, float]], names: tuple[str, ...], out: np.ndarray,
+                  t: float) -> None:
+    """The law's signals of this step into ``out`` (one per name), else :class:`ControllerFailure` saying why."""
+    try:
+        values = signals()
+        for i, name in enumerate(names):
+            out[i] = float(values[name])
+    except Exception as exc:  # noqa: BLE001  (the user's hook: its message, naming the time)
+        raise ControllerFailure(f"the law's signals() at t = {t:.6g} s: {type(exc).__name__}: {exc}; a dict of a "
+                                f"float per name of signal_names {names} is required") from None
+
+
 class _PythonStepper:
     """The same closed loop with the Python law, one mj_step at a time (no compiled law, or after a warning).
 
@@ -348,8 +383,10 @@ class _PythonStepper:
     def __init__(self, model: mujoco.MjModel, where: _Plant, substeps: int, log: bool, law: Callable[..., float],
                  reference: tuple[np.ndarray, np.ndarray, np.ndarray], voltage_limit: float,
                  disturbance: np.ndarray | None = None, fields: Mapping[str, np.ndarray] | None = None, *,
-                 period: float = 1.0, strict: bool = False, chain: Any = None) -> None:
+                 period: float = 1.0, strict: bool = False, chain: Any = None,
+                 signals: Callable[[], Mapping[str, float]] | None = None, signal_names: tuple[str, ...] = ()) -> None:
         self.model, self.where, self.substeps, self.log = model, where, substeps, log
+        self.signals, self.signal_names = (signals, signal_names) if signal_names else (None, ())
         self.chain = chain  # the sensor between the plant and the law (wmr_mj.hardware.SensingChain), or None
         self.period, self.strict = period, strict
         self._own = False  # whether self.model is this stepper's own copy (made at the first load change)
@@ -394,6 +431,7 @@ class _PythonStepper:
         quat = np.empty((count, 4))
         period, strict = self.period, self.strict
         chain, motor_qpos = self.chain, w.motor_qpos
+        signals, names = self.signals, self.signal_names
         i2 = 0.0 if chain is None else float(chain.parameters[P_GEAR_RATIO])  # as the callback reads it
         for j in range(count):
             if dist is not None:
@@ -413,6 +451,13 @@ class _PythonStepper:
                     raise
             else:
                 u_cmd = law((k0 + j) * period, am, adm, a0_all[j], a0d_all[j], a0dd_all[j])
+            if signals is not None:
+                try:
+                    _read_signals(signals, names, block.law_signals[j], (k0 + j) * period)
+                except ControllerFailure as exc:
+                    exc.steps_done = j
+                    block.heading[:j] = _heading(quat[:j])
+                    raise
             if u_cmd != u_cmd:  # NaN from a diverged law: apply nothing, keep the record
                 u = 0.0
             else:
@@ -484,6 +529,7 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
     reference, disturbance, loads = _checked_inputs(schedule)
     strict = not compiled_law.supports(controller)
     chain = _sensing_chain(schedule, params)
+    names = law_signal_names(controller)
     controller.reset(control_period=schedule.period)
     if schedule.tracker is not None:
         schedule.tracker.reset(schedule.path_reference, control_period=schedule.period)
@@ -491,7 +537,7 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
     def python_stepper(fields: Mapping[str, np.ndarray] | None = None) -> _PythonStepper:
         return _PythonStepper(plain, where, schedule.substeps, on_block is not None, controller.step, reference,
                               params.voltage_limit, disturbance, fields, period=schedule.period, strict=strict,
-                              chain=chain)
+                              chain=chain, signals=controller.signals if names else None, signal_names=names)
 
     if backend == "compiled":
         first: _CompiledStepper | _PythonStepper
@@ -501,7 +547,7 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
         first, lawful, ref_adr = python_stepper(), None, 0
     loop = _BlockLoop(first, python_stepper, schedule=schedule, plain=plain, where=where, reference=reference,
                       loads=loads, sensed=chain is not None, k_i=params.k_i, on_block=on_block, lawful=lawful,
-                      ref_adr=ref_adr, note=note)
+                      ref_adr=ref_adr, note=note, signal_names=names)
     return loop.run(on_progress)
 
 
@@ -521,7 +567,7 @@ class _BlockLoop:
                  plain: mujoco.MjModel, where: _Plant, reference: tuple[np.ndarray, np.ndarray, np.ndarray],
                  loads: list[tuple[int, dict[str, np.ndarray]]], sensed: bool, k_i: float,
                  on_block: Callable[[dict[str, np.ndarray]], None] | None, lawful: mujoco.MjModel | None,
-                 ref_adr: int, note: str | None) -> None:
+                 ref_adr: int, note: str | None, signal_names: tuple[str, ...] = ()) -> None:
         self.stepper, self.python_stepper = stepper, python_stepper
         self.n, self.period, self.tracker = schedule.n, schedule.period, schedule.tracker
         self.plain, self.where, self.reference, self.loads = plain, where, reference, loads
@@ -530,7 +576,8 @@ class _BlockLoop:
         self.log = on_block is not None
         self.used = "compiled" if isinstance(stepper, _CompiledStepper) else "python"
         self.note = note
-        self.rows = {key: np.empty(self.n) for key in ROW_FIELDS + SENSED_ROW_FIELDS * sensed}
+        self.signal_keys = tuple(LAW_SIGNAL_PREFIX + name for name in signal_names)
+        self.rows = {key: np.empty(self.n) for key in ROW_FIELDS + SENSED_ROW_FIELDS * sensed + self.signal_keys}
         self.C_xy = np.empty((self.n, 2))
         self.block_len = max(1, int(round(1.0 / self.period)))  # one simulated second per block
         if self.tracker is not None:
@@ -555,10 +602,10 @@ class _BlockLoop:
                 self.cnt = cnt = min(self.block_len, self.n - k0)
                 b = self.blocks.get(cnt)
                 if b is None:
-                    b = self.blocks[cnt] = _Block(cnt, self.plain, self.log, self.sensed)
+                    b = self.blocks[cnt] = _Block(cnt, self.plain, self.log, self.sensed, len(self.signal_keys))
                 self.before_block(k0, cnt)
                 self.advance(b, k0, cnt)
-                _record_block(self.rows, self.C_xy, b, k0, self.period, self.reference, self.k_i)
+                _record_block(self.rows, self.C_xy, b, k0, self.period, self.reference, self.k_i, self.signal_keys)
                 self.k = k0 + cnt
                 self.hand_over(self.k)
                 if on_progress is not None:
@@ -581,7 +628,8 @@ class _BlockLoop:
         if done_in_block and self.k == self.k0:
             part = self.blocks[done_in_block] = _Block.head(self.blocks[self.cnt], done_in_block)
             self.cnt = done_in_block
-            _record_block(self.rows, self.C_xy, part, self.k0, self.period, self.reference, self.k_i)
+            _record_block(self.rows, self.C_xy, part, self.k0, self.period, self.reference, self.k_i,
+                          self.signal_keys)
             self.k = self.k0 + done_in_block
 
     def hand_over(self, upto: int) -> None:
@@ -721,8 +769,9 @@ def _compiled_stepper(params: C80Parameters, controller: Any, options: dict[str,
 
 
 def _record_block(rows: dict[str, np.ndarray], C_xy: np.ndarray, b: _Block, k0: int, period: float,
-                  reference: tuple[np.ndarray, np.ndarray, np.ndarray], k_i: float) -> None:
-    """The rows of one stepped block (control steps k0 .. k0 + len(b)), and C's xy."""
+                  reference: tuple[np.ndarray, np.ndarray, np.ndarray], k_i: float,
+                  signal_keys: tuple[str, ...] = ()) -> None:
+    """The rows of one stepped block (control steps k0 .. k0 + len(b)), and C's xy (and the law's signals)."""
     a0_all, a0d_all, a0dd_all = reference
     cnt = len(b.alpha)
     sl = slice(k0, k0 + cnt)
@@ -743,3 +792,5 @@ def _record_block(rows: dict[str, np.ndarray], C_xy: np.ndarray, b: _Block, k0: 
     if len(b.alpha_measured):
         rows["alpha_measured"][sl] = b.alpha_measured
         rows["alpha_dot_measured"][sl] = b.alpha_dot_measured
+    for i, key in enumerate(signal_keys):
+        rows[key][sl] = b.law_signals[:, i]

@@ -149,6 +149,11 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
     plant = plant_parameters(config, base)
     estimate = estimate_parameters(base)
     controller, law_settings = controller_and_settings(config, estimate)
+    if config.sensing.velocity == "none" and getattr(controller, "reads_velocity", True):
+        raise ParameterError(f"controller {controller.name!r} reads alpha', which --sensing velocity=none does not "
+                             "give it; accepted: a law that estimates alpha' from the angle (reads_velocity = False, "
+                             "docs/guides/plugins.md), or a velocity estimate (exact, tachometer, difference, "
+                             "filtered)")
     tracker = tracker_for(config, estimate)
     substeps = control_substeps(config)
     period = substeps * TIMESTEP
