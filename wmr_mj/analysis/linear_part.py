@@ -199,17 +199,7 @@ def _assemble(Ac: np.ndarray, Bc: np.ndarray, Cc: np.ndarray, Dc: np.ndarray, *,
         u = u + Dc[0, j] * inputs[j]
     for i, row in enumerate(xc):
         u = u + Cc[0, i] * row
-    u_applied = r.unit(r.u_line[-1]) if d_a else u
-    nxt = np.zeros((n, n + 2))
-    nxt[0] = r.unit(0) + T * r.unit(1) - (T * T / 2.0) * u_applied
-    nxt[1] = r.unit(1) - T * u_applied
-    for line, head in ((r.E_line, r.unit(0)), (r.V_line, r.unit(1)), (r.u_line, u)):
-        for j, idx in enumerate(line):
-            nxt[idx] = head if j == 0 else r.unit(line[j - 1])
-    if r.has_prev:
-        nxt[r.prev] = E_hat
-    if filt_row is not None:
-        nxt[r.filt] = filt_row
+    nxt = r.plant_step(u=u, E_hat=E_hat, filt_row=filt_row, T=T, d_a=d_a)
     for i, idx in enumerate(r.ctrl):
         row = np.zeros(n + 2)
         for j, src in enumerate(xc):
@@ -217,13 +207,7 @@ def _assemble(Ac: np.ndarray, Bc: np.ndarray, Cc: np.ndarray, Dc: np.ndarray, *,
         for j, y in enumerate(inputs):
             row = row + Bc[i, j] * y
         nxt[idx] = row
-    out = np.stack([r.unit(0), r.unit(1), u])
-    w_position, w_rate = np.zeros(n), np.zeros(n)
-    w_position[0], w_rate[1] = 1.0, 1.0
-    arrays = {"A": nxt[:, :n], "B": nxt[:, n:], "C": out[:, :n], "D": out[:, n:], "w_position": w_position,
-              "w_rate": w_rate, "w_held": (T * T / 2.0) * w_position + T * w_rate}
-    for x in arrays.values():
-        x.flags.writeable = False
+    arrays = r.arrays(nxt, u, T)
     return SampledLoop(**arrays, kp=math.nan, kd=math.nan, control_period=T, velocity=velocity, filter_tau=tau,
                        sensing_delay=d_s, actuation_delay=d_a)
 

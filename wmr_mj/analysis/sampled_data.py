@@ -197,6 +197,36 @@ class _Rows:
         r[j] = 1.0
         return r
 
+    def plant_step(self, *, u: np.ndarray, E_hat: np.ndarray, filt_row: np.ndarray | None, T: float,
+                   d_a: int) -> np.ndarray:
+        """The next state's rows [x, e, n_v] of every line but a law's own states: the held plant step under the
+        command applied (u, or u d_a periods late), the delay lines shifted, the estimator's memory."""
+        n = self.n
+        u_applied = self.unit(self.u_line[-1]) if d_a else u
+        nxt = np.zeros((n, n + 2))
+        nxt[0] = self.unit(0) + T * self.unit(1) - (T * T / 2.0) * u_applied
+        nxt[1] = self.unit(1) - T * u_applied
+        for line, head in ((self.E_line, self.unit(0)), (self.V_line, self.unit(1)), (self.u_line, u)):
+            for j, idx in enumerate(line):
+                nxt[idx] = head if j == 0 else self.unit(line[j - 1])
+        if self.has_prev:
+            nxt[self.prev] = E_hat
+        if filt_row is not None:
+            nxt[self.filt] = filt_row
+        return nxt
+
+    def arrays(self, nxt: np.ndarray, u: np.ndarray, T: float) -> dict[str, np.ndarray]:
+        """The loop's A, B (from [e, n_v]), C, D (rows E, E', u) and the disturbance columns, read-only."""
+        n = self.n
+        out = np.stack([self.unit(0), self.unit(1), u])
+        w_position, w_rate = np.zeros(n), np.zeros(n)
+        w_position[0], w_rate[1] = 1.0, 1.0
+        arrays = {"A": nxt[:, :n], "B": nxt[:, n:], "C": out[:, :n], "D": out[:, n:], "w_position": w_position,
+                  "w_rate": w_rate, "w_held": (T * T / 2.0) * w_position + T * w_rate}
+        for x in arrays.values():
+            x.flags.writeable = False
+        return arrays
+
 
 def sampled_loop(*, kp: float, kd: float, control_period: float, velocity: VelocityEstimate | str = "exact",
                  filter_tau: float | None = None, sensing_delay: int = 0, actuation_delay: int = 0) -> SampledLoop:
@@ -242,24 +272,8 @@ def sampled_loop(*, kp: float, kd: float, control_period: float, velocity: Veloc
         else:
             filt_row, rate_hat = None, difference - r.unit(n + 1)
     u = K_P * E_hat + K_D * rate_hat
-    u_applied = r.unit(r.u_line[-1]) if d_a else u
-    nxt = np.zeros((n, n + 2))
-    nxt[0] = r.unit(0) + T * r.unit(1) - (T * T / 2.0) * u_applied
-    nxt[1] = r.unit(1) - T * u_applied
-    for line, head in ((r.E_line, r.unit(0)), (r.V_line, r.unit(1)), (r.u_line, u)):
-        for j, idx in enumerate(line):
-            nxt[idx] = head if j == 0 else r.unit(line[j - 1])
-    if r.has_prev:
-        nxt[r.prev] = E_hat
-    if filt_row is not None:
-        nxt[r.filt] = filt_row
-    out = np.stack([r.unit(0), r.unit(1), u])
-    w_position, w_rate = np.zeros(n), np.zeros(n)
-    w_position[0], w_rate[1] = 1.0, 1.0
-    arrays = {"A": nxt[:, :n], "B": nxt[:, n:], "C": out[:, :n], "D": out[:, n:], "w_position": w_position,
-              "w_rate": w_rate, "w_held": (T * T / 2.0) * w_position + T * w_rate}
-    for x in arrays.values():
-        x.flags.writeable = False
+    nxt = r.plant_step(u=u, E_hat=E_hat, filt_row=filt_row, T=T, d_a=d_a)
+    arrays = r.arrays(nxt, u, T)
     return SampledLoop(**arrays, kp=K_P, kd=K_D, control_period=T, velocity=str(velocity), filter_tau=tau,
                        sensing_delay=d_s, actuation_delay=d_a)
 
