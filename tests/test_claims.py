@@ -165,3 +165,16 @@ def test_a_built_in_whose_claim_holds_under_no_estimate_says_so_in_one_line(caps
     assert main(["run", "--controller", "pd", "--path", "paper-circle", "--duration", "10", "--no-log"]) == 0
     err = capsys.readouterr().err.splitlines()
     assert err[0] == f"wmr-mj: note: {note}"
+
+
+def test_robustness_certificate_of_a_plug_in_prints_no_paper_claim(capsys):
+    """Issue 36: `robustness --certificate` with a plug-in printed the paper's claim, which `run` calls not
+    applicable: it prints the law's own claim only, in text and JSON."""
+    assert main(["robustness", "--certificate", "--controller", CLAIMED]) == 0
+    text = capsys.readouterr().out
+    assert "(its own claim, not the paper's section 4)" in text
+    assert not any(line.lstrip().lower().startswith(("paper", "the paper")) for line in text.splitlines())
+    assert "(4.21)" not in text and "(4.23)" not in text
+    assert main(["robustness", "--certificate", "--controller", CLAIMED, "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert not any(key.startswith("paper") for key in out)

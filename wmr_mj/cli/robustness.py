@@ -457,9 +457,10 @@ def run_certificate(args: argparse.Namespace) -> int:
     paper = parts.analysis
     if as_json:
         out = cert.as_dict()
-        out["paper_region"] = {"E_max": paper.E_max if paper.stable else None,
-                               "Edot_max": paper.Edot_max if paper.stable else None,
-                               "condition": paper.condition, "stable": bool(paper.stable)}
+        if parts.paper_law:  # the paper's region says nothing of a law outside its family (run: not applicable)
+            out["paper_region"] = {"E_max": paper.E_max if paper.stable else None,
+                                   "Edot_max": paper.Edot_max if paper.stable else None,
+                                   "condition": paper.condition, "stable": bool(paper.stable)}
         out["config"] = config.as_dict()
         out.update(certificate_breakdown(cert))
         print_json(out)
