@@ -43,7 +43,7 @@ from wmr_mj.sim.config import (
     plant_parameters,
 )
 from wmr_mj.sim.log_header import LogHeader
-from wmr_mj.sim.parts import control_substeps
+from wmr_mj.sim.parts import RunLabels, control_substeps
 
 
 def reference_run(
@@ -186,7 +186,7 @@ def reference_run(
                            sup_E_settled=_sup(done["E"][after]), sup_Edot_settled=_sup(done["E_dot"][after]),
                            saturated_fraction=saturated / k, left_range_at=left_range_at,
                            final_alpha=done["alpha"][-1], control_steps=k, steps=k * substeps, wall_s=wall)
-    summary = report(config, measured, analysis=analysis, params=params, certificate=certificate,
+    summary = report(RunLabels.of(config), measured, analysis=analysis, params=params, certificate=certificate,
                      drift=_drift_of(done["E"], done["alpha0_dot"][-1] - done["E_dot"][-1], period),
                      path=judge_path(reference, done["t"][at], r_C[:k][at], done["heading"][at], settle_s=settle_s,
                                      certificate=certificate, steering_range=params.steering_range))

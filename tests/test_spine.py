@@ -105,15 +105,30 @@ class _Reads:
         return getattr(self._config, name)
 
 
-#: what the run's summary and log record of the config (its labels and the record itself): read below
-#: resolve_run to be written out, never to build anything
-RECORDED = {"model", "kp", "kd", "path", "as_dict"}
+class _Header:
+    """A logger that keeps the run's header (what the log would record) and drops the rows."""
+
+    last: object = None
+
+    def __init__(self, header) -> None:
+        _Header.last = header
+
+    def write_block(self, *args, **kwargs) -> None:
+        pass
+
+    def close(self, *args, **kwargs) -> None:
+        pass
+
+
+#: what run_parts may read of the config: nothing (its labels and its record, ``as_dict``, are read once by
+#: resolve_run: RunParts.labels, RunParts.record)
+RECORDED: set[str] = set()
 
 
 @pytest.mark.slow
 def test_below_resolve_run_the_config_is_only_recorded():
-    """run_parts reads the typed parts (sensing, signals, reference bounds, route, ...) and no field of the
-    config but the labels it records; the run's numbers are the same as run_closed_loop's."""
+    """run_parts reads the typed parts (sensing, signals, reference bounds, route, labels, the config's record,
+    ...) and no field of the config, nor its as_dict; the run's numbers are the same as run_closed_loop's."""
     import dataclasses
 
     import numpy as np
@@ -129,8 +144,9 @@ def test_below_resolve_run_the_config_is_only_recorded():
                        reference_bounds="paper", correction=True)
     parts = resolve_run(config)
     spy = _Reads(config)
-    seen = run_parts(dataclasses.replace(parts, config=spy), progress=False)
+    seen = run_parts(dataclasses.replace(parts, config=spy), progress=False, logger_factory=_Header)
     assert spy.read <= RECORDED, f"read below resolve_run: {sorted(spy.read - RECORDED)}"
+    assert _Header.last.config == config.as_dict()  # the log's record of the config, taken by resolve_run
     plain = run_closed_loop(config, progress=False)
     timing = ("wall_s", "realtime_factor")  # the two runs' clocks, the only keys that differ
 

@@ -83,13 +83,14 @@ def config_from_args(args: argparse.Namespace, **extra):
     if extra.get("m1", None) is M1_NOMINAL:
         extra["m1"] = None  # --m1 not given: the cart's nominal m1
     given_range: Any = None if m1_range is M1_RANGE else tuple(m1_range)  # None: the cart's m1 box
-    config = RunConfig(**law_fields(choice), cart=cart, tracker=tracker, tracker_params=tracker_params,
-                       duration=args.duration, control_period=args.control_period, path=args.path,
-                       plant_overrides=parse_assignments(args.param), m1_inertia=args.m1_inertia, box=args.box,
-                       m1_range=given_range, steering_friction=args.steering_friction,
-                       tyre_contact=args.tyre_contact, box_ranges=box_ranges_from_args(args),
-                       correction=bool(getattr(args, "correction", False)),
-                       reference_bounds=getattr(args, "reference_bounds", None), **hardware_from_args(args), **extra)
+    config = RunConfig.from_inputs(**law_fields(choice), cart=cart, tracker=tracker, tracker_params=tracker_params,
+                                   duration=args.duration, control_period=args.control_period, path=args.path,
+                                   plant_overrides=parse_assignments(args.param), m1_inertia=args.m1_inertia,
+                                   box=args.box, m1_range=given_range, steering_friction=args.steering_friction,
+                                   tyre_contact=args.tyre_contact, box_ranges=box_ranges_from_args(args),
+                                   correction=bool(getattr(args, "correction", False)),
+                                   reference_bounds=getattr(args, "reference_bounds", None),
+                                   **hardware_from_args(args), **extra)
     args.m1_range = config.m1_range  # --m1-range not given: the cart's m1 box, which the commands read from args
     return config
 

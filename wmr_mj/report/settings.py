@@ -110,8 +110,8 @@ class ValidateSettings:
         if self.uncertainty not in UNCERTAINTY_NAMES:
             raise UnknownNameError("uncertainty box name", str(self.uncertainty), UNCERTAINTY_NAMES)
         # a named path or a route file, and the cart (a bad spec, a delay off the grid): refused as a run would
-        probe = RunConfig(path=self.path, sensing=self.sensing, actuation=self.actuation,
-                          transmission=self.transmission, cart=self.cart)
+        probe = RunConfig.from_inputs(path=self.path, sensing=self.sensing, actuation=self.actuation,
+                                      transmission=self.transmission, cart=self.cart)
         for name in ("sensing", "actuation", "transmission"):
             object.__setattr__(self, name, getattr(probe, name))  # the typed part
         from wmr_mj.sim.designs import design_changes
@@ -121,7 +121,7 @@ class ValidateSettings:
 
         for token in self.designs:  # an unknown law, a missing file, a bad setting: refused before any run
             # built once: a parameter the law does not take, a claim() that raises or returns no Certificate
-            resolve_run(RunConfig(**design_changes(token), cart=self.cart))
+            resolve_run(RunConfig.from_inputs(**design_changes(token), cart=self.cart))
         if 0 < self.search_budget < self.min_search_budget:
             raise ParameterError(f"search_budget = {self.search_budget} is below one generation of CMA-ES (the "
                                  f"searches' portfolio); give 0 (no search) or an integer >= {self.min_search_budget}")
@@ -162,10 +162,10 @@ class ValidateSettings:
         certified design's gains derived on it (:func:`wmr_mj.sim.designs.on_cart`)."""
         from wmr_mj.sim.designs import on_cart
 
-        return RunConfig(**on_cart(design.config_changes(), self.cart), duration=self.duration, m1=self.nominal_m1,
-                         path=self.path, m1_range=as_pair(self.m1_range), box_ranges=self.ranges, seed=self.seed,
-                         sensing=self.sensing, actuation=self.actuation, transmission=self.transmission,
-                         cart=self.cart)
+        return RunConfig.from_inputs(**on_cart(design.config_changes(), self.cart), duration=self.duration,
+                                     m1=self.nominal_m1, path=self.path, m1_range=as_pair(self.m1_range),
+                                     box_ranges=self.ranges, seed=self.seed, sensing=self.sensing,
+                                     actuation=self.actuation, transmission=self.transmission, cart=self.cart)
 
     def as_dict(self) -> dict[str, Any]:
         d = asdict(self)

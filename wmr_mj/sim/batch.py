@@ -64,7 +64,7 @@ from wmr_mj.sim.config import (
     plant_parameters,
 )
 from wmr_mj.sim.engine import LAW_BACKENDS, batch_law_backend, batch_model
-from wmr_mj.sim.parts import RunParts, resolve_run
+from wmr_mj.sim.parts import RunLabels, RunParts, resolve_run
 from wmr_mj.sim.summary import BatchFigures, RunSummary, voltage_effort
 
 __all__ = ["run_batch", "shares_one_batch", "batch_model", "batch_law_backend", "LAW_BACKENDS", "thread_count",
@@ -499,6 +499,8 @@ def _summaries(configs: Sequence[RunConfig], plants: Sequence[C80Parameters], st
     progress = (None if parts.route_length_m is None  # one path: one progress
                 else RouteProgress.along(parts.route_length_m, reference, n * substeps * TIMESTEP))
     reports = []
+    # the configs differ only in their plants (shares_one_batch): the first's labels are every run's
+    labels = parts.labels if parts.labels is not None else RunLabels.of(configs[0], name=parts.controller_name)
     for i, (c, p) in enumerate(zip(configs, plants)):
         certificate = certificates[i]
         measured = RunMeasures(status="completed", settle_s=settle_s, sup_E=stats.sup_E[i], sup_Edot=stats.sup_Ed[i],
@@ -507,8 +509,8 @@ def _summaries(configs: Sequence[RunConfig], plants: Sequence[C80Parameters], st
                                left_range_at=None if np.isnan(stats.left_at[i]) else float(stats.left_at[i]),
                                final_alpha=stats.final_alpha[i], control_steps=n, steps=n * substeps,
                                wall_s=wall / nsim, effort=voltage_effort(stats.voltage[:, i], period))
-        r = report(c, measured, analysis=analysis, params=p, certificate=certificate,
-                   claims_nothing=certificate is None, name=run.parts.controller_name,
+        r = report(labels, measured, analysis=analysis, params=p, certificate=certificate,
+                   claims_nothing=certificate is None,
                    drift=drift(prev_window=float(stats.drift_prev[i]), last_window=float(stats.drift_last[i]),
                                final_alpha_dot=float(stats.final_alpha_dot[i]),
                                last_halves=((float(stats.drift_halves[i, 0]), float(stats.drift_halves[i, 1]))

@@ -47,7 +47,6 @@ from wmr_mj.plant.mjcf import TIMESTEP, scene_xml
 from wmr_mj.sim.config import (
     RunConfig,
     build_reference,
-    controller_name,
     estimate_parameters,
 )
 from wmr_mj.sim.engine import (
@@ -59,7 +58,7 @@ from wmr_mj.sim.engine import (
 )
 from wmr_mj.sim.log_header import LogHeader
 from wmr_mj.sim.measured_errors import with_measured_errors
-from wmr_mj.sim.parts import RunParts, control_substeps, resolve_run
+from wmr_mj.sim.parts import RunLabels, RunParts, control_substeps, resolve_run
 from wmr_mj.sim.summary import RunSummary, voltage_effort
 
 __all__ = ["RunResult", "RunMeasures", "run_closed_loop", "report", "run_on_reduced_model", "ROW_FIELDS", "judge_path",
@@ -173,15 +172,16 @@ class RunMeasures:
     effort: Any = None  # the applied voltage's (wmr_mj.sim.summary.VoltageEffort); None: not measured
 
 
-def report(config: RunConfig, measured: RunMeasures, *, analysis, params: C80Parameters, certificate=None,
-           drift: Drift | None = None, path: PathJudgement | None = None, claims_nothing: bool = False,
-           name: str | None = None) -> RunSummary:
+def report(labels: RunLabels, measured: RunMeasures, *, analysis, params: C80Parameters, certificate=None,
+           drift: Drift | None = None, path: PathJudgement | None = None, claims_nothing: bool = False
+           ) -> RunSummary:
     """The run's report: sup errors (whole run and after the entry transient) against the region.
 
     Shared by the single run and the batched sweep so both report alike.
 
     Args:
-        config: the run's configuration.
+        labels: what the summary calls the run's law, estimate, gains and path (``RunParts.labels``, read from
+            the config once by ``resolve_run``; :meth:`RunLabels.of` for a config of one's own).
         analysis: the paper's region (``RobustnessResult``): the summary's E_max, Edot_max, inside,
             E_ratio, Edot_ratio are the paper's claim.
         measured: what the run measured (:class:`RunMeasures`, units there).
@@ -192,7 +192,6 @@ def report(config: RunConfig, measured: RunMeasures, *, analysis, params: C80Par
         path: C's path errors, bound and verdict (:func:`judge_path`); None: not measured.
         claims_nothing: the controller states no claim (``certificate_for`` gave None): the verdict
             is 'no-claim', never a pass.
-        name: what the summary calls the law (``RunParts.controller_name``; None: from the config).
 
     Returns:
         RunSummary: ``to_dict()`` writes the JSON interface.
@@ -207,12 +206,12 @@ def report(config: RunConfig, measured: RunMeasures, *, analysis, params: C80Par
         judged = judge_run(certificate=certificate, analysis=analysis, sup_E=sup_E, sup_Edot=sup_Edot, drift=drift)
     return RunSummary(
         status=m.status,
-        controller=controller_name(config) if name is None else name,
-        model=str(config.model),
+        controller=labels.controller,
+        model=labels.model,
         m1=float(params.m1),
-        kp=config.kp,
-        kd=config.kd,
-        path=config.path,
+        kp=labels.kp,
+        kd=labels.kd,
+        path=labels.path,
         duration=steps * TIMESTEP,
         steps=int(steps),
         control_steps=int(m.control_steps),
@@ -387,6 +386,16 @@ def run_closed_loop(
     return run_parts(parts, logger_factory=logger_factory, progress=progress, law=law)
 
 
+def _labels(parts: RunParts) -> RunLabels:
+    """The run's labels, as ``resolve_run`` read them (parts made elsewhere, without them: from the config)."""
+    return parts.labels if parts.labels is not None else RunLabels.of(parts.config, name=parts.controller_name)
+
+
+def _record(parts: RunParts) -> dict[str, Any]:
+    """The config as the run's log records it, as ``resolve_run`` took it (a copy: the log may keep it)."""
+    return dict(parts.record) if parts.record is not None else parts.config.as_dict()
+
+
 def run_parts(parts: RunParts, *, logger_factory: Callable[..., Any] | None = None, progress: bool | None = None,
               law: str = "auto") -> RunResult:
     """:func:`run_closed_loop` of a config already resolved (:func:`wmr_mj.sim.parts.resolve_run`)."""
@@ -408,7 +417,7 @@ def run_parts(parts: RunParts, *, logger_factory: Callable[..., Any] | None = No
         mujoco.mj_getState(m, d, state, mujoco.mjtState.mjSTATE_INTEGRATION)
         # the log carries the scene's MJCF as the plant compiles it, sky included
         logger = logger_factory(LogHeader(
-            mjcf_xml=scene_xml(params, **options), config=config.as_dict(), parameters=params.as_dict(),
+            mjcf_xml=scene_xml(params, **options), config=_record(parts), parameters=params.as_dict(),
             initial_state=state, timestep=dt, control_substeps=substeps, model=m,
             bounds=({"E_max": parts.claim.E_max, "Edot_max": parts.claim.Edot_max} if parts.claim is not None
                     else {"E_max": math.inf, "Edot_max": math.inf}),
@@ -447,9 +456,8 @@ def run_parts(parts: RunParts, *, logger_factory: Callable[..., Any] | None = No
                            effort=voltage_effort(done["voltage"], period))
     path = judge_path(reference, done["t"][at], run.C_xy[at], done["heading"][at], settle_s=settle_s,
                       certificate=certificate, steering_range=params.steering_range, corrected=outer is not None)
-    summary = report(config, measured, analysis=analysis, params=params,
+    summary = report(_labels(parts), measured, analysis=analysis, params=params,
                      certificate=None if run.failure is not None else certificate, claims_nothing=certificate is None,
-                     name=parts.controller_name,
                      drift=_drift_of(done["E"], done["alpha0_dot"][-1] - done["E_dot"][-1], period),
                      path=path)
     if outer is not None:

@@ -85,7 +85,7 @@ def design_from_token(token: str, suite: Suite, *, cart: Mapping[str, Any] | Non
         box = dict(cart_file(RunConfig(cart=on)).uncertainty.get(suite.adversary.uncertainty, box))
     m1_range = box.pop("m1")
     changes = {**on_cart(design_changes(token), on), **(cart or {})}
-    config = RunConfig(**changes, m1_range=m1_range, box_ranges=box, duration=suite.duration)
+    config = RunConfig.from_inputs(**changes, m1_range=m1_range, box_ranges=box, duration=suite.duration)
     from wmr_mj.sim.parts import resolve_run
 
     resolve_run(config)  # built once: a parameter the law does not take, a claim() that raises, before any run

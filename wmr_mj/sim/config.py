@@ -23,6 +23,7 @@ import numpy as np
 
 from controllers import SteeringController, make_controller, model_from_source
 from controllers.computed_torque import CONTROLLER_NAMES, FRICTION_SIGNS, MODEL_SOURCES
+from controllers.registry import BUILTIN_CONTROLLERS, BUILTIN_TRACKERS, is_builtin
 from wmr_mj._util.checks import as_pair
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.hardware.cart import CART_PARTS, cart_dict
@@ -39,6 +40,7 @@ from wmr_mj.params import (
     with_params,
 )
 from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS, TIMESTEP, TYRE_CONTACT_MODELS
+from wmr_mj.sim.signals import signals_from
 
 __all__ = [
     "PATH_NAMES",
@@ -139,46 +141,27 @@ class RunConfig:
         return state
 
     def __post_init__(self) -> None:
-        _check_cart(self)
-        _check_plugin(self, "controller")
-        _check_plugin(self, "tracker")
-        if self.model is None:
-            object.__setattr__(self, "model", default_model(self.controller, self.controller_params,
-                                                            cls=self._plugins.get("controller_class")))
-        if self.model not in MODEL_SOURCES:
-            raise UnknownNameError("model source", str(self.model), MODEL_SOURCES)
-        if self.friction_sign not in FRICTION_SIGNS:
-            raise UnknownNameError("friction sign", self.friction_sign, FRICTION_SIGNS)
-        _check_path(self)
-        if not isinstance(self.correction, bool):
-            raise ParameterError(f"correction = {self.correction!r} is not accepted: True or False")
-        if self.box not in ("derived", "paper"):
-            raise UnknownNameError("box", self.box, ("derived", "paper"))
-        if self.steering_friction not in STEERING_FRICTION_MODELS:
-            raise UnknownNameError("steering friction model", self.steering_friction, STEERING_FRICTION_MODELS)
-        if self.tyre_contact not in TYRE_CONTACT_MODELS:
-            raise UnknownNameError("tyre contact model", self.tyre_contact, TYRE_CONTACT_MODELS)
-        for name in ("m1", "duration", "kp", "kd"):
-            value = getattr(self, name)
-            if not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
-                raise ParameterError(f"{name} = {value!r} is not accepted; a finite number > 0 is required")
-        if self.control_period is not None and (not math.isfinite(self.control_period) or self.control_period <= 0):
-            raise ParameterError(f"control_period = {self.control_period!r} s must be finite and > 0")
-        _check_period_fits(self.control_period, self.duration)
-        lo, hi = self.m1_range
-        if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo < hi):
-            raise ParameterError(f"m1_range = {self.m1_range!r} must be (lo, hi) with 0 < lo < hi")
-        from wmr_mj.sim.signals import signals_from
+        _coerce_inputs(self)  # the convenience path: what from_inputs does (nothing read where nothing needs it)
+        _check_fields(self)  # the rest: no file read, no module imported
 
-        object.__setattr__(self, "signals", signals_from(self.signals))
-        _check_hardware(self)
-        from wmr_mj.reference.bounds import reference_bounds_from
+    @classmethod
+    def from_inputs(cls, **user_input: Any) -> RunConfig:
+        """The coercer: a RunConfig from what a user gives, the one way a config reads a file or imports user code.
 
-        object.__setattr__(self, "reference_bounds", reference_bounds_from(self.reference_bounds))
-        names = parameter_names()
-        for name in self.plant_overrides:
-            if name not in names:
-                raise UnknownNameError("parameter", name, names)
+        A built-in law or tracker name, a path of :data:`PATH_NAMES`, typed parts (a ``Sensing``, a
+        ``Signals``, ...), spec strings and mappings are checked as they are, with no file read and no module
+        imported. What needs either is coerced here (:func:`_coerce_inputs`): a plug-in given by name
+        (``FILE.py:Class``, ``module:Class``, an entry point: imported and its source hashed once, its
+        ``default_model`` read), a route (a packaged name, a .toml/.json file, a Path or Route object), a
+        signals .json file or JSON text, a cart part's .json/.toml file. ``RunConfig(...)`` given such input
+        coerces it the same way, through the same function (the convenience path); the commands, the config
+        builders of compare and the reports, and :func:`config_from_dict` call this.
+
+        Raises:
+            ParameterError, UnknownNameError: what cannot be coerced or is refused, in one line.
+        """
+        return cls(**user_input)
+
 
     def as_dict(self) -> dict[str, Any]:
         d = dataclasses.asdict(self)
@@ -292,15 +275,84 @@ def _parameters_of_text(text: str, path: str) -> C80Parameters:
     return parameters_of_cart(_cart_of_text(text, path))
 
 
+def _coerce_inputs(config: RunConfig) -> None:
+    """The config's user inputs as its typed fields (:meth:`RunConfig.from_inputs`): the plug-ins found (a name
+    that is not built in imported here, once), the model a law runs with where none is named, the path, the
+    signals, the cart's parts and the reference bounds. A built-in name, a named path, a typed part and a spec
+    string read no file and import no module.
+
+    Raises:
+        ParameterError, UnknownNameError: a plug-in, route, signals or part that cannot be read or is refused.
+    """
+    _check_cart(config)
+    _check_plugin(config, "controller")
+    _check_plugin(config, "tracker")
+    if config.model is None:
+        object.__setattr__(config, "model", default_model(config.controller, config.controller_params,
+                                                          cls=config._plugins.get("controller_class")))
+    _check_path(config)
+    object.__setattr__(config, "signals", signals_from(config.signals))
+    _typed_hardware(config)
+    from wmr_mj.reference.bounds import reference_bounds_from
+
+    object.__setattr__(config, "reference_bounds", reference_bounds_from(config.reference_bounds))
+
+
+def _check_fields(config: RunConfig) -> None:
+    """The config's typed fields checked, with no file read and no module imported.
+
+    Raises:
+        ParameterError, UnknownNameError: an unknown name or a value out of range, in one line.
+    """
+    if config.model not in MODEL_SOURCES:
+        raise UnknownNameError("model source", str(config.model), MODEL_SOURCES)
+    if config.friction_sign not in FRICTION_SIGNS:
+        raise UnknownNameError("friction sign", config.friction_sign, FRICTION_SIGNS)
+    if not isinstance(config.correction, bool):
+        raise ParameterError(f"correction = {config.correction!r} is not accepted: True or False")
+    if config.box not in ("derived", "paper"):
+        raise UnknownNameError("box", config.box, ("derived", "paper"))
+    if config.steering_friction not in STEERING_FRICTION_MODELS:
+        raise UnknownNameError("steering friction model", config.steering_friction, STEERING_FRICTION_MODELS)
+    if config.tyre_contact not in TYRE_CONTACT_MODELS:
+        raise UnknownNameError("tyre contact model", config.tyre_contact, TYRE_CONTACT_MODELS)
+    for name in ("m1", "duration", "kp", "kd"):
+        value = getattr(config, name)
+        if not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
+            raise ParameterError(f"{name} = {value!r} is not accepted; a finite number > 0 is required")
+    if config.control_period is not None and (not math.isfinite(config.control_period) or config.control_period <= 0):
+        raise ParameterError(f"control_period = {config.control_period!r} s must be finite and > 0")
+    _check_period_fits(config.control_period, config.duration)
+    lo, hi = config.m1_range
+    if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo < hi):
+        raise ParameterError(f"m1_range = {config.m1_range!r} must be (lo, hi) with 0 < lo < hi")
+    _check_hardware(config)
+    names = parameter_names()
+    for name in config.plant_overrides:
+        if name not in names:
+            raise UnknownNameError("parameter", name, names)
+
+
 def _check_hardware(config: RunConfig) -> None:
-    """The config's sensing, actuation and transmission as their typed parts (:mod:`wmr_mj.hardware`; None:
-    ideal), each delay checked against the grid it runs on: the sensing's against the control period, the
-    actuation's against the physics step (MuJoCo's actuator delay).
+    """The config's sensing, actuation and transmission (typed by :func:`_typed_hardware`), each delay checked
+    against the grid it runs on: the sensing's against the control period, the actuation's against the physics
+    step (MuJoCo's actuator delay).
 
     Raises:
         ParameterError, UnknownNameError: a malformed spec, a bad value, a delay the grid cannot represent.
     """
-    from wmr_mj.hardware import Actuation, Sensing, Transmission, check_cart, is_ideal_cart
+    from wmr_mj.hardware import check_cart, is_ideal_cart
+
+    config.sensing.delay_steps(TIMESTEP if config.control_period is None else config.control_period)
+    config.actuation.delay_steps(TIMESTEP)
+    if not is_ideal_cart(config):  # the limits that need the plant and the duration (hardware.cart.check_cart)
+        check_cart(config, plant_parameters(config))
+
+
+def _typed_hardware(config: RunConfig) -> None:
+    """The config's sensing, actuation and transmission as their typed parts (None: ideal); a spec naming a
+    .json/.toml file is read here."""
+    from wmr_mj.hardware import Actuation, Sensing, Transmission
 
     cart = cart_file(config)
     for name, cls in (("sensing", Sensing), ("actuation", Actuation), ("transmission", Transmission)):
@@ -309,10 +361,6 @@ def _check_hardware(config: RunConfig) -> None:
             default = cart.defaults["backlash" if name == "transmission" else name]
             given = Transmission(backlash=default) if name == "transmission" else default
         object.__setattr__(config, name, given if isinstance(given, cls) else cls.from_spec(given))
-    config.sensing.delay_steps(TIMESTEP if config.control_period is None else config.control_period)
-    config.actuation.delay_steps(TIMESTEP)
-    if not is_ideal_cart(config):  # the limits that need the plant and the duration (hardware.cart.check_cart)
-        check_cart(config, plant_parameters(config))
 
 
 def _check_plugin(config: RunConfig, kind: str) -> None:
@@ -338,6 +386,8 @@ def _check_plugin(config: RunConfig, kind: str) -> None:
                 raise ParameterError(f"controller {given!r} takes its settings as RunConfig fields (kp, kd, model, "
                                      f"friction_sign, friction_width), not controller_params {sorted(params)}")
             return
+        if is_builtin(given, kind):
+            return  # a built-in law or tracker: its class is the registry's (_builtin_class), nothing to import
         _resolved(config, kind)  # a missing file, class or method: one line, before any run
         return
     if isinstance(given, base):
@@ -392,6 +442,16 @@ def _instance_source(given: Any, kind: str):
                         params=describe_params(params), source_sha256=source_hash(cls))
 
 
+def _builtin_class(name: str, kind: str) -> type:
+    """The class of a built-in law or tracker (``controllers.registry.BUILTIN_CONTROLLERS``/``BUILTIN_TRACKERS``),
+    read from its module, which the ``controllers`` package imports: nothing is imported here."""
+    import sys
+
+    builtins = BUILTIN_CONTROLLERS if kind == "controller" else BUILTIN_TRACKERS
+    module_name, _, class_name = builtins[name].partition(":")
+    return getattr(sys.modules[module_name], class_name)
+
+
 def default_model(controller: Any, params: Mapping[str, Any] | None = None, *, cls: type | None = None) -> str:
     """The model source a law runs with where the run names none: its class's ``default_model``
     (:attr:`controllers.base.SteeringController.default_model`); 'paper' for computed-torque, pd and a
@@ -399,7 +459,9 @@ def default_model(controller: Any, params: Mapping[str, Any] | None = None, *, c
     from controllers.base import SteeringController
     from controllers.registry import resolve
 
-    if cls is None and isinstance(controller, str) and controller not in CONTROLLER_NAMES:
+    if cls is None and isinstance(controller, str) and is_builtin(controller):
+        cls = _builtin_class(controller, "controller")
+    elif cls is None and isinstance(controller, str) and controller not in CONTROLLER_NAMES:
         cls = resolve(controller, params, kind="controller")[0]
     elif cls is None and isinstance(controller, SteeringController):
         cls = type(controller)
@@ -427,10 +489,12 @@ def controller_name(config: RunConfig) -> str:
 def _check_path(config: RunConfig) -> None:
     """Accept a path name, a route (name, file, canonical JSON) or a Path/Route object (stored as its
     canonical JSON, so the config stays hashable and JSON-able); a malformed route raises here."""
+    p = config.path
+    if isinstance(p, str) and p in PATH_NAMES:
+        return  # a named path: nothing to read
     from wmr_mj.reference.paths import Path
     from wmr_mj.reference.route import Route, is_route_spec, load_route, route_from_path, route_names
 
-    p = config.path
     if isinstance(p, Path):
         object.__setattr__(config, "path", route_from_path(p).text)
     elif isinstance(p, Route):
@@ -718,7 +782,7 @@ def config_from_dict(obj: Mapping[str, Any]) -> RunConfig:
         record = d.pop(f"{kind}_plugin", None)
         if record is not None:
             d[kind] = _plugin_again(kind, record)
-    return RunConfig(**d)
+    return RunConfig.from_inputs(**d)
 
 
 def _plugin_again(kind: str, record: Mapping[str, Any]) -> str:

@@ -16,6 +16,7 @@ Usage::
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -44,7 +45,32 @@ from wmr_mj.sim.config import (
     tracker_for,
 )
 
-__all__ = ["RunParts", "resolve_run", "control_substeps", "signal_inputs"]
+__all__ = ["RunParts", "RunLabels", "resolve_run", "control_substeps", "signal_inputs"]
+
+
+@dataclass(frozen=True, kw_only=True)
+class RunLabels:
+    """What a run's summary calls its law, estimate, gains and path: read from the config once, by
+    :func:`resolve_run`, so that nothing below it reads the config's strings (the summary's ``controller``,
+    ``model``, ``kp``, ``kd``, ``path`` keys).
+
+    Attributes:
+        controller: the law's name (a built-in's name, a plug-in's ``name``).
+        model: the estimate's model source. kp [1/s^2], kd [1/s]: the gains as given.
+        path: C's path as the config names it (a path name, a route name or file, canonical route JSON).
+    """
+
+    controller: str
+    model: str
+    kp: float
+    kd: float
+    path: str
+
+    @classmethod
+    def of(cls, config: RunConfig, *, name: str | None = None) -> RunLabels:
+        """The labels of ``config``; ``name``: the law's name where already known (else from the config)."""
+        return cls(controller=controller_name(config) if name is None else name, model=str(config.model),
+                   kp=config.kp, kd=config.kd, path=config.path)
 
 
 def control_substeps(config: RunConfig, timestep: float = TIMESTEP) -> int:
@@ -96,6 +122,8 @@ class RunParts:
             None on the other named paths.
         measurement: the error bounds on what the law reads, from the cart's parts
             (:func:`wmr_mj.sim.certify.measurement_errors_of`; exact on an ideal cart).
+        labels: what the summary calls the law, estimate, gains and path (:class:`RunLabels`).
+        record: the config as its log records it (``RunConfig.as_dict()``, taken once here).
     """
 
     config: RunConfig
@@ -124,6 +152,8 @@ class RunParts:
     loads: tuple[tuple[int, Any], ...] = ()
     route_length_m: float | None = None
     measurement: MeasurementErrors = MeasurementErrors.exact()
+    labels: RunLabels | None = None
+    record: Mapping[str, Any] | None = None
 
     @property
     def claim(self) -> Certificate | None:
@@ -166,8 +196,9 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
     options = plant_options(config)
     disturbance, loads = signal_inputs(config.signals, plant, options, n=n, period=period,
                                        m1_inertia=config.m1_inertia)
+    name = controller_name(config)
     return RunParts(config=config, base=base, plant=plant, estimate=estimate, controller=controller,
-                    controller_name=controller_name(config), tracker=tracker, reference=reference,
+                    controller_name=name, tracker=tracker, reference=reference,
                     settle_s=settle_s, substeps=substeps, period=period, n=n, options=options,
                     analysis=analysis, claims=claim_set(**{LAW_CLAIM: law_claim}),
                     paper_law=paper_estimate is not None, law_settings=law_settings, sensing=config.sensing,
@@ -175,7 +206,8 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
                     reference_bounds=reference_bounds_of(config, reference), signals=config.signals,
                     disturbance=disturbance, loads=loads,
                     route_length_m=route_length(config.path) or manoeuvre_length(config.path),  # lane-change's
-                    measurement=measurement_errors_of(config, plant))
+                    measurement=measurement_errors_of(config, plant), labels=RunLabels.of(config, name=name),
+                    record=config.as_dict())
 
 
 def signal_inputs(signals: Any, plant: C80Parameters, options: dict[str, Any], *, n: int, period: float,

@@ -128,8 +128,9 @@ def _route_law_options(choice: LawChoice, controller: str, params: dict, setting
     else:
         declared = declared_parameters(controller) - {"model"}  # a model is the context's, never a parameter
         preset_values = {k: getattr(design, k) for k in settings}
-        probe = RunConfig(controller=controller, controller_params=params, model=preset_values["model"]
-                          if preset_values["model"] != "identified" else "paper", kp=design.kp, kd=design.kd)
+        model = preset_values["model"] if preset_values["model"] != "identified" else "paper"
+        probe = RunConfig.from_inputs(controller=controller, controller_params=params, model=model, kp=design.kp,
+                                      kd=design.kd)
         reads = controller_and_settings(probe, estimate_parameters(C80))[1]
     out = dict(params)
     for option, fields in given.items():
