@@ -182,14 +182,16 @@ def test_a_route_longer_than_the_run_is_reported_unfinished(capsys):
     assert "route not finished: its reference covers 7 m of the route's 8.1 m in 35 s" in text
 
 
-def test_the_packaged_loop_run_short_is_unfinished_and_a_named_path_has_no_route_keys(capsys):
+def test_the_packaged_loop_run_short_is_unfinished_and_a_closed_named_path_has_no_route_keys(capsys):
     s = _run_json(capsys, "--path", "agv-loop", "--duration", "5")
     lap = load_route("agv-loop").path.length
     # one lap, not the laps the reference repeats; its corners cut the waypoints' 52 m polygon
     assert s["route_length_m"] == lap and 40.0 < lap < 52.0
     # it starts mid-way along its first straight leg: C at V_A for 5 s (tolerance as above)
     assert s["route_driven_m"] == pytest.approx(C80.V_A * 5.0, rel=1e-9) and s["route_finished"] is False
-    named = _run_json(capsys, "--path", "lane-change", "--duration", "1")
+    # the paper circle has no end to reach; the lane change has a manoeuvre, judged as a route (issue 36:
+    # a lane change cut short is partial, tests/test_slips36.py)
+    named = _run_json(capsys, "--path", "paper-circle", "--duration", "10")
     assert not any(k.startswith("route_") for k in named)
 
 

@@ -174,3 +174,18 @@ def test_the_printout_names_the_certificate_taken():
     bounded = {"inputs": {"certificate": "sampled-data", "certificates": {"section-4": {"E_max": 0.25}}}}
     assert _which_certificate(bounded) == "the sampled-data certificate (section 4's: |E| <= 0.25 rad)"
     assert _which_certificate({"condition": 0.5, "inputs": {}}).startswith("(4.23) = 0.5")
+
+
+def test_a_delay_beyond_the_evaluated_periods_leaves_section_4_alone():
+    """A sensing delay of 0.3 s (300 periods at 1 ms, beyond MAX_SAMPLED_DELAY_PERIODS) is not evaluated: the law's
+    claim is section 4's, and the record says why the sampled-data one was not computed."""
+    from wmr_mj.sim.certify import MAX_SAMPLED_DELAY_PERIODS, certificate_for
+    from wmr_mj.sim.config import RunConfig, build_reference, estimate_parameters
+    from wmr_mj.sim.designs import preset
+
+    assert 0.3 / T > MAX_SAMPLED_DELAY_PERIODS
+    config = RunConfig.from_inputs(**preset("certified").config_changes(), sensing="delay=0.3", duration=20.0)
+    reference = build_reference(config.path, estimate_parameters(), dt=T, duration=20.0)[0]
+    cert = certificate_for(config, reference)
+    assert cert.inputs["certificate"] == "section-4"
+    assert cert.inputs["certificates"]["sampled-data"]["reason"].startswith("not computed: a delay of 300")

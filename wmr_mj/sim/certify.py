@@ -296,6 +296,13 @@ def certificate_of(config: Any, reference: Any, *, base: C80Parameters, estimate
     return replace_inputs(cert, inputs)
 
 
+#: the longest delay, in control periods (sensing plus actuation), for which the sampled-data certificate is computed:
+#: its loop carries one state per period of delay, so a delay of seconds at a 1 ms period would cost minutes; far
+#: beyond the delay margin of any gains the designs use (64 periods for K_P = 100, K_D = 20 at 1 ms). A longer
+#: delay leaves section 4's certificate alone (no sampled-data bound is claimed: never a looser verdict).
+MAX_SAMPLED_DELAY_PERIODS = 256
+
+
 def _with_sampled_data(cert: Certificate, config: Any, controller: Any, context: ClaimContext,
                        plant: C80Parameters) -> Certificate:
     """The law's claim on a cart that is not ideal: section 4's (``cert``) or the sampled-data certificate
@@ -317,6 +324,10 @@ def _with_sampled_data(cert: Certificate, config: Any, controller: Any, context:
     try:
         cart = SampledCart.of(config.sensing, control_period=context.control_period, gear_ratio=plant.i2, play=play,
                               actuation_delay_s=config.actuation.delay, measurement=context.measurement)
+        delay_periods = cart.sensing_delay + cart.actuation_delay
+        if delay_periods > MAX_SAMPLED_DELAY_PERIODS:  # a state per period of delay: its matrices grow as d^2
+            raise ParameterError(f"not computed: a delay of {delay_periods} control periods is beyond the "
+                                 f"{MAX_SAMPLED_DELAY_PERIODS} the sampled-data certificate evaluates")
         sampled = sampled_certificate(plant=context.plant, estimate=estimate, gains=Gains(kp=controller.kp,
                                       kd=controller.kd), reference=context.reference, limits=context.limits,
                                       compensation=Compensation(friction_sign=sign,
