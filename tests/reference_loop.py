@@ -44,6 +44,7 @@ from wmr_mj.sim.config import (
 )
 from wmr_mj.sim.log_header import LogHeader
 from wmr_mj.sim.parts import RunLabels, control_substeps
+from wmr_mj.sim.summary import voltage_effort
 
 
 def reference_run(
@@ -185,13 +186,20 @@ def reference_run(
     measured = RunMeasures(status=status, settle_s=settle_s, sup_E=_sup(done["E"]), sup_Edot=_sup(done["E_dot"]),
                            sup_E_settled=_sup(done["E"][after]), sup_Edot_settled=_sup(done["E_dot"][after]),
                            saturated_fraction=saturated / k, left_range_at=left_range_at,
-                           final_alpha=done["alpha"][-1], control_steps=k, steps=k * substeps, wall_s=wall)
+                           final_alpha=done["alpha"][-1], control_steps=k, steps=k * substeps, wall_s=wall,
+                           effort=voltage_effort(done["voltage"], period))  # the applied voltage's
     summary = report(RunLabels.of(config), measured, analysis=analysis, params=params, certificate=certificate,
                      drift=_drift_of(done["E"], done["alpha0_dot"][-1] - done["E_dot"][-1], period),
                      path=judge_path(reference, done["t"][at], r_C[:k][at], done["heading"][at], settle_s=settle_s,
                                      certificate=certificate, steering_range=params.steering_range))
     summary = dataclasses.replace(summary, mujoco_warnings=int(sum(w.number for w in d.warning)),
                                   analysis=analysis.as_dict(), controller_config=controller.describe())
+    from wmr_mj.reference.route import RouteProgress, route_length
+    from wmr_mj.sim.config import manoeuvre_length
+
+    route_m = route_length(config.path) or manoeuvre_length(config.path)  # a route's, or a lane change's manoeuvre
+    if route_m is not None:
+        summary = dataclasses.replace(summary, route=RouteProgress.along(route_m, reference, summary.duration))
     if logger is not None:
         flush(k)
         logger.close(summary.to_dict(), status=status)
