@@ -46,7 +46,25 @@ def one_error_line(capsys) -> str:
     Returns:
         The line, ``wmr-mj: error: ...``.
     """
-    err = capsys.readouterr().err
+    return _the_one_line(capsys.readouterr().err)
+
+
+def refused_line(capsys, argv: list[str]) -> str:
+    """Runs ``wmr-mj ARGV`` in process and returns its one error line, asserting exit status 2, nothing on
+    stdout, one line on stderr and no traceback (:func:`one_error_line`).
+
+    Args:
+        capsys: pytest's capture fixture; argv: the command's arguments, without ``wmr-mj``.
+    """
+    from wmr_mj.cli.app import main
+
+    assert main(argv) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "", captured.out
+    return _the_one_line(captured.err)
+
+
+def _the_one_line(err: str) -> str:
     lines = err.strip().splitlines()
     assert len(lines) == 1, err
     assert lines[0].startswith("wmr-mj: error: ") and "Traceback" not in err

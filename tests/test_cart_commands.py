@@ -12,6 +12,7 @@ import json
 from pathlib import Path
 
 import pytest
+from helpers import refused_line
 
 from wmr_mj.carts import CARTS_DIR, load_cart
 from wmr_mj.cli.app import main
@@ -47,14 +48,6 @@ def _run_json(capsys, *extra: str) -> dict:
     obj = json.loads(capsys.readouterr().out)
     return {k: v for k, v in obj.items() if k not in TIMINGS}
 
-
-def _one_error_line(capsys, argv: list[str]) -> str:
-    assert main(argv) == 2
-    captured = capsys.readouterr()
-    lines = captured.err.strip().splitlines()
-    assert len(lines) == 1, captured.err
-    assert "Traceback" not in captured.err and captured.out == ""
-    return lines[0]
 
 
 # -- the C80 to the bit -------------------------------------------------------------------------------------------
@@ -92,7 +85,7 @@ def test_a_carts_stops_refuse_a_path_that_needs_more_steering(tmp_path, capsys):
     """The paper circle needs asin(l1/R) = 0.659 rad; a cart with 0.6 rad stops refuses it in one line (exit 2),
     the C80's 0.9 rad stops take it."""
     stops = _cart(tmp_path, ('[supply.steering_range]\nvalue = 0.9', '[supply.steering_range]\nvalue = 0.6'))
-    line = _one_error_line(capsys, ["run", "--cart", str(stops), "--duration", "10", "--no-log"])
+    line = refused_line(capsys, ["run", "--cart", str(stops), "--duration", "10", "--no-log"])
     assert line.startswith("wmr-mj: error: path infeasible") and "max_angle = 0.6 rad" in line
     assert main(["run", "--duration", "10", "--no-log", "--json"]) == 0
 
@@ -181,6 +174,6 @@ def test_a_cart_in_a_log_verifies_by_replay(tmp_path, capsys):
                                      ["compare", "paper"], ["falsify"]])
 @pytest.mark.parametrize("cart", ["no-such-cart", "missing/cart.toml"])
 def test_a_bad_cart_is_one_line_and_exit_2(command, cart, capsys):
-    line = _one_error_line(capsys, [*command, "--cart", cart])
+    line = refused_line(capsys, [*command, "--cart", cart])
     assert line == (f"wmr-mj: error: cart {cart!r} is neither a file nor a shipped cart; accepted: a path to a "
                     ".toml cart file or one of c80, c80-re40")

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import jsonschema
 import pytest
+from helpers import refused_line
 
 from wmr_mj.carts import CARTS_DIR, SCHEMA_PATH, cart_names, load_cart, load_schema
 from wmr_mj.carts.schema import SUPPORTED_KEYWORDS, resolve, schema_table
@@ -208,14 +209,6 @@ SCHEMA_CASES = {
 }
 
 
-def _one_error_line(capsys, argv) -> str:
-    assert main(argv) == 2
-    captured = capsys.readouterr()
-    lines = captured.err.strip().splitlines()
-    assert len(lines) == 1, captured.err
-    assert "Traceback" not in captured.err and captured.out == ""
-    return lines[0]
-
 
 @pytest.mark.parametrize("case", list(SCHEMA_CASES))
 def test_wrong_file_is_one_line_and_exit_2(case, tmp_path, capsys):
@@ -223,7 +216,7 @@ def test_wrong_file_is_one_line_and_exit_2(case, tmp_path, capsys):
     document = _c80_document()
     mutate(document)
     path = _write(tmp_path, document)
-    line = _one_error_line(capsys, ["cart", "check", str(path)])
+    line = refused_line(capsys, ["cart", "check", str(path)])
     assert line.startswith(f"wmr-mj: error: cart file {str(path)!r}: ")
     for text in expected:
         assert text in line, (text, line)
@@ -268,17 +261,17 @@ def test_rules_beside_the_schema_are_one_line_and_exit_2(case, tmp_path, capsys)
     mutate, expected = RULE_CASES[case]
     document = _c80_document()
     mutate(document)
-    line = _one_error_line(capsys, ["cart", "check", str(_write(tmp_path, document))])
+    line = refused_line(capsys, ["cart", "check", str(_write(tmp_path, document))])
     for text in expected:
         assert text in line, (text, line)
 
 
 def test_unreadable_files_are_one_line_and_exit_2(tmp_path, capsys):
-    line = _one_error_line(capsys, ["cart", "check", str(tmp_path / "nope.toml")])
+    line = refused_line(capsys, ["cart", "check", str(tmp_path / "nope.toml")])
     assert "is neither a file nor a shipped cart" in line and "c80" in line
     bad = tmp_path / "bad.toml"
     bad.write_text("name = \n", encoding="utf-8")
-    assert "is not valid TOML" in _one_error_line(capsys, ["cart", "check", str(bad)])
+    assert "is not valid TOML" in refused_line(capsys, ["cart", "check", str(bad)])
 
 
 def test_load_cart_raises_parameter_error():

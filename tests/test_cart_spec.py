@@ -11,6 +11,7 @@ import math
 from pathlib import Path
 
 import pytest
+from helpers import one_error_line
 
 from wmr_mj.cli.app import main
 from wmr_mj.errors import ParameterError, UnknownNameError
@@ -28,18 +29,10 @@ HERE = Path(__file__).resolve().parent.parent
 SHORT = ["--preset", "certified", "--path", "lane-change", "--duration", "6", "--no-log"]
 
 
-def _one_error_line(capsys) -> str:
-    """The one line a refusal writes on stderr (no traceback)."""
-    err = capsys.readouterr().err
-    lines = err.strip().splitlines()
-    assert len(lines) == 1, err
-    assert lines[0].startswith("wmr-mj: error: ") and "Traceback" not in err
-    return lines[0]
-
 
 def _refused(capsys, argv: list[str], words: list[str]) -> str:
     assert main(argv) == 2
-    line = _one_error_line(capsys)
+    line = one_error_line(capsys)
     assert all(w in line for w in words), line
     return line
 
