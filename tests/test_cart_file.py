@@ -104,7 +104,7 @@ def test_c80_sources_are_the_model_cards():
 def test_c80_file_found_from_any_folder(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     cart = load_cart("c80")
-    assert cart.path == CARTS_DIR / "c80.toml" and cart_names() == ("c80", "c80-re40")
+    assert cart.path == CARTS_DIR / "c80.toml" and cart_names() == ("c80", "c80-magmotor")
     assert cart.parameters == C80_CART.parameters
 
 
