@@ -93,16 +93,16 @@ def certified_on_cart(cart: Any) -> dict[str, Any]:
     default sensing, actuation and play: omega_r [rad/s], kp, kd, certified, E_max [rad], Edot_max [rad/s],
     voltage_max [V], voltage_limit [V], met, unmet (assumption names); or omega_r None and 'reason' where the rule
     finds no omega_r on its grid."""
-    from wmr_mj.errors import ParameterError
+    from wmr_mj.errors import InfeasiblePathError, ParameterError
     from wmr_mj.sim.config import RunConfig
     from wmr_mj.sim.designs import certified_design
     from wmr_mj.sim.parts import resolve_run
 
-    try:
+    try:  # a paper circle the cart's supply or stops cannot follow: the cart's answer, not the user's input
         design = certified_design(cart)
-    except ParameterError as exc:
+        claim = resolve_run(RunConfig(**design.config_changes(), cart=cart)).claim
+    except (ParameterError, InfeasiblePathError) as exc:
         return {"omega_r": None, "reason": str(exc)}
-    claim = resolve_run(RunConfig(**design.config_changes(), cart=cart)).claim
     assert claim is not None  # the computed-torque law always states its certificate
     return {"omega_r": design.kd, "kp": design.kp, "kd": design.kd, "certified": claim.certified,
             "E_max": claim.E_max, "Edot_max": claim.Edot_max, "voltage_max": claim.voltage_max,
@@ -119,6 +119,7 @@ def design_on_cart(cart: Any, *, seed: int = 0, budget: int = DESIGN_BUDGET) -> 
         else binding (the assumption, or why no certificate covers the cart's sensing); budget, seed, evaluations,
         and the ``wmr-mj design`` command that runs the same search.
     """
+    from wmr_mj.errors import InfeasiblePathError
     from wmr_mj.sim.certify import measurement_errors_of
     from wmr_mj.sim.config import RunConfig, base_for
     from wmr_mj.sim.design_search import DesignProblem, search_design
@@ -131,7 +132,10 @@ def design_on_cart(cart: Any, *, seed: int = 0, budget: int = DESIGN_BUDGET) -> 
     if not measurement.covered:  # design refuses such a cart's sensing (no certificate can cover it)
         return {**out, "certified": False, "evaluations": 0,
                 "binding": f"the default sensing ({measurement.why_not}: no certificate covers it)"}
-    result = search_design(DesignProblem(base=base, seed=seed, budget=budget))
+    try:
+        result = search_design(DesignProblem(base=base, seed=seed, budget=budget))
+    except InfeasiblePathError as exc:  # the cart cannot follow the paper circle: no gains certify it
+        return {**out, "certified": False, "evaluations": 0, "binding": f"the paper circle's feasibility ({exc})"}
     out.update(certified=result.certified, evaluations=result.evaluations)
     if not result.certified:
         return {**out, "binding": result.binding}
