@@ -92,7 +92,7 @@ def test_a_carts_stops_refuse_a_path_that_needs_more_steering(tmp_path, capsys):
 
 def test_the_certified_rule_on_a_cart_gives_its_own_omega_r(tmp_path, capsys):
     """--preset certified on a cart runs the rule on it: omega_r from certified_omega_r(cart=) called directly.
-    On the wide-box cart the rule gives 25 rad/s, not the C80's 20; on c80-re40 its value is the rule's too."""
+    On the wide-box cart the rule gives 25 rad/s, not the C80's 20; on c80-magmotor its value is the rule's too."""
     wide = str(_wide_box_cart(tmp_path))
     omega_r = certified_omega_r(cart=wide)
     assert omega_r is not None and omega_r != CERTIFIED.kd
@@ -100,33 +100,36 @@ def test_the_certified_rule_on_a_cart_gives_its_own_omega_r(tmp_path, capsys):
     assert (design.kp, design.kd) == (omega_r * omega_r / 4.0, omega_r)
     summary = _run_json(capsys, "--preset", "certified", "--cart", wide)
     assert (summary["kp"], summary["kd"]) == (omega_r * omega_r / 4.0, omega_r)
-    re40 = certified_design("c80-re40")
-    assert re40.kd == certified_omega_r(cart="c80-re40") and re40.kp == re40.kd ** 2 / 4.0
+    re40 = certified_design("c80-magmotor")
+    assert re40.kd == certified_omega_r(cart="c80-magmotor") and re40.kp == re40.kd ** 2 / 4.0
     assert preset("certified") is CERTIFIED  # the C80's design, as before
 
 
 def test_the_second_cart_is_its_file(tmp_path):
-    """c80-re40: the motor and gear of its file, every other parameter the C80's."""
-    cart = load_cart("c80-re40")
-    base = base_for(RunConfig(cart="c80-re40"))
+    """c80-magmotor: the motor and gear of its file, every other parameter the C80's. The motor's numbers are its
+    data sheet's lines (Rt = 0.31 Ohm; Ke = 13.3 V/krpm in V s/rad), the gear the C80's rule C_V = 4.77 V s/rad."""
+    import math
+
+    cart = load_cart("c80-magmotor")
+    base = base_for(RunConfig(cart="c80-magmotor"))
     c80 = load_cart("c80").parameters
-    assert (base.R_a, base.k_i, base.k_b, base.i2) == (0.299, 0.0302, 0.0302, 2197 / 27)
+    k = 13.3 * 60.0 / (2.0 * math.pi * 1000.0)
+    assert (base.R_a, base.k_i, base.k_b, base.i2) == (0.31, k, k, 4.77 / k)
     assert {k: v for k, v in cart.parameters.items() if k not in ("R_a", "k_i", "k_b", "i2")} == \
         {k: v for k, v in c80.items() if k not in ("R_a", "k_i", "k_b", "i2")}
-    assert all(("maxon" in cart.sources[k]) for k in ("R_a", "k_i", "k_b", "i2"))
-    assert all(cart.sources[k].startswith("assumption") for k in cart.parameters if k not in ("R_a", "k_i", "k_b",
-                                                                                              "i2"))
+    assert all(("Magmotor" in cart.sources[k]) for k in ("R_a", "k_i", "k_b"))
+    assert all(cart.sources[k].startswith("assumption") for k in cart.parameters if k not in ("R_a", "k_i", "k_b"))
 
 
 def test_cart_check_reports_the_certified_design_in_its_second_line(capsys):
-    assert main(["cart", "check", "c80-re40", "--json"]) == 0
+    assert main(["cart", "check", "c80-magmotor", "--json"]) == 0
     got = json.loads(capsys.readouterr().out)["certified_design"]
-    config = RunConfig(cart="c80-re40", **certified_design("c80-re40").config_changes())
+    config = RunConfig(cart="c80-magmotor", **certified_design("c80-magmotor").config_changes())
     claim = resolve_run(config).claim
-    assert got["omega_r"] == certified_omega_r(cart="c80-re40")
+    assert got["omega_r"] == certified_omega_r(cart="c80-magmotor")
     assert (got["E_max"], got["voltage_max"], got["certified"]) == (claim.E_max, claim.voltage_max, claim.certified)
     assert got["voltage_limit"] == 24.0 and got["unmet"] == list(claim.unmet)
-    assert main(["cart", "check", "c80-re40"]) == 0
+    assert main(["cart", "check", "c80-magmotor"]) == 0
     second = capsys.readouterr().out.splitlines()[1]
     assert second.startswith(f"certified design on this cart: omega_r = {got['omega_r']:g} rad/s")
     assert f"E_max = {claim.E_max:.4g} rad" in second
@@ -137,10 +140,10 @@ def test_robustness_box_derived_on_a_cart_is_the_carts_box(capsys):
     here with the closed forms of C80Parameters.coefficients at the box's two m1 ends."""
     from wmr_mj.params import with_params
 
-    assert main(["robustness", "--box", "derived", "--cart", "c80-re40", "--json"]) == 0
+    assert main(["robustness", "--box", "derived", "--cart", "c80-magmotor", "--json"]) == 0
     box = json.loads(capsys.readouterr().out)["box"]
-    base = base_for(RunConfig(cart="c80-re40"))
-    ends = [with_params(base, m1=m).coefficients("paper") for m in load_cart("c80-re40").uncertainty["m1"]["m1"]]
+    base = base_for(RunConfig(cart="c80-magmotor"))
+    ends = [with_params(base, m1=m).coefficients("paper") for m in load_cart("c80-magmotor").uncertainty["m1"]["m1"]]
     for name in ("P", "C_V", "F", "K"):
         values = [getattr(c, name) for c in ends]
         assert box[name] == pytest.approx([min(values), max(values)], rel=1e-12), name  # rel: rounding only
@@ -155,14 +158,14 @@ def test_a_cart_in_a_log_verifies_by_replay(tmp_path, capsys):
     from wmr_mj.sim.config import config_from_dict
 
     log = tmp_path / "re40.mcap"
-    assert main(["run", "--cart", "c80-re40", "--preset", "certified", "--duration", "10", "--out", str(log)]) == 0
+    assert main(["run", "--cart", "c80-magmotor", "--preset", "certified", "--duration", "10", "--out", str(log)]) == 0
     capsys.readouterr()
-    text = (CARTS_DIR / "c80-re40.toml").read_text(encoding="utf-8")
+    text = (CARTS_DIR / "c80-magmotor.toml").read_text(encoding="utf-8")
     loaded = load_log(log)
     assert loaded.attachments["cart.toml"].decode("utf-8") == text
     assert loaded.config["cart"]["text"] == text
     again = config_from_dict(loaded.config)
-    assert base_for(again) == base_for(RunConfig(cart="c80-re40"))
+    assert base_for(again) == base_for(RunConfig(cart="c80-magmotor"))
     assert main(["replay", str(log), "--verify"]) == 0
     out = capsys.readouterr().out
     assert "verify     bit-identical" in out and "re-run: the voltages it applied are bit-identical" in out
@@ -176,4 +179,4 @@ def test_a_cart_in_a_log_verifies_by_replay(tmp_path, capsys):
 def test_a_bad_cart_is_one_line_and_exit_2(command, cart, capsys):
     line = refused_line(capsys, [*command, "--cart", cart])
     assert line == (f"wmr-mj: error: cart {cart!r} is neither a file nor a shipped cart; accepted: a path to a "
-                    ".toml cart file or one of c80, c80-re40")
+                    ".toml cart file or one of c80, c80-magmotor")

@@ -104,7 +104,7 @@ def test_c80_sources_are_the_model_cards():
 def test_c80_file_found_from_any_folder(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     cart = load_cart("c80")
-    assert cart.path == CARTS_DIR / "c80.toml" and cart_names() == ("c80", "c80-re40")
+    assert cart.path == CARTS_DIR / "c80.toml" and cart_names() == ("c80", "c80-magmotor")
     assert cart.parameters == C80_CART.parameters
 
 
@@ -327,7 +327,8 @@ def test_every_shipped_cart_passes_cart_check(name, capsys):
     assert out[0].startswith(f"cart {cart.name} {cart.version} ({CARTS_DIR / f'{name}.toml'}): passes: ")
     assert "no MuJoCo warning" in out[0]
     assert out[1].startswith("certified design on this cart: ")  # its second line (tests/test_cart_commands.py)
-    assert out[3].startswith("steps: 1000 steps (1 s)") and "0 MuJoCo warnings" in out[3]
+    assert out[2].startswith("design certifies it: ")  # its third line (tests/test_cart_check_design.py)
+    assert out[4].startswith("steps: 1000 steps (1 s)") and "0 MuJoCo warnings" in out[4]
 
 
 def test_cart_check_passes_on_a_scaled_cart_json(tmp_path, capsys):

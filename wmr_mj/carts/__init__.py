@@ -7,7 +7,7 @@ Usage::
 
     from wmr_mj.carts import load_cart, cart_names
 
-    cart_names()                          # ('c80', 'c80-re40')
+    cart_names()                          # ('c80', 'c80-magmotor')
     cart = load_cart("mine.toml")         # one line and ParameterError for a wrong file
 """
 

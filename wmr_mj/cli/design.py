@@ -30,7 +30,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="a path every certificate must hold on (repeatable; default paper-circle)")
     p.add_argument("--uncertainty", default=None, help="the plant box: m1 (default) or full (wmr_mj/params.py)")
     p.add_argument("--m1-range", nargs=2, type=float, metavar=("LO", "HI"), default=M1_RANGE,
-                   help="m1 range of the box, kg (default 550 750)")
+                   help="m1 range of the box, kg (default: the cart's m1 box, 550 750 on the C80)")
     p.add_argument("--range", action="append", metavar="NAME=LO:HI", help="another ranged parameter of the box")
     p.add_argument("--reference-bounds", metavar="paper|KEY=VALUE,...", default=None,
                    help="declared reference bounds the certificates cover (default: each path's own)")
@@ -64,9 +64,9 @@ def problem_from_args(args: argparse.Namespace) -> Any:
     from wmr_mj.cli._common import box_ranges_from_args
     from wmr_mj.cli.run import hardware_from_args
     from wmr_mj.errors import ParameterError
-    from wmr_mj.params import C80
+    from wmr_mj.params import M1_RANGE
     from wmr_mj.sim.certify import measurement_errors_of
-    from wmr_mj.sim.config import RunConfig
+    from wmr_mj.sim.config import RunConfig, base_for
     from wmr_mj.sim.design_search import OBJECTIVES, DesignProblem, check_periods
     from wmr_mj.sim.designs import CERTIFIED
 
@@ -75,6 +75,9 @@ def problem_from_args(args: argparse.Namespace) -> Any:
     lo, hi = (float(v) for v in args.m1_range)
     if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo <= hi):
         raise ParameterError(f"--m1-range {lo:g} {hi:g} is an empty box; LO <= HI, both > 0 kg, is accepted")
+    # --cart: the cart's parameter set, supply and stops, its default sensing, actuation and play (the parts not
+    # given stay None) and, where --m1-range is not given (its default, the very object), its m1 box
+    m1_range: Any = None if args.m1_range is M1_RANGE else (lo, hi)
     ranges = box_ranges_from_args(args)
     for name, (a, b) in ranges.items():
         if not a <= b:
@@ -85,9 +88,10 @@ def problem_from_args(args: argparse.Namespace) -> Any:
     except ValueError:
         raise ParameterError(f"--periods {args.periods!r} is not a list of numbers (s), e.g. 0.001,0.002") from None
     check_periods(periods, args.duration)
-    base = RunConfig(**CERTIFIED.config_changes(), m1_range=(lo, hi), box_ranges=ranges, duration=args.duration,
-                     reference_bounds=args.reference_bounds, **hardware_from_args(args))
-    measurement = measurement_errors_of(base, C80)
+    base = RunConfig(**CERTIFIED.config_changes(), m1_range=m1_range, box_ranges=ranges, duration=args.duration,
+                     reference_bounds=args.reference_bounds, cart=getattr(args, "cart", None),
+                     **hardware_from_args(args))
+    measurement = measurement_errors_of(base, base_for(base))
     if not measurement.covered:
         raise ParameterError(f"{measurement.why_not}: no certificate can cover it (--sensing, --actuation, "
                              "--backlash); a bounded error is accepted")
@@ -99,6 +103,7 @@ def problem_from_args(args: argparse.Namespace) -> Any:
 def run(args: argparse.Namespace) -> int:
     import time
 
+    from wmr_mj._util.files import write_json_atomic
     from wmr_mj.cli._common import print_json
     from wmr_mj.errors import ParameterError
     from wmr_mj.sim.design_search import design_dict, search_design, write_design
@@ -111,6 +116,9 @@ def run(args: argparse.Namespace) -> int:
     wall = time.perf_counter() - t0
     write_design(result, args.out)
     out = design_dict(result)
+    if problem.base.cart is not None:  # the file records the cart searched on (name, version, path, the file's
+        out["cart"] = dict(problem.base.cart)  # text); a C80 design's file has no "cart" key, as a C80 config
+        write_json_atomic(args.out, out)
     out.update(file=str(args.out), wall_s=wall, run=run_line(args))
     if result.certified and args.check > 0:
         out["check"] = check_design(problem, result, args.check)
@@ -167,11 +175,14 @@ def run_line(args: argparse.Namespace) -> str:
     from wmr_mj.params import M1_RANGE
 
     words = ["wmr-mj", "run", "--design", shlex.quote(str(args.out))]
+    if getattr(args, "cart", None) is not None:
+        words += ["--cart", shlex.quote(str(args.cart))]
     if args.path:
         words += ["--path", shlex.quote(args.path[0])]
     if args.uncertainty is not None:
         words += ["--uncertainty", args.uncertainty]
-    if tuple(args.m1_range) != tuple(M1_RANGE):
+    if tuple(args.m1_range) != tuple(M1_RANGE) or (getattr(args, "cart", None) is not None
+                                                   and args.m1_range is not M1_RANGE):  # given on a cart: its own
         words += ["--m1-range", *(repr(float(v)) for v in args.m1_range)]
     words += [w for item in args.range or [] for w in ("--range", shlex.quote(item))]
     if args.reference_bounds is not None:

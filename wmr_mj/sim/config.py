@@ -331,6 +331,23 @@ def _check_fields(config: RunConfig) -> None:
     for name in config.plant_overrides:
         if name not in names:
             raise UnknownNameError("parameter", name, names)
+    _check_motor_constant(config)
+
+
+def _check_motor_constant(config: RunConfig) -> None:
+    """k_b equal to k_i after the overrides, as a cart file must have them (:mod:`wmr_mj.carts.cartfile`): one flux
+    in SI units, and MuJoCo's dcmotor has one constant (it would silently use their geometric mean)."""
+    from wmr_mj.carts.cartfile import MOTOR_CONSTANT_RTOL
+
+    overrides = config.plant_overrides
+    if "k_i" not in overrides and "k_b" not in overrides:
+        return
+    base = base_for(config)
+    k_i, k_b = overrides.get("k_i", base.k_i), overrides.get("k_b", base.k_b)
+    if abs(k_b - k_i) > MOTOR_CONSTANT_RTOL * abs(k_i):
+        raise ParameterError(f"--param: k_b = {k_b!r} V s/rad and k_i = {k_i!r} N m/A differ; accepted: k_b equal to "
+                             "k_i (one flux in SI units; MuJoCo's dcmotor has one constant), e.g. --param "
+                             f"k_i={k_i!r} --param k_b={k_i!r}")
 
 
 def _check_hardware(config: RunConfig) -> None:
