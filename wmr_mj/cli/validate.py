@@ -53,7 +53,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--design", action="append", metavar="DESIGN", default=None,
                    help="a design of your own, judged beside the ladder (its rung and its nominal run): a preset, "
                         "a law's name, FILE.py:Class or module:Class, with ,key=value settings as for wmr-mj "
-                        "compare, e.g. 'sliding-mode' or 'my_law.py:MyLaw,k=2' (repeatable)")
+                        "compare, e.g. 'sliding-mode' or 'my_law.py:MyLaw,k=2', or a design file FILE.json "
+                        "(wmr-mj design --out: its gains and cart; validate's --sensing, --actuation, --backlash "
+                        "replace a part) (repeatable)")
     add_threads(p, help="simulation threads (default 0: all CPUs)")
     add_out(p, help="report folder (default logs/validate-<timestamp>/; an existing folder resumes its sweeps)")
     add_json(p, help="print the summary object (summary.json) on stdout")

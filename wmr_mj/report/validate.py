@@ -196,15 +196,17 @@ def correction_stage(settings: ValidateSettings, folder: Path, st: Stages) -> di
 
 def designs_stage(settings: ValidateSettings, folder: Path, st: Stages, *, first_index: int) -> list[dict[str, Any]]:
     """``validate --design TOKEN``: each design of the user's (a plug-in law, a tracker, other gains; a token
-    as ``wmr-mj compare`` takes it) judged beside the ladder: its rung (:func:`run_rung`: the same m1 sweep,
-    its verdicts against its own claim) and its nominal run (summary.json's ``designs``)."""
+    as ``wmr-mj compare`` takes it, a design file ``FILE.json`` among them) judged beside the ladder: its rung
+    (:func:`run_rung`: the same m1 sweep, its verdicts against its own claim) and its nominal run
+    (summary.json's ``designs``)."""
     from wmr_mj.sim.closed_loop import run_parts
+    from wmr_mj.sim.compare import FileDesign, is_design_file
     from wmr_mj.sim.designs import TokenDesign
     from wmr_mj.sim.parts import resolve_run
 
     out = []
     for k, token in enumerate(settings.designs, start=first_index):
-        design = TokenDesign(token)
+        design: DesignLike = FileDesign(token, settings.cart) if is_design_file(token) else TokenDesign(token)
         parts = resolve_run(settings.config(design))  # the rung's claim and its nominal run: one resolution
         rung = run_rung(settings, k, design, folder, st, None, parts=parts)
         st.start(f"design-{k}", f"nominal run of {token} at m1 = {settings.nominal_m1:g} kg")
