@@ -500,7 +500,8 @@ def cart_design_rows(summary: Summary) -> list[list[str]]:
 def cart_design_blocks(summary: Summary) -> list[Block]:
     """The design ``wmr-mj design`` finds for the 12-bit axis encoder beside the certified design on it, in
     section (e), where the report has it (reports written before it have no ``cart_design``)."""
-    sec = ValidateSummary.of(summary).cart_design
+    summary = ValidateSummary.of(summary)
+    sec = summary.cart_design
     if sec is None:
         return []
     search = sec.search
@@ -513,10 +514,10 @@ def cart_design_blocks(summary: Summary) -> list[Block]:
             ("p", f"The design is what '{sec.command}' finds ({search['method']}, seed {search['seed']}, "
                   f"{search['evaluations']} certificates): the gains, sign width and period whose certificate on "
                   f"this cart is the smallest over the box; it is written to {sec.design_file} ('wmr-mj run "
-                  f"--design {sec.design_file}') and swept as that file reads back. Both designs run the same m1 "
-                  "draws on the same cart; each run is judged against its own design's certificate, and sup|E|/E_max "
-                  "is of that certificate. TV u: the voltage's total variation per second, the mean over the "
-                  "runs." + found)]
+                  f"--design {summary.folder}/{sec.design_file}') and swept as that file reads back. Both designs "
+                  "run the same m1 draws on the same cart; each run is judged against its own design's "
+                  "certificate, and sup|E|/E_max is of that certificate. TV u: the voltage's total variation per "
+                  "second, the mean over the runs." + found)]
 
 
 def cart_design_finding(sec: Any) -> str:
