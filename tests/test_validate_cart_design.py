@@ -147,3 +147,31 @@ def test_validate_judges_the_users_design_file(validated, own_design):
     assert rung["config"]["sensing"] == written["sensing"]  # the file's cart: validate gave none
     rows = _runs(folder, rung["runs_csv"])
     assert Counter(r["verdict"] for r in rows) == Counter({k: v for k, v in rung["verdicts"].items() if v})
+
+
+def test_the_recorded_command_searches_the_sections_problem():
+    """The command the section records, parsed by ``wmr-mj design`` itself, finds the design the section's problem
+    finds, for settings away from every default (path, m1 box, duration, actuation, seed, budget)."""
+    import argparse
+    import shlex
+
+    from wmr_mj.cli import design as design_cli
+    from wmr_mj.report.cart_design import design_command, design_problem
+    from wmr_mj.report.settings import ValidateSettings
+    from wmr_mj.sim.design_search import search_design
+
+    settings = ValidateSettings(n=1, duration=12.0, path="lane-change", m1_range=(560.0, 740.0),
+                                actuation="delay=0.002", search_budget=0)
+    problem = design_problem(settings, seed=2, budget=12)
+    command = design_command(settings, problem)
+    for option in ("--path lane-change", "--m1-range 560 740", "--duration 12", "--actuation delay=0.002", "--seed 2",
+                   "--budget 12"):
+        assert option in command, option
+    parser = argparse.ArgumentParser()
+    design_cli.register(parser.add_subparsers())
+    args = parser.parse_args(shlex.split(command)[1:])
+    again = design_cli.problem_from_args(args)
+    ours, theirs = search_design(problem), search_design(again)
+    assert ours.score == theirs.score and ours.certified == theirs.certified
+    assert {k: ours.settings[k] for k in ("kp", "kd", "friction_width", "control_period", "sensing", "actuation")} \
+        == {k: theirs.settings[k] for k in ("kp", "kd", "friction_width", "control_period", "sensing", "actuation")}

@@ -2,9 +2,11 @@
 
 Runs the paper's design against the paper's claim and against its own certificate, the
 ladder from the paper's design to the certified one (one change per rung, a sweep of m1
-each), the worst-case search beside the Monte-Carlo worst and the certificate, and the
-plant's measured friction law, then writes a report folder (index.html, index.md,
-summary.json, summary.csv, per-run CSVs, the worst runs' MCAP logs, figures). Prints on stdout
+each), the worst-case search beside the Monte-Carlo worst and the certificate, the
+plant's measured friction law, the certified design on real encoders and, beside it, the design
+``wmr-mj design`` finds for the 12-bit axis encoder (its gains, certificate and runs), then
+writes a report folder (index.html, index.md, summary.json, summary.csv, per-run CSVs, the
+worst runs' MCAP logs, figures). Prints on stdout
 a five-line verdict first (the question; the paper's design; why; the certified design; where
 the report is: ``wmr_mj.report.text.verdict_lines``, the same lines that open index.md and
 index.html), then the details, and one line per stage on stderr. See :mod:`wmr_mj.report.validate`.

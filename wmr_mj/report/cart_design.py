@@ -153,6 +153,8 @@ def design_command(settings: ValidateSettings, problem: Any) -> str:
         words += ["--actuation", shlex.quote(_spec(problem.base.actuation.as_dict()))]
     if problem.base.transmission.backlash:
         words += ["--backlash", repr(problem.base.transmission.backlash)]
+    if settings.cart is not None:  # the cart file the search ran on (its parameter set, box and stops)
+        words += ["--cart", shlex.quote(str(settings.cart["path"]))]
     if settings.path != "paper-circle":
         words += ["--path", shlex.quote(settings.path)]
     if settings.uncertainty != "m1":
