@@ -70,6 +70,7 @@ def _json(capsys, argv: list[str]) -> dict:
     return json.loads(capsys.readouterr().out)
 
 
+@pytest.mark.slow
 def test_compares_row_of_a_design_file_is_run_design_file(design_file, tmp_path, capsys):
     suite = tmp_path / "suite.toml"
     suite.write_text(SUITE)
