@@ -7,7 +7,9 @@ FILE.py:Class), ``correction=true``, ``model=...``, ``kp=...``, ``kd=...``, ``om
 own parameters (``sliding-mode,k=5``). A law's name means what ``wmr-mj run --controller NAME`` means: the
 law with its own defaults (``computed-torque`` and ``pd`` with the paper's model and gains, so
 ``computed-torque`` is the ``paper`` preset; ``sliding-mode`` and ``adaptive-computed-torque`` on the
-non-holonomic model); ``certified`` names the certified design. Example::
+non-holonomic model); ``certified`` names the certified design. A DESIGN ending in ``.json`` is a design file
+(``wmr-mj design --out FILE.json``): its law, gains, period and cart, as ``wmr-mj run --design FILE`` reads
+them (a bad file: one line, exit status 2). Example::
 
     wmr-mj compare paper certified certified,correction=true sliding-mode adaptive-computed-torque \\
         sliding-mode,tracker=pure-pursuit --scenarios 'circle/*' --budget 32
@@ -36,7 +38,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                               "adversary's) is certified-outside: it breaks that design's claim (a banner above "
                               "the table names the run); 2 bad input")
     p.add_argument("designs", nargs="+", metavar="DESIGN", help="a preset, a law's name, FILE.py:Class or "
-                                                               "module:Class, with ,key=value settings")
+                                                               "module:Class, with ,key=value settings; or a "
+                                                               "design file FILE.json (wmr-mj design --out)")
     p.add_argument("--suite", default="standard-v1",
                    help=f"the scenario suite: one of {', '.join(suite_names())} or a suite file (.toml)")
     p.add_argument("--scenarios", action="append", metavar="PATTERN",

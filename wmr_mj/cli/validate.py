@@ -2,9 +2,11 @@
 
 Runs the paper's design against the paper's claim and against its own certificate, the
 ladder from the paper's design to the certified one (one change per rung, a sweep of m1
-each), the worst-case search beside the Monte-Carlo worst and the certificate, and the
-plant's measured friction law, then writes a report folder (index.html, index.md,
-summary.json, summary.csv, per-run CSVs, the worst runs' MCAP logs, figures). Prints on stdout
+each), the worst-case search beside the Monte-Carlo worst and the certificate, the
+plant's measured friction law, the certified design on real encoders and, beside it, the design
+``wmr-mj design`` finds for the 12-bit axis encoder (its gains, certificate and runs), then
+writes a report folder (index.html, index.md, summary.json, summary.csv, per-run CSVs, the
+worst runs' MCAP logs, figures). Prints on stdout
 a five-line verdict first (the question; the paper's design; why; the certified design; where
 the report is: ``wmr_mj.report.text.verdict_lines``, the same lines that open index.md and
 index.html), then the details, and one line per stage on stderr. See :mod:`wmr_mj.report.validate`.
@@ -53,7 +55,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--design", action="append", metavar="DESIGN", default=None,
                    help="a design of your own, judged beside the ladder (its rung and its nominal run): a preset, "
                         "a law's name, FILE.py:Class or module:Class, with ,key=value settings as for wmr-mj "
-                        "compare, e.g. 'sliding-mode' or 'my_law.py:MyLaw,k=2' (repeatable)")
+                        "compare, e.g. 'sliding-mode' or 'my_law.py:MyLaw,k=2', or a design file FILE.json "
+                        "(wmr-mj design --out: its gains and cart; validate's --sensing, --actuation, --backlash "
+                        "replace a part) (repeatable)")
     add_threads(p, help="simulation threads (default 0: all CPUs)")
     add_out(p, help="report folder (default logs/validate-<timestamp>/; an existing folder resumes its sweeps)")
     add_json(p, help="print the summary object (summary.json) on stdout")

@@ -22,6 +22,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+from wmr_mj.report.cart_design import CartDesign
 from wmr_mj.sim.records import Record
 
 __all__ = ["Rung", "CertifiedRule", "PathSummary", "ValidateSummary"]
@@ -138,6 +139,8 @@ class ValidateSummary(Record):
         certified_outside: certified-outside runs of every rung, design, search and sensing run.
         sensing: the certified design on realistic sensing (:mod:`wmr_mj.report.sensing`); None in reports
             before it (no ``sensing`` key).
+        cart_design: the design ``wmr-mj design`` finds for the 12-bit axis encoder beside the certified design
+            on it (:mod:`wmr_mj.report.cart_design`); None in reports before it (no ``cart_design`` key).
         versions: the software's.
         findings: the report's findings, in sentences.
         timings_s: each stage's wall time [s].
@@ -145,7 +148,7 @@ class ValidateSummary(Record):
     """
 
     _records = {"ladder": Rung, "certified_rule": CertifiedRule, "correction_rung": Rung, "path": PathSummary,
-                "designs": Rung}
+                "designs": Rung, "cart_design": CartDesign}
 
     folder: str
     created: str
@@ -164,18 +167,19 @@ class ValidateSummary(Record):
     designs: tuple[Rung, ...] = ()
     certified_outside: int
     sensing: Mapping[str, Any] | None = None
+    cart_design: CartDesign | None = None
     versions: Mapping[str, str]
     findings: tuple[str, ...] = ()
     timings_s: Mapping[str, float] = field(default_factory=dict)
     wall_s: float = math.nan
 
     def to_dict(self) -> dict[str, Any]:
-        """summary.json's object: ``designs`` only where there are some, ``sensing``, ``path`` and
-        ``correction_rung`` only where the report has them."""
+        """summary.json's object: ``designs`` only where there are some, ``sensing``, ``cart_design``, ``path``
+        and ``correction_rung`` only where the report has them."""
         out = super().to_dict()
         if not self.designs:
             del out["designs"]
-        for key in ("sensing", "path", "correction_rung"):
+        for key in ("sensing", "cart_design", "path", "correction_rung"):
             if out[key] is None:
                 del out[key]
         return out

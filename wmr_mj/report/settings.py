@@ -114,6 +114,7 @@ class ValidateSettings:
                                       transmission=self.transmission, cart=self.cart)
         for name in ("sensing", "actuation", "transmission"):
             object.__setattr__(self, name, getattr(probe, name))  # the typed part
+        from wmr_mj.sim.compare import design_token_changes, is_design_file
         from wmr_mj.sim.designs import design_changes
 
         object.__setattr__(self, "designs", tuple(str(t) for t in self.designs))
@@ -121,7 +122,8 @@ class ValidateSettings:
 
         for token in self.designs:  # an unknown law, a missing file, a bad setting: refused before any run
             # built once: a parameter the law does not take, a claim() that raises or returns no Certificate
-            resolve_run(RunConfig.from_inputs(**design_changes(token), cart=self.cart))
+            changes = design_token_changes(token, cart=self.cart) if is_design_file(token) else design_changes(token)
+            resolve_run(RunConfig.from_inputs(**changes, cart=self.cart))
         if 0 < self.search_budget < self.min_search_budget:
             raise ParameterError(f"search_budget = {self.search_budget} is below one generation of CMA-ES (the "
                                  f"searches' portfolio); give 0 (no search) or an integer >= {self.min_search_budget}")
@@ -159,13 +161,22 @@ class ValidateSettings:
 
     def config(self, design: DesignLike) -> RunConfig:
         """The run of ``design`` these settings sweep (m1 at nominal; the sweep draws it), on the cart: the
-        certified design's gains derived on it (:func:`wmr_mj.sim.designs.on_cart`)."""
+        certified design's gains derived on it (:func:`wmr_mj.sim.designs.on_cart`). A design file
+        (:class:`wmr_mj.sim.compare.FileDesign`) keeps its gains and the parts of its own cart, but where these
+        settings give a part that is not ideal (validate's --sensing, --actuation, --backlash), as ``run --design
+        FILE`` keeps the options given."""
+        from wmr_mj.sim.compare import FileDesign
         from wmr_mj.sim.designs import on_cart
 
-        return RunConfig.from_inputs(**on_cart(design.config_changes(), self.cart), duration=self.duration,
-                                     m1=self.nominal_m1, path=self.path, m1_range=as_pair(self.m1_range),
-                                     box_ranges=self.ranges, seed=self.seed, sensing=self.sensing,
-                                     actuation=self.actuation, transmission=self.transmission, cart=self.cart)
+        changes = design.config_changes()
+        if not isinstance(design, FileDesign):
+            changes = on_cart(changes, self.cart)
+        given = cart_dict(self)  # the parts these settings make non-ideal: they replace the design file's own
+        hardware = {name: getattr(self, name) for name in CART_PARTS if name in given or name not in changes}
+        changes = {k: v for k, v in changes.items() if k not in hardware}
+        return RunConfig.from_inputs(**changes, duration=self.duration, m1=self.nominal_m1, path=self.path,
+                                     m1_range=as_pair(self.m1_range), box_ranges=self.ranges, seed=self.seed,
+                                     cart=self.cart, **hardware)
 
     def as_dict(self) -> dict[str, Any]:
         d = asdict(self)

@@ -12,7 +12,9 @@ path and the paths C travelled under both designs) follows directly. Then, in or
 (c) the certified design: its rule, its certificate with every assumption, its counts,
     the worst-case search beside the Monte-Carlo worst and the certificate, the full box;
 (d) the plant's measured friction law; (e) the certified design on realistic sensing (encoders on the
-steering axis and the motor shaft: verdict, voltage activity, dead band; where the report has it);
+steering axis and the motor shaft: verdict, voltage activity, dead band; where the report has it), then the
+design ``wmr-mj design`` finds for the 12-bit axis encoder beside the certified design on it (gains,
+certificate, verdict counts and worst sup|E|/E_max over the same m1 draws; where the report has it);
 (f) identification; (g) findings (computed sentences); figures; files; software.
 
 A ``certified-outside`` run (a bug or a modelling gap) is announced in a banner directly under
@@ -477,6 +479,63 @@ def sensing_blocks(summary: Summary) -> list[Block]:
                   f"differenced velocity reads 0.")]
 
 
+CART_DESIGN_COLUMNS = ("design", "K_P 1/s^2", "K_D 1/s", "sign width rad/s", "certificate", "E_max rad", "needs V",
+                       "runs (cert-in/CERT-OUT/uncert-in/uncert-out)", "worst sup|E| rad", "worst sup|E|/E_max",
+                       "TV u V/s")
+
+
+def cart_design_rows(summary: Summary) -> list[list[str]]:
+    """One row per design of summary.json's ``cart_design`` (:mod:`wmr_mj.report.cart_design`)."""
+    sec = ValidateSummary.of(summary).cart_design
+    out = []
+    for d in () if sec is None else sec.designs:
+        v = d.verdicts
+        out.append([d.label, _fmt(d.kp, ".6g"), _fmt(d.kd, ".6g"), _fmt(d.friction_width, ".4g"),
+                    d.certificate or "none", _fmt(d.E_max, ".4g", "none"), _fmt(d.voltage_max, ".3g", "-"),
+                    "/".join(str(v.get(k, 0)) for k in VERDICTS) + (" !!!" if d.certified_outside else ""),
+                    _fmt(d.worst_sup_E, ".4g"), _fmt(d.worst_certificate_ratio, ".3f"), _fmt(d.mean_tv_voltage)])
+    return out
+
+
+def cart_design_blocks(summary: Summary) -> list[Block]:
+    """The design ``wmr-mj design`` finds for the 12-bit axis encoder beside the certified design on it, in
+    section (e), where the report has it (reports written before it have no ``cart_design``)."""
+    summary = ValidateSummary.of(summary)
+    sec = summary.cart_design
+    if sec is None:
+        return []
+    search = sec.search
+    found = ("" if not sec.binding else f" Nothing in the search's box certifies this cart: {sec.binding} binds; "
+             "the row shows the best point found.")
+    return [("h3", f"The design for {sec.sensing} ({sec.label}) beside the certified design, {sec.n} runs each "
+                   f"over m1 {sec.m1_range[0]:g}-{sec.m1_range[1]:g} kg ({sec.sampling}, seed {sec.seed}), "
+                   f"{sec.duration:g} s"),
+            ("table", CART_DESIGN_COLUMNS, cart_design_rows(summary)),
+            ("p", f"The design is what '{sec.command}' finds ({search['method']}, seed {search['seed']}, "
+                  f"{search['evaluations']} certificates): the gains, sign width and period whose certificate on "
+                  f"this cart is the smallest over the box; it is written to {sec.design_file} ('wmr-mj run "
+                  f"--design {summary.folder}/{sec.design_file}') and swept as that file reads back. Both designs "
+                  "run the same m1 draws on the same cart; each run is judged against its own design's "
+                  "certificate, and sup|E|/E_max is of that certificate. TV u: the voltage's total variation per "
+                  "second, the mean over the runs." + found)]
+
+
+def cart_design_finding(sec: Any) -> str:
+    """One sentence: the found design's certificate and runs beside the certified design's on the cart."""
+    certified, designed = sec.designs[0], sec.designs[1]
+
+    def runs(d: Any) -> str:
+        return (f"{d.verdicts.get('certified-inside', 0)}/{d.n} runs certified-inside, worst sup|E| "
+                f"{_fmt(d.worst_sup_E, '.3g')} rad = {_fmt(d.worst_certificate_ratio, '.3f')} of its E_max")
+
+    def bound(d: Any) -> str:
+        return "no certificate" if d.E_max is None else f"E_max {_fmt(d.E_max, '.3g')} rad ({d.certificate})"
+
+    return (f"On the {sec.sensing} cart, '{sec.command}' finds K_P = {_fmt(designed.kp, '.4g')}, K_D = "
+            f"{_fmt(designed.kd, '.4g')}: {bound(designed)}, {runs(designed)}; the certified design there has "
+            f"{bound(certified)}, {runs(certified)}.")
+
+
 def sensing_finding(section: Mapping[str, Any]) -> str:
     """One sentence: which presets keep the certificate, what the coarsest costs, where the dead band sits."""
     runs = section["runs"]
@@ -583,6 +642,8 @@ def findings(summary: Summary) -> list[str]:
     out += _friction_finding(summary) + _identification_finding(summary) + _paper_view_finding(summary)
     if summary.sensing:
         out.append(sensing_finding(summary.sensing))
+    if summary.cart_design is not None and len(summary.cart_design.designs) == 2:
+        out.append(cart_design_finding(summary.cart_design))
     n_out = summary.certified_outside
     out.append("No run of this report is certified-outside." if not n_out else
                f"!!! {n_out} run(s) are CERTIFIED-OUTSIDE: a bug or a modelling gap; report it. !!!")
@@ -600,6 +661,8 @@ def banner(summary: Summary) -> list[Block]:
               if s["verdicts"]["certified-outside"]]
     if (summary.sensing or {}).get("certified_outside"):
         where.append(f"realistic sensing ({(summary.sensing or {})['certified_outside']})")
+    if summary.cart_design is not None and summary.cart_design.certified_outside:
+        where.append(f"the design for {summary.cart_design.sensing} ({summary.cart_design.certified_outside})")
     return [("loud", f"!!! CERTIFIED-OUTSIDE: {n} run(s) ({', '.join(where)}) are outside a certificate whose "
                      "assumptions all hold. This is a bug or a modelling gap: report it. !!!")]
 
@@ -633,6 +696,7 @@ def answer_blocks(summary: Summary, *, brief: bool = False, with_banner: bool = 
                f"{summary.settings['nominal_m1']:g} kg, constant voltages from the home keyframe)"),
         ("table", FRICTION_COLUMNS, friction_rows(summary)),
         *sensing_blocks(summary),
+        *cart_design_blocks(summary),
     ]
 
 
@@ -703,6 +767,10 @@ def _files(summary: ValidateSummary) -> list[tuple[str, str]]:
         out.append((s["evaluations_csv"], f"every run of the search '{s['key']}'"))
         if s.get("log"):
             out.append((s["log"], f"the worst run of the search '{s['key']}' (wmr-mj replay opens it)"))
+    if summary.cart_design is not None:
+        sec = summary.cart_design
+        out.append((sec.design_file, f"the design for {sec.sensing} (wmr-mj run --design FILE reads it)"))
+        out += [(d.runs_csv, f"per-run results of {d.label} on {sec.sensing}") for d in sec.designs]
     return out
 
 

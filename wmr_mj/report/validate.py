@@ -16,6 +16,9 @@
 5. :func:`nominal_stage`: the paper's and the certified design at m1 = 650 kg (time histories);
 5b. :func:`wmr_mj.report.sensing.sensing_stage`: the certified design at the top of the m1 box on exact
    sensing and on realistic encoders (verdict, voltage activity, dead band; summary.json's ``sensing``);
+5c. :func:`wmr_mj.report.cart_design.cart_design_stage`: the design ``wmr-mj design`` finds for the 12-bit axis
+   encoder, and it and the certified design swept on that cart over the same m1 draws (summary.json's
+   ``cart_design``);
 6. :func:`wmr_mj.report.figures.figures_stage`: PNG + SVG in figures/;
 7. :func:`write_report`: summary.json, summary.csv, index.md, index.html (atomic), rendered
    by :mod:`wmr_mj.report.text`, which opens with the answer.
@@ -196,15 +199,17 @@ def correction_stage(settings: ValidateSettings, folder: Path, st: Stages) -> di
 
 def designs_stage(settings: ValidateSettings, folder: Path, st: Stages, *, first_index: int) -> list[dict[str, Any]]:
     """``validate --design TOKEN``: each design of the user's (a plug-in law, a tracker, other gains; a token
-    as ``wmr-mj compare`` takes it) judged beside the ladder: its rung (:func:`run_rung`: the same m1 sweep,
-    its verdicts against its own claim) and its nominal run (summary.json's ``designs``)."""
+    as ``wmr-mj compare`` takes it, a design file ``FILE.json`` among them) judged beside the ladder: its rung
+    (:func:`run_rung`: the same m1 sweep, its verdicts against its own claim) and its nominal run
+    (summary.json's ``designs``)."""
     from wmr_mj.sim.closed_loop import run_parts
+    from wmr_mj.sim.compare import FileDesign, is_design_file
     from wmr_mj.sim.designs import TokenDesign
     from wmr_mj.sim.parts import resolve_run
 
     out = []
     for k, token in enumerate(settings.designs, start=first_index):
-        design = TokenDesign(token)
+        design: DesignLike = FileDesign(token, settings.cart) if is_design_file(token) else TokenDesign(token)
         parts = resolve_run(settings.config(design))  # the rung's claim and its nominal run: one resolution
         rung = run_rung(settings, k, design, folder, st, None, parts=parts)
         st.start(f"design-{k}", f"nominal run of {token} at m1 = {settings.nominal_m1:g} kg")
@@ -324,6 +329,7 @@ def run_validate(settings: ValidateSettings, out_dir: str | os.PathLike, *, log:
     Returns the summary, read by attribute (summary.json is its ``to_dict()``). Stage lines go to ``stream`` (default
     stderr) when ``log``; ``tty`` forces or suppresses the live counter.
     """
+    from wmr_mj.report.cart_design import cart_design_stage
     from wmr_mj.report.figures import figures_stage
     from wmr_mj.report.search import search_stage
     from wmr_mj.report.sensing import sensing_stage
@@ -343,6 +349,7 @@ def run_validate(settings: ValidateSettings, out_dir: str | os.PathLike, *, log:
     searches = search_stage(settings, folder, st, ladder)  # the search stage reads the rungs' JSON
     nominal = nominal_stage(settings, st)
     sensing = sensing_stage(settings, st)
+    cart_design = cart_design_stage(settings, folder, st)
     figures, fig7 = figures_stage(settings, folder, st, rungs, searches, nominal)
     st.start("report", "summary.json, summary.csv, index.md, index.html")
     summary = ValidateSummary(
@@ -353,8 +360,9 @@ def run_validate(settings: ValidateSettings, out_dir: str | os.PathLike, *, log:
         identification=identification, paper_example=fig7, figures=figures,
         correction_rung=corrected, path=_path_summary(settings), designs=tuple(designs),
         certified_outside=sum(r.certified_outside for r in [*rungs, *designs]) + corrected.certified_outside
-        + sum(s["verdicts"]["certified-outside"] for s in searches) + sensing["certified_outside"],
-        sensing=sensing, versions=software_versions())
+        + sum(s["verdicts"]["certified-outside"] for s in searches) + sensing["certified_outside"]
+        + cart_design.certified_outside,
+        sensing=sensing, cart_design=cart_design, versions=software_versions())
     summary = dataclasses.replace(summary, findings=tuple(findings(summary)))
     summary = dataclasses.replace(summary, timings_s=dict(st.timings), wall_s=time.perf_counter() - wall0)
     write_report(summary, folder)

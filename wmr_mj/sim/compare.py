@@ -7,7 +7,9 @@ built-in law, ``FILE.py:Class`` or ``module:Class``, with ``,key=value`` setting
 (``lam=5``). A law's name means the law with its own defaults, as ``wmr-mj run --controller NAME`` and
 ``RunConfig(controller=NAME)`` mean it (:func:`wmr_mj.sim.designs.design_changes`): ``computed-torque`` is the
 paper's design (the ``paper`` preset: paper model, K_P = 6, K_D = 9), ``sliding-mode`` runs on the non-holonomic
-model, its default estimate, under which its claim can hold. ``certified`` is the certified design.
+model, its default estimate, under which its claim can hold. ``certified`` is the certified design. A token
+ending in ``.json`` is a design file (:func:`is_design_file`: the file ``wmr-mj design --out FILE.json`` writes),
+read as ``wmr-mj run --design FILE`` reads it (:func:`design_file_changes`): its law, gains, period and cart.
 Every design declares the suite's uncertainty box, so a claim covers the plants the suite runs.
 
 Usage::
@@ -48,7 +50,8 @@ from wmr_mj.sim.config import (
 from wmr_mj.sim.records import Record, plain
 from wmr_mj.sim.suite import Scenario, Suite, versions
 
-__all__ = ["Design", "design_from_token", "ScenarioRun", "DesignRow", "CompareResult", "CompareReport", "compare",
+__all__ = ["Design", "design_from_token", "is_design_file", "design_file_changes", "design_token_changes",
+           "FileDesign", "ScenarioRun", "DesignRow", "CompareResult", "CompareReport", "compare",
            "run_scenario", "adversary_spec", "adversary_cart_box", "ADVERSARY_CART_AXES"]
 
 
@@ -61,8 +64,9 @@ class Design:
 
 
 def design_from_token(token: str, suite: Suite, *, cart: Mapping[str, Any] | None = None) -> Design:
-    """A design from ``NAME[,key=value...]`` (:func:`wmr_mj.sim.designs.design_changes`), declaring the
-    suite's uncertainty box and running the suite's duration.
+    """A design from ``NAME[,key=value...]`` (:func:`wmr_mj.sim.designs.design_changes`) or a design file
+    ``FILE.json`` (:func:`design_file_changes`), declaring the suite's uncertainty box and running the suite's
+    duration.
 
     Args:
         token: the design as named.
@@ -75,8 +79,6 @@ def design_from_token(token: str, suite: Suite, *, cart: Mapping[str, Any] | Non
     Raises:
         UnknownNameError, ParameterError: an unknown preset or law, a bad setting (one line each).
     """
-    from wmr_mj.sim.designs import design_changes, on_cart
-
     box = uncertainty_ranges(suite.adversary.uncertainty)
     on = (cart or {}).get("cart")  # a cart file (compare --cart): its box, the certified gains derived on it
     if on is not None:
@@ -84,12 +86,105 @@ def design_from_token(token: str, suite: Suite, *, cart: Mapping[str, Any] | Non
 
         box = dict(cart_file(RunConfig(cart=on)).uncertainty.get(suite.adversary.uncertainty, box))
     m1_range = box.pop("m1")
-    changes = {**on_cart(design_changes(token), on), **(cart or {})}
+    changes = {**design_token_changes(token, cart=on), **(cart or {})}
     config = RunConfig.from_inputs(**changes, m1_range=m1_range, box_ranges=box, duration=suite.duration)
     from wmr_mj.sim.parts import resolve_run
 
     resolve_run(config)  # built once: a parameter the law does not take, a claim() that raises, before any run
     return Design(label=str(token), config=config)
+
+
+#: the one rule that tells a design file from a design's name: the token ends in this suffix
+DESIGN_FILE_SUFFIX = ".json"
+
+
+def is_design_file(token: str) -> bool:
+    """True where ``token`` names a design file: its name (before any ``,key=value``) ends in ``.json``
+    (:data:`DESIGN_FILE_SUFFIX`); no preset, law, ``FILE.py:Class`` nor ``module:Class`` does."""
+    return str(token).partition(",")[0].strip().lower().endswith(DESIGN_FILE_SUFFIX)
+
+
+def design_file_changes(path: str, *, cart: Any = None) -> dict[str, Any]:
+    """The RunConfig fields a design file sets, as ``wmr-mj run --design FILE`` sets them: the law's through
+    :func:`wmr_mj.sim.spec.law_fields` (the file's controller, model, K_P, K_D, sign and width, none left to a
+    preset), its control period, and the parts of its cart (sensing, actuation, backlash) as typed parts.
+
+    Args:
+        path: the design file (``wmr-mj design --out FILE.json``).
+        cart: the cart file the law is built on (``RunConfig.cart``; None: the C80); the file's gains are kept.
+
+    Raises:
+        ParameterError: a file that cannot be read or is not a design file, a setting a run refuses (one line
+            naming the file).
+    """
+    from wmr_mj.hardware import Actuation, Sensing, Transmission
+    from wmr_mj.sim.design_search import design_file_settings
+    from wmr_mj.sim.spec import LawChoice, law_fields
+
+    try:
+        s = design_file_settings(path)
+    except ParameterError as exc:  # read_design names the run option; here the file is a design's name
+        raise ParameterError(str(exc).replace("--design ", "design ", 1)) from None
+    law = law_fields(LawChoice(cart=cart, controller=s["controller"], model=s["model"], kp=s["kp"], kd=s["kd"],
+                               friction_sign=s["friction_sign"], friction_width=s["friction_width"],
+                               controller_params=s.get("controller_params") or {}))
+    law = {k: v for k, v in law.items() if v or k not in ("controller_params", "identified", "coefficients")}
+    out = {**law, "control_period": s["control_period"]}
+    parts: dict[str, tuple[Any, str]] = {"sensing": (Sensing, "sensing"), "actuation": (Actuation, "actuation"),
+                                         "transmission": (Transmission, "backlash")}
+    for name, (cls, key) in parts.items():
+        if s.get(key) is not None:
+            try:
+                out[name] = cls.from_spec(s[key])
+            except (ParameterError, ValueError, TypeError) as exc:
+                raise ParameterError(f"design {str(path)!r}: its {key} is not accepted: {exc}") from None
+    return out
+
+
+def design_token_changes(token: str, *, cart: Any = None) -> dict[str, Any]:
+    """The RunConfig fields of the design ``token`` names: a design file's (:func:`design_file_changes`, where
+    :func:`is_design_file`), else the preset's or law's (:func:`wmr_mj.sim.designs.design_changes`), the
+    certified design's gains derived on ``cart`` (:func:`wmr_mj.sim.designs.on_cart`).
+
+    Raises:
+        UnknownNameError, ParameterError: an unknown preset or law, a bad setting, a bad design file (one line).
+    """
+    from wmr_mj.sim.designs import design_changes, on_cart
+
+    if is_design_file(token):
+        if "," in str(token):
+            raise ParameterError(f"design {token!r}: a design file takes no ,key=value settings (the file is the "
+                                 "design); give the file alone")
+        return design_file_changes(str(token).strip(), cart=cart)
+    return on_cart(design_changes(token), cart)
+
+
+@dataclass(frozen=True)
+class FileDesign:
+    """A design file named as a design (``validate --design FILE.json``), shaped as
+    :class:`wmr_mj.sim.designs.DesignLike` for validate's rungs; ``cart``: the cart file the law is built on."""
+
+    path: str
+    cart: Any = None
+
+    @property
+    def name(self) -> str:
+        from pathlib import Path
+
+        return re.sub(r"[^A-Za-z0-9_.-]+", "-", Path(self.path).stem).strip("-")[:60] or "design"
+
+    @property
+    def label(self) -> str:
+        return self.path
+
+    def config_changes(self) -> dict[str, Any]:
+        return design_file_changes(self.path, cart=self.cart)
+
+    def describe(self) -> str:
+        from wmr_mj.sim.config import controller_for, estimate_parameters
+
+        return (f"{controller_for(RunConfig(**self.config_changes()), estimate_parameters()).label()} "
+                f"(the design file {self.path})")
 
 
 @dataclass(frozen=True)
