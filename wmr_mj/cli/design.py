@@ -16,10 +16,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     from wmr_mj.sim.design_search import METHODS, OBJECTIVES
 
     p = sub.add_parser(
-        "design", help="the computed-torque gains, sign width, filter and period a given cart certifies",
+        "design", help="the computed-torque (or sliding-mode) gains, sign width, filter and period a given cart "
+                       "certifies",
         description="A seeded search (CMA-ES or scipy's differential evolution) over omega_n and zeta "
-                    "(K_P = omega_n^2, K_D = 2 zeta omega_n), the Coulomb sign's smoothing width, the velocity "
-                    "filter's tau_f "
+                    "(K_P = omega_n^2, K_D = 2 zeta omega_n; with --controller sliding-mode: lam, phi, k and eta), the "
+                    "Coulomb sign's smoothing width, the velocity filter's tau_f "
                     "(where --sensing has velocity=filtered) and the control period (--periods), minimising the "
                     "certificate a run computes (the worst over --path) subject to every one of its assumptions "
                     "over the plant box. Writes a design file that `wmr-mj run --design FILE` (and sweep, falsify, "
