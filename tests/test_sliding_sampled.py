@@ -165,3 +165,15 @@ def test_runs_are_certified_inside_or_uncertified(sensing):
 def test_a_law_without_layer_gain_gets_no_sampled_bound():
     cert = _claim(sensing="magnetic-12bit-axis", controller_params={"lam": 5.0, "phi": 0.2, "k": 0.0, "eta": 0.0})
     assert "k = 0.0 V" in cert.inputs["certificates"]["sampled-data"]["reason"]
+
+
+def test_the_run_names_the_boundary_layer_beside_the_sampled_certificate(capsys):
+    from wmr_mj.cli.app import main
+
+    argv = ["run", "--controller", "sliding-mode", "--model", "nonholonomic", "--sensing", "delay=0.02",
+            "--m1", "750", "--duration", "10", "--no-log"]
+    for name, value in CERTIFYING.items():
+        argv += ["--controller-param", f"{name}={value}"]
+    assert main(argv) == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("certificate:"))
+    assert "the sampled-data certificate (the boundary layer's: none: the layer did not settle" in line
