@@ -112,10 +112,11 @@ def test_worst_quantisation_sequence_reaches_the_layer_bound_and_random_ones_sta
     phi = 2.0 * bound
     s_top, _ = _plain_loop(lam=lam, g=g, phi=phi, T=T, d=d, e=worst)
     assert s_top == pytest.approx(bound, rel=0.01)
+    E_bound = peak_gains(loop).gain("E", "quantisation") * q  # E's own row: the telescoped difference
     rng = np.random.default_rng(1)
     for _ in range(5):
-        s_top, _ = _plain_loop(lam=lam, g=g, phi=phi, T=T, d=d, e=rng.uniform(-q, q, 1500))
-        assert s_top <= bound
+        s_top, E_top = _plain_loop(lam=lam, g=g, phi=phi, T=T, d=d, e=rng.uniform(-q, q, 1500))
+        assert s_top <= bound and E_top <= E_bound
 
 
 def _sampled(**changes):
