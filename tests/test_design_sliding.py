@@ -56,3 +56,14 @@ def test_an_unknown_law_is_one_line_exit_2(tmp_path, capsys):
     assert rc == 2 and len(err.splitlines()) == 1
     assert "--controller 'pd' is not accepted; one of computed-torque, sliding-mode" in err
     assert not (tmp_path / "d.json").exists()
+
+
+def test_on_the_ideal_cart_the_sliding_design_is_judged_by_its_boundary_layer(tmp_path, capsys):
+    """No sampled certificate on the ideal cart: the design's certificate is the law's continuous claim,
+    E_max = phi/lam exactly, and the file names it."""
+    out = tmp_path / "ideal.json"
+    assert main(["design", "--controller", "sliding-mode", "--budget", "30", "--out", str(out), "--json"]) == 0
+    printed = json.loads(capsys.readouterr().out)
+    c = printed["settings"]["controller_params"]
+    assert printed["certificates"]["paper-circle"]["certificate"] == "boundary-layer"
+    assert printed["E_max"] == c["phi"] / c["lam"]

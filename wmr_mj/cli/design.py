@@ -146,6 +146,8 @@ def check_design(problem: Any, result: Any, n: int) -> dict[str, Any]:
 
 
 def _print(result: Any, args: argparse.Namespace, out: dict[str, Any], wall: float) -> None:
+    from wmr_mj.sim.design_search import certificate_name
+
     s = result.settings
     paths = ", ".join(result.paths)
     if not result.certified:
@@ -165,7 +167,7 @@ def _print(result: Any, args: argparse.Namespace, out: dict[str, Any], wall: flo
           + (f", tau_f {tau * 1e3:.4g} ms" if tau is not None else ""))
     for path, cert in result.certificates.items():
         print(f"  {path}: certified, E_max {cert.E_max:.6g} rad, voltage {cert.voltage_max:.4g} V "
-              f"({cert.inputs.get('certificate', 'section-4')}; {len(cert.assumptions)} assumptions met)")
+              f"({certificate_name(cert)}; {len(cert.assumptions)} assumptions met)")
     if "check" in out:
         c = out["check"]
         print(f"check: {c['n']} runs over the box on {c['path']}: "

@@ -371,13 +371,20 @@ def _finish(problem: DesignProblem, config: Any, found: float, evaluations: int,
                         seed=problem.seed, periods=periods, paths=problem.paths)
 
 
+def certificate_name(cert: Any) -> str:
+    """Which analysis gave ``cert``: ``inputs['certificate']`` where the run computed two, else the law's own
+    ('boundary-layer' for sliding mode, 'section-4' for computed torque)."""
+    inputs = cert.inputs
+    own = "boundary-layer" if inputs.get("controller") == "sliding-mode" else "section-4"
+    return str(inputs.get("certificate", own))
+
+
 def _certificate_dict(cert: Any) -> dict[str, Any] | None:
     if cert is None:
         return None
-    inputs = cert.inputs
     return {"certified": cert.certified, "E_max": cert.E_max if cert.valid else None,
             "voltage_max": cert.voltage_max if cert.valid else None, "reason": cert.reason,
-            "certificate": inputs.get("certificate", "section-4"),
+            "certificate": certificate_name(cert),
             "assumptions": [a.as_dict() for a in cert.assumptions]}
 
 
