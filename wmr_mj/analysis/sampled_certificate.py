@@ -288,6 +288,7 @@ class _Solved:
     alpha_m: float
     terms: SampledDataTerms | None
     failure: str = ""
+    Wt: float = math.nan  # sup|w + rho| [rad/s^2], what drives the loop (the sliding-mode layer check reads it)
 
 
 def _solve_at(bound: _Bound, lin: _Linear, cart: SampledCart, T: float, c_hat: float, x: float, y: float) -> _Solved:
@@ -353,7 +354,7 @@ def _solve_at(bound: _Bound, lin: _Linear, cart: SampledCart, T: float, c_hat: f
     y_new = Ys + T * A2
     x_new = Es + T * Ys + 0.5 * T * T * A2
     eps_v = cart.velocity_error + lag * (b.a0dd + A2)
-    return _Solved(x_new, y_new, U, W, A2, eps_a, eps_v, A_m, dataclasses.replace(terms, W=W, U=U))
+    return _Solved(x_new, y_new, U, W, A2, eps_a, eps_v, A_m, dataclasses.replace(terms, W=W, U=U), Wt=Wt)
 
 
 def _S(alpha: float) -> float:

@@ -303,10 +303,13 @@ def _which_certificate(cert: dict) -> str:
     inputs = cert.get("inputs") or {}
     if inputs.get("certificate") != "sampled-data":
         return f"(4.23) = {_num(cert.get('condition'), '.4f')}"
-    other = (inputs.get("certificates") or {}).get("section-4") or {}
+    record = inputs.get("certificates") or {}
+    name = "boundary-layer" if "boundary-layer" in record else "section-4"  # the sliding-mode law's own claim
+    other = record.get(name) or {}
     section4 = (f"|E| <= {_num(other.get('E_max'))} rad" if other.get("E_max") is not None
                 else f"none: {other.get('reason') or 'no finite bound'}")
-    return f"the sampled-data certificate (section 4's: {section4})"
+    label = "the boundary layer's" if name == "boundary-layer" else "section 4's"
+    return f"the sampled-data certificate ({label}: {section4})"
 
 
 _NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")

@@ -1,4 +1,5 @@
-"""``wmr-mj design``: the computed-torque gains a given cart can certify (:mod:`wmr_mj.sim.design_search`)."""
+"""``wmr-mj design``: the computed-torque (or sliding-mode) gains a given cart can certify
+(:mod:`wmr_mj.sim.design_search`)."""
 
 from __future__ import annotations
 
@@ -15,10 +16,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     from wmr_mj.sim.design_search import METHODS, OBJECTIVES
 
     p = sub.add_parser(
-        "design", help="the computed-torque gains, sign width, filter and period a given cart certifies",
+        "design", help="the computed-torque (or sliding-mode) gains, sign width, filter and period a given cart "
+                       "certifies",
         description="A seeded search (CMA-ES or scipy's differential evolution) over omega_n and zeta "
-                    "(K_P = omega_n^2, K_D = 2 zeta omega_n), the Coulomb sign's smoothing width, the velocity "
-                    "filter's tau_f "
+                    "(K_P = omega_n^2, K_D = 2 zeta omega_n; with --controller sliding-mode: lam, phi, k and eta), the "
+                    "Coulomb sign's smoothing width, the velocity filter's tau_f "
                     "(where --sensing has velocity=filtered) and the control period (--periods), minimising the "
                     "certificate a run computes (the worst over --path) subject to every one of its assumptions "
                     "over the plant box. Writes a design file that `wmr-mj run --design FILE` (and sweep, falsify, "
@@ -26,6 +28,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         epilog="exit status: 0 a certified design found; 1 none certifies (the binding assumption is named); "
                "2 bad input")
     add_hardware_options(p)
+    p.add_argument("--controller", default="computed-torque", metavar="LAW",
+                   help="the law searched: computed-torque (default: omega_n, zeta) or sliding-mode (lam, phi, k, eta "
+                        "on the non-holonomic model); both with the sign's width, tau_f and the period")
     p.add_argument("--path", action="append", metavar="NAME|FILE",
                    help="a path every certificate must hold on (repeatable; default paper-circle)")
     p.add_argument("--uncertainty", default=None, help="the plant box: m1 (default) or full (wmr_mj/params.py)")
@@ -67,9 +72,11 @@ def problem_from_args(args: argparse.Namespace) -> Any:
     from wmr_mj.params import M1_RANGE
     from wmr_mj.sim.certify import measurement_errors_of
     from wmr_mj.sim.config import RunConfig, base_for
-    from wmr_mj.sim.design_search import OBJECTIVES, DesignProblem, check_periods
+    from wmr_mj.sim.design_search import LAWS, OBJECTIVES, DesignProblem, check_periods
     from wmr_mj.sim.designs import CERTIFIED
 
+    if args.controller not in LAWS:
+        raise ParameterError(f"--controller {args.controller!r} is not accepted; one of {', '.join(LAWS)}")
     if args.objective not in OBJECTIVES:
         raise ParameterError(f"--objective {args.objective!r} is not accepted; one of {', '.join(OBJECTIVES)}")
     lo, hi = (float(v) for v in args.m1_range)
@@ -88,7 +95,9 @@ def problem_from_args(args: argparse.Namespace) -> Any:
     except ValueError:
         raise ParameterError(f"--periods {args.periods!r} is not a list of numbers (s), e.g. 0.001,0.002") from None
     check_periods(periods, args.duration)
-    base = RunConfig(**CERTIFIED.config_changes(), m1_range=m1_range, box_ranges=ranges, duration=args.duration,
+    law = (CERTIFIED.config_changes() if args.controller == "computed-torque"
+           else {"controller": "sliding-mode", "model": "nonholonomic"})
+    base = RunConfig(**law, m1_range=m1_range, box_ranges=ranges, duration=args.duration,
                      reference_bounds=args.reference_bounds, cart=getattr(args, "cart", None),
                      **hardware_from_args(args))
     measurement = measurement_errors_of(base, base_for(base))
@@ -145,6 +154,8 @@ def check_design(problem: Any, result: Any, n: int) -> dict[str, Any]:
 
 
 def _print(result: Any, args: argparse.Namespace, out: dict[str, Any], wall: float) -> None:
+    from wmr_mj.sim.design_search import certificate_name
+
     s = result.settings
     paths = ", ".join(result.paths)
     if not result.certified:
@@ -152,14 +163,19 @@ def _print(result: Any, args: argparse.Namespace, out: dict[str, Any], wall: flo
               f"{paths}; {result.evaluations} certificates in {wall:.1f} s)")
         return
     tau = s["sensing"].filter_tau
+    if s["controller"] == "sliding-mode":
+        c = s["controller_params"]
+        law = (f"sliding mode lam = {c['lam']:.6g} 1/s, phi = {c['phi']:.6g} rad/s, k = {c['k']:.6g} V, eta = "
+               f"{c['eta']:.4g} V, sign width {c['friction_width']:.4g} rad/s")
+    else:
+        law = (f"K_P = {s['kp']:.6g} 1/s^2, K_D = {s['kd']:.6g} 1/s (omega_n {math.sqrt(s['kp']):.4g} rad/s, zeta "
+               f"{s['kd'] / (2 * math.sqrt(s['kp'])):.3g}), sign width {s['friction_width']:.4g} rad/s")
     print(f"design ({result.objective}, {args.method}, seed {result.seed}, {result.evaluations} certificates in "
-          f"{wall:.1f} s): "
-          f"K_P = {s['kp']:.6g} 1/s^2, K_D = {s['kd']:.6g} 1/s (omega_n {math.sqrt(s['kp']):.4g} rad/s, zeta "
-          f"{s['kd'] / (2 * math.sqrt(s['kp'])):.3g}), sign width {s['friction_width']:.4g} rad/s, period "
-          f"{s['control_period'] * 1e3:g} ms" + (f", tau_f {tau * 1e3:.4g} ms" if tau is not None else ""))
+          f"{wall:.1f} s): {law}, period {s['control_period'] * 1e3:g} ms"
+          + (f", tau_f {tau * 1e3:.4g} ms" if tau is not None else ""))
     for path, cert in result.certificates.items():
         print(f"  {path}: certified, E_max {cert.E_max:.6g} rad, voltage {cert.voltage_max:.4g} V "
-              f"({cert.inputs.get('certificate', 'section-4')}; {len(cert.assumptions)} assumptions met)")
+              f"({certificate_name(cert)}; {len(cert.assumptions)} assumptions met)")
     if "check" in out:
         c = out["check"]
         print(f"check: {c['n']} runs over the box on {c['path']}: "

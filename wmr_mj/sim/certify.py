@@ -308,14 +308,19 @@ def _with_sampled_data(cert: Certificate, config: Any, controller: Any, context:
     """The law's claim on a cart that is not ideal: section 4's (``cert``) or the sampled-data certificate
     (:func:`wmr_mj.analysis.sampled_certificate.sampled_certificate`), whichever is certified with the smaller
     E_max (a certified one before one that is not; section 4's on a tie). Computed for the computed-torque law
-    only (the paper's family); its claim on the ideal cart is ``cert``, untouched. The other one's E_max and
-    reason are recorded under ``inputs['certificates']``, and ``inputs['certificate']`` names the one taken.
+    (the paper's family) and the sliding-mode law (its boundary layer as a sampled loop,
+    :func:`wmr_mj.analysis.sliding_sampled.sliding_sampled_certificate`, beside its continuous claim, named
+    'boundary-layer'); a claim on the ideal cart is ``cert``, untouched. The other one's E_max and reason are
+    recorded under ``inputs['certificates']``, and ``inputs['certificate']`` names the one taken.
     """
-    if context.measurement.is_exact or getattr(controller, "name", None) != "computed-torque":
+    name = getattr(controller, "name", None)
+    if context.measurement.is_exact or name not in ("computed-torque", "sliding-mode"):
         return cert
     from wmr_mj.analysis.certificate import Compensation, Estimate, Gains
     from wmr_mj.analysis.sampled_certificate import SampledCart, sampled_certificate
+    from wmr_mj.analysis.sliding_sampled import sliding_sampled_certificate
 
+    own = "boundary-layer" if name == "sliding-mode" else "section-4"  # the law's claim as it is today
     c = controller.model.coefficients
     sign = controller.friction_sign
     estimate = Estimate(P=c.P, C_V=c.C_V, F=0.0 if sign == "none" else c.F, K=c.K, gyro=c.gyro,
@@ -328,25 +333,31 @@ def _with_sampled_data(cert: Certificate, config: Any, controller: Any, context:
         if delay_periods > MAX_SAMPLED_DELAY_PERIODS:  # a state per period of delay: its matrices grow as d^2
             raise ParameterError(f"not computed: a delay of {delay_periods} control periods is beyond the "
                                  f"{MAX_SAMPLED_DELAY_PERIODS} the sampled-data certificate evaluates")
-        sampled = sampled_certificate(plant=context.plant, estimate=estimate, gains=Gains(kp=controller.kp,
-                                      kd=controller.kd), reference=context.reference, limits=context.limits,
-                                      compensation=Compensation(friction_sign=sign,
-                                                                friction_width=controller.friction_width),
-                                      control_period=context.control_period, cart=cart,
-                                      initial_error=context.initial_error, stated=context.stated)
+        compensation = Compensation(friction_sign=sign, friction_width=controller.friction_width)
+        if name == "sliding-mode":  # its layer as a sampled loop (wmr_mj.analysis.sliding_sampled)
+            sampled = sliding_sampled_certificate(plant=context.plant, estimate=estimate, lam=controller.lam,
+                                                  phi=controller.phi, k=controller.k, reference=context.reference,
+                                                  limits=context.limits, compensation=compensation,
+                                                  control_period=context.control_period, cart=cart,
+                                                  initial_error=context.initial_error, stated=context.stated)
+        else:
+            sampled = sampled_certificate(plant=context.plant, estimate=estimate, gains=Gains(kp=controller.kp,
+                                          kd=controller.kd), reference=context.reference, limits=context.limits,
+                                          compensation=compensation, control_period=context.control_period,
+                                          cart=cart, initial_error=context.initial_error, stated=context.stated)
     except ParameterError as exc:  # e.g. an actuation delay that is not a whole number of control periods
-        return replace_inputs(cert, {**dict(cert.inputs), "certificate": "section-4",
+        return replace_inputs(cert, {**dict(cert.inputs), "certificate": own,
                                      "certificates": {"sampled-data": {"E_max": None, "reason": str(exc)}}})
 
     def rank(c: Certificate) -> tuple[bool, float]:
         return (not c.certified, c.E_max if c.valid else math.inf)
 
     taken = sampled if rank(sampled) < rank(cert) else cert
-    record = {"section-4" if c is cert else "sampled-data": {"E_max": c.E_max if c.valid else None,
-                                                             "certified": c.certified, "reason": c.reason}
+    record = {own if c is cert else "sampled-data": {"E_max": c.E_max if c.valid else None,
+                                                     "certified": c.certified, "reason": c.reason}
               for c in (cert, sampled)}
     return replace_inputs(taken, {**dict(taken.inputs), "certificate": "sampled-data" if taken is sampled
-                                  else "section-4", "certificates": record})
+                                  else own, "certificates": record})
 
 
 def _plant_box(config: Any, base: C80Parameters, estimate_params: C80Parameters,

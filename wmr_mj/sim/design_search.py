@@ -1,10 +1,17 @@
-"""The gains a given cart can certify: a seeded search over the computed-torque law's parameters whose objective
-is the run's own certificate (``wmr-mj design``).
+"""The gains a given cart can certify: a seeded search over a law's parameters whose objective is the run's own
+certificate (``wmr-mj design``): the computed-torque law (the default) or the sliding-mode law (:data:`LAWS`).
 
 The search space (for each control period of a given list): the natural frequency omega_n and the damping
 ratio zeta of the error dynamics, K_P = omega_n^2, K_D = 2 zeta omega_n; the Coulomb sign's smoothing width w
 (rad/s); and, where the cart's velocity estimate is ``filtered``, its time constant tau_f (s). The law is the
 certified design's family (computed torque, the non-holonomic model, the measured sign, smoothed).
+
+The sliding-mode family (``controller='sliding-mode'``, the non-holonomic model, the measured sign, smoothed):
+the surface's slope lam (1/s), the layer phi (rad/s), the switching gain k (V) and the sliding condition's margin
+eta (V), each searched in log, with the sign's width, tau_f and the period as above. Its certificate is the one a
+run computes: on a sensed cart the better of the continuous boundary layer and the layer as a sampled loop
+(:mod:`wmr_mj.analysis.sliding_sampled`); its start is the law's defaults (lam 5, phi 0.2, k 3, eta 0.2) with the
+narrowest sign width of the range (the default's exact sign, width 0, lies outside a log range).
 
 Each point is scored by :func:`wmr_mj.sim.certify.certificate_of` on the parts a run resolves
 (:func:`wmr_mj.sim.parts.resolve_run`, once per period and path): the certificate of the design is the one
@@ -35,7 +42,7 @@ from typing import Any
 
 from wmr_mj.errors import ParameterError
 
-__all__ = ["DesignProblem", "DesignResult", "OBJECTIVES", "METHODS", "DESIGN_FIELDS", "search_design",
+__all__ = ["DesignProblem", "DesignResult", "OBJECTIVES", "METHODS", "LAWS", "DESIGN_FIELDS", "search_design",
            "evaluate_design", "write_design", "read_design", "design_file_settings", "check_periods"]
 
 #: what the search minimises: the worst certified E_max over the paths (rad), the worst certified voltage (V),
@@ -45,9 +52,13 @@ OBJECTIVES = ("E_max", "voltage", "margin")
 #: seeds 0 and 1 where differential evolution found 0.019517 rad, bench/bench_design.py) or scipy's
 #: differential evolution
 METHODS = ("cma", "de")
+#: the laws searched: their families are in the module docstring
+LAWS = ("computed-torque", "sliding-mode")
 #: the RunConfig settings a design file sets (``run --design FILE``), as a preset does
-DESIGN_FIELDS = ("controller", "model", "kp", "kd", "friction_sign", "friction_width", "control_period",
-                 "sensing", "actuation", "transmission")
+DESIGN_FIELDS = ("controller", "controller_params", "model", "kp", "kd", "friction_sign", "friction_width",
+                 "control_period", "sensing", "actuation", "transmission")
+#: the sliding-mode law's searched parameters, in the point's order (each in log)
+SLIDING_PARAMETERS = ("lam", "phi", "k", "eta")
 #: the file's format tag and version
 FORMAT = "wmr-mj design"
 PENALTY = 1.0e6  # an uncertified point's score: above every feasible one (plus its number of unmet assumptions)
@@ -71,6 +82,7 @@ class DesignProblem:
         omega_n: natural frequency range, rad/s; zeta: damping ratio range; width: the sign's smoothing range,
             rad/s (searched in log); tau_f: the filter's time constant range, s (searched in log; only where the
             cart's velocity estimate is filtered).
+        lam (1/s), phi (rad/s), k (V), eta (V): the sliding-mode law's ranges (``base.controller`` 'sliding-mode').
     """
 
     base: Any
@@ -84,6 +96,10 @@ class DesignProblem:
     zeta: tuple[float, float] = (0.5, 3.0)
     width: tuple[float, float] = (1.0e-3, 1.0)
     tau_f: tuple[float, float] = (1.0e-3, 0.2)
+    lam: tuple[float, float] = (1.0, 60.0)
+    phi: tuple[float, float] = (0.05, 20.0)
+    k: tuple[float, float] = (0.5, 24.0)
+    eta: tuple[float, float] = (1.0e-3, 1.0)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -159,14 +175,32 @@ class _Scorer:
         self.template = dataclasses.replace(problem.base, control_period=period)
         self.parts = {path: resolve_run(dataclasses.replace(self.template, path=path)) for path in problem.paths}
         self.filtered = self.template.sensing.velocity == "filtered"
+        self.sliding = self.template.controller == "sliding-mode"
         self.evaluations = 0
 
+    def bounds(self, period: float) -> list[tuple[float, float]]:
+        """The point's box: (log omega_n, zeta, log10 w) or (log lam, log phi, log k, log eta, log10 w), then
+        log tau_f where the estimate is filtered."""
+        p = self.problem
+        width = (math.log10(p.width[0]), math.log10(p.width[1]))
+        if self.sliding:
+            out = [(math.log(lo), math.log(hi)) for lo, hi in (p.lam, p.phi, p.k, p.eta)] + [width]
+        else:
+            out = [(math.log(p.omega_n[0]), math.log(p.omega_n[1])), p.zeta, width]
+        if self.filtered:
+            out.append((math.log(max(p.tau_f[0], period)), math.log(p.tau_f[1])))
+        return out
+
     def config(self, x: Any) -> Any:
-        """The RunConfig of the point x = (log omega_n, zeta, log10 w[, log tau_f]) (a sequence or an array)."""
-        kp, kd = _gains(math.exp(x[0]), float(x[1]))
+        """The RunConfig of the point x (a sequence or an array; :meth:`bounds`)."""
         sensing = self.template.sensing
         if self.filtered:
-            sensing = dataclasses.replace(sensing, filter_tau=math.exp(x[3]))
+            sensing = dataclasses.replace(sensing, filter_tau=math.exp(x[-1]))
+        if self.sliding:
+            params: dict[str, Any] = {n: math.exp(float(v)) for n, v in zip(SLIDING_PARAMETERS, x)}
+            params.update(friction_sign="measured", friction_width=10.0 ** float(x[4]))
+            return dataclasses.replace(self.template, controller_params=params, sensing=sensing)
+        kp, kd = _gains(math.exp(x[0]), float(x[1]))
         return dataclasses.replace(self.template, kp=kp, kd=kd, friction_width=10.0 ** float(x[2]), sensing=sensing)
 
     def certificates(self, config: Any) -> dict[str, Any]:
@@ -183,7 +217,7 @@ class _Scorer:
         return out
 
     def __call__(self, x: Any) -> float:
-        return score(self.certificates(self.config(x)), self.problem.objective)
+        return score(self.certificates(self.config(x)), self.problem.objective, graded=self.sliding)
 
 
 def _margin(cert: Any) -> float:
@@ -193,17 +227,22 @@ def _margin(cert: Any) -> float:
     return min(margins, default=0.0)
 
 
-def score(certificates: Mapping[str, Any], objective: str) -> float:
+def score(certificates: Mapping[str, Any], objective: str, *, graded: bool = False) -> float:
     """The objective over the paths' certificates: the worst one; :data:`PENALTY` plus the unmet assumptions'
-    count where any certificate is missing or not certified."""
-    unmet = 0
+    count where any certificate is missing or not certified. ``graded`` (the sliding-mode search, whose default
+    start has its layer saturated: a flat plateau of one unmet assumption): plus x/(1 + x) < 1, x the sum of
+    log(value/limit) over the unmet checked assumptions with a finite value and limit > 0, so the optimiser sees
+    how far a point is from meeting them (the count still ranks first)."""
+    unmet, excess = 0, 0.0
     for cert in certificates.values():
         if cert is None:
             unmet += 100
         elif not cert.certified:
             unmet += len(cert.unmet) + (0 if cert.valid else 1)
+            excess += sum(math.log(a.value / a.limit) for a in cert.assumptions
+                          if not a.met and a.kind == "checked" and math.isfinite(a.value) and a.value > a.limit > 0)
     if unmet:
-        return PENALTY + unmet
+        return PENALTY + unmet + (excess / (1.0 + excess) if graded else 0.0)
     certs = list(certificates.values())
     if objective == "E_max":
         return max(c.E_max for c in certs)
@@ -224,11 +263,18 @@ def binding_of(certificates: Mapping[str, Any]) -> str:
 
 
 def _preset_point(scorer: _Scorer, bounds: list[tuple[float, float]]) -> list[float] | None:
-    """The certified preset's point (omega_n 10, zeta 1, w 0.01, the cart's own tau_f) where it is in bounds."""
+    """The certified preset's point (omega_n 10, zeta 1, w 0.01, the cart's own tau_f) where it is in bounds; for
+    sliding mode the law's defaults with the narrowest width (module docstring)."""
     from wmr_mj.sim.designs import CERTIFIED
 
-    omega_n = math.sqrt(CERTIFIED.kp)
-    x = [math.log(omega_n), CERTIFIED.kd / (2.0 * omega_n), math.log10(CERTIFIED.friction_width)]
+    if scorer.sliding:
+        from controllers.sliding_mode import SlidingMode
+
+        defaults = SlidingMode.__init__.__kwdefaults__ or {}
+        x = [math.log(float(defaults[n])) for n in SLIDING_PARAMETERS] + [bounds[4][0]]
+    else:
+        omega_n = math.sqrt(CERTIFIED.kp)
+        x = [math.log(omega_n), CERTIFIED.kd / (2.0 * omega_n), math.log10(CERTIFIED.friction_width)]
     if scorer.filtered:
         x.append(math.log(scorer.template.sensing.filter_tau))
     return x if all(lo <= v <= hi for v, (lo, hi) in zip(x, bounds)) else None
@@ -246,14 +292,13 @@ def search_design(problem: DesignProblem) -> DesignResult:
     if problem.method not in METHODS:
         raise ParameterError(f"--method {problem.method!r} is not accepted; one of {', '.join(METHODS)}")
     periods = check_periods(problem.periods, problem.base.duration)
+    if problem.base.controller not in LAWS:
+        raise ParameterError(f"--controller {problem.base.controller!r} is not accepted; one of {', '.join(LAWS)}")
     best: tuple[float, Any] | None = None
     evaluations = 0
     for period in periods:
         scorer = _Scorer(problem, period)
-        bounds = [(math.log(problem.omega_n[0]), math.log(problem.omega_n[1])), problem.zeta,
-                  (math.log10(problem.width[0]), math.log10(problem.width[1]))]
-        if scorer.filtered:
-            bounds.append((math.log(max(problem.tau_f[0], period)), math.log(problem.tau_f[1])))
+        bounds = scorer.bounds(period)
         run = _cma if problem.method == "cma" else _differential_evolution
         value, x = run(scorer, bounds, problem)
         evaluations += scorer.evaluations
@@ -313,7 +358,7 @@ def evaluate_design(config: Any, paths: Sequence[str]) -> dict[str, Any]:
 def _finish(problem: DesignProblem, config: Any, found: float, evaluations: int,
             periods: tuple[float, ...]) -> DesignResult:
     certificates = evaluate_design(config, problem.paths)
-    value = score(certificates, problem.objective)
+    value = score(certificates, problem.objective, graded=problem.base.controller == "sliding-mode")
     if value != found:  # the search's certificate is the run's: a difference is a bug, never rounded away
         raise RuntimeError(f"design: the search scored {found!r} but the run's certificate gives {value!r}")
     settings = {name: getattr(config, name) for name in DESIGN_FIELDS}
@@ -326,13 +371,20 @@ def _finish(problem: DesignProblem, config: Any, found: float, evaluations: int,
                         seed=problem.seed, periods=periods, paths=problem.paths)
 
 
+def certificate_name(cert: Any) -> str:
+    """Which analysis gave ``cert``: ``inputs['certificate']`` where the run computed two, else the law's own
+    ('boundary-layer' for sliding mode, 'section-4' for computed torque)."""
+    inputs = cert.inputs
+    own = "boundary-layer" if inputs.get("controller") == "sliding-mode" else "section-4"
+    return str(inputs.get("certificate", own))
+
+
 def _certificate_dict(cert: Any) -> dict[str, Any] | None:
     if cert is None:
         return None
-    inputs = cert.inputs
     return {"certified": cert.certified, "E_max": cert.E_max if cert.valid else None,
             "voltage_max": cert.voltage_max if cert.valid else None, "reason": cert.reason,
-            "certificate": inputs.get("certificate", "section-4"),
+            "certificate": certificate_name(cert),
             "assumptions": [a.as_dict() for a in cert.assumptions]}
 
 
@@ -340,8 +392,14 @@ def design_dict(result: DesignResult) -> dict[str, Any]:
     """The design file's content: the settings (the cart's parts as their spec mappings), the certificate of
     each path, the search."""
     s = dict(result.settings)
-    settings = {k: s[k] for k in ("controller", "model", "kp", "kd", "friction_sign", "friction_width",
-                                  "control_period")}
+    if s["controller"] == "sliding-mode":  # its parameters are the law's own (--controller-param), kp/kd unused
+        params = dict(s["controller_params"])
+        settings = {"controller": s["controller"], "model": s["model"], "kp": None, "kd": None,
+                    "friction_sign": params.pop("friction_sign"), "friction_width": params.pop("friction_width"),
+                    "controller_params": params, "control_period": s["control_period"]}
+    else:
+        settings = {k: s[k] for k in ("controller", "model", "kp", "kd", "friction_sign", "friction_width",
+                                      "control_period")}
     settings.update(sensing=s["sensing"].as_dict(), actuation=s["actuation"].as_dict(),
                     backlash=s["transmission"].backlash)
     return {"format": FORMAT, "version": 1, "settings": settings, "certified": result.certified,
@@ -378,9 +436,12 @@ def read_design(path: str | os.PathLike) -> dict[str, Any]:
 
 def design_file_settings(path: str | os.PathLike) -> dict[str, Any]:
     """The settings of a design file, as the run options spell them (controller, model, kp, kd, friction_sign,
-    friction_width, control_period, sensing, actuation, backlash): ``run --design FILE`` fills each option not
-    given explicitly from them, as a preset does."""
+    friction_width, control_period, sensing, actuation, backlash, and a sliding-mode design's controller_param):
+    ``run --design FILE`` fills each option not given explicitly from them, as a preset does."""
     settings = read_design(path)["settings"]
-    return {k: settings.get(k) for k in ("controller", "model", "kp", "kd", "friction_sign", "friction_width",
-                                         "control_period", "sensing", "actuation", "backlash")}
+    out = {k: settings.get(k) for k in ("controller", "model", "kp", "kd", "friction_sign", "friction_width",
+                                        "control_period", "sensing", "actuation", "backlash")}
+    if settings.get("controller_params"):
+        out["controller_param"] = dict(settings["controller_params"])
+    return out
 
