@@ -1,0 +1,121 @@
+"""How tight a claim is on a cart: the certificate a run takes beside the worst sup|E| an adversary finds.
+
+The certificate's E_max is an upper bound on sup|E| over its box; the worst sup|E| that :func:`falsify` finds
+over the same box (its search and its random sample, both counted) is a lower bound on the worst case. Their
+ratio, the tightness, says how much of the bound the plant can be made to use: 1 would be exact, and a ratio
+above 1 on a certified run would be a broken claim (``certified-outside``, counted in :attr:`verdicts`).
+
+Usage::
+
+    from wmr_mj.sim.config import RunConfig
+    from wmr_mj.sim.designs import CERTIFIED
+    from wmr_mj.sim.tightness import cart_tightness
+    base = RunConfig(**CERTIFIED.config_changes(), sensing="magnetic-12bit-axis", path="lane-change")
+    t = cart_tightness(base, budget=64)          # the m1 box by default: 128 runs
+    t.E_max, t.worst_sup_E, t.tightness, t.verdicts
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+__all__ = ["CartTightness", "cart_tightness", "certificate_columns"]
+
+
+@dataclass(frozen=True, kw_only=True)
+class CartTightness:
+    """One cart on one path: the run's certificate and the worst the adversary found.
+
+    Attributes:
+        path: the reference path.
+        certificate: the certificate the run takes, 'section-4' or 'sampled-data' ('' where there is none).
+        certified: the claim is certified (every assumption met).
+        E_max: the run's certificate's E_max, rad (None: no valid bound).
+        E_max_section4: section 4's certificate's E_max, rad (None: it has none).
+        E_max_sampled: the sampled-data certificate's E_max, rad (None: none, or not computed, as on the
+            ideal cart, where section 4's is the claim).
+        worst_sup_E: the largest sup|E| of every run, search and random sample, rad.
+        worst_params: that run's ranged parameters (e.g. {'m1': 750.0}).
+        search_sup_E: the search's worst sup|E|, rad; random_sup_E: the random sample's, rad.
+        verdicts: verdict -> number of runs (both phases).
+        runs: runs simulated; budget: falsify's budget; seed: its seed; box: the ranges searched.
+    """
+
+    path: str
+    certificate: str
+    certified: bool
+    E_max: float | None
+    E_max_section4: float | None
+    E_max_sampled: float | None
+    worst_sup_E: float
+    worst_params: Mapping[str, float]
+    search_sup_E: float
+    random_sup_E: float
+    verdicts: Mapping[str, int]
+    runs: int
+    budget: int
+    seed: int
+    box: Mapping[str, tuple[float, float]]
+
+    @property
+    def tightness(self) -> float | None:
+        """worst_sup_E / E_max (None where there is no E_max)."""
+        return None if self.E_max is None else self.worst_sup_E / self.E_max
+
+
+def certificate_columns(cert: Any) -> dict[str, Any]:
+    """The E_max columns of a run's certificate (:class:`wmr_mj.analysis.certificate.Certificate` or None).
+
+    Returns:
+        {'certificate', 'certified', 'E_max', 'E_max_section4', 'E_max_sampled'} (rad, None where none); on the
+        ideal cart, where no sampled-data certificate is computed, section 4's is the one taken.
+    """
+    if cert is None:
+        return {"certificate": "", "certified": False, "E_max": None, "E_max_section4": None, "E_max_sampled": None}
+    e_max = float(cert.E_max) if cert.valid and math.isfinite(cert.E_max) else None
+    inputs = cert.inputs
+    both = inputs.get("certificates")
+    if both is None:  # section 4's alone (the ideal cart, or a law with no sampled-data certificate)
+        return {"certificate": "section-4", "certified": bool(cert.certified), "E_max": e_max,
+                "E_max_section4": e_max, "E_max_sampled": None}
+    return {"certificate": str(inputs.get("certificate", "section-4")), "certified": bool(cert.certified),
+            "E_max": e_max, "E_max_section4": both.get("section-4", {}).get("E_max", e_max),
+            "E_max_sampled": both.get("sampled-data", {}).get("E_max")}
+
+
+def cart_tightness(base: Any, *, box: Mapping[str, tuple[float, float]] | None = None, budget: int = 64,
+                   seed: int = 0, method: str = "portfolio", nthread: int = 1) -> CartTightness:
+    """The run's certificate on ``base`` and the worst sup|E| that falsify finds over ``box``.
+
+    Args:
+        base: the run (:class:`wmr_mj.sim.config.RunConfig`): the law, the cart, the path, the duration.
+        box: the ranges searched (None: m1 over the certificate's ``base.m1_range``, kg).
+        budget: falsify's budget (as many runs again on its random sample).
+        seed: falsify's seed; method: its search (:data:`wmr_mj.sim.falsify.METHODS`).
+        nthread: threads of the batch.
+
+    Returns:
+        :class:`CartTightness`; its E_max columns are the certificate ``run`` computes for ``base``
+        (``resolve_run(base).claim``), the one every run of the search shares.
+
+    Raises:
+        ParameterError: what falsify refuses (a budget below one population, a bad range or path).
+    """
+    from wmr_mj.sim.falsify import FalsifySpec, check_runnable, falsify
+
+    if box is None:
+        box = {"m1": (float(base.m1_range[0]), float(base.m1_range[1]))}
+    spec = FalsifySpec(base=base, box=dict(box), objective="sup-E", budget=budget, seed=seed, method=method)
+    parts = check_runnable(base)
+    result = falsify(spec, nthread=nthread, parts=parts)
+    runs = list(result.search) + list(result.random)
+    worst = max(runs, key=lambda e: e.sup_E)
+    return CartTightness(path=str(base.path), **certificate_columns(parts.claim), worst_sup_E=worst.sup_E,
+                         worst_params=dict(worst.params), search_sup_E=max(e.sup_E for e in result.search),
+                         random_sup_E=max(e.sup_E for e in result.random),
+                         verdicts=dict(Counter(e.verdict for e in runs)), runs=len(runs), budget=budget, seed=seed,
+                         box={k: (float(v[0]), float(v[1])) for k, v in box.items()})
