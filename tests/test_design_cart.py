@@ -1,8 +1,8 @@
 """``wmr-mj design --cart FILE|NAME`` (issue 37 item 2): the search runs on the cart, and its file reproduces.
 
 The independent truth is ``wmr-mj run``: the design file written on a cart, run with ``run --design FILE --cart``
-(the very line design prints), must give the certificate the file states, to the bit; the same file run without
-``--cart`` (on the C80) must not, or the search would not have run on the cart at all. The cart's m1 box is read
+(the very line design prints), must give the certificate the file states, to the bit; the same file run with
+``--cart c80`` (on the C80) must not, or the search would not have run on the cart at all. The cart's m1 box is read
 from the cart file itself. Budgets and durations are small (a few seconds each); the numbers compared are the
 same computation's, so they are compared exactly.
 """
@@ -52,8 +52,8 @@ def test_design_on_a_cart_is_reproduced_by_run_with_the_cart(tmp_path, capsys):
     cert = _run_certificate(capsys, got["run"])
     assert cert["certified"] and (cert["E_max"], cert["voltage_max"]) == (stated["E_max"], stated["voltage_max"])
     assert [a["value"] for a in cert["assumptions"]] == [a["value"] for a in stated["assumptions"]]
-    # the same design on the C80 (no --cart) has another certificate: the search did run on the cart
-    on_c80 = _run_certificate(capsys, got["run"].replace(" --cart c80-magmotor", ""))
+    # the same design run on the C80 (--cart c80) has another certificate: the search did run on the cart
+    on_c80 = _run_certificate(capsys, got["run"].replace(" --cart c80-magmotor", " --cart c80"))
     assert on_c80["E_max"] != stated["E_max"] and on_c80["voltage_max"] != stated["voltage_max"]
 
 

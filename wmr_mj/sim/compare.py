@@ -114,17 +114,22 @@ def design_file_changes(path: str, *, cart: Any = None) -> dict[str, Any]:
         cart: the cart file the law is built on (``RunConfig.cart``; None: the C80); the file's gains are kept.
 
     Raises:
-        ParameterError: a file that cannot be read or is not a design file, a setting a run refuses (one line
-            naming the file).
+        ParameterError: a file that cannot be read or is not a design file, a setting a run refuses, a design
+            found on another cart where ``cart`` is None (one line naming the file).
     """
     from wmr_mj.hardware import Actuation, Sensing, Transmission
-    from wmr_mj.sim.design_search import design_file_settings
+    from wmr_mj.sim.design_search import design_file_settings, read_design
     from wmr_mj.sim.spec import LawChoice, law_fields
 
     try:
         s = design_file_settings(path)
+        found_on = read_design(path).get("cart")
     except ParameterError as exc:  # read_design names the run option; here the file is a design's name
         raise ParameterError(str(exc).replace("--design ", "design ", 1)) from None
+    if cart is None and isinstance(found_on, dict):  # every design here runs on the command's one cart
+        raise ParameterError(f"design {str(path)!r} was found on cart {found_on.get('name')!r} "
+                             f"({found_on.get('path')}); give --cart FILE to run every design on that cart (the "
+                             "C80 is the default)")
     law = law_fields(LawChoice(cart=cart, controller=s["controller"], model=s["model"], kp=s["kp"], kd=s["kd"],
                                friction_sign=s["friction_sign"], friction_width=s["friction_width"],
                                controller_params=s.get("controller_params") or {}))

@@ -43,7 +43,7 @@ from typing import Any
 from wmr_mj.errors import ParameterError
 
 __all__ = ["DesignProblem", "DesignResult", "OBJECTIVES", "METHODS", "LAWS", "DESIGN_FIELDS", "search_design",
-           "evaluate_design", "write_design", "read_design", "design_file_settings", "check_periods"]
+           "evaluate_design", "write_design", "read_design", "design_file_settings", "design_cart", "check_periods"]
 
 #: what the search minimises: the worst certified E_max over the paths (rad), the worst certified voltage (V),
 #: or minus the smallest relative margin 1 - value/limit of the certificate's checked assumptions
@@ -445,3 +445,37 @@ def design_file_settings(path: str | os.PathLike) -> dict[str, Any]:
         out["controller_param"] = dict(settings["controller_params"])
     return out
 
+
+
+def design_cart(path: str | os.PathLike, given: Any = None) -> Any:
+    """The cart a run of the design file ``path`` is on: ``given`` where a cart is named (an explicit --cart
+    overrides the file, as every explicit option does); else the cart the design was found on, which the file
+    records (``wmr-mj design --cart``): the file the record names, found where it was, beside the design file, or
+    among the shipped carts, holding the very text the design was found on. A design found on the C80 records
+    none: None.
+
+    Without this a design found on another cart would run on the C80 with that cart's gains, and its certificate
+    would silently be another cart's.
+
+    Raises:
+        ParameterError: the design's cart file is nowhere to be found with the text it had (moved or changed): one
+            line naming it and what is accepted.
+    """
+    from pathlib import Path
+
+    from wmr_mj.carts import cart_names, cart_path
+
+    recorded = read_design(path).get("cart")
+    if given is not None or not isinstance(recorded, Mapping):
+        return given
+    where = Path(str(recorded.get("path", "")))
+    candidates = [where, Path(path).parent / where.name, *(cart_path(name) for name in cart_names())]
+    for candidate in candidates:
+        try:
+            if candidate.is_file() and candidate.read_text(encoding="utf-8") == recorded.get("text"):
+                return str(candidate)
+        except OSError:
+            continue
+    raise ParameterError(f"--design {os.fspath(path)!r} was found on cart {recorded.get('name')!r} "
+                         f"{recorded.get('version', '')} ({where}), which is no longer there with the same text; "
+                         "give --cart FILE (the cart to run it on; --cart c80 for the C80)")
