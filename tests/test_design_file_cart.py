@@ -86,3 +86,18 @@ def test_compare_refuses_a_design_found_on_another_cart_without_cart(tmp_path, c
         design_file_changes(str(tmp_path / "d.json"))
     changes = design_file_changes(str(tmp_path / "d.json"), cart="c80-magmotor")
     assert changes["controller"] == "computed-torque"
+
+
+def test_every_writer_of_a_design_file_records_its_cart(tmp_path):
+    """write_design itself records the cart (validate's section (e) writes its design file through it, not
+    through the design command): the file then runs on that cart, and a C80 design's file records none."""
+    from wmr_mj.sim.config import RunConfig
+    from wmr_mj.sim.design_search import DesignProblem, search_design, write_design
+    from wmr_mj.sim.designs import CERTIFIED
+
+    for cart, expected in (("c80-magmotor", str(CARTS_DIR / "c80-magmotor.toml")), (None, None)):
+        base = RunConfig(**CERTIFIED.config_changes(), duration=10.0, cart=cart)
+        write_design(search_design(DesignProblem(base=base, budget=4)), tmp_path / "d.json")
+        written = json.loads((tmp_path / "d.json").read_text(encoding="utf-8"))
+        assert ("cart" in written) == (cart is not None)
+        assert design_cart(tmp_path / "d.json") == expected

@@ -112,7 +112,6 @@ def problem_from_args(args: argparse.Namespace) -> Any:
 def run(args: argparse.Namespace) -> int:
     import time
 
-    from wmr_mj._util.files import write_json_atomic
     from wmr_mj.cli._common import print_json
     from wmr_mj.errors import ParameterError
     from wmr_mj.sim.design_search import design_dict, search_design, write_design
@@ -125,9 +124,6 @@ def run(args: argparse.Namespace) -> int:
     wall = time.perf_counter() - t0
     write_design(result, args.out)
     out = design_dict(result)
-    if problem.base.cart is not None:  # the file records the cart searched on (name, version, path, the file's
-        out["cart"] = dict(problem.base.cart)  # text); a C80 design's file has no "cart" key, as a C80 config
-        write_json_atomic(args.out, out)
     out.update(file=str(args.out), wall_s=wall, run=run_line(args))
     if result.certified and args.check > 0:
         out["check"] = check_design(problem, result, args.check)

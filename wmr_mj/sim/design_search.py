@@ -115,6 +115,7 @@ class DesignResult:
         evaluations: certificate evaluations spent.
         box: what the certificates were computed for besides the design (m1_range, box_ranges, box,
             reference_bounds, duration): the run options a run needs to compute the same certificate.
+        cart: the cart searched on, as its config records it (name, version, path, the file's text); None: the C80.
         objective, seed, periods, paths: the search's.
     """
 
@@ -129,6 +130,7 @@ class DesignResult:
     periods: tuple[float, ...] = ()
     paths: tuple[str, ...] = ()
     box: Mapping[str, Any] | None = None
+    cart: Mapping[str, Any] | None = None
 
     @property
     def E_max(self) -> float:
@@ -368,7 +370,7 @@ def _finish(problem: DesignProblem, config: Any, found: float, evaluations: int,
            "duration": config.duration}
     return DesignResult(box=box, settings=settings, certified=value < PENALTY, score=value, certificates=certificates,
                         binding=binding_of(certificates), evaluations=evaluations, objective=problem.objective,
-                        seed=problem.seed, periods=periods, paths=problem.paths)
+                        seed=problem.seed, periods=periods, paths=problem.paths, cart=config.cart)
 
 
 def certificate_name(cert: Any) -> str:
@@ -407,7 +409,10 @@ def design_dict(result: DesignResult) -> dict[str, Any]:
             "certificates": {p: _certificate_dict(c) for p, c in result.certificates.items()},
             "box": result.box, "search": {"objective": result.objective, "score": result.score, "seed": result.seed,
                        "periods": list(result.periods), "paths": list(result.paths),
-                       "evaluations": result.evaluations}}
+                       "evaluations": result.evaluations},
+            # the cart searched on (name, version, path, the file's text: design_cart finds it again); a C80
+            # design's file has no "cart" key, as a C80 config's record has none
+            **({} if result.cart is None else {"cart": dict(result.cart)})}
 
 
 def write_design(result: DesignResult, path: str | os.PathLike) -> None:
