@@ -1,14 +1,14 @@
 """``wmr-mj design``'s cost: one certificate evaluation, and a whole design.
 
     .venv/bin/python bench/bench_design.py [--sensing magnetic-12bit-axis] [--repeats 50] [--budget 600]
-                                           [--designs 1] [--seeds 2]
+                                           [--designs 1] [--seeds 2] [--controller computed-torque|sliding-mode]
 
 Printed:
 
   evaluation: the median wall time (and the quartiles) of one point's score as the search computes it
               (``wmr_mj.sim.design_search._Scorer``: the law built from the point's gains and
               ``wmr_mj.sim.certify.certificate_of`` on the parts ``resolve_run`` gave once), over ``--repeats``
-              points drawn uniformly in the search space (seeded);
+              points drawn uniformly in the law's search space (``_Scorer.bounds``, seeded);
   design:     for each optimiser (:data:`wmr_mj.sim.design_search.METHODS`) and seed (0 .. ``--seeds`` - 1),
               the median wall time of ``search_design`` (the paper circle, the 1 ms period, ``--budget``
               points) over ``--designs`` repeats, with its certified E_max (the same every repeat: the search
@@ -32,7 +32,7 @@ def main() -> None:
 
     from wmr_mj.hardware import Sensing
     from wmr_mj.sim.config import RunConfig
-    from wmr_mj.sim.design_search import METHODS, DesignProblem, _Scorer, search_design
+    from wmr_mj.sim.design_search import LAWS, METHODS, DesignProblem, _Scorer, search_design
     from wmr_mj.sim.designs import CERTIFIED
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -41,17 +41,16 @@ def main() -> None:
     ap.add_argument("--budget", type=int, default=600)
     ap.add_argument("--designs", type=int, default=1)
     ap.add_argument("--seeds", type=int, default=2)
+    ap.add_argument("--controller", default="computed-torque", choices=LAWS)
     args = ap.parse_args()
 
-    base = RunConfig(**CERTIFIED.config_changes(), sensing=Sensing.from_spec(args.sensing))
+    law = (CERTIFIED.config_changes() if args.controller == "computed-torque"
+           else {"controller": "sliding-mode", "model": "nonholonomic"})  # as `wmr-mj design --controller` builds it
+    base = RunConfig(**law, sensing=Sensing.from_spec(args.sensing))
     problem = DesignProblem(base=base, budget=args.budget)
     scorer = _Scorer(problem, 0.001)
     rng = np.random.default_rng(0)
-    lows = [math.log(problem.omega_n[0]), problem.zeta[0], math.log10(problem.width[0])]
-    highs = [math.log(problem.omega_n[1]), problem.zeta[1], math.log10(problem.width[1])]
-    if scorer.filtered:
-        lows.append(math.log(problem.tau_f[0]))
-        highs.append(math.log(problem.tau_f[1]))
+    lows, highs = (list(side) for side in zip(*scorer.bounds(0.001)))
     times = []
     for _ in range(args.repeats):
         x = rng.uniform(lows, highs)
@@ -59,7 +58,7 @@ def main() -> None:
         scorer(x)
         times.append(time.perf_counter() - t0)
     q1, med, q3 = statistics.quantiles(times, n=4)
-    print(f"evaluation ({args.sensing}, {args.repeats} points): median {med * 1e3:.1f} ms "
+    print(f"evaluation ({args.controller}, {args.sensing}, {args.repeats} points): median {med * 1e3:.1f} ms "
           f"(quartiles {q1 * 1e3:.1f}-{q3 * 1e3:.1f} ms)")
     for method in METHODS:
         for seed in range(args.seeds):

@@ -5,6 +5,7 @@
   runner's block contract, without the closed loop (the log tests).
 - :func:`ros2_decoded`, :func:`chunk_spans`, :func:`foxglove_read`: independent readers of a log.
 - :class:`StopAfter3000Rows`: a logger that stops a run with Ctrl-C after its third simulated second.
+- :func:`example_module`: an example script of ``examples/`` imported as a module (it is no package).
 
 The runs that many files repeat are session fixtures in ``tests/conftest.py``, not here.
 
@@ -32,6 +33,22 @@ import pytest
 from wmr_mj.logs.writer import LogHeader, LogOptions, RunLogger
 
 TESTS = Path(__file__).resolve().parent
+EXAMPLES = TESTS.parent / "examples"
+
+
+def example_module(name: str):
+    """``examples/NAME.py`` imported as a module (examples are scripts, not a package), run once per call.
+
+    Args:
+        name: the script's stem, e.g. ``"observer_law"``.
+    """
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location(f"{name}_example", EXAMPLES / f"{name}.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 
 
 # --------------------------------------------------------------------------- bad input

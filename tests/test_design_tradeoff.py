@@ -8,13 +8,13 @@ first), and the preset's E_max is the certificate a run computes for that cart.
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
+from helpers import example_module
 
 import wmr_mj as wm
 from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE
@@ -25,11 +25,7 @@ SCRIPT = ROOT / "examples" / "design_tradeoff.py"
 
 
 def _module():
-    spec = importlib.util.spec_from_file_location("design_tradeoff_example", SCRIPT)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return example_module("design_tradeoff")
 
 
 @pytest.fixture(scope="module")

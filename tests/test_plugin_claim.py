@@ -131,14 +131,9 @@ def test_observer_example_claim_covers_the_13_bit_3_ms_cart():
 
 
 def _observer_module():
-    import importlib.util
-    from pathlib import Path
+    from helpers import example_module
 
-    path = Path(__file__).resolve().parents[1] / "examples" / "observer_law.py"
-    spec = importlib.util.spec_from_file_location("observer_law_example", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return example_module("observer_law")
 
 
 def test_law_signals_in_the_rows_and_the_log(tmp_path):

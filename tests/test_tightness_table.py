@@ -7,7 +7,6 @@ bit by ``run_closed_loop``), and the printed tightness against worst / E_max of 
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import math
 import subprocess
@@ -15,6 +14,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from helpers import example_module
 
 import wmr_mj as wm
 from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE
@@ -29,11 +29,7 @@ CARTS = ("ideal", "sensing delay 20 ms", "12-bit axis encoder, differenced")
 
 
 def _module():
-    spec = importlib.util.spec_from_file_location("tightness_table_example", SCRIPT)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return example_module("tightness_table")
 
 
 @pytest.fixture(scope="module")
