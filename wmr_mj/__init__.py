@@ -38,6 +38,7 @@ from wmr_mj.params import C80, C80Parameters, Coefficients, parameter_names, wit
 from ._version import __version__ as __version__
 
 if TYPE_CHECKING:
+    from wmr_mj.carts import CartFile, load_cart
     from wmr_mj.logs.reader import load_log
     from wmr_mj.logs.writer import LogOptions, RunLogger
     from wmr_mj.report.results import ValidateSummary
@@ -45,6 +46,7 @@ if TYPE_CHECKING:
     from wmr_mj.sim.closed_loop import RunResult, run_closed_loop
     from wmr_mj.sim.compare import CompareReport, CompareResult, Design, DesignRow, compare, design_from_token
     from wmr_mj.sim.config import RunConfig, controller_for
+    from wmr_mj.sim.design_search import DesignProblem, DesignResult, search_design, write_design
     from wmr_mj.sim.designs import CERTIFIED, PAPER, PRESETS, preset
     from wmr_mj.sim.falsify import FalsifyReport, FalsifyResult, FalsifySpec, falsify
     from wmr_mj.sim.log_header import LogHeader
@@ -54,6 +56,7 @@ if TYPE_CHECKING:
     from wmr_mj.sim.suite import load_suite
     from wmr_mj.sim.sweep import SweepSpec, SweepSummary, run_sweep
     from wmr_mj.sim.sweep_result import SweepResult, sweep
+    from wmr_mj.sim.tightness import CartTightness, cart_tightness
 
 #: name -> the module that defines it, imported on first access
 _LAZY: dict[str, str] = {
@@ -93,6 +96,14 @@ _LAZY: dict[str, str] = {
     "Design": "wmr_mj.sim.compare",
     "design_from_token": "wmr_mj.sim.compare",
     "ResultPlot": "wmr_mj.sim.notebook",
+    "load_cart": "wmr_mj.carts",
+    "CartFile": "wmr_mj.carts",
+    "DesignProblem": "wmr_mj.sim.design_search",
+    "DesignResult": "wmr_mj.sim.design_search",
+    "search_design": "wmr_mj.sim.design_search",
+    "write_design": "wmr_mj.sim.design_search",
+    "cart_tightness": "wmr_mj.sim.tightness",
+    "CartTightness": "wmr_mj.sim.tightness",
 }
 
 __all__ = [
@@ -116,6 +127,16 @@ __all__ = [
     "Actuation",
     "Transmission",
     "sensing_preset_names",
+    # a cart of your own (a TOML file: wmr_mj/carts/c80.toml to copy; RunConfig(cart=...))
+    "load_cart",
+    "CartFile",
+    # the gains a given cart can certify (wmr-mj design), and how tight a cart's claim is against the adversary
+    "DesignProblem",
+    "DesignResult",
+    "search_design",
+    "write_design",
+    "cart_tightness",
+    "CartTightness",
     # what acts on the plant during a run: a steering disturbance, load changes
     "Signals",
     "Disturbance",
