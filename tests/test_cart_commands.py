@@ -107,18 +107,20 @@ def test_the_certified_rule_on_a_cart_gives_its_own_omega_r(tmp_path, capsys):
 
 def test_the_second_cart_is_its_file(tmp_path):
     """c80-magmotor: the motor and gear of its file, every other parameter the C80's. The motor's numbers are its
-    data sheet's lines (Rt = 0.31 Ohm; Ke = 13.3 V/krpm in V s/rad), the gear the C80's rule C_V = 4.77 V s/rad."""
+    data sheet's lines (Rt = 0.31 Ohm; Ke = 13.3 V/krpm in V s/rad), the gear the Beckhoff NP045's 2-stage 32:1."""
     import math
 
     cart = load_cart("c80-magmotor")
     base = base_for(RunConfig(cart="c80-magmotor"))
     c80 = load_cart("c80").parameters
     k = 13.3 * 60.0 / (2.0 * math.pi * 1000.0)
-    assert (base.R_a, base.k_i, base.k_b, base.i2) == (0.31, k, k, 4.77 / k)
+    assert (base.R_a, base.k_i, base.k_b, base.i2) == (0.31, k, k, 32.0)
     assert {k: v for k, v in cart.parameters.items() if k not in ("R_a", "k_i", "k_b", "i2")} == \
         {k: v for k, v in c80.items() if k not in ("R_a", "k_i", "k_b", "i2")}
     assert all(("Magmotor" in cart.sources[k]) for k in ("R_a", "k_i", "k_b"))
-    assert all(cart.sources[k].startswith("assumption") for k in cart.parameters if k not in ("R_a", "k_i", "k_b"))
+    assert "Beckhoff" in cart.sources["i2"]
+    assert all(cart.sources[k].startswith("assumption") for k in cart.parameters if k not in ("R_a", "k_i", "k_b",
+                                                                                             "i2"))
 
 
 def test_cart_check_reports_the_certified_design_in_its_second_line(capsys):
