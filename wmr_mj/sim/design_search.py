@@ -137,6 +137,33 @@ class DesignResult:
         """The worst E_max over the paths, rad (inf where a certificate has none)."""
         return max((c.E_max if c is not None and c.valid else math.inf) for c in self.certificates.values())
 
+    # -- in a notebook (wmr_mj.sim.notebook): each path's certificate as a table, the design in a few lines
+    def to_pandas(self) -> Any:
+        """One row per path: ``path``, ``certified``, ``certificate`` (which analysis gave it), ``E_max [rad]``,
+        ``Edot_max [rad/s]``, ``voltage_max [V]`` and ``unmet`` (the assumptions not met, by name).
+
+        Raises:
+            WmrMjError: pandas is not installed (``pip install 'wmr-mj[notebook]'``).
+        """
+        from wmr_mj.sim import notebook
+
+        rows = []
+        for path, cert in self.certificates.items():
+            valid = cert is not None and cert.valid
+            rows.append({"path": path, "certified": bool(cert is not None and cert.certified),
+                         "certificate": certificate_name(cert) if cert is not None else "",
+                         "E_max [rad]": cert.E_max if valid else None,
+                         "Edot_max [rad/s]": cert.Edot_max if valid else None,
+                         "voltage_max [V]": cert.voltage_max if valid else None,
+                         "unmet": ", ".join(a.name for a in cert.assumptions if not a.met) if cert else ""})
+        return notebook.records_frame(rows)
+
+    def _repr_html_(self) -> str:
+        from wmr_mj.sim import notebook
+
+        return notebook.html_lines("design", "certified" if self.certified else "nothing certifies",
+                                   design_lines(self))
+
 
 def check_periods(periods: Sequence[float], duration: float) -> tuple[float, ...]:
     """The period list, each checked: > 0, a whole number of 1 ms physics steps, and a divisor of the run.
@@ -371,6 +398,28 @@ def _finish(problem: DesignProblem, config: Any, found: float, evaluations: int,
     return DesignResult(box=box, settings=settings, certified=value < PENALTY, score=value, certificates=certificates,
                         binding=binding_of(certificates), evaluations=evaluations, objective=problem.objective,
                         seed=problem.seed, periods=periods, paths=problem.paths, cart=config.cart)
+
+
+def design_lines(result: DesignResult) -> list[str]:
+    """The design in a few lines: the law's parameters, then each path's certificate (or what binds)."""
+    from wmr_mj.sim.notebook import number
+
+    s = result.settings
+    if s["controller"] == "sliding-mode":
+        law = "sliding mode " + ", ".join(f"{k} = {number(v)}" for k, v in s["controller_params"].items()
+                                          if isinstance(v, float))
+    else:
+        law = f"computed torque K_P = {number(s['kp'], '1/s^2')}, K_D = {number(s['kd'], '1/s')}, " \
+              f"sign width {number(s['friction_width'], 'rad/s')}"
+    lines = [f"{law}, period {number(s['control_period'] * 1e3, 'ms')} ({result.objective}, seed {result.seed}, "
+             f"{result.evaluations} certificates)"]
+    if not result.certified:
+        lines.append(f"{result.binding} binds at the best point found")
+    for path, cert in result.certificates.items():
+        if cert is not None and cert.valid:
+            lines.append(f"{path}: E_max {number(cert.E_max, 'rad')}, {number(cert.voltage_max, 'V')} "
+                         f"({certificate_name(cert)}{'' if cert.certified else ', not certified'})")
+    return lines
 
 
 def certificate_name(cert: Any) -> str:

@@ -66,6 +66,33 @@ class CartTightness:
         """worst_sup_E / E_max (None where there is no E_max)."""
         return None if self.E_max is None else self.worst_sup_E / self.E_max
 
+    # -- in a notebook (wmr_mj.sim.notebook): a one-row table (rows of several carts concatenate), a few lines
+    def to_pandas(self) -> Any:
+        """One row: ``path``, ``certificate``, ``certified``, the three E_max columns [rad], ``worst_sup_E [rad]``,
+        ``tightness [-]``, ``runs`` and the verdict counts (one column each).
+
+        Raises:
+            WmrMjError: pandas is not installed (``pip install 'wmr-mj[notebook]'``).
+        """
+        from wmr_mj.sim import notebook
+
+        return notebook.records_frame([{
+            "path": self.path, "certificate": self.certificate, "certified": self.certified,
+            "E_max [rad]": self.E_max, "E_max_section4 [rad]": self.E_max_section4,
+            "E_max_sampled [rad]": self.E_max_sampled, "worst_sup_E [rad]": self.worst_sup_E,
+            "tightness [-]": self.tightness, "runs": self.runs, **dict(self.verdicts)}])
+
+    def _repr_html_(self) -> str:
+        from wmr_mj.sim.notebook import html_lines, number, verdict_counts_text
+
+        where = ", ".join(f"{k} = {v:.6g}" for k, v in self.worst_params.items())
+        return html_lines("tightness", number(self.tightness), [
+            f"{self.path}: E_max {number(self.E_max, 'rad')} ({self.certificate or 'no certificate'}; section 4 "
+            f"{number(self.E_max_section4, 'rad')}, sampled-data {number(self.E_max_sampled, 'rad')})",
+            f"worst sup|E| found {number(self.worst_sup_E, 'rad')} at {where} (search {number(self.search_sup_E)}, "
+            f"random {number(self.random_sup_E)}; falsify budget {self.budget}, seed {self.seed})",
+            f"{self.runs} runs: {verdict_counts_text(self.verdicts)}"])
+
 
 def certificate_columns(cert: Any) -> dict[str, Any]:
     """The E_max columns of a run's certificate (:class:`wmr_mj.analysis.certificate.Certificate` or None).

@@ -1,0 +1,62 @@
+"""A design and a cart's tightness in a notebook: ``.to_pandas()`` and ``_repr_html_`` (issue 36's contract for
+every result, extended to ``DesignResult`` and ``CartTightness``).
+
+The independent truth is each result's own fields: the table's cells are the certificates' numbers and the
+tightness the result computes, to the bit, and the lines name the design's gains and its binding assumption. Small
+budgets and 9 s runs (the circle's entry takes 8.1 s) keep it to seconds.
+"""
+
+from __future__ import annotations
+
+import html
+import math
+
+import pytest
+
+import wmr_mj as wm
+
+pytest.importorskip("pandas")
+
+
+@pytest.fixture(scope="module")
+def found():
+    base = wm.RunConfig(**wm.CERTIFIED.config_changes(), sensing=wm.Sensing.from_spec("magnetic-12bit-axis"),
+                        duration=9.0)
+    return base, wm.search_design(wm.DesignProblem(base=base, paths=("paper-circle", "lane-change"), budget=12))
+
+
+def test_a_design_as_a_table_and_a_few_lines(found):
+    _, result = found
+    assert result.certified
+    table = result.to_pandas()
+    assert list(table["path"]) == ["paper-circle", "lane-change"]
+    for (_, row), cert in zip(table.iterrows(), result.certificates.values()):
+        assert row["E_max [rad]"] == cert.E_max and row["voltage_max [V]"] == cert.voltage_max
+        assert row["certified"] == cert.certified and row["unmet"] == ""
+    assert max(table["E_max [rad]"]) == result.E_max
+    lines = result._repr_html_()
+    assert "<b>certified</b>" in lines and f"{result.settings['kp']:.4g}" in lines
+    assert lines.count(": E_max ") == 2  # one line per path
+
+
+def test_a_design_that_nothing_certifies_names_what_binds():
+    base = wm.RunConfig(**wm.CERTIFIED.config_changes(), sensing=wm.Sensing.from_spec(
+        "encoder_ticks=256,velocity=difference"), duration=9.0)
+    result = wm.search_design(wm.DesignProblem(base=base, budget=8))
+    assert not result.certified and result.binding
+    text = html.unescape(result._repr_html_())
+    assert "nothing certifies" in text and f"{result.binding} binds" in text
+    assert math.isinf(result.E_max) or not all(row for row in result.to_pandas()["certified"])
+
+
+def test_a_tightness_row_as_a_table_and_a_few_lines(found):
+    base, result = found
+    row = wm.cart_tightness(base.replace(**result.settings), budget=5)
+    table = row.to_pandas()
+    assert len(table) == 1
+    got = table.iloc[0]
+    assert got["E_max [rad]"] == row.E_max and got["worst_sup_E [rad]"] == row.worst_sup_E
+    assert got["tightness [-]"] == row.worst_sup_E / row.E_max
+    assert sum(int(got[v]) for v in row.verdicts) == row.runs
+    lines = row._repr_html_()
+    assert f"{row.tightness:.4g}" in lines and f"{row.runs} runs" in lines
