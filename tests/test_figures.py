@@ -1,4 +1,4 @@
-"""wmr-mj figures and wmr_mj.report.plots: the paper's Figs. 4-7 as PNG + SVG, headless."""
+"""wmr-mj figures and wmr_mj.figures.plots: the paper's Figs. 4-7 as PNG + SVG, headless."""
 
 from __future__ import annotations
 
@@ -15,8 +15,7 @@ import pytest  # noqa: E402
 
 from wmr_mj.analysis.robustness import ParameterBox, analyse  # noqa: E402
 from wmr_mj.cli.app import main  # noqa: E402
-from wmr_mj.report.paper_example import paper_example  # noqa: E402
-from wmr_mj.report.plots import (  # noqa: E402
+from wmr_mj.figures.plots import (  # noqa: E402
     PAPER_FIGURE_NAMES,
     REGION_GID,
     Series,
@@ -25,6 +24,7 @@ from wmr_mj.report.plots import (  # noqa: E402
     paper_figures,
     plot_region,
 )
+from wmr_mj.report.paper_example import paper_example  # noqa: E402
 
 DURATION = "10"  # long enough to reach the paper circle (entry ends at ~8.1 s)
 
@@ -136,7 +136,7 @@ def _legend_labels(fig):
 
 
 def test_verdict_plane_draws_each_region_exactly_and_counts_each_verdict():
-    from wmr_mj.report.plots import CERTIFICATE_GID, Region, figure_verdict_plane
+    from wmr_mj.figures.plots import CERTIFICATE_GID, Region, figure_verdict_plane
 
     cert = [(0.0, 0.0), (0.04, 0.0), (0.046, 0.34), (0.0, 0.33)]
     paper = [(0.0, 0.0), (0.005, 0.0), (0.005, 0.04), (0.0, 0.04)]
@@ -155,7 +155,7 @@ def test_verdict_plane_draws_each_region_exactly_and_counts_each_verdict():
 
 
 def test_verdict_plane_splits_into_region_scale_and_full_range_when_runs_leave_it():
-    from wmr_mj.report.plots import Region, figure_verdict_plane
+    from wmr_mj.figures.plots import Region, figure_verdict_plane
 
     region = Region("r", [(0.0, 0.0), (0.1, 0.0), (0.1, 0.1), (0.0, 0.1)])
     E = [0.05, 1.5, 0.6]  # two beyond 3x the region
@@ -169,7 +169,7 @@ def test_verdict_plane_splits_into_region_scale_and_full_range_when_runs_leave_i
 
 
 def test_ladder_bars_add_up_to_each_rungs_runs():
-    from wmr_mj.report.plots import VERDICT_COLORS, figure_ladder
+    from wmr_mj.figures.plots import VERDICT_COLORS, figure_ladder
 
     counts = [{"uncertified-outside": 5}, {"uncertified-inside": 2, "uncertified-outside": 3},
               {"certified-inside": 5}]
@@ -186,7 +186,7 @@ def test_ladder_bars_add_up_to_each_rungs_runs():
 
 
 def test_search_history_running_worst_and_reference_lines():
-    from wmr_mj.report.plots import SearchHistory, figure_search_history
+    from wmr_mj.figures.plots import SearchHistory, figure_search_history
 
     values = [0.3, None, 0.5, 0.4, 0.7, 0.6]
     fig = figure_search_history([SearchHistory("t", "ratio", values, mc_worst=0.65, bound=1.0),
@@ -203,7 +203,7 @@ def test_search_history_running_worst_and_reference_lines():
 
 @pytest.mark.slow
 def test_time_history_draws_the_bounds_it_is_given(example):
-    from wmr_mj.report.plots import figure_time_history
+    from wmr_mj.figures.plots import figure_time_history
 
     fig = figure_time_history(example.mujoco_rows, example.mujoco_summary, voltage_limit=24.0,
                               bounds=(0.0463, 0.341), bound_name="certificate")

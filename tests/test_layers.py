@@ -13,11 +13,12 @@ rank  modules                                     what
 3     wmr_mj.reference                            paths of C and alpha0(t)
 4     wmr_mj.analysis                             the paper's section 4, the certificate, verdicts
 5     controllers                                 steering laws and path trackers, each with its claim
-6     wmr_mj.sim                                  closed loop, batch, sweep, falsify, designs
-7     wmr_mj.logs                                 MCAP format, writer, reader, replay, video
-8     wmr_mj.report                               validate, text, HTML, figures
-9     wmr_mj.cli                                  the wmr-mj commands
-10    wmr_mj (its ``__init__``)                   the public API: may import any layer
+6     wmr_mj.figures                              headless figures: the drawing, and each result's ``.plot()``
+7     wmr_mj.sim                                  closed loop, batch, sweep, falsify, designs
+8     wmr_mj.logs                                 MCAP format, writer, reader, replay, video
+9     wmr_mj.report                               validate, text, HTML, the figures it writes
+10    wmr_mj.cli                                  the wmr-mj commands
+11    wmr_mj (its ``__init__``)                   the public API: may import any layer
 ====  ==========================================  =====================================================
 """
 
@@ -34,6 +35,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("wmr_mj.reference",),
     ("wmr_mj.analysis",),
     ("controllers",),
+    ("wmr_mj.figures",),
     ("wmr_mj.sim",),
     ("wmr_mj.logs",),
     ("wmr_mj.report",),
@@ -95,6 +97,7 @@ def test_rank_of_known_modules():
     assert rank("wmr_mj.hardware.sensing") == 1
     assert rank("wmr_mj") == len(LAYERS) - 1
     assert rank("controllers.computed_torque") == 5
+    assert rank("wmr_mj.figures.results") < rank("wmr_mj.sim.closed_loop")  # a result's plot() imports it
     assert rank("numpy") is None
 
 

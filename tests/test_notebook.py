@@ -1,4 +1,4 @@
-"""Results in a notebook (wmr_mj.sim.notebook, wmr_mj.report.notebook, examples/notebook.ipynb).
+"""Results in a notebook (wmr_mj.sim.notebook, wmr_mj.figures.results, examples/notebook.ipynb).
 
 Each ``.to_pandas()`` is held against the result's own arrays and records (the same values under the unit
 names of wmr_mj.sim.notebook), each ``.plot()`` against the data it draws (the E line's points are the rows),
@@ -225,10 +225,9 @@ def test_a_notebook_needs_nothing_below_the_top_level():
     for name in ("sweep", "SweepResult", "design_from_token", "Design", "CompareReport", "DesignRow", "ResultPlot",
                  "load_suite", "compare", "falsify", "FalsifySpec", "SweepSpec", "run_closed_loop", "RunConfig"):
         assert name in wm.__all__ and getattr(wm, name) is not None
-    import importlib
+    from wmr_mj.figures import results  # the drawing, in the layer below the results
 
-    backend = importlib.import_module(notebook.PLOT_BACKEND)  # the drawing, in the report layer
-    assert all(hasattr(backend, f"plot_{kind}") for kind in ("run", "sweep", "falsify", "compare"))
+    assert all(hasattr(results, f"plot_{kind}") for kind in ("run", "sweep", "falsify", "compare", "validate"))
 
 
 def _cells(nb) -> list[tuple[str, str]]:

@@ -58,7 +58,7 @@ def _chromium(*args: str, timeout: float = 60) -> subprocess.CompletedProcess:
 def report(tmp_path_factory) -> tuple[Path, dict]:
     """A report folder written by the report writer from the fixture summary."""
     from wmr_mj import C80
-    from wmr_mj.report import plots
+    from wmr_mj.figures import plots
     from wmr_mj.report.validate import write_report
     from wmr_mj.sim.config import build_reference
 

@@ -385,11 +385,11 @@ def test_the_compare_figure_draws_each_design_in_its_own_colour_with_a_legend():
 
     from matplotlib.colors import to_hex
 
-    from wmr_mj.report.compare import figure
+    from wmr_mj.figures.results import figure_compare
 
     rows = tuple(SimpleNamespace(label=name, requirements_passed=k, requirements_total=4, rms_voltage=1.0 + k,
                                  cross_track_max=0.01 * (k + 1)) for k, name in enumerate(("certified", "pd", "smc")))
-    fig = figure(SimpleNamespace(rows=rows))
+    fig = figure_compare(SimpleNamespace(rows=rows))
     bars_ax, scatter_ax = fig.axes[:2]
     bars = [to_hex(p.get_facecolor()) for p in bars_ax.patches]
     points = [to_hex(c.get_facecolor()[0]) for c in scatter_ax.collections]

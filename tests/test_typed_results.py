@@ -73,7 +73,7 @@ def _tiny_result(method: str) -> FalsifyResult:
 
 @pytest.mark.parametrize("method", ["portfolio", "de", "vertices-polish"])
 def test_the_history_plot_legend_carries_the_method_label(method):
-    from wmr_mj.report.plots import falsify_history
+    from wmr_mj.figures.plots import falsify_history
 
     fig = falsify_history(_tiny_result(method))
     legend = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]

@@ -39,6 +39,7 @@ from ._version import __version__ as __version__
 
 if TYPE_CHECKING:
     from wmr_mj.carts import CartFile, load_cart
+    from wmr_mj.figures.results import ResultPlot
     from wmr_mj.logs.reader import load_log
     from wmr_mj.logs.writer import LogOptions, RunLogger
     from wmr_mj.report.results import ValidateSummary
@@ -50,7 +51,6 @@ if TYPE_CHECKING:
     from wmr_mj.sim.designs import CERTIFIED, PAPER, PRESETS, preset
     from wmr_mj.sim.falsify import FalsifyReport, FalsifyResult, FalsifySpec, falsify
     from wmr_mj.sim.log_header import LogHeader
-    from wmr_mj.sim.notebook import ResultPlot
     from wmr_mj.sim.parts import RunParts, resolve_run
     from wmr_mj.sim.signals import Disturbance, LoadChange, Signals
     from wmr_mj.sim.suite import load_suite
@@ -95,7 +95,7 @@ _LAZY: dict[str, str] = {
     "DesignRow": "wmr_mj.sim.compare",
     "Design": "wmr_mj.sim.compare",
     "design_from_token": "wmr_mj.sim.compare",
-    "ResultPlot": "wmr_mj.sim.notebook",
+    "ResultPlot": "wmr_mj.figures.results",
     "load_cart": "wmr_mj.carts",
     "CartFile": "wmr_mj.carts",
     "DesignProblem": "wmr_mj.sim.design_search",

@@ -180,8 +180,8 @@ def run(args: argparse.Namespace) -> int:
     from wmr_mj._util.files import check_output_path, write_json_atomic, write_text_atomic
     from wmr_mj._util.progress import counter_callback, progress_bar
     from wmr_mj.cli._common import print_json
+    from wmr_mj.figures.plots import falsify_history, save_figure
     from wmr_mj.logs.writer import run_logged
-    from wmr_mj.report.plots import falsify_history, save_figure
     from wmr_mj.sim.falsify import OBJECTIVE_LABELS, FalsifySpec, check_runnable, falsify, worst_config
 
     objective = _objective(args)

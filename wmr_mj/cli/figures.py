@@ -3,7 +3,7 @@
 Fig. 4 desired trajectory (paths of A and C), Fig. 5 alpha0(t), Fig. 6
 alpha0'(t) and alpha0''(t), Fig. 7 the region (4.21)-(4.23) of the (5.1) example
 with the error trajectories of the paper's view (reduced paper model as the
-plant) and of the MuJoCo plant. See :mod:`wmr_mj.report.plots`.
+plant) and of the MuJoCo plant. See :mod:`wmr_mj.figures.plots`.
 """
 
 from __future__ import annotations
@@ -31,8 +31,8 @@ def default_folder(prefix: str) -> str:
 
 def run(args: argparse.Namespace) -> int:
     from wmr_mj._util.files import check_output_path
+    from wmr_mj.figures.plots import paper_figures, write_figures
     from wmr_mj.report.paper_example import paper_example
-    from wmr_mj.report.plots import paper_figures, write_figures
 
     out = check_output_path(args.out or default_folder("figures"), kind="dir", option="--out")
     example = paper_example(duration=args.duration)

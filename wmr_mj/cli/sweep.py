@@ -232,7 +232,7 @@ def _plot(results: list[dict], runs: SweepSummary, stem: Path) -> Path:
 
     from matplotlib.patches import Rectangle
 
-    from wmr_mj.report.plots import new_figure, save_figure
+    from wmr_mj.figures.plots import new_figure, save_figure
 
     fig, ax = new_figure(5.0, 4.0)
     for (E_max, Ed_max), colour, label in (

@@ -1,4 +1,5 @@
-"""The comparison's table (Markdown, CSV, HTML) and figure (``wmr-mj compare``).
+"""The comparison's table (Markdown, CSV, HTML) and files (``wmr-mj compare``); its figure is
+:func:`wmr_mj.figures.results.figure_compare`.
 
 Usage::
 
@@ -17,7 +18,7 @@ from typing import Any
 
 from wmr_mj.sim.compare import CompareResult, DesignRow, runs_json
 
-__all__ = ["table_rows", "markdown", "csv_text", "html_page", "figure", "write_report", "COLUMNS", "legend_lines",
+__all__ = ["table_rows", "markdown", "csv_text", "html_page", "write_report", "COLUMNS", "legend_lines",
            "banner_lines", "cart_text"]
 
 #: (header, what it says) of every column, in order
@@ -196,38 +197,14 @@ def html_page(result: CompareResult, figure_name: str = "compare.png") -> str:
             f"<ul>{notes}</ul></body></html>\n")
 
 
-def figure(result: CompareResult):
-    """(a) the requirement checks each design held; (b) effort (RMS voltage) against the worst cross-track."""
-    from wmr_mj.report.plots import new_figure
-
-    fig, (a, b) = new_figure(10.0, 3.6, ncols=2)
-    labels = [r.label for r in result.rows]
-    held = [r.requirements_passed / r.requirements_total if r.requirements_total else 0.0 for r in result.rows]
-    y = range(len(labels))
-    colours = [f"C{i % 10}" for i in range(len(labels))]  # one per design, the same in both panels
-    a.barh(list(y), held, color=colours)
-    a.set_yticks(list(y), labels, fontsize=8)
-    a.invert_yaxis()
-    a.set_xlim(0, 1)
-    a.set_xlabel("fraction of requirement checks held")
-    a.set_title("(a) requirements over the suite")
-    for i, r in enumerate(result.rows):
-        b.scatter(r.rms_voltage, r.cross_track_max if r.cross_track_max is not None else math.nan, color=colours[i],
-                  label=r.label)
-    b.set_xlabel("RMS voltage [V]")
-    b.set_ylabel("worst |cross-track| [m]")
-    b.set_title("(b) effort against C's path")
-    b.legend(fontsize=7, frameon=False)
-    return fig
-
-
 def write_report(result: CompareResult, out: Path) -> dict[str, str]:
     """compare.md, compare.csv, compare.html, compare.png and compare.json (and runs.jsonl) in ``out``,
     each written atomically; returns their paths by kind."""
     import json
 
     from wmr_mj._util.files import write_json_atomic, write_text_atomic
-    from wmr_mj.report.plots import save_figure
+    from wmr_mj.figures.plots import save_figure
+    from wmr_mj.figures.results import figure_compare
 
     out.mkdir(parents=True, exist_ok=True)
     paths = {"markdown": out / "compare.md", "csv": out / "compare.csv", "html": out / "compare.html",
@@ -237,5 +214,5 @@ def write_report(result: CompareResult, out: Path) -> dict[str, str]:
     write_text_atomic(paths["html"], html_page(result))
     write_text_atomic(paths["runs"], runs_json(result))
     write_json_atomic(paths["json"], json.loads(json.dumps(result.as_dict(), default=str)))
-    (png,) = save_figure(figure(result), out / "compare", formats=("png",))
+    (png,) = save_figure(figure_compare(result), out / "compare", formats=("png",))
     return {**{k: str(v) for k, v in paths.items()}, "figure": str(png)}

@@ -1,13 +1,13 @@
 """Stage 6 of ``wmr-mj validate``: every figure of the report, PNG + SVG, in figures/.
 
-- ``ladder``: the verdict counts of each rung (:func:`wmr_mj.report.plots.figure_ladder`);
+- ``ladder``: the verdict counts of each rung (:func:`wmr_mj.figures.plots.figure_ladder`);
 - ``rung_<k>_<name>``: every run of rung k at (sup|E|, sup|E'|) by verdict, with the
   certificate's region (when it exists) and the paper's claim
-  (:func:`wmr_mj.report.plots.figure_verdict_plane`);
+  (:func:`wmr_mj.figures.plots.figure_verdict_plane`);
 - ``history_paper``, ``history_certified``: the nominal runs' E, E', voltage against the
   certificate's bounds, or the paper's claim where there is no certificate;
 - ``search_history``: each search's runs, its running worst, the Monte-Carlo worst;
-- the paper's Figs. 4-7 (:func:`wmr_mj.report.plots.paper_figures`): Fig. 4 with the paths C
+- the paper's Figs. 4-7 (:func:`wmr_mj.figures.plots.paper_figures`): Fig. 4 with the paths C
   travelled in the nominal runs (the paper's and the certified design, :func:`travelled_paths`),
   Fig. 7 with the paper's design on the MuJoCo plant at m1 = 650 kg.
 
@@ -33,7 +33,7 @@ __all__ = ["figures_stage", "travelled_paths"]
 
 
 def _rung_figure(rung: Rung, folder: Path):
-    from wmr_mj.report import plots
+    from wmr_mj.figures import plots
     from wmr_mj.sim.sweep import read_runs
 
     rows = read_runs((folder / rung.runs_csv).parent)
@@ -57,7 +57,7 @@ def _wrap(text: str, width: int) -> str:
 
 
 def _history_figures(nominal: Mapping[str, Any]) -> dict[str, Any]:
-    from wmr_mj.report import plots
+    from wmr_mj.figures import plots
 
     figs = {}
     for name, run in nominal.items():
@@ -73,7 +73,7 @@ def _history_figures(nominal: Mapping[str, Any]) -> dict[str, Any]:
 
 
 def _search_figure(searches: Sequence[Mapping[str, Any]], rungs: Sequence[Rung]):
-    from wmr_mj.report import plots
+    from wmr_mj.figures import plots
 
     histories = []
     for s in searches:
@@ -106,7 +106,7 @@ def figures_stage(settings: ValidateSettings, folder: Path, st: Stages, rungs: S
                   searches: Sequence[Mapping[str, Any]], nominal: Mapping[str, Any]
                   ) -> tuple[dict[str, list[str]], dict[str, Any]]:
     """Write every figure (PNG + SVG) into figures/: ({stem: [relative paths]}, Fig. 7's numbers)."""
-    from wmr_mj.report import plots
+    from wmr_mj.figures import plots
     from wmr_mj.report.paper_example import paper_example
 
     st.start("figures", "figures (PNG + SVG)")

@@ -1,10 +1,10 @@
 """The paper's (5.1) example computed for Figs. 4-7: the reference, the analysis and the runs.
 
 This module computes (reference, (5.1) analysis, reduced-model and MuJoCo runs);
-:mod:`wmr_mj.report.plots` only draws the result::
+:mod:`wmr_mj.figures.plots` only draws the result::
 
     from wmr_mj.report.paper_example import paper_example
-    from wmr_mj.report.plots import paper_figures, write_figures
+    from wmr_mj.figures.plots import paper_figures, write_figures
     paths = write_figures(paper_figures(paper_example()), "logs/figures")
 """
 
@@ -27,7 +27,8 @@ __all__ = ["PaperExample", "paper_example"]
 
 @dataclass
 class PaperExample:
-    """Data of the paper's Figs. 4-7 (see :func:`paper_example`; drawn by :func:`wmr_mj.report.plots.paper_figures`)."""
+    """Data of the paper's Figs. 4-7 (see :func:`paper_example`; drawn by
+    :func:`wmr_mj.figures.plots.paper_figures`)."""
 
     reference: Any
     settle_s: float

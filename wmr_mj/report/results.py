@@ -207,8 +207,8 @@ class ValidateSummary(Record):
         return notebook.validate_frame(self.rungs)
 
     def plot(self) -> Any:
-        """The verdicts of each rung (the report's ladder figure), as a :class:`wmr_mj.sim.notebook.ResultPlot`."""
-        from wmr_mj.report.notebook import plot_validate
+        """The verdicts of each rung (the report's ladder figure), as a :class:`wmr_mj.figures.results.ResultPlot`."""
+        from wmr_mj.figures.results import plot_validate
 
         return plot_validate(self)
 

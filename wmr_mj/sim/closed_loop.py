@@ -101,10 +101,10 @@ class RunResult:
 
     def plot(self, **options: Any) -> Any:
         """E and E' between the certificate's bounds, the voltage between the supply limits, and C's path
-        (a :class:`wmr_mj.sim.notebook.ResultPlot`: ``.figure``, ``.axes``)."""
-        from wmr_mj.sim import notebook
+        (a :class:`wmr_mj.figures.results.ResultPlot`: ``.figure``, ``.axes``)."""
+        from wmr_mj.figures.results import plot_run
 
-        return notebook.plot(self, "run", **options)
+        return plot_run(self, **options)
 
     def _repr_html_(self) -> str:
         from wmr_mj.sim import notebook

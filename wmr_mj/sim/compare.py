@@ -422,10 +422,10 @@ class CompareResult:
 
     def plot(self, **options: Any) -> Any:
         """The comparison's figure (compare.png: the requirement checks held, effort against C's path), as a
-        :class:`wmr_mj.sim.notebook.ResultPlot`."""
-        from wmr_mj.sim import notebook
+        :class:`wmr_mj.figures.results.ResultPlot`."""
+        from wmr_mj.figures.results import plot_compare
 
-        return notebook.plot(self, "compare", **options)
+        return plot_compare(self, **options)
 
     def _repr_html_(self) -> str:
         from wmr_mj.sim import notebook

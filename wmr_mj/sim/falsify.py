@@ -1034,6 +1034,16 @@ class FalsifyResult:
         return 1 + max((e.generation for e in self.search), default=-1)
 
     @property
+    def method_label(self) -> str:
+        """The search's method in words (:data:`METHOD_LABELS`: ``vertices, then CMA-ES``), as its figure says it."""
+        return METHOD_LABELS[self.spec.method]
+
+    @property
+    def objective_label(self) -> str:
+        """The objective in words (:data:`OBJECTIVE_LABELS`: ``sup|E|/E_max of the certificate``)."""
+        return OBJECTIVE_LABELS[self.spec.objective]
+
+    @property
     def tightness(self) -> Tightness | None:
         """How tight the certificate is, where the objective is its ratio sup|E|/E_max: the worst
         found (a lower bound on the worst case: a run reached it) beside the certificate's E_max (an
@@ -1136,10 +1146,10 @@ class FalsifyResult:
 
     def plot(self, **options: Any) -> Any:
         """The search beside random: each run's objective and the running worst of each
-        (a :class:`wmr_mj.sim.notebook.ResultPlot`)."""
-        from wmr_mj.sim import notebook
+        (a :class:`wmr_mj.figures.results.ResultPlot`)."""
+        from wmr_mj.figures.results import plot_falsify
 
-        return notebook.plot(self, "falsify", **options)
+        return plot_falsify(self, **options)
 
     def _repr_html_(self) -> str:
         from wmr_mj.sim import notebook

@@ -6,10 +6,8 @@ for the per-run tables of a sweep and a search), as python-control's ``TimeRespo
 PyBaMM's variables ("Terminal voltage [V]") do. pandas is imported only when a table is asked for: it is the
 optional extra ``wmr-mj[notebook]``, and without it :func:`require_pandas` says in one line what to install.
 
-The figures are drawn by :data:`PLOT_BACKEND` (``wmr_mj.report.notebook``, which reuses
-``wmr_mj.report.plots``), imported by name when a figure is asked for, as pandas imports its plotting
-backend: the results live in this layer, the drawing in the report layer above it, and a result's ``plot()``
-reaches it without this layer importing upwards.
+The figures are drawn by :mod:`wmr_mj.figures.results` (a :class:`~wmr_mj.figures.results.ResultPlot` each),
+in the layer below this one: each result's ``plot()`` imports its ``plot_<kind>`` from there.
 
 This module is a leaf of ``wmr_mj.sim``: the results' modules import it inside their methods, so it imports
 none of them (their data is handed in, read by attribute).
@@ -18,25 +16,20 @@ none of them (their data is handed in, read by attribute).
 from __future__ import annotations
 
 import html
-import importlib
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from wmr_mj.errors import WmrMjError
 
-__all__ = ["NOTEBOOK_INSTALL", "require_pandas", "ROW_UNITS", "row_column", "RUN_COLUMNS", "run_column", "ResultPlot",
-           "PLOT_BACKEND", "plot", "rows_frame", "runs_frame", "records_frame", "compare_frame", "validate_frame",
-           "html_lines", "verdict_counts_text", "number", "run_html", "falsify_html", "compare_html", "validate_html"]
+__all__ = ["NOTEBOOK_INSTALL", "require_pandas", "ROW_UNITS", "row_column", "RUN_COLUMNS", "run_column", "rows_frame",
+           "runs_frame", "records_frame", "compare_frame", "validate_frame", "html_lines", "verdict_counts_text",
+           "number", "run_html", "falsify_html", "compare_html", "validate_html"]
 
 #: what to run for the tables and the notebook (pyproject's optional extra)
 NOTEBOOK_INSTALL = "pip install 'wmr-mj[notebook]'"
-
-#: the module that draws a result's figure (``plot_run``, ``plot_sweep``, ``plot_falsify``, ``plot_compare``)
-PLOT_BACKEND = "wmr_mj.report.notebook"
 
 #: a run's recorded quantity (``RunResult.rows``, ``wmr_mj.sim.engine.ROW_FIELDS`` and SENSED_ROW_FIELDS; C's
 #: position) -> its unit: the one table of a run's names and units
@@ -113,34 +106,6 @@ def run_column(name: str, units: Mapping[str, str] | None = None) -> str:
         return RUN_COLUMNS[name]
     unit = (units or {}).get(name)
     return name if not unit else f"{name} [{unit}]"
-
-
-@dataclass(frozen=True)
-class ResultPlot:
-    """A result's figure (``result.plot()``), as python-control's ``ControlPlot``.
-
-    Attributes:
-        figure: the matplotlib Figure (not attached to pyplot: a notebook shows it by ``figure`` or by this
-            object's own display).
-        axes: its axes, in the order the figure reads (a tuple).
-    """
-
-    figure: Any
-    axes: tuple[Any, ...]
-
-    def _repr_png_(self) -> bytes:  # a notebook shows the figure when the plot is a cell's value
-        import io
-
-        buf = io.BytesIO()
-        self.figure.savefig(buf, format="png", dpi=100, bbox_inches="tight")
-        return buf.getvalue()
-
-
-def plot(result: Any, kind: str, **options: Any) -> ResultPlot:
-    """``result``'s figure, drawn by :data:`PLOT_BACKEND`'s ``plot_<kind>`` (``run``, ``sweep``, ``falsify``,
-    ``compare``)."""
-    backend = importlib.import_module(PLOT_BACKEND)
-    return getattr(backend, f"plot_{kind}")(result, **options)
 
 
 def rows_frame(rows: Mapping[str, np.ndarray], C_xy: np.ndarray | None = None) -> Any:

@@ -65,10 +65,13 @@ class SweepResult:
 
     def plot(self, **options: Any) -> Any:
         """sup|E| of every run against each ranged parameter, one panel each, with the certificate's E_max
-        (:class:`wmr_mj.sim.notebook.ResultPlot`)."""
+        (:class:`wmr_mj.figures.results.ResultPlot`); each panel's x label is the parameter's column in
+        :meth:`to_pandas` (with its unit)."""
+        from wmr_mj.figures.results import plot_sweep
         from wmr_mj.sim import notebook
 
-        return notebook.plot(self, "sweep", **options)
+        units = parameter_units(self.spec.names)
+        return plot_sweep(self, xlabels=[notebook.run_column(n, units) for n in self.spec.names], **options)
 
     def _repr_html_(self) -> str:
         from wmr_mj.sim import notebook

@@ -1,28 +1,53 @@
-"""The figures of a result's ``.plot()`` (:data:`wmr_mj.sim.notebook.PLOT_BACKEND`): each a
-:class:`~wmr_mj.sim.notebook.ResultPlot` with the figure and its axes, drawn with :mod:`wmr_mj.report.plots`
-and :func:`wmr_mj.report.compare.figure` (the same figures the commands write).
+"""The figures of a result's ``.plot()``: each a :class:`ResultPlot` with the figure and its axes, drawn with
+:mod:`wmr_mj.figures.plots` (the same figures the commands write).
 
 - :func:`plot_run`: E and E' between the bounds the run is judged by, the voltage between the supply limits
-  (:func:`wmr_mj.report.plots.plot_time_history`), and C's path beside its reference.
+  (:func:`wmr_mj.figures.plots.plot_time_history`), and C's path beside its reference.
 - :func:`plot_sweep`: sup|E| of every run against each ranged parameter, with the certificate's E_max.
-- :func:`plot_falsify`: the search beside random (:func:`wmr_mj.report.plots.falsify_history`).
-- :func:`plot_compare`: compare's figure (:func:`wmr_mj.report.compare.figure`).
-- :func:`plot_validate`: the ladder's verdicts (:func:`wmr_mj.report.plots.figure_ladder`).
+- :func:`plot_falsify`: the search beside random (:func:`wmr_mj.figures.plots.falsify_history`).
+- :func:`plot_compare`: compare's figure (:func:`figure_compare`, compare.png).
+- :func:`plot_validate`: the ladder's verdicts (:func:`wmr_mj.figures.plots.figure_ladder`).
+
+The results (``RunResult``, ``SweepResult``, ``FalsifyResult``, ``CompareResult`` in ``wmr_mj.sim``,
+``ValidateSummary`` in ``wmr_mj.report``) import these in their ``plot()``; this module is below them and
+imports none of them: each result is handed in and read by attribute, and what only its layer knows (a sweep's
+axis labels, a search's words) it hands in too.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from wmr_mj.figures import plots
 from wmr_mj.params import C80
-from wmr_mj.report import plots
-from wmr_mj.sim.notebook import ResultPlot, run_column
-from wmr_mj.sim.sweep_result import parameter_units
 
-__all__ = ["plot_run", "plot_sweep", "plot_falsify", "plot_compare", "plot_validate"]
+__all__ = ["ResultPlot", "plot_run", "plot_sweep", "plot_falsify", "plot_compare", "plot_validate", "figure_compare"]
+
+
+@dataclass(frozen=True)
+class ResultPlot:
+    """A result's figure (``result.plot()``), as python-control's ``ControlPlot``.
+
+    Attributes:
+        figure: the matplotlib Figure (not attached to pyplot: a notebook shows it by ``figure`` or by this
+            object's own display).
+        axes: its axes, in the order the figure reads (a tuple).
+    """
+
+    figure: Any
+    axes: tuple[Any, ...]
+
+    def _repr_png_(self) -> bytes:  # a notebook shows the figure when the plot is a cell's value
+        import io
+
+        buf = io.BytesIO()
+        self.figure.savefig(buf, format="png", dpi=100, bbox_inches="tight")
+        return buf.getvalue()
 
 
 def _plot(fig: Any) -> ResultPlot:
@@ -79,15 +104,23 @@ def _finite(x: float | None) -> float | None:
     return None if x is None or not math.isfinite(float(x)) else float(x)
 
 
-def plot_sweep(result: Any) -> ResultPlot:
+def plot_sweep(result: Any, *, xlabels: Sequence[str] | None = None) -> ResultPlot:
     """A sweep (``SweepResult``): sup|E| of every run against each ranged parameter (one panel each, the
     value each run used), coloured by verdict, with the certificate's E_max: one dashed line where every run
-    has the same, else each run's as a dash at its value (a ranged cart's axis changes the claim)."""
+    has the same, else each run's as a dash at its value (a ranged cart's axis changes the claim).
+
+    Args:
+        result: the sweep (read by attribute: ``spec.names``, ``rows``, ``summary.n``).
+        xlabels: each panel's x label, one per ranged parameter in ``spec.names``' order (the sweep's table's
+            column names, with units); default the bare names.
+    """
     names = result.spec.names
+    labels = tuple(names) if xlabels is None else tuple(xlabels)
+    if len(labels) != len(names):
+        raise ValueError(f"xlabels: {len(labels)} labels for {len(names)} ranged parameters")
     fig, axes = plots.new_figure(3.6 * len(names) + 0.6, 3.4, 1, len(names), sharey=True)
     axes = tuple(np.atleast_1d(axes))
-    units = parameter_units(names)
-    for ax, name in zip(axes, names):
+    for ax, name, label in zip(axes, names, labels):
         groups: dict[str, list[Any]] = {}
         for r in result.rows:  # by verdict, in the verdicts' order; any other word (no-claim, failed) as "other"
             verdict = r.get("verdict")
@@ -104,7 +137,7 @@ def plot_sweep(result: Any) -> ResultPlot:
         elif bounds:  # each run's cart has its own claim (a cart's axis ranged): each run's bound, a dash
             ax.scatter(*zip(*bounds), marker="_", s=160, color="#1b4f72", label="certificate's E_max, each run's",
                        zorder=2)
-        ax.set_xlabel(run_column(name, units))
+        ax.set_xlabel(label)
     axes[0].set_ylabel("sup |E| [rad]")
     axes[-1].legend(loc="best", fontsize=6.5)
     fig.suptitle(f"sweep of {result.summary.n} runs", fontsize=10)
@@ -117,10 +150,33 @@ def plot_falsify(result: Any) -> ResultPlot:
 
 
 def plot_compare(result: Any) -> ResultPlot:
-    """A comparison (``CompareResult``): compare.png's figure."""
-    from wmr_mj.report.compare import figure
+    """A comparison (``CompareResult``): compare.png's figure (:func:`figure_compare`)."""
+    return _plot(figure_compare(result))
 
-    return _plot(figure(result))
+
+def figure_compare(result: Any) -> Any:
+    """compare.png: (a) the requirement checks each design held; (b) effort (RMS voltage) against the worst
+    cross-track. ``result``: a ``CompareResult`` (read by attribute: each of ``rows``' ``label``,
+    ``requirements_passed``, ``requirements_total``, ``rms_voltage`` [V], ``cross_track_max`` [m])."""
+    fig, (a, b) = plots.new_figure(10.0, 3.6, ncols=2)
+    labels = [r.label for r in result.rows]
+    held = [r.requirements_passed / r.requirements_total if r.requirements_total else 0.0 for r in result.rows]
+    y = range(len(labels))
+    colours = [f"C{i % 10}" for i in range(len(labels))]  # one per design, the same in both panels
+    a.barh(list(y), held, color=colours)
+    a.set_yticks(list(y), labels, fontsize=8)
+    a.invert_yaxis()
+    a.set_xlim(0, 1)
+    a.set_xlabel("fraction of requirement checks held")
+    a.set_title("(a) requirements over the suite")
+    for i, r in enumerate(result.rows):
+        b.scatter(r.rms_voltage, r.cross_track_max if r.cross_track_max is not None else math.nan, color=colours[i],
+                  label=r.label)
+    b.set_xlabel("RMS voltage [V]")
+    b.set_ylabel("worst |cross-track| [m]")
+    b.set_title("(b) effort against C's path")
+    b.legend(fontsize=7, frameon=False)
+    return fig
 
 
 def plot_validate(summary: Any) -> ResultPlot:

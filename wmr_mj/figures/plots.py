@@ -4,6 +4,10 @@ Everything draws on ``matplotlib.figure.Figure`` objects with the Agg canvas
 (no pyplot, no display), so it runs on servers and in tests. SVG text stays
 text (``svg.fonttype = 'none'``), lines stay vectors.
 
+Each function is handed its data (a reference, a summary, a search, the paper's example) and reads it by
+attribute: this module sits below ``wmr_mj.sim`` (its layer, ``wmr_mj.figures``) and imports nothing of the
+layers that make those results, so the results of ``wmr_mj.sim`` can draw with it.
+
 Axes-level functions (reusable by ``validate`` and ``replay``)::
 
     plot_paths(ax, reference)                    # Fig. 4: paths of A and C, equal aspect
@@ -30,7 +34,7 @@ The validation's figures (``wmr-mj validate``)::
 The paper's figures::
 
     from wmr_mj.report.paper_example import paper_example   # computes (runs the simulations)
-    from wmr_mj.report.plots import paper_figures, write_figures  # only draws
+    from wmr_mj.figures.plots import paper_figures, write_figures  # only draws
     example = paper_example()                 # reference, (5.1) analysis, reduced + MuJoCo runs
     paths = write_figures(paper_figures(example), "logs/figures")
 
@@ -65,10 +69,6 @@ from wmr_mj.params import M1_NOMINAL  # noqa: E402
 
 if TYPE_CHECKING:
     from matplotlib.typing import RcKeyType
-
-    from wmr_mj.report.paper_example import PaperExample
-    from wmr_mj.sim.falsify import FalsifyResult
-    from wmr_mj.sim.summary import RunSummary
 
 __all__ = [
     "STYLE",
@@ -550,7 +550,7 @@ def plot_time_history(axes, rows: Mapping[str, np.ndarray], *, E_max: float | No
         ax.legend(loc="upper right", fontsize=6.5, framealpha=0.9)
 
 
-def figure_time_history(rows: Mapping[str, np.ndarray], summary: RunSummary, *,
+def figure_time_history(rows: Mapping[str, np.ndarray], summary: Any, *,
                         voltage_limit: float | None = None, title: str | None = None,
                         bounds: tuple[float | None, float | None] | None = None,
                         bound_name: str | None = None) -> Figure:
@@ -558,7 +558,7 @@ def figure_time_history(rows: Mapping[str, np.ndarray], summary: RunSummary, *,
 
     Args:
         rows: the run's rows (``RunResult.rows``).
-        summary: the run's summary.
+        summary: the run's summary (``RunSummary``, read by attribute).
         voltage_limit: the supply to draw [V]; None: none.
         title: the figure's title; default the model and m1.
         bounds: (E_max [rad], Edot_max [rad/s]) to draw, named ``bound_name``; default the
@@ -762,7 +762,7 @@ def figure_search_history(histories: Sequence[SearchHistory], *, title: str | No
 
 
 # --------------------------------------------------------------------------- the paper's example
-def fig7_series(example: PaperExample) -> list[Series]:
+def fig7_series(example: Any) -> list[Series]:
     series = []
     styles = [(_COLORS["reduced"], "-"), (_COLORS["reduced2"], "--")]
     for (name, rows), (color, ls) in zip(example.reduced, styles):
@@ -776,8 +776,9 @@ def fig7_series(example: PaperExample) -> list[Series]:
     return series
 
 
-def paper_figures(example: PaperExample) -> dict[str, Figure]:
-    """{stem: Figure} of Figs. 4-7 (stems :data:`PAPER_FIGURE_NAMES`)."""
+def paper_figures(example: Any) -> dict[str, Figure]:
+    """{stem: Figure} of Figs. 4-7 (stems :data:`PAPER_FIGURE_NAMES`) of ``example``
+    (:class:`wmr_mj.report.paper_example.PaperExample`, read by attribute)."""
     from wmr_mj.reference.bounds import PAPER_BOUNDS
 
     ref = example.reference
@@ -803,13 +804,16 @@ def close_all(figures: Iterable[Figure]) -> None:
         fig.clear()
 
 
-def falsify_history(result: FalsifyResult):
+def falsify_history(result: Any):
     """The search's history: each run's objective in evaluation order, and the running worst
-    of the search and of the random sample (same budget)."""
-    from wmr_mj.sim.falsify import METHOD_LABELS, OBJECTIVE_LABELS
+    of the search and of the random sample (same budget).
 
+    Args:
+        result: the search (``FalsifyResult``, read by attribute: ``spec``, ``search``, ``random``, and the
+            words of its method and objective, ``method_label`` and ``objective_label``).
+    """
     fig, ax = new_figure(6.0, 3.6)
-    search_label = METHOD_LABELS[result.spec.method]
+    search_label = result.method_label
     for evals, color, label in ((result.search, "C3", search_label),
                                 (result.random, "0.45", "random (Latin hypercube)")):
         x = np.arange(1, len(evals) + 1)
@@ -822,7 +826,7 @@ def falsify_history(result: FalsifyResult):
     if result.spec.objective != "sup-E" and worst >= 0.5:  # in view without squashing the data
         ax.axhline(1.0, color="0.2", lw=0.8, ls="--", label="region boundary (ratio 1)")
     ax.set_xlabel("simulations")
-    ax.set_ylabel(OBJECTIVE_LABELS[result.spec.objective])
+    ax.set_ylabel(result.objective_label)
     ax.set_title(f"worst-case search, {len(result.spec.box)} parameters, budget {result.spec.budget}, "
                  f"seed {result.spec.seed}", fontsize=9)
     ax.legend(loc="best", fontsize=8)
