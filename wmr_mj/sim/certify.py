@@ -171,10 +171,14 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
     declares for the reference it writes (measured on every run: ``controllers.tracking.within_declared``),
     with the assumptions it states.
 
-    Measurement (``measurement``, :class:`~wmr_mj.analysis.measurement.MeasurementErrors`; None: exact,
-    every number as before): handed to the claim as ``ClaimContext.measurement``; the computed-torque,
-    PD and sliding-mode claims absorb the bounds, and a claim that does not state the assumption
-    'sensing and actuation covered' gets it unmet (:func:`wmr_mj.analysis.claim.covers_measurement`).
+    Measurement (``measurement``, :class:`~wmr_mj.analysis.measurement.MeasurementErrors`): None, the cart's own
+    (:func:`measurement_errors_of` on config.sensing, actuation and transmission; exact on the ideal cart, every
+    number as before), and then, on a cart that is not ideal, the sampled-data certificate is computed beside the
+    law's own and the certified one with the smaller E_max taken (it is derived from the cart's parts, not from
+    summed bounds); given, those bounds in place of the cart's (a what-if), and the law's own claim alone. Handed
+    to the claim as ``ClaimContext.measurement``; the computed-torque, PD and sliding-mode claims absorb the
+    bounds, and a claim that does not state the assumption 'sensing and actuation covered' gets it unmet
+    (:func:`wmr_mj.analysis.claim.covers_measurement`).
 
     Returns:
         The controller's claim (``SteeringController.claim``: the section-4 certificate for the
@@ -266,7 +270,9 @@ def certificate_of(config: Any, reference: Any, *, base: C80Parameters, estimate
         # declares, which every run measures (controllers.tracking.within_declared)
         bounds = tracker.declared_bounds(bounds)
         stated = stated + tracker.stated_assumptions()
-    derived = measurement is None  # the cart's own errors: the sampled-data certificate may be computed too
+    # the cart's own errors (None): the sampled-data certificate, derived from the cart's parts, may be computed
+    # too; bounds given in their place are a what-if that the cart's parts do not describe, so the law's claim alone
+    derived = measurement is None
     if measurement is None:
         measurement = measurement_errors_of(config, plant)
     context = ClaimContext(plant=plant_box, reference=bounds,
