@@ -102,7 +102,7 @@ from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE, VERDICTS
 from wmr_mj.errors import ParameterError, UnknownNameError, WmrMjError
 from wmr_mj.params import parameter_names
 from wmr_mj.sim.config import RunConfig
-from wmr_mj.sim.records import Record, UnmetAssumption
+from wmr_mj.sim.records import BrokenRun, Record, UnmetAssumption
 
 __all__ = [
     "OBJECTIVES",
@@ -887,31 +887,6 @@ class Tightness(Record):
     found_sup_E: float
     E_max: float | None
     text: str
-
-
-@dataclass(frozen=True, kw_only=True)
-class BrokenRun(Record):
-    """The run of a search that breaks the law's claim most (:attr:`FalsifyResult.claim_broken`).
-
-    Attributes:
-        phase: "search" or "random".
-        run: its place in its phase, 1-based.
-        params: every ranged parameter of the run, full precision.
-        sup_E: its sup|E| [rad].
-        sup_Edot: its sup|E'| [rad/s].
-        E_max: the certificate's E_max [rad]; None where it has none.
-        ratio: sup|E|/E_max [-]; None where undefined.
-        count: the certified-outside runs of both phases.
-    """
-
-    phase: str
-    run: int
-    params: Mapping[str, float]
-    sup_E: float
-    sup_Edot: float
-    E_max: float | None
-    ratio: float | None
-    count: int
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -23,7 +23,7 @@ import dataclasses
 from collections.abc import Mapping
 from typing import Any, ClassVar, TypeVar
 
-__all__ = ["Record", "plain", "UnmetAssumption"]
+__all__ = ["Record", "plain", "UnmetAssumption", "BrokenRun"]
 
 R = TypeVar("R", bound="Record")
 
@@ -103,3 +103,35 @@ class UnmetAssumption(Record):
         if self.value_range is not None:
             out["value_range"] = list(self.value_range)
         return out
+
+
+@dataclasses.dataclass(frozen=True, kw_only=True)
+class BrokenRun(Record):
+    """The run that breaks the law's claim most: a sweep's (:attr:`wmr_mj.sim.sweep.SweepSummary.claim_broken`)
+    or a search's (:attr:`wmr_mj.sim.falsify.FalsifyResult.claim_broken`), one record for both.
+
+    Attributes:
+        run: a sweep's run index, or its place in its search phase (1-based); None where a sweep's row has none.
+        params: the run's ranged parameters (a sweep's m1 among them), full precision.
+        sup_E: its sup|E| [rad].
+        sup_Edot: its sup|E'| [rad/s].
+        E_max: the certificate's E_max [rad]; None where it has none.
+        ratio: sup|E|/E_max of the certificate [-]; None where undefined.
+        count: the certified-outside runs (a sweep's, or both phases of a search).
+        phase: a search's phase, "search" or "random"; None for a sweep (its JSON then has no ``phase``).
+    """
+
+    run: int | None
+    params: Mapping[str, float]
+    sup_E: float
+    sup_Edot: float
+    E_max: float | None
+    ratio: float | None
+    count: int
+    phase: str | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        """A search's JSON begins with ``phase`` (falsify --json's order); a sweep's has none."""
+        out = super().to_dict()
+        phase = out.pop("phase")
+        return out if phase is None else {"phase": phase, **out}

@@ -42,7 +42,7 @@ from wmr_mj.errors import ParameterError, SchedulerError, UnknownNameError
 from wmr_mj.params import M1_RANGE, parameter_names
 from wmr_mj.sim.batch import run_batch
 from wmr_mj.sim.config import RunConfig, config_from_dict
-from wmr_mj.sim.records import Record, UnmetAssumption
+from wmr_mj.sim.records import BrokenRun, Record, UnmetAssumption
 from wmr_mj.sim.summary import RunSummary
 
 __all__ = [
@@ -60,7 +60,7 @@ __all__ = [
     "flat_row",
     "max_at",
     "Worst",
-    "BrokenSweepRun",
+    "BrokenRun",
     "SweepSummary",
     "config_from_dict",
     "connect",
@@ -610,30 +610,7 @@ class RequirementSweep(Record):
                    undefined=len(rows) - len(values))
 
 
-@dataclass(frozen=True, kw_only=True)
-class BrokenSweepRun(Record):
-    """The run of a sweep that breaks the law's claim most (:attr:`SweepSummary.claim_broken`).
-
-    Attributes:
-        run: the run's index in the sweep; None where its row has none.
-        params: m1 [kg] and each ranged parameter of the run.
-        sup_E: its sup|E| [rad].
-        sup_Edot: its sup|E'| [rad/s].
-        E_max: the certificate's E_max [rad]; None where the row has none.
-        ratio: sup|E|/E_max of the certificate [-]; None where undefined.
-        count: the sweep's certified-outside runs.
-    """
-
-    run: int | None
-    params: Mapping[str, float]
-    sup_E: float
-    sup_Edot: float
-    E_max: float | None
-    ratio: float | None
-    count: int
-
-
-def _claim_broken(rows: Sequence[Mapping[str, Any]], names: Sequence[str]) -> BrokenSweepRun | None:
+def _claim_broken(rows: Sequence[Mapping[str, Any]], names: Sequence[str]) -> BrokenRun | None:
     """SweepSummary.claim_broken of ``rows``: the certified-outside run of the largest cert_E_ratio."""
     from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE
 
@@ -645,11 +622,11 @@ def _claim_broken(rows: Sequence[Mapping[str, Any]], names: Sequence[str]) -> Br
         return -math.inf if r.get("cert_E_ratio") is None else float(r["cert_E_ratio"])
 
     r = max(broken, key=ratio)  # max keeps the first of equals
-    return BrokenSweepRun(run=int(r["run"]) if r.get("run") is not None else None,
-                          params={n: float(r[n]) for n in names if r.get(n) is not None}, sup_E=float(r["sup_E"]),
-                          sup_Edot=float(r["sup_Edot"]),
-                          E_max=None if r.get("cert_E_max") is None else float(r["cert_E_max"]),
-                          ratio=None if ratio(r) == -math.inf else ratio(r), count=len(broken))
+    return BrokenRun(run=int(r["run"]) if r.get("run") is not None else None,
+                     params={n: float(r[n]) for n in names if r.get(n) is not None}, sup_E=float(r["sup_E"]),
+                     sup_Edot=float(r["sup_Edot"]),
+                     E_max=None if r.get("cert_E_max") is None else float(r["cert_E_max"]),
+                     ratio=None if ratio(r) == -math.inf else ratio(r), count=len(broken))
 
 
 def _unmet_over(rows: Sequence[Mapping[str, Any]]) -> tuple[UnmetAssumption, ...]:
@@ -786,7 +763,7 @@ class SweepSummary(Record):
 
     _records = {"sup_E": Worst, "sup_Edot": Worst, "certificate_E_ratio": Worst, "certificate_Edot_ratio": Worst,
                 "paper_E_ratio": Worst, "paper_Edot_ratio": Worst, "path_cross_track": Worst,
-                "requirements": RequirementSweep, "claim_broken": BrokenSweepRun, "unmet": UnmetAssumption,
+                "requirements": RequirementSweep, "claim_broken": BrokenRun, "unmet": UnmetAssumption,
                 "effort": Effort, "effort_by_level": AxisEffort}
 
     n: int
@@ -812,7 +789,7 @@ class SweepSummary(Record):
     path_cross_track: Worst = Worst(None, None)
     path_verdicts: Mapping[str, int] | None = None
     requirements: tuple[RequirementSweep, ...] = ()
-    claim_broken: BrokenSweepRun | None = None
+    claim_broken: BrokenRun | None = None
     unmet: tuple[UnmetAssumption, ...] = ()
     effort: Effort | None = None
     effort_by_level: tuple[AxisEffort, ...] = ()
