@@ -38,3 +38,17 @@ def test_equal_motor_constants_are_accepted_and_are_a_carts(tmp_path):
     mine.write_text(text.replace("value = 0.0795\n", "value = 0.09\n"), encoding="utf-8")
     by_param = plant_parameters(RunConfig(plant_overrides={"k_i": 0.09, "k_b": 0.09}))
     assert by_param == plant_parameters(RunConfig(cart=str(mine)))
+
+
+@pytest.mark.parametrize("command", [["model", "params"], ["identify", "--duration", "5"]])
+def test_model_params_and_identify_refuse_them_too(command, capsys):
+    """The commands that apply --param to the parameter set directly (not through RunConfig) check it as well."""
+    line = refused_line(capsys, [*command, "--param", "k_b=0.09"])
+    assert "k_b = 0.09 V s/rad and k_i = 0.0795 N m/A differ" in line
+
+
+def test_model_params_accepts_equal_constants(capsys):
+    from wmr_mj.cli.app import main
+
+    assert main(["model", "params", "--param", "k_i=0.09", "--param", "k_b=0.09", "--json"]) == 0
+    capsys.readouterr()

@@ -35,7 +35,12 @@ def run(args: argparse.Namespace) -> int:
         check_output_path(args.out, kind="file", option="--out")
     base = cart_parameters(args)
     m1 = base.m1 if args.m1 is M1_NOMINAL else args.m1  # --m1 not given: the cart's
-    params = with_params(base, m1=m1, **parse_assignments(args.param))
+    overrides = parse_assignments(args.param)
+    params = with_params(base, m1=m1, **overrides)
+    if "k_i" in overrides or "k_b" in overrides:
+        from wmr_mj.sim.config import check_motor_constant
+
+        check_motor_constant(params.k_i, params.k_b)
     result = identify_plant(params, duration=args.duration, seed=args.seed)
     obj = result.as_dict()
     if args.out:

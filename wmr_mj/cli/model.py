@@ -37,7 +37,12 @@ def run(args: argparse.Namespace) -> int:
 
         raise ParameterError(f"model {args.action} is for the C80's files in models/; it takes no --cart (a cart's "
                              "model card: wmr-mj cart card FILE); accepted with --cart: params, slip, friction")
-    params = with_params(cart_parameters(args), **parse_assignments(args.param))
+    overrides = parse_assignments(args.param)
+    params = with_params(cart_parameters(args), **overrides)
+    if "k_i" in overrides or "k_b" in overrides:
+        from wmr_mj.sim.config import check_motor_constant
+
+        check_motor_constant(params.k_i, params.k_b)
     if args.action == "write":
         for path in write_model_files(params):
             print(f"wrote {path}")

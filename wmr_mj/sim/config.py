@@ -335,15 +335,27 @@ def _check_fields(config: RunConfig) -> None:
 
 
 def _check_motor_constant(config: RunConfig) -> None:
-    """k_b equal to k_i after the overrides, as a cart file must have them (:mod:`wmr_mj.carts.cartfile`): one flux
-    in SI units, and MuJoCo's dcmotor has one constant (it would silently use their geometric mean)."""
-    from wmr_mj.carts.cartfile import MOTOR_CONSTANT_RTOL
-
+    """k_b equal to k_i after the overrides (:func:`check_motor_constant`)."""
     overrides = config.plant_overrides
     if "k_i" not in overrides and "k_b" not in overrides:
         return
     base = base_for(config)
-    k_i, k_b = overrides.get("k_i", base.k_i), overrides.get("k_b", base.k_b)
+    check_motor_constant(overrides.get("k_i", base.k_i), overrides.get("k_b", base.k_b))
+
+
+def check_motor_constant(k_i: float, k_b: float) -> None:
+    """k_b equal to k_i, as a cart file must have them (:mod:`wmr_mj.carts.cartfile`): one flux in SI units, and
+    MuJoCo's dcmotor has one constant (it would silently use their geometric mean). Every command that takes
+    ``--param`` checks it after its overrides.
+
+    Args:
+        k_i: the torque constant, N m/A. k_b: the back-EMF constant, V s/rad.
+
+    Raises:
+        ParameterError: they differ by more than a rounding (one line naming both and what is accepted).
+    """
+    from wmr_mj.carts.cartfile import MOTOR_CONSTANT_RTOL
+
     if abs(k_b - k_i) > MOTOR_CONSTANT_RTOL * abs(k_i):
         raise ParameterError(f"--param: k_b = {k_b!r} V s/rad and k_i = {k_i!r} N m/A differ; accepted: k_b equal to "
                              "k_i (one flux in SI units; MuJoCo's dcmotor has one constant), e.g. --param "
