@@ -23,8 +23,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                     "Coulomb sign's smoothing width, the velocity filter's tau_f "
                     "(where --sensing has velocity=filtered) and the control period (--periods), minimising the "
                     "certificate a run computes (the worst over --path) subject to every one of its assumptions "
-                    "over the plant box. Writes a design file that `wmr-mj run --design FILE` (and sweep, falsify, "
-                    "robustness --certificate) read back as the same design.",
+                    "over the plant box, on the cart (--cart FILE|NAME: its parameters, box, supply and stops; its "
+                    "default sensing, actuation and play unless given). Writes a design file that `wmr-mj run --design "
+                    "FILE` (and sweep, falsify, robustness --certificate; compare FILE.json, validate --design "
+                    "FILE.json) read back as the same design, on the cart it was found on.",
         epilog="exit status: 0 a certified design found; 1 none certifies (the binding assumption is named); "
                "2 bad input")
     add_hardware_options(p)
