@@ -5,6 +5,8 @@
 #     text_representation:
 #       extension: .py
 #       format_name: percent
+#       format_version: '1.3'
+#       jupytext_version: 1.19.6
 #   kernelspec:
 #     display_name: Python 3 (ipykernel)
 #     language: python
@@ -100,3 +102,17 @@ comparison.to_pandas()[["design", "scenario", "verdict", "sup_E [rad]", "rms_vol
 
 # %%
 comparison
+
+# %% [markdown]
+# ## A design for your cart, attacked
+# `wmr-mj design` as a function: the gains whose certificate on the second shipped cart, with a 12-bit encoder on
+# the steering axis, is the smallest (the certified preset has none there), then the adversary over the m1 box.
+
+# %%
+cart_base = wm.RunConfig(**wm.CERTIFIED.config_changes(), cart="c80-magmotor", duration=DURATION,
+                         sensing=wm.Sensing.from_spec("magnetic-12bit-axis"))
+found = wm.search_design(wm.DesignProblem(base=cart_base, budget=24 if QUICK else 600))
+found.to_pandas()
+
+# %%
+wm.cart_tightness(cart_base.replace(**found.settings), budget=5 if QUICK else 64)
