@@ -32,8 +32,7 @@ def main() -> None:
 
     from wmr_mj.hardware import Sensing
     from wmr_mj.sim.config import RunConfig
-    from wmr_mj.sim.design_search import LAWS, METHODS, DesignProblem, _Scorer, search_design
-    from wmr_mj.sim.designs import CERTIFIED
+    from wmr_mj.sim.design_search import LAWS, METHODS, DesignProblem, _Scorer, law_changes, search_design
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--sensing", default="magnetic-12bit-axis")
@@ -44,9 +43,7 @@ def main() -> None:
     ap.add_argument("--controller", default="computed-torque", choices=LAWS)
     args = ap.parse_args()
 
-    law = (CERTIFIED.config_changes() if args.controller == "computed-torque"
-           else {"controller": "sliding-mode", "model": "nonholonomic"})  # as `wmr-mj design --controller` builds it
-    base = RunConfig(**law, sensing=Sensing.from_spec(args.sensing))
+    base = RunConfig(**law_changes(args.controller), sensing=Sensing.from_spec(args.sensing))
     problem = DesignProblem(base=base, budget=args.budget)
     scorer = _Scorer(problem, 0.001)
     rng = np.random.default_rng(0)

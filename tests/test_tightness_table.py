@@ -121,3 +121,16 @@ def test_an_unknown_cart_is_refused_in_one_line():
     assert proc.returncode == 2 and proc.stdout == ""
     errors = [line for line in proc.stderr.splitlines() if "error:" in line]
     assert len(errors) == 1 and "'no such cart'" in errors[0] and "ideal" in errors[0]
+
+
+def test_certificate_columns_of_sliding_mode_read_its_own_claim_beside_the_sampled_one():
+    """Sliding mode's own claim is recorded as 'boundary-layer' (not 'section-4'): its column is that claim's E_max,
+    not the one taken, where the two differ (λ 20, φ 6, k 24 on the 12-bit cart, as tests/test_sliding_sampled.py)."""
+    config = wm.RunConfig(controller="sliding-mode", controller_params={"lam": 20.0, "phi": 6.0, "k": 24.0},
+                          sensing=wm.Sensing.from_spec("magnetic-12bit-axis"), duration=10.0)
+    cert = resolve_run(config).claim
+    both = cert.inputs["certificates"]
+    columns = certificate_columns(cert)
+    assert columns["certificate"] == cert.inputs["certificate"] == "sampled-data"
+    assert columns["E_max_section4"] == both["boundary-layer"]["E_max"] != columns["E_max"]
+    assert columns["E_max_sampled"] == both["sampled-data"]["E_max"] == columns["E_max"]

@@ -13,11 +13,12 @@ cart's default sensing, actuation and play: E_max, the voltage bound against the
 unmet. This is a report, not a check: a cart whose design cannot be certified still passes ``cart check``.
 
 Its third line answers whether ``wmr-mj design`` can certify the cart on its default sensing: the design search
-(:func:`wmr_mj.sim.design_search.search_design`, CMA-ES seeded with ``--seed``, :data:`DESIGN_BUDGET`
-certificates, the paper circle, the cart's m1 box, a 1 ms period) run on the cart, as ``wmr-mj design --cart FILE
---seed S`` runs it: "design certifies it: E_max ... rad (K_P ..., K_D ...)" or "no gains in the box certify this
-cart: ... binds". Also a report: it does not change the exit status. It adds about 2 s (2026-11-27, 2 cores under
-a shared load of 4-5: 603 certificates in 2.0 s, the whole ``cart check c80`` in 5.3 s wall).
+(:func:`wmr_mj.sim.design_search.search_design`, CMA-ES seeded with ``--seed``, design's default budget
+(:data:`wmr_mj.sim.design_search.DEFAULT_BUDGET`) of certificates, the paper circle, the cart's m1 box, a 1 ms
+period) run on the cart, as ``wmr-mj design --cart FILE --seed S`` runs it: "design certifies it: E_max ... rad
+(K_P ..., K_D ...)" or "no gains in the box certify this cart: ... binds". Also a report: it does not change the
+exit status. It adds about 2 s (2026-11-27, 2 cores under a shared load of 4-5: 603 certificates in 2.0 s, the
+whole ``cart check c80`` in 5.3 s wall).
 """
 
 from __future__ import annotations
@@ -26,11 +27,6 @@ import argparse
 from typing import Any
 
 from wmr_mj.cli._common import positive_float
-
-#: certificates the design search of ``cart check`` scores (``wmr-mj design --budget``): design's own default, so
-#: the answer is what ``wmr-mj design --cart FILE --seed S`` gives; about 2 s (2026-11-27, 2 cores: 603 certificates
-#: in 1.1-2.0 s on the C80)
-DESIGN_BUDGET = 600
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -110,28 +106,37 @@ def certified_on_cart(cart: Any) -> dict[str, Any]:
             "met": [a.name for a in claim.assumptions if a.met], "unmet": list(claim.unmet)}
 
 
-def design_on_cart(cart: Any, *, seed: int = 0, budget: int = DESIGN_BUDGET) -> dict[str, Any]:
+def design_on_cart(cart: Any, *, seed: int | None = None, budget: int | None = None) -> dict[str, Any]:
     """Can ``wmr-mj design`` certify ``cart`` (a checked CartFile) on its default sensing, actuation and play? The
     design search on the paper circle over the cart's m1 box, computed-torque law, 1 ms period, E_max minimised.
 
     Returns:
         certified; where certified: E_max [rad], voltage_max [V], kp [1/s^2], kd [1/s], friction_width [rad/s];
         else binding (the assumption, or why no certificate covers the cart's sensing); budget, seed, evaluations,
-        and the ``wmr-mj design`` command that runs the same search.
+        and the ``wmr-mj design`` command that runs the same search. seed, budget: None, design's defaults
+        (:data:`~wmr_mj.sim.design_search.DEFAULT_SEED`, :data:`~wmr_mj.sim.design_search.DEFAULT_BUDGET`).
     """
     from wmr_mj.errors import InfeasiblePathError
-    from wmr_mj.sim.certify import measurement_errors_of
-    from wmr_mj.sim.config import RunConfig, base_for
-    from wmr_mj.sim.design_search import DesignProblem, search_design
-    from wmr_mj.sim.designs import CERTIFIED
+    from wmr_mj.sim.config import RunConfig
+    from wmr_mj.sim.design_search import (
+        DEFAULT_BUDGET,
+        DEFAULT_SEED,
+        DesignProblem,
+        law_changes,
+        search_design,
+        uncovered,
+    )
 
-    command = f"wmr-mj design --cart {cart.path} --seed {seed}" + ("" if budget == 600 else f" --budget {budget}")
+    seed = DEFAULT_SEED if seed is None else seed
+    budget = DEFAULT_BUDGET if budget is None else budget
+    command = (f"wmr-mj design --cart {cart.path} --seed {seed}"
+               + ("" if budget == DEFAULT_BUDGET else f" --budget {budget}"))
     out: dict[str, Any] = {"budget": budget, "seed": seed, "command": command}
-    base = RunConfig(**CERTIFIED.config_changes(), cart=cart)
-    measurement = measurement_errors_of(base, base_for(base))
-    if not measurement.covered:  # design refuses such a cart's sensing (no certificate can cover it)
+    base = RunConfig(**law_changes("computed-torque"), cart=cart)
+    why_not = uncovered(base)
+    if why_not:  # design refuses such a cart's sensing (no certificate can cover it)
         return {**out, "certified": False, "evaluations": 0,
-                "binding": f"the default sensing ({measurement.why_not}: no certificate covers it)"}
+                "binding": f"the default sensing ({why_not}: no certificate covers it)"}
     try:
         result = search_design(DesignProblem(base=base, seed=seed, budget=budget))
     except InfeasiblePathError as exc:  # the cart cannot follow the paper circle: no gains certify it

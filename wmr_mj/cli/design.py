@@ -13,7 +13,7 @@ from wmr_mj.cli.options import add_json, positive_float, positive_int
 def register(sub: argparse._SubParsersAction) -> None:
     from wmr_mj.cli.run import add_hardware_options
     from wmr_mj.params import M1_RANGE
-    from wmr_mj.sim.design_search import METHODS, OBJECTIVES
+    from wmr_mj.sim.design_search import DEFAULT_BUDGET, DEFAULT_SEED, METHODS, OBJECTIVES
 
     p = sub.add_parser(
         "design", help="the computed-torque (or sliding-mode) gains, sign width, filter and period a given cart "
@@ -51,9 +51,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--method", default="cma", choices=METHODS,
                    help="the optimiser: cma (CMA-ES, the default: the better of the two in bench/bench_design.py) "
                         "or de (scipy's differential evolution)")
-    p.add_argument("--seed", type=int, default=0, help="the optimiser's seed (same seed, same design; default 0)")
-    p.add_argument("--budget", type=positive_int, default=600,
-                   help="certificate evaluations per period and path, about (default 600)")
+    p.add_argument("--seed", type=int, default=DEFAULT_SEED,
+                   help=f"the optimiser's seed (same seed, same design; default {DEFAULT_SEED})")
+    p.add_argument("--budget", type=positive_int, default=DEFAULT_BUDGET,
+                   help=f"certificate evaluations per period and path, about (default {DEFAULT_BUDGET})")
     p.add_argument("--check", type=int, default=0, metavar="N",
                    help="then sweep N runs over the box at the design and count the verdicts (default 0: none)")
     p.add_argument("--out", default="design.json", metavar="FILE", help="the design file (default design.json)")
@@ -72,13 +73,10 @@ def problem_from_args(args: argparse.Namespace) -> Any:
     from wmr_mj.cli.run import hardware_from_args
     from wmr_mj.errors import ParameterError
     from wmr_mj.params import M1_RANGE
-    from wmr_mj.sim.certify import measurement_errors_of
-    from wmr_mj.sim.config import RunConfig, base_for
-    from wmr_mj.sim.design_search import LAWS, OBJECTIVES, DesignProblem, check_periods
-    from wmr_mj.sim.designs import CERTIFIED
+    from wmr_mj.sim.config import RunConfig
+    from wmr_mj.sim.design_search import OBJECTIVES, DesignProblem, check_periods, law_changes, uncovered
 
-    if args.controller not in LAWS:
-        raise ParameterError(f"--controller {args.controller!r} is not accepted; one of {', '.join(LAWS)}")
+    law = law_changes(args.controller)
     if args.objective not in OBJECTIVES:
         raise ParameterError(f"--objective {args.objective!r} is not accepted; one of {', '.join(OBJECTIVES)}")
     lo, hi = (float(v) for v in args.m1_range)
@@ -97,15 +95,13 @@ def problem_from_args(args: argparse.Namespace) -> Any:
     except ValueError:
         raise ParameterError(f"--periods {args.periods!r} is not a list of numbers (s), e.g. 0.001,0.002") from None
     check_periods(periods, args.duration)
-    law = (CERTIFIED.config_changes() if args.controller == "computed-torque"
-           else {"controller": "sliding-mode", "model": "nonholonomic"})
     base = RunConfig(**law, m1_range=m1_range, box_ranges=ranges, duration=args.duration,
                      reference_bounds=args.reference_bounds, cart=getattr(args, "cart", None),
                      **hardware_from_args(args))
-    measurement = measurement_errors_of(base, base_for(base))
-    if not measurement.covered:
-        raise ParameterError(f"{measurement.why_not}: no certificate can cover it (--sensing, --actuation, "
-                             "--backlash); a bounded error is accepted")
+    why_not = uncovered(base)
+    if why_not:
+        raise ParameterError(f"{why_not}: no certificate can cover it (--sensing, --actuation, --backlash); a "
+                             "bounded error is accepted")
     return DesignProblem(base=base, paths=tuple(args.path or ("paper-circle",)), periods=periods,
                          objective=args.objective, method=args.method, seed=args.seed,
                          budget=args.budget)
@@ -152,7 +148,7 @@ def check_design(problem: Any, result: Any, n: int) -> dict[str, Any]:
 
 
 def _print(result: Any, args: argparse.Namespace, out: dict[str, Any], wall: float) -> None:
-    from wmr_mj.sim.design_search import certificate_name
+    from wmr_mj.sim.certify import certificate_name
 
     s = result.settings
     paths = ", ".join(result.paths)

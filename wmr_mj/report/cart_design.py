@@ -36,6 +36,7 @@ from typing import Any
 from wmr_mj._util.checks import as_pair
 from wmr_mj._util.progress import Stages
 from wmr_mj.report.settings import ValidateSettings, loud, stage_progress
+from wmr_mj.sim.design_search import DEFAULT_BUDGET, DEFAULT_SEED
 from wmr_mj.sim.records import Record
 
 __all__ = ["DESIGN_SENSING", "DESIGN_SEED", "DESIGN_BUDGET", "DESIGN_RUNS", "DesignOnCart", "CartDesign",
@@ -44,8 +45,8 @@ __all__ = ["DESIGN_SENSING", "DESIGN_SEED", "DESIGN_BUDGET", "DESIGN_RUNS", "Des
 #: The cart the section designs for: the 12-bit axis encoder (ams AS5045), its velocity differenced.
 DESIGN_SENSING = "magnetic-12bit-axis"
 #: The search's seed and budget: ``wmr-mj design``'s defaults, so that its command finds the same design.
-DESIGN_SEED = 0
-DESIGN_BUDGET = 600
+DESIGN_SEED = DEFAULT_SEED
+DESIGN_BUDGET = DEFAULT_BUDGET
 #: The runs of each design on the cart, at most (the report's n where smaller): issue 35's 16-run sweep.
 DESIGN_RUNS = 16
 
@@ -184,6 +185,7 @@ def _design_on_cart(name: str, label: str, base: Any, settings: ValidateSettings
                     n: int) -> DesignOnCart:
     """Sweep ``base`` over the m1 draws (resumable in cart-design-<name>/) and summarise it with its certificate."""
     from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE
+    from wmr_mj.sim.certify import certificate_name
     from wmr_mj.sim.parts import resolve_run
     from wmr_mj.sim.sweep import SweepSpec, SweepSummary, read_runs, run_sweep
 
@@ -200,7 +202,7 @@ def _design_on_cart(name: str, label: str, base: Any, settings: ValidateSettings
         name=name, label=label, kp=float(base.kp), kd=float(base.kd), friction_sign=str(base.friction_sign),
         friction_width=float(base.friction_width), control_period=base.control_period,
         filter_tau=base.sensing.filter_tau, certified=bool(cert is not None and cert.certified),
-        certificate=None if valid is None else str(valid.inputs.get("certificate", "section-4")),
+        certificate=None if valid is None else certificate_name(valid),
         E_max=None if valid is None else float(valid.E_max),
         voltage_max=None if valid is None else float(valid.voltage_max),
         unmet=tuple(cert.unmet) if cert is not None else ("no claim (the law states none)",), n=runs["n"],

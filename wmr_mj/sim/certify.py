@@ -302,6 +302,19 @@ def certificate_of(config: Any, reference: Any, *, base: C80Parameters, estimate
     return replace_inputs(cert, inputs)
 
 
+def own_certificate_name(controller_name: Any) -> str:
+    """The name of a law's own claim beside the sampled-data certificate: 'boundary-layer' for sliding mode,
+    'section-4' for the rest (the paper's family)."""
+    return "boundary-layer" if controller_name == "sliding-mode" else "section-4"
+
+
+def certificate_name(cert: Certificate) -> str:
+    """Which analysis gave ``cert``: ``inputs['certificate']`` where the run computed two
+    (:func:`_with_sampled_data`), else the law's own (:func:`own_certificate_name`)."""
+    inputs = cert.inputs
+    return str(inputs.get("certificate", own_certificate_name(inputs.get("controller"))))
+
+
 #: the longest delay, in control periods (sensing plus actuation), for which the sampled-data certificate is computed:
 #: its loop carries one state per period of delay, so a delay of seconds at a 1 ms period would cost minutes; far
 #: beyond the delay margin of any gains the designs use (64 periods for K_P = 100, K_D = 20 at 1 ms). A longer
@@ -326,7 +339,7 @@ def _with_sampled_data(cert: Certificate, config: Any, controller: Any, context:
     from wmr_mj.analysis.sampled_certificate import SampledCart, sampled_certificate
     from wmr_mj.analysis.sliding_sampled import sliding_sampled_certificate
 
-    own = "boundary-layer" if name == "sliding-mode" else "section-4"  # the law's claim as it is today
+    own = own_certificate_name(name)  # the law's claim as it is today
     c = controller.model.coefficients
     sign = controller.friction_sign
     estimate = Estimate(P=c.P, C_V=c.C_V, F=0.0 if sign == "none" else c.F, K=c.K, gyro=c.gyro,

@@ -42,8 +42,9 @@ from typing import Any
 
 from wmr_mj.errors import ParameterError
 
-__all__ = ["DesignProblem", "DesignResult", "OBJECTIVES", "METHODS", "LAWS", "DESIGN_FIELDS", "search_design",
-           "evaluate_design", "write_design", "read_design", "design_file_settings", "design_cart", "check_periods"]
+__all__ = ["DesignProblem", "DesignResult", "OBJECTIVES", "METHODS", "LAWS", "DEFAULT_SEED", "DEFAULT_BUDGET",
+           "DESIGN_FIELDS", "law_changes", "uncovered", "search_design", "evaluate_design", "write_design",
+           "read_design", "design_file_settings", "design_cart", "check_periods"]
 
 #: what the search minimises: the worst certified E_max over the paths (rad), the worst certified voltage (V),
 #: or minus the smallest relative margin 1 - value/limit of the certificate's checked assumptions
@@ -54,6 +55,10 @@ OBJECTIVES = ("E_max", "voltage", "margin")
 METHODS = ("cma", "de")
 #: the laws searched: their families are in the module docstring
 LAWS = ("computed-torque", "sliding-mode")
+#: the search's seed and budget (certificates per period and path, about) where none is given: ``wmr-mj design``'s,
+#: and what validate's section (e) and ``cart check`` search with, so that the command finds the same design
+DEFAULT_SEED = 0
+DEFAULT_BUDGET = 600
 #: the RunConfig settings a design file sets (``run --design FILE``), as a preset does
 DESIGN_FIELDS = ("controller", "controller_params", "model", "kp", "kd", "friction_sign", "friction_width",
                  "control_period", "sensing", "actuation", "transmission")
@@ -90,8 +95,8 @@ class DesignProblem:
     periods: tuple[float, ...] = (0.001,)
     objective: str = "E_max"
     method: str = "cma"
-    seed: int = 0
-    budget: int = 600
+    seed: int = DEFAULT_SEED
+    budget: int = DEFAULT_BUDGET
     omega_n: tuple[float, float] = (2.0, 40.0)
     zeta: tuple[float, float] = (0.5, 3.0)
     width: tuple[float, float] = (1.0e-3, 1.0)
@@ -146,6 +151,7 @@ class DesignResult:
             WmrMjError: pandas is not installed (``pip install 'wmr-mj[notebook]'``).
         """
         from wmr_mj.sim import notebook
+        from wmr_mj.sim.certify import certificate_name
 
         rows = []
         for path, cert in self.certificates.items():
@@ -163,6 +169,31 @@ class DesignResult:
 
         return notebook.html_lines("design", "certified" if self.certified else "nothing certifies",
                                    design_lines(self))
+
+
+def law_changes(law: str) -> dict[str, Any]:
+    """The RunConfig fields of the law a design searches, before the gains the search sets: computed torque as
+    the certified preset has it (its model, its measured smoothed sign), sliding mode on the non-holonomic model.
+
+    Raises:
+        ParameterError: a law not in :data:`LAWS` (one line listing them).
+    """
+    from wmr_mj.sim.designs import CERTIFIED
+
+    if law not in LAWS:
+        raise ParameterError(f"--controller {law!r} is not accepted; one of {', '.join(LAWS)}")
+    return CERTIFIED.config_changes() if law == "computed-torque" else {"controller": law, "model": "nonholonomic"}
+
+
+def uncovered(base: Any) -> str:
+    """Why no certificate can cover ``base``'s cart (its sensing, actuation and play on its parameter set), so that
+    no design can certify it (e.g. "Gaussian noise has no bound"); '' where its errors are covered. What ``wmr-mj
+    design`` refuses before any search and ``cart check`` reports as binding."""
+    from wmr_mj.sim.certify import measurement_errors_of
+    from wmr_mj.sim.config import base_for
+
+    measurement = measurement_errors_of(base, base_for(base))
+    return "" if measurement.covered else str(measurement.why_not)
 
 
 def check_periods(periods: Sequence[float], duration: float) -> tuple[float, ...]:
@@ -402,6 +433,7 @@ def _finish(problem: DesignProblem, config: Any, found: float, evaluations: int,
 
 def design_lines(result: DesignResult) -> list[str]:
     """The design in a few lines: the law's parameters, then each path's certificate (or what binds)."""
+    from wmr_mj.sim.certify import certificate_name
     from wmr_mj.sim.notebook import number
 
     s = result.settings
@@ -422,15 +454,9 @@ def design_lines(result: DesignResult) -> list[str]:
     return lines
 
 
-def certificate_name(cert: Any) -> str:
-    """Which analysis gave ``cert``: ``inputs['certificate']`` where the run computed two, else the law's own
-    ('boundary-layer' for sliding mode, 'section-4' for computed torque)."""
-    inputs = cert.inputs
-    own = "boundary-layer" if inputs.get("controller") == "sliding-mode" else "section-4"
-    return str(inputs.get("certificate", own))
-
-
 def _certificate_dict(cert: Any) -> dict[str, Any] | None:
+    from wmr_mj.sim.certify import certificate_name
+
     if cert is None:
         return None
     return {"certified": cert.certified, "E_max": cert.E_max if cert.valid else None,

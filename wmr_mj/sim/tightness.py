@@ -103,14 +103,16 @@ def certificate_columns(cert: Any) -> dict[str, Any]:
     """
     if cert is None:
         return {"certificate": "", "certified": False, "E_max": None, "E_max_section4": None, "E_max_sampled": None}
+    from wmr_mj.sim.certify import certificate_name, own_certificate_name
+
     e_max = float(cert.E_max) if cert.valid and math.isfinite(cert.E_max) else None
-    inputs = cert.inputs
-    both = inputs.get("certificates")
-    if both is None:  # section 4's alone (the ideal cart, or a law with no sampled-data certificate)
-        return {"certificate": "section-4", "certified": bool(cert.certified), "E_max": e_max,
+    both = cert.inputs.get("certificates")
+    if both is None:  # the law's own claim alone (the ideal cart, or a law with no sampled-data certificate)
+        return {"certificate": certificate_name(cert), "certified": bool(cert.certified), "E_max": e_max,
                 "E_max_section4": e_max, "E_max_sampled": None}
-    return {"certificate": str(inputs.get("certificate", "section-4")), "certified": bool(cert.certified),
-            "E_max": e_max, "E_max_section4": both.get("section-4", {}).get("E_max", e_max),
+    own = own_certificate_name(cert.inputs.get("controller"))  # section 4's, or sliding mode's boundary layer
+    return {"certificate": certificate_name(cert), "certified": bool(cert.certified), "E_max": e_max,
+            "E_max_section4": both.get(own, {}).get("E_max", e_max),
             "E_max_sampled": both.get("sampled-data", {}).get("E_max")}
 
 
