@@ -67,3 +67,19 @@ def test_on_the_ideal_cart_the_sliding_design_is_judged_by_its_boundary_layer(tm
     c = printed["settings"]["controller_params"]
     assert printed["certificates"]["paper-circle"]["certificate"] == "boundary-layer"
     assert printed["E_max"] == c["phi"] / c["lam"]
+
+
+def test_compare_and_validate_read_a_sliding_design_file_as_run_does(designed):
+    """compare FILE.json and validate --design FILE.json build the design through design_file_changes: the
+    sliding-mode law's own parameters (lam, phi, k, eta) must reach it, as they reach run --design FILE (they once
+    did not: the law ran with its defaults). The truth: the file's certificate, which run reproduces above."""
+    from wmr_mj.sim.compare import design_file_changes
+    from wmr_mj.sim.config import RunConfig
+    from wmr_mj.sim.parts import resolve_run
+
+    _, out, printed = designed
+    changes = design_file_changes(str(out))
+    for name, value in printed["settings"]["controller_params"].items():
+        assert changes["controller_params"][name] == value, name
+    cert = resolve_run(RunConfig(**changes)).claim
+    assert cert.E_max == printed["certificates"]["paper-circle"]["E_max"]

@@ -105,13 +105,14 @@ def with_design_file(args: argparse.Namespace) -> argparse.Namespace:
             file that is no longer there (and no --cart given).
     """
     from wmr_mj.errors import ParameterError
-    from wmr_mj.sim.design_search import design_cart, design_file_settings
+    from wmr_mj.sim.design_search import design_cart, design_file_settings, read_design
 
     if args.preset is not None:
         raise ParameterError("give --design FILE or --preset, not both (a design file is a preset of its own)")
-    settings = design_file_settings(args.design)
+    data = read_design(args.design)
+    settings = design_file_settings(args.design, data)
     if hasattr(args, "cart"):  # the cart the design was found on, unless --cart names one
-        settings["cart"] = design_cart(args.design, args.cart)
+        settings["cart"] = design_cart(args.design, args.cart, data=data)
     if args.omega_r is not None:
         settings.pop("kp"), settings.pop("kd")
     merged = argparse.Namespace(**vars(args))

@@ -122,17 +122,17 @@ def design_file_changes(path: str, *, cart: Any = None) -> dict[str, Any]:
     from wmr_mj.sim.spec import LawChoice, law_fields
 
     try:
-        s = design_file_settings(path)
-        found_on = read_design(path).get("cart")
+        data = read_design(path)
     except ParameterError as exc:  # read_design names the run option; here the file is a design's name
         raise ParameterError(str(exc).replace("--design ", "design ", 1)) from None
+    s, found_on = design_file_settings(path, data), data.get("cart")
     if cart is None and isinstance(found_on, dict):  # every design here runs on the command's one cart
         raise ParameterError(f"design {str(path)!r} was found on cart {found_on.get('name')!r} "
                              f"({found_on.get('path')}); give --cart FILE to run every design on that cart (the "
                              "C80 is the default)")
     law = law_fields(LawChoice(cart=cart, controller=s["controller"], model=s["model"], kp=s["kp"], kd=s["kd"],
                                friction_sign=s["friction_sign"], friction_width=s["friction_width"],
-                               controller_params=s.get("controller_params") or {}))
+                               controller_params=s.get("controller_param") or {}))
     law = {k: v for k, v in law.items() if v or k not in ("controller_params", "identified", "coefficients")}
     out = {**law, "control_period": s["control_period"]}
     parts: dict[str, tuple[Any, str]] = {"sensing": (Sensing, "sensing"), "actuation": (Actuation, "actuation"),

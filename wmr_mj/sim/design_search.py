@@ -514,11 +514,12 @@ def read_design(path: str | os.PathLike) -> dict[str, Any]:
     return data
 
 
-def design_file_settings(path: str | os.PathLike) -> dict[str, Any]:
+def design_file_settings(path: str | os.PathLike, data: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """The settings of a design file, as the run options spell them (controller, model, kp, kd, friction_sign,
     friction_width, control_period, sensing, actuation, backlash, and a sliding-mode design's controller_param):
-    ``run --design FILE`` fills each option not given explicitly from them, as a preset does."""
-    settings = read_design(path)["settings"]
+    ``run --design FILE`` fills each option not given explicitly from them, as a preset does. ``data``: the file's
+    content where it was read already (:func:`read_design`)."""
+    settings = (read_design(path) if data is None else data)["settings"]
     out = {k: settings.get(k) for k in ("controller", "model", "kp", "kd", "friction_sign", "friction_width",
                                         "control_period", "sensing", "actuation", "backlash")}
     if settings.get("controller_params"):
@@ -527,7 +528,7 @@ def design_file_settings(path: str | os.PathLike) -> dict[str, Any]:
 
 
 
-def design_cart(path: str | os.PathLike, given: Any = None) -> Any:
+def design_cart(path: str | os.PathLike, given: Any = None, *, data: Mapping[str, Any] | None = None) -> Any:
     """The cart a run of the design file ``path`` is on: ``given`` where a cart is named (an explicit --cart
     overrides the file, as every explicit option does); else the cart the design was found on, which the file
     records (``wmr-mj design --cart``): the file the record names, found where it was, beside the design file, or
@@ -537,6 +538,8 @@ def design_cart(path: str | os.PathLike, given: Any = None) -> Any:
     Without this a design found on another cart would run on the C80 with that cart's gains, and its certificate
     would silently be another cart's.
 
+    ``data``: the file's content where it was read already (:func:`read_design`).
+
     Raises:
         ParameterError: the design's cart file is nowhere to be found with the text it had (moved or changed): one
             line naming it and what is accepted.
@@ -545,7 +548,7 @@ def design_cart(path: str | os.PathLike, given: Any = None) -> Any:
 
     from wmr_mj.carts import cart_names, cart_path
 
-    recorded = read_design(path).get("cart")
+    recorded = (read_design(path) if data is None else data).get("cart")
     if given is not None or not isinstance(recorded, Mapping):
         return given
     where = Path(str(recorded.get("path", "")))
