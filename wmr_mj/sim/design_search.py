@@ -180,9 +180,13 @@ def law_changes(law: str) -> dict[str, Any]:
     """
     from wmr_mj.sim.designs import CERTIFIED
 
+    _check_law(law)
+    return CERTIFIED.config_changes() if law == "computed-torque" else {"controller": law, "model": "nonholonomic"}
+
+
+def _check_law(law: Any) -> None:
     if law not in LAWS:
         raise ParameterError(f"--controller {law!r} is not accepted; one of {', '.join(LAWS)}")
-    return CERTIFIED.config_changes() if law == "computed-torque" else {"controller": law, "model": "nonholonomic"}
 
 
 def uncovered(base: Any) -> str:
@@ -352,8 +356,7 @@ def search_design(problem: DesignProblem) -> DesignResult:
     if problem.method not in METHODS:
         raise ParameterError(f"--method {problem.method!r} is not accepted; one of {', '.join(METHODS)}")
     periods = check_periods(problem.periods, problem.base.duration)
-    if problem.base.controller not in LAWS:
-        raise ParameterError(f"--controller {problem.base.controller!r} is not accepted; one of {', '.join(LAWS)}")
+    _check_law(problem.base.controller)
     best: tuple[float, Any] | None = None
     evaluations = 0
     for period in periods:
