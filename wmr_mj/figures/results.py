@@ -24,7 +24,6 @@ from typing import Any
 import numpy as np
 
 from wmr_mj.figures import plots
-from wmr_mj.params import C80
 
 __all__ = ["ResultPlot", "plot_run", "plot_sweep", "plot_falsify", "plot_compare", "plot_validate", "figure_compare"]
 
@@ -65,16 +64,16 @@ def run_bounds(summary: Any) -> tuple[float | None, float | None, str]:
     return None, None, ""
 
 
-def plot_run(result: Any, *, title: str | None = None) -> ResultPlot:
+def plot_run(result: Any, *, supply: float, title: str | None = None) -> ResultPlot:
     """A run (``RunResult``): E, E' and the voltage against time (axes 0-2, bounds dashed), C's path (axis 3).
 
     Args:
         result: the run.
+        supply: the plant's supply limit, V (the run's parameter set: its cart's, with its overrides).
         title: the figure's title; default the law, m1 and the verdict.
     """
     s = result.summary
     E_max, Edot_max, whose = run_bounds(s)
-    supply = float(result.config.plant_overrides.get("voltage_limit", C80.voltage_limit))
     with plots.rc_context(plots.STYLE):
         fig = plots.Figure(figsize=(10.0, 5.6))
         grid = fig.add_gridspec(3, 2, width_ratios=(1.5, 1.0))

@@ -103,8 +103,10 @@ class RunResult:
         """E and E' between the certificate's bounds, the voltage between the supply limits, and C's path
         (a :class:`wmr_mj.figures.results.ResultPlot`: ``.figure``, ``.axes``)."""
         from wmr_mj.figures.results import plot_run
+        from wmr_mj.sim.config import plant_parameters
 
-        return plot_run(self, **options)
+        # the supply of the plant the run simulated: its cart's, with its --param overrides
+        return plot_run(self, supply=float(plant_parameters(self.config).voltage_limit), **options)
 
     def _repr_html_(self) -> str:
         from wmr_mj.sim import notebook
