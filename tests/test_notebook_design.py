@@ -62,20 +62,38 @@ def test_a_tightness_row_as_a_table_and_a_few_lines(found):
     assert f"{row.tightness:.4g}" in lines and f"{row.runs} runs" in lines
 
 
-def test_a_runs_plot_draws_the_supply_of_its_own_cart(tmp_path):
-    """The voltage axis's limits are the supply of the plant the run simulated: a cart file's (20 V here), not the
-    C80's 24 V (the figure once read only --param overrides on the C80's parameter set)."""
-    import numpy as np
-
+@pytest.fixture(scope="module")
+def twenty_volt_run(tmp_path_factory):
+    """A 9 s run of the certified design on a copy of c80.toml whose supply is 20 V."""
     from wmr_mj.carts import CARTS_DIR
 
     text = (CARTS_DIR / "c80.toml").read_text(encoding="utf-8")
     old = "[supply.voltage_limit]\nvalue = 24.0"
     assert old in text
-    cart = tmp_path / "twenty.toml"
+    cart = tmp_path_factory.mktemp("cart") / "twenty.toml"
     cart.write_text(text.replace(old, "[supply.voltage_limit]\nvalue = 20.0"), encoding="utf-8")
-    run = wm.run_closed_loop(wm.RunConfig(**wm.CERTIFIED.config_changes(), cart=str(cart), duration=9.0),
-                             progress=False)
-    v_ax = run.plot().axes[2]
-    levels = {float(line.get_ydata()[0]) for line in v_ax.lines if len(set(np.asarray(line.get_ydata()))) == 1}
+    return wm.run_closed_loop(wm.RunConfig(**wm.CERTIFIED.config_changes(), cart=str(cart), duration=9.0),
+                              progress=False)
+
+
+def _levels(ax) -> set[float]:
+    """The heights of an axis's horizontal lines."""
+    import numpy as np
+
+    return {float(line.get_ydata()[0]) for line in ax.lines if len(set(np.asarray(line.get_ydata()))) == 1}
+
+
+def test_a_runs_plot_draws_the_supply_of_its_own_cart(twenty_volt_run):
+    """The voltage axis's limits are the supply of the plant the run simulated: a cart file's (20 V here), not the
+    C80's 24 V (the figure once read only --param overrides on the C80's parameter set)."""
+    levels = _levels(twenty_volt_run.plot().axes[2])
+    assert {20.0, -20.0} <= levels and 24.0 not in levels
+
+
+def test_validates_history_figure_draws_the_supply_of_its_cart(twenty_volt_run):
+    """validate --cart's history figures likewise (they drew the C80's 24 V on every cart)."""
+    from wmr_mj.report.figures import _history_figures
+
+    fig = _history_figures({"certified": twenty_volt_run})["history_certified"]
+    levels = set().union(*(_levels(ax) for ax in fig.axes))
     assert {20.0, -20.0} <= levels and 24.0 not in levels

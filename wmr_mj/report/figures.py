@@ -25,7 +25,6 @@ from typing import Any
 import numpy as np
 
 from wmr_mj._util.progress import Stages
-from wmr_mj.params import C80
 from wmr_mj.report.results import Rung
 from wmr_mj.report.settings import ValidateSettings
 
@@ -58,6 +57,7 @@ def _wrap(text: str, width: int) -> str:
 
 def _history_figures(nominal: Mapping[str, Any]) -> dict[str, Any]:
     from wmr_mj.figures import plots
+    from wmr_mj.sim.config import plant_parameters
 
     figs = {}
     for name, run in nominal.items():
@@ -67,7 +67,7 @@ def _history_figures(nominal: Mapping[str, Any]) -> dict[str, Any]:
         else:
             bounds, whose = (s.E_max, s.Edot_max), "paper's claim"
         figs[f"history_{name}"] = plots.figure_time_history(
-            run.rows, s, voltage_limit=C80.voltage_limit, bounds=bounds, bound_name=whose,
+            run.rows, s, voltage_limit=plant_parameters(run.config).voltage_limit, bounds=bounds, bound_name=whose,
             title=f"{name} design on the MuJoCo plant, m1 = {s.m1:g} kg: {s.verdict}")
     return figs
 
