@@ -12,7 +12,9 @@ Printed:
   design:     for each optimiser (:data:`wmr_mj.sim.design_search.METHODS`) and seed (0 .. ``--seeds`` - 1),
               the median wall time of ``search_design`` (the paper circle, the 1 ms period, ``--budget``
               points) over ``--designs`` repeats, with its certified E_max (the same every repeat: the search
-              is seeded): which optimiser finds the smaller certificate at the same budget.
+              is seeded): which optimiser finds the smaller certificate at the same budget;
+  random:     beside them, ``--budget`` points drawn uniformly in the same box per seed, the best certified
+              E_max kept (the objective is E_max, so the score is it): what the optimisers add over sampling.
 
 The machine may be shared: the quartiles say how much the load blurs the medians.
 """
@@ -32,7 +34,15 @@ def main() -> None:
 
     from wmr_mj.hardware import Sensing
     from wmr_mj.sim.config import RunConfig
-    from wmr_mj.sim.design_search import LAWS, METHODS, DesignProblem, _Scorer, law_changes, search_design
+    from wmr_mj.sim.design_search import (
+        LAWS,
+        METHODS,
+        PENALTY,
+        DesignProblem,
+        _Scorer,
+        law_changes,
+        search_design,
+    )
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--sensing", default="magnetic-12bit-axis")
@@ -68,6 +78,14 @@ def main() -> None:
             print(f"design {method} seed {seed} (budget {args.budget}, {evaluations} evaluations, {args.designs} "
                   f"repeats): median {statistics.median(walls):.1f} s (min {min(walls):.1f}, max "
                   f"{max(walls):.1f}); certified E_max {e_max:.6g} rad")
+    for seed in range(args.seeds):  # the baseline: as many points drawn uniformly in the same box, the best kept
+        rng = np.random.default_rng(seed)
+        t0 = time.perf_counter()
+        best = min(scorer(rng.uniform(lows, highs)) for _ in range(args.budget))
+        wall = time.perf_counter() - t0
+        found = f"certified E_max {best:.6g} rad" if best < PENALTY else "none certified"
+        print(f"design random seed {seed} (budget {args.budget}, {args.budget} evaluations, uniform in the search's "
+              f"box): {wall:.1f} s; {found}")
 
 
 if __name__ == "__main__":
