@@ -57,6 +57,10 @@ class InfeasiblePathError(WmrMjError, ValueError):
     """A reference path violates the steering range, rate or acceleration limit."""
 
 
+class StiffReferenceError(InfeasiblePathError):
+    """A reference whose integration would not end in bounded time (a wheelbase tiny against the path)."""
+
+
 class LogError(WmrMjError):
     """An MCAP log is missing, not MCAP, corrupt, or of an unknown schema version."""
 

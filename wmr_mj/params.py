@@ -44,6 +44,7 @@ __all__ = [
     "C80",
     "C80_CART",
     "parameters_of_cart",
+    "check_physical_sense",
     "Coefficients",
     "COEFFICIENT_NAMES",
     "CoefficientModel",
@@ -340,6 +341,49 @@ def parameter_names() -> tuple[str, ...]:
 PARAMETER_SOURCES: dict[str, str] = {name: C80_CART.sources[name] for name in parameter_names()}
 
 
+#: The largest ratio of two body masses of the multibody model a parameter set may ask for. Measured on the C80's
+#: bodies (2026-11-28, MuJoCo 4.0, 1 s of random steering voltages at the 1 ms step): m1 = 10^7.5 kg (a ratio of
+#: 4.0e6 to the 8 kg front wheel) stepped with no warning, m1 = 1e8 kg (1.25e7) warned at once that the inertia
+#: matrix is too close to singular; 1e6 keeps a factor of 4 from the first warning.
+MAX_BODY_MASS_RATIO = 1e6
+
+
+def check_physical_sense(p: C80Parameters) -> None:
+    """Refuses a parameter set whose plant is absurd, before any step: what a cart file's schema cannot say.
+
+    Checked: the reduced coefficients of both models are finite (P, C_V > 0; F, K, gyro >= 0); the supply breaks
+    the steering's friction (F, the voltage whose stall torque equals the steering's Coulomb torque, below
+    voltage_limit: otherwise the motor cannot move the steering at all); the body masses within
+    :data:`MAX_BODY_MASS_RATIO` of each other (beyond it MuJoCo warns of a singular inertia matrix).
+
+    Raises:
+        ParameterError: one line naming the culprit, its value and what is accepted.
+    """
+    masses = {"m1": p.m1, "rear_axle_mass": p.rear_axle_mass, "rear_wheel_mass": p.rear_wheel_mass,
+              "front_axle_mass": p.front_axle_mass, "front_wheel_mass": p.front_wheel_mass}
+    heavy, light = max(masses, key=masses.__getitem__), min(masses, key=masses.__getitem__)
+    if masses[heavy] > MAX_BODY_MASS_RATIO * masses[light]:
+        raise ParameterError(
+            f"{heavy} = {masses[heavy]:.4g} kg is {masses[heavy] / masses[light]:.3g} times {light} = "
+            f"{masses[light]:.4g} kg; accepted: a ratio of at most {MAX_BODY_MASS_RATIO:.0e} (beyond it MuJoCo "
+            "warns that the inertia matrix is singular)")
+    for model in COEFFICIENT_MODELS:
+        c = p.coefficients(model)
+        for name, value in c.as_dict().items():
+            positive = name in ("P", "C_V")
+            if not math.isfinite(value) or (value <= 0.0 if positive else value < 0.0):
+                raise ParameterError(
+                    f"the reduced coefficient {name} = {value!r} ({model} model) is not accepted; accepted: finite and "
+                    f"{'> 0' if positive else '>= 0'} (check R_a, k_i, i2, the masses and the geometry it is made of)")
+    F = p.coefficients("paper").F
+    if not F < p.voltage_limit:
+        raise ParameterError(
+            f"the motor cannot move the steering: its Coulomb friction needs F = {F:.4g} V at stall "
+            f"((R_a/k_i) (l3 l4/(l1 i2)) mu Q, from R_a = {p.R_a:.4g} Ohm, k_i = {p.k_i:.4g} N m/A, i2 = {p.i2:.4g}, "
+            f"mu = {p.mu:.4g}) and the supply gives voltage_limit = {p.voltage_limit:.4g} V; accepted: F below the "
+            "supply")
+
+
 def parameters_of_cart(cart: CartFile) -> C80Parameters:
     """The parameter set of a checked cart file (:func:`wmr_mj.carts.load_cart`).
 
@@ -353,7 +397,9 @@ def parameters_of_cart(cart: CartFile) -> C80Parameters:
         raise ParameterError(f"cart file {str(cart.path)!r}: its parameters differ from the parameter set's in "
                              f"{', '.join(odd)}; accepted: exactly {', '.join(names)}")
     try:
-        return C80Parameters(**{name: cart.parameters[name] for name in names})
+        params = C80Parameters(**{name: cart.parameters[name] for name in names})
+        check_physical_sense(params)
+        return params
     except ParameterError as exc:
         raise ParameterError(f"cart file {str(cart.path)!r}: {exc}") from None
 

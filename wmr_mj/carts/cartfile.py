@@ -159,6 +159,15 @@ def _check_rules(document: Mapping[str, Any]) -> None:
             if not lo < hi:
                 raise ParameterError(f"uncertainty.{box}.{name}.range = {entry['range']!r} {entry['unit']} is not "
                                      "accepted; accepted: [lo, hi] with lo < hi")
+    m1, inertia_mass = document["chassis"]["m1"]["value"], document["chassis"]["chassis_inertia_mass"]["value"]
+    if m1 < inertia_mass:
+        raise ParameterError(f"chassis.m1.value = {m1!r} kg is not accepted; accepted: at least chassis."
+                             f"chassis_inertia_mass.value = {inertia_mass!r} kg (m1 beyond the chassis' own mass is "
+                             "its payload, which cannot be negative)")
+    for box, ranges in document["uncertainty"].items():
+        if "m1" in ranges and not ranges["m1"]["range"][0] <= m1 <= ranges["m1"]["range"][1]:
+            raise ParameterError(f"chassis.m1.value = {m1!r} kg is not accepted; accepted: inside its own box "
+                                 f"uncertainty.{box}.m1.range = {ranges['m1']['range']!r} kg")
     version, newest = document["version"], document["changelog"][0]
     if not newest.startswith(version):
         raise ParameterError(f"changelog[0] = {newest!r} is not accepted; accepted: the newest line first, beginning "

@@ -198,15 +198,22 @@ def run(args: argparse.Namespace) -> int:
 
     from wmr_mj.carts import load_cart
     from wmr_mj.cli._common import print_json
-    from wmr_mj.errors import ParameterError
+    from wmr_mj.errors import InfeasiblePathError, ParameterError, StiffReferenceError
     from wmr_mj.params import parameters_of_cart
     from wmr_mj.plant.cartcheck import check_identification, step_with_random_controls
+    from wmr_mj.sim.config import build_reference
 
     cart = load_cart(args.cart)
     params = parameters_of_cart(cart)
     parts = _default_parts(cart)
     if args.action == "card":
         return _write_card(cart, args.out)
+    try:  # a reference that cannot be built in bounded time is an absurd cart: refused before any step
+        build_reference("paper-circle", params, dt=1e-3, duration=35.0)
+    except StiffReferenceError as exc:
+        raise ParameterError(f"cart file {str(cart.path)!r}: {exc}") from None
+    except InfeasiblePathError:  # a circle the cart cannot steer: the cart's answer, reported below
+        pass
     certified = certified_on_cart(cart)
     t0 = time.perf_counter()
     design = design_on_cart(cart, seed=args.seed)

@@ -91,7 +91,7 @@ from scipy.optimize import brentq
 
 from wmr_mj._util.checks import positive_real as _positive
 from wmr_mj._util.checks import real as _number
-from wmr_mj.errors import InfeasiblePathError, ParameterError
+from wmr_mj.errors import InfeasiblePathError, ParameterError, StiffReferenceError
 from wmr_mj.params import C80, C80Parameters
 from wmr_mj.reference.bounds import PAPER_BOUNDS, ReferenceBounds
 
@@ -117,6 +117,12 @@ SegmentKind = Literal["line", "arc", "transition", "ramp", "lane_change"]
 
 _RTOL = 1e-10
 _ATOL = 1e-12
+#: The most wheelbases of C's path one reference may integrate. alpha relaxes towards its circle's angle over
+#: a length l1 / cos(alpha), so the explicit integrator's steps grow as (path length) / l1. Measured building
+#: the paper circle's reference (35 s, 8.8 m of C's path) on a loaded 2-core machine (2026-11-28): l1 = 1e-3 m
+#: (8.8e3 wheelbases) took 1.1 s, 1e-4 m (8.8e4) 9 s, 3e-5 m (2.9e5) 36 s; 1e-6 m would take hours. The C80
+#: (l1 = 0.612 m) integrates 14 wheelbases there.
+MAX_WHEELBASES_INTEGRATED = 1e4
 _JOIN_TOL = 1e-9  # curvature mismatch accepted at a joint, 1/m
 
 
@@ -578,6 +584,7 @@ def _integrate(
     t_stop: float | None = None,
 ) -> _Run:
     """Integrate [alpha, t, phi_C, x_C, y_C] over s, segment by segment (C starts at 0, heading phi0 = alpha_init)."""
+    _check_integrable(path, l1, V_A, max_angle=max_angle, t_stop=t_stop)
     run = _Run()
     y = np.array([alpha_init, 0.0, alpha_init, 0.0, 0.0])
     s0 = 0.0
@@ -634,6 +641,24 @@ def _integrate(
         y = res.y[:, -1].copy()
         s0 += seg.length
     return run
+
+
+def _check_integrable(path: Path, l1: float, V_A: float, *, max_angle: float, t_stop: float | None) -> None:
+    """Refuses, before any step, a reference whose integration would not end in bounded time.
+
+    Raises:
+        StiffReferenceError: C's path (up to ``t_stop``: C moves at most V_A / cos(max_angle) per second) is more
+            than :data:`MAX_WHEELBASES_INTEGRATED` wheelbases long.
+    """
+    span = float(path.length)
+    if t_stop is not None:
+        span = min(span, V_A * t_stop / max(math.cos(min(max_angle, math.pi / 2)), 1e-3))
+    if span > MAX_WHEELBASES_INTEGRATED * l1:
+        raise StiffReferenceError(
+            f"path cannot be integrated in bounded time: the steering angle relaxes over the wheelbase l1 = {l1:.4g} m "
+            f"and C's {span:.4g} m of path are {span / l1:.3g} wheelbases; accepted: at most "
+            f"{MAX_WHEELBASES_INTEGRATED:.0f} (a wheelbase of at least {span / MAX_WHEELBASES_INTEGRATED:.3g} m for "
+            "this path, or a shorter path or --duration)")
 
 
 def _raise_limit(name, s0, z, seg, s_local, l1, V_A, max_angle, max_rate, max_accel):
