@@ -6,8 +6,9 @@ The report is written by the report writer (``wmr_mj.report.validate.write_repor
 tests/data/validate_summary.json, the summary.json of a small validate run
 (``wmr-mj validate --n 3 --duration 10 --identify-duration 10 --search-budget 5 --seed 3``, the
 searches' per-run values cut to 5), with Fig. 4 drawn by ``plots.figure_paths`` over the paper
-circle and a placeholder for every other figure. Skips where no Chromium binary is found (CI has
-none; on Debian: ``apt-get install chromium``).
+circle and a placeholder for every other figure; and from another cart's (c80-magmotor's)
+tests/data/validate_summary_magmotor.json. Skips where no Chromium binary is found (on Debian:
+``apt-get install chromium``; CI's .ci/run installs it).
 """
 
 from __future__ import annotations
@@ -29,7 +30,10 @@ import matplotlib.image as mpimg  # noqa: E402
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
-FIXTURE = Path(__file__).parent / "data" / "validate_summary.json"
+# the C80's, and another cart's: the summary of `wmr-mj validate --cart c80-magmotor --n 3 --duration 10
+# --identify-duration 10 --search-budget 5 --seed 3` (2026-11-28), its folder's paths made relative
+FIXTURES = {name: Path(__file__).parent / "data" / f"{name}.json"
+            for name in ("validate_summary", "validate_summary_magmotor")}
 WIDTH, HEIGHT = 1400, 900
 BROWSERS = ("chromium", "chromium-browser", "google-chrome", "google-chrome-stable", "chrome")
 CHROMIUM = next((path for path in map(shutil.which, BROWSERS) if path), None)
@@ -54,16 +58,16 @@ def _chromium(*args: str, timeout: float = 60) -> subprocess.CompletedProcess:
                               capture_output=True, text=True, timeout=timeout)
 
 
-@pytest.fixture(scope="module")
-def report(tmp_path_factory) -> tuple[Path, dict]:
-    """A report folder written by the report writer from the fixture summary."""
+@pytest.fixture(scope="module", params=sorted(FIXTURES))
+def report(request, tmp_path_factory) -> tuple[Path, dict]:
+    """A report folder written by the report writer from a fixture summary (the C80's, another cart's)."""
     from wmr_mj import C80
     from wmr_mj.figures import plots
     from wmr_mj.report.validate import write_report
     from wmr_mj.sim.config import build_reference
 
     folder = tmp_path_factory.mktemp("report")
-    summary = json.loads(FIXTURE.read_text())
+    summary = json.loads(FIXTURES[request.param].read_text())
     summary["folder"] = str(folder)
     reference = build_reference("paper-circle", C80, dt=1e-3, duration=10.0)[0]
     C = np.asarray(reference.C_xy)
