@@ -119,6 +119,14 @@ def test_every_relative_link_resolves(page):
     assert not broken, f"{page.relative_to(ROOT)}: {broken}"
 
 
+@pytest.mark.parametrize("page", [README, DOCS / "index.md"], ids=lambda p: str(p.relative_to(ROOT)))
+def test_every_guide_and_reference_page_is_linked_from_the_front_pages(page):
+    linked = {(page.parent / t.partition("#")[0]).resolve() for t in _links(page)}
+    pages = sorted((*(DOCS / "guides").glob("*.md"), *(DOCS / "reference").glob("*.md")))
+    missing = [str(p.relative_to(ROOT)) for p in pages if p.resolve() not in linked]
+    assert not missing, f"{page.relative_to(ROOT)} links none of {missing}"
+
+
 # ------------------------------------------------------------------------------------- the commands reference
 def test_the_commands_reference_names_every_built_in_law_and_tracker():
     from controllers.registry import BUILTIN_TRACKERS, controller_names
