@@ -95,9 +95,10 @@ def render_model_card(params: C80Parameters = C80, *, cart: Any = None) -> str:
     else:
         _cart_header_section(w, cart)
     _parameter_section(w, p, cart)
-    _coefficient_section(w, p, paper, nh, M1_RANGE if cart is None else cart.uncertainty["m1"]["m1"])
+    _coefficient_section(w, p, paper, nh, M1_RANGE if cart is None else cart.uncertainty["m1"]["m1"],
+                         paper_cart=cart is None)
     _modelling_section(w, p, laws)
-    _slip_section(w, p, slip)
+    _slip_section(w, p, slip, paper_cart=cart is None)
     _identification_section(w, ident, paper, nh)
     _friction_section(w, laws)
     _contact_section(w, contacts, C80 if cart is None else p)
@@ -158,7 +159,10 @@ def _parameter_section(w, p: C80Parameters, cart: Any = None) -> None:
     w("")
 
 
-def _coefficient_section(w, p: C80Parameters, paper, nh, m1_range: tuple[float, float] = M1_RANGE) -> None:
+def _coefficient_section(w, p: C80Parameters, paper, nh, m1_range: tuple[float, float] = M1_RANGE, *,
+                         paper_cart: bool = True) -> None:
+    """The coefficients table; ``paper_cart``: the C80's card, whose K and F are read against (5.1)'s intervals
+    (another cart's card states its own spans and labels (5.1)'s column as the paper's C80)."""
     lo, hi = (with_params(p, m1=m) for m in m1_range)
     paper_lo, paper_hi = lo.coefficients("paper"), hi.coefficients("paper")
     w("## Reduced-model coefficients beside the paper's (5.1)")
@@ -173,11 +177,21 @@ def _coefficient_section(w, p: C80Parameters, paper, nh, m1_range: tuple[float, 
         w(f"| {k} | {_g(getattr(paper, k))} | ({_g(min(a, b))}, {_g(max(a, b))}) | "
           f"{'({:g}, {:g})'.format(*interval) if interval else '-'} | {_g(getattr(nh, k))} | {units[k]} |")
     w("")
+    scaled = (f"({_g(with_params(p, m1=m1_range[0], m1_inertia='scale').coefficients().K)}, "
+              f"{_g(with_params(p, m1=m1_range[1], m1_inertia='scale').coefficients().K)}) V. ")
+    if not paper_cart:
+        k_lo, k_hi = sorted((paper_lo.K, paper_hi.K))
+        f_lo, f_hi = sorted((paper_lo.F, paper_hi.F))
+        w(f"Over this cart's m1 box K spans ({_g(k_lo)}, {_g(k_hi)}) V, m1 changing as a compact payload at the "
+          "chassis centre of mass (`m1_inertia='payload'`, where I_z1 does not depend on m1); scaling the chassis "
+          "inertia with m1 instead (`m1_inertia='scale'`) gives K over " + scaled
+          + f"F follows (2.7) with Q = (m1 + m2 + m3) g: ({_g(f_lo)}, {_g(f_hi)}) V. The column (5.1) is the "
+          "paper's C80, shown for comparison only.")
+        w("")
+        return
     w("K spans the paper's interval because m1 changes as a compact payload at the chassis centre of mass "
       "(`m1_inertia='payload'`, the reading of (2.3), where I_z1 does not depend on m1). Scaling the chassis inertia "
-      "with m1 instead (`m1_inertia='scale'`) gives K over "
-      f"({_g(with_params(p, m1=m1_range[0], m1_inertia='scale').coefficients().K)}, "
-      f"{_g(with_params(p, m1=m1_range[1], m1_inertia='scale').coefficients().K)}) V. "
+      "with m1 instead (`m1_inertia='scale'`) gives K over " + scaled +
       "F follows (2.7) with Q = (m1 + m2 + m3) g, so it spans a wider interval than (5.1) prints: the paper's F "
       "interval does not follow its own formula when m1 varies.")
     w("")
@@ -228,14 +242,17 @@ def _modelling_section(w, p: C80Parameters, laws: dict[str, FrictionLaw]) -> Non
     w("")
 
 
-def _slip_section(w, p: C80Parameters, slip) -> None:
+def _slip_section(w, p: C80Parameters, slip, *, paper_cart: bool = True) -> None:
+    where = ("On the steady 1 m circle of C" if paper_cart
+             else "On a steady circle of C of radius 1 m (the measurement's, not a path of this cart's)")
+    speeds = "at the paper's speeds" if paper_cart else "at this cart's V_A"
     w("## Measured: wheel side slip")
     w("")
-    w(f"On the steady 1 m circle of C at V_A = {p.V_A:g} m/s (`wmr-mj model slip`, 30 s, after 10 s): the largest "
+    w(f"{where} at V_A = {p.V_A:g} m/s (`wmr-mj model slip`, 30 s, after 10 s): the largest "
       f"side-slip speed of a wheel's contact point is {1e3 * slip['max_slip_m_s']:.3f} mm/s "
       f"({100 * slip['max_slip_fraction']:.2f}% of V_A, slip angle {1e3 * slip['max_slip_angle_rad']:.2f} mrad), "
       f"rms {1e3 * slip['rms_slip_m_s']:.3f} mm/s, under side forces up to {100 * slip['max_side_force_ratio']:.2g}% "
-      "of a wheel's normal force. The contacts slip slightly (see *Measured: tyre contacts*); at the paper's speeds "
+      f"of a wheel's normal force. The contacts slip slightly (see *Measured: tyre contacts*); {speeds} "
       "the wheels roll without side slip to within that figure.")
     w("")
 
