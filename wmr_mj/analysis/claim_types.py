@@ -238,6 +238,9 @@ class Certificate:
         reason: why there is no bound ('' when there is). iterations: the fixed point's iterations.
         inputs: what the claim rests on (:class:`ClaimInputs`; a mapping is taken as the law's inputs).
         claimant: whose claim it is (the controller's name; '' for the section-4 analysis of the run's law).
+        analysis: which analysis gave it, as the law names it ('section-4', 'boundary-layer', 'sampled-data';
+            '' where the law names none); not in the JSON, whose ``inputs['certificate']`` names the one a run
+            took where it computed two.
 
     ``E_max``, ``Edot_max`` and, for section 4's region, ``condition``, ``gamma1`` ... ``delta3`` read the
     region; ``friction_term`` ... ``friction_width`` read the terms.
@@ -256,6 +259,7 @@ class Certificate:
     iterations: int = 0
     inputs: ClaimInputs = field(default_factory=ClaimInputs, compare=False, hash=False)
     claimant: str = ""
+    analysis: str = field(default="", compare=False)
 
     def __post_init__(self) -> None:
         check_region(self.region)
