@@ -97,3 +97,29 @@ def test_the_cli_refuses_a_plug_in_with_a_built_ins_name_in_one_line_exit_2(plug
     assert main(["run", "--controller", f"{plug_ins}:Impostor", "--duration", "10", "--no-log"]) == 2
     line = one_error_line(capsys)
     assert "takes the built-in name 'sliding-mode'" in line and "name = " in line
+
+
+#: section 4's keys: the gains of (4.14), (4.18), the condition (4.23) and the terms of delta1
+SECTION_4_KEYS = ("condition", "gamma1", "gamma2", "delta1", "delta2", "delta3", "friction_term", "gyro_term", "K_term",
+                  "P_term", "C_V_term", "gyro_Edot_term", "dead_band", "kp", "kd", "friction_width", "friction_sign",
+                  "regime")
+
+
+def test_each_claimant_writes_only_its_own_terms():
+    """The sampled-data certificate (the certified design on the 12-bit cart) and sliding mode's boundary
+    layer write none of section 4's keys (on main: kp 0.0, kd 0.0, friction_sign 'none' beside the law's K_P);
+    section 4's certificate writes all of them, with the law's gains."""
+    from wmr_mj.sim.designs import CERTIFIED
+
+    design = RunConfig(**CERTIFIED.config_changes()).replace(m1=750.0, reference_bounds="paper", duration=12.0)
+    sampled = resolve_run(design.replace(sensing="magnetic-12bit-axis")).claim
+    assert sampled.inputs["certificate"] == "sampled-data"
+    out = sampled.as_dict()
+    assert not set(SECTION_4_KEYS) & set(out), sorted(set(SECTION_4_KEYS) & set(out))
+    assert out["inputs"]["kp"] == design.kp and "terms" in out["inputs"]  # its own record: the gains, its terms
+    layer = resolve_run(RunConfig(controller="sliding-mode", **{**BASE, "sensing": "ideal"})).claim
+    assert layer.analysis == "boundary-layer" and not set(SECTION_4_KEYS) & set(layer.as_dict())
+    section4 = resolve_run(design).claim
+    out = section4.as_dict()
+    assert section4.analysis == "section-4" and set(SECTION_4_KEYS) <= set(out)
+    assert out["kp"] == design.kp and out["kd"] == design.kd
