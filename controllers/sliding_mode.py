@@ -61,7 +61,7 @@ from typing import Any
 
 import numpy as np
 
-from controllers.base import BuildContext, SteeringController
+from controllers.base import BuildContext, DesignParameter, SteeringController
 from controllers.sampled_claim import with_sampled_data
 from wmr_mj.analysis.certificate import Assumption, Certificate, Compensation, Estimate, friction_term
 from wmr_mj.analysis.claim import ClaimContext, box_claim
@@ -165,6 +165,10 @@ class SlidingMode(SteeringController):
     """
 
     name = "sliding-mode"
+    #: what ``wmr-mj design`` searches of this law: lam, phi, k, eta (each in log), graded (its default layer saturates)
+    design_parameters = (DesignParameter("lam", "1/s"), DesignParameter("phi", "rad/s"), DesignParameter("k", "V"),
+                         DesignParameter("eta", "V", ".4g"))
+    design_graded = True
     # under the paper's model K^ = 5.33 V while the plant's K is about 0: the uncertainty bound D = 9.6 V
     # exceeds the default switching gain k = 3 V, so the claim cannot hold; the non-holonomic model's K^ = 0
     default_model = "nonholonomic"
