@@ -42,8 +42,8 @@ These are a stated margin, not a sampled-data proof; the tests
 (tests/test_sliding_mode.py) check the bound on a zero-order-hold simulation. On a cart that is not ideal a run
 also computes the layer as a sampled loop (:mod:`wmr_mj.analysis.sliding_sampled`: inside the layer the law is
 computed torque at K_P = lam k/(P^ phi), K_D = lam + k/(P^ phi), and the law's measured s is bounded by its l1
-gains), and is judged by the certified one with the smaller E_max (:func:`wmr_mj.sim.certify.certificate_of`;
-this claim is then named 'boundary-layer').
+gains), and is judged by the certified one with the smaller E_max (:meth:`SlidingMode.claim`,
+:func:`controllers.sampled_claim.with_sampled_data`; this claim is named 'boundary-layer').
 
 Usage::
 

@@ -174,9 +174,10 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
 
     Measurement (``measurement``, :class:`~wmr_mj.analysis.measurement.MeasurementErrors`): None, the cart's own
     (:func:`measurement_errors_of` on config.sensing, actuation and transmission; exact on the ideal cart, every
-    number as before), and then, on a cart that is not ideal, the sampled-data certificate is computed beside the
-    law's own and the certified one with the smaller E_max taken (it is derived from the cart's parts, not from
-    summed bounds); given, those bounds in place of the cart's (a what-if), and the law's own claim alone. Handed
+    number as before), and then, on a cart that is not ideal, a law with a sampled-data analysis (the computed-torque
+    and sliding-mode laws and their subclasses) computes it beside its own claim and takes the certified one with the
+    smaller E_max (``ClaimContext.sampled_data``; it is derived from the cart's parts, not from summed bounds);
+    given, those bounds in place of the cart's (a what-if), and the law's continuous claim alone. Handed
     to the claim as ``ClaimContext.measurement``; the computed-torque, PD and sliding-mode claims absorb the
     bounds, and a claim that does not state the assumption 'sensing and actuation covered' gets it unmet
     (:func:`wmr_mj.analysis.claim.covers_measurement`).
