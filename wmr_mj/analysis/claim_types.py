@@ -346,8 +346,10 @@ class Certificate:
         return f"{'certified' if self.certified else 'uncertified'}-{where}"
 
     def as_dict(self) -> dict[str, Any]:
-        """JSON-ready (inf -> None): the Interface keys E_max, Edot_max, condition, valid,
-        assumptions [{name, met, value, limit, ...}], and the terms behind them."""
+        """JSON-ready (inf -> None): the Interface keys E_max, Edot_max, valid, assumptions [{name, met, value,
+        limit, ...}], and what the claimant itself has: section 4's region writes condition and gamma1 ... delta3,
+        section 4's terms (:meth:`SmallGainTerms.json_items`) their keys and the regime; a claim without them (a box
+        claim, the sampled-data certificate, whose own terms are in its ``inputs``) writes none of them."""
         small_gain = isinstance(self.region, SmallGainRegion)
         out: dict[str, Any] = {"E_max": finite_or_none(self.E_max), "Edot_max": finite_or_none(self.Edot_max)}
         if small_gain:  # section 4's region: (4.23) and the gains of (4.14), (4.18); no other claim has them
