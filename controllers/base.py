@@ -59,7 +59,7 @@ in Python in the same engine, one call per control step, and the run says so and
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -69,13 +69,23 @@ if TYPE_CHECKING:
     from wmr_mj.analysis.claim import ClaimContext
     from wmr_mj.plant.reduced import SteeringModel
 
-__all__ = ["SteeringController", "BatchLaw", "saturate", "BuildContext", "law_methods_missing"]
+__all__ = ["SteeringController", "BatchLaw", "saturate", "BuildContext", "law_methods_missing", "DesignParameter"]
 
 #: law(alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot, E, E_dot, u) -> u: alpha, alpha_dot (n,) arrays
 #: (rad, rad/s; strided views are fine); the reference as floats; E = alpha0 - alpha and
 #: E_dot = alpha0_dot - alpha_dot are written into the (n,) arrays E, E_dot; the unsaturated
 #: voltage (V) into u, which is returned.
 BatchLaw = Callable[[np.ndarray, np.ndarray, float, float, float, np.ndarray, np.ndarray, np.ndarray], np.ndarray]
+
+
+class DesignParameter(NamedTuple):
+    """One of a law's own parameters that a design search varies (``wmr-mj design``; in log, as the law's
+    ``controller_params``): its name (a keyword of the law and a range of ``DesignProblem``), its unit and the format
+    a design prints it with."""
+
+    name: str
+    unit: str
+    format: str = ".6g"
 
 
 class BuildContext:
@@ -139,6 +149,12 @@ class SteeringController:
     #: the names of the law's own signals (its alpha' estimate, an observer's state), logged beside the rows as
     #: ``law_NAME`` (:meth:`signals`); a law that logs any runs in Python on the engine, one call per step
     signal_names: tuple[str, ...] = ()
+    #: the law's own parameters a design search varies (:class:`DesignParameter`, in order); (): the run's gains K_P,
+    #: K_D (searched as omega_n, zeta), as for the computed-torque law
+    design_parameters: tuple[DesignParameter, ...] = ()
+    #: whether a design search grades an uncertified point by how far its unmet assumptions are from their limits
+    #: (a law whose default start sits on a flat plateau of one unmet assumption, as sliding mode's saturated layer)
+    design_graded: bool = False
 
     @classmethod
     def from_context(cls, context: BuildContext, **params: Any) -> SteeringController:

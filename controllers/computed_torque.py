@@ -34,8 +34,10 @@ from typing import Literal, get_args
 import numpy as np
 
 from controllers.base import SteeringController
+from controllers.sampled_claim import named, with_sampled_data
 from wmr_mj.analysis.certificate import Certificate, Compensation, Estimate, Gains, certify
 from wmr_mj.analysis.claim import ClaimContext
+from wmr_mj.analysis.sampled_certificate import sampled_certificate
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import C80, COEFFICIENT_NAMES, PAPER_KD, PAPER_KP, C80Parameters
 from wmr_mj.plant.reduced import (
@@ -59,6 +61,7 @@ __all__ = [
     "FRICTION_SIGNS",
     "CONTROLLER_NAMES",
     "make_controller",
+    "SECTION_4",
 ]
 
 #: Where the controller's model comes from: a reduced model on the parameters, the identified
@@ -66,6 +69,8 @@ __all__ = [
 ModelSource = Literal[ModelName, "identified", "explicit"]
 MODEL_SOURCES: tuple[str, ...] = get_args(ModelSource)
 CONTROLLER_NAMES = ("computed-torque", "pd")
+#: the name of section 4's certificate in a run's ``inputs['certificate']`` (beside 'sampled-data')
+SECTION_4 = "section-4"
 
 
 def _check_gain(name: str, value: float) -> float:
@@ -288,13 +293,21 @@ class ComputedTorque(SteeringController):
 
     def claim(self, context: ClaimContext) -> Certificate:
         """The section-4 analysis redone for this law on the run's plant box
-        (:func:`wmr_mj.analysis.certificate.certify`)."""
+        (:func:`wmr_mj.analysis.certificate.certify`), named 'section-4'; on a cart that is not ideal
+        (``context.wants_sampled_data``) beside the sampled-data certificate of its loop on the cart's parts
+        (:func:`wmr_mj.analysis.sampled_certificate.sampled_certificate`), the certified one with the smaller E_max
+        taken (:func:`controllers.sampled_claim.with_sampled_data`)."""
         c = self.model.coefficients
         sign = self.friction_sign
         estimate = Estimate(P=c.P, C_V=c.C_V, F=0.0 if sign == "none" else c.F, K=c.K, gyro=c.gyro,
                             V_A=self.model.V_A)
-        return _section4(context, estimate, Compensation(friction_sign=sign, friction_width=self.friction_width),
-                         kp=self.kp, kd=self.kd)
+        compensation = Compensation(friction_sign=sign, friction_width=self.friction_width)
+        own = _section4(context, estimate, compensation, kp=self.kp, kd=self.kd)
+        gains = Gains(kp=self.kp, kd=self.kd)
+        return with_sampled_data(own, SECTION_4, context, lambda cart: sampled_certificate(
+            plant=context.plant, estimate=estimate, gains=gains, reference=context.reference, limits=context.limits,
+            compensation=compensation, control_period=context.control_period, cart=cart,
+            initial_error=context.initial_error, stated=context.stated))
 
     def describe(self) -> dict:
         return {"controller": self.name, "model": self.model.name, "kp": self.kp, "kd": self.kd,
@@ -355,8 +368,8 @@ class PDController(SteeringController):
         """The section-4 analysis for a law without feedforward or compensation."""
         c = self.model.coefficients
         estimate = Estimate(P=c.P, C_V=0.0, F=0.0, K=0.0, gyro=0.0, V_A=self.model.V_A)
-        return _section4(context, estimate, Compensation(friction_sign="none", friction_width=0.0, feedforward=False),
-                         kp=self.kp, kd=self.kd)
+        return named(_section4(context, estimate, Compensation(friction_sign="none", friction_width=0.0,
+                                                               feedforward=False), kp=self.kp, kd=self.kd), SECTION_4)
 
     def describe(self) -> dict:
         return {"controller": self.name, "model": self.model.name, "kp": self.kp, "kd": self.kd,

@@ -42,7 +42,7 @@ from wmr_mj.errors import ParameterError, UnknownNameError
 
 __all__ = ["PluginSource", "LocatedSource", "resolve", "parse_params", "locate_source", "check_recorded_source",
            "recorded_spec", "BUILTIN_CONTROLLERS", "BUILTIN_TRACKERS", "ENTRY_POINT_GROUPS",
-           "controller_names", "tracker_names", "source_hash", "is_builtin"]
+           "controller_names", "tracker_names", "source_hash", "is_builtin", "refuse_builtin_name"]
 
 #: built-in steering laws: name -> "module:Class"
 BUILTIN_CONTROLLERS: dict[str, str] = {
@@ -79,9 +79,25 @@ class PluginSource:
     params: Mapping[str, Any] = field(default_factory=dict)
     source_sha256: str | None = None
 
+    def __post_init__(self) -> None:
+        refuse_builtin_name(self.name, self.import_path, origin=self.origin)
+
     def as_dict(self) -> dict[str, Any]:
         return {"spec": self.spec, "name": self.name, "origin": self.origin, "import_path": self.import_path,
                 "params": dict(self.params), "source_sha256": self.source_sha256}
+
+
+def refuse_builtin_name(name: str, import_path: str, *, origin: str) -> None:
+    """Refuse a plug-in that takes a built-in's name: every output would call it the built-in (its claim, its
+    record, its log). A built-in's own class, given by name or as an object, keeps its name.
+
+    Raises:
+        ParameterError: ``name`` is a built-in law's or tracker's and ``import_path`` is not that built-in's class.
+    """
+    builtin = BUILTIN_CONTROLLERS.get(name, BUILTIN_TRACKERS.get(name))
+    if origin != "builtin" and builtin is not None and import_path != builtin:
+        raise ParameterError(f"{import_path} takes the built-in name {name!r} (of {builtin}): a plug-in names "
+                             "itself, set name = '...' in its class")
 
 
 def controller_names() -> tuple[str, ...]:

@@ -42,8 +42,8 @@ These are a stated margin, not a sampled-data proof; the tests
 (tests/test_sliding_mode.py) check the bound on a zero-order-hold simulation. On a cart that is not ideal a run
 also computes the layer as a sampled loop (:mod:`wmr_mj.analysis.sliding_sampled`: inside the layer the law is
 computed torque at K_P = lam k/(P^ phi), K_D = lam + k/(P^ phi), and the law's measured s is bounded by its l1
-gains), and is judged by the certified one with the smaller E_max (:func:`wmr_mj.sim.certify.certificate_of`;
-this claim is then named 'boundary-layer').
+gains), and is judged by the certified one with the smaller E_max (:meth:`SlidingMode.claim`,
+:func:`controllers.sampled_claim.with_sampled_data`; this claim is named 'boundary-layer').
 
 Usage::
 
@@ -61,8 +61,9 @@ from typing import Any
 
 import numpy as np
 
-from controllers.base import BuildContext, SteeringController
-from wmr_mj.analysis.certificate import Assumption, Certificate, friction_term
+from controllers.base import BuildContext, DesignParameter, SteeringController
+from controllers.sampled_claim import with_sampled_data
+from wmr_mj.analysis.certificate import Assumption, Certificate, Compensation, Estimate, friction_term
 from wmr_mj.analysis.claim import ClaimContext, box_claim
 from wmr_mj.analysis.measurement import (
     DELAY_FIXED_POINT,
@@ -70,12 +71,15 @@ from wmr_mj.analysis.measurement import (
     inv_cos2_slope,
     sin_cos3_slope,
 )
+from wmr_mj.analysis.sliding_sampled import sliding_sampled_certificate
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.plant.reduced import SteeringModel
 
 __all__ = ["SlidingMode", "Uncertainty", "MeasuredLayer", "SAMPLING_FRACTION", "SLIDING_FRICTION_SIGNS",
-           "MEASURED_STEP"]
+           "MEASURED_STEP", "BOUNDARY_LAYER"]
 
+#: The name of the boundary layer's claim in a run's ``inputs['certificate']`` (beside 'sampled-data').
+BOUNDARY_LAYER = "boundary-layer"
 #: The largest change of s over one control period, as a fraction of the layer phi.
 SAMPLING_FRACTION = 0.1
 #: Name of the sampling check under measurement errors and a delay: what it measures, the step
@@ -161,6 +165,10 @@ class SlidingMode(SteeringController):
     """
 
     name = "sliding-mode"
+    #: what ``wmr-mj design`` searches of this law: lam, phi, k, eta (each in log), graded (its default layer saturates)
+    design_parameters = (DesignParameter("lam", "1/s"), DesignParameter("phi", "rad/s"), DesignParameter("k", "V"),
+                         DesignParameter("eta", "V", ".4g"))
+    design_graded = True
     # under the paper's model K^ = 5.33 V while the plant's K is about 0: the uncertainty bound D = 9.6 V
     # exceeds the default switching gain k = 3 V, so the claim cannot hold; the non-holonomic model's K^ = 0
     default_model = "nonholonomic"
@@ -336,6 +344,23 @@ class SlidingMode(SteeringController):
                              voltage_max=voltage, uncertainty=unc, reason="")
 
     def claim(self, context: ClaimContext) -> Certificate:
+        """The boundary layer (:meth:`layer_claim`), named 'boundary-layer'; on a cart that is not ideal
+        (``context.wants_sampled_data``) beside the layer as a sampled loop on the cart's parts
+        (:func:`wmr_mj.analysis.sliding_sampled.sliding_sampled_certificate`), the certified one with the smaller
+        E_max taken (:func:`controllers.sampled_claim.with_sampled_data`)."""
+        m = self.model
+        c = m.coefficients
+        estimate = Estimate(P=c.P, C_V=c.C_V, F=0.0 if self.friction_sign == "none" else c.F, K=c.K, gyro=c.gyro,
+                            V_A=m.V_A)
+        compensation = Compensation(friction_sign=self.friction_sign, friction_width=self.friction_width)
+        return with_sampled_data(self.layer_claim(context), BOUNDARY_LAYER, context,
+                                 lambda cart: sliding_sampled_certificate(
+                                     plant=context.plant, estimate=estimate, lam=self.lam, phi=self.phi, k=self.k,
+                                     reference=context.reference, limits=context.limits, compensation=compensation,
+                                     control_period=context.control_period, cart=cart,
+                                     initial_error=context.initial_error, stated=context.stated))
+
+    def layer_claim(self, context: ClaimContext) -> Certificate:
         """|E| <= phi/lam, |E'| <= 2 phi (the boundary layer, Slotine & Li 7.2) with its assumptions:
         the switching gain above the uncertainty, the sampling margin, and the run's. Under
         ``context.measurement`` (not exact) the layer grows to :meth:`measured_layer`'s Phi."""

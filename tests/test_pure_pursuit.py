@@ -130,6 +130,8 @@ def test_lane_change_on_mujoco_is_certified_with_the_tracker_measured():
 class _Overshooting(PurePursuit):
     """Declares pure pursuit's bounds but writes alpha0 0.1 rad beyond them (a test's bad tracker)."""
 
+    name = "overshooting-pursuit"  # a plug-in names itself (controllers.registry.refuse_builtin_name)
+
     def block(self, k0, count):
         a, ad, add = super().block(k0, count)
         return a + self.alpha_max + 0.1, ad, add

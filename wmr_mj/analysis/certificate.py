@@ -23,11 +23,7 @@ Usage::
 
 from __future__ import annotations
 
-import dataclasses
-from collections.abc import Mapping
-from typing import Any
-
-from wmr_mj.analysis.claim import fixed_point
+from wmr_mj.analysis.claim import fixed_point, replace_inputs
 from wmr_mj.analysis.claim_types import (
     VERDICTS,
     Assumption,
@@ -95,7 +91,3 @@ __all__ = [
 ]
 
 
-def replace_inputs(cert: Certificate, inputs: Mapping[str, Any]) -> Certificate:
-    """``cert`` with ``inputs`` (a copy of ``cert.inputs``, updated) as its inputs: the law's stay typed, the
-    keys that are new or changed become the run's (:meth:`ClaimInputs.with_record`)."""
-    return dataclasses.replace(cert, inputs=cert.inputs.with_record(inputs))

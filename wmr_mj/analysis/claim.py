@@ -50,11 +50,14 @@ from wmr_mj.params import C80Parameters
 from wmr_mj.reference.bounds import ReferenceBounds
 
 __all__ = ["ClaimContext", "box_claim", "run_assumptions", "RunAssumptions", "shared_assumptions", "fixed_point",
-           "with_measured", "covers_measurement", "INITIAL_TOLERANCE"]
+           "with_measured", "covers_measurement", "best_certificate", "replace_inputs", "SAMPLED_DATA_NAME",
+           "INITIAL_TOLERANCE"]
 
 #: The tolerance on |E(0)|, |E'(0)| of the assumption 'zero initial error' (the reference's rounding at t = 0).
 INITIAL_TOLERANCE = 1e-9
 _FIXED_POINT_ITERATIONS = 10000
+#: The sampled-data certificate's name in a run's ``inputs['certificate']`` and ``inputs['certificates']``.
+SAMPLED_DATA_NAME = "sampled-data"
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -84,6 +87,11 @@ class ClaimContext:
         gear_ratio: i2 of the run's plant (a motor-side encoder's step at the axis is 2 pi / (N i2)); None:
             the estimate's.
         play: the gear's play b [rad at the axis] (0 without play; never covered today: see ``measurement``).
+        sampled_data: whether ``measurement`` is the cart's own, derived from its parts (``sensing``,
+            ``actuation_delay``, ``play``): a law with a sampled-data analysis then computes it beside its
+            continuous claim (:func:`best_certificate`); False where the bounds are a what-if that the parts do
+            not describe (or the run computes no such analysis). On an ideal cart (exact measurement) none is
+            computed either way.
     """
 
     plant: PlantBox
@@ -99,6 +107,13 @@ class ClaimContext:
     actuation_delay: float = 0.0
     gear_ratio: float | None = None
     play: float = 0.0
+    sampled_data: bool = False
+
+    @property
+    def wants_sampled_data(self) -> bool:
+        """Whether a law with a sampled-data analysis computes it for this run: the cart's own measurement
+        (``sampled_data``) on a cart that is not ideal."""
+        return self.sampled_data and not self.measurement.is_exact
 
     def __post_init__(self) -> None:
         if not isinstance(self.measurement, MeasurementErrors):
@@ -239,3 +254,35 @@ def covers_measurement(cert: Certificate, measurement: MeasurementErrors) -> Cer
     fields.update(met=False, value=1.0, note=(f"{cert.claimant or 'the claim'} states nothing about sensing or "
                                               "actuation: it covers exact measurement only"))
     return dataclasses.replace(cert, assumptions=(*cert.assumptions, Assumption(**fields)))
+
+
+def best_certificate(own: Certificate, own_name: str, sampled: Certificate | str) -> Certificate:
+    """A law's claim on a cart that is not ideal: its continuous claim ``own`` (named ``own_name``: 'section-4',
+    'boundary-layer') or its sampled-data certificate ``sampled``, whichever is certified with the smaller E_max
+    (a certified one before one that is not; ``own`` on a tie). The other one's E_max, whether it is certified and
+    its reason are recorded under ``inputs['certificates']``, and ``inputs['certificate']`` names the one taken.
+
+    Args:
+        own: the law's continuous claim, as it covers the run's measurement (:func:`covers_measurement`).
+        own_name: its name.
+        sampled: the sampled-data certificate, or why it was not computed (one line): ``own`` is then taken.
+    """
+    if isinstance(sampled, str):
+        return replace_inputs(own, {**dict(own.inputs), "certificate": own_name,
+                                  "certificates": {SAMPLED_DATA_NAME: {"E_max": None, "reason": sampled}}})
+
+    def rank(c: Certificate) -> tuple[bool, float]:
+        return (not c.certified, c.E_max if c.valid else math.inf)
+
+    taken = sampled if rank(sampled) < rank(own) else own
+    record = {own_name if c is own else SAMPLED_DATA_NAME: {"E_max": c.E_max if c.valid else None,
+                                                             "certified": c.certified, "reason": c.reason}
+              for c in (own, sampled)}
+    return replace_inputs(taken, {**dict(taken.inputs), "certificate": SAMPLED_DATA_NAME if taken is sampled
+                                else own_name, "certificates": record})
+
+
+def replace_inputs(cert: Certificate, inputs: Mapping[str, Any]) -> Certificate:
+    """``cert`` with ``inputs`` (a copy of ``cert.inputs``, updated) as its inputs: the law's stay typed, the
+    keys that are new or changed become the run's (:meth:`ClaimInputs.with_record`)."""
+    return dataclasses.replace(cert, inputs=cert.inputs.with_record(inputs))

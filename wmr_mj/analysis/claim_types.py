@@ -149,9 +149,20 @@ class SmallGainTerms:
     delta1_parts: tuple[tuple[str, float], ...] = ()
     measurement_cause: MeasurementCause | None = None
 
+    def json_items(self) -> dict[str, Any]:
+        """The terms as :meth:`Certificate.as_dict` writes them (inf -> None): :data:`_TERM_KEYS` in order, then
+        disturbance_term and measurement_term where not 0, then friction_sign."""
+        out: dict[str, Any] = {name: finite_or_none(getattr(self, name)) for name in _TERM_KEYS}
+        if self.disturbance_term:
+            out["disturbance_term"] = finite_or_none(self.disturbance_term)
+        if self.measurement_term:
+            out["measurement_term"] = finite_or_none(self.measurement_term)
+        out["friction_sign"] = self.friction_sign
+        return out
 
-#: What the JSON has always written for a claim without section 4's terms (a law's box claim): these
-#: numbers are no claim of the law's; they keep the JSON's keys and values as they were.
+
+#: What the term properties of a claim without section 4's terms read (a law's box claim, the sampled-data
+#: certificate): placeholders, no claim of the law's; its JSON writes none of them (:meth:`Certificate.as_dict`).
 _NO_TERMS = SmallGainTerms(friction_term=math.nan, gyro_term=math.nan, friction_sign="none")
 
 #: The terms' keys in the JSON, in order (disturbance_term, measurement_term and friction_sign follow).
@@ -221,7 +232,8 @@ def _small_gain_value(name: str, doc: str) -> property:
 def _term(name: str) -> property:
     def get(self: Certificate) -> Any:
         return getattr(self.terms if self.terms is not None else _NO_TERMS, name)
-    return property(get, doc=f"``terms.{name}`` (:class:`SmallGainTerms`; a box claim's JSON placeholder without).")
+    return property(get, doc=f"``terms.{name}`` (:class:`SmallGainTerms`; a placeholder for a claim without them, "
+                             "which its JSON does not write).")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -238,6 +250,9 @@ class Certificate:
         reason: why there is no bound ('' when there is). iterations: the fixed point's iterations.
         inputs: what the claim rests on (:class:`ClaimInputs`; a mapping is taken as the law's inputs).
         claimant: whose claim it is (the controller's name; '' for the section-4 analysis of the run's law).
+        analysis: which analysis gave it, as the law names it ('section-4', 'boundary-layer', 'sampled-data';
+            '' where the law names none); not in the JSON, whose ``inputs['certificate']`` names the one a run
+            took where it computed two.
 
     ``E_max``, ``Edot_max`` and, for section 4's region, ``condition``, ``gamma1`` ... ``delta3`` read the
     region; ``friction_term`` ... ``friction_width`` read the terms.
@@ -256,6 +271,7 @@ class Certificate:
     iterations: int = 0
     inputs: ClaimInputs = field(default_factory=ClaimInputs, compare=False, hash=False)
     claimant: str = ""
+    analysis: str = field(default="", compare=False)
 
     def __post_init__(self) -> None:
         check_region(self.region)
@@ -330,29 +346,22 @@ class Certificate:
         return f"{'certified' if self.certified else 'uncertified'}-{where}"
 
     def as_dict(self) -> dict[str, Any]:
-        """JSON-ready (inf -> None): the Interface keys E_max, Edot_max, condition, valid,
-        assumptions [{name, met, value, limit, ...}], and the terms behind them."""
-        out: dict[str, Any] = {
-            "E_max": finite_or_none(self.E_max),
-            "Edot_max": finite_or_none(self.Edot_max),
-            "condition": finite_or_none(self.condition),
-            "valid": bool(self.valid),
-            "certified": self.certified,
-            "reason": self.reason,
-            "assumptions": [a.as_dict() for a in self.assumptions],
-            "unmet": list(self.unmet),
-        }
-        for name in ("gamma1", "gamma2", "delta1", "delta2", "delta3", "alpha_max", "voltage_max"):
+        """JSON-ready (inf -> None): the Interface keys E_max, Edot_max, valid, assumptions [{name, met, value,
+        limit, ...}], and what the claimant itself has: section 4's region writes condition and gamma1 ... delta3,
+        section 4's terms (:meth:`SmallGainTerms.json_items`) their keys and the regime; a claim without them (a box
+        claim, the sampled-data certificate, whose own terms are in its ``inputs``) writes none of them."""
+        small_gain = isinstance(self.region, SmallGainRegion)
+        out: dict[str, Any] = {"E_max": finite_or_none(self.E_max), "Edot_max": finite_or_none(self.Edot_max)}
+        if small_gain:  # section 4's region: (4.23) and the gains of (4.14), (4.18); no other claim has them
+            out["condition"] = finite_or_none(self.condition)
+        out.update(valid=bool(self.valid), certified=self.certified, reason=self.reason,
+                   assumptions=[a.as_dict() for a in self.assumptions], unmet=list(self.unmet))
+        for name in ("gamma1", "gamma2", "delta1", "delta2", "delta3") if small_gain else ():
             out[name] = finite_or_none(getattr(self, name))
-        terms = self.terms if self.terms is not None else _NO_TERMS
-        for name in _TERM_KEYS:
-            out[name] = finite_or_none(getattr(terms, name))
-        if terms.disturbance_term:
-            out["disturbance_term"] = finite_or_none(terms.disturbance_term)
-        if terms.measurement_term:
-            out["measurement_term"] = finite_or_none(terms.measurement_term)
-        out["friction_sign"] = terms.friction_sign
-        out["regime"] = _regime(self.terms)
+        out.update(alpha_max=finite_or_none(self.alpha_max), voltage_max=finite_or_none(self.voltage_max))
+        if self.terms is not None:  # section 4's terms; a claim without them writes none
+            out.update(self.terms.json_items())
+            out["regime"] = _regime(self.terms)
         out["iterations"] = int(self.iterations)
         out["vertices"] = [list(v) for v in self.vertices]
         out["inputs"] = _clean_inputs(self.inputs)

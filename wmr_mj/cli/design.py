@@ -157,10 +157,11 @@ def _print(result: Any, args: argparse.Namespace, out: dict[str, Any], wall: flo
               f"{paths}; {result.evaluations} certificates in {wall:.1f} s)")
         return
     tau = s["sensing"].filter_tau
-    if s["controller"] == "sliding-mode":
+    if result.law_parameters:  # the law's own parameters (controllers.base.DesignParameter), not the run's gains
         c = s["controller_params"]
-        law = (f"sliding mode lam = {c['lam']:.6g} 1/s, phi = {c['phi']:.6g} rad/s, k = {c['k']:.6g} V, eta = "
-               f"{c['eta']:.4g} V, sign width {c['friction_width']:.4g} rad/s")
+        law = (s["controller"].replace("-", " ") + " "
+               + ", ".join(f"{p.name} = {c[p.name]:{p.format}} {p.unit}" for p in result.law_parameters)
+               + f", sign width {c['friction_width']:.4g} rad/s")
     else:
         law = (f"K_P = {s['kp']:.6g} 1/s^2, K_D = {s['kd']:.6g} 1/s (omega_n {math.sqrt(s['kp']):.4g} rad/s, zeta "
                f"{s['kd'] / (2 * math.sqrt(s['kp'])):.3g}), sign width {s['friction_width']:.4g} rad/s")

@@ -18,6 +18,7 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
+from controllers.sampled_claim import MAX_SAMPLED_DELAY_PERIODS
 from wmr_mj._util.checks import finite_number, interval
 from wmr_mj.analysis.certificate import (
     GYRO_BAND,
@@ -50,7 +51,7 @@ from wmr_mj.sim.config import (
 )
 
 __all__ = ["certificate_for", "certificate_of", "claim_on_estimate", "identified_spread",
-           "box_spans", "outside_the_box", "reference_within"]
+           "box_spans", "outside_the_box", "reference_within", "certificate_name", "MAX_SAMPLED_DELAY_PERIODS"]
 
 
 def identified_spread(identified: Any) -> dict[str, tuple[float, float]]:
@@ -173,9 +174,10 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
 
     Measurement (``measurement``, :class:`~wmr_mj.analysis.measurement.MeasurementErrors`): None, the cart's own
     (:func:`measurement_errors_of` on config.sensing, actuation and transmission; exact on the ideal cart, every
-    number as before), and then, on a cart that is not ideal, the sampled-data certificate is computed beside the
-    law's own and the certified one with the smaller E_max taken (it is derived from the cart's parts, not from
-    summed bounds); given, those bounds in place of the cart's (a what-if), and the law's own claim alone. Handed
+    number as before), and then, on a cart that is not ideal, a law with a sampled-data analysis (the computed-torque
+    and sliding-mode laws and their subclasses) computes it beside its own claim and takes the certified one with the
+    smaller E_max (``ClaimContext.sampled_data``; it is derived from the cart's parts, not from summed bounds);
+    given, those bounds in place of the cart's (a what-if), and the law's continuous claim alone. Handed
     to the claim as ``ClaimContext.measurement``; the computed-torque, PD and sliding-mode claims absorb the
     bounds, and a claim that does not state the assumption 'sensing and actuation covered' gets it unmet
     (:func:`wmr_mj.analysis.claim.covers_measurement`).
@@ -279,7 +281,7 @@ def certificate_of(config: Any, reference: Any, *, base: C80Parameters, estimate
                            limits=PlantLimits(steering_range=plant.steering_range, voltage_limit=plant.voltage_limit),
                            control_period=period, initial_error=initial, stated=stated, estimate=estimate_params,
                            measurement=measurement, sensing=config.sensing, actuation_delay=config.actuation.delay,
-                           gear_ratio=plant.i2, play=config.transmission.backlash)
+                           gear_ratio=plant.i2, play=config.transmission.backlash, sampled_data=derived)
     try:
         cert = controller.claim(context)
     except Exception as exc:  # noqa: BLE001  (any error of a law's own claim: one line naming the law, before any step)
@@ -291,8 +293,6 @@ def certificate_of(config: Any, reference: Any, *, base: C80Parameters, estimate
         raise ParameterError(f"controller {controller.name!r}: claim() returned {type(cert).__name__}, not a "
                              "Certificate (see wmr_mj.analysis.claim.box_claim) or None")
     cert = covers_measurement(cert, measurement)
-    if derived:
-        cert = _with_sampled_data(cert, config, controller, context, plant)
     inputs = dict(cert.inputs)
     inputs.update(model=config.model, controller=controller.name, box_rule=config.box,
                   m1_range=list(config.m1_range), box_ranges={k: list(v) for k, v in ranges.items()},
@@ -302,81 +302,11 @@ def certificate_of(config: Any, reference: Any, *, base: C80Parameters, estimate
     return replace_inputs(cert, inputs)
 
 
-def own_certificate_name(controller_name: Any) -> str:
-    """The name of a law's own claim beside the sampled-data certificate: 'boundary-layer' for sliding mode,
-    'section-4' for the rest (the paper's family)."""
-    return "boundary-layer" if controller_name == "sliding-mode" else "section-4"
-
-
 def certificate_name(cert: Certificate) -> str:
-    """Which analysis gave ``cert``: ``inputs['certificate']`` where the run computed two
-    (:func:`_with_sampled_data`), else the law's own (:func:`own_certificate_name`)."""
-    inputs = cert.inputs
-    return str(inputs.get("certificate", own_certificate_name(inputs.get("controller"))))
-
-
-#: the longest delay, in control periods (sensing plus actuation), for which the sampled-data certificate is computed:
-#: its loop carries one state per period of delay, so a delay of seconds at a 1 ms period would cost minutes; far
-#: beyond the delay margin of any gains the designs use (64 periods for K_P = 100, K_D = 20 at 1 ms). A longer
-#: delay leaves section 4's certificate alone (no sampled-data bound is claimed: never a looser verdict).
-MAX_SAMPLED_DELAY_PERIODS = 256
-
-
-def _with_sampled_data(cert: Certificate, config: Any, controller: Any, context: ClaimContext,
-                       plant: C80Parameters) -> Certificate:
-    """The law's claim on a cart that is not ideal: section 4's (``cert``) or the sampled-data certificate
-    (:func:`wmr_mj.analysis.sampled_certificate.sampled_certificate`), whichever is certified with the smaller
-    E_max (a certified one before one that is not; section 4's on a tie). Computed for the computed-torque law
-    (the paper's family) and the sliding-mode law (its boundary layer as a sampled loop,
-    :func:`wmr_mj.analysis.sliding_sampled.sliding_sampled_certificate`, beside its continuous claim, named
-    'boundary-layer'); a claim on the ideal cart is ``cert``, untouched. The other one's E_max and reason are
-    recorded under ``inputs['certificates']``, and ``inputs['certificate']`` names the one taken.
-    """
-    name = getattr(controller, "name", None)
-    if context.measurement.is_exact or name not in ("computed-torque", "sliding-mode"):
-        return cert
-    from wmr_mj.analysis.certificate import Compensation, Estimate, Gains
-    from wmr_mj.analysis.sampled_certificate import SampledCart, sampled_certificate
-    from wmr_mj.analysis.sliding_sampled import sliding_sampled_certificate
-
-    own = own_certificate_name(name)  # the law's claim as it is today
-    c = controller.model.coefficients
-    sign = controller.friction_sign
-    estimate = Estimate(P=c.P, C_V=c.C_V, F=0.0 if sign == "none" else c.F, K=c.K, gyro=c.gyro,
-                        V_A=controller.model.V_A)
-    play = config.transmission.backlash if config.sensing.reads_motor_side else 0.0
-    try:
-        cart = SampledCart.of(config.sensing, control_period=context.control_period, gear_ratio=plant.i2, play=play,
-                              actuation_delay_s=config.actuation.delay, measurement=context.measurement)
-        delay_periods = cart.sensing_delay + cart.actuation_delay
-        if delay_periods > MAX_SAMPLED_DELAY_PERIODS:  # a state per period of delay: its matrices grow as d^2
-            raise ParameterError(f"not computed: a delay of {delay_periods} control periods is beyond the "
-                                 f"{MAX_SAMPLED_DELAY_PERIODS} the sampled-data certificate evaluates")
-        compensation = Compensation(friction_sign=sign, friction_width=controller.friction_width)
-        if name == "sliding-mode":  # its layer as a sampled loop (wmr_mj.analysis.sliding_sampled)
-            sampled = sliding_sampled_certificate(plant=context.plant, estimate=estimate, lam=controller.lam,
-                                                  phi=controller.phi, k=controller.k, reference=context.reference,
-                                                  limits=context.limits, compensation=compensation,
-                                                  control_period=context.control_period, cart=cart,
-                                                  initial_error=context.initial_error, stated=context.stated)
-        else:
-            sampled = sampled_certificate(plant=context.plant, estimate=estimate, gains=Gains(kp=controller.kp,
-                                          kd=controller.kd), reference=context.reference, limits=context.limits,
-                                          compensation=compensation, control_period=context.control_period,
-                                          cart=cart, initial_error=context.initial_error, stated=context.stated)
-    except ParameterError as exc:  # e.g. an actuation delay that is not a whole number of control periods
-        return replace_inputs(cert, {**dict(cert.inputs), "certificate": own,
-                                     "certificates": {"sampled-data": {"E_max": None, "reason": str(exc)}}})
-
-    def rank(c: Certificate) -> tuple[bool, float]:
-        return (not c.certified, c.E_max if c.valid else math.inf)
-
-    taken = sampled if rank(sampled) < rank(cert) else cert
-    record = {own if c is cert else "sampled-data": {"E_max": c.E_max if c.valid else None,
-                                                     "certified": c.certified, "reason": c.reason}
-              for c in (cert, sampled)}
-    return replace_inputs(taken, {**dict(taken.inputs), "certificate": "sampled-data" if taken is sampled
-                                  else own, "certificates": record})
+    """Which analysis gave ``cert``: ``inputs['certificate']`` where the run computed two (the law's claim beside
+    the sampled-data certificate, :func:`controllers.sampled_claim.with_sampled_data`), else the analysis the law
+    named (:attr:`Certificate.analysis`: 'section-4', 'boundary-layer'), 'section-4' where it named none."""
+    return str(cert.inputs.get("certificate", cert.analysis or "section-4"))
 
 
 def _plant_box(config: Any, base: C80Parameters, estimate_params: C80Parameters,

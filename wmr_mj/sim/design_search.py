@@ -62,8 +62,6 @@ DEFAULT_BUDGET = 600
 #: the RunConfig settings a design file sets (``run --design FILE``), as a preset does
 DESIGN_FIELDS = ("controller", "controller_params", "model", "kp", "kd", "friction_sign", "friction_width",
                  "control_period", "sensing", "actuation", "transmission")
-#: the sliding-mode law's searched parameters, in the point's order (each in log)
-SLIDING_PARAMETERS = ("lam", "phi", "k", "eta")
 #: the file's format tag and version
 FORMAT = "wmr-mj design"
 PENALTY = 1.0e6  # an uncertified point's score: above every feasible one (plus its number of unmet assumptions)
@@ -121,6 +119,8 @@ class DesignResult:
         box: what the certificates were computed for besides the design (m1_range, box_ranges, box,
             reference_bounds, duration): the run options a run needs to compute the same certificate.
         cart: the cart searched on, as its config records it (name, version, path, the file's text); None: the C80.
+        law_parameters: the law's own parameters the search varied (``controllers.base.DesignParameter``, the
+            law's ``design_parameters``); (): its gains K_P, K_D.
         objective, seed, periods, paths: the search's.
     """
 
@@ -136,6 +136,7 @@ class DesignResult:
     paths: tuple[str, ...] = ()
     box: Mapping[str, Any] | None = None
     cart: Mapping[str, Any] | None = None
+    law_parameters: tuple[Any, ...] = ()
 
     @property
     def E_max(self) -> float:
@@ -239,7 +240,12 @@ class _Scorer:
         self.template = dataclasses.replace(problem.base, control_period=period)
         self.parts = {path: resolve_run(dataclasses.replace(self.template, path=path)) for path in problem.paths}
         self.filtered = self.template.sensing.velocity == "filtered"
-        self.sliding = self.template.controller == "sliding-mode"
+        law = type(next(iter(self.parts.values())).controller)
+        #: the law's own parameters searched (controllers.base.DesignParameter; (): its gains as omega_n, zeta),
+        #: whether an uncertified point is graded, and the law's keyword defaults (the search's start)
+        self.law_parameters: tuple[str, ...] = tuple(p.name for p in law.design_parameters)
+        self.graded = bool(law.design_graded)
+        self.law_defaults = law.__init__.__kwdefaults__ or {}
         self.evaluations = 0
 
     def bounds(self, period: float) -> list[tuple[float, float]]:
@@ -247,8 +253,8 @@ class _Scorer:
         log tau_f where the estimate is filtered."""
         p = self.problem
         width = (math.log10(p.width[0]), math.log10(p.width[1]))
-        if self.sliding:
-            out = [(math.log(lo), math.log(hi)) for lo, hi in (p.lam, p.phi, p.k, p.eta)] + [width]
+        if self.law_parameters:
+            out = [(math.log(lo), math.log(hi)) for lo, hi in (getattr(p, n) for n in self.law_parameters)] + [width]
         else:
             out = [(math.log(p.omega_n[0]), math.log(p.omega_n[1])), p.zeta, width]
         if self.filtered:
@@ -260,9 +266,9 @@ class _Scorer:
         sensing = self.template.sensing
         if self.filtered:
             sensing = dataclasses.replace(sensing, filter_tau=math.exp(x[-1]))
-        if self.sliding:
-            params: dict[str, Any] = {n: math.exp(float(v)) for n, v in zip(SLIDING_PARAMETERS, x)}
-            params.update(friction_sign="measured", friction_width=10.0 ** float(x[4]))
+        if self.law_parameters:
+            params: dict[str, Any] = {n: math.exp(float(v)) for n, v in zip(self.law_parameters, x)}
+            params.update(friction_sign="measured", friction_width=10.0 ** float(x[len(self.law_parameters)]))
             return dataclasses.replace(self.template, controller_params=params, sensing=sensing)
         kp, kd = _gains(math.exp(x[0]), float(x[1]))
         return dataclasses.replace(self.template, kp=kp, kd=kd, friction_width=10.0 ** float(x[2]), sensing=sensing)
@@ -281,7 +287,7 @@ class _Scorer:
         return out
 
     def __call__(self, x: Any) -> float:
-        return score(self.certificates(self.config(x)), self.problem.objective, graded=self.sliding)
+        return score(self.certificates(self.config(x)), self.problem.objective, graded=self.graded)
 
 
 def _margin(cert: Any) -> float:
@@ -331,11 +337,9 @@ def _preset_point(scorer: _Scorer, bounds: list[tuple[float, float]]) -> list[fl
     sliding mode the law's defaults with the narrowest width (module docstring)."""
     from wmr_mj.sim.designs import CERTIFIED
 
-    if scorer.sliding:
-        from controllers.sliding_mode import SlidingMode
-
-        defaults = SlidingMode.__init__.__kwdefaults__ or {}
-        x = [math.log(float(defaults[n])) for n in SLIDING_PARAMETERS] + [bounds[4][0]]
+    if scorer.law_parameters:
+        own = scorer.law_parameters
+        x = [math.log(float(scorer.law_defaults[n])) for n in own] + [bounds[len(own)][0]]
     else:
         omega_n = math.sqrt(CERTIFIED.kp)
         x = [math.log(omega_n), CERTIFIED.kd / (2.0 * omega_n), math.log10(CERTIFIED.friction_width)]
@@ -413,15 +417,22 @@ def _cma(scorer: _Scorer, bounds: list[tuple[float, float]], problem: DesignProb
 
 def evaluate_design(config: Any, paths: Sequence[str]) -> dict[str, Any]:
     """Each path's certificate of ``config`` as ``wmr-mj run`` computes it (``resolve_run(...).claim``)."""
+    return {path: parts.claim for path, parts in _resolved(config, paths).items()}
+
+
+def _resolved(config: Any, paths: Sequence[str]) -> dict[str, Any]:
+    """Each path's :class:`~wmr_mj.sim.parts.RunParts` of ``config``, as ``wmr-mj run`` resolves it."""
     from wmr_mj.sim.parts import resolve_run
 
-    return {path: resolve_run(dataclasses.replace(config, path=path)).claim for path in paths}
+    return {path: resolve_run(dataclasses.replace(config, path=path)) for path in paths}
 
 
 def _finish(problem: DesignProblem, config: Any, found: float, evaluations: int,
             periods: tuple[float, ...]) -> DesignResult:
-    certificates = evaluate_design(config, problem.paths)
-    value = score(certificates, problem.objective, graded=problem.base.controller == "sliding-mode")
+    resolved = _resolved(config, problem.paths)
+    certificates = {path: parts.claim for path, parts in resolved.items()}
+    law = type(next(iter(resolved.values())).controller)
+    value = score(certificates, problem.objective, graded=law.design_graded)
     if value != found:  # the search's certificate is the run's: a difference is a bug, never rounded away
         raise RuntimeError(f"design: the search scored {found!r} but the run's certificate gives {value!r}")
     settings = {name: getattr(config, name) for name in DESIGN_FIELDS}
@@ -431,7 +442,8 @@ def _finish(problem: DesignProblem, config: Any, found: float, evaluations: int,
            "duration": config.duration}
     return DesignResult(box=box, settings=settings, certified=value < PENALTY, score=value, certificates=certificates,
                         binding=binding_of(certificates), evaluations=evaluations, objective=problem.objective,
-                        seed=problem.seed, periods=periods, paths=problem.paths, cart=config.cart)
+                        seed=problem.seed, periods=periods, paths=problem.paths, cart=config.cart,
+                        law_parameters=law.design_parameters)
 
 
 def design_lines(result: DesignResult) -> list[str]:
@@ -440,9 +452,9 @@ def design_lines(result: DesignResult) -> list[str]:
     from wmr_mj.sim.notebook import number
 
     s = result.settings
-    if s["controller"] == "sliding-mode":
-        law = "sliding mode " + ", ".join(f"{k} = {number(v)}" for k, v in s["controller_params"].items()
-                                          if isinstance(v, float))
+    if result.law_parameters:  # the law's own parameters (controller_params), not the run's gains
+        law = s["controller"].replace("-", " ") + " " + ", ".join(
+            f"{k} = {number(v)}" for k, v in s["controller_params"].items() if isinstance(v, float))
     else:
         law = f"computed torque K_P = {number(s['kp'], '1/s^2')}, K_D = {number(s['kd'], '1/s')}, " \
               f"sign width {number(s['friction_width'], 'rad/s')}"
@@ -472,7 +484,7 @@ def design_dict(result: DesignResult) -> dict[str, Any]:
     """The design file's content: the settings (the cart's parts as their spec mappings), the certificate of
     each path, the search."""
     s = dict(result.settings)
-    if s["controller"] == "sliding-mode":  # its parameters are the law's own (--controller-param), kp/kd unused
+    if result.law_parameters:  # its parameters are the law's own (--controller-param), kp/kd unused
         params = dict(s["controller_params"])
         settings = {"controller": s["controller"], "model": s["model"], "kp": None, "kd": None,
                     "friction_sign": params.pop("friction_sign"), "friction_width": params.pop("friction_width"),

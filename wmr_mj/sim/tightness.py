@@ -103,16 +103,17 @@ def certificate_columns(cert: Any) -> dict[str, Any]:
     """
     if cert is None:
         return {"certificate": "", "certified": False, "E_max": None, "E_max_section4": None, "E_max_sampled": None}
-    from wmr_mj.sim.certify import certificate_name, own_certificate_name
+    from wmr_mj.sim.certify import certificate_name
 
     e_max = float(cert.E_max) if cert.valid and math.isfinite(cert.E_max) else None
     both = cert.inputs.get("certificates")
     if both is None:  # the law's own claim alone (the ideal cart, or a law with no sampled-data certificate)
         return {"certificate": certificate_name(cert), "certified": bool(cert.certified), "E_max": e_max,
                 "E_max_section4": e_max, "E_max_sampled": None}
-    own = own_certificate_name(cert.inputs.get("controller"))  # section 4's, or sliding mode's boundary layer
+    # the law's own (section 4's, or sliding mode's boundary layer): the one beside the sampled-data certificate
+    own: dict[str, Any] = next((record for name, record in both.items() if name != "sampled-data"), {})
     return {"certificate": certificate_name(cert), "certified": bool(cert.certified), "E_max": e_max,
-            "E_max_section4": both.get(own, {}).get("E_max", e_max),
+            "E_max_section4": own.get("E_max", e_max),
             "E_max_sampled": both.get("sampled-data", {}).get("E_max")}
 
 

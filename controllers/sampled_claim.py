@@ -1,0 +1,81 @@
+"""A law's sampled-data certificate beside its continuous claim: the cart it is computed on, and the pair judged.
+
+On a cart that is not ideal (``ClaimContext.wants_sampled_data``), the computed-torque and sliding-mode laws
+compute, beside their continuous claim (section 4's, the boundary layer), the sampled-data certificate of their
+loop on the cart's own parts (:mod:`wmr_mj.analysis.sampled_certificate`, :mod:`wmr_mj.analysis.sliding_sampled`),
+and claim the certified one with the smaller E_max (:func:`wmr_mj.analysis.claim.best_certificate`). A subclass
+inherits its parent's pair with its :meth:`~controllers.base.SteeringController.claim`.
+
+Usage::
+
+    from controllers.sampled_claim import with_sampled_data
+    def claim(self, context):
+        own = ...                                          # the continuous claim
+        return with_sampled_data(own, "section-4", context,
+                                 lambda cart: sampled_certificate(..., cart=cart))
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable
+
+from wmr_mj.analysis.claim import SAMPLED_DATA_NAME, ClaimContext, best_certificate, covers_measurement
+from wmr_mj.analysis.claim_types import Certificate
+from wmr_mj.analysis.sampled_certificate import SampledCart
+from wmr_mj.errors import ParameterError
+
+__all__ = ["MAX_SAMPLED_DELAY_PERIODS", "sampled_cart", "with_sampled_data", "named"]
+
+#: the longest delay, in control periods (sensing plus actuation), for which the sampled-data certificate is computed:
+#: its loop carries one state per period of delay, so a delay of seconds at a 1 ms period would cost minutes; far
+#: beyond the delay margin of any gains the designs use (64 periods for K_P = 100, K_D = 20 at 1 ms). A longer
+#: delay leaves the continuous claim alone (no sampled-data bound is claimed: never a looser verdict).
+MAX_SAMPLED_DELAY_PERIODS = 256
+
+
+def sampled_cart(context: ClaimContext) -> SampledCart:
+    """The run's cart as the sampled-data certificate takes it (:meth:`SampledCart.of`): the sensing, the control
+    period, the gear ratio, the play where the encoder reads the motor side, the actuation delay, the coverage.
+
+    Raises:
+        ParameterError: a delay that is not a whole number of control periods, or one longer than
+            :data:`MAX_SAMPLED_DELAY_PERIODS`.
+    """
+    sensing = context.sensing
+    play = context.play if sensing.reads_motor_side else 0.0
+    assert context.gear_ratio is not None  # ClaimContext sets it (the estimate's i2 where none is given)
+    cart = SampledCart.of(sensing, control_period=context.control_period, gear_ratio=context.gear_ratio, play=play,
+                          actuation_delay_s=context.actuation_delay, measurement=context.measurement)
+    delay_periods = cart.sensing_delay + cart.actuation_delay
+    if delay_periods > MAX_SAMPLED_DELAY_PERIODS:  # a state per period of delay: its matrices grow as d^2
+        raise ParameterError(f"not computed: a delay of {delay_periods} control periods is beyond the "
+                             f"{MAX_SAMPLED_DELAY_PERIODS} the sampled-data certificate evaluates")
+    return cart
+
+
+def named(cert: Certificate, analysis: str) -> Certificate:
+    """``cert`` with the name of the analysis that gave it (:attr:`Certificate.analysis`)."""
+    return dataclasses.replace(cert, analysis=analysis)
+
+
+def with_sampled_data(own: Certificate, own_name: str, context: ClaimContext,
+                      sampled: Callable[[SampledCart], Certificate]) -> Certificate:
+    """The law's claim: ``own`` (named ``own_name``) alone where the run asks for no sampled-data analysis, else
+    the better of ``own`` and ``sampled(cart)`` (:func:`wmr_mj.analysis.claim.best_certificate`; ``own`` with the
+    reason where the cart cannot be evaluated).
+
+    Args:
+        own: the law's continuous claim. own_name: its name ('section-4', 'boundary-layer').
+        context: the run's (:class:`~wmr_mj.analysis.claim.ClaimContext`).
+        sampled: the sampled-data certificate of the law's loop on a cart (:func:`sampled_cart`).
+    """
+    own = named(own, own_name)
+    if not context.wants_sampled_data:
+        return own
+    own = covers_measurement(own, context.measurement)
+    try:
+        cert = named(sampled(sampled_cart(context)), SAMPLED_DATA_NAME)
+    except ParameterError as exc:  # e.g. an actuation delay that is not a whole number of control periods
+        return best_certificate(own, own_name, str(exc))
+    return best_certificate(own, own_name, cert)
