@@ -19,15 +19,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from controllers import SteeringController
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.sim.config import RunConfig, estimate_of
 from wmr_mj.sim.search_space import hardware_axis, path_axis, signal_axis
-
-if TYPE_CHECKING:
-    from wmr_mj.sim.falsify import FalsifySpec
 
 __all__ = ["OBJECTIVES", "OBJECTIVE_LABELS", "objective_value", "objective_source", "check_objective_applies",
            "check_objective_defined", "shares_the_base_certificate", "verdict_of"]
@@ -98,13 +95,14 @@ def shares_the_base_certificate(base: RunConfig, names: Sequence[str]) -> bool:
     return not any(hardware_axis(n) or signal_axis(n) or path_axis(n) or n in reaching for n in names)
 
 
-def check_objective_defined(parts: Any, spec: FalsifySpec) -> None:
+def check_objective_defined(parts: Any, spec: Any) -> None:
     """Refuse, before any step, a search whose objective is undefined for every run: the certificate's
     ratio where the base's certificate has no finite bound and every run shares it
     (:func:`shares_the_base_certificate`); ``run`` knows this before it steps, and so does falsify.
 
     Args:
-        parts: ``spec.base`` resolved (:func:`check_runnable`).
+        parts: ``spec.base`` resolved (:func:`wmr_mj.sim.falsify.check_runnable`).
+        spec: the search (a :class:`wmr_mj.sim.falsify.FalsifySpec`): its objective, base and names.
 
     Raises:
         ParameterError: one line naming why there is no bound and what to search instead.

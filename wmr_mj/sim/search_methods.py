@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Generator
 
 import numpy as np
 
@@ -241,10 +241,6 @@ def covering_design(d: int, runs: int, rng: np.random.Generator | None = None) -
     return (design + 1.0) / 2.0
 
 
-class _BudgetSpent(Exception):
-    """The local optimiser asked for more runs than the budget has left."""
-
-
 
 def search_optimiser(bounds: np.ndarray, *, budget: int, seed: int = 0, population: int | None = None,
                      method: str = "portfolio") -> Optimiser:
@@ -285,6 +281,10 @@ def random_worst(evaluate: Callable[[np.ndarray], np.ndarray], bounds: np.ndarra
     return drive(Points(points), evaluate, maximise=True)
 
 
+#: a strategy's sub-step: yields one batch, receives its told values, returns the values (maximised)
+_Evaluated = Generator[np.ndarray, np.ndarray, np.ndarray]
+
+
 class _BudgetSpent(Exception):
     """The local optimiser asked for more runs than the budget has left."""
 
@@ -312,13 +312,13 @@ def _search_vertices_polish(bounds: np.ndarray, *, budget: int, seed: int = 0, f
     d = len(bounds)
     check_budget(budget, MIN_POPULATION)
 
-    def steps() -> StepsGenerator:
+    def strategy() -> StepsGenerator:
         rng = np.random.default_rng(np.random.SeedSequence(seed).spawn(4)[3])
         lo, span = bounds[:, 0], bounds[:, 1] - bounds[:, 0]
         seen: dict[tuple[float, ...], float] = {}  # unit-box point -> its value (maximised)
         spent = 0
 
-        def run(unit: np.ndarray) -> StepsGenerator:
+        def run(unit: np.ndarray) -> _Evaluated:
             """Evaluate unit-box points (rows) not seen before, within the budget; values of all."""
             nonlocal spent
             unit = np.clip(np.atleast_2d(np.asarray(unit, dtype=float)), 0.0, 1.0)
@@ -360,7 +360,7 @@ def _search_vertices_polish(bounds: np.ndarray, *, budget: int, seed: int = 0, f
             finally:
                 polish.close()
 
-    return Steps(steps)
+    return Steps(strategy)
 
 
 def _search_cma(bounds: np.ndarray, *, budget: int, seed: int = 0, population: int | None = None,
@@ -400,7 +400,7 @@ def _search_cma(bounds: np.ndarray, *, budget: int, seed: int = 0, population: i
     lam0 = cma_population(d) if population is None else population
     check_budget(budget, lam0, what="CMA-ES")
 
-    def steps() -> StepsGenerator:
+    def strategy() -> StepsGenerator:
         rng = np.random.default_rng(np.random.SeedSequence(seed).spawn(5)[4])
         lo, span = bounds[:, 0], bounds[:, 1] - bounds[:, 0]
         n = max(d, 2)
@@ -408,7 +408,7 @@ def _search_cma(bounds: np.ndarray, *, budget: int, seed: int = 0, population: i
         values: list[np.ndarray] = []  # their values (maximised)
         spent = 0
 
-        def run(unit: np.ndarray) -> StepsGenerator:  # a coordinate at 1 is the upper bound itself, not lo + span
+        def run(unit: np.ndarray) -> _Evaluated:  # a coordinate at 1 is the upper bound itself, not lo + span
             nonlocal spent
             unit_points.append(unit)
             v = -(yield np.where(unit[:, :d] >= 1.0, bounds[:, 1], lo + unit[:, :d] * span))  # told minus them
@@ -463,7 +463,7 @@ def _search_cma(bounds: np.ndarray, *, budget: int, seed: int = 0, population: i
             xs[:, :d] += np.where(moved, PORTFOLIO_COORDINATE_STEP * rng.standard_normal((k, d)), 0.0)
             yield from run(np.clip(xs, 0.0, 1.0))
 
-    return Steps(steps)
+    return Steps(strategy)
 
 
 def _search_de(bounds: np.ndarray, *, budget: int, seed: int = 0, population: int | None = None) -> Optimiser:
