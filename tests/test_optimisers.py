@@ -97,7 +97,7 @@ def test_the_loop_records_every_batch_and_the_best_in_either_sense():
             super().tell(values)
 
     drive(Recorder([[0.0, 0.0, 0.0]]), rosen, maximise=True)
-    assert told[0].tolist() == [-2.0]  # Rosenbrock at 0 is 2; the optimisers minimise: a maximised value is told negated
+    assert told[0].tolist() == [-2.0]  # Rosenbrock at 0 is 2: the optimisers minimise, a maximum is told negated
 
 
 def test_an_evaluate_that_returns_the_wrong_number_of_values_is_refused():
