@@ -47,7 +47,10 @@ generation (differential evolution's or CMA-ES's population) is refused before a
 Where the objective is the certificate's ratio, :attr:`FalsifyResult.tightness` sets the worst
 found (a lower bound on the worst case) beside the certificate's E_max (an upper bound): "the worst
 found is X of the certificate's bound: the certificate is 1/X times the worst case found"; where X
-exceeds 1, "the worst run is X times the claimed bound: the claim is exceeded".
+exceeds 1, "the worst run is X times the claimed bound: the claim is exceeded". Whatever the objective, the
+worst run carries its certificate: :attr:`WorstRun.E_max`, :attr:`WorstRun.binding_term` (the largest part of
+its delta1) and the tightness of that run's certificate (for another objective, the worst run is that
+objective's, and the sentence says so).
 
 Whatever the objective, a run of either phase that is ``certified-outside`` breaks the law's claim:
 :attr:`FalsifyResult.claim_broken` names the one that breaks it most (its parameters), and
@@ -103,6 +106,8 @@ from wmr_mj.sim.config import RunConfig
 from wmr_mj.sim.falsify_objectives import (
     OBJECTIVE_LABELS,
     OBJECTIVES,
+    binding_term,
+    certificate_E_max,
     check_objective_applies,
     check_objective_defined,
     objective_source,
@@ -151,6 +156,7 @@ __all__ = [
     "WorstRun",
     "RandomWorst",
     "Tightness",
+    "BindingTerm",
     "BrokenRun",
     "Evaluation",
     "Trace",
@@ -321,11 +327,26 @@ class Evaluation:
 
 
 @dataclass(frozen=True, kw_only=True)
+class BindingTerm(Record):
+    """The largest part of delta1 of a run's certificate, the term that binds its E_max most
+    (:func:`wmr_mj.sim.falsify_objectives.binding_term`).
+
+    Attributes:
+        name: the term's name in the certificate's JSON (``friction_term``, ``gyro_term``, ``K_term``, ...).
+        value: its value [rad/s^2].
+    """
+
+    name: str
+    value: float
+
+
+@dataclass(frozen=True, kw_only=True)
 class Tightness(Record):
     """How tight the certificate is (:attr:`FalsifyResult.tightness`).
 
     Attributes:
-        ratio: the worst objective found, sup|E|/E_max of the certificate [-] (a lower bound on the worst case).
+        ratio: sup|E|/E_max of the worst run's certificate [-] (where the objective is that ratio, the worst
+            objective found: a lower bound on the worst case).
         factor: 1/ratio, how many times the worst case found the certificate is (inf where ratio <= 0).
         found_sup_E: the worst run's sup|E| [rad].
         E_max: the certificate's E_max [rad] (an upper bound); None where the run has none.
@@ -342,10 +363,11 @@ class Tightness(Record):
 @dataclass(frozen=True, kw_only=True)
 class WorstRun(Record):
     """The search's worst run (``falsify --json``'s ``worst``): its parameters, objective, sup|E| [rad],
-    sup|E'| [rad/s], verdict, generation and index (0-based in the search), and the claim's assumptions it
-    does not meet."""
+    sup|E'| [rad/s], verdict, generation and index (0-based in the search), the claim's assumptions it
+    does not meet, and its certificate, whatever the objective: its E_max [rad] (None where the run has none)
+    and the largest term of its delta1 (:class:`BindingTerm`; None where it has none)."""
 
-    _records = {"unmet": UnmetAssumption}
+    _records = {"unmet": UnmetAssumption, "binding_term": BindingTerm}
 
     params: Mapping[str, float]
     objective: float | None
@@ -355,6 +377,8 @@ class WorstRun(Record):
     generation: int
     index: int
     unmet: tuple[UnmetAssumption, ...]
+    E_max: float | None = None
+    binding_term: BindingTerm | None = None
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -389,7 +413,8 @@ class FalsifyReport(Record):
         claim_broken: the run that breaks the claim most; None when none does.
         box: each ranged parameter -> (lo, hi).
         worst: the search's worst run.
-        tightness: how tight the certificate is, where the objective is its ratio; else None.
+        tightness: how tight the worst run's certificate is, whatever the objective; None where the objective is
+            not the certificate's ratio and that run has no certificate.
         random: the random sample's worst run.
         log: the MCAP log of the worst run's re-run; None where not written.
     """
@@ -470,27 +495,33 @@ class FalsifyResult:
 
     @property
     def tightness(self) -> Tightness | None:
-        """How tight the certificate is, where the objective is its ratio sup|E|/E_max: the worst
-        found (a lower bound on the worst case: a run reached it) beside the certificate's E_max (an
-        upper bound), their ratio X and 1/X, and the sentence falsify prints. None for other objectives."""
-        if self.spec.objective != "certificate":
-            return None
+        """How tight the certificate is, whatever the objective: the worst run's sup|E| (where the objective is
+        the certificate's ratio, the worst found: a lower bound on the worst case, a run reached it) beside its
+        certificate's E_max (an upper bound), their ratio X and 1/X, and the sentence falsify prints. Where the
+        objective is another, the worst run is that objective's, and the sentence says so; None where that run
+        has no certificate."""
         w = self.worst
-        certificate = w.summary.get("certificate")
-        e_max = certificate.get("E_max") if isinstance(certificate, Mapping) else None
-        x = w.objective
+        e_max = certificate_E_max(w.summary)
+        if self.spec.objective == "certificate":
+            x = w.objective
+        elif e_max is None:
+            return None
+        else:
+            x = objective_value(w.summary, "certificate")
         factor = 1.0 / x if x is not None and x > 0 else math.inf
-        bound = "n/a" if e_max is None else f"{float(e_max):.4g}"
+        bound = "n/a" if e_max is None else f"{e_max:.4g}"
         if x is not None and x > 1.0:  # exceeded: said as such, never as a fraction of the worst case
             text = (f"the worst run is {x:.3g} times the claimed bound (sup|E| = {w.sup_E:.4g} rad found, <= "
                     f"{bound} rad claimed): the claim is exceeded"
                     + (" and its assumptions hold: CERTIFIED-OUTSIDE" if w.verdict == CERTIFIED_OUTSIDE else
                        f" where its assumptions are not all met ({w.verdict}): not a broken claim"))
         else:
-            text = (f"the worst found is {x:.4g} of the certificate's bound: the certificate is {factor:.3g} times "
-                    f"the worst case found (sup|E| >= {w.sup_E:.4g} rad found, <= {bound} rad certified)")
-        return Tightness(ratio=x, factor=factor, found_sup_E=w.sup_E, E_max=None if e_max is None else float(e_max),
-                         text=text)
+            text = (f"the worst found is {_number(x, '.4g')} of the certificate's bound: the certificate is "
+                    f"{factor:.3g} times the worst case found (sup|E| >= {w.sup_E:.4g} rad found, <= {bound} rad "
+                    "certified)")
+        if self.spec.objective != "certificate":
+            text += f" (the worst run by {OBJECTIVE_LABELS[self.spec.objective]})"
+        return Tightness(ratio=x, factor=factor, found_sup_E=w.sup_E, E_max=e_max, text=text)
 
     @property
     def claim_broken(self) -> BrokenRun | None:
@@ -527,6 +558,7 @@ class FalsifyResult:
     def report(self, *, log: str | None = None) -> FalsifyReport:
         """What the search found, typed (``log``: the worst run's MCAP log, where written)."""
         w, r = self.worst, self.random_worst
+        binding = binding_term(w.summary)
         return FalsifyReport(
             objective=self.spec.objective, objective_label=OBJECTIVE_LABELS[self.spec.objective],
             objective_source=self.objective_source, budget=self.spec.budget, evaluations=len(self.search),
@@ -537,7 +569,9 @@ class FalsifyResult:
             worst=WorstRun(params=dict(w.params), objective=w.objective, sup_E=w.sup_E, sup_Edot=w.sup_Edot,
                            verdict=w.verdict, generation=w.generation, index=w.index,
                            unmet=tuple(UnmetAssumption.from_dict(a)
-                                       for a in unmet_assumptions(w.summary.get("certificate")))),
+                                       for a in unmet_assumptions(w.summary.get("certificate"))),
+                           E_max=certificate_E_max(w.summary),
+                           binding_term=None if binding is None else BindingTerm(name=binding[0], value=binding[1])),
             tightness=self.tightness,
             random=RandomWorst(worst_objective=r.objective, worst_params=dict(r.params), evaluations=len(self.random),
                                sup_E=r.sup_E, verdict=r.verdict),
@@ -668,6 +702,10 @@ def check_runnable(base: RunConfig) -> Any:
     from wmr_mj.sim.parts import resolve_run
 
     return resolve_run(base)
+
+
+def _number(x: float | None, spec: str) -> str:
+    return "n/a" if x is None else format(x, spec)
 
 
 def worst_config(result: FalsifyResult) -> RunConfig:

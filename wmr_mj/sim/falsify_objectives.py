@@ -6,8 +6,8 @@ any run, an objective that says nothing of the run's controller or is undefined 
 - ``sup-E``: sup|E| itself, rad;
 - ``requirement``: minus the robustness of an STL requirement (> 0: falsified).
 
-Whatever the objective, a run's certificate is read the same way (:func:`certificate_of_run`): its E_max,
-its ratio and the largest term of its delta1 (:func:`binding_term`), which falsify's worst run carries.
+Whatever the objective, a run's certificate is read the same way: its E_max (:func:`certificate_E_max`) and the
+largest term of its delta1 (:func:`binding_term`), which falsify's worst run carries.
 
 Usage::
 
@@ -27,7 +27,7 @@ from wmr_mj.sim.config import RunConfig, estimate_of
 from wmr_mj.sim.search_space import hardware_axis, path_axis, signal_axis
 
 __all__ = ["OBJECTIVES", "OBJECTIVE_LABELS", "objective_value", "objective_source", "check_objective_applies",
-           "check_objective_defined", "shares_the_base_certificate", "verdict_of"]
+           "check_objective_defined", "shares_the_base_certificate", "verdict_of", "certificate_E_max", "binding_term"]
 
 OBJECTIVES = ("certificate", "paper", "sup-E", "requirement")
 OBJECTIVE_LABELS = {"certificate": "sup|E|/E_max of the certificate", "paper": "sup|E|/E_max of the paper's region",
@@ -141,3 +141,30 @@ def verdict_of(summary: Mapping[str, Any]) -> str:
     if verdict is not None:
         return str(verdict)
     return "inside" if summary.get("inside") else "outside"
+
+
+def certificate_E_max(summary: Mapping[str, Any]) -> float | None:
+    """The E_max [rad] of a run's certificate (its summary's ``certificate``); None where the run has none."""
+    certificate = summary.get("certificate")
+    e_max = certificate.get("E_max") if isinstance(certificate, Mapping) else None
+    return None if e_max is None else float(e_max)
+
+
+def binding_term(summary: Mapping[str, Any]) -> tuple[str, float] | None:
+    """The largest part of delta1 [rad/s^2] of a run's certificate, the term that binds its E_max most, as
+    (its JSON name, its value): among the ``*_term`` parts at the certificate's top level (section 4's) or, where
+    none of those is above 0, under its ``inputs.terms`` (the sampled-data certificate's); gyro_Edot_term, a part
+    of delta3 [1/s], is not one. The first of equals; None where the run has no certificate or no term above 0."""
+    certificate = summary.get("certificate")
+    if not isinstance(certificate, Mapping):
+        return None
+    inputs = certificate.get("inputs")
+    nested = inputs.get("terms") if isinstance(inputs, Mapping) else None
+    for terms in (certificate, nested if isinstance(nested, Mapping) else {}):
+        parts = {name: float(v) for name, v in terms.items()
+                 if name.endswith("_term") and name != "gyro_Edot_term" and isinstance(v, (int, float))
+                 and not isinstance(v, bool) and math.isfinite(v)}
+        if parts and max(parts.values()) > 0.0:
+            name = max(parts, key=lambda n: parts[n])  # max keeps the first of equals
+            return name, parts[name]
+    return None
