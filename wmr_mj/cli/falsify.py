@@ -207,18 +207,18 @@ def run(args: argparse.Namespace) -> int:
     warning = undefined_objective_warning(result)  # runs left blank by the objective: said, on stderr
     if warning is not None:
         print(warning, file=sys.stderr, flush=True)
-    summary, logged_sup_E = _write_outputs(result, args, out, law_settings=parts.law_settings)
+    summary, logged_sup_E = _write_outputs(result, base, args, out, law_settings=parts.law_settings)
     if args.json:
         print_json(summary)
     else:
-        _print_text(result, summary, args, logged_sup_E)
+        _print_text(result, base, summary, args, logged_sup_E)
     return exit_status(summary)
 
 
-def _write_outputs(result, args: argparse.Namespace, out, *, law_settings) -> tuple[dict, float]:
+def _write_outputs(result, base, args: argparse.Namespace, out, *, law_settings) -> tuple[dict, float]:
     """Re-run the worst run serially with its MCAP log, write the search's files (falsify.json, evaluations.csv,
     the history plot, the worst run's signals and searched path where it has them): (the JSON, the re-run's
-    sup|E| [rad])."""
+    sup|E| [rad]). ``base``: the command's base run (its controller, cart, path and reference bounds)."""
     from wmr_mj._util.files import write_json_atomic, write_text_atomic
     from wmr_mj.cli._common import add_controller_source
     from wmr_mj.figures.plots import falsify_history, save_figure
@@ -226,7 +226,7 @@ def _write_outputs(result, args: argparse.Namespace, out, *, law_settings) -> tu
     from wmr_mj.logs.writer import run_logged
     from wmr_mj.sim.falsify import worst_config
 
-    base, worst, log_path = result.spec.base, result.worst, out / "worst.mcap"
+    worst, log_path = result.worst, out / "worst.mcap"
     config = worst_config(result)
     logged = run_logged(config, str(log_path))
     summary = result.report(log=str(log_path)).to_dict()  # the JSON, with the files and the cart added below
@@ -258,12 +258,12 @@ def _write_outputs(result, args: argparse.Namespace, out, *, law_settings) -> tu
     return summary, logged.sup_E
 
 
-def _print_text(result, summary: dict, args: argparse.Namespace, logged_sup_E: float) -> None:
+def _print_text(result, base, summary: dict, args: argparse.Namespace, logged_sup_E: float) -> None:
     """falsify's printout: how the search ran, the worst of the search and of the random sample, the claim,
     the worst run's certificate (E_max, the largest term of delta1) and tightness, its parameters and files."""
     from wmr_mj.sim.falsify import OBJECTIVE_LABELS, worst_config
 
-    spec, worst, base = result.spec, result.worst, result.spec.base
+    spec, worst = result.spec, result.worst
     report = result.report(log=summary["log"])
     names, how = ", ".join(spec.names), _how_text(spec, result, report)
     print(f"worst-case search over {len(spec.names)} parameter(s) ({names}; box {args.uncertainty}): {how}, "
