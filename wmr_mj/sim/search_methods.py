@@ -71,7 +71,6 @@ METHODS = ("portfolio", "cma", "vertices-polish", "lhs-polish", "de")
 METHOD_LABELS = {"portfolio": "vertices, then CMA-ES", "cma": "CMA-ES", "vertices-polish": "vertices, then Nelder-Mead",
                  "lhs-polish": "Latin hypercube, then Nelder-Mead", "de": "differential evolution"}
 MIN_POPULATION = 5  # scipy's differential evolution needs at least 5 members
-_POPULATION_OF = {"de": "differential evolution", "cma": "CMA-ES", "portfolio": "CMA-ES"}  # methods with generations
 
 
 def population_size(budget: int, d: int) -> int:
@@ -80,9 +79,13 @@ def population_size(budget: int, d: int) -> int:
     return max(MIN_POPULATION, min(10 * d, budget // 8))
 
 
-
-
 def check_budget(budget: int, population: int, what: str = "differential evolution") -> None:
+    """Refuse, before any run, a budget that is not a whole number >= 1, a population below
+    :data:`MIN_POPULATION`, or a budget below one generation of ``population`` (``what``: the method, in words).
+
+    Raises:
+        ParameterError: one line naming the value and what is accepted.
+    """
     if isinstance(budget, bool) or not isinstance(budget, int) or budget < 1:
         raise ParameterError(f"budget = {budget!r} is not accepted; give the number of simulations, an integer >= 1")
     if isinstance(population, bool) or not isinstance(population, int) or population < MIN_POPULATION:
