@@ -15,6 +15,9 @@ from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.sim.closed_loop import run_closed_loop
 from wmr_mj.sim.config import RunConfig
 from wmr_mj.sim.falsify import (
+    Evaluation,
+    FalsifyReport,
+    FalsifyResult,
     FalsifySpec,
     covering_design,
     falsify,
@@ -278,3 +281,67 @@ def test_bench_falsify_refuses_a_corrupt_cache_in_one_line(tmp_path):
                           "--cache", str(bad)], capture_output=True, text=True, timeout=120)
     assert out.returncode == 2 and "Traceback" not in out.stderr
     assert f"--cache '{bad}' is not a cache this bench wrote" in out.stderr.splitlines()[-1]
+
+
+# -- the worst run carries its certificate, whatever the objective (issue 44) -----------------------------------
+
+def _result_of(objective: str, certificates: list[dict]) -> FalsifyResult:
+    """A search of three runs whose summaries carry the given certificates, sup|E| rising with the index."""
+    spec = FalsifySpec(box={"m1": (550.0, 750.0)}, budget=8, objective=objective)
+    evals = [Evaluation(phase=phase, index=i, generation=0, params={"m1": 600.0 + i},
+                        objective=objective_value(summary, objective), summary=summary)
+             for phase in ("search", "random")
+             for i, summary in enumerate({"sup_E": 0.01 * (i + 1), "sup_Edot": 0.1, "verdict": "certified-inside",
+                                          "certificate": cert} for i, cert in enumerate(certificates))]
+    return FalsifyResult(spec=spec, search=evals[:3], random=evals[3:], objective_source="test")
+
+
+def test_the_worst_by_sup_E_carries_its_certificate_its_largest_term_and_the_tightness():
+    # section 4's terms at the certificate's top level (gyro_Edot_term is delta3's, 1/s: never the one)
+    certs = [{"E_max": 0.1, "E_ratio": 0.01 * (i + 1) / 0.1, "friction_term": 4.0, "gyro_term": 0.5 + i,
+              "K_term": 0.0, "gyro_Edot_term": 99.0} for i in range(3)]
+    report = _result_of("sup-E", certs).report()
+    w = report.worst
+    assert w.sup_E == 0.03 and w.E_max == 0.1  # the worst by sup|E| is the third run
+    assert (w.binding_term.name, w.binding_term.value) == ("friction_term", 4.0)
+    t = report.tightness
+    assert t is not None and t.ratio == 0.03 / 0.1 and t.E_max == 0.1 and t.factor == 1.0 / t.ratio
+    assert t.text.startswith("the worst found is 0.3 of the certificate's bound") and "by sup|E| [rad]" in t.text
+    out = report.to_dict()
+    assert out["worst"]["E_max"] == 0.1 and out["worst"]["binding_term"] == {"name": "friction_term", "value": 4.0}
+    assert out["tightness"]["ratio"] == 0.3 * 0.1 / 0.1
+    assert FalsifyReport.from_dict(out).to_dict() == out
+
+
+def test_a_sampled_data_certificate_gives_its_largest_term_from_its_inputs_and_a_run_without_one_none():
+    sampled = {"E_max": 0.1, "E_ratio": 0.3, "friction_term": None, "K_term": 0.0,
+               "inputs": {"terms": {"friction_term": 8.4, "feedforward_hold_term": 0.3, "gyro_term": 0.04}}}
+    w = _result_of("sup-E", [sampled] * 3).report().worst
+    assert (w.binding_term.name, w.binding_term.value) == ("friction_term", 8.4)
+    none = _result_of("sup-E", [None] * 3).report()
+    assert none.worst.E_max is None and none.worst.binding_term is None and none.tightness is None
+    # the certificate's own objective: the tightness as it always was, its sentence without the objective's note
+    t = _result_of("certificate", [{"E_max": 0.1, "E_ratio": 0.1 * (i + 1)} for i in range(3)]).report().tightness
+    assert t.ratio == 0.30000000000000004 and "(the worst run by" not in t.text
+
+
+@pytest.mark.slow
+def test_cli_falsify_sup_E_prints_and_writes_the_worst_runs_certificate(tmp_path, capsys):
+    from wmr_mj.cli.app import main
+    from wmr_mj.sim.designs import CERTIFIED
+    from wmr_mj.sim.parts import resolve_run
+
+    argv = ["falsify", "--preset", "certified", "--path", "lane-change", "--duration", "3", "--uncertainty", "m1",
+            "--budget", "6", "--nthread", "2", "--objective", "sup-E"]
+    assert main([*argv, "--out", str(tmp_path / "j"), "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    w = summary["worst"]
+    # its certificate, computed again for the worst run by the run's own resolution
+    config = RunConfig(**CERTIFIED.config_changes(), path="lane-change", duration=3.0, m1=w["params"]["m1"])
+    claim = resolve_run(config).claim
+    terms = {n: getattr(claim.terms, n) for n in ("friction_term", "gyro_term", "K_term", "P_term", "C_V_term")}
+    assert w["E_max"] == claim.E_max and w["binding_term"]["name"] == max(terms, key=lambda n: terms[n])
+    assert summary["tightness"]["ratio"] == pytest.approx(w["sup_E"] / claim.E_max, rel=1e-12)  # E_ratio, 1 ulp
+    assert main([*argv, "--out", str(tmp_path / "t")]) == 0
+    out = capsys.readouterr().out
+    assert f"worst run's certificate: E_max = {claim.E_max:.6g} rad" in out and "tightness: the worst found" in out

@@ -165,7 +165,7 @@ def test_from_200_runs_the_global_phase_is_two_independent_cma_runs_from_the_scr
     """6-D at 300: 32 vertices, then 19 generations of 9 split 9 + 10 between two CMA-ES runs, then the local
     phase. The first run is the one-run portfolio's own, to the bit, up to the split; the second is a fresh
     CMA-ES at the vertices' screened start with the first step (0.3 of each range), to the bit."""
-    import wmr_mj.sim.falsify as falsify_module
+    import wmr_mj.sim.search_methods as search_methods
 
     box6 = np.array([[-1.0, 1.0]] * 6)
     peak = np.array([0.6, 0.6, 0.6, -0.6, 0.6, 0.6])
@@ -180,7 +180,7 @@ def test_from_200_runs_the_global_phase_is_two_independent_cma_runs_from_the_scr
     split, global_end = 32 + 9 * 9, 32 + 19 * 9
     ends = np.cumsum(calls).tolist()
     assert calls[ends.index(split) + 1:ends.index(global_end) + 1] == [9] * 10  # the second run: 10 generations of 9
-    monkeypatch.setattr(falsify_module, "PORTFOLIO_GLOBAL_RUNS_LONG", 1)
+    monkeypatch.setattr(search_methods, "PORTFOLIO_GLOBAL_RUNS_LONG", 1)
     one = search_worst(sphere, box6, budget=300, seed=4)
     assert np.array_equal(two.points[:split], one.points[:split])
     assert not np.array_equal(two.points[split:global_end], one.points[split:global_end])
@@ -206,7 +206,7 @@ def test_from_200_runs_the_local_phase_ends_in_coordinate_moves_of_the_worst_poi
     moves in batches of 9 (the last 7): each point is the worst point found before its batch with one or more
     coordinates moved by a normal step of 0.05 of the range, the others equal to the bit. Before them the
     search is the one without the moves, to the bit; below 200 runs there are none."""
-    import wmr_mj.sim.falsify as falsify_module
+    import wmr_mj.sim.search_methods as search_methods
 
     box6 = np.array([[-1.0, 1.0]] * 6)
     peak = np.array([0.3, -0.4, 0.1, 0.25, -0.2, 0.5])
@@ -231,7 +231,7 @@ def test_from_200_runs_the_local_phase_ends_in_coordinate_moves_of_the_worst_poi
     assert 1.0 <= np.mean(moved_counts) <= 2.0 and max(moved_counts) < 6
     # about 70 normal steps of standard deviation 0.05: their sample's is within 4 standard errors (1/sqrt(2n))
     assert abs(np.std(steps) / 0.05 - 1.0) < 4.0 / np.sqrt(2 * len(steps)), np.std(steps)
-    monkeypatch.setattr(falsify_module, "PORTFOLIO_COORDINATE_SHARE", 0.0)
+    monkeypatch.setattr(search_methods, "PORTFOLIO_COORDINATE_SHARE", 0.0)
     without = search_worst(bump6, box6, budget=300, seed=3)
     assert np.array_equal(trace.points[:start], without.points[:start])
     assert not np.array_equal(trace.points[start:], without.points[start:])
@@ -242,7 +242,7 @@ def test_the_coordinate_moves_climb_a_thin_ridge_that_an_isotropic_step_seldom_s
     x0 = 1 on it; the vertices all lie off it, at 0.3 x0): at a budget of 300 the portfolio comes within 5%
     of the maximum in at least 14 of 20 seeds (measured here: 17; random sampling's median 0.74 of it).
     Without the coordinate moves, the local CMA-ES to the end as below 200 runs: 11 of 20, below that."""
-    import wmr_mj.sim.falsify as falsify_module
+    import wmr_mj.sim.search_methods as search_methods
 
     def ridge(x: np.ndarray) -> np.ndarray:
         return x[:, 0] * np.exp(-(((x[:, 1] - x[:, 2] - 0.1) / 0.01) ** 2)) + 0.3 * x[:, 0]
@@ -253,7 +253,7 @@ def test_the_coordinate_moves_climb_a_thin_ridge_that_an_isotropic_step_seldom_s
         return search_worst(ridge, unit6, budget=300, seed=seed).values.max() >= 0.95 * 1.3
 
     assert sum(close(seed) for seed in range(20)) >= 14
-    monkeypatch.setattr(falsify_module, "PORTFOLIO_COORDINATE_SHARE", 0.0)
+    monkeypatch.setattr(search_methods, "PORTFOLIO_COORDINATE_SHARE", 0.0)
     assert sum(close(seed) for seed in range(20)) < 14
 
 

@@ -11,7 +11,7 @@ import pytest
 
 import wmr_mj
 from wmr_mj.analysis.verdicts import VERDICTS
-from wmr_mj.sim import falsify as falsify_module
+from wmr_mj.sim import search_methods
 from wmr_mj.sim.config import RunConfig
 from wmr_mj.sim.falsify import METHOD_LABELS, METHODS, Evaluation, FalsifyResult, FalsifySpec
 
@@ -40,7 +40,7 @@ def test_the_package_docstring_example_runs():
 
 # -- the falsify history plot's label names the search that runs ------------------------------------
 
-#: the words that name each private search of wmr_mj.sim.falsify, as a reader knows them
+#: the words that name each private search of wmr_mj.sim.search_methods, as a reader knows them
 _SEARCH_WORDS = {"_search_cma": "CMA-ES", "_search_de": "differential evolution",
                  "_search_vertices_polish": "Nelder-Mead"}
 
@@ -49,9 +49,9 @@ _SEARCH_WORDS = {"_search_cma": "CMA-ES", "_search_de": "differential evolution"
 def test_each_method_label_names_the_search_that_runs(method, monkeypatch):
     called: list[tuple[str, dict]] = []
     for name in _SEARCH_WORDS:
-        monkeypatch.setattr(falsify_module, name,
+        monkeypatch.setattr(search_methods, name,
                             lambda *a, _name=name, **kw: called.append((_name, kw)))
-    falsify_module.search_worst(lambda p: np.zeros(len(p)), np.array([[0.0, 1.0]]), budget=64, method=method)
+    search_methods.search_optimiser(np.array([[0.0, 1.0]]), budget=64, method=method)
     (name, kwargs), = called
     label = METHOD_LABELS[method]
     assert _SEARCH_WORDS[name] in label, (method, name, label)

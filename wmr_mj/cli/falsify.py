@@ -175,14 +175,20 @@ def _base_and_box(args: argparse.Namespace):
 
 
 def run(args: argparse.Namespace) -> int:
+    import sys
     import time
 
-    from wmr_mj._util.files import check_output_path, write_json_atomic, write_text_atomic
+    from wmr_mj._util.files import check_output_path, write_text_atomic
     from wmr_mj._util.progress import counter_callback, progress_bar
     from wmr_mj.cli._common import print_json
-    from wmr_mj.figures.plots import falsify_history, save_figure
-    from wmr_mj.logs.writer import run_logged
-    from wmr_mj.sim.falsify import OBJECTIVE_LABELS, FalsifySpec, check_runnable, falsify, worst_config
+    from wmr_mj.sim.falsify import (
+        FalsifySpec,
+        check_objective_applies,
+        check_objective_defined,
+        check_runnable,
+        falsify,
+        undefined_objective_warning,
+    )
 
     objective = _objective(args)
     args.uncertainty = args.uncertainty or "full"
@@ -190,8 +196,6 @@ def run(args: argparse.Namespace) -> int:
     spec = FalsifySpec(base=base, box=box, objective=objective, budget=args.budget, seed=args.seed,
                        population=args.population, method=args.method, requirement=args.require)
     parts = check_runnable(base)  # a duration too short for the path: one line, before any output or search
-    from wmr_mj.sim.falsify import check_objective_applies, check_objective_defined
-
     check_objective_applies(parts.controller, spec.objective)  # before the output folder is made
     check_objective_defined(parts, spec)
     out = check_output_path(args.out or f"logs/falsify-{time.strftime('%Y%m%d-%H%M%S')}", kind="dir", option="--out")
@@ -200,22 +204,32 @@ def run(args: argparse.Namespace) -> int:
                          progress=counter_callback(bar),  # evaluations.csv after every generation: Ctrl-C keeps them
                          checkpoint=lambda partial: write_text_atomic(out / "evaluations.csv", _table(partial)),
                          parts=parts)
-    from wmr_mj.sim.falsify import undefined_objective_warning
-
     warning = undefined_objective_warning(result)  # runs left blank by the objective: said, on stderr
     if warning is not None:
-        import sys
-
         print(warning, file=sys.stderr, flush=True)
-    log_path = out / "worst.mcap"
+    summary, logged_sup_E = _write_outputs(result, base, args, out, law_settings=parts.law_settings)
+    if args.json:
+        print_json(summary)
+    else:
+        _print_text(result, base, summary, args, logged_sup_E)
+    return exit_status(summary)
+
+
+def _write_outputs(result, base, args: argparse.Namespace, out, *, law_settings) -> tuple[dict, float]:
+    """Re-run the worst run serially with its MCAP log, write the search's files (falsify.json, evaluations.csv,
+    the history plot, the worst run's signals and searched path where it has them): (the JSON, the re-run's
+    sup|E| [rad]). ``base``: the command's base run (its controller, cart, path and reference bounds)."""
+    from wmr_mj._util.files import write_json_atomic, write_text_atomic
+    from wmr_mj.cli._common import add_controller_source
+    from wmr_mj.figures.plots import falsify_history, save_figure
+    from wmr_mj.hardware import cart_dict
+    from wmr_mj.logs.writer import run_logged
+    from wmr_mj.sim.falsify import worst_config
+
+    worst, log_path = result.worst, out / "worst.mcap"
     config = worst_config(result)
     logged = run_logged(config, str(log_path))
-    worst = result.worst
-    report = result.report(log=str(log_path))
-    summary = report.to_dict()  # the JSON (falsify.json, --json), with the files and the cart added below
-    from wmr_mj.cli._common import add_controller_source
-    from wmr_mj.hardware import cart_dict
-
+    summary = result.report(log=str(log_path)).to_dict()  # the JSON, with the files and the cart added below
     add_controller_source(summary, base)
     summary.update(cart_dict(base))  # the base's cart where not ideal; the worst run's beside its parameters
     summary["worst"].update(cart_dict(config))
@@ -232,7 +246,7 @@ def run(args: argparse.Namespace) -> int:
     summary.update({
         "reproduced": logged.sup_E == worst.sup_E,  # the serial re-run gives the batch's bits
         "reproduce": reproduce_command(config, worst.params, args, signals_file=signals_file, path_file=path_file,
-                                       law_settings=parts.law_settings),
+                                       law_settings=law_settings),
         "reference_bounds": None if base.reference_bounds is None else base.reference_bounds.as_dict(),
         "uncertainty": args.uncertainty,
         "folder": str(out),
@@ -241,19 +255,29 @@ def run(args: argparse.Namespace) -> int:
     })
     write_text_atomic(out / "evaluations.csv", _table(result))
     write_json_atomic(out / "falsify.json", summary)
-    if args.json:
-        print_json(summary)
-        return exit_status(summary)
+    return summary, logged.sup_E
+
+
+def _print_text(result, base, summary: dict, args: argparse.Namespace, logged_sup_E: float) -> None:
+    """falsify's printout: how the search ran, the worst of the search and of the random sample, the claim,
+    the worst run's certificate (E_max, the largest term of delta1) and tightness, its parameters and files."""
+    from wmr_mj.sim.falsify import OBJECTIVE_LABELS, worst_config
+
+    spec, worst = result.spec, result.worst
+    report = result.report(log=summary["log"])
     names, how = ", ".join(spec.names), _how_text(spec, result, report)
     print(f"worst-case search over {len(spec.names)} parameter(s) ({names}; box {args.uncertainty}): {how}, "
           f"seed {spec.seed}")
-    print(f"objective: {OBJECTIVE_LABELS[objective]}  [{result.objective_source}]")
+    print(f"objective: {OBJECTIVE_LABELS[spec.objective]}  [{result.objective_source}]")
     fmt = lambda x: "n/a" if x is None else f"{x:.6g}"  # noqa: E731
     print(f"search : worst objective {fmt(worst.objective)} in {len(result.search)} runs "
           f"(sup|E| = {worst.sup_E:.6g} rad, sup|E'| = {worst.sup_Edot:.6g} rad/s, {worst.verdict})")
     rw = result.random_worst
     print(f"random : worst objective {fmt(rw.objective)} in {len(result.random)} runs (Latin hypercube, same seed)")
     print("".join(f"{line}\n" for line in claim_lines(report)), end="")
+    certificate = certificate_line(report)
+    if certificate is not None:
+        print(certificate)
     if report.tightness is not None:
         print(f"tightness: {report.tightness.text}")
     if spec.objective == "requirement":
@@ -263,19 +287,29 @@ def run(args: argparse.Namespace) -> int:
               + (f"FALSIFIED, first at run {first_s} of the search" if first_s else "not falsified by the search")
               + (f"; random: first at run {first_r}" if first_r else "; random: not falsified"))
     print("worst parameters: " + ", ".join(f"{k} = {v!r}" for k, v in worst.params.items()))
-    _print_cart(base, config, spec.names)
-    if signals_file is not None:
+    _print_cart(base, worst_config(result), spec.names)
+    if "signals_file" in summary:
         print(f"worst signals: {json.dumps(summary['worst']['signals'], separators=(',', ':'))}")
-    if path_file is not None:
-        print(f"worst path: {path_file} (a knot path within the declared reference bounds)")
+    if "path_file" in summary:
+        print(f"worst path: {summary['path_file']} (a knot path within the declared reference bounds)")
     if base.reference_bounds is not None:
         print(_bounds_line(base.reference_bounds))
     print(f"reproduce: {summary['reproduce']}")
     if not summary["reproduced"]:
-        print(f"WARNING: the serial re-run gave sup|E| = {logged.sup_E!r}, the search {worst.sup_E!r}",
-              flush=True)
-    print(f"log:   {log_path}\nplot:  {summary['plot'][0]}\ntable: {summary['table']}")
-    return exit_status(summary)
+        print(f"WARNING: the serial re-run gave sup|E| = {logged_sup_E!r}, the search {worst.sup_E!r}", flush=True)
+    print(f"log:   {summary['log']}\nplot:  {summary['plot'][0]}\ntable: {summary['table']}")
+
+
+def certificate_line(report: FalsifyReport) -> str | None:
+    """The worst run's certificate, whatever the objective: its E_max and the largest term of its delta1; None
+    where the run has neither."""
+    w = report.worst
+    if w.E_max is None and w.binding_term is None:
+        return None
+    line = "worst run's certificate: " + ("no E_max" if w.E_max is None else f"E_max = {w.E_max:.6g} rad")
+    if w.binding_term is not None:
+        line += f", its largest term of delta1 {w.binding_term.name} = {w.binding_term.value:.4g} rad/s^2"
+    return line
 
 
 def _print_cart(base, worst, names) -> None:

@@ -40,7 +40,10 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 from wmr_mj.errors import ParameterError
+from wmr_mj.sim.optimisers import CMAES, Chain, DifferentialEvolution, Optimiser, Points, drive
 
 __all__ = ["DesignProblem", "DesignResult", "OBJECTIVES", "METHODS", "LAWS", "DEFAULT_SEED", "DEFAULT_BUDGET",
            "DESIGN_FIELDS", "law_changes", "uncovered", "search_design", "evaluate_design", "write_design",
@@ -365,9 +368,7 @@ def search_design(problem: DesignProblem) -> DesignResult:
     evaluations = 0
     for period in periods:
         scorer = _Scorer(problem, period)
-        bounds = scorer.bounds(period)
-        run = _cma if problem.method == "cma" else _differential_evolution
-        value, x = run(scorer, bounds, problem)
+        value, x = _search(scorer, scorer.bounds(period), problem)
         evaluations += scorer.evaluations
         if best is None or value < best[0]:
             best = (value, scorer.config(x))
@@ -375,44 +376,41 @@ def search_design(problem: DesignProblem) -> DesignResult:
     return _finish(problem, best[1], best[0], evaluations, periods)
 
 
-def _differential_evolution(scorer: _Scorer, bounds: list[tuple[float, float]],
-                            problem: DesignProblem) -> tuple[float, Any]:
-    """scipy's differential evolution (seeded, one worker, no gradient polish), the preset's point in its first
-    population: the best (score, point)."""
-    from scipy.optimize import differential_evolution
+def _optimiser(scorer: _Scorer, bounds: list[tuple[float, float]], problem: DesignProblem) -> Optimiser:
+    """The optimiser of ``problem.method`` (:mod:`wmr_mj.sim.optimisers`), minimising the score.
 
-    popsize = 10
-    maxiter = max(1, problem.budget // (popsize * len(bounds)) - 1)
-    result = differential_evolution(scorer, bounds, seed=problem.seed, popsize=popsize, maxiter=maxiter,
-                                    polish=False, updating="immediate", workers=1, tol=0.0, init="sobol",
-                                    x0=_preset_point(scorer, bounds))
-    return float(result.fun), result.x
-
-
-def _cma(scorer: _Scorer, bounds: list[tuple[float, float]], problem: DesignProblem) -> tuple[float, Any]:
-    """CMA-ES (``cmaes``, falsify's optimiser: its own seeded generator, bounds kept by resampling), started at
-    the preset's point (scored first) or the box's centre with a step of 0.3 of the narrowest range, ``budget``
-    points: the best (score, point) of every point scored."""
-    import numpy as np
-    from cmaes import CMA
-
-    box = np.array(bounds, dtype=float)
+    - ``cma``: CMA-ES (``cmaes``, falsify's optimiser: its own seeded generator, bounds kept by resampling),
+      started at the preset's point, which is scored first, or at the box's centre, with a step of 0.3 of the
+      narrowest range; whole generations until ``budget`` points are scored.
+    - ``de``: scipy's differential evolution (seeded, one worker, no gradient polish), the preset's point in its
+      first population, popsize 10, budget // (10 dimensions) - 1 generations (at least 1), one point at a time.
+    """
     x0 = _preset_point(scorer, bounds)
+    if problem.method == "de":
+        popsize = 10
+        maxiter = max(1, problem.budget // (popsize * len(bounds)) - 1)
+        return DifferentialEvolution(bounds, seed=problem.seed, popsize=popsize, maxiter=maxiter, polish=False,
+                                     updating="immediate", workers=1, tol=0.0, init="sobol", x0=x0)
+    box = np.array(bounds, dtype=float)
     mean = np.array(x0) if x0 is not None else box.mean(axis=1)
-    best = (scorer(mean), mean)
-    n = 1
-    opt = CMA(mean=mean, sigma=0.3 * float(np.min(box[:, 1] - box[:, 0])), bounds=box, seed=problem.seed)
-    while n < problem.budget:
-        told = []
-        for _ in range(opt.population_size):
-            x = opt.ask()
-            value = scorer(x)
-            n += 1
-            told.append((x, value))
-            if value < best[0]:
-                best = (value, x)
-        opt.tell(told)
-    return float(best[0]), best[1]
+    return Chain(Points(mean), CMAES(mean=mean, sigma=0.3 * float(np.min(box[:, 1] - box[:, 0])), bounds=box,
+                                     seed=problem.seed))
+
+
+def _search(scorer: _Scorer, bounds: list[tuple[float, float]], problem: DesignProblem) -> tuple[float, Any]:
+    """The best (score, point) of one period's search (:func:`_optimiser`, driven by the one loop
+    :func:`wmr_mj.sim.optimisers.drive`): differential evolution's own result; CMA-ES's first point of the
+    smallest score."""
+    optimiser = _optimiser(scorer, bounds, problem)
+    budget = problem.budget if problem.method == "cma" else None
+    trace = drive(optimiser, lambda points: [scorer(x) for x in points], budget=budget)
+    if isinstance(optimiser, DifferentialEvolution):
+        return float(optimiser.result.fun), optimiser.result.x
+    best = 0
+    for i, value in enumerate(trace.values):  # the first of the smallest, as scored in order
+        if value < trace.values[best]:
+            best = i
+    return float(trace.values[best]), trace.points[best]
 
 
 def evaluate_design(config: Any, paths: Sequence[str]) -> dict[str, Any]:

@@ -47,7 +47,10 @@ generation (differential evolution's or CMA-ES's population) is refused before a
 Where the objective is the certificate's ratio, :attr:`FalsifyResult.tightness` sets the worst
 found (a lower bound on the worst case) beside the certificate's E_max (an upper bound): "the worst
 found is X of the certificate's bound: the certificate is 1/X times the worst case found"; where X
-exceeds 1, "the worst run is X times the claimed bound: the claim is exceeded".
+exceeds 1, "the worst run is X times the claimed bound: the claim is exceeded". Whatever the objective, the
+worst run carries its certificate: :attr:`WorstRun.E_max`, :attr:`WorstRun.binding_term` (the largest part of
+its delta1) and the tightness of that run's certificate (for another objective, the worst run is that
+objective's, and the sentence says so).
 
 Whatever the objective, a run of either phase that is ``certified-outside`` breaks the law's claim:
 :attr:`FalsifyResult.claim_broken` names the one that breaks it most (its parameters), and
@@ -87,22 +90,59 @@ NAME=VALUE ...`` give the same sup|E|; the same seed gives the same search.
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
-import itertools
 import math
-import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE, VERDICTS
-from wmr_mj.errors import ParameterError, UnknownNameError, WmrMjError
+from wmr_mj._util.checks import positive_range
+from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE, VERDICTS, unmet_assumptions
+from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import parameter_names
 from wmr_mj.sim.config import RunConfig
+from wmr_mj.sim.falsify_objectives import (
+    OBJECTIVE_LABELS,
+    OBJECTIVES,
+    binding_term,
+    certificate_E_max,
+    check_objective_applies,
+    check_objective_defined,
+    objective_source,
+    objective_value,
+    shares_the_base_certificate,
+    verdict_of,
+)
 from wmr_mj.sim.records import BrokenRun, Record, UnmetAssumption
+from wmr_mj.sim.search_methods import (
+    METHOD_LABELS,
+    METHODS,
+    MIN_POPULATION,
+    PORTFOLIO_COORDINATE_STEP,
+    Trace,
+    check_budget,
+    cma_population,
+    covering_design,
+    population_size,
+    portfolio_coordinate_runs,
+    portfolio_global_runs,
+    portfolio_local_phase,
+    portfolio_phases,
+    portfolio_vertices,
+    random_worst,
+    screened_start,
+    search_worst,
+)
+from wmr_mj.sim.search_space import (
+    check_hardware_range,
+    config_for,
+    hardware_axis,
+    hardware_values,
+    path_axis,
+    signal_axis,
+)
 
 __all__ = [
     "OBJECTIVES",
@@ -116,6 +156,7 @@ __all__ = [
     "WorstRun",
     "RandomWorst",
     "Tightness",
+    "BindingTerm",
     "BrokenRun",
     "Evaluation",
     "Trace",
@@ -131,110 +172,20 @@ __all__ = [
     "falsify",
     "check_runnable",
     "worst_config",
+    # re-exported from wmr_mj.sim.falsify_objectives and wmr_mj.sim.search_methods, where they live
+    "MIN_POPULATION",
+    "PORTFOLIO_COORDINATE_STEP",
+    "check_budget",
+    "check_objective_applies",
+    "check_objective_defined",
+    "shares_the_base_certificate",
+    "undefined_objective_warning",
+    "portfolio_local_phase",
+    "portfolio_phases",
+    "screened_start",
 ]
 
-OBJECTIVES = ("certificate", "paper", "sup-E", "requirement")
-#: Search methods (module docstring): the portfolio (default: vertices, CMA-ES, a local CMA-ES), CMA-ES alone,
-#: vertices or a Latin hypercube then a Nelder-Mead polish, differential evolution.
-METHODS = ("portfolio", "cma", "vertices-polish", "lhs-polish", "de")
-#: What each method does, in a few words (the legend of the search's history plot); a test keeps each
-#: label true to the search :func:`search_worst` dispatches the method to.
-METHOD_LABELS = {"portfolio": "vertices, then CMA-ES", "cma": "CMA-ES", "vertices-polish": "vertices, then Nelder-Mead",
-                 "lhs-polish": "Latin hypercube, then Nelder-Mead", "de": "differential evolution"}
-OBJECTIVE_LABELS = {"certificate": "sup|E|/E_max of the certificate", "paper": "sup|E|/E_max of the paper's region",
-                    "sup-E": "sup|E| [rad]", "requirement": "-robustness of the requirement (> 0: falsified)"}
-MIN_POPULATION = 5  # scipy's differential evolution needs at least 5 members
 _POPULATION_OF = {"de": "differential evolution", "cma": "CMA-ES", "portfolio": "CMA-ES"}  # methods with generations
-
-
-# -- the objective, read from a run's summary ----------------------------------------------
-
-def _ratio(sup: float, bound: Any) -> float | None:
-    if bound is None:
-        return None
-    bound = float(bound)
-    return sup / bound if math.isfinite(bound) and bound > 0 else None
-
-
-def objective_value(summary: Mapping[str, Any], objective: str) -> float | None:
-    """The number falsify maximises for one run's summary (None where it is undefined,
-    e.g. a region that does not exist). The one place that reads it; see objective_source."""
-    if objective not in OBJECTIVES:
-        raise UnknownNameError("objective", objective, OBJECTIVES)
-    if objective == "sup-E":
-        return float(summary["sup_E"])
-    if objective == "requirement":
-        (req,) = summary["requirements"]
-        return None if req["robustness"] is None else -float(req["robustness"])
-    if objective == "paper":
-        region = summary.get("paper_region")
-        if isinstance(region, Mapping) and region.get("E_max") is not None:
-            return _ratio(float(summary["sup_E"]), region["E_max"])
-        return summary.get("E_ratio")
-    certificate = summary.get("certificate")
-    if isinstance(certificate, Mapping) and "E_ratio" in certificate:
-        return certificate["E_ratio"]
-    return summary.get("E_ratio")
-
-
-def check_objective_applies(law: Any, objective: str) -> None:
-    """Refuse, before any run, an objective that says nothing of the run's controller (``law``, the resolved
-    run's: :attr:`wmr_mj.sim.parts.RunParts.controller`): the certificate's ratio for a law that states no
-    claim, the paper's for a law that is not the paper's.
-
-    Raises:
-        ParameterError: naming the controller and the objectives that apply.
-    """
-    from controllers import SteeringController
-    from wmr_mj.sim.config import estimate_of
-
-    if objective not in ("certificate", "paper"):
-        return
-    if objective == "certificate" and type(law).claim is SteeringController.claim:
-        raise ParameterError(f"controller {law.name!r} states no claim, so there is no certificate to search "
-                             "against: falsify a requirement (--require STL) or maximise sup|E| (--objective sup-E)")
-    if objective == "paper" and estimate_of(law) is None:
-        raise ParameterError(f"the paper's region is for its computed-torque law, not controller {law.name!r}: "
-                             "falsify a requirement (--require STL) or maximise sup|E| (--objective sup-E)")
-
-
-def shares_the_base_certificate(base: RunConfig, names: Sequence[str]) -> bool:
-    """Whether every run of ``base`` searched over ``names`` is judged by the base's certificate: m1 and plant
-    parameters only (the certificate is over the config's box, whatever the run's plant in it), none of
-    which reaches the certificate otherwise: the plant's limits (voltage_limit, steering_range), the gear
-    ratio i2 where the sensing is not ideal and R_a where the actuation is not (their coverage reads them:
-    :func:`wmr_mj.sim.certify.measurement_errors_of`). The cart's, the signals' and the path's axes give
-    each run its own."""
-    from wmr_mj.sim.search_space import hardware_axis, path_axis, signal_axis
-
-    reaching = {"voltage_limit", "steering_range"}
-    if not base.sensing.is_ideal or not base.transmission.is_ideal:
-        reaching.add("i2")
-    if not base.actuation.is_ideal:
-        reaching.add("R_a")
-    return not any(hardware_axis(n) or signal_axis(n) or path_axis(n) or n in reaching for n in names)
-
-
-def check_objective_defined(parts: Any, spec: FalsifySpec) -> None:
-    """Refuse, before any step, a search whose objective is undefined for every run: the certificate's
-    ratio where the base's certificate has no finite bound and every run shares it
-    (:func:`shares_the_base_certificate`); ``run`` knows this before it steps, and so does falsify.
-
-    Args:
-        parts: ``spec.base`` resolved (:func:`check_runnable`).
-
-    Raises:
-        ParameterError: one line naming why there is no bound and what to search instead.
-    """
-    claim = parts.claim
-    if spec.objective != "certificate" or claim is None or not shares_the_base_certificate(spec.base, spec.names):
-        return
-    if claim.valid and 0.0 < claim.E_max < math.inf and 0.0 < claim.Edot_max:
-        return
-    why = getattr(claim, "reason", None) or ", ".join(claim.unmet) or "no finite bound"
-    raise ParameterError(f"the objective sup|E|/E_max of the certificate is undefined for every run: controller "
-                         f"{parts.controller.name!r} has no certificate over this box ({why}; see wmr-mj robustness "
-                         "--certificate): search --objective sup-E or a requirement (--require STL) instead")
 
 
 def undefined_objective_warning(result: FalsifyResult) -> str | None:
@@ -257,493 +208,6 @@ def undefined_objective_warning(result: FalsifyResult) -> str | None:
     return text
 
 
-def objective_source(summary: Mapping[str, Any], objective: str) -> str:
-    """Which field of the summary :func:`objective_value` read, in words (for the report)."""
-    if objective == "sup-E":
-        return "sup_E"
-    if objective == "requirement":
-        return f"-robustness of {summary['requirements'][0]['formula']} (rtamt, runs one by one)"
-    if objective == "paper":
-        region = summary.get("paper_region")
-        if isinstance(region, Mapping) and region.get("E_max") is not None:
-            return "sup_E / paper_region.E_max"
-        return "E_ratio (the run's analysis region; the summary has no paper_region)"
-    certificate = summary.get("certificate")
-    if isinstance(certificate, Mapping) and "E_ratio" in certificate:
-        return "certificate.E_ratio"
-    return ("E_ratio of the run's analysis region: the run summary carries no certificate yet, so the "
-            "objective falls back to the region the run is judged by today")
-
-
-def _verdict(summary: Mapping[str, Any]) -> str:
-    verdict = summary.get("verdict")
-    if verdict is not None:
-        return str(verdict)
-    return "inside" if summary.get("inside") else "outside"
-
-
-# -- the search itself: any evaluate(points) -> values ----------------------------------------
-
-@dataclass(frozen=True)
-class Trace:
-    """Every point a search evaluated, in order: points (E, d), values (E,) (NaN: undefined),
-    generation (E,) (0: the initial population; the random sample is all 0)."""
-
-    points: np.ndarray
-    values: np.ndarray
-    generation: np.ndarray
-
-    @property
-    def best(self) -> int:
-        """Index of the largest value (the first of equals); -1 if none is defined."""
-        finite = np.where(np.isnan(self.values), -np.inf, self.values)
-        return int(np.argmax(finite)) if finite.size and np.isfinite(finite).any() else -1
-
-
-class _Recorder:
-    """Calls evaluate(points (S, d)) -> values (S,), checks the shape, and keeps every batch in order
-    (a batch is a generation) for the search's :class:`Trace`."""
-
-    def __init__(self, evaluate: Callable[[np.ndarray], np.ndarray]) -> None:
-        self._evaluate = evaluate
-        self._points: list[np.ndarray] = []
-        self._values: list[np.ndarray] = []
-        self._generation: list[np.ndarray] = []
-        self.spent = 0  # points evaluated so far
-
-    def __call__(self, batch: np.ndarray) -> np.ndarray:
-        v = np.asarray(self._evaluate(batch), dtype=float).reshape(-1)
-        if v.shape != (len(batch),):
-            raise ValueError(f"evaluate returned {v.shape} values for {len(batch)} points")
-        self._generation.append(np.full(len(batch), len(self._points)))
-        self._points.append(batch)
-        self._values.append(v)
-        self.spent += len(batch)
-        return v
-
-    def trace(self) -> Trace:
-        return Trace(np.concatenate(self._points), np.concatenate(self._values), np.concatenate(self._generation))
-
-
-def population_size(budget: int, d: int) -> int:
-    """Members per generation: 10 per parameter, but at most an eighth of the budget (so
-    that at least 8 generations run), and never below scipy's minimum of 5."""
-    return max(MIN_POPULATION, min(10 * d, budget // 8))
-
-
-def _check_budget(budget: int, population: int, what: str = "differential evolution") -> None:
-    if isinstance(budget, bool) or not isinstance(budget, int) or budget < 1:
-        raise ParameterError(f"budget = {budget!r} is not accepted; give the number of simulations, an integer >= 1")
-    if isinstance(population, bool) or not isinstance(population, int) or population < MIN_POPULATION:
-        raise ParameterError(f"population = {population!r} is not accepted; {what} needs an "
-                             f"integer >= {MIN_POPULATION}")
-    if budget < population:
-        raise ParameterError(f"budget = {budget} simulations is below one population of {population} ({what} "
-                             f"evaluates a whole population per generation); give a budget >= {population}")
-
-
-def _unit_to_box(unit: np.ndarray, bounds: np.ndarray) -> np.ndarray:
-    return bounds[:, 0] + unit * (bounds[:, 1] - bounds[:, 0])
-
-
-def _streams(seed: int) -> list[np.random.Generator]:
-    """Independent generators for the initial population, the evolution and the random sample."""
-    return [np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(3)]
-
-
-@contextlib.contextmanager
-def _user_errors_unwrapped():
-    """scipy wraps what the objective raises in a RuntimeError; give back a WmrMjError (bad input,
-    one line at the CLI) as itself."""
-    try:
-        yield
-    except RuntimeError as exc:
-        cause = exc.__cause__ or exc.__context__
-        if isinstance(cause, WmrMjError):
-            raise cause from None
-        raise
-
-
-def search_worst(evaluate: Callable[[np.ndarray], np.ndarray], bounds: np.ndarray, *, budget: int, seed: int = 0,
-                 population: int | None = None, method: str = "portfolio") -> Trace:
-    """Maximise ``evaluate`` over the box ``bounds`` (d, 2) with ``method`` (:data:`METHODS`).
-
-    evaluate(points (S, d)) -> values (S,), NaN where undefined, is called with a batch of
-    points at a time. At most ``budget`` points are evaluated. Seeded: the same seed gives
-    the same points. population: members per generation of differential evolution or CMA-ES.
-    """
-    if method not in METHODS:
-        raise UnknownNameError("search method", method, METHODS)
-    if method == "de":
-        return _search_de(evaluate, bounds, budget=budget, seed=seed, population=population)
-    if method in ("portfolio", "cma"):
-        return _search_cma(evaluate, bounds, budget=budget, seed=seed, population=population,
-                           vertices=method == "portfolio")
-    return _search_vertices_polish(evaluate, bounds, budget=budget, seed=seed, first=method.split("-")[0])
-
-
-def covering_design(d: int, runs: int, rng: np.random.Generator | None = None) -> np.ndarray:
-    """Vertices of the unit box (runs, d) in {0, 1}: all 2^d when runs >= 2^d, else a two-level
-    fractional factorial 2^(d-p) of 2^k <= runs points (k base factors in full factorial, every
-    other factor the product of a subset of them, the largest subsets first: the highest
-    resolution this simple construction gives). rng: random sign flips of the columns (a
-    fold-over of the design), so that seeds cover different corners."""
-    if runs < 1:
-        raise ParameterError(f"runs = {runs!r}: a covering design needs at least one point")
-    k = min(d, int(math.floor(math.log2(runs))))
-    base = np.array(list(itertools.product((-1.0, 1.0), repeat=k))).reshape(2 ** k, k)
-    columns = [base[:, j] for j in range(k)]
-    subsets = [c for size in range(k, 1, -1) for c in itertools.combinations(range(k), size)]
-    for j in range(d - k):
-        if subsets:
-            sub = subsets[j % len(subsets)]
-            col = np.prod(base[:, list(sub)], axis=1) * (-1.0 if j >= len(subsets) else 1.0)
-        else:  # k <= 1: alternate the single base column
-            col = (base[:, 0] if k else np.ones(1)) * (-1.0 if j % 2 else 1.0)
-        columns.append(col)
-    design = np.column_stack(columns) if columns else np.zeros((1, 0))
-    if rng is not None and 2 ** d > runs:
-        design = design * rng.choice((-1.0, 1.0), size=d)
-    return (design + 1.0) / 2.0
-
-
-class _BudgetSpent(Exception):
-    """The local optimiser asked for more runs than the budget has left."""
-
-
-def _search_vertices_polish(evaluate: Callable[[np.ndarray], np.ndarray], bounds: np.ndarray, *, budget: int,
-                            seed: int = 0, first: str = "vertices") -> Trace:
-    """The box's vertices first, then a bounded local search from the worst found.
-
-    first='lhs' (``--method lhs-polish``): a seeded Latin hypercube of half the budget instead of
-    the vertices (its stream is not the random sample's), for spaces whose worst case is interior
-    (C's path: knots between the bounds), then the same polish.
-
-    1. Vertices, one batch: all 2^d corners where the budget allows them (2^d <= budget), else a
-       fractional-factorial covering design of at most half the budget (:func:`covering_design`,
-       seeded sign flips).
-    2. Polish: scipy's Nelder-Mead with bounds, in the unit box, from the worst point so far,
-       its initial simplex stepping inward from it by a seeded 5-20% of each range (evaluated
-       as one batch), then one run per call; when it converges with budget left it restarts from
-       the next-worst evaluated point. A point evaluated before is not run again.
-
-    Robust-control worst cases sit at vertices more often than not (the objective is monotone
-    in most parameters), which is why they come first; the polish finds an interior maximum
-    near the worst vertex, or confirms the vertex. Deterministic for a seed.
-    """
-    from scipy.optimize import minimize
-
-    bounds = np.asarray(bounds, dtype=float)
-    d = len(bounds)
-    _check_budget(budget, MIN_POPULATION)
-    rng = np.random.default_rng(np.random.SeedSequence(seed).spawn(4)[3])
-    lo, span = bounds[:, 0], bounds[:, 1] - bounds[:, 0]
-    rec = _Recorder(evaluate)
-    seen: dict[tuple[float, ...], float] = {}
-
-    def run(unit: np.ndarray) -> np.ndarray:
-        """Evaluate unit-box points (rows) not seen before, within the budget; values of all."""
-        unit = np.clip(np.atleast_2d(np.asarray(unit, dtype=float)), 0.0, 1.0)
-        keys = [tuple(u.tolist()) for u in unit]
-        new = list(dict.fromkeys(k for k in keys if k not in seen))
-        if rec.spent + len(new) > budget:
-            raise _BudgetSpent
-        if new:
-            v = rec(lo + np.array(new) * span)
-            seen.update(zip(new, v.tolist()))
-        return np.array([seen[k] for k in keys])
-
-    def spent() -> int:
-        return rec.spent
-
-    if first == "lhs":
-        from wmr_mj.sim.sweep import latin_hypercube
-
-        run(latin_hypercube(max(1, budget // 2), d, rng))
-    else:
-        run(covering_design(d, budget if 2 ** d <= budget else max(1, budget // 2), rng))
-    starts_used: list[np.ndarray] = []
-
-    def energy(x: np.ndarray) -> float:  # Nelder-Mead minimises
-        v = float(run(x)[0])
-        return 1e300 if math.isnan(v) else -v
-
-    while spent() < budget:
-        keys = sorted(seen, key=lambda k: -math.inf if math.isnan(seen[k]) else seen[k], reverse=True)
-        start = next((np.array(k) for k in keys
-                      if all(np.max(np.abs(np.array(k) - s)) > 1e-3 for s in starts_used)), None)
-        if start is None:
-            break
-        starts_used.append(start)
-        inward = np.where(start > 0.5, -1.0, 1.0)
-        steps = rng.uniform(0.05, 0.2, size=d) * inward
-        simplex = np.vstack([start, start + np.diag(steps)])
-        try:
-            run(simplex[1:][: budget - spent()])  # the initial simplex as one batch
-            if spent() >= budget:
-                break
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                minimize(energy, start, method="Nelder-Mead", bounds=[(0.0, 1.0)] * d,
-                         options={"initial_simplex": simplex, "maxfev": budget, "xatol": 1e-4, "fatol": 1e-7})
-        except _BudgetSpent:
-            break
-    return rec.trace()
-
-
-#: CMA-ES's starting step, in units of each range (the search runs in the unit box).
-CMA_SIGMA0 = 0.3
-#: The portfolio evaluates all 2^d vertices where they fit this share of the budget and number at most
-#: PORTFOLIO_MAX_VERTICES (a monotone worst case is then found exactly: the full box, d = 5, at any budget >= 64) ...
-PORTFOLIO_VERTEX_SHARE = 0.5
-PORTFOLIO_MAX_VERTICES = 32
-#: ... else a covering of at most this share of the budget (measured: the benchmarks guide). C's path (d = 6)
-#: at a budget of 300: 32 of its 64 vertices, not all 64.
-PORTFOLIO_COVER_SHARE = 0.125
-#: The last share of the budget is a local CMA-ES around the worst point found, its step a share of each range
-#: (measured: the benchmarks guide): (share of the budget, step) below PORTFOLIO_LONG_BUDGET runs ...
-PORTFOLIO_LOCAL_SHORT = (0.2, 0.05)
-#: ... and from there on, where the global phase has had its runs: a longer, finer local phase.
-PORTFOLIO_LOCAL_LONG = (0.3, 0.02)
-PORTFOLIO_LONG_BUDGET = 200
-#: CMA-ES starts from the box's centre, moved by PORTFOLIO_SCREEN_SHIFT of a range towards the worse side of every
-#: parameter whose main effect over the vertices is significant, |t| > PORTFOLIO_SCREEN_T (a two-level screening).
-PORTFOLIO_SCREEN_T = 3.0
-PORTFOLIO_SCREEN_SHIFT = 0.25
-#: From PORTFOLIO_LONG_BUDGET runs on, the global phase is this many independent CMA-ES runs from the same start,
-#: equal in whole generations (below it, one): on a rough objective one run's mean can wander off to a poorer region.
-PORTFOLIO_GLOBAL_RUNS_LONG = 2
-#: From PORTFOLIO_LONG_BUDGET runs on, this share of the local phase (its end) is coordinate moves of the worst point
-#: found: each member moves each coordinate with probability 1/d (at least one) by a normal step of
-#: PORTFOLIO_COORDINATE_STEP of its range. On C's path the high values lie on thin ridges (two adjacent knots a set
-#: step apart): a move of the coordinates off a ridge's normal stays on it, an isotropic step seldom does.
-PORTFOLIO_COORDINATE_SHARE = 0.5
-PORTFOLIO_COORDINATE_STEP = 0.05
-
-
-def portfolio_local_phase(budget: int) -> tuple[float, float]:
-    """(share of the budget, step as a share of each range) of the portfolio's local phase:
-    :data:`PORTFOLIO_LOCAL_SHORT` below :data:`PORTFOLIO_LONG_BUDGET` runs, else :data:`PORTFOLIO_LOCAL_LONG`."""
-    return PORTFOLIO_LOCAL_LONG if budget >= PORTFOLIO_LONG_BUDGET else PORTFOLIO_LOCAL_SHORT
-
-
-def portfolio_global_runs(d: int, budget: int, population: int | None = None) -> int:
-    """How many independent CMA-ES runs, from the same start, share the portfolio's global phase in d parameters
-    at ``budget``, as :func:`search_worst` spends them: one below :data:`PORTFOLIO_LONG_BUDGET` runs,
-    :data:`PORTFOLIO_GLOBAL_RUNS_LONG` from there on, at most one per whole generation of ``population``
-    (default :func:`cma_population`) in :func:`portfolio_phases`' global phase."""
-    lam = cma_population(d) if population is None else population
-    runs = PORTFOLIO_GLOBAL_RUNS_LONG if budget >= PORTFOLIO_LONG_BUDGET else 1
-    return max(1, min(runs, portfolio_phases(d, budget, lam)[1] // lam))
-
-
-def portfolio_coordinate_runs(d: int, budget: int, population: int | None = None) -> int:
-    """How many of the portfolio's local runs (:func:`portfolio_phases`' last) are coordinate moves of the worst
-    point found, at the end: none below :data:`PORTFOLIO_LONG_BUDGET` runs, else what is left after the local
-    CMA-ES has :data:`PORTFOLIO_COORDINATE_SHARE`'s complement of them in whole generations of ``population``
-    (default :func:`cma_population`)."""
-    if budget < PORTFOLIO_LONG_BUDGET or PORTFOLIO_COORDINATE_SHARE <= 0.0:
-        return 0
-    lam = cma_population(d) if population is None else population
-    local = portfolio_phases(d, budget, lam)[2]
-    return local - int((1.0 - PORTFOLIO_COORDINATE_SHARE) * local) // lam * lam
-
-
-def portfolio_phases(d: int, budget: int, population: int | None = None) -> tuple[int, int, int]:
-    """The portfolio's runs in d parameters at ``budget``: (vertices, global CMA-ES, local CMA-ES), as
-    :func:`search_worst` spends them (the global phase in whole generations of ``population``, default
-    :func:`cma_population`; no local phase where the global one would have no whole generation)."""
-    lam = cma_population(d) if population is None else population
-    nv = min(portfolio_vertices(d, budget), budget)
-    local = int(portfolio_local_phase(budget)[0] * budget)
-    global_end = nv + (budget - nv - local) // lam * lam if local else budget
-    if global_end <= nv:
-        global_end = budget
-    return nv, global_end - nv, budget - global_end
-
-
-def screened_start(corners: np.ndarray, values: np.ndarray) -> np.ndarray:
-    """CMA-ES's first mean (d,) in the unit box, from the vertices' values: the two-level screening of a
-    designed experiment. The main effects are fitted by least squares on the corners (n, d) in {0, 1}
-    (orthogonal columns for :func:`covering_design`'s designs); a parameter whose effect b_i exceeds
-    :data:`PORTFOLIO_SCREEN_T` standard errors (s / sqrt(n), s from the residuals) starts
-    :data:`PORTFOLIO_SCREEN_SHIFT` from the centre on its worse side, every other at the centre. Undefined
-    (NaN) values are left out; with no residual degree of freedom every parameter starts at the centre."""
-    ok = np.isfinite(values)
-    X, y = 2.0 * np.asarray(corners, dtype=float)[ok] - 1.0, np.asarray(values, dtype=float)[ok]
-    start = np.full(np.shape(corners)[1], 0.5)
-    dof = len(y) - X.shape[1] - 1
-    if dof < 1:
-        return start
-    A = np.column_stack([np.ones(len(y)), X])
-    coef = np.linalg.lstsq(A, y, rcond=None)[0]
-    resid = y - A @ coef
-    se = math.sqrt(float(resid @ resid) / dof / len(y))
-    for i, b in enumerate(coef[1:]):
-        if abs(b) > PORTFOLIO_SCREEN_T * se and b != 0.0:
-            start[i] = 0.5 + PORTFOLIO_SCREEN_SHIFT * math.copysign(1.0, b)
-    return start
-
-
-def cma_population(d: int) -> int:
-    """CMA-ES's members per generation: its default 4 + floor(3 ln d), at least :data:`MIN_POPULATION`
-    (5 in 1-D, 6 in 2-D, 8 in 4-5-D, 9 in 6-D)."""
-    return max(MIN_POPULATION, 4 + int(math.floor(3 * math.log(max(d, 1)))))
-
-
-def portfolio_vertices(d: int, budget: int) -> int:
-    """How many vertices the portfolio evaluates first: all 2^d where they fit
-    :data:`PORTFOLIO_VERTEX_SHARE` of the budget and number at most :data:`PORTFOLIO_MAX_VERTICES`,
-    else the largest power of two within :data:`PORTFOLIO_COVER_SHARE` of it (a fractional-factorial
-    covering), at least 2."""
-    if 2 ** d <= min(int(PORTFOLIO_VERTEX_SHARE * budget), PORTFOLIO_MAX_VERTICES):
-        return 2 ** d
-    share = int(PORTFOLIO_COVER_SHARE * budget)
-    return max(2, 2 ** int(math.floor(math.log2(max(share, 2)))))
-
-
-def _search_cma(evaluate: Callable[[np.ndarray], np.ndarray], bounds: np.ndarray, *, budget: int, seed: int = 0,
-                population: int | None = None, vertices: bool = True) -> Trace:
-    """CMA-ES (the ``cmaes`` package), a generation per batch, in the unit box with its bounds;
-    with ``vertices`` (the ``portfolio``) the box's vertices first, as one batch, and a last local
-    CMA-ES around the worst point found.
-
-    1. (portfolio) :func:`portfolio_vertices` vertices, one batch: all 2^d where they fit
-       :data:`PORTFOLIO_VERTEX_SHARE` of the budget and number at most :data:`PORTFOLIO_MAX_VERTICES`,
-       else a seeded fractional-factorial covering.
-    2. CMA-ES: mean at the box's centre (not at the worst vertex: measured worse on interior maxima),
-       (portfolio) moved towards the worse side of each parameter whose main effect over the vertices
-       is significant (:func:`screened_start`), step :data:`CMA_SIGMA0` of each range, ``population``
-       (default :func:`cma_population`) members per generation, evaluated as one batch; the package
-       resamples a member outside the box (up to 100 times, then clips it). An undefined value (NaN)
-       ranks below every defined one. When CMA-ES stops (converged, flat) with budget left it
-       restarts from a seeded uniform point with twice the population (IPOP). (portfolio) This global
-       phase runs whole generations of the first population up to the budget less the local phase's
-       share of it (:func:`portfolio_local_phase`), from 200 runs on as :func:`portfolio_global_runs`
-       independent runs from the same start (step CMA_SIGMA0, the first population), equal in whole
-       generations; a run that stops early restarts within its share as above.
-    3. (portfolio) The local phase: CMA-ES from the worst point found, its step
-       (:func:`portfolio_local_phase`) of each range, the first population (restarted there when it
-       stops), to the budget; none where the global phase would have no whole generation before it
-       (tiny budgets). From 200 runs on the local CMA-ES ends early, in whole generations, and the
-       rest (:func:`portfolio_coordinate_runs`) is coordinate moves: batches of ``population`` copies
-       of the worst point found so far, each with every coordinate moved with probability 1/d (at
-       least one) by a normal step of :data:`PORTFOLIO_COORDINATE_STEP`, clipped to the box. The last
-       generation of each phase is cut to the budget.
-
-    In one dimension (which ``cmaes`` does not take) it searches a square whose second coordinate
-    is ignored. Deterministic for a seed (``cmaes`` keeps its own generator, seeded from it).
-    """
-    from cmaes import CMA
-
-    bounds = np.asarray(bounds, dtype=float)
-    d = len(bounds)
-    lam0 = cma_population(d) if population is None else population
-    _check_budget(budget, lam0, what="CMA-ES")
-    seeds = np.random.SeedSequence(seed).spawn(5)[4]
-    rng = np.random.default_rng(seeds)
-    lo, span = bounds[:, 0], bounds[:, 1] - bounds[:, 0]
-    rec = _Recorder(evaluate)
-    n = max(d, 2)
-    unit_points: list[np.ndarray] = []  # what CMA-ES asked, in the unit box (the recorder keeps the box's)
-
-    def run(unit: np.ndarray) -> np.ndarray:  # a coordinate at 1 is the upper bound itself, not lo + span
-        unit_points.append(unit)
-        return rec(np.where(unit[:, :d] >= 1.0, bounds[:, 1], lo + unit[:, :d] * span))
-
-    def incumbent() -> np.ndarray:
-        """The worst point found so far, in the unit box (the first of equals; NaN ranks last)."""
-        v = rec.trace().values
-        return np.concatenate(unit_points)[int(np.argmax(np.where(np.isnan(v), -np.inf, v)))]
-
-    start = np.full(n, 0.5)
-    if vertices:
-        corners = covering_design(d, portfolio_vertices(d, budget), rng)
-        corner_values = run(np.hstack([corners, np.full((len(corners), n - d), 0.5)]))
-        start[:d] = screened_start(corners, corner_values)
-    local_sigma = portfolio_local_phase(budget)[1]
-    # the global phase in whole generations of the first population, the local phase the rest; a budget
-    # that leaves the global phase no whole generation has no local phase (CMA-ES from the centre, as before)
-    global_end = rec.spent + portfolio_phases(d, budget, lam0)[1] if vertices else budget
-    generations = (global_end - rec.spent) // lam0
-    runs = portfolio_global_runs(d, budget, lam0) if vertices else 1
-    run_ends = [rec.spent + generations * (i + 1) // runs * lam0 for i in range(runs - 1)] + [global_end]
-    local_end = budget - (portfolio_coordinate_runs(d, budget, lam0) if vertices else 0)
-    mean, lam, sigma = start, lam0, CMA_SIGMA0
-    while rec.spent < local_end:
-        if rec.spent >= global_end:  # the local phase (and its restarts): around the worst point found
-            mean, lam, sigma = np.clip(incumbent(), 0.0, 1.0), lam0, local_sigma
-        elif rec.spent >= run_ends[0]:  # the global phase's next independent run, from the same start
-            run_ends.pop(0)
-            mean, lam, sigma = start, lam0, CMA_SIGMA0
-        opt = CMA(mean=mean, sigma=sigma, bounds=np.array([[0.0, 1.0]] * n), population_size=lam,
-                  seed=int(rng.integers(2 ** 31 - 1)))
-        end = run_ends[0] if rec.spent < global_end else local_end
-        while rec.spent < end:
-            xs = np.array([opt.ask() for _ in range(opt.population_size)])
-            k = min(len(xs), end - rec.spent)
-            v = run(xs[:k])
-            if k < len(xs):
-                break
-            opt.tell([(x, 1e300 if math.isnan(e) else -e) for x, e in zip(xs, v)])  # cmaes minimises
-            if opt.should_stop():
-                break
-        mean, lam = rng.uniform(0.0, 1.0, n), 2 * lam  # IPOP restart (of the global phase)
-    while rec.spent < budget:  # coordinate moves of the worst point found, a generation's worth per batch
-        k = min(lam0, budget - rec.spent)
-        moved = rng.random((k, d)) < 1.0 / d
-        unmoved = ~moved.any(axis=1)
-        moved[unmoved, rng.integers(d, size=int(unmoved.sum()))] = True  # at least one coordinate each
-        xs = np.repeat(incumbent()[None, :], k, axis=0)
-        xs[:, :d] += np.where(moved, PORTFOLIO_COORDINATE_STEP * rng.standard_normal((k, d)), 0.0)
-        run(np.clip(xs, 0.0, 1.0))
-    return rec.trace()
-
-
-def _search_de(evaluate: Callable[[np.ndarray], np.ndarray], bounds: np.ndarray, *, budget: int, seed: int = 0,
-                 population: int | None = None) -> Trace:
-    """Maximise ``evaluate`` over the box ``bounds`` (d, 2) with scipy's differential evolution.
-
-    evaluate(points (S, d)) -> values (S,), NaN where undefined, is called once per
-    generation with the whole population. At most ``budget`` points are evaluated:
-    ``population`` (default :func:`population_size`) per generation, for
-    budget // population generations, the first a Latin hypercube. Seeded: the same
-    seed gives the same points.
-    """
-    from scipy.optimize import differential_evolution
-
-    from wmr_mj.sim.sweep import latin_hypercube
-
-    bounds = np.asarray(bounds, dtype=float)
-    d = len(bounds)
-    population = population_size(budget, d) if population is None else population
-    _check_budget(budget, population)
-    init_rng, evolve_rng, _ = _streams(seed)
-    init = _unit_to_box(latin_hypercube(population, d, init_rng), bounds)
-    rec = _Recorder(evaluate)
-
-    def energies(x: np.ndarray) -> np.ndarray:  # x: (d, S); DE minimises
-        v = rec(np.array(x.T, dtype=float))
-        return np.where(np.isnan(v), np.inf, -v)
-
-    with warnings.catch_warnings(), _user_errors_unwrapped():
-        warnings.simplefilter("ignore", RuntimeWarning)  # inf energies of undefined points
-        differential_evolution(energies, bounds, maxiter=budget // population - 1, init=init, polish=False,
-                               tol=0.0, atol=0.0, updating="deferred", vectorized=True, rng=evolve_rng)
-    return rec.trace()
-
-
-def random_worst(evaluate: Callable[[np.ndarray], np.ndarray], bounds: np.ndarray, *, n: int,
-                 seed: int = 0) -> Trace:
-    """The same budget spent at random: ``n`` Latin-hypercube points of the box, one call."""
-    from wmr_mj.sim.sweep import latin_hypercube
-
-    bounds = np.asarray(bounds, dtype=float)
-    points = _unit_to_box(latin_hypercube(n, len(bounds), _streams(seed)[2]), bounds)
-    values = np.asarray(evaluate(points), dtype=float).reshape(-1)
-    return Trace(points, values, np.zeros(n, dtype=int))
-
-
 # -- falsify: the search on closed-loop runs ------------------------------------------------
 
 @dataclass(frozen=True, kw_only=True)
@@ -762,8 +226,6 @@ class FalsifySpec:
     requirement: str | None = None  # objective 'requirement': an STL formula (wmr_mj.analysis.requirements)
 
     def __post_init__(self) -> None:
-        from wmr_mj._util.checks import positive_range as _check_range
-
         if self.objective not in OBJECTIVES:
             raise UnknownNameError("objective", self.objective, OBJECTIVES)
         if self.method not in METHODS:
@@ -772,8 +234,6 @@ class FalsifySpec:
             raise ParameterError("the objective 'requirement' goes with a requirement (an STL formula), and only it")
         if self.requirement is not None:
             self.parsed_requirement  # noqa: B018  (refused here, before any run, when malformed)
-        from wmr_mj.sim.search_space import check_hardware_range, config_for, hardware_axis, path_axis, signal_axis
-
         if not self.box:
             raise ParameterError("the box is empty; give at least one ranged parameter (e.g. --uncertainty m1)")
         names = parameter_names()
@@ -787,7 +247,7 @@ class FalsifySpec:
                 continue
             if name not in names:
                 raise UnknownNameError("parameter", name, names)
-            _check_range(name, lo, hi)
+            positive_range(name, lo, hi)
         amplitude = self.box.get("disturbance.amplitude")
         signals = self.base.signals
         if amplitude is not None and signals is not None and signals.d_max is None:
@@ -797,7 +257,7 @@ class FalsifySpec:
         config_for(self.base, self.names, [lo for lo, _ in self.box.values()])  # a bad axis fails before any run
         if isinstance(self.seed, bool) or not isinstance(self.seed, int):
             raise ParameterError(f"seed = {self.seed!r} is not accepted; give an integer")
-        _check_budget(self.budget, self.population_size if self.population_size is not None else MIN_POPULATION,
+        check_budget(self.budget, self.population_size if self.population_size is not None else MIN_POPULATION,
                       what=_POPULATION_OF.get(self.method, "the search"))
 
     @property
@@ -829,8 +289,6 @@ class FalsifySpec:
     def recorded_values(self, point: Sequence[float]) -> dict[str, float]:
         """Each ranged parameter -> the value its run used (what the search's tables record): as proposed, but a
         hardware axis rounded as the run has it (:func:`wmr_mj.sim.search_space.hardware_values`)."""
-        from wmr_mj.sim.search_space import hardware_axis, hardware_values
-
         out = {n: float(v) for n, v in zip(self.names, point)}
         out.update(hardware_values(self.base, {n: v for n, v in out.items() if hardware_axis(n)}))
         return out
@@ -838,8 +296,6 @@ class FalsifySpec:
     def config(self, point: Sequence[float]) -> RunConfig:
         """The run at ``point`` (values in ``names`` order): m1, the plant overrides and the signals'
         parameters set (:func:`wmr_mj.sim.search_space.config_for`)."""
-        from wmr_mj.sim.search_space import config_for
-
         return config_for(self.base, self.names, point)
 
 
@@ -867,7 +323,21 @@ class Evaluation:
 
     @property
     def verdict(self) -> str:
-        return _verdict(self.summary)
+        return verdict_of(self.summary)
+
+
+@dataclass(frozen=True, kw_only=True)
+class BindingTerm(Record):
+    """The largest part of delta1 of a run's certificate, the term that binds its E_max most
+    (:func:`wmr_mj.sim.falsify_objectives.binding_term`).
+
+    Attributes:
+        name: the term's name in the certificate's JSON (``friction_term``, ``gyro_term``, ``K_term``, ...).
+        value: its value [rad/s^2].
+    """
+
+    name: str
+    value: float
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -875,7 +345,8 @@ class Tightness(Record):
     """How tight the certificate is (:attr:`FalsifyResult.tightness`).
 
     Attributes:
-        ratio: the worst objective found, sup|E|/E_max of the certificate [-] (a lower bound on the worst case).
+        ratio: sup|E|/E_max of the worst run's certificate [-] (where the objective is that ratio, the worst
+            objective found: a lower bound on the worst case).
         factor: 1/ratio, how many times the worst case found the certificate is (inf where ratio <= 0).
         found_sup_E: the worst run's sup|E| [rad].
         E_max: the certificate's E_max [rad] (an upper bound); None where the run has none.
@@ -892,10 +363,11 @@ class Tightness(Record):
 @dataclass(frozen=True, kw_only=True)
 class WorstRun(Record):
     """The search's worst run (``falsify --json``'s ``worst``): its parameters, objective, sup|E| [rad],
-    sup|E'| [rad/s], verdict, generation and index (0-based in the search), and the claim's assumptions it
-    does not meet."""
+    sup|E'| [rad/s], verdict, generation and index (0-based in the search), the claim's assumptions it
+    does not meet, and its certificate, whatever the objective: its E_max [rad] (None where the run has none)
+    and the largest term of its delta1 (:class:`BindingTerm`; None where it has none)."""
 
-    _records = {"unmet": UnmetAssumption}
+    _records = {"unmet": UnmetAssumption, "binding_term": BindingTerm}
 
     params: Mapping[str, float]
     objective: float | None
@@ -905,6 +377,8 @@ class WorstRun(Record):
     generation: int
     index: int
     unmet: tuple[UnmetAssumption, ...]
+    E_max: float | None = None
+    binding_term: BindingTerm | None = None
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -939,7 +413,8 @@ class FalsifyReport(Record):
         claim_broken: the run that breaks the claim most; None when none does.
         box: each ranged parameter -> (lo, hi).
         worst: the search's worst run.
-        tightness: how tight the certificate is, where the objective is its ratio; else None.
+        tightness: how tight the worst run's certificate is, whatever the objective; None where the objective is
+            not the certificate's ratio and that run has no certificate.
         random: the random sample's worst run.
         log: the MCAP log of the worst run's re-run; None where not written.
     """
@@ -1020,27 +495,33 @@ class FalsifyResult:
 
     @property
     def tightness(self) -> Tightness | None:
-        """How tight the certificate is, where the objective is its ratio sup|E|/E_max: the worst
-        found (a lower bound on the worst case: a run reached it) beside the certificate's E_max (an
-        upper bound), their ratio X and 1/X, and the sentence falsify prints. None for other objectives."""
-        if self.spec.objective != "certificate":
-            return None
+        """How tight the certificate is, whatever the objective: the worst run's sup|E| (where the objective is
+        the certificate's ratio, the worst found: a lower bound on the worst case, a run reached it) beside its
+        certificate's E_max (an upper bound), their ratio X and 1/X, and the sentence falsify prints. Where the
+        objective is another, the worst run is that objective's, and the sentence says so; None where that run
+        has no certificate."""
         w = self.worst
-        certificate = w.summary.get("certificate")
-        e_max = certificate.get("E_max") if isinstance(certificate, Mapping) else None
-        x = w.objective
+        e_max = certificate_E_max(w.summary)
+        if self.spec.objective == "certificate":
+            x = w.objective
+        elif e_max is None:
+            return None
+        else:
+            x = objective_value(w.summary, "certificate")
         factor = 1.0 / x if x is not None and x > 0 else math.inf
-        bound = "n/a" if e_max is None else f"{float(e_max):.4g}"
+        bound = "n/a" if e_max is None else f"{e_max:.4g}"
         if x is not None and x > 1.0:  # exceeded: said as such, never as a fraction of the worst case
             text = (f"the worst run is {x:.3g} times the claimed bound (sup|E| = {w.sup_E:.4g} rad found, <= "
                     f"{bound} rad claimed): the claim is exceeded"
                     + (" and its assumptions hold: CERTIFIED-OUTSIDE" if w.verdict == CERTIFIED_OUTSIDE else
                        f" where its assumptions are not all met ({w.verdict}): not a broken claim"))
         else:
-            text = (f"the worst found is {x:.4g} of the certificate's bound: the certificate is {factor:.3g} times "
-                    f"the worst case found (sup|E| >= {w.sup_E:.4g} rad found, <= {bound} rad certified)")
-        return Tightness(ratio=x, factor=factor, found_sup_E=w.sup_E, E_max=None if e_max is None else float(e_max),
-                         text=text)
+            text = (f"the worst found is {_number(x, '.4g')} of the certificate's bound: the certificate is "
+                    f"{factor:.3g} times the worst case found (sup|E| >= {w.sup_E:.4g} rad found, <= {bound} rad "
+                    "certified)")
+        if self.spec.objective != "certificate":
+            text += f" (the worst run by {OBJECTIVE_LABELS[self.spec.objective]})"
+        return Tightness(ratio=x, factor=factor, found_sup_E=w.sup_E, E_max=e_max, text=text)
 
     @property
     def claim_broken(self) -> BrokenRun | None:
@@ -1076,9 +557,8 @@ class FalsifyResult:
 
     def report(self, *, log: str | None = None) -> FalsifyReport:
         """What the search found, typed (``log``: the worst run's MCAP log, where written)."""
-        from wmr_mj.analysis.verdicts import unmet_assumptions
-
         w, r = self.worst, self.random_worst
+        binding = binding_term(w.summary)
         return FalsifyReport(
             objective=self.spec.objective, objective_label=OBJECTIVE_LABELS[self.spec.objective],
             objective_source=self.objective_source, budget=self.spec.budget, evaluations=len(self.search),
@@ -1089,7 +569,9 @@ class FalsifyResult:
             worst=WorstRun(params=dict(w.params), objective=w.objective, sup_E=w.sup_E, sup_Edot=w.sup_Edot,
                            verdict=w.verdict, generation=w.generation, index=w.index,
                            unmet=tuple(UnmetAssumption.from_dict(a)
-                                       for a in unmet_assumptions(w.summary.get("certificate")))),
+                                       for a in unmet_assumptions(w.summary.get("certificate"))),
+                           E_max=certificate_E_max(w.summary),
+                           binding_term=None if binding is None else BindingTerm(name=binding[0], value=binding[1])),
             tightness=self.tightness,
             random=RandomWorst(worst_objective=r.objective, worst_params=dict(r.params), evaluations=len(self.random),
                                sup_E=r.sup_E, verdict=r.verdict),
@@ -1220,6 +702,10 @@ def check_runnable(base: RunConfig) -> Any:
     from wmr_mj.sim.parts import resolve_run
 
     return resolve_run(base)
+
+
+def _number(x: float | None, spec: str) -> str:
+    return "n/a" if x is None else format(x, spec)
 
 
 def worst_config(result: FalsifyResult) -> RunConfig:
