@@ -44,6 +44,7 @@ from wmr_mj.analysis.regions import BoxRegion
 from wmr_mj.analysis.sampled_data import PeakGains, SampledLoop, _norm_bound, _Rows, peak_gains, sampled_loop
 from wmr_mj.analysis.small_gain import Compensation, Estimate, Gains, _Bound
 from wmr_mj.errors import ParameterError
+from wmr_mj.hardware.estimators import velocity_estimator
 from wmr_mj.hardware.sensing import Sensing, measurement_error_bounds
 from wmr_mj.hardware.spec import whole_periods
 from wmr_mj.reference.bounds import ReferenceBounds
@@ -261,7 +262,7 @@ def _linear(bound: _Bound, cart: SampledCart, T: float, c_hat: float) -> _Linear
         ref_rate = 0.5 * T * bound.a0dd  # alpha0'(t_k) - (alpha0(t_k) - alpha0(t_{k-1}))/T
     else:
         tau = float(cart.filter_tau or 0.0)
-        a = math.exp(-T / tau)
+        a = velocity_estimator("filtered", control_period=T, filter_tau=tau).a
         ref_rate = (T * a / (1.0 - a) + 0.5 * T + tau / math.e) * bound.a0dd  # mean age, and the missing weight
     velocity_channel = cart.velocity_noise + ref_rate
     if not gains.stable:
