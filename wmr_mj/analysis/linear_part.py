@@ -47,13 +47,12 @@ from wmr_mj.analysis.sampled_data import (
     _delayed,
     _estimate,
     _Rows,
-    _whole_periods,
     peak_bounds,
     peak_gains,
 )
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.hardware.estimators import velocity_estimator
-from wmr_mj.hardware.spec import whole_periods
+from wmr_mj.hardware.spec import whole_period_count, whole_periods
 
 if TYPE_CHECKING:
     from wmr_mj.analysis.claim import ClaimContext
@@ -160,7 +159,8 @@ def sampled_loop_of(controller: LinearModel, *, control_period: float, continuou
     if m != (1 if velocity == "none" else 2):
         raise ParameterError(f"controller has {m} input(s) but velocity is {velocity!r}: one input (E^) goes with "
                              "'none', two (E^, E^') with a velocity estimate of the sensing")
-    d_s, d_a = _whole_periods("sensing_delay", sensing_delay), _whole_periods("actuation_delay", actuation_delay)
+    d_s = whole_period_count("sensing_delay", sensing_delay)
+    d_a = whole_period_count("actuation_delay", actuation_delay)
     return _assemble(Ac, Bc, Cc, Dc, T=T, velocity=velocity, tau=tau, d_s=d_s, d_a=d_a)
 
 

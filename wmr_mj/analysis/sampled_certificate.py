@@ -47,7 +47,7 @@ from wmr_mj.errors import ParameterError
 from wmr_mj.hardware.estimators import velocity_estimator
 from wmr_mj.hardware.sensing import Sensing, measurement_error_bounds
 from wmr_mj.hardware.spec import whole_periods
-from wmr_mj.reference.bounds import ReferenceBounds
+from wmr_mj.reference.bounds import ReferenceBounds, sin_cos3
 
 __all__ = ["SAMPLED_DATA", "SampledCart", "SampledDataTerms", "SampledDataInputs", "sampled_certificate",
            "damped_loop"]
@@ -303,7 +303,7 @@ def _solve_at(bound: _Bound, lin: _Linear, cart: SampledCart, T: float, c_hat: f
     if A_m >= 0.5 * math.pi:
         return _Solved(x, y, inf, inf, inf, eps_a, inf, A_m, None,
                        f"the measured angle reaches pi/2 (max|alpha0| + E_max + e_alpha = {A_m:.4g} rad)")
-    S, c2, c2m = _S(A), math.cos(A) ** 2, math.cos(A_m) ** 2
+    S, c2, c2m = sin_cos3(A), math.cos(A) ** 2, math.cos(A_m) ** 2
     P_lo, corners = b.P_corners[0], b.P_corners
     F, r = b.plant.box.F, b.plant.friction_over_P
     hold_dd = 2.0 * b.a0dd  # alpha0''(t) - alpha0''(t_k'): no jerk bound
@@ -356,10 +356,6 @@ def _solve_at(bound: _Bound, lin: _Linear, cart: SampledCart, T: float, c_hat: f
     x_new = Es + T * Ys + 0.5 * T * T * A2
     eps_v = cart.velocity_error + lag * (b.a0dd + A2)
     return _Solved(x_new, y_new, U, W, A2, eps_a, eps_v, A_m, dataclasses.replace(terms, W=W, U=U), Wt=Wt)
-
-
-def _S(alpha: float) -> float:
-    return math.sin(alpha) / math.cos(alpha) ** 3
 
 
 def _fixed_point(step: Any, a0: float) -> tuple[_Solved | None, int, str]:
@@ -431,7 +427,7 @@ def sampled_certificate(*, plant: PlantBox, estimate: Estimate, gains: Gains, re
     alpha_max = bound.a0 + E_max
     est = bound.estimate
     voltage_max = (est.P * (bound.P_ff / est.P * bound.a0dd + solved.U) + abs(est.C_V) * bound.a0d
-                   + abs(est.K) * _S(solved.alpha_m) + bound.F_comp
+                   + abs(est.K) * sin_cos3(solved.alpha_m) + bound.F_comp
                    + abs(bound.Gam_hat) * (bound.a0d + Edot_max + solved.eps_v)
                    / math.cos(solved.alpha_m) ** 2)
     assert solved.terms is not None

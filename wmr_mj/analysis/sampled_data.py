@@ -45,6 +45,7 @@ from wmr_mj._util.checks import positive_real
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.hardware.estimators import VelocityEstimator, delay_line, velocity_estimator
 from wmr_mj.hardware.sensing import Sensing, VelocityEstimate
+from wmr_mj.hardware.spec import whole_period_count
 
 __all__ = [
     "SampledLoop",
@@ -153,13 +154,6 @@ class PeakGains:
         if source not in SOURCES:
             raise UnknownNameError("sampled-loop source", source, SOURCES)
         return float(self.gains[OUTPUTS.index(output), SOURCES.index(source)])
-
-
-def _whole_periods(name: str, value: object) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
-        raise ParameterError(f"{name} = {value!r} is not accepted; a whole number of control periods >= 0 "
-                             "is required")
-    return int(value)
 
 
 def _check_estimate(velocity: str, filter_tau: float | None) -> float | None:
@@ -292,7 +286,8 @@ def sampled_loop(*, kp: float, kd: float, control_period: float, velocity: Veloc
     K_P, K_D = positive_real("kp", kp, " 1/s^2"), positive_real("kd", kd, " 1/s")
     T = positive_real("control_period", control_period, " s")
     tau = _check_estimate(str(velocity), filter_tau)
-    d_s, d_a = _whole_periods("sensing_delay", sensing_delay), _whole_periods("actuation_delay", actuation_delay)
+    d_s = whole_period_count("sensing_delay", sensing_delay)
+    d_a = whole_period_count("actuation_delay", actuation_delay)
     r = _Rows(str(velocity), d_s, d_a)
     n = r.n
     E_hat = _delayed(r.unit(0), r.E_line, r)[1] - r.unit(n)  # E[k - d_s] - e[k]
@@ -499,7 +494,7 @@ def characteristic_polynomial(*, kp: float, kd: float, control_period: float,
     K_P, K_D = positive_real("kp", kp, " 1/s^2"), positive_real("kd", kd, " 1/s")
     T = positive_real("control_period", control_period, " s")
     tau = _check_estimate(str(velocity), filter_tau)
-    d = _whole_periods("delay", delay)
+    d = whole_period_count("delay", delay)
     P = np.polynomial.polynomial  # coefficients lowest power first below
     plant_den, plant_num = np.array([1.0, -2.0, 1.0]), np.array([T * T / 2.0, T * T / 2.0])
     if velocity in ("exact", "tachometer"):
@@ -554,7 +549,7 @@ def delay_margin(*, kp: float, kd: float, control_period: float, velocity: Veloc
     Raises:
         ParameterError, UnknownNameError: as :func:`sampled_loop`.
     """
-    _whole_periods("max_delay", max_delay)
+    whole_period_count("max_delay", max_delay)
     for d in range(max_delay + 1):
         poly = characteristic_polynomial(kp=kp, kd=kd, control_period=control_period, velocity=velocity,
                                          filter_tau=filter_tau, delay=d)

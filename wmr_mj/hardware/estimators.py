@@ -50,6 +50,7 @@ from typing import Literal, get_args
 import numpy as np
 
 from wmr_mj.errors import ParameterError, UnknownNameError
+from wmr_mj.hardware.spec import whole_period_count
 
 __all__ = ["DiscreteSystem", "VelocityEstimator", "LinearVelocityEstimate", "LINEAR_VELOCITY_ESTIMATES",
            "velocity_estimator", "delay_line"]
@@ -167,10 +168,7 @@ def delay_line(periods: int) -> DiscreteSystem:
     Raises:
         ParameterError: d not a whole number >= 0.
     """
-    if isinstance(periods, bool) or not isinstance(periods, (int, np.integer)) or periods < 0:
-        raise ParameterError(f"delay = {periods!r} periods is not accepted; a whole number of control periods >= 0 "
-                             "is required")
-    d = int(periods)
+    d = whole_period_count("delay", periods)
     A = np.eye(d, k=-1)
     B = np.zeros((d, 1))
     C = np.zeros((1, d))
