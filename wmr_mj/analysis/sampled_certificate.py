@@ -36,7 +36,7 @@ from typing import Any
 
 import numpy as np
 
-from wmr_mj.analysis.claim import shared_assumptions
+from wmr_mj.analysis.claim import least_fixed_point, shared_assumptions, tangent_reason
 from wmr_mj.analysis.claim_types import Assumption, Certificate, ClaimInputs
 from wmr_mj.analysis.measurement import MeasurementErrors, coverage_assumption_fields, inv_cos2_slope, sin_cos3_slope
 from wmr_mj.analysis.plant_box import PlantBox, PlantLimits
@@ -360,23 +360,27 @@ def _solve_at(bound: _Bound, lin: _Linear, cart: SampledCart, T: float, c_hat: f
 
 def _fixed_point(step: Any, a0: float) -> tuple[_Solved | None, int, str]:
     """The least (x, y) with (x, y) = step(x, y), iterated from (0, 0) (each coordinate rises; ``step`` is
-    increasing in both), checked not tangent: step at (x, y) (1 + h) lies below it (as the scalar fixed point
-    of :func:`wmr_mj.analysis.claim.fixed_point`)."""
-    x = y = 0.0
-    for k in range(1, _ITERATIONS + 1):
-        s = step(x, y)
+    increasing in both) by :func:`wmr_mj.analysis.claim.least_fixed_point`, checked not tangent: step at
+    (x, y) (1 + h) lies below it; the step at the settled point returned."""
+    def rise(v: tuple[float, ...]) -> tuple[tuple[float, ...], str]:
+        s = step(*v)
         if s.failure:
-            return None, k, f"no sampled-data bound: {s.failure}"
+            return v, f"no sampled-data bound: {s.failure}"
         if a0 + s.x >= 0.5 * math.pi:
-            return None, k, f"no sampled-data bound: max|alpha0| + E_max reaches pi/2 (E_max = {s.x:.4g} rad)"
-        if s.x <= x * (1.0 + 1e-13) + 1e-300 and s.y <= y * (1.0 + 1e-13) + 1e-300:
-            h = 1e-6
-            bumped = step(x * (1.0 + h) + 1e-12, y * (1.0 + h) + 1e-12)
-            if bumped.failure or not (bumped.x < x * (1.0 + h) + 1e-12 and bumped.y < y * (1.0 + h) + 1e-12):
-                return None, k, f"tangent fixed point at E_max = {x:.4g} rad: the bound does not confine the error"
-            return step(max(x, s.x), max(y, s.y)), k, ""
-        x, y = max(x, s.x), max(y, s.y)
-    return None, _ITERATIONS, f"no sampled-data bound: E_max did not settle in {_ITERATIONS} iterations"
+            return v, f"no sampled-data bound: max|alpha0| + E_max reaches pi/2 (E_max = {s.x:.4g} rad)"
+        return (s.x, s.y), ""
+
+    def tangent(previous: tuple[float, ...], _settled: tuple[float, ...]) -> str:
+        x, y = previous
+        h = 1e-6
+        bumped = step(x * (1.0 + h) + 1e-12, y * (1.0 + h) + 1e-12)
+        if bumped.failure or not (bumped.x < x * (1.0 + h) + 1e-12 and bumped.y < y * (1.0 + h) + 1e-12):
+            return tangent_reason(x)
+        return ""
+
+    point, k, reason = least_fixed_point(rise, 2, tangent=tangent, max_iterations=_ITERATIONS,
+                                         what="no sampled-data bound")
+    return (None, k, reason) if point is None else (step(*point), k, "")
 
 
 def sampled_certificate(*, plant: PlantBox, estimate: Estimate, gains: Gains, reference: ReferenceBounds,
