@@ -29,7 +29,8 @@ With alpha0 = 0 (the reference's own terms are exogenous and not part of this co
 - E^'[k] = (E^[k] - E^[k-1]) / T - n_v[k]                        (difference)
 - E^'[k] = y[k] - n_v[k], y[k] = a y[k-1] + (1 - a)(E^[k] - E^[k-1]) / T, a = exp(-T / tau_f)   (filtered)
 
-Outputs: E[k], E'[k] (at the sampling instants) and u[k].
+Outputs: E[k], E'[k] (at the sampling instants) and u[k]. The estimate and the delay lines are the systems of
+:mod:`wmr_mj.hardware.estimators` (defined there once): the loop's rows are read from their matrices.
 """
 
 from __future__ import annotations
@@ -264,7 +265,8 @@ def sampled_loop(*, kp: float, kd: float, control_period: float, velocity: Veloc
 
     The plant's step is exact: exp([[0, 1], [0, 0]] T) = [[1, T], [0, 1]], and the held u enters through
     int_0^T exp(A_c s) ds B_c = [T^2/2, T] (with E'' = -u, the sign is -); the estimator's rows are the
-    sensing chain's own recursions (module docstring).
+    matrices of the sensing chain's own estimator (:func:`wmr_mj.hardware.estimators.velocity_estimator`), the
+    delays those of :func:`~wmr_mj.hardware.estimators.delay_line`.
 
     Args:
         kp: K_P, 1/s^2 (> 0). kd: K_D, 1/s (> 0).
