@@ -51,7 +51,7 @@ from wmr_mj.reference.bounds import ReferenceBounds
 
 __all__ = ["ClaimContext", "box_claim", "run_assumptions", "RunAssumptions", "shared_assumptions", "fixed_point",
            "with_measured", "covers_measurement", "best_certificate", "replace_inputs", "SAMPLED_DATA_NAME",
-           "INITIAL_TOLERANCE"]
+           "INITIAL_TOLERANCE", "least_fixed_point", "tangent_reason"]
 
 #: The tolerance on |E(0)|, |E'(0)| of the assumption 'zero initial error' (the reference's rounding at t = 0).
 INITIAL_TOLERANCE = 1e-9
@@ -179,34 +179,74 @@ def run_assumptions(*, alpha_max: float, voltage_max: float, context: ClaimConte
                                     initial_error=context.initial_error, initial_tolerance=initial_tolerance))
 
 
+def least_fixed_point(step: Callable[[tuple[float, ...]], tuple[tuple[float, ...], str]], dimension: int, *,
+                      tangent: Callable[[tuple[float, ...], tuple[float, ...]], str], max_iterations: int,
+                      what: str = "no fixed point") -> tuple[tuple[float, ...] | None, int, str]:
+    """The least point v >= 0 with v = step(v), iterated from 0: the one fixed-point iteration of the claims.
+
+    Each iterate is the componentwise max of the last and its step (``step`` is increasing in every coordinate,
+    so the iterates rise); it has settled where no coordinate of the step exceeds the iterate by more than 1e-13
+    relative (1e-300 absolute). :func:`fixed_point` (section 4's E_max) and the sampled-data certificate's
+    (E_max, Edot_max) (:mod:`wmr_mj.analysis.sampled_certificate`) both iterate here.
+
+    Args:
+        step: v -> (step(v), "" or the complete reason no bound exists there, which ends the iteration).
+        dimension: the number of coordinates.
+        tangent: (the last iterate, the settled point) -> "" where the step confines the point (it lies below
+            a point just above it), else the reason (a tangent fixed point: the bound does not confine the error).
+        max_iterations: the most steps.
+        what: the start of the reason where it does not settle ('no fixed point').
+
+    Returns:
+        (the settled point, iterations, "") or (None, iterations, the reason).
+    """
+    x = (0.0,) * dimension
+    for k in range(1, max_iterations + 1):
+        nxt, failure = step(x)
+        if failure:
+            return None, k, failure
+        settled = all(n <= v * (1.0 + 1e-13) + 1e-300 for n, v in zip(nxt, x))
+        previous, x = x, tuple(max(v, n) for v, n in zip(x, nxt))
+        if settled:
+            reason = tangent(previous, x)
+            return (None, k, reason) if reason else (x, k, "")
+    return None, max_iterations, f"{what}: E_max did not settle in {max_iterations} iterations"
+
+
+def tangent_reason(E_max: float) -> str:
+    """The reason of a tangent fixed point at ``E_max`` [rad] (:func:`least_fixed_point`)."""
+    return f"tangent fixed point at E_max = {E_max:.4g} rad: the bound does not confine the error"
+
+
 def fixed_point(phi: Callable[[float], float], alpha0_max: float, *,
                 max_iterations: int = _FIXED_POINT_ITERATIONS) -> tuple[float, int, str]:
-    """Least x >= 0 with x = phi(x), alpha = alpha0_max + x staying in (-pi/2, pi/2).
+    """Least x >= 0 with x = phi(x), alpha = alpha0_max + x staying in (-pi/2, pi/2) (:func:`least_fixed_point`).
 
     phi(x) is the bound at alpha_max = alpha0_max + x (increasing; inf where (4.23)
     fails). Returns (x*, iterations, reason); x* = inf with the reason when the
     iteration leaves (-pi/2, pi/2), (4.23) fails on the way, the fixed point is tangent
     (phi(x) >= x just above it), or it does not settle.
     """
-    x = 0.0
-    for k in range(1, max_iterations + 1):
+    def step(v: tuple[float, ...]) -> tuple[tuple[float, ...], str]:
+        x = v[0]
         if alpha0_max + x >= 0.5 * math.pi:
-            return math.inf, k, (f"no fixed point: the bound on |alpha| = max|alpha0| + E_max reaches pi/2 "
-                                 f"(iterate E_max = {x:.4g} rad), where sin/cos^3 and 1/cos^2 are unbounded")
+            return v, (f"no fixed point: the bound on |alpha| = max|alpha0| + E_max reaches pi/2 "
+                       f"(iterate E_max = {x:.4g} rad), where sin/cos^3 and 1/cos^2 are unbounded")
         nxt = phi(x)
         if not math.isfinite(nxt):
-            return math.inf, k, (f"no fixed point: (4.23) fails at alpha_max = {alpha0_max + x:.4g} rad "
-                                 f"(iterate E_max = {x:.4g} rad)")
-        if nxt <= x * (1.0 + 1e-13) + 1e-300:
-            x = max(x, nxt)
-            break
-        x = nxt
-    else:
-        return math.inf, max_iterations, f"no fixed point: E_max did not settle in {max_iterations} iterations"
-    h = max(1e-6 * x, 1e-12)
-    if alpha0_max + x + h < 0.5 * math.pi and not phi(x + h) < x + h:
-        return math.inf, k, f"tangent fixed point at E_max = {x:.4g} rad: the bound does not confine the error"
-    return x, k, ""
+            return v, (f"no fixed point: (4.23) fails at alpha_max = {alpha0_max + x:.4g} rad "
+                       f"(iterate E_max = {x:.4g} rad)")
+        return (nxt,), ""
+
+    def tangent(_previous: tuple[float, ...], settled: tuple[float, ...]) -> str:
+        x = settled[0]
+        h = max(1e-6 * x, 1e-12)
+        if alpha0_max + x + h < 0.5 * math.pi and not phi(x + h) < x + h:
+            return tangent_reason(x)
+        return ""
+
+    point, k, reason = least_fixed_point(step, 1, tangent=tangent, max_iterations=max_iterations)
+    return (math.inf, k, reason) if point is None else (point[0], k, "")
 
 
 def box_claim(*, claimant: str, E_max: float, Edot_max: float = math.inf, context: ClaimContext, alpha_max: float,

@@ -44,12 +44,15 @@ from wmr_mj.analysis.sampled_data import (
     PeakGains,
     SampledLoop,
     _check_estimate,
+    _delayed,
+    _estimate,
     _Rows,
-    _whole_periods,
     peak_bounds,
     peak_gains,
 )
 from wmr_mj.errors import ParameterError, UnknownNameError
+from wmr_mj.hardware.estimators import velocity_estimator
+from wmr_mj.hardware.spec import whole_period_count, whole_periods
 
 if TYPE_CHECKING:
     from wmr_mj.analysis.claim import ClaimContext
@@ -156,7 +159,8 @@ def sampled_loop_of(controller: LinearModel, *, control_period: float, continuou
     if m != (1 if velocity == "none" else 2):
         raise ParameterError(f"controller has {m} input(s) but velocity is {velocity!r}: one input (E^) goes with "
                              "'none', two (E^, E^') with a velocity estimate of the sensing")
-    d_s, d_a = _whole_periods("sensing_delay", sensing_delay), _whole_periods("actuation_delay", actuation_delay)
+    d_s = whole_period_count("sensing_delay", sensing_delay)
+    d_a = whole_period_count("actuation_delay", actuation_delay)
     return _assemble(Ac, Bc, Cc, Dc, T=T, velocity=velocity, tau=tau, d_s=d_s, d_a=d_a)
 
 
@@ -179,27 +183,20 @@ def _assemble(Ac: np.ndarray, Bc: np.ndarray, Cc: np.ndarray, Dc: np.ndarray, *,
               tau: float | None, d_s: int, d_a: int) -> SampledLoop:
     r = _RowsOf(velocity, d_s, d_a, Ac.shape[0])
     n = r.n
-    E_hat = r.unit(r.E_line[-1] if d_s else 0) - r.unit(n)  # E[k - d_s] - e[k]
-    filt_row = None
+    E_hat = _delayed(r.unit(0), r.E_line, r)[1] - r.unit(n)  # E[k - d_s] - e[k]
+    estimator_rows: list[np.ndarray] = []
     if velocity == "none":
         inputs = [E_hat]
-    elif r.delayed_rate:
-        inputs = [E_hat, r.unit(r.V_line[-1] if d_s else 1) - r.unit(n + 1)]
-    else:  # as sampled_loop: the difference, through the chain's filter where filtered
-        difference = (E_hat - r.unit(r.prev)) / T
-        if r.has_filter:
-            a = math.exp(-T / tau) if tau is not None else 0.0
-            filt_row = a * r.unit(r.filt) + (1.0 - a) * difference
-            inputs = [E_hat, filt_row - r.unit(n + 1)]
-        else:
-            inputs = [E_hat, difference - r.unit(n + 1)]
+    else:  # as sampled_loop: the sensing's estimate, from its matrices
+        estimate, estimator_rows = _estimate(r, velocity_estimator(velocity, control_period=T, filter_tau=tau), E_hat)
+        inputs = [E_hat, estimate - r.unit(n + 1)]
     xc = [r.unit(i) for i in r.ctrl]
     u = Dc[0, 0] * inputs[0]
     for j in range(1, len(inputs)):
         u = u + Dc[0, j] * inputs[j]
     for i, row in enumerate(xc):
         u = u + Cc[0, i] * row
-    nxt = r.plant_step(u=u, E_hat=E_hat, filt_row=filt_row, T=T, d_a=d_a)
+    nxt = r.plant_step(u=u, estimator_rows=estimator_rows, T=T)
     for i, idx in enumerate(r.ctrl):
         row = np.zeros(n + 2)
         for j, src in enumerate(xc):
@@ -292,7 +289,7 @@ def linear_part_bounds(controller: LinearModel, *, context: ClaimContext, w: flo
                            velocity=sensing.velocity if reads_velocity else "none",
                            filter_tau=sensing.filter_tau if reads_velocity else None,
                            sensing_delay=sensing.delay_steps(T),
-                           actuation_delay=_whole_periods_of("actuation delay", context.actuation_delay, T))
+                           actuation_delay=whole_periods("actuation delay", context.actuation_delay, T))
     gains = peak_gains(loop)
     bounds = _source_bounds(context)
     if not (isinstance(reference_rate, (int, float)) and 0.0 <= reference_rate < math.inf):
@@ -311,10 +308,4 @@ def linear_part_bounds(controller: LinearModel, *, context: ClaimContext, w: flo
                            velocity_noise=bounds["velocity_noise"])
     return LinearPartBounds(E_max=E, Edot_max=Ed, u_max=u, by_source=by_source, source_bounds=bounds, gains=gains,
                             loop=loop)
-
-
-def _whole_periods_of(name: str, delay: float, T: float) -> int:
-    from wmr_mj.hardware.spec import whole_periods
-
-    return whole_periods(name, delay, T)
 

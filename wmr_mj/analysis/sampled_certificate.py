@@ -36,7 +36,7 @@ from typing import Any
 
 import numpy as np
 
-from wmr_mj.analysis.claim import shared_assumptions
+from wmr_mj.analysis.claim import least_fixed_point, shared_assumptions, tangent_reason
 from wmr_mj.analysis.claim_types import Assumption, Certificate, ClaimInputs
 from wmr_mj.analysis.measurement import MeasurementErrors, coverage_assumption_fields, inv_cos2_slope, sin_cos3_slope
 from wmr_mj.analysis.plant_box import PlantBox, PlantLimits
@@ -44,9 +44,10 @@ from wmr_mj.analysis.regions import BoxRegion
 from wmr_mj.analysis.sampled_data import PeakGains, SampledLoop, _norm_bound, _Rows, peak_gains, sampled_loop
 from wmr_mj.analysis.small_gain import Compensation, Estimate, Gains, _Bound
 from wmr_mj.errors import ParameterError
+from wmr_mj.hardware.estimators import velocity_estimator
 from wmr_mj.hardware.sensing import Sensing, measurement_error_bounds
 from wmr_mj.hardware.spec import whole_periods
-from wmr_mj.reference.bounds import ReferenceBounds
+from wmr_mj.reference.bounds import ReferenceBounds, sin_cos3
 
 __all__ = ["SAMPLED_DATA", "SampledCart", "SampledDataTerms", "SampledDataInputs", "sampled_certificate",
            "damped_loop"]
@@ -261,7 +262,7 @@ def _linear(bound: _Bound, cart: SampledCart, T: float, c_hat: float) -> _Linear
         ref_rate = 0.5 * T * bound.a0dd  # alpha0'(t_k) - (alpha0(t_k) - alpha0(t_{k-1}))/T
     else:
         tau = float(cart.filter_tau or 0.0)
-        a = math.exp(-T / tau)
+        a = velocity_estimator("filtered", control_period=T, filter_tau=tau).a
         ref_rate = (T * a / (1.0 - a) + 0.5 * T + tau / math.e) * bound.a0dd  # mean age, and the missing weight
     velocity_channel = cart.velocity_noise + ref_rate
     if not gains.stable:
@@ -302,7 +303,7 @@ def _solve_at(bound: _Bound, lin: _Linear, cart: SampledCart, T: float, c_hat: f
     if A_m >= 0.5 * math.pi:
         return _Solved(x, y, inf, inf, inf, eps_a, inf, A_m, None,
                        f"the measured angle reaches pi/2 (max|alpha0| + E_max + e_alpha = {A_m:.4g} rad)")
-    S, c2, c2m = _S(A), math.cos(A) ** 2, math.cos(A_m) ** 2
+    S, c2, c2m = sin_cos3(A), math.cos(A) ** 2, math.cos(A_m) ** 2
     P_lo, corners = b.P_corners[0], b.P_corners
     F, r = b.plant.box.F, b.plant.friction_over_P
     hold_dd = 2.0 * b.a0dd  # alpha0''(t) - alpha0''(t_k'): no jerk bound
@@ -357,29 +358,29 @@ def _solve_at(bound: _Bound, lin: _Linear, cart: SampledCart, T: float, c_hat: f
     return _Solved(x_new, y_new, U, W, A2, eps_a, eps_v, A_m, dataclasses.replace(terms, W=W, U=U), Wt=Wt)
 
 
-def _S(alpha: float) -> float:
-    return math.sin(alpha) / math.cos(alpha) ** 3
-
-
 def _fixed_point(step: Any, a0: float) -> tuple[_Solved | None, int, str]:
     """The least (x, y) with (x, y) = step(x, y), iterated from (0, 0) (each coordinate rises; ``step`` is
-    increasing in both), checked not tangent: step at (x, y) (1 + h) lies below it (as the scalar fixed point
-    of :func:`wmr_mj.analysis.claim.fixed_point`)."""
-    x = y = 0.0
-    for k in range(1, _ITERATIONS + 1):
-        s = step(x, y)
+    increasing in both) by :func:`wmr_mj.analysis.claim.least_fixed_point`, checked not tangent: step at
+    (x, y) (1 + h) lies below it; the step at the settled point returned."""
+    def rise(v: tuple[float, ...]) -> tuple[tuple[float, ...], str]:
+        s = step(*v)
         if s.failure:
-            return None, k, f"no sampled-data bound: {s.failure}"
+            return v, f"no sampled-data bound: {s.failure}"
         if a0 + s.x >= 0.5 * math.pi:
-            return None, k, f"no sampled-data bound: max|alpha0| + E_max reaches pi/2 (E_max = {s.x:.4g} rad)"
-        if s.x <= x * (1.0 + 1e-13) + 1e-300 and s.y <= y * (1.0 + 1e-13) + 1e-300:
-            h = 1e-6
-            bumped = step(x * (1.0 + h) + 1e-12, y * (1.0 + h) + 1e-12)
-            if bumped.failure or not (bumped.x < x * (1.0 + h) + 1e-12 and bumped.y < y * (1.0 + h) + 1e-12):
-                return None, k, f"tangent fixed point at E_max = {x:.4g} rad: the bound does not confine the error"
-            return step(max(x, s.x), max(y, s.y)), k, ""
-        x, y = max(x, s.x), max(y, s.y)
-    return None, _ITERATIONS, f"no sampled-data bound: E_max did not settle in {_ITERATIONS} iterations"
+            return v, f"no sampled-data bound: max|alpha0| + E_max reaches pi/2 (E_max = {s.x:.4g} rad)"
+        return (s.x, s.y), ""
+
+    def tangent(previous: tuple[float, ...], _settled: tuple[float, ...]) -> str:
+        x, y = previous
+        h = 1e-6
+        bumped = step(x * (1.0 + h) + 1e-12, y * (1.0 + h) + 1e-12)
+        if bumped.failure or not (bumped.x < x * (1.0 + h) + 1e-12 and bumped.y < y * (1.0 + h) + 1e-12):
+            return tangent_reason(x)
+        return ""
+
+    point, k, reason = least_fixed_point(rise, 2, tangent=tangent, max_iterations=_ITERATIONS,
+                                         what="no sampled-data bound")
+    return (None, k, reason) if point is None else (step(*point), k, "")
 
 
 def sampled_certificate(*, plant: PlantBox, estimate: Estimate, gains: Gains, reference: ReferenceBounds,
@@ -430,7 +431,7 @@ def sampled_certificate(*, plant: PlantBox, estimate: Estimate, gains: Gains, re
     alpha_max = bound.a0 + E_max
     est = bound.estimate
     voltage_max = (est.P * (bound.P_ff / est.P * bound.a0dd + solved.U) + abs(est.C_V) * bound.a0d
-                   + abs(est.K) * _S(solved.alpha_m) + bound.F_comp
+                   + abs(est.K) * sin_cos3(solved.alpha_m) + bound.F_comp
                    + abs(bound.Gam_hat) * (bound.a0d + Edot_max + solved.eps_v)
                    / math.cos(solved.alpha_m) ** 2)
     assert solved.terms is not None

@@ -29,12 +29,14 @@ With alpha0 = 0 (the reference's own terms are exogenous and not part of this co
 - E^'[k] = (E^[k] - E^[k-1]) / T - n_v[k]                        (difference)
 - E^'[k] = y[k] - n_v[k], y[k] = a y[k-1] + (1 - a)(E^[k] - E^[k-1]) / T, a = exp(-T / tau_f)   (filtered)
 
-Outputs: E[k], E'[k] (at the sampling instants) and u[k].
+Outputs: E[k], E'[k] (at the sampling instants) and u[k]. The estimate and the delay lines are the systems of
+:mod:`wmr_mj.hardware.estimators` (defined there once): the loop's rows are read from their matrices.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -42,7 +44,9 @@ import scipy.linalg
 
 from wmr_mj._util.checks import positive_real
 from wmr_mj.errors import ParameterError, UnknownNameError
+from wmr_mj.hardware.estimators import VelocityEstimator, delay_line, velocity_estimator
 from wmr_mj.hardware.sensing import Sensing, VelocityEstimate
+from wmr_mj.hardware.spec import whole_period_count
 
 __all__ = [
     "SampledLoop",
@@ -153,13 +157,6 @@ class PeakGains:
         return float(self.gains[OUTPUTS.index(output), SOURCES.index(source)])
 
 
-def _whole_periods(name: str, value: object) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
-        raise ParameterError(f"{name} = {value!r} is not accepted; a whole number of control periods >= 0 "
-                             "is required")
-    return int(value)
-
-
 def _check_estimate(velocity: str, filter_tau: float | None) -> float | None:
     if velocity not in VELOCITY_ESTIMATES:
         raise UnknownNameError("velocity estimate", velocity, VELOCITY_ESTIMATES)
@@ -197,22 +194,21 @@ class _Rows:
         r[j] = 1.0
         return r
 
-    def plant_step(self, *, u: np.ndarray, E_hat: np.ndarray, filt_row: np.ndarray | None, T: float,
-                   d_a: int) -> np.ndarray:
+    def plant_step(self, *, u: np.ndarray, estimator_rows: Sequence[np.ndarray], T: float) -> np.ndarray:
         """The next state's rows [x, e, n_v] of every line but a law's own states: the held plant step under the
-        command applied (u, or u d_a periods late), the delay lines shifted, the estimator's memory."""
+        command applied (u through the actuation delay), the delay lines shifted (each a
+        :func:`~wmr_mj.hardware.estimators.delay_line`), the estimator's next state (``estimator_rows``, from
+        :func:`_estimate`)."""
         n = self.n
-        u_applied = self.unit(self.u_line[-1]) if d_a else u
+        u_applied = _delayed(u, self.u_line, self)[1]
         nxt = np.zeros((n, n + 2))
         nxt[0] = self.unit(0) + T * self.unit(1) - (T * T / 2.0) * u_applied
         nxt[1] = self.unit(1) - T * u_applied
         for line, head in ((self.E_line, self.unit(0)), (self.V_line, self.unit(1)), (self.u_line, u)):
-            for j, idx in enumerate(line):
-                nxt[idx] = head if j == 0 else self.unit(line[j - 1])
-        if self.has_prev:
-            nxt[self.prev] = E_hat
-        if filt_row is not None:
-            nxt[self.filt] = filt_row
+            for idx, row in zip(line, _delayed(head, line, self)[0]):
+                nxt[idx] = row
+        for idx, row in zip((self.prev, self.filt)[:len(estimator_rows)], estimator_rows):
+            nxt[idx] = row
         return nxt
 
     def arrays(self, nxt: np.ndarray, u: np.ndarray, T: float) -> dict[str, np.ndarray]:
@@ -228,13 +224,49 @@ class _Rows:
         return arrays
 
 
+def _combine(M: np.ndarray, rows: Sequence[np.ndarray], width: int) -> list[np.ndarray]:
+    """M times the stacked ``rows``: row i is the sum over j of M[i, j] rows[j] (each a row over [x, e, n_v]), in
+    order of j, the terms whose coefficient is 0 skipped (a sparse product: the same linear map; an entry that
+    one term alone reaches is that term's product, so a coefficient 1 copies its row to the bit)."""
+    out = []
+    for coefficients in M:
+        total: np.ndarray | None = None
+        for c, row in zip(coefficients, rows):
+            if c != 0.0:
+                total = c * row if total is None else total + c * row
+        out.append(np.zeros(width) if total is None else total)
+    return out
+
+
+def _delayed(head: np.ndarray, line: Sequence[int], r: _Rows) -> tuple[list[np.ndarray], np.ndarray]:
+    """The delay :func:`~wmr_mj.hardware.estimators.delay_line` of len(line) periods on the signal ``head``, its
+    state the rows ``line``: (the state's next rows, the output row: ``head`` len(line) periods late)."""
+    system = delay_line(len(line))
+    state, width = [r.unit(i) for i in line], r.n + 2
+    nxt = _combine(np.hstack([system.A, system.B]), [*state, head], width)
+    return nxt, _combine(np.hstack([system.C, system.D]), [*state, head], width)[0]
+
+
+def _estimate(r: _Rows, estimator: VelocityEstimator, E_hat: np.ndarray) -> tuple[np.ndarray, list[np.ndarray]]:
+    """The velocity estimate's row (before its noise) and its state's next rows, from the estimator's matrices
+    (:attr:`~wmr_mj.hardware.estimators.VelocityEstimator.system`): its inputs the measured angle E^ and the rate
+    read d_s periods late, its state (E^[k-1], y[k-1]) at ``r.prev``, ``r.filt``."""
+    system, width = estimator.system, r.n + 2
+    state = [r.unit(i) for i in (r.prev, r.filt)[:system.n_states]]
+    rate = _delayed(r.unit(1), r.V_line, r)[1] if r.delayed_rate else r.unit(1)  # unread where it differences
+    inputs = [*state, E_hat, rate]
+    estimate = _combine(np.hstack([system.C, system.D]), inputs, width)[0]
+    return estimate, _combine(np.hstack([system.A, system.B]), inputs, width)
+
+
 def sampled_loop(*, kp: float, kd: float, control_period: float, velocity: VelocityEstimate | str = "exact",
                  filter_tau: float | None = None, sensing_delay: int = 0, actuation_delay: int = 0) -> SampledLoop:
     """The PD servo on the double integrator at period T under zero-order hold, with delays and the estimator.
 
     The plant's step is exact: exp([[0, 1], [0, 0]] T) = [[1, T], [0, 1]], and the held u enters through
     int_0^T exp(A_c s) ds B_c = [T^2/2, T] (with E'' = -u, the sign is -); the estimator's rows are the
-    sensing chain's own recursions (module docstring).
+    matrices of the sensing chain's own estimator (:func:`wmr_mj.hardware.estimators.velocity_estimator`), the
+    delays those of :func:`~wmr_mj.hardware.estimators.delay_line`.
 
     Args:
         kp: K_P, 1/s^2 (> 0). kd: K_D, 1/s (> 0).
@@ -256,23 +288,16 @@ def sampled_loop(*, kp: float, kd: float, control_period: float, velocity: Veloc
     K_P, K_D = positive_real("kp", kp, " 1/s^2"), positive_real("kd", kd, " 1/s")
     T = positive_real("control_period", control_period, " s")
     tau = _check_estimate(str(velocity), filter_tau)
-    d_s, d_a = _whole_periods("sensing_delay", sensing_delay), _whole_periods("actuation_delay", actuation_delay)
+    d_s = whole_period_count("sensing_delay", sensing_delay)
+    d_a = whole_period_count("actuation_delay", actuation_delay)
     r = _Rows(str(velocity), d_s, d_a)
     n = r.n
-    E_hat = r.unit(r.E_line[-1] if d_s else 0) - r.unit(n)  # E[k - d_s] - e[k]
-    if r.delayed_rate:
-        rate_hat = r.unit(r.V_line[-1] if d_s else 1) - r.unit(n + 1)
-        filt_row = None
-    else:
-        difference = (E_hat - r.unit(r.prev)) / T
-        if r.has_filter:
-            a = math.exp(-T / tau) if tau is not None else 0.0  # as SensingChain: exp once, then 1 - a
-            filt_row = a * r.unit(r.filt) + (1.0 - a) * difference
-            rate_hat = filt_row - r.unit(n + 1)
-        else:
-            filt_row, rate_hat = None, difference - r.unit(n + 1)
+    E_hat = _delayed(r.unit(0), r.E_line, r)[1] - r.unit(n)  # E[k - d_s] - e[k]
+    estimate, estimator_rows = _estimate(r, velocity_estimator(str(velocity), control_period=T, filter_tau=tau),
+                                         E_hat)
+    rate_hat = estimate - r.unit(n + 1)
     u = K_P * E_hat + K_D * rate_hat
-    nxt = r.plant_step(u=u, E_hat=E_hat, filt_row=filt_row, T=T, d_a=d_a)
+    nxt = r.plant_step(u=u, estimator_rows=estimator_rows, T=T)
     arrays = r.arrays(nxt, u, T)
     return SampledLoop(**arrays, kp=K_P, kd=K_D, control_period=T, velocity=str(velocity), filter_tau=tau,
                        sensing_delay=d_s, actuation_delay=d_a)
@@ -471,14 +496,14 @@ def characteristic_polynomial(*, kp: float, kd: float, control_period: float,
     K_P, K_D = positive_real("kp", kp, " 1/s^2"), positive_real("kd", kd, " 1/s")
     T = positive_real("control_period", control_period, " s")
     tau = _check_estimate(str(velocity), filter_tau)
-    d = _whole_periods("delay", delay)
+    d = whole_period_count("delay", delay)
     P = np.polynomial.polynomial  # coefficients lowest power first below
     plant_den, plant_num = np.array([1.0, -2.0, 1.0]), np.array([T * T / 2.0, T * T / 2.0])
     if velocity in ("exact", "tachometer"):
         num = P.polyadd(P.polymul([K_P], plant_num), [-K_D * T, K_D * T])
         den = plant_den
     else:
-        a = math.exp(-T / tau) if tau is not None else 0.0
+        a = velocity_estimator(str(velocity), control_period=T, filter_tau=tau).a  # 0 for the difference
         c_den = [-a * T, T]  # T (z - a); a = 0 gives the difference's T z
         c_num = P.polyadd(P.polymul([K_P], c_den), P.polymul([K_D * (1.0 - a)], [-1.0, 1.0]))
         num, den = P.polymul(c_num, plant_num), P.polymul(c_den, plant_den)
@@ -526,7 +551,7 @@ def delay_margin(*, kp: float, kd: float, control_period: float, velocity: Veloc
     Raises:
         ParameterError, UnknownNameError: as :func:`sampled_loop`.
     """
-    _whole_periods("max_delay", max_delay)
+    whole_period_count("max_delay", max_delay)
     for d in range(max_delay + 1):
         poly = characteristic_polynomial(kp=kp, kd=kd, control_period=control_period, velocity=velocity,
                                          filter_tau=filter_tau, delay=d)

@@ -173,7 +173,7 @@ from wmr_mj.analysis.regions import SmallGainRegion
 from wmr_mj.analysis.robustness import _check_gains, exact_gammas
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.plant.reduced import FRICTION_SIGNS
-from wmr_mj.reference.bounds import ReferenceBounds
+from wmr_mj.reference.bounds import ReferenceBounds, sin_cos3
 
 __all__ = [
     "Estimate",
@@ -207,10 +207,6 @@ def friction_term(mode: str, *, F: tuple[float, float], F_hat: float) -> float:
     if mode == "measured":
         return max(F_max, abs(F_hat))
     return F_max + abs(F_hat)
-
-
-def _S(alpha: float) -> float:
-    return math.sin(alpha) / math.cos(alpha) ** 3
 
 
 def loop_crossover(kp: float, kd: float) -> tuple[float, float]:
@@ -478,7 +474,7 @@ class _Bound:
 
     def at(self, alpha_max: float) -> _AtAngle:
         """delta1, delta3 and (4.23) with the plant's angle up to ``alpha_max`` [rad]."""
-        S, c2 = _S(alpha_max), math.cos(alpha_max) ** 2
+        S, c2 = sin_cos3(alpha_max), math.cos(alpha_max) ** 2
         rest = self.dK * S + self.dC * self.a0d + self.dG * self.a0d / c2
         if self.plant.disturbance:  # |d_V|/P beside the other terms (module docstring)
             delta1 = max((abs(p - self.P_ff) * self.a0dd + self.phi_at(p) + rest + self.dist_at(p)) / p
@@ -632,7 +628,7 @@ class _Measured:
         eps_v = self.eps_alpha_dot(at, E_max, Edot_max)
         rate = b.a0d + Edot_max + eps_v
         return (est.P * (b.P_ff / est.P * b.a0dd + b.kd * (Edot_max + eps_v) + b.kp * (E_max + at.eps_alpha))
-                + abs(est.K) * _S(at.alpha_m) + abs(est.C_V) * rate + b.F_comp
+                + abs(est.K) * sin_cos3(at.alpha_m) + abs(est.C_V) * rate + b.F_comp
                 + abs(b.Gam_hat) * rate / math.cos(at.alpha_m) ** 2)
 
     def solve(self) -> tuple[float, int, str]:

@@ -15,7 +15,8 @@ Each part declares, in its one class, its model change (``model_options()``: wha
 builds), its coverage (``coverage(...)``: a :class:`Coverage`, the error bound a claim may use or why none is
 derived) and its ``label()``; the model, the engine and the claims read them there (:mod:`.coverage`).
 
-Modules: :mod:`.spec` (the one parser), :mod:`.coverage`, :mod:`.sensing`, :mod:`.actuation`,
+Modules: :mod:`.spec` (the one parser, the whole-periods check), :mod:`.coverage`, :mod:`.sensing`,
+:mod:`.estimators` (the velocity estimates and the delay as discrete linear systems), :mod:`.actuation`,
 :mod:`.transmission`, :mod:`.presets` (named hardware with sources), :mod:`.cart` (the three parts in one line
 and one mapping).
 """

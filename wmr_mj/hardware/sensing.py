@@ -31,7 +31,10 @@ The pipeline, once per control step k at t_k = k T (T the control period), in th
     through y_k = a y_{k-1} + (1 - a) x_k, a = exp(-T / tau_f), y_{-1} = 0 (the exact discretisation of
     1/(tau_f s + 1) for an input held over each period); ``none``: no velocity is read, alpha'_m[k] is NaN (the
     law reads the measured angle only and estimates alpha' itself; no velocity noise is accepted). Then
-    ``alpha'_m[k] = v_k + n_alpha'[k]`` where set.
+    ``alpha'_m[k] = v_k + n_alpha'[k]`` where set. Each estimate (and the delay of (a)) is defined once, as a
+    discrete linear system, in :mod:`wmr_mj.hardware.estimators`: the step runs it in the factored form above
+    with the coefficients a and 1 - a of its :class:`~wmr_mj.hardware.estimators.VelocityEstimator`
+    (:attr:`SensingChain.estimator`); the certificate's loop reads its matrices (``tests/test_estimators.py``).
 
 Noise, drawn up front: ``rng = numpy.random.default_rng(seed)``; first the n_steps noise values on alpha
 (``rng.uniform(-B, B, n_steps)`` or ``rng.normal(0.0, sigma, n_steps)``), only where noise on alpha is set;
@@ -42,8 +45,8 @@ never added, so the ideal chain returns its inputs to the bit).
 For a port to C (the state lives in MuJoCo's userdata; the parameters and the noise arrays are passed in):
 every operation of :meth:`SensingChain.step` is one IEEE-754 double operation in the order written (no
 fused multiply-add: compile with ``-ffp-contract=off``; no reduction; a division stays a division); the
-coefficients c, a and 1 - a are computed once here and read from :attr:`SensingChain.parameters`, so the C
-step calls no ``exp``. The layouts (index constants of this module):
+coefficients c, a and 1 - a are computed once (a and 1 - a by the estimator) and read from
+:attr:`SensingChain.parameters`, so the C step calls no ``exp``. The layouts (index constants of this module):
 
 - parameters (float64): ``P_TICKS_PER_RAD`` c (0 without an encoder), ``P_GEAR_RATIO`` i2, ``P_PERIOD`` T (s),
   ``P_FILTER_A`` a, ``P_FILTER_ONE_MINUS_A`` 1 - a, ``P_DELAY_STEPS`` d, ``P_ENCODER_SIDE`` (0 axis, 1 motor;
@@ -66,6 +69,7 @@ import numpy as np
 
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.hardware.coverage import Coverage
+from wmr_mj.hardware.estimators import velocity_estimator
 from wmr_mj.hardware.presets import SENSING_PRESETS
 from wmr_mj.hardware.spec import (
     Converter,
@@ -438,9 +442,13 @@ class SensingChain:
             p[P_TICKS_PER_RAD] = sensing.encoder_ticks / (2.0 * math.pi)
         p[P_GEAR_RATIO] = i2
         p[P_PERIOD] = self.control_period
-        if sensing.filter_tau is not None:
-            p[P_FILTER_A] = math.exp(-self.control_period / sensing.filter_tau)
-            p[P_FILTER_ONE_MINUS_A] = 1.0 - p[P_FILTER_A]
+        #: the velocity estimate's coefficients (a, 1 - a), defined once (:mod:`wmr_mj.hardware.estimators`); None
+        #: where no velocity is read
+        self.estimator = (None if sensing.velocity == "none" else
+                          velocity_estimator(sensing.velocity, control_period=self.control_period,
+                                             filter_tau=sensing.filter_tau))
+        if self.estimator is not None:
+            p[P_FILTER_A], p[P_FILTER_ONE_MINUS_A] = self.estimator.a, self.estimator.one_minus_a
         p[P_DELAY_STEPS] = d
         p[P_ENCODER_SIDE] = _SIDE_CODES[sensing.encoder_side]
         p[P_ROUNDING] = _ROUNDING_CODES[sensing.encoder_rounding]

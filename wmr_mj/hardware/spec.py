@@ -35,6 +35,8 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any, Literal, TypeVar, Union, get_args, get_origin
 
+import numpy as np
+
 from wmr_mj.errors import ParameterError, UnknownNameError
 
 __all__ = [
@@ -48,6 +50,7 @@ __all__ = [
     "to_optional_float",
     "to_choice",
     "whole_periods",
+    "whole_period_count",
     "spec_string",
 ]
 
@@ -291,13 +294,18 @@ def spec_string(spec: Mapping[str, object]) -> str:
     return ",".join(f"{k}={'none' if v is None else v}" for k, v in spec.items())
 
 
-def whole_periods(what: str, duration: float, period: float) -> int:
+def whole_periods(what: str, duration: float, period: float, *, periods: str = "periods", why: str = "") -> int:
     """``duration`` as a whole number of ``period`` (both s), within 1e-9 relative; else ParameterError.
+
+    The one check that a duration (a sensing or actuation delay) is a whole number of periods (control periods,
+    physics steps); :func:`whole_period_count` checks a count already in periods.
 
     Args:
         what: the duration's name in the message ('sensing delay').
         duration: s, >= 0.
         period: s, > 0.
+        periods: what the periods are called in the message ('physics steps').
+        why: a reason the message gives after the period (' (MuJoCo reads ...)').
 
     Returns:
         n >= 0 with |duration - n period| <= 1e-9 max(duration, period).
@@ -311,7 +319,19 @@ def whole_periods(what: str, duration: float, period: float) -> int:
     below, above = math.floor(duration / period) * period, math.ceil(duration / period) * period
     # 1e-9 relative: a delay typed in decimal (0.005) is rarely an exact double multiple of 0.001
     if abs(duration - n * period) > 1e-9 * max(abs(duration), period):
-        raise ParameterError(f"{what} = {duration!r} s is not a whole number of periods of {period!r} s "
-                             f"({duration / period:.6g} periods); accepted: a multiple such as "
+        raise ParameterError(f"{what} = {duration!r} s is not a whole number of {periods} of {period!r} s{why} "
+                             f"({duration / period:.6g} {periods}); accepted: a multiple such as "
                              f"{below:g} s or {above:g} s")
     return int(n)
+
+
+def whole_period_count(what: str, value: object) -> int:
+    """``value``, a count of control periods, as an int >= 0 (a NumPy integer accepted, bool refused).
+
+    Raises:
+        ParameterError: anything else (the message names ``what``).
+    """
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
+        raise ParameterError(f"{what} = {value!r} is not accepted; a whole number of control periods >= 0 "
+                             "is required")
+    return int(value)

@@ -56,6 +56,7 @@ import numpy as np
 
 from wmr_mj.errors import ModelFileError, ParameterError, UnknownNameError
 from wmr_mj.hardware.actuation import Actuation
+from wmr_mj.hardware.spec import whole_periods
 from wmr_mj.hardware.transmission import Transmission
 from wmr_mj.params import C80, C80Parameters
 
@@ -206,11 +207,8 @@ def _drive_train(*, actuation_delay_s: float = 0.0, inductance_H: float = 0.0, c
     and what the model alone requires: a delay of whole physics steps, inertia on the motor side of a play."""
     actuation = Actuation.from_model_options(actuation_delay_s=actuation_delay_s, inductance_H=inductance_H,
                                              current_limit_A=current_limit_A)
-    steps = actuation.delay / TIMESTEP
-    # 1e-9 of a step: 0.003 / 0.001 = 2.9999999999999996 is three steps, 0.0025 is not
-    if abs(steps - round(steps)) > 1e-9:
-        raise ParameterError(f"actuation_delay_s = {actuation.delay!r} s is not a whole number of physics steps of "
-                             f"{TIMESTEP!r} s (MuJoCo reads a delayed ctrl at whole steps); give a multiple of it")
+    whole_periods("actuation_delay_s", actuation.delay, TIMESTEP, periods="physics steps",
+                  why=" (MuJoCo reads a delayed ctrl at whole steps)")
     transmission = Transmission.from_model_options(backlash_rad=backlash_rad)
     armature = motor_armature_kgm2
     if isinstance(armature, bool) or not isinstance(armature, (int, float)) or not math.isfinite(armature) \

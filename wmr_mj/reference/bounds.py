@@ -34,7 +34,8 @@ __all__ = ["ReferenceBounds", "PAPER_BOUNDS", "angle_of_sin_cos3", "sin_cos3", "
 
 
 def sin_cos3(angle: float) -> float:
-    """sin(a)/cos^3(a) of an angle a in [0, pi/2) [rad] (the paper's (5.1) quantity) [-]."""
+    """S(a) = sin(a)/cos^3(a) of an angle |a| < pi/2 [rad] (the stiffness's shape in (2.13), the paper's (5.1)
+    quantity) [-]; its one scalar definition: the certificates (small_gain, sampled_certificate) call it."""
     return math.sin(angle) / math.cos(angle) ** 3
 
 

@@ -94,7 +94,9 @@ enum { N_VELOCITY_CODES = 5 };
 
 int wmr_mj_sensing_layout(void) { return 100000 * N_VELOCITY_CODES + 1000 * SENSE_HEADER + 10 * N_PARAMETERS + S_RING; }
 
-/* SensingChain.step of wmr_mj/hardware/sensing.py, operation for operation (the same bits) */
+/* SensingChain.step of wmr_mj/hardware/sensing.py, operation for operation (the same bits); the estimate and the
+ * delay are the systems of wmr_mj/hardware/estimators.py, whose coefficients (a, 1 - a) the parameters carry
+ * (tests/test_estimators.py drives this function against their matrices) */
 static void sense(const mjtNum* sp, mjtNum* s, long long k, double alpha, double alpha_dot, double motor,
                   double* alpha_m_out, double* alpha_dot_m_out) {
   const mjtNum* p = sp + SENSE_HEADER;
