@@ -28,12 +28,16 @@ from wmr_mj.cli.options import add_json, add_out, add_seed, add_threads
 _nonneg_int = int_at_least(0)
 
 
+#: the command's line in ``wmr-mj --help`` (read without registering the command: wmr_mj/cli/app.py)
+HELP = ("headline report: the paper's design, the ladder to the certified design, the worst-case search, the "
+        "plant's friction law; writes index.html")
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     from wmr_mj.report.settings import DEFAULT_DURATION, DEFAULT_N, DEFAULT_SEARCH_BUDGET, FULL_BOX_FACTOR
     from wmr_mj.sim.sweep import SAMPLINGS
 
-    p = sub.add_parser("validate", help="headline report: the paper's design, the ladder to the certified design, "
-                                        "the worst-case search, the plant's friction law; writes index.html",
+    p = sub.add_parser("validate", help=HELP,
                        description=__doc__.split("\n\n")[1] if __doc__ else None)
     p.add_argument("--n", type=positive_int, default=DEFAULT_N,
                    help=f"runs per rung of the ladder (default {DEFAULT_N}; --n 100 for the full counts)")
