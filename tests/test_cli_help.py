@@ -1,9 +1,9 @@
 """Building the ``wmr-mj`` parser imports no simulation: ``wmr-mj --help`` and a bad option answer at once.
 
 The truth is ``sys.modules`` of a fresh interpreter (a subprocess: this one has imported everything already)
-after ``import wmr_mj.cli.app`` and building the parser as ``main`` builds it for each command line; and the
-help pages, whose lists of names (the laws, the paths, the suites) are computed when shown, name what the
-library holds. Timed by bench/bench_cli_help.py, not here.
+after ``import wmr_mj.cli.app``, building the parser as ``main`` builds it for a command line and refusing a bad
+option with it; and the help pages, whose lists of names (the laws, the paths, the suites) are computed when
+shown, name what the library holds. Timed by bench/bench_cli_help.py, not here.
 """
 
 from __future__ import annotations
@@ -25,10 +25,17 @@ HEAVY_LAYERS = ("wmr_mj.sim", "wmr_mj.reference", "wmr_mj.plant", "wmr_mj.analys
 LIGHT_COMMANDS = tuple(c for c in COMMANDS if c not in ("validate", "design"))
 
 _PROBE = """
-import json, sys
+import contextlib, io, json, sys
 from wmr_mj.cli.app import build_parser
 for command in json.loads(sys.argv[1]):
-    build_parser(tuple(command))
+    parser = build_parser(tuple(command))
+    with contextlib.redirect_stderr(io.StringIO()) as err:
+        try:  # a bad option, refused as main refuses it
+            parser.parse_args([*command, "--bogus"])
+        except SystemExit as exc:
+            assert exc.code == 2 and len(err.getvalue().splitlines()) == 1, err.getvalue()
+        else:
+            raise AssertionError("--bogus was accepted")
 heavy = sorted(m for m in sys.modules if m.split(".")[0] in json.loads(sys.argv[2])
                or m.startswith(tuple(p + "." for p in json.loads(sys.argv[3]))) or m in json.loads(sys.argv[3]))
 print(json.dumps(heavy))
@@ -42,13 +49,14 @@ def _imported_by_building(commands: list[list[str]]) -> list[str]:
 
 
 def test_the_top_level_parser_imports_no_simulation():
-    """``wmr-mj --help``, ``wmr-mj`` and ``wmr-mj no-such-command`` build the parser with no command registered."""
+    """``wmr-mj --help``, ``wmr-mj`` and ``wmr-mj --bogus`` build the parser with no command registered."""
     assert _imported_by_building([[]]) == []
 
 
 @pytest.mark.parametrize("command", LIGHT_COMMANDS)
 def test_a_commands_parser_imports_no_simulation(command):
-    """``wmr-mj run --bogus`` builds run's options, helps included, without importing what runs it."""
+    """``wmr-mj run --bogus`` builds run's options, helps included, and refuses the option in one line without
+    importing what runs it."""
     assert _imported_by_building([[command]]) == []
 
 
