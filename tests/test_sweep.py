@@ -96,9 +96,10 @@ def test_dask_gives_the_same_numbers_as_local(tmp_path):
 
 
 @pytest.mark.slow
-def test_unreachable_scheduler_is_a_clear_error():
+def test_unreachable_scheduler_is_a_clear_error(tmp_path):
     with pytest.raises(SchedulerError, match="cannot reach"):
-        run_sweep(SweepSpec(n=1, base=BASE), scheduler="tcp://127.0.0.1:9")
+        run_sweep(SweepSpec(n=1, base=BASE), out_dir=tmp_path / "sweep", scheduler="tcp://127.0.0.1:9")
+    assert not (tmp_path / "sweep").exists()  # refused before the folder and its sweep.json are written
 
 
 @pytest.mark.parametrize("kwargs,error", [({"n": 0}, ParameterError), ({"m1_range": (700.0, 600.0)}, ParameterError),
@@ -147,12 +148,14 @@ def test_uncertainty_box_and_ranges_from_the_command_line():
                                   ["--range", "mu=0.03:0.01"], ["--sampling", "sobol"],
                                   ["--scheduler", "tcp://127.0.0.1:9"], ["--range", "mu=abc"]])
 def test_cli_sweep_bad_input_exits_2(argv, tmp_path):
-    proc = subprocess.run([sys.executable, "-m", "wmr_mj.cli", "sweep", "--duration", "10", "--out", str(tmp_path),
+    out = tmp_path / "sweep"
+    proc = subprocess.run([sys.executable, "-m", "wmr_mj.cli", "sweep", "--duration", "10", "--out", str(out),
                            *argv],
                           capture_output=True, text=True, timeout=120)
     assert proc.returncode == 2, proc.stderr
     assert len(proc.stderr.strip().splitlines()) == 1, proc.stderr
     assert "Traceback" not in proc.stderr
+    assert not out.exists()  # refused before anything is written
 
 
 @pytest.mark.slow

@@ -373,28 +373,6 @@ def test_validate_latest_is_a_copy_where_symlinks_are_unavailable(tmp_path, monk
 
 
 @pytest.mark.slow
-def test_a_design_of_the_users_is_judged_beside_the_ladder(tmp_path):
-    """validate --design: a plug-in's rung (its verdicts against its own claim) and its nominal run, named as
-    itself; a law without a claim counts no pass and the paper's region is not applied to it."""
-    example = Path(__file__).resolve().parents[1] / "examples" / "my_pid.py"
-    folder = tmp_path / "report"
-    proc = _cli("validate", "--n", "2", "--duration", "10", "--identify-duration", "10", "--search-budget", "0",
-                "--design", "sliding-mode", "--design", f"{example}:MyPID,ki=10", "--out", str(folder), "--json")
-    assert proc.returncode == 0, proc.stderr
-    summary = json.loads(proc.stdout)
-    smc, pid = summary["designs"]
-    assert (smc["index"], pid["index"]) == (len(LADDER) + 2, len(LADDER) + 3)
-    assert smc["certificate"]["E_max"] == pytest.approx(0.04) and smc["n"] == 2
-    assert smc["verdicts"]["certified-inside"] + smc["verdicts"]["uncertified-inside"] == 2
-    assert pid["passes"] == 0 and pid["verdicts"].get("no-claim") == 2 and pid["paper_law"] is False
-    assert pid["nominal"]["verdict"] == "no-claim"
-    rows = _rows(folder, pid["runs_csv"])
-    assert len(rows) == 2 and {r["verdict"] for r in rows} == {"no-claim"}
-    md = (folder / "index.md").read_text()
-    assert "sliding-mode" in md and "MyPID,ki=10" in md
-
-
-@pytest.mark.slow
 def test_the_certified_design_on_realistic_sensing_section(validated):
     from wmr_mj.report.sensing import REALISTIC_SENSING
 

@@ -1,5 +1,6 @@
 """validate's section (e), second part: the design ``wmr-mj design`` finds for the 12-bit axis encoder, beside the
-certified design on that cart (issue 35 item 5), and ``validate --design FILE``.
+certified design on that cart (issue 35 item 5), and ``validate --design``: a law's name, a plug-in's file and a
+design file judged beside the ladder, all in the one validate run this file shares.
 
 The truths: the design is the one the recorded ``wmr-mj design`` command writes (run here as a command); every
 count and worst ratio is recomputed from the sweeps' runs.csv by a plain loop; a run of ``run --design FILE`` at
@@ -20,7 +21,9 @@ from pathlib import Path
 import pytest
 
 from wmr_mj.analysis.verdicts import VERDICTS
+from wmr_mj.sim.designs import LADDER
 
+EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "my_pid.py"
 N = 2
 DURATION = 10.0  # s: C reaches the paper circle (its entry takes 8.09 s)
 ARGS = ("validate", "--n", str(N), "--duration", f"{DURATION:g}", "--identify-duration", "10",
@@ -50,8 +53,11 @@ def own_design(tmp_path_factory) -> Path:
 
 @pytest.fixture(scope="module")
 def validated(tmp_path_factory, own_design):
+    """One run for every test here: the section, and three designs of the user's beside the ladder (a law's name, a
+    plug-in's file, a design file)."""
     folder = tmp_path_factory.mktemp("validate") / "report"
-    proc = _cli(*ARGS, "--design", str(own_design), "--out", str(folder), "--json")
+    proc = _cli(*ARGS, "--design", "sliding-mode", "--design", f"{EXAMPLE}:MyPID,ki=10", "--design", str(own_design),
+                "--out", str(folder), "--json")
     assert proc.returncode == 0, proc.stderr
     return folder, json.loads(proc.stdout)
 
@@ -140,13 +146,30 @@ def test_the_report_shows_the_section_and_reads_back(validated):
 @pytest.mark.slow
 def test_validate_judges_the_users_design_file(validated, own_design):
     folder, summary = validated
-    (rung,) = summary["designs"]
+    (rung,) = [d for d in summary["designs"] if d["token"] == str(own_design)]
     written = json.loads(own_design.read_text())["settings"]
     assert rung["token"] == str(own_design) and rung["n"] == N
     assert (rung["config"]["kp"], rung["config"]["kd"]) == (written["kp"], written["kd"])
     assert rung["config"]["sensing"] == written["sensing"]  # the file's cart: validate gave none
     rows = _runs(folder, rung["runs_csv"])
     assert Counter(r["verdict"] for r in rows) == Counter({k: v for k, v in rung["verdicts"].items() if v})
+
+
+@pytest.mark.slow
+def test_a_design_of_the_users_is_judged_beside_the_ladder(validated, own_design):
+    """validate --design: a plug-in's rung (its verdicts against its own claim) and its nominal run, named as
+    itself; a law without a claim counts no pass and the paper's region is not applied to it."""
+    folder, summary = validated
+    smc, pid, mine = summary["designs"]
+    assert (smc["index"], pid["index"]) == (len(LADDER) + 2, len(LADDER) + 3) and mine["token"] == str(own_design)
+    assert smc["certificate"]["E_max"] == pytest.approx(0.04) and smc["n"] == 2
+    assert smc["verdicts"]["certified-inside"] + smc["verdicts"]["uncertified-inside"] == 2
+    assert pid["passes"] == 0 and pid["verdicts"].get("no-claim") == 2 and pid["paper_law"] is False
+    assert pid["nominal"]["verdict"] == "no-claim"
+    rows = _runs(folder, pid["runs_csv"])
+    assert len(rows) == 2 and {r["verdict"] for r in rows} == {"no-claim"}
+    md = (folder / "index.md").read_text()
+    assert "sliding-mode" in md and "MyPID,ki=10" in md
 
 
 def test_the_recorded_command_searches_the_sections_problem():

@@ -1,9 +1,13 @@
 """The ``wmr-mj`` command line.
 
-Each subcommand lives in ``wmr_mj.cli.<name>`` and provides
-``register(subparsers)``, which adds its parser and sets ``func(args) -> int``.
-Command modules import heavy libraries inside ``func`` so that ``--help`` and
-argument errors stay fast.
+Each subcommand lives in ``wmr_mj.cli.<name>`` and provides ``HELP`` (its line in
+``wmr-mj --help``) and ``register(subparsers)``, which adds its parser and sets
+``func(args) -> int``. A command line registers only its own command (the others are
+listed by name and ``HELP``), and a command module imports its implementation (the
+simulation, MuJoCo, scipy) inside ``func``, a help that names what a heavy module
+holds being computed for ``--help`` alone (``wmr_mj.cli.options.add_argument_with_help_of``):
+so ``wmr-mj --help`` and a bad option answer without importing the simulation
+(``bench/bench_cli_help.py``; tests/test_cli_help.py checks what building a parser imports).
 
 Bad input raises a :class:`wmr_mj.errors.WmrMjError`; it is printed here as one
 line ``wmr-mj: error: ...`` and the exit status is 2.
@@ -14,7 +18,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import sys
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 
 from wmr_mj.errors import WmrMjError
 
@@ -29,7 +33,10 @@ class _OneLineParser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(commands: Collection[str] = COMMANDS) -> argparse.ArgumentParser:
+    """The ``wmr-mj`` parser: the commands named in ``commands`` (default: all) with all their options; the
+    others by name and one-line help alone (as ``wmr-mj --help`` lists them), not registered, so a command line
+    builds only its own command's options."""
     parser = _OneLineParser(
         prog="wmr-mj",
         description="MuJoCo validation testbed for computed-torque steering control of the C80 cart.",
@@ -37,13 +44,22 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for name in COMMANDS:
         try:
+            # a command's module by name: light at import (argparse-level), its implementation imported by its func
             module = importlib.import_module(f"wmr_mj.cli.{name}")
         except ModuleNotFoundError as exc:
             if exc.name != f"wmr_mj.cli.{name}":
                 raise
             continue  # command not built yet
-        module.register(sub)
+        if name in commands:
+            module.register(sub)
+        else:
+            sub.add_parser(name, help=module.HELP)
     return parser
+
+
+def _commands_of(argv: Sequence[str]) -> tuple[str, ...]:
+    """The command a command line gives (its first word), or none (``wmr-mj --help``, a bad command)."""
+    return (argv[0],) if argv and argv[0] in COMMANDS else ()
 
 
 def _mujoco_importable() -> str | None:
@@ -66,8 +82,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     if problem is not None:
         print(f"wmr-mj: error: {problem}", file=sys.stderr)
         return 2
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    argv = sys.argv[1:] if argv is None else list(argv)
+    args = build_parser(_commands_of(argv)).parse_args(argv)
     try:
         return int(args.func(args) or 0)
     except WmrMjError as exc:

@@ -28,9 +28,12 @@ from typing import Any
 
 from wmr_mj.cli._common import positive_float
 
+#: the command's line in ``wmr-mj --help`` (read without registering the command: wmr_mj/cli/app.py)
+HELP = "check a cart file (TOML): schema, compile and step, identification"
+
 
 def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("cart", help="check a cart file (TOML): schema, compile and step, identification")
+    p = sub.add_parser("cart", help=HELP)
     p.add_argument("action", choices=("check", "card"),
                    help="check: read the file against its schema, compile and step the generated model for 1 s "
                         "with random controls (no MuJoCo warning), identify P, C_V, F, K, gyro from a simulated "

@@ -24,15 +24,17 @@ from __future__ import annotations
 
 import argparse
 
-from wmr_mj.cli.options import add_json, add_out, add_seed, add_threads
+from wmr_mj.cli.options import add_argument_with_help_of, add_json, add_out, add_seed, add_threads
+
+#: the command's line in ``wmr-mj --help`` (read without registering the command: wmr_mj/cli/app.py)
+HELP = ("every design on every scenario of a versioned suite, then the same adversary: one table (Markdown, "
+        "CSV, HTML) and a figure")
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     from wmr_mj.cli._common import CLAIM_BROKEN_EXIT
-    from wmr_mj.sim.suite import suite_names
 
-    p = sub.add_parser("compare", help="every design on every scenario of a versioned suite, then the same "
-                                       "adversary: one table (Markdown, CSV, HTML) and a figure",
+    p = sub.add_parser("compare", help=HELP,
                        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter,
                        epilog=f"exit status: 0; {CLAIM_BROKEN_EXIT} when a run of a design (a scenario's or the "
                               "adversary's) is certified-outside: it breaks that design's claim (a banner above "
@@ -40,8 +42,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("designs", nargs="+", metavar="DESIGN", help="a preset, a law's name, FILE.py:Class or "
                                                                "module:Class, with ,key=value settings; or a "
                                                                "design file FILE.json (wmr-mj design --out)")
-    p.add_argument("--suite", default="standard-v1",
-                   help=f"the scenario suite: one of {', '.join(suite_names())} or a suite file (.toml)")
+    add_argument_with_help_of(p, "--suite", _suite_help, default="standard-v1")
     p.add_argument("--scenarios", action="append", metavar="PATTERN",
                    help="only the scenarios whose id matches (shell pattern, e.g. 'circle/*'; repeatable)")
     p.add_argument("--budget", type=int, default=32,
@@ -58,6 +59,12 @@ def register(sub: argparse._SubParsersAction) -> None:
 
     add_hardware_options(p)  # every design's cart: its scenarios (but one that names its own) and its adversary
     p.set_defaults(func=run)
+
+
+def _suite_help() -> str:
+    from wmr_mj.sim.suite import suite_names
+
+    return f"the scenario suite: one of {', '.join(suite_names())} or a suite file (.toml)"
 
 
 def _cart_options(args: argparse.Namespace) -> dict:

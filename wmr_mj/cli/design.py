@@ -9,6 +9,9 @@ from typing import Any
 
 from wmr_mj.cli.options import add_json, positive_float, positive_int
 
+#: the command's line in ``wmr-mj --help`` (read without registering the command: wmr_mj/cli/app.py)
+HELP = "the computed-torque (or sliding-mode) gains, sign width, filter and period a given cart certifies"
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     from wmr_mj.cli.run import add_hardware_options
@@ -16,8 +19,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     from wmr_mj.sim.design_search import DEFAULT_BUDGET, DEFAULT_SEED, METHODS, OBJECTIVES
 
     p = sub.add_parser(
-        "design", help="the computed-torque (or sliding-mode) gains, sign width, filter and period a given cart "
-                       "certifies",
+        "design", help=HELP,
         description="A seeded search (CMA-ES or scipy's differential evolution) over omega_n and zeta "
                     "(K_P = omega_n^2, K_D = 2 zeta omega_n; with --controller sliding-mode: lam, phi, k and eta), the "
                     "Coulomb sign's smoothing width, the velocity filter's tau_f "

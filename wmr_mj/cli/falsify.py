@@ -16,13 +16,16 @@ _AGAINST = ("certificate", "paper")
 _OBJECTIVE_KINDS = ("ratio", "sup-E")
 
 
+#: the command's line in ``wmr-mj --help`` (read without registering the command: wmr_mj/cli/app.py)
+HELP = ("worst-case search over the uncertainty box (its vertices, then CMA-ES; or a local polish, or "
+        "differential evolution) on mujoco.batch, beside the same budget spent at random")
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     from wmr_mj.cli._common import CLAIM_BROKEN_EXIT
     from wmr_mj.cli.run import add_run_options, add_signal_options
 
-    p = sub.add_parser("falsify", help="worst-case search over the uncertainty box (its vertices, then CMA-ES; "
-                                       "or a local polish, or differential evolution) on mujoco.batch, beside the "
-                                       "same budget spent at random",
+    p = sub.add_parser("falsify", help=HELP,
                        epilog=f"exit status: 0 nothing falsified; {CLAIM_BROKEN_EXIT} falsified: a run of the search "
                               "or of the random sample is certified-outside (it breaks the law's claim), or the "
                               "--require is falsified; 1 the serial re-run of the worst run did not reproduce it; "

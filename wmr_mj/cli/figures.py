@@ -13,9 +13,12 @@ import argparse
 from wmr_mj.cli._common import positive_float
 from wmr_mj.cli.options import add_out
 
+#: the command's line in ``wmr-mj --help`` (read without registering the command: wmr_mj/cli/app.py)
+HELP = "regenerate the paper's Figs. 4-7 (PNG and SVG, headless)"
+
 
 def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("figures", help="regenerate the paper's Figs. 4-7 (PNG and SVG, headless)",
+    p = sub.add_parser("figures", help=HELP,
                        description=__doc__.split("\n\n")[1] if __doc__ else None)
     add_out(p, help="output folder (default logs/figures-<timestamp>/)")
     p.add_argument("--duration", type=positive_float, default=35.0,

@@ -8,9 +8,12 @@ from wmr_mj.cli._common import parse_assignments, positive_float
 from wmr_mj.cli.options import add_json, add_out, add_seed
 from wmr_mj.params import M1_NOMINAL
 
+#: the command's line in ``wmr-mj --help`` (read without registering the command: wmr_mj/cli/app.py)
+HELP = "excite the plant's steering and fit P, C_V, F, K, gyro by least squares"
+
 
 def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("identify", help="excite the plant's steering and fit P, C_V, F, K, gyro by least squares")
+    p = sub.add_parser("identify", help=HELP)
     p.add_argument("--m1", type=positive_float, default=M1_NOMINAL,
                    help="chassis mass of the plant, kg (default: the cart's, 650 on the C80)")
     p.add_argument("--duration", type=positive_float, default=60.0, help="excitation length, s (default 60)")

@@ -7,9 +7,12 @@ import argparse
 
 from wmr_mj.cli.options import add_json
 
+#: the command's line in ``wmr-mj --help`` (read without registering the command: wmr_mj/cli/app.py)
+HELP = "write/check the MJCF files generated from the C80 parameter set"
+
 
 def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("model", help="write/check the MJCF files generated from the C80 parameter set")
+    p = sub.add_parser("model", help=HELP)
     p.add_argument("action", choices=("write", "check", "params", "slip", "friction", "card", "image"),
                    help="write: regenerate models/*.xml; check: exit 1 if they differ from the parameter set; "
                         "params: print the parameter set with sources and the derived coefficients; "

@@ -3,6 +3,9 @@
 * :func:`add_seed`, :func:`add_threads`, :func:`add_out`, :func:`add_json`: the shared options (``--seed``,
   ``--nthread``, ``--out``, ``--json``), one type and one rule each, with the help the command gives.
 * :func:`parse_ranges`: ``--range NAME=LO:HI`` as every command reads it (:data:`RANGE_RULE`).
+* :func:`add_argument_with_help_of`: an option whose help names what a heavy module holds (the laws, the paths),
+  computed when the help is shown, so that building a parser imports no simulation (``wmr-mj --help`` and a bad
+  option answer at once; ``bench/bench_cli_help.py``).
 
 Usage::
 
@@ -16,11 +19,12 @@ from __future__ import annotations
 
 import argparse
 import math
-from collections.abc import Collection, Iterable
+from collections.abc import Callable, Collection, Iterable
 from dataclasses import dataclass, field
 
-__all__ = ["positive_float", "int_at_least", "positive_int", "non_negative_int", "parse_range", "add_seed",
-           "add_threads", "add_out", "add_json", "RANGE_RULE", "RANGE_KINDS", "RANGE_ACCEPTS", "Ranges", "parse_ranges",
+__all__ = ["add_argument_with_help_of", "positive_float", "int_at_least", "positive_int", "non_negative_int",
+           "parse_range", "add_seed", "add_threads", "add_out", "add_json", "RANGE_RULE", "RANGE_KINDS",
+           "RANGE_ACCEPTS", "Ranges", "parse_ranges",
            "command_ranges", "range_kind", "box_ranges_from_args", "hardware_ranges_from_args"]
 
 
@@ -93,6 +97,46 @@ def add_out(p: argparse.ArgumentParser, *, help: str, metavar: str = "DIR") -> N
 def add_json(p: argparse.ArgumentParser, *, help: str = "print one JSON object") -> None:
     """``--json``: print one JSON object on stdout instead of the text report."""
     p.add_argument("--json", action="store_true", help=help)
+
+
+class _HelpOnRead:
+    """An argparse action's ``help`` computed the first time it is read (by the help formatter), then kept."""
+
+    _help_text: str | Callable[[], str] | None
+
+    @property
+    def help(self) -> str | None:
+        if callable(self._help_text):
+            self._help_text = self._help_text()
+        return self._help_text
+
+    @help.setter
+    def help(self, value: str | Callable[[], str] | None) -> None:
+        self._help_text = value
+
+
+_HELP_ON_READ: dict[type, type] = {}
+
+
+def _help_on_read(action_class: type) -> type:
+    """``action_class`` with its ``help`` read on demand (one subclass per argparse action class)."""
+    if action_class not in _HELP_ON_READ:
+        _HELP_ON_READ[action_class] = type(action_class.__name__, (_HelpOnRead, action_class), {})
+    return _HELP_ON_READ[action_class]
+
+
+def add_argument_with_help_of(p: argparse.ArgumentParser | argparse._ArgumentGroup, flag: str,
+                              help_of: Callable[[], str], **settings) -> argparse.Action:
+    """``p.add_argument(flag, **settings)`` with the help ``help_of()``, called only when a help page is formatted.
+
+    A help that lists names held by a heavy module (the laws of ``controllers``, the paths of ``wmr_mj.sim``)
+    would import it while the parser is built, for every command line; here it is imported for ``--help`` alone.
+    The action is argparse's own (``settings['action']``), its class given a ``help`` read on demand.
+    """
+    action = p.add_argument(flag, **settings)
+    action.__class__ = _help_on_read(type(action))
+    action.help = help_of  # type: ignore[assignment]  # the property's setter: a function, called when read
+    return action
 
 
 #: What a --range name may be, by kind: what each kind is, for the line that refuses it.

@@ -29,11 +29,14 @@ from typing import Any
 from wmr_mj.cli._common import positive_float, positive_int, print_json
 from wmr_mj.cli.options import add_json
 
+#: the command's line in ``wmr-mj --help`` (read without registering the command: wmr_mj/cli/app.py)
+HELP = "summarise, plot, verify (bit for bit) or render a run log"
+
 
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "replay",
-        help="summarise, plot, verify (bit for bit) or render a run log",
+        help=HELP,
         description="summarise, plot, verify (bit for bit) or render a wmr-mj run log (MCAP)",
     )
     p.add_argument("log", metavar="LOG", help="MCAP run log written by `wmr-mj run`")

@@ -32,10 +32,14 @@ def _nonneg_float(text: str) -> float:
     return value
 
 
+#: the command's line in ``wmr-mj --help`` (read without registering the command: wmr_mj/cli/app.py)
+HELP = "robustness condition (4.23) and error bounds of the computed-torque controller"
+
+
 def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
         "robustness",
-        help="robustness condition (4.23) and error bounds of the computed-torque controller",
+        help=HELP,
         description=(
             "Evaluate the robustness analysis of section 4: operator gains gamma1, gamma2 (4.14), "
             "delta1 (4.18), the coefficients of ||E|| and ||E'|| in (4.19), condition (4.23) and the "

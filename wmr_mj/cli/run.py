@@ -122,11 +122,15 @@ def with_design_file(args: argparse.Namespace) -> argparse.Namespace:
     return merged
 
 
+#: the command's line in ``wmr-mj --help`` (read without registering the command: wmr_mj/cli/app.py)
+HELP = "simulate the circle headless with a controller and report the errors"
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     from wmr_mj.cli._common import CLAIM_BROKEN_EXIT
 
     p = sub.add_parser(
-        "run", help="simulate the circle headless with a controller and report the errors",
+        "run", help=HELP,
         epilog=f"exit status: 0; {CLAIM_BROKEN_EXIT} when the run is certified-outside: it breaks the law's claim "
                "(the banner above the verdict); 1 the law failed mid-run; 2 bad input; 130 interrupted",
         description="One closed-loop run on the MuJoCo plant, reported against the regions. The run is a "

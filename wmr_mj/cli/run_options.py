@@ -25,7 +25,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from wmr_mj.cli.options import positive_float
+from wmr_mj.cli.options import add_argument_with_help_of, positive_float
 
 __all__ = ["RunOption", "Replay", "run_options", "add_options", "add_option", "command_line", "GROUPS"]
 
@@ -65,7 +65,7 @@ class RunOption:
             or 'command' (each command adds its own, with its own help: ``--m1``, ``--range``).
         sets: the RunConfig field it sets ('' where it sets none directly: ``--preset``, ``--omega-r``).
         settings: argparse's keywords (type, default, metavar, action, nargs, choices).
-        help: its help, or a function of nothing giving it (names read where the parser is built).
+        help: its help, or a function of nothing giving it (names a heavy module holds: called for --help only).
         write: ``write(config, replay)``: the words that give ``config``'s field back ([] where nothing needs
             writing: a default, an option another row writes, the same field written by another row).
     """
@@ -285,13 +285,20 @@ def add_options(p: argparse.ArgumentParser | Any, group: str) -> None:
     """Add the rows of ``group`` (:data:`GROUPS`) to the parser (or argument group) ``p``, in the table's order."""
     for row in run_options():
         if row.group == group:
-            p.add_argument(row.flag, help=row.help() if callable(row.help) else row.help, **row.settings)
+            _add_row(p, row)
 
 
 def add_option(p: argparse.ArgumentParser | Any, flag: str) -> None:
     """Add the one row ``flag`` of the table to ``p`` (``--cart`` in ``identify`` and ``model``)."""
-    row = next(r for r in run_options() if r.flag == flag)
-    p.add_argument(row.flag, help=row.help() if callable(row.help) else row.help, **row.settings)
+    _add_row(p, next(r for r in run_options() if r.flag == flag))
+
+
+def _add_row(p: argparse.ArgumentParser | Any, row: RunOption) -> None:
+    """One row's option; a help that is a function (it names what a heavy module holds) is called for --help only."""
+    if callable(row.help):
+        add_argument_with_help_of(p, row.flag, row.help, **row.settings)
+    else:
+        p.add_argument(row.flag, help=row.help, **row.settings)
 
 
 def command_line(config: Any, replay: Replay, *, command: str = "wmr-mj run") -> str:

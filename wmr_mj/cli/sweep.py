@@ -13,12 +13,15 @@ if TYPE_CHECKING:
     from wmr_mj.sim.sweep import SweepSummary
 
 
+#: the command's line in ``wmr-mj --help`` (read without registering the command: wmr_mj/cli/app.py)
+HELP = "Monte-Carlo over m1 (and --uncertainty/--range) on mujoco.batch: per-run verdicts, table and plot"
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     from wmr_mj.cli.run import add_require_option, add_run_options, add_signal_options
 
     p = sub.add_parser("sweep",
-                       help="Monte-Carlo over m1 (and --uncertainty/--range) on mujoco.batch: per-run "
-                            "verdicts, table and plot",
+                       help=HELP,
                        epilog=f"exit status: 0; {CLAIM_BROKEN_EXIT} when a run is certified-outside: it breaks the "
                               "law's claim (a banner names the run; summary.json's claim_broken); 2 bad input")
     add_run_options(p)

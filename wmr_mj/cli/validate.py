@@ -23,22 +23,24 @@ from __future__ import annotations
 import argparse
 
 from wmr_mj.cli._common import int_at_least, positive_float, positive_int
-from wmr_mj.cli.options import add_json, add_out, add_seed, add_threads
+from wmr_mj.cli.options import add_argument_with_help_of, add_json, add_out, add_seed, add_threads
+from wmr_mj.report.defaults import DEFAULT_DURATION, DEFAULT_N, DEFAULT_SEARCH_BUDGET, FULL_BOX_FACTOR
 
 _nonneg_int = int_at_least(0)
 
 
-def register(sub: argparse._SubParsersAction) -> None:
-    from wmr_mj.report.settings import DEFAULT_DURATION, DEFAULT_N, DEFAULT_SEARCH_BUDGET, FULL_BOX_FACTOR
-    from wmr_mj.sim.sweep import SAMPLINGS
+#: the command's line in ``wmr-mj --help`` (read without registering the command: wmr_mj/cli/app.py)
+HELP = ("headline report: the paper's design, the ladder to the certified design, the worst-case search, the "
+        "plant's friction law; writes index.html")
 
-    p = sub.add_parser("validate", help="headline report: the paper's design, the ladder to the certified design, "
-                                        "the worst-case search, the plant's friction law; writes index.html",
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("validate", help=HELP,
                        description=__doc__.split("\n\n")[1] if __doc__ else None)
     p.add_argument("--n", type=positive_int, default=DEFAULT_N,
                    help=f"runs per rung of the ladder (default {DEFAULT_N}; --n 100 for the full counts)")
     add_seed(p, help="seed of the m1 samples, the searches and the identification (default 0)")
-    p.add_argument("--sampling", choices=SAMPLINGS, default="lhs", help="sampling of m1 (default lhs)")
+    add_argument_with_help_of(p, "--sampling", _sampling_help, default="lhs")  # the names checked by the settings
     p.add_argument("--duration", type=positive_float, default=DEFAULT_DURATION,
                    help=f"simulated time per run, s (default {DEFAULT_DURATION:g}; >= ~10 s reaches the circle)")
     p.add_argument("--identify-duration", type=positive_float, default=60.0,
@@ -65,6 +67,12 @@ def register(sub: argparse._SubParsersAction) -> None:
 
     add_hardware_options(p)  # the cart of every run of the report (summary.json's settings record it)
     p.set_defaults(func=run)
+
+
+def _sampling_help() -> str:
+    from wmr_mj.sim.sweep import SAMPLINGS
+
+    return f"sampling of m1: one of {', '.join(SAMPLINGS)} (default lhs)"
 
 
 def run(args: argparse.Namespace) -> int:

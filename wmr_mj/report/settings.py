@@ -18,6 +18,7 @@ from wmr_mj._util.checks import as_pair, integer_at_least, positive_number
 from wmr_mj._util.progress import Stages
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.hardware.cart import CART_PARTS, cart_dict
+from wmr_mj.report.defaults import DEFAULT_DURATION, DEFAULT_N, DEFAULT_SEARCH_BUDGET, FULL_BOX_FACTOR
 from wmr_mj.sim.config import RunConfig, build_reference
 from wmr_mj.sim.designs import DesignLike
 from wmr_mj.sim.sweep import max_at  # noqa: F401  (re-exported: the report reads runs.csv with it)
@@ -36,13 +37,6 @@ __all__ = [
     "loud",
 ]
 
-#: Defaults of ``wmr-mj validate``: 4 rungs x 32 runs of 35 s and 3 searches (30 + 30 + 56 runs) take
-#: about a minute on 2 cores, so ``make demo`` fits 3 minutes with the install; ``--n 100``: full counts.
-DEFAULT_N = 32
-DEFAULT_DURATION = 35.0
-#: Simulations of each m1-box search; the 5-parameter full-box search gets FULL_BOX_FACTOR times as many.
-DEFAULT_SEARCH_BUDGET = 30
-FULL_BOX_FACTOR = 2
 #: What a ladder rung may change, in groups of RunConfig fields: each rung changes exactly one.
 LADDER_GROUPS = {"controller": ("controller",), "model source": ("model",),
                  "compensation": ("friction_sign", "friction_width"), "gains": ("kp", "kd")}

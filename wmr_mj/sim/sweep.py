@@ -30,10 +30,12 @@ import io
 import json
 import math
 import os
+import socket
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
+from urllib.parse import urlsplit
 
 import numpy as np
 
@@ -464,11 +466,34 @@ def _connect(scheduler: str):
         from distributed import Client
     except ImportError:
         raise SchedulerError("--scheduler needs the Dask extra: pip install 'wmr-mj[dask]'") from None
+    if _refused(scheduler):
+        raise SchedulerError(f"cannot reach the Dask scheduler at {scheduler!r} (ConnectionRefusedError); give the "
+                             "address of a running scheduler, e.g. tcp://127.0.0.1:8786")
     try:
         return Client(scheduler, timeout="5s", set_as_default=False)
     except (OSError, TimeoutError, ValueError) as exc:
         raise SchedulerError(f"cannot reach the Dask scheduler at {scheduler!r} ({type(exc).__name__}); "
                              "give the address of a running scheduler, e.g. tcp://127.0.0.1:8786") from None
+
+
+def _refused(scheduler: str) -> bool:
+    """True where nothing listens at a ``tcp://HOST:PORT`` address: the host refuses the connection at once,
+    where a ``Client`` would retry until its timeout. False for another scheme, or any other answer (the
+    ``Client`` then says what is wrong)."""
+    address = urlsplit(scheduler)
+    try:
+        port = address.port
+    except ValueError:
+        return False
+    if address.scheme != "tcp" or address.hostname is None or port is None:
+        return False
+    try:
+        with socket.create_connection((address.hostname, port), timeout=5.0):
+            return False
+    except ConnectionRefusedError:
+        return True
+    except OSError:
+        return False
 
 
 def _chunk_progress(progress: Callable[[float, int], None] | None, done: int, size: int,
@@ -487,10 +512,22 @@ def run_sweep(spec: SweepSpec, *, out_dir: str | os.PathLike | None = None, chun
     progress(done, total) is called as runs finish and, locally, as a chunk steps (done
     is then fractional).
     """
-    from wmr_mj._util.files import write_json_atomic, write_text_atomic
-
     if chunk < 1:
         raise ParameterError(f"chunk = {chunk} must be >= 1")
+    # an unreachable scheduler is refused before anything is written (the folder, sweep.json)
+    client = _connect(scheduler) if scheduler is not None else None
+    try:
+        return _run_sweep(spec, out_dir, chunk, nthread, client, progress)
+    finally:
+        if client is not None:
+            client.close()
+
+
+def _run_sweep(spec: SweepSpec, out_dir: str | os.PathLike | None, chunk: int, nthread: int, client: Any,
+               progress: Callable[[float, int], None] | None) -> list[dict[str, Any]]:
+    """:func:`run_sweep` once its inputs are checked: locally, or on ``client`` (a Dask client) where given."""
+    from wmr_mj._util.files import write_json_atomic, write_text_atomic
+
     done: dict[int, dict[str, Any]] = {}
     out = Path(out_dir) if out_dir is not None else None
     extra = list(spec.names[1:])
@@ -528,14 +565,10 @@ def run_sweep(spec: SweepSpec, *, out_dir: str | os.PathLike | None = None, chun
 
     if progress is not None:
         progress(len(done), spec.n)
-    if scheduler is not None:
-        client = _connect(scheduler)
-        try:
-            futures = [client.submit(_run_chunk, spec_json, c, 1, pure=False) for c in chunks]
-            for fut in futures:  # in order; each finished chunk is saved before the next is awaited
-                record(fut.result())
-        finally:
-            client.close()
+    if client is not None:
+        futures = [client.submit(_run_chunk, spec_json, c, 1, pure=False) for c in chunks]
+        for fut in futures:  # in order; each finished chunk is saved before the next is awaited
+            record(fut.result())
     else:
         for c in chunks:
             record(_run_chunk(spec_json, c, nthread, _chunk_progress(progress, len(done), len(c), spec.n)))
