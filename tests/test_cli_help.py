@@ -22,7 +22,7 @@ HEAVY_LAYERS = ("wmr_mj.sim", "wmr_mj.reference", "wmr_mj.plant", "wmr_mj.analys
                 "wmr_mj.figures", "wmr_mj.logs")
 #: of those, the modules that hold a command's defaults and import only the standard library at their top (and their
 #: packages): validate's and design's
-DEFAULTS_MODULES = ("wmr_mj.report", "wmr_mj.report.defaults", "wmr_mj.sim", "wmr_mj.sim.design_search")
+DEFAULTS_MODULES = ("wmr_mj.report", "wmr_mj.report.defaults", "wmr_mj.sim", "wmr_mj.sim.design_options")
 
 _PROBE = """
 import contextlib, io, json, sys

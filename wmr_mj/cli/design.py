@@ -16,7 +16,7 @@ HELP = "the computed-torque (or sliding-mode) gains, sign width, filter and peri
 def register(sub: argparse._SubParsersAction) -> None:
     from wmr_mj.cli.run import add_hardware_options
     from wmr_mj.params import M1_RANGE
-    from wmr_mj.sim.design_search import DEFAULT_BUDGET, DEFAULT_SEED, METHODS, OBJECTIVES
+    from wmr_mj.sim.design_options import DEFAULT_BUDGET, DEFAULT_SEED, METHODS, OBJECTIVES
 
     p = sub.add_parser(
         "design", help=HELP,

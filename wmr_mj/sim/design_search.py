@@ -43,25 +43,13 @@ from typing import Any
 import numpy as np
 
 from wmr_mj.errors import ParameterError
+from wmr_mj.sim.design_options import DEFAULT_BUDGET, DEFAULT_SEED, LAWS, METHODS, OBJECTIVES
 from wmr_mj.sim.optimisers import CMAES, Chain, DifferentialEvolution, Optimiser, Points, drive
 
 __all__ = ["DesignProblem", "DesignResult", "OBJECTIVES", "METHODS", "LAWS", "DEFAULT_SEED", "DEFAULT_BUDGET",
            "DESIGN_FIELDS", "law_changes", "uncovered", "search_design", "evaluate_design", "write_design",
            "read_design", "design_file_settings", "design_cart", "check_periods"]
 
-#: what the search minimises: the worst certified E_max over the paths (rad), the worst certified voltage (V),
-#: or minus the smallest relative margin 1 - value/limit of the certificate's checked assumptions
-OBJECTIVES = ("E_max", "voltage", "margin")
-#: the optimisers: CMA-ES (``cmaes``; the default: at 640 points on the 12-bit cart it found 0.018894 rad on
-#: seeds 0 and 1 where differential evolution found 0.019517 rad, bench/bench_design.py) or scipy's
-#: differential evolution
-METHODS = ("cma", "de")
-#: the laws searched: their families are in the module docstring
-LAWS = ("computed-torque", "sliding-mode")
-#: the search's seed and budget (certificates per period and path, about) where none is given: ``wmr-mj design``'s,
-#: and what validate's section (e) and ``cart check`` search with, so that the command finds the same design
-DEFAULT_SEED = 0
-DEFAULT_BUDGET = 600
 #: the RunConfig settings a design file sets (``run --design FILE``), as a preset does
 DESIGN_FIELDS = ("controller", "controller_params", "model", "kp", "kd", "friction_sign", "friction_width",
                  "control_period", "sensing", "actuation", "transmission")
