@@ -113,6 +113,10 @@ CoefficientModel = Literal["paper", "nonholonomic"]
 COEFFICIENT_MODELS: tuple[str, ...] = get_args(CoefficientModel)
 
 
+#: The parameters that may be 0 (every other one is > 0): the armature inductance L_a (0: no electrical lag).
+NONNEGATIVE_PARAMETERS: frozenset[str] = frozenset({"L_a"})
+
+
 @dataclass(frozen=True, kw_only=True)
 class C80Parameters:
     """Physical parameters of the C80 cart (SI units). The defaults are the C80's, read from its cart file
@@ -144,6 +148,9 @@ class C80Parameters:
     front_wheel_width: float = _C80_VALUES["front_wheel_width"]
     # steering motor (2.9)-(2.10)
     R_a: float = _C80_VALUES["R_a"]
+    # the armature inductance L_a, H (>= 0; 0: the current follows the voltage at once, the paper's (2.10)); the
+    # default inductance of the dcmotor (wmr_mj.plant.mjcf), which ``--actuation inductance=`` overrides
+    L_a: float = _C80_VALUES["L_a"]
     k_i: float = _C80_VALUES["k_i"]
     k_b: float = _C80_VALUES["k_b"]
     i2: float = _C80_VALUES["i2"]
@@ -162,7 +169,10 @@ class C80Parameters:
                 raise ParameterError(
                     f"parameter {f.name} must be a number, got {value!r}"
                 )
-            if not math.isfinite(value) or value <= 0.0:
+            if f.name in NONNEGATIVE_PARAMETERS:
+                if not math.isfinite(value) or value < 0.0:
+                    raise ParameterError(f"parameter {f.name} = {value!r} is not accepted: it must be finite and >= 0")
+            elif not math.isfinite(value) or value <= 0.0:
                 raise ParameterError(
                     f"parameter {f.name} = {value!r} is not accepted: "
                     "every C80 parameter must be finite and > 0"
