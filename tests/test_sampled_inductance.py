@@ -158,3 +158,46 @@ def test_the_cart_files_limit_is_the_actuations():
     from wmr_mj.hardware.cart import MAX_ELECTRICAL_TIME_CONSTANT_S
 
     assert in_cart_file == MAX_ELECTRICAL_TIME_CONSTANT_S
+
+
+# -- the cart's motor.L_a, end to end (the plant, the coverage, the claim) ----------------------------------------
+def _cart_with_inductance(tmp_path, L_a: float):
+    from wmr_mj.carts import CARTS_DIR
+
+    text = (CARTS_DIR / "c80.toml").read_text(encoding="utf-8")
+    anchor = '[motor.L_a]\nvalue = 0.0\n'
+    assert anchor in text
+    path = tmp_path / "inductive.toml"
+    path.write_text(text.replace(anchor, f"[motor.L_a]\nvalue = {L_a!r}\n"), encoding="utf-8")
+    return path
+
+
+def test_the_carts_inductance_reaches_the_dcmotor_and_an_actuation_overrides_it():
+    from wmr_mj.params import C80, with_params
+    from wmr_mj.plant.mjcf import compile_model
+
+    steer = 0  # the steering motor is the first actuator
+    assert compile_model(C80)[0].na == 0  # the C80: no current state, today's model
+    model, _ = compile_model(with_params(C80, L_a=0.001))
+    assert model.na == 1 and model.actuator_dynprm[steer][0] == 0.001
+    model, _ = compile_model(with_params(C80, L_a=0.001), inductance_H=0.002)
+    assert model.actuator_dynprm[steer][0] == 0.002
+
+
+def test_a_cart_file_with_inductance_is_certified_on_the_12bit_encoder(tmp_path):
+    """motor.L_a = R_a x 1 ms in the cart file, no --actuation: the measurement carries L_a/R_a = 1 ms, section 4
+    leaves it uncovered, and the sampled-data certificate holds it: certified, E_max as with --actuation inductance=
+    (the same number, 0.1107 rad at m1 = 750 kg, docs/guides/certificates.md)."""
+    import wmr_mj as wm
+    from wmr_mj.sim.config import RunConfig
+    from wmr_mj.sim.parts import resolve_run
+
+    base = {**wm.CERTIFIED.config_changes(), "sensing": "magnetic-12bit-axis", "m1": 750.0}
+    from_cart = resolve_run(RunConfig(**base, cart=str(_cart_with_inductance(tmp_path, 0.001)))).claim
+    from_option = resolve_run(RunConfig(**base, actuation="inductance=0.001")).claim
+    without = resolve_run(RunConfig(**base)).claim
+    assert from_cart.certified and from_cart.inputs["certificate"] == "sampled-data"
+    assert not from_cart.inputs["certificates"]["section-4"]["certified"]
+    assert from_cart.E_max == from_option.E_max
+    assert without.E_max < from_cart.E_max < 1.2 * without.E_max  # the lag costs a little, never nothing
+    assert from_cart.inputs["cart"]["electrical_time_constant"] == pytest.approx(0.001)
