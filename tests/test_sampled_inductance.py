@@ -201,3 +201,19 @@ def test_a_cart_file_with_inductance_is_certified_on_the_12bit_encoder(tmp_path)
     assert from_cart.E_max == from_option.E_max
     assert without.E_max < from_cart.E_max < 1.2 * without.E_max  # the lag costs a little, never nothing
     assert from_cart.inputs["cart"]["electrical_time_constant"] == pytest.approx(0.001)
+
+
+def test_a_cart_file_without_L_a_reads_0_and_one_beyond_the_limit_is_refused_in_one_line():
+    from wmr_mj.carts import CARTS_DIR, load_cart_text
+    from wmr_mj.errors import ParameterError
+    from wmr_mj.params import parameters_of_cart
+
+    text = (CARTS_DIR / "c80.toml").read_text(encoding="utf-8")
+    entry = text[text.index("[motor.L_a]"):text.index("[motor.k_i]")]
+    omitted = load_cart_text(text.replace(entry, ""))
+    assert omitted.parameters["L_a"] == 0.0 and omitted.units["L_a"] == "H"
+    assert parameters_of_cart(omitted) == parameters_of_cart(load_cart_text(text))
+    with pytest.raises(ParameterError) as refused:  # R_a = 1 Ohm: 0.2 H is 0.2 s, beyond 0.1 s
+        load_cart_text(text.replace("[motor.L_a]\nvalue = 0.0\n", "[motor.L_a]\nvalue = 0.2\n"))
+    message = str(refused.value)
+    assert "\n" not in message and "motor.L_a.value = 0.2 H is not accepted" in message and "L_a <= 0.1 H" in message

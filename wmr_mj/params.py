@@ -37,6 +37,7 @@ from dataclasses import dataclass, fields
 from typing import Any, Literal, get_args
 
 from wmr_mj.carts import CartFile, load_cart
+from wmr_mj.carts.cartfile import MAX_ELECTRICAL_TIME_CONSTANT_S
 from wmr_mj.errors import ParameterError, UnknownNameError
 
 __all__ = [
@@ -364,7 +365,8 @@ def check_physical_sense(p: C80Parameters) -> None:
     Checked: the reduced coefficients of both models are finite (P, C_V > 0; F, K, gyro >= 0); the supply breaks
     the steering's friction (F, the voltage whose stall torque equals the steering's Coulomb torque, below
     voltage_limit: otherwise the motor cannot move the steering at all); the body masses within
-    :data:`MAX_BODY_MASS_RATIO` of each other (beyond it MuJoCo warns of a singular inertia matrix).
+    :data:`MAX_BODY_MASS_RATIO` of each other (beyond it MuJoCo warns of a singular inertia matrix); the armature's
+    L_a/R_a at most :data:`wmr_mj.carts.cartfile.MAX_ELECTRICAL_TIME_CONSTANT_S`.
 
     Raises:
         ParameterError: one line naming the culprit, its value and what is accepted.
@@ -385,6 +387,11 @@ def check_physical_sense(p: C80Parameters) -> None:
                 raise ParameterError(
                     f"the reduced coefficient {name} = {value!r} ({model} model) is not accepted; accepted: finite and "
                     f"{'> 0' if positive else '>= 0'} (check R_a, k_i, i2, the masses and the geometry it is made of)")
+    if not p.L_a / p.R_a <= MAX_ELECTRICAL_TIME_CONSTANT_S:
+        raise ParameterError(
+            f"L_a = {p.L_a:.4g} H is not accepted: its electrical time constant L_a/R_a = {p.L_a / p.R_a:.3g} s (R_a = "
+            f"{p.R_a:.4g} Ohm) exceeds {MAX_ELECTRICAL_TIME_CONSTANT_S:g} s; accepted: L_a <= "
+            f"{MAX_ELECTRICAL_TIME_CONSTANT_S * p.R_a:.4g} H")
     F = p.coefficients("paper").F
     if not F < p.voltage_limit:
         raise ParameterError(
