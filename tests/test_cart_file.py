@@ -31,11 +31,12 @@ from wmr_mj.params import (
 
 ROOT = Path(__file__).resolve().parents[1]
 
-# The C80 parameter set as params.py wrote it before the cart file (main at 0577203): the independent truth.
+# The C80 parameter set as params.py wrote it before the cart file (main at 0577203): the independent truth; L_a
+# (issue 42, the armature inductance) is 0 H, the paper's motor, which had none.
 TODAY = dict(V_A=0.2, g=9.81, m1=650.0, chassis_length=1.75, chassis_width=0.85, chassis_height=0.30,
              chassis_inertia_mass=650.0, l1=0.612, l2=0.30, l3=0.142, l4=0.25, rear_axle_mass=40.0,
              rear_wheel_mass=10.0, r2=0.15, rear_wheel_width=0.08, i1=20.0, front_axle_mass=14.0,
-             front_wheel_mass=8.0, r3=0.10, front_wheel_width=0.06, R_a=1.0, k_i=0.0795, k_b=0.0795, i2=60.0,
+             front_wheel_mass=8.0, r3=0.10, front_wheel_width=0.06, R_a=1.0, L_a=0.0, k_i=0.0795, k_b=0.0795, i2=60.0,
              voltage_limit=24.0, steering_range=0.9, mu=0.0172, f2=0.0005, f3=0.0005, ground_friction=1.0)
 TODAY_FULL_BOX = {"m1": (550.0, 750.0), "mu": (0.0129, 0.0215), "ground_friction": (0.6, 1.0), "R_a": (1.0, 1.3),
                   "V_A": (0.15, 0.25)}
@@ -234,7 +235,7 @@ def _range_upside_down(d):
 
 
 def _changelog_of_another_version(d):
-    d["version"] = "1.1.0"
+    d["version"] = "1.2.0"
 
 
 def _two_motor_constants(d):
@@ -249,7 +250,7 @@ RULE_CASES = {
     "l3 beyond l1": (_centre_behind_rear_axle_rule, ["chassis.l3.value = 0.7 m", "below the wheelbase",
                                                     "chassis.l1.value = 0.612 m"]),
     "lo above hi": (_range_upside_down, ["uncertainty.full.mu.range = [0.0215, 0.0129]", "lo < hi"]),
-    "changelog": (_changelog_of_another_version, ["changelog[0]", "beginning with the version '1.1.0'"]),
+    "changelog": (_changelog_of_another_version, ["changelog[0]", "beginning with the version '1.2.0'"]),
     "k_b other than k_i": (_two_motor_constants, ["motor.k_b.value = 0.08745 V s/rad is not accepted",
                                                   "equal to motor.k_i.value = 0.0795 N m/A"]),
     "sensing preset": (_unknown_sensing, ["defaults.sensing.value = 'laser-99bit'", "magnetic-12bit-axis"]),

@@ -81,8 +81,10 @@ def test_each_sensing_stage_has_its_bound_beside_it():
 
 def test_each_part_declares_its_coverage():
     assert Actuation(delay=0.003).coverage(R_a=C80.R_a) == Coverage(delay=0.003)
-    why = Actuation(inductance=0.002, current_limit=5.0).coverage(R_a=2.0).why_not
-    assert len(why) == 2 and "L_a/R_a = 1 ms" in why[0] and "current limit (5 A)" in why[1]
+    driven = Actuation(inductance=0.002, current_limit=5.0).coverage(R_a=2.0)
+    # the inductance is bounded (its L_a/R_a, held by the sampled-data certificate), the current limit is not
+    assert driven.electrical_time_constant == 0.002 / 2.0
+    assert len(driven.why_not) == 1 and "current limit (5 A)" in driven.why_not[0]
     assert Transmission().coverage(encoder_on_motor=True) == Coverage()
     motor = Transmission(backlash=0.005).coverage(encoder_on_motor=True)
     axis = Transmission(backlash=0.005).coverage(encoder_on_motor=False)

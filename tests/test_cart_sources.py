@@ -54,8 +54,8 @@ def test_every_value_is_the_sheets_or_labelled_an_assumption():
     assert all(part in sources["parameter i2"] for part in GEAR_SHEET) and "line" in sources["parameter i2"]
     assert load_cart(CART).parameters["i2"] in NP045_TWO_STAGE_RATIOS
     # the rest: every one labelled, none of them naming the sheet as its source
-    # 30 parameters, 6 ranges (m1: m1; full: m1, mu, ground_friction, R_a, V_A), 3 defaults
-    assert len(sources) == 30 + 6 + 3
+    # 31 parameters (with L_a), 6 ranges (m1: m1; full: m1, mu, ground_friction, R_a, V_A), 3 defaults
+    assert len(sources) == 31 + 6 + 3
     assert not any(SHEET[1] in s and not s.startswith("assumption") for k, s in sources.items() if k not in from_sheet)
 
 
@@ -76,5 +76,6 @@ def test_the_file_says_it_is_not_a_real_vehicle():
     text = (CARTS_DIR / f"{CART}.toml").read_text(encoding="utf-8")
     assert "this is not a real vehicle's parameter set" in text
     changelog = load_cart(CART).changelog
-    assert changelog[0].startswith("2.1.0 (2026-11-27): the gear is the Beckhoff NP045")
-    assert changelog[1].startswith("2.0.0 (2026-11-27): the steering motor is the Magmotor")
+    assert changelog[0].startswith("2.2.0 (2026-11-28): the armature inductance motor.L_a, 0 H")
+    assert changelog[1].startswith("2.1.0 (2026-11-27): the gear is the Beckhoff NP045")
+    assert changelog[2].startswith("2.0.0 (2026-11-27): the steering motor is the Magmotor")

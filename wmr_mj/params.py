@@ -37,6 +37,7 @@ from dataclasses import dataclass, fields
 from typing import Any, Literal, get_args
 
 from wmr_mj.carts import CartFile, load_cart
+from wmr_mj.carts.cartfile import MAX_ELECTRICAL_TIME_CONSTANT_S
 from wmr_mj.errors import ParameterError, UnknownNameError
 
 __all__ = [
@@ -113,6 +114,10 @@ CoefficientModel = Literal["paper", "nonholonomic"]
 COEFFICIENT_MODELS: tuple[str, ...] = get_args(CoefficientModel)
 
 
+#: The parameters that may be 0 (every other one is > 0): the armature inductance L_a (0: no electrical lag).
+NONNEGATIVE_PARAMETERS: frozenset[str] = frozenset({"L_a"})
+
+
 @dataclass(frozen=True, kw_only=True)
 class C80Parameters:
     """Physical parameters of the C80 cart (SI units). The defaults are the C80's, read from its cart file
@@ -144,6 +149,9 @@ class C80Parameters:
     front_wheel_width: float = _C80_VALUES["front_wheel_width"]
     # steering motor (2.9)-(2.10)
     R_a: float = _C80_VALUES["R_a"]
+    # the armature inductance L_a, H (>= 0; 0: the current follows the voltage at once, the paper's (2.10)); the
+    # default inductance of the dcmotor (wmr_mj.plant.mjcf), which ``--actuation inductance=`` overrides
+    L_a: float = _C80_VALUES["L_a"]
     k_i: float = _C80_VALUES["k_i"]
     k_b: float = _C80_VALUES["k_b"]
     i2: float = _C80_VALUES["i2"]
@@ -162,7 +170,10 @@ class C80Parameters:
                 raise ParameterError(
                     f"parameter {f.name} must be a number, got {value!r}"
                 )
-            if not math.isfinite(value) or value <= 0.0:
+            if f.name in NONNEGATIVE_PARAMETERS:
+                if not math.isfinite(value) or value < 0.0:
+                    raise ParameterError(f"parameter {f.name} = {value!r} is not accepted: it must be finite and >= 0")
+            elif not math.isfinite(value) or value <= 0.0:
                 raise ParameterError(
                     f"parameter {f.name} = {value!r} is not accepted: "
                     "every C80 parameter must be finite and > 0"
@@ -354,7 +365,8 @@ def check_physical_sense(p: C80Parameters) -> None:
     Checked: the reduced coefficients of both models are finite (P, C_V > 0; F, K, gyro >= 0); the supply breaks
     the steering's friction (F, the voltage whose stall torque equals the steering's Coulomb torque, below
     voltage_limit: otherwise the motor cannot move the steering at all); the body masses within
-    :data:`MAX_BODY_MASS_RATIO` of each other (beyond it MuJoCo warns of a singular inertia matrix).
+    :data:`MAX_BODY_MASS_RATIO` of each other (beyond it MuJoCo warns of a singular inertia matrix); the armature's
+    L_a/R_a at most :data:`wmr_mj.carts.cartfile.MAX_ELECTRICAL_TIME_CONSTANT_S`.
 
     Raises:
         ParameterError: one line naming the culprit, its value and what is accepted.
@@ -375,6 +387,11 @@ def check_physical_sense(p: C80Parameters) -> None:
                 raise ParameterError(
                     f"the reduced coefficient {name} = {value!r} ({model} model) is not accepted; accepted: finite and "
                     f"{'> 0' if positive else '>= 0'} (check R_a, k_i, i2, the masses and the geometry it is made of)")
+    if not p.L_a / p.R_a <= MAX_ELECTRICAL_TIME_CONSTANT_S:
+        raise ParameterError(
+            f"L_a = {p.L_a:.4g} H is not accepted: its electrical time constant L_a/R_a = {p.L_a / p.R_a:.3g} s (R_a = "
+            f"{p.R_a:.4g} Ohm) exceeds {MAX_ELECTRICAL_TIME_CONSTANT_S:g} s; accepted: L_a <= "
+            f"{MAX_ELECTRICAL_TIME_CONSTANT_S * p.R_a:.4g} H")
     F = p.coefficients("paper").F
     if not F < p.voltage_limit:
         raise ParameterError(

@@ -60,6 +60,9 @@ class MeasurementErrors:
         covered: False where some error of the run has no derived bound; the certificate is then
             uncertified (assumption :data:`MEASUREMENT_COVERED`).
         why_not: what is not covered (required when ``covered`` is False).
+        electrical_time_constant_s: the armature current's lag L_a/R_a [s] >= 0 (0: none). Bounded, but only a
+            certificate whose loop holds the current absorbs it (the sampled-data one); any other claim leaves the
+            run uncovered (:func:`coverage_assumption_fields`).
 
     Raises:
         ParameterError: a bound that is not a finite number >= 0, ``covered`` not a bool, or
@@ -71,10 +74,12 @@ class MeasurementErrors:
     delay_s: float
     covered: bool = True
     why_not: str | None = None
+    electrical_time_constant_s: float = 0.0
 
     def __post_init__(self) -> None:
-        for name in ("alpha_error_max", "alpha_dot_error_max", "delay_s"):
-            if name != "delay_s" and self.covered is False and getattr(self, name) == math.inf:
+        for name in ("alpha_error_max", "alpha_dot_error_max", "delay_s", "electrical_time_constant_s"):
+            unbounded = self.covered is False and getattr(self, name) == math.inf
+            if name in ("alpha_error_max", "alpha_dot_error_max") and unbounded:
                 continue  # an error with no bound (Gaussian noise) is infinite, and never covered
             object.__setattr__(self, name, finite_number(name, getattr(self, name), minimum=0.0))
         if not isinstance(self.covered, bool):
@@ -91,27 +96,38 @@ class MeasurementErrors:
     def is_exact(self) -> bool:
         """No error, no delay, covered: the certificates are today's, bit for bit."""
         return (self.covered and self.alpha_error_max == 0.0 and self.alpha_dot_error_max == 0.0
-                and self.delay_s == 0.0)
+                and self.delay_s == 0.0 and self.electrical_time_constant_s == 0.0)
 
     def as_dict(self) -> dict[str, Any]:
-        """JSON-ready: the five fields."""
-        return {"alpha_error_max": self.alpha_error_max, "alpha_dot_error_max": self.alpha_dot_error_max,
-                "delay_s": self.delay_s, "covered": self.covered, "why_not": self.why_not}
+        """JSON-ready: the fields (the electrical time constant only where there is one: no key changes elsewhere)."""
+        out = {"alpha_error_max": self.alpha_error_max, "alpha_dot_error_max": self.alpha_dot_error_max,
+               "delay_s": self.delay_s, "covered": self.covered, "why_not": self.why_not}
+        if self.electrical_time_constant_s:
+            out["electrical_time_constant_s"] = self.electrical_time_constant_s
+        return out
 
 
-def coverage_assumption_fields(measurement: MeasurementErrors, claimant: str = "") -> dict[str, Any]:
+def coverage_assumption_fields(measurement: MeasurementErrors, claimant: str = "", *,
+                               absorbs_electrical_lag: bool = False) -> dict[str, Any]:
     """The fields of the assumption :data:`MEASUREMENT_COVERED` (an ``Assumption(**fields)``).
 
-    value 0 (covered) or 1 (not) against the limit 0; the note names what is missing.
+    value 0 (covered) or 1 (not) against the limit 0; the note names what is missing. An armature inductance
+    (``measurement.electrical_time_constant_s`` > 0) is covered only by a claim that ``absorbs_electrical_lag`` (its
+    loop holds the current: the sampled-data certificate).
     """
     who = f"{claimant}: " if claimant else ""
+    tau_e = measurement.electrical_time_constant_s
+    why = [measurement.why_not] if not measurement.covered else []
+    if tau_e and not absorbs_electrical_lag:
+        why.append(f"the armature inductance (L_a/R_a = {tau_e * 1e3:.3g} ms) is not in this claim's motor model")
+    covered = not why
     note = (f"{who}bounds |e_alpha| <= {measurement.alpha_error_max:.4g} rad, |e_alpha'| <= "
-            f"{measurement.alpha_dot_error_max:.4g} rad/s, delay {measurement.delay_s:.4g} s")
-    if not measurement.covered:
-        note = f"{who}no bound derived: {measurement.why_not}"
+            f"{measurement.alpha_dot_error_max:.4g} rad/s, delay {measurement.delay_s:.4g} s"
+            + (f", L_a/R_a {tau_e:.4g} s in the loop" if tau_e else ""))
+    if not covered:
+        note = f"{who}no bound derived: {'; '.join(str(w) for w in why)}"
     return dict(name=MEASUREMENT_COVERED, equation="every sensing and actuation error of the run has a derived bound",
-                met=bool(measurement.covered), value=0.0 if measurement.covered else 1.0, limit=0.0, note=note,
-                kind="checked")
+                met=covered, value=0.0 if covered else 1.0, limit=0.0, note=note, kind="checked")
 
 
 def sin_cos3_slope(alpha: float) -> float:

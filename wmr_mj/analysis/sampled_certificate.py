@@ -41,7 +41,15 @@ from wmr_mj.analysis.claim_types import Assumption, Certificate, ClaimInputs
 from wmr_mj.analysis.measurement import MeasurementErrors, coverage_assumption_fields, inv_cos2_slope, sin_cos3_slope
 from wmr_mj.analysis.plant_box import PlantBox, PlantLimits
 from wmr_mj.analysis.regions import BoxRegion
-from wmr_mj.analysis.sampled_data import PeakGains, SampledLoop, _norm_bound, _Rows, peak_gains, sampled_loop
+from wmr_mj.analysis.sampled_data import (
+    PeakGains,
+    SampledLoop,
+    _norm_bound,
+    _Rows,
+    current_moments,
+    peak_gains,
+    sampled_loop,
+)
 from wmr_mj.analysis.small_gain import Compensation, Estimate, Gains, _Bound
 from wmr_mj.errors import ParameterError
 from wmr_mj.hardware.estimators import velocity_estimator
@@ -69,6 +77,8 @@ class SampledCart:
         velocity_error: the estimate's static error bound, rad/s (with ``velocity_lag``, s, times sup|alpha''|):
             used only where the law's velocity enters outside the linear loop (the gyro compensation).
         measurement: the run's coverage (an uncovered part makes the certificate uncertified).
+        electrical_time_constant: tau_e = L_a/R_a, s, the armature current's lag (0: none; > 0: a state of the
+            sampled loop, ``docs/guides/certificates.md``, "The armature inductance in the sampled loop").
     """
 
     velocity: str
@@ -80,6 +90,7 @@ class SampledCart:
     velocity_error: float
     velocity_lag: float
     measurement: MeasurementErrors
+    electrical_time_constant: float = 0.0
 
     @classmethod
     def of(cls, sensing: Sensing, *, control_period: float, gear_ratio: float, play: float = 0.0,
@@ -89,7 +100,7 @@ class SampledCart:
         Args:
             sensing: the sensor. control_period: T, s. gear_ratio: i2. play: b, rad (counted where the encoder is
                 on the motor side). actuation_delay_s: s, a whole number of control periods.
-            measurement: the run's coverage (default: covered).
+            measurement: the run's coverage (default: covered); its ``electrical_time_constant_s`` is the cart's.
 
         Raises:
             ParameterError: a delay that is not a whole number of control periods.
@@ -100,7 +111,8 @@ class SampledCart:
                    actuation_delay=whole_periods("actuation delay", actuation_delay_s, control_period),
                    angle_error=b.alpha_error_max, velocity_noise=sensing.velocity_noise_bound(),
                    velocity_error=b.alpha_dot_error_max, velocity_lag=b.alpha_dot_lag,
-                   measurement=measurement if measurement is not None else MeasurementErrors.exact())
+                   measurement=measurement if measurement is not None else MeasurementErrors.exact(),
+                   electrical_time_constant=measurement.electrical_time_constant_s if measurement is not None else 0.0)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -169,7 +181,8 @@ class SampledDataInputs:
                          "sensing_delay_periods": cart.sensing_delay, "actuation_delay_periods": cart.actuation_delay,
                          "angle_error": cart.angle_error, "velocity_noise": cart.velocity_noise,
                          "velocity_error": cart.velocity_error, "velocity_lag": cart.velocity_lag,
-                         "measurement": cart.measurement.as_dict()},
+                         "measurement": cart.measurement.as_dict(),
+                         "electrical_time_constant": cart.electrical_time_constant},
                 "reference": {"alpha0_max": self.reference.alpha_max, "alpha0_dot_max": self.reference.alpha_dot_max,
                               "alpha0_ddot_max": self.reference.alpha_ddot_max},
                 "terms": self.terms.to_dict() if self.terms is not None else None}
@@ -182,7 +195,10 @@ def damped_loop(*, kp: float, kd: float, c_hat: float, control_period: float, ca
     compensation C_V^ alpha_m' = C_V^ (alpha0' - E^') reads the same estimate), then the plant's back-EMF over the
     period: with s = t - t_k and u_a the held command, -c^ E'(t) = -c^ E'[k] + c^ s (u_a + c^ E'[k]) + rho(t),
     |rho| <= c^^2 s^2/2 sup|E''| + c^ s sup|w| (left in the disturbance), so over one period
-    E gains -(T^2/2 - c^ T^3/6)(u_a + c^ E'[k]) and E' gains -(T - c^ T^2/2)(u_a + c^ E'[k]).
+    E gains -(T^2/2 - c^ T^3/6)(u_a + c^ E'[k]) and E' gains -(T - c^ T^2/2)(u_a + c^ E'[k]). With the armature
+    current j (``cart.electrical_time_constant`` > 0), u_a is j(t) and its integrals over the period are exact
+    (:func:`~wmr_mj.analysis.sampled_data.current_moments`): E' gains -(m1 - c^ m2) - c^ (T - c^ T^2/2) E'[k], E
+    gains -(m2 - c^ m3) - c^ (T^2/2 - c^ T^3/6) E'[k], m_i the i-fold integral of j.
 
     Raises:
         ParameterError: K_D - c^ <= 0 (the sampled servo then has no damping of its own), as sampled_loop.
@@ -192,19 +208,25 @@ def damped_loop(*, kp: float, kd: float, c_hat: float, control_period: float, ca
         raise ParameterError(f"K_D - C_V^/P^ = {kd:g} - {c_hat:g} <= 0: the sampled servo has no damping of its own")
     loop = sampled_loop(kp=kp, kd=kd_loop, control_period=control_period, velocity=cart.velocity,
                         filter_tau=cart.filter_tau, sensing_delay=cart.sensing_delay,
-                        actuation_delay=cart.actuation_delay)
+                        actuation_delay=cart.actuation_delay, electrical_time_constant=cart.electrical_time_constant)
     T, n = control_period, loop.n_states
-    applied = np.zeros(n + 2)  # u[k - d_a] over (state, e, n_v)
-    if cart.actuation_delay:
-        applied[n - 1] = 1.0  # the last of the command's shift register
-    else:
-        applied[:n], applied[n:] = loop.C[2], loop.D[2]
-    drive = applied.copy()
-    drive[1] += c_hat  # u_a + c^ E'[k]
+    applied = loop.applied_row()  # u[k - d_a] over (state, e, n_v)
     rows = np.zeros((2, n + 2))
     rows[0, 0], rows[0, 1], rows[1, 1] = 1.0, T, 1.0
-    rows[0] -= (0.5 * T * T - c_hat * T ** 3 / 6.0) * drive
-    rows[1] -= (T - 0.5 * c_hat * T * T) * drive
+    if loop.current_index is None:
+        drive = applied.copy()
+        drive[1] += c_hat  # u_a + c^ E'[k]
+        rows[0] -= (0.5 * T * T - c_hat * T ** 3 / 6.0) * drive
+        rows[1] -= (T - 0.5 * c_hat * T * T) * drive
+    else:
+        m = current_moments(T, cart.electrical_time_constant)
+        j = np.zeros(n + 2)
+        j[loop.current_index] = 1.0
+        m1, m2, m3 = (m[i, 0] * applied + m[i, 1] * j for i in (1, 2, 3))
+        rows[0] -= m2 - c_hat * m3
+        rows[0, 1] -= c_hat * (0.5 * T * T - c_hat * T ** 3 / 6.0)
+        rows[1] -= m1 - c_hat * m2
+        rows[1, 1] -= c_hat * (T - 0.5 * c_hat * T * T)
     A, B = np.array(loop.A), np.array(loop.B)
     A[:2], B[:2] = rows[:, :n], rows[:, n:]
     for x in (A, B):
@@ -296,7 +318,8 @@ def _solve_at(bound: _Bound, lin: _Linear, cart: SampledCart, T: float, c_hat: f
     """One step of the fixed point: the coefficients at (x, y), the linear small gain solved for W."""
     inf = math.inf
     b, est = bound, bound.estimate
-    span = (cart.sensing_delay + cart.actuation_delay + 1) * T  # t - t_{k - d_a - d_s} < span
+    # t - t_{k - d_a - d_s} < span; the current's lag weighs the law's past outputs at mean age tau_e beyond it
+    span = (cart.sensing_delay + cart.actuation_delay + 1) * T + cart.electrical_time_constant
     A = b.a0 + x
     eps_a = cart.angle_error + span * (b.a0d + y)
     A_m = A + eps_a
@@ -328,6 +351,7 @@ def _solve_at(bound: _Bound, lin: _Linear, cart: SampledCart, T: float, c_hat: f
     delta_c = max(abs(c_hat - cv / p) for cv in (C_V_lo, C_V_hi) for p in corners)
     k_y = delta_c + b.dG / (c2 * P_lo)
     k_A = gam * lag / c2m  # the gyro compensation's age times sup|E''|
+    k_A += c_hat * cart.electrical_time_constant  # c^ |E' - H[E']| <= c^ tau_e sup|E''| (the current's back-EMF lag)
     (gE, gV, gU), (ME, MV, MU) = lin.g, lin.M
     # unknowns: W = sup|w| (the remainder), Wt = sup|w + rho| (what the loop is driven by), A2 = sup|E''|
     q = 1.0 / (1.0 - c_hat * T)
@@ -462,7 +486,7 @@ def _assumptions(*, alpha_max: float, alpha_m: float, voltage_max: float, limits
         Assumption("sampled small gain", "delta_u g_u + k_y g_E' + (k_y T + k_A)(g_u + c^ g_E' + 1) < 1",
                    valid and loop_gain < 1.0, loop_gain, 1.0, "the nonlinear remainder through the sampled loop",
                    kind="checked"),
-        Assumption(**coverage_assumption_fields(cart.measurement, SAMPLED_DATA)),
+        Assumption(**coverage_assumption_fields(cart.measurement, SAMPLED_DATA, absorbs_electrical_lag=True)),
     )
     return (shared.reachable, shared.stops, shared.supply, shared.initial, *own, *stated)
 

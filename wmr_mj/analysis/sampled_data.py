@@ -29,6 +29,11 @@ With alpha0 = 0 (the reference's own terms are exogenous and not part of this co
 - E^'[k] = (E^[k] - E^[k-1]) / T - n_v[k]                        (difference)
 - E^'[k] = y[k] - n_v[k], y[k] = a y[k-1] + (1 - a)(E^[k] - E^[k-1]) / T, a = exp(-T / tau_f)   (filtered)
 
+With an armature inductance (``electrical_time_constant`` tau_e = L_a/R_a > 0) the held command reaches the plant
+through the motor's current: E'' = -j(t) + w(t) with tau_e j' = u[k - d_a] - j, exact over the period (the current j
+is one more state, its step the zero-order hold of a first-order lag: :func:`current_moments`); tau_e = 0 is the loop
+above, bit for bit. Derivation: ``docs/guides/certificates.md``, "The armature inductance in the sampled loop".
+
 Outputs: E[k], E'[k] (at the sampling instants) and u[k]. The estimate and the delay lines are the systems of
 :mod:`wmr_mj.hardware.estimators` (defined there once): the loop's rows are read from their matrices.
 """
@@ -38,6 +43,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import scipy.linalg
@@ -56,6 +62,7 @@ __all__ = [
     "peak_gains",
     "peak_bounds",
     "characteristic_polynomial",
+    "current_moments",
     "jury_stable",
     "delay_margin",
     "OUTPUTS",
@@ -91,6 +98,8 @@ class SampledLoop:
         w_position, w_rate, w_held: (n,) each.
         kp: K_P, 1/s^2. kd: K_D, 1/s. control_period: T, s. velocity: the estimate. filter_tau: tau_f, s
         (filtered only). sensing_delay, actuation_delay: d_s, d_a, whole control periods.
+        electrical_time_constant: tau_e = L_a/R_a, s (0: no current state; > 0: the current j, rad/s^2, is the last
+            state).
     """
 
     A: np.ndarray
@@ -107,11 +116,28 @@ class SampledLoop:
     filter_tau: float | None
     sensing_delay: int
     actuation_delay: int
+    electrical_time_constant: float = 0.0
 
     @property
     def n_states(self) -> int:
         """The augmented state's dimension n."""
         return int(self.A.shape[0])
+
+    @property
+    def current_index(self) -> int | None:
+        """The index of the current state j (the last), None without inductance."""
+        return self.n_states - 1 if self.electrical_time_constant > 0.0 else None
+
+    def applied_row(self) -> np.ndarray:
+        """The command acting over step k, u[k - d_a], as a row over [x (n), e, n_v]: the last of the command's
+        shift register (before the current state, where there is one), or the law's own row without delay."""
+        n = self.n_states
+        row = np.zeros(n + 2)
+        if self.actuation_delay:
+            row[n - 1 - (self.current_index is not None)] = 1.0
+        else:
+            row[:n], row[n:] = self.C[2], self.D[2]
+        return row
 
 
 @dataclass(frozen=True, eq=False)
@@ -173,7 +199,7 @@ def _check_estimate(velocity: str, filter_tau: float | None) -> float | None:
 class _Rows:
     """Index bookkeeping of the augmented state; each row is over [x (n), e, n_v]."""
 
-    def __init__(self, velocity: str, d_s: int, d_a: int):
+    def __init__(self, velocity: str, d_s: int, d_a: int, current: bool = False):
         self.delayed_rate = velocity in ("exact", "tachometer")
         self.has_prev = not self.delayed_rate
         self.has_filter = velocity == "filtered"
@@ -187,23 +213,33 @@ class _Rows:
         self.filt = i if self.has_filter else -1
         i += self.has_filter
         self.u_line = list(range(i, i + d_a))
-        self.n = i + d_a
+        i += d_a
+        self.current = i if current else -1  # the armature current j (last), -1: none
+        self.n = i + current
 
     def unit(self, j: int) -> np.ndarray:
         r = np.zeros(self.n + 2)
         r[j] = 1.0
         return r
 
-    def plant_step(self, *, u: np.ndarray, estimator_rows: Sequence[np.ndarray], T: float) -> np.ndarray:
+    def plant_step(self, *, u: np.ndarray, estimator_rows: Sequence[np.ndarray], T: float,
+                   tau_e: float = 0.0) -> np.ndarray:
         """The next state's rows [x, e, n_v] of every line but a law's own states: the held plant step under the
-        command applied (u through the actuation delay), the delay lines shifted (each a
-        :func:`~wmr_mj.hardware.estimators.delay_line`), the estimator's next state (``estimator_rows``, from
-        :func:`_estimate`)."""
+        command applied (u through the actuation delay; through the current j where tau_e > 0), the delay lines
+        shifted (each a :func:`~wmr_mj.hardware.estimators.delay_line`), the estimator's next state
+        (``estimator_rows``, from :func:`_estimate`)."""
         n = self.n
         u_applied = _delayed(u, self.u_line, self)[1]
         nxt = np.zeros((n, n + 2))
-        nxt[0] = self.unit(0) + T * self.unit(1) - (T * T / 2.0) * u_applied
-        nxt[1] = self.unit(1) - T * u_applied
+        if self.current < 0:
+            nxt[0] = self.unit(0) + T * self.unit(1) - (T * T / 2.0) * u_applied
+            nxt[1] = self.unit(1) - T * u_applied
+        else:  # E'' = -j: E' loses the integral of j over the period, E its double integral
+            m = current_moments(T, tau_e)
+            j = self.unit(self.current)
+            nxt[0] = self.unit(0) + T * self.unit(1) - (m[2, 0] * u_applied + m[2, 1] * j)
+            nxt[1] = self.unit(1) - (m[1, 0] * u_applied + m[1, 1] * j)
+            nxt[self.current] = m[0, 0] * u_applied + m[0, 1] * j
         for line, head in ((self.E_line, self.unit(0)), (self.V_line, self.unit(1)), (self.u_line, u)):
             for idx, row in zip(line, _delayed(head, line, self)[0]):
                 nxt[idx] = row
@@ -211,7 +247,7 @@ class _Rows:
             nxt[idx] = row
         return nxt
 
-    def arrays(self, nxt: np.ndarray, u: np.ndarray, T: float) -> dict[str, np.ndarray]:
+    def arrays(self, nxt: np.ndarray, u: np.ndarray, T: float) -> dict[str, Any]:
         """The loop's A, B (from [e, n_v]), C, D (rows E, E', u) and the disturbance columns, read-only."""
         n = self.n
         out = np.stack([self.unit(0), self.unit(1), u])
@@ -259,8 +295,34 @@ def _estimate(r: _Rows, estimator: VelocityEstimator, E_hat: np.ndarray) -> tupl
     return estimate, _combine(np.hstack([system.A, system.B]), inputs, width)
 
 
+def current_moments(control_period: float, electrical_time_constant: float) -> np.ndarray:
+    """The current over one period, exactly: j(s) = u + (j_k - u) exp(-s/tau_e) for the held command u from j(0) = j_k.
+
+    Row 0 is j(T), rows 1-3 the integrals of j over [0, T] once, twice and three times (int_0^T (T - s)^(m-1)/(m-1)!
+    j(s) ds), each as its coefficients of (u, j_k). With M_0 = tau_e (1 - exp(-T/tau_e)) and M_m = tau_e (T^m/m! -
+    M_(m-1)) (the moments of exp(-s/tau_e), by parts), row m is (T^m/m! - M_(m-1), M_(m-1)). tau_e = 0: j = u at once,
+    rows (1, 0), (T, 0), (T^2/2, 0), (T^3/6, 0).
+
+    Args:
+        control_period: T, s (> 0). electrical_time_constant: tau_e = L_a/R_a, s (>= 0).
+
+    Returns:
+        (4, 2) array.
+    """
+    T, tau = float(control_period), float(electrical_time_constant)
+    powers = (1.0, T, T * T / 2.0, T ** 3 / 6.0)
+    if tau == 0.0:
+        return np.array([[p, 0.0] for p in powers])
+    decay = math.exp(-T / tau)
+    M = [-tau * math.expm1(-T / tau)]
+    for m in (1, 2):
+        M.append(tau * (powers[m] - M[-1]))
+    return np.array([[1.0 - decay, decay]] + [[powers[m] - M[m - 1], M[m - 1]] for m in (1, 2, 3)])
+
+
 def sampled_loop(*, kp: float, kd: float, control_period: float, velocity: VelocityEstimate | str = "exact",
-                 filter_tau: float | None = None, sensing_delay: int = 0, actuation_delay: int = 0) -> SampledLoop:
+                 filter_tau: float | None = None, sensing_delay: int = 0, actuation_delay: int = 0,
+                 electrical_time_constant: float = 0.0) -> SampledLoop:
     """The PD servo on the double integrator at period T under zero-order hold, with delays and the estimator.
 
     The plant's step is exact: exp([[0, 1], [0, 0]] T) = [[1, T], [0, 1]], and the held u enters through
@@ -276,6 +338,8 @@ def sampled_loop(*, kp: float, kd: float, control_period: float, velocity: Veloc
         filter_tau: tau_f, s (> 0), for 'filtered' only.
         sensing_delay: d_s, whole control periods (>= 0): the law reads the state of step k - d_s.
         actuation_delay: d_a, whole control periods (>= 0): the command of step k acts over step k + d_a.
+        electrical_time_constant: tau_e = L_a/R_a, s (>= 0): the command reaches the plant through the armature
+            current, tau_e j' = u[k - d_a] - j, E'' = -j (one more state, the last); 0: at once (no state).
 
     Returns:
         The :class:`SampledLoop` (arrays read-only).
@@ -290,17 +354,19 @@ def sampled_loop(*, kp: float, kd: float, control_period: float, velocity: Veloc
     tau = _check_estimate(str(velocity), filter_tau)
     d_s = whole_period_count("sensing_delay", sensing_delay)
     d_a = whole_period_count("actuation_delay", actuation_delay)
-    r = _Rows(str(velocity), d_s, d_a)
+    tau_e = 0.0 if electrical_time_constant == 0 else positive_real("electrical_time_constant",
+                                                                     electrical_time_constant, " s")
+    r = _Rows(str(velocity), d_s, d_a, current=tau_e > 0.0)
     n = r.n
     E_hat = _delayed(r.unit(0), r.E_line, r)[1] - r.unit(n)  # E[k - d_s] - e[k]
     estimate, estimator_rows = _estimate(r, velocity_estimator(str(velocity), control_period=T, filter_tau=tau),
                                          E_hat)
     rate_hat = estimate - r.unit(n + 1)
     u = K_P * E_hat + K_D * rate_hat
-    nxt = r.plant_step(u=u, estimator_rows=estimator_rows, T=T)
+    nxt = r.plant_step(u=u, estimator_rows=estimator_rows, T=T, tau_e=tau_e)
     arrays = r.arrays(nxt, u, T)
     return SampledLoop(**arrays, kp=K_P, kd=K_D, control_period=T, velocity=str(velocity), filter_tau=tau,
-                       sensing_delay=d_s, actuation_delay=d_a)
+                       sensing_delay=d_s, actuation_delay=d_a, electrical_time_constant=tau_e)
 
 
 def sampled_loop_for(sensing: Sensing, *, kp: float, kd: float, control_period: float,

@@ -84,7 +84,7 @@ def layer_loop(loop: SampledLoop, *, lam: float) -> SampledLoop:
     """
     probe = sampled_loop(kp=lam, kd=1.0, control_period=loop.control_period, velocity=loop.velocity,
                          filter_tau=loop.filter_tau, sensing_delay=loop.sensing_delay,
-                         actuation_delay=loop.actuation_delay)
+                         actuation_delay=loop.actuation_delay, electrical_time_constant=loop.electrical_time_constant)
     C, D = np.array(loop.C), np.array(loop.D)
     C[2], D[2] = probe.C[2], probe.D[2]
     for x in (C, D):

@@ -56,6 +56,10 @@ PARAMETER_SECTIONS: tuple[str, ...] = tuple(
     key for key in load_schema()["required"] if key not in ("name", "version", "changelog", "uncertainty", "defaults"))
 #: How far k_b may differ from k_i, relative: a rounding, not a second constant (see _check_rules).
 MOTOR_CONSTANT_RTOL = 1e-9
+#: The largest armature electrical time constant L_a / R_a accepted in a cart file's motor.L_a, s: the limit of
+#: --actuation inductance=, :data:`wmr_mj.hardware.cart.MAX_ELECTRICAL_TIME_CONSTANT_S` (its source there; the
+#: carts sit below the hardware layer, so it is written twice and a test holds the two equal).
+MAX_ELECTRICAL_TIME_CONSTANT_S = 0.1
 #: The keys of the [defaults] section: the default sensing, actuation and play of a run on the cart.
 DEFAULT_KEYS: tuple[str, ...] = tuple(load_schema()["properties"]["defaults"]["required"])
 
@@ -159,6 +163,11 @@ def _check_rules(document: Mapping[str, Any]) -> None:
             if not lo < hi:
                 raise ParameterError(f"uncertainty.{box}.{name}.range = {entry['range']!r} {entry['unit']} is not "
                                      "accepted; accepted: [lo, hi] with lo < hi")
+    R_a, L_a = document["motor"]["R_a"]["value"], document["motor"].get("L_a", {"value": 0.0})["value"]
+    if not L_a / R_a <= MAX_ELECTRICAL_TIME_CONSTANT_S:
+        raise ParameterError(f"motor.L_a.value = {L_a!r} H is not accepted; accepted: an electrical time constant "
+                             f"L_a/R_a of at most {MAX_ELECTRICAL_TIME_CONSTANT_S:g} s (R_a = {R_a!r} Ohm: L_a <= "
+                             f"{MAX_ELECTRICAL_TIME_CONSTANT_S * R_a:.4g} H), as --actuation inductance= accepts")
     m1, inertia_mass = document["chassis"]["m1"]["value"], document["chassis"]["chassis_inertia_mass"]["value"]
     if m1 < inertia_mass:
         raise ParameterError(f"chassis.m1.value = {m1!r} kg is not accepted; accepted: at least chassis."
@@ -174,7 +183,25 @@ def _check_rules(document: Mapping[str, Any]) -> None:
                              f"with the version {version!r}")
 
 
+#: The optional parameters and the entry a file that omits one gets: the armature inductance, 0 H (the paper's motor).
+OPTIONAL_PARAMETERS: Mapping[str, tuple[str, Mapping[str, Any]]] = {
+    "L_a": ("motor", {"value": 0.0, "unit": "H",
+                      "source": "not given in the file: 0 H, the current follows the voltage at once (the paper's "
+                                "motor (2.9)-(2.10))"}),
+}
+
+
+def _with_optional(document: Mapping[str, Any]) -> dict[str, Any]:
+    """``document`` with every optional parameter it omits at its default (:data:`OPTIONAL_PARAMETERS`)."""
+    filled = {section: dict(entries) if isinstance(entries, Mapping) else entries
+              for section, entries in document.items()}
+    for name, (section, entry) in OPTIONAL_PARAMETERS.items():
+        filled[section].setdefault(name, dict(entry))
+    return filled
+
+
 def _cart_of(document: Mapping[str, Any], path: Path, text: str) -> CartFile:
+    document = _with_optional(document)
     sections = {s: tuple(document[s]) for s in PARAMETER_SECTIONS}
     entries = {name: document[s][name] for s, names in sections.items() for name in names}
     boxes = document["uncertainty"]

@@ -1,8 +1,10 @@
 """The actuation chain between the law's voltage and the motor: a delay, the armature inductance, a current
 limit. The part declares its model change (:meth:`Actuation.model_options`: MuJoCo's actuator ``delay`` and the
 ``dcmotor``'s inductance and saturation, which :mod:`wmr_mj.plant.mjcf` builds), its coverage
-(:meth:`Actuation.coverage`: the delay the claims charge; the inductance and the current limit are not in the
-proof's motor model) and its label (:mod:`wmr_mj.hardware.coverage`).
+(:meth:`Actuation.coverage`: the delay the claims charge, the electrical time constant L_a/R_a that the
+sampled-data certificate holds as a state of its loop (``docs/guides/certificates.md``, "The armature inductance in
+the sampled loop"; the continuous claims have no current and stay uncovered); a current limit is in no claim's
+motor model) and its label (:mod:`wmr_mj.hardware.coverage`).
 
 Usage::
 
@@ -12,12 +14,13 @@ Usage::
     a.electrical_time_constant(R_a=1.0)        # L_a / R_a = 0.0005 s
     Actuation().is_ideal                       # True: today's plant
     a.model_options()                          # {'actuation_delay_s': 0.002, 'inductance_H': 0.0005, ...}
-    a.coverage(R_a=1.0).why_not                # ('the armature inductance (L_a = 0.0005 H, ...) is not in ...', ...)
+    a.coverage(R_a=1.0).electrical_time_constant   # 0.0005 s: held by the sampled-data certificate
+    a.coverage(R_a=1.0).why_not                # ('the current limit (20 A) is not in the proof's motor model',)
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 from wmr_mj.errors import ParameterError
@@ -61,6 +64,21 @@ class Actuation:
         """True for today's plant: no delay, no inductance, no current limit."""
         return self.delay == 0.0 and self.inductance == 0.0 and self.current_limit is None
 
+    def on_motor(self, *, L_a: float) -> Actuation:
+        """This actuation on a motor whose cart gives the armature inductance ``L_a`` (H, the cart file's
+        ``motor.L_a``): the cart's inductance where this part sets none (0), else this part's (an inductance given,
+        e.g. ``--actuation inductance=``, overrides the cart's; ``--param L_a=0`` removes the cart's).
+
+        Raises:
+            ParameterError: L_a negative or not finite.
+        """
+        if self.inductance > 0.0:
+            return self
+        inductance = to_float("actuation", "L_a", L_a)
+        if inductance < 0.0:
+            raise ParameterError(f"actuation: L_a = {L_a!r} H is not accepted; an inductance >= 0 H is required")
+        return self if inductance == 0.0 else replace(self, inductance=inductance)
+
     def electrical_time_constant(self, R_a: float) -> float:
         """tau_e = L_a / R_a, s, for the armature resistance ``R_a`` (Ohm, > 0).
 
@@ -102,19 +120,20 @@ class Actuation:
         return from_model_options(cls, MODEL_KEYWORDS, options)
 
     def coverage(self, *, R_a: float) -> Coverage:
-        """The delay the claims charge (s), and what the proof's motor model has not: the inductance (with its
-        time constant L_a/R_a for the armature resistance ``R_a``, Ohm) and a current limit.
+        """The delay the claims charge (s), the electrical time constant L_a/R_a (s, for the armature resistance
+        ``R_a``, Ohm: bounded, held by the sampled-data certificate as the current's state; a claim without the
+        current leaves it uncovered, :func:`wmr_mj.analysis.measurement.coverage_assumption_fields`), and what no
+        claim's motor model has: a current limit (|i_a| <= I_max clips the torque the loop asks for; no bound of
+        what the clipping does to E is derived).
 
         Raises:
             ParameterError: R_a not > 0 where an inductance is set.
         """
         why: list[str] = []
-        if self.inductance > 0:
-            why.append(f"the armature inductance (L_a = {self.inductance:g} H, L_a/R_a = "
-                       f"{self.electrical_time_constant(R_a) * 1e3:.3g} ms) is not in the proof's motor model")
+        tau_e = self.electrical_time_constant(R_a) if self.inductance > 0 else 0.0
         if self.current_limit is not None:
             why.append(f"the current limit ({self.current_limit:g} A) is not in the proof's motor model")
-        return Coverage(delay=self.delay, why_not=tuple(why))
+        return Coverage(delay=self.delay, electrical_time_constant=tau_e, why_not=tuple(why))
 
     def label(self) -> str:
         """One short line: 'ideal', or e.g. 'delay 2 ms, L_a 0.5 mH, current limit 20 A'."""

@@ -48,6 +48,7 @@ class Coverage:
     alpha_dot_error: float = 0.0  # rad/s, on what it reads of alpha'
     delay: float = 0.0  # s, between the state and the voltage it produces
     lag: float = 0.0  # s, a velocity estimate's lag (times sup|alpha''|)
+    electrical_time_constant: float = 0.0  # s, L_a/R_a: the current's lag, held by the sampled-data certificate alone
     why_not: tuple[str, ...] = ()  # what has no derived bound, one sentence each; () where covered
 
     @property

@@ -226,12 +226,14 @@ def measurement_errors_of(config: Any, plant: C80Parameters) -> MeasurementError
     play with the encoder on the motor side (the motor angle / i2 would be within b of alpha with a rigid
     stop, but MuJoCo's stop is a soft limit pressed in under torque: measured 0.00554 rad against b +
     Delta/i2 = 0.005013 rad, docs/guides/hardware.md, and no sound bound of its penetration is derived), the
-    armature inductance and a current limit (the proof's motor has neither).
+    current limit (the proof's motor has none). The armature inductance (the actuation's, else the plant's L_a) is
+    bounded: its L_a/R_a is ``electrical_time_constant_s``, which only the sampled-data certificate holds.
 
     Returns:
         :meth:`MeasurementErrors.exact` for an ideal cart (every number as before).
     """
-    sensing, actuation, transmission = config.sensing, config.actuation, config.transmission
+    sensing, transmission = config.sensing, config.transmission
+    actuation = config.actuation.on_motor(L_a=plant.L_a)  # the cart's armature inductance where the run sets none
     if sensing.is_ideal and actuation.is_ideal and transmission.is_ideal:
         return MeasurementErrors.exact()
     period = config.control_period if config.control_period is not None else TIMESTEP
@@ -243,7 +245,8 @@ def measurement_errors_of(config: Any, plant: C80Parameters) -> MeasurementError
     why = sensed.why_not + play.why_not + driven.why_not
     return MeasurementErrors(alpha_error_max=sensed.alpha_error, alpha_dot_error_max=sensed.alpha_dot_error,
                              delay_s=sensed.delay + driven.delay + sensed.lag,  # in this order: the same double
-                             covered=not why, why_not="; ".join(why) or None)
+                             covered=not why, why_not="; ".join(why) or None,
+                             electrical_time_constant_s=driven.electrical_time_constant)
 
 
 def certificate_of(config: Any, reference: Any, *, base: C80Parameters, estimate: C80Parameters,

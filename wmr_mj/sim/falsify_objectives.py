@@ -84,10 +84,11 @@ def shares_the_base_certificate(base: RunConfig, names: Sequence[str]) -> bool:
     """Whether every run of ``base`` searched over ``names`` is judged by the base's certificate: m1 and plant
     parameters only (the certificate is over the config's box, whatever the run's plant in it), none of
     which reaches the certificate otherwise: the plant's limits (voltage_limit, steering_range), the gear
-    ratio i2 where the sensing is not ideal and R_a where the actuation is not (their coverage reads them:
+    ratio i2 where the sensing is not ideal, the armature inductance L_a, and R_a where the actuation is not
+    ideal (their coverage reads them:
     :func:`wmr_mj.sim.certify.measurement_errors_of`). The cart's, the signals' and the path's axes give
     each run its own."""
-    reaching = {"voltage_limit", "steering_range"}
+    reaching = {"voltage_limit", "steering_range", "L_a"}  # L_a: the armature's lag, in the sampled loop
     if not base.sensing.is_ideal or not base.transmission.is_ideal:
         reaching.add("i2")
     if not base.actuation.is_ideal:
