@@ -83,8 +83,9 @@ class Recording:
 
     @property
     def period(self) -> float:
-        """The median time step, s."""
-        return float(np.median(np.diff(self.t))) if self.t.size > 1 else math.nan
+        """The median time step, s, to 9 significant digits (times written as 0.001 k differ from k ms in the last
+        bits; the delay, a whole number of periods, is then written as the cart file's 0.005 and not 0.00499...)."""
+        return float(f"{float(np.median(np.diff(self.t))):.9g}") if self.t.size > 1 else math.nan
 
     @property
     def duration(self) -> float:
@@ -231,8 +232,8 @@ def check_recording(rec: Recording, *, voltage_limit: float, steering_range: flo
     worst = int(np.argmax(np.abs(rec.alpha)))
     if abs(rec.alpha[worst]) > steering_range:
         raise ParameterError(f"recording {name!r}: alpha_rad = {rec.alpha[worst]:.6g} rad at t = {rec.t[worst]:.9g} s "
-                             f"is beyond the cart's stops +-{steering_range:g} rad; accepted: |alpha| <= steering_range "
-                             "(a wrong unit, zero or sign, or the wrong cart file)")
+                             f"is beyond the cart's stops +-{steering_range:g} rad; accepted: |alpha| <= "
+                             "steering_range (a wrong unit, zero or sign, or the wrong cart file)")
     worst = int(np.argmax(np.abs(rec.voltage)))
     if abs(rec.voltage[worst]) > voltage_limit * (1.0 + SUPPLY_TOLERANCE):
         raise ParameterError(f"recording {name!r}: u_V = {rec.voltage[worst]:.6g} V at t = {rec.t[worst]:.9g} s is "
