@@ -195,3 +195,14 @@ def test_columns_map_other_names(tmp_path):
     path.write_text("time,volts,steer\n0,1,0.1\n0.001,2,0.2\n", encoding="utf-8")
     rec = read_csv(path, columns={"t_s": "time", "u_V": "volts", "alpha_rad": "steer"})
     assert rec.voltage.tolist() == [1.0, 2.0] and rec.alpha.tolist() == [0.1, 0.2]
+
+
+def test_excite_writes_a_plan_within_the_stops_and_the_supply(tmp_path, capsys):
+    out = tmp_path / "plan.csv"
+    assert main(["excite", "--cart", str(TRUTH), "--duration", "6", "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    plan = np.loadtxt(out, delimiter=",", skiprows=1)
+    truth = parameters_of_cart(load_cart(TRUTH))
+    assert out.read_text(encoding="utf-8").startswith("t_s,alpha0_rad,u_dither_V\n") and plan.shape == (6000, 3)
+    assert np.max(np.abs(plan[:, 1])) <= truth.steering_range and np.max(np.abs(plan[:, 2])) <= truth.voltage_limit
+    assert "front_axle_mass" in printed and "mu" in printed

@@ -19,7 +19,7 @@ from collections.abc import Sequence
 from wmr_mj.errors import WmrMjError
 
 COMMANDS = ("identify", "robustness", "run", "replay", "sweep", "falsify", "compare", "validate", "figures", "model",
-            "cart", "design")
+            "cart", "design", "excite")
 
 
 class _OneLineParser(argparse.ArgumentParser):
