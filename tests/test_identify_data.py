@@ -20,9 +20,11 @@ import pytest
 from wmr_mj.carts import load_cart
 from wmr_mj.cli.app import main
 from wmr_mj.errors import ParameterError
+from wmr_mj.logs.recordings import read_run_log
 from wmr_mj.params import parameters_of_cart
 from wmr_mj.plant.output_error import MODEL_ERROR_FLOOR, Interval, fit_recordings
 from wmr_mj.plant.recordings import Recording, check_recording, read_csv
+from wmr_mj.report.identify import IdentifyReport
 
 DATA = Path(__file__).resolve().parent / "data"
 TRUTH = DATA / "identify_truth.toml"
@@ -66,7 +68,7 @@ def identified(recordings: dict[str, Path]) -> tuple[dict, Path, int]:
     out = recordings["folder"] / "new.toml"
     code, printed = _main_json(["identify", "--cart", str(START), "--data", f"{recordings['lane']}:m1=100",
                                 "--data", str(recordings["eight"]), "--holdout", str(recordings["hold"]),
-                                "--out", str(out), "--json"])
+                                "--out", str(out), "--json", "--report", str(recordings["folder"] / "report")])
     return printed, out, code
 
 
@@ -206,3 +208,29 @@ def test_excite_writes_a_plan_within_the_stops_and_the_supply(tmp_path, capsys):
     assert out.read_text(encoding="utf-8").startswith("t_s,alpha0_rad,u_dither_V\n") and plan.shape == (6000, 3)
     assert np.max(np.abs(plan[:, 1])) <= truth.steering_range and np.max(np.abs(plan[:, 2])) <= truth.voltage_limit
     assert "front_axle_mass" in printed and "mu" in printed
+
+
+def test_report_html_beside_png_and_the_result_reads(identified, recordings):
+    obj, _out, _code = identified
+    folder = recordings["folder"] / "report"
+    assert sorted(Path(p).name for p in obj["report"]) == ["identify.html", "identify.png"]
+    assert (folder / "identify.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    page = (folder / "identify.html").read_text(encoding="utf-8")
+    assert "95 % interval" in page and "identify.png" in page and "Hold-out" in page
+    start = parameters_of_cart(load_cart(START))
+    fit = fit_recordings([read_csv(recordings["lane_short"])], start, draws=50)
+    report = IdentifyReport.of(fit, [read_csv(recordings["lane_short"])], start)
+    table = report.to_pandas()
+    assert table.loc["P", "value"] == fit.coefficients["P"].value and table.loc["mu", "unit"] == "-"
+    assert len(report.plot().axes) == 2
+
+
+def test_a_run_log_is_a_recording_with_its_m1(tmp_path):
+    log = tmp_path / "run.mcap"
+    code = main(["run", "--cart", str(TRUTH), "--controller", f"{LAW}:DitheredPD", "--sensing", SENSING,
+                 "--path", "lane-change", "--duration", "4", "--m1", "110", "--out", str(log), "--no-progress"])
+    assert code == 0
+    rec = read_run_log(log)
+    assert rec.m1 == 110.0 and rec.samples == 4000 and rec.sha256
+    counts = rec.alpha * TICKS / (2 * np.pi)
+    assert np.max(np.abs(counts - np.rint(counts))) < 1e-6  # the angle the law read, on the encoder's grid

@@ -33,6 +33,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--holdout", metavar="FILE[:m1=KG]",
                    help="a recording the fit never sees: the identified model must predict it (normalised RMS error "
                         "at most 0.1, else exit 1)")
+    p.add_argument("--report", metavar="DIR",
+                   help="with --data: write identify.html and identify.png (recorded against simulated angle on the "
+                        "hold-out, or the first recording; residuals; the table of intervals) into DIR")
     p.add_argument("--columns", metavar="KEY=NAME,...",
                    help="CSV column names of another header: t_s=...,u_V=...,alpha_rad=...,speed_m_per_s=...")
     add_json(p, help="print one JSON object")
@@ -51,10 +54,10 @@ def run(args: argparse.Namespace) -> int:
 
     if args.data:
         return run_data(args)
-    if args.holdout or args.columns:
+    if args.holdout or args.columns or args.report:
         from wmr_mj.errors import ParameterError
 
-        raise ParameterError("--holdout and --columns need --data (recordings of the cart to identify from)")
+        raise ParameterError("--holdout, --columns and --report need --data (recordings of the cart to identify from)")
     if args.out:  # before the identification, which takes a while
         check_output_path(args.out, kind="file", option="--out")
     base = cart_parameters(args)
@@ -138,6 +141,8 @@ def run_data(args: argparse.Namespace) -> int:
     if not args.out:
         raise ParameterError("identify --data needs --out NEW.toml: the identified cart file")
     out = check_output_path(args.out, kind="file", option="--out")
+    if args.report:
+        check_output_path(args.report, kind="dir", option="--report")
     start = load_cart(args.cart or "c80")
     params = parameters_of_cart(start)
     columns = parse_columns(args.columns)
@@ -149,6 +154,12 @@ def run_data(args: argparse.Namespace) -> int:
     text = identified_cart_text(start, fit, recordings, date=date, command=command)
     Path(out).write_text(text, encoding="utf-8")
     nrmse = holdout_error(fit, holdout, params) if holdout is not None else None
+    report_files: list[str] = []
+    if args.report:
+        from wmr_mj.report.identify import IdentifyReport
+
+        report = IdentifyReport.of(fit, recordings, params, holdout=holdout)
+        report_files = [str(p) for p in report.write(args.report)]
     failed = nrmse is not None and not nrmse <= HOLDOUT_NRMSE_MAX
     obj = {
         "coefficients": {k: v.as_dict() for k, v in fit.coefficients.items()},
@@ -169,11 +180,14 @@ def run_data(args: argparse.Namespace) -> int:
         "holdout": None if holdout is None else {"file": holdout.name, "nrmse": nrmse,
                                                  "nrmse_max": HOLDOUT_NRMSE_MAX, "passed": not failed},
         "cart": str(out),
+        "report": report_files,
     }
     if args.json:
         print_json(obj)
     else:
         _print_fit(fit, recordings, holdout, nrmse, out)
+        for path in report_files:
+            print(f"wrote {path}")
     if failed and holdout is not None:
         print(f"hold-out {holdout.name}: the identified model does not predict it: normalised RMS error {nrmse:.3g} "
               f"above {HOLDOUT_NRMSE_MAX:g}", file=sys.stderr)
