@@ -22,7 +22,7 @@ from wmr_mj.cli.app import main
 from wmr_mj.errors import ParameterError
 from wmr_mj.logs.recordings import read_run_log
 from wmr_mj.params import parameters_of_cart
-from wmr_mj.plant.output_error import MODEL_ERROR_FLOOR, Interval, fit_recordings
+from wmr_mj.plant.output_error import MODEL_ERROR_FLOOR, POORLY_DETERMINED, Interval, fit_recordings
 from wmr_mj.plant.recordings import Recording, check_recording, read_csv
 from wmr_mj.report.identify import IdentifyReport
 
@@ -234,3 +234,30 @@ def test_a_run_log_is_a_recording_with_its_m1(tmp_path):
     assert rec.m1 == 110.0 and rec.samples == 4000 and rec.sha256
     counts = rec.alpha * TICKS / (2 * np.pi)
     assert np.max(np.abs(counts - np.rint(counts))) < 1e-6  # the angle the law read, on the encoder's grid
+
+
+def test_the_jacobians_intervals_are_far_narrower_than_the_bootstraps(recordings):
+    """What mujoco.sysid.calculate_intervals computes (s^2 and the Jacobian) on a quantised closed-loop recording,
+    beside the block bootstrap: the data's own part of the bootstrap's interval (the model floor aside) is wider."""
+    start = parameters_of_cart(load_cart(START))
+    fit = fit_recordings([read_csv(recordings["lane_long"])], start)
+    for i, name in enumerate(("P", "C_V", "F")):
+        lo, hi = np.percentile(fit.draws[:, i], [2.5, 97.5])
+        assert 0 < fit.jacobian_half_width[name] < 0.5 * (hi - lo) / 2, name
+
+
+def test_a_recording_that_does_not_excite_the_inertia_leaves_it_wide(tmp_path):
+    """No dither: a PD tracking a smooth lane change hides P alpha'' (a few per cent of the voltage): the
+    inertia's interval comes out wide, never a confident wrong number."""
+    from wmr_mj.sim.closed_loop import run_closed_loop
+    from wmr_mj.sim.config import RunConfig
+
+    truth = parameters_of_cart(load_cart(TRUTH))
+    cfg = RunConfig.from_inputs(cart=str(TRUTH), sensing=SENSING, path="lane-change", duration=12.0,
+                                controller=f"{LAW}:DitheredPD", controller_params={"amplitude": 0.0})
+    rec = read_csv(_write_csv(dict(run_closed_loop(cfg, progress=False).rows), tmp_path / "smooth.csv"))
+    fit = fit_recordings([rec], parameters_of_cart(load_cart(START)))
+    iv = fit.physical["front_axle_mass"]
+    assert iv.contains(truth.front_axle_mass) or iv.relative_half_width > 0.5
+    assert iv.relative_half_width > POORLY_DETERMINED  # identify warns
+    assert fit.delay.contains(DELAY_S)  # the delay, which trades with the inertia, is left open too

@@ -210,10 +210,13 @@ def _print_fit(fit, recordings, holdout, nrmse, out) -> None:
     enc = ("not readable (the angle is not on one grid)" if fit.encoder_ticks is None
            else f"{fit.encoder_ticks} ticks/rev")
     print(f"encoder: {enc}; noise beyond the quantisation: {fit.noise_rad:.3g} rad")
-    wide = [n for n, iv in fit.physical.items() if iv.relative_half_width > 0.25]
+    from wmr_mj.plant.output_error import POORLY_DETERMINED
+
+    wide = [n for n, iv in fit.physical.items() if iv.relative_half_width > POORLY_DETERMINED]
     if wide:
-        print(f"warning: {', '.join(wide)} poorly determined (95 % half-width above 25 %): the recordings do not "
-              "excite them; a box this wide may decide the certificate")
+        print(f"warning: {', '.join(wide)} poorly determined (95 % half-width above {100 * POORLY_DETERMINED:g} %): "
+              "the recordings do not excite them (the delay's interval is then the whole search); a box this wide "
+              "may decide the certificate (wmr-mj excite writes an experiment that excites them)")
     if holdout is not None:
         print(f"hold-out {holdout.name}: normalised RMS error {nrmse:.3g}")
     print(f"wrote {out}")

@@ -44,6 +44,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.optimize import least_squares
+from scipy.stats import t as student_t
 
 from wmr_mj.errors import ParameterError
 from wmr_mj.params import C80Parameters, with_params
@@ -51,7 +52,8 @@ from wmr_mj.plant.recordings import Recording
 
 __all__ = ["Interval", "SteeringFit", "fit_recordings", "simulate_recording", "encoder_ticks_of", "noise_of",
            "SEGMENT_S", "RATE_WINDOW_S", "MAX_DELAY_S", "BOOTSTRAP_DRAWS", "CONFIDENCE", "physical_of",
-           "IDENTIFIED_PARAMETERS", "holdout_error", "HOLDOUT_NRMSE_MAX", "BURN_IN_S", "MODEL_ERROR_FLOOR"]
+           "IDENTIFIED_PARAMETERS", "holdout_error", "HOLDOUT_NRMSE_MAX", "BURN_IN_S", "MODEL_ERROR_FLOOR",
+           "POORLY_DETERMINED"]
 
 #: Segment length, s: long enough for the slowest response (stick-slip under a PD law, a few hundred ms) to
 #: show in it, short enough that a simulation from the recorded state does not drift on a few per cent of error.
@@ -77,6 +79,11 @@ CONFIDENCE = 0.95
 #: C_V, F and mu differ from the file's by up to 1.6 %, beyond the bootstrap's spread (which sees the data's
 #: variation, not a bias the model carries); the physics notes measure P within 1 % between MuJoCo and Drake.
 MODEL_ERROR_FLOOR = 0.02
+#: A 95 % half-width above this (relative) is poorly determined: identify warns, and where the inertia (P) is
+#: poorly determined the delay's interval becomes the whole search, 0 to MAX_DELAY_S: a lag looks like inertia,
+#: and a recording that does not excite the one does not fix the other (measured: a PD tracking a lane change
+#: without dither, truth 5 ms, profile minimum at 16 ms with P 70 % off).
+POORLY_DETERMINED = 0.25
 #: The cart-file parameters identification replaces, with what carries each (the rest fixed from the cart).
 IDENTIFIED_PARAMETERS: dict[str, str] = {
     "front_axle_mass": "P = (R_a/k_i) J/i2: the steering inertia J, through the front beam's mass (the wheels, "
@@ -130,6 +137,9 @@ class SteeringFit:
         segments, segment_steps: how many segments, and their length in control periods.
         m1: the chassis mass of each recording, kg.
         draws: the bootstrap's draws of (P, C_V, F), (BOOTSTRAP_DRAWS, 3).
+        jacobian_half_width: 'P', 'C_V', 'F' -> the 95 % half-width the Jacobian and s^2 of the residuals give
+            (t quantile x sqrt(s^2 diag((J^T J)^-1)), what ``mujoco.sysid.calculate_intervals`` computes): beside
+            the intervals above, to show how narrow it is on coloured residuals; not used.
     """
 
     coefficients: dict[str, Interval]
@@ -144,6 +154,7 @@ class SteeringFit:
     segment_steps: int
     m1: tuple[float, ...]
     draws: np.ndarray = field(repr=False)
+    jacobian_half_width: dict[str, float] = field(default_factory=dict)
 
     def as_dict(self) -> dict[str, object]:
         return {
@@ -216,28 +227,39 @@ def _total_weight(params: C80Parameters, m1: float | None) -> float:
     return params.Q if m1 is None else with_params(params, m1=m1).Q
 
 
-def _simulate(theta: np.ndarray, seg: _Segments, delay: int, *, period: float, inv_l1: float) -> np.ndarray:
-    """The simulated angle (L, S) of each segment under ``theta`` = (P, C_V, F), the voltage ``delay`` periods
-    before the angle read: the implicit Euler step of the rate with the Coulomb friction as a set-valued law
-    (the rate stops where the friction's impulse over the step exceeds it: stiction), then alpha += dt alpha'."""
-    P, C_V, F = (float(x) for x in theta)
-    L = seg.steps
+def _simulate_columns(P: np.ndarray, C_V: np.ndarray, F: np.ndarray, alpha0: np.ndarray, rate0: np.ndarray,
+                      seg: _Segments, columns: np.ndarray, *, period: float, inv_l1: float) -> np.ndarray:
+    """The simulated angle (L, C) of C columns, column c being segment ``columns[c]`` under its own (P, C_V, F)
+    from its own initial angle and rate (each (C,)): the implicit Euler step of the rate with the Coulomb friction
+    as a set-valued law (the rate stops where the friction's impulse over the step exceeds it: stiction), then
+    alpha += dt alpha'. One loop over the steps; the columns (segments, delays, perturbed coefficients) at once."""
     dt = period
-    a = seg.alpha[delay].copy()
-    w = seg.rate[delay].copy()
-    friction = dt * F * seg.friction_scale
-    out = np.empty((L, a.size))
+    a = alpha0.astype(float).copy()
+    w = rate0.astype(float).copy()
+    friction = dt * F * seg.friction_scale[columns]
+    Pw = P.copy()
+    damping = dt * C_V
+    gyro = dt * P * inv_l1
+    out = np.empty((seg.steps, a.size))
     out[0] = a
     u, v = seg.voltage, seg.speed
-    gyro = P * inv_l1
-    for k in range(L - 1):
+    for k in range(seg.steps - 1):
         c = np.cos(a)
-        denom = P + dt * (C_V + gyro * v[k] / (c * c))
-        wt = P * w + dt * u[k]
+        denom = Pw + damping + gyro * v[k, columns] / (c * c)
+        wt = Pw * w + dt * u[k, columns]
         w = np.sign(wt) * np.maximum(np.abs(wt) - friction, 0.0) / denom
         a = a + dt * w
         out[k + 1] = a
     return out
+
+
+def _simulate(theta: np.ndarray, seg: _Segments, delay: int, *, period: float, inv_l1: float) -> np.ndarray:
+    """The simulated angle (L, S) of each segment under ``theta`` = (P, C_V, F), the voltage ``delay`` periods
+    before the angle read (:func:`_simulate_columns`)."""
+    S = seg.alpha.shape[1]
+    ones = np.ones(S)
+    return _simulate_columns(theta[0] * ones, theta[1] * ones, theta[2] * ones, seg.alpha[delay], seg.rate[delay],
+                             seg, np.arange(S), period=period, inv_l1=inv_l1)
 
 
 def _residuals(theta: np.ndarray, seg: _Segments, delay: int, *, period: float, inv_l1: float) -> np.ndarray:
@@ -290,10 +312,62 @@ def _fit_theta(theta0: np.ndarray, seg: _Segments, delay: int, *, period: float,
     return np.asarray(np.exp(sol.x))
 
 
+#: The most simulation columns one batch of the delay profile steps at once (memory: steps x columns doubles).
+_PROFILE_COLUMNS = 8192
+
+
 def _delay_costs(theta: np.ndarray, seg: _Segments, max_delay: int, *, period: float, inv_l1: float) -> np.ndarray:
-    """(max_delay + 1, S): each segment's sum of squared residuals at each delay."""
-    return np.stack([np.sum(_residuals(theta, seg, d, period=period, inv_l1=inv_l1) ** 2, axis=0)
-                     for d in range(max_delay + 1)])
+    """(max_delay + 1, S): each segment's sum of squared residuals at each delay, the coefficients re-fitted at
+    each (a profile: one Gauss-Newton step from ``theta`` by forward differences), so that a delay the coefficients
+    can make up for (a lag looks like inertia) costs no more than it should. All delays and perturbations are
+    simulated as columns of one batch (:func:`_simulate_columns`)."""
+    S = seg.alpha.shape[1]
+    burn, L = seg.burn_in, seg.steps
+    h = 1e-4
+    variants = np.tile(theta, (4, 1))
+    for i in range(3):
+        variants[i + 1, i] *= 1 + h
+    per_delay = max(1, _PROFILE_COLUMNS // (4 * S))
+    thetas = np.empty((max_delay + 1, 3))
+    plain = np.empty((max_delay + 1, S))  # each segment's cost at theta itself
+    for first in range(0, max_delay + 1, per_delay):
+        delays = np.arange(first, min(first + per_delay, max_delay + 1))
+        # columns ordered (delay, variant, segment)
+        d_col = np.repeat(delays, 4 * S)
+        v_col = np.tile(np.repeat(np.arange(4), S), delays.size)
+        s_col = np.tile(np.arange(S), 4 * delays.size)
+        th = variants[v_col]
+        sim = _simulate_columns(th[:, 0], th[:, 1], th[:, 2], seg.alpha[d_col, s_col], seg.rate[d_col, s_col], seg,
+                                s_col, period=period, inv_l1=inv_l1).reshape(L, delays.size, 4, S)
+        for j, d in enumerate(delays):
+            rec = seg.alpha[d + burn: d + L]
+            res = rec[:, None, :] - sim[burn:, j]  # (L', 4, S)
+            res = res - res.mean(axis=0)
+            r = res[:, 0]
+            plain[d] = np.sum(r * r, axis=0)
+            J = (res[:, 1:] - r[:, None, :]) / (h * theta)[None, :, None]  # (L', 3, S)
+            flat = np.moveaxis(J, 1, -1).reshape(-1, 3)
+            step = np.linalg.lstsq(flat, -r.ravel(), rcond=None)[0]
+            thetas[d] = theta + step if np.all(theta + step > 0) else theta
+    d_col = np.repeat(np.arange(max_delay + 1), S)
+    s_col = np.tile(np.arange(S), max_delay + 1)
+    th = thetas[d_col]
+    costs = np.empty((max_delay + 1, S))
+    chunk = max(1, _PROFILE_COLUMNS // S)
+    for first in range(0, max_delay + 1, chunk):
+        sel = slice(first * S, min(first + chunk, max_delay + 1) * S)
+        best = _simulate_columns(th[sel, 0], th[sel, 1], th[sel, 2], seg.alpha[d_col[sel], s_col[sel]],
+                                 seg.rate[d_col[sel], s_col[sel]], seg, s_col[sel], period=period,
+                                 inv_l1=inv_l1).reshape(L, -1, S)
+        for j in range(best.shape[1]):
+            d = first + j
+            res = seg.alpha[d + burn: d + L] - best[burn:, j]
+            res = res - res.mean(axis=0)
+            costs[d] = np.sum(res * res, axis=0)
+    # a step that made a delay worse (far from theta the linearisation fails) keeps theta's own cost there
+    worse = costs.sum(axis=1) > plain.sum(axis=1)
+    costs[worse] = plain[worse]
+    return costs
 
 
 def _segment_jacobian(theta: np.ndarray, seg: _Segments, delay: int, *, period: float,
@@ -392,14 +466,8 @@ def fit_recordings(recordings: Sequence[Recording], params: C80Parameters, *, se
     scale = 1.0 if recordings[0].m1 is None else _total_weight(params, recordings[0].m1) / params.Q
     theta = np.array([start.P, start.C_V, start.F * scale])
     kw = {"period": period, "inv_l1": inv_l1}
-    delay = 0
-    for _ in range(3):  # fit, profile the delay, refit: the delay moves by whole periods and settles in two rounds
-        theta = _fit_theta(theta, seg, delay, **kw)
-        costs = _delay_costs(theta, seg, max_delay, **kw)
-        best = int(np.argmin(costs.sum(axis=1)))
-        if best == delay:
-            break
-        delay = best
+    theta = _fit_theta(theta, seg, 0, **kw)  # fit without delay, profile the delay, refit at the best
+    delay = int(np.argmin(_delay_costs(theta, seg, max_delay, **kw).sum(axis=1)))
     theta = _fit_theta(theta, seg, delay, **kw)
     costs = _delay_costs(theta, seg, max_delay, **kw)
     rng = np.random.default_rng(seed)
@@ -411,7 +479,12 @@ def fit_recordings(recordings: Sequence[Recording], params: C80Parameters, *, se
         theta_d = theta if d == delay else _fit_theta(theta, seg, d, **kw)
         fits[d] = (theta_d, *_segment_jacobian(theta_d, seg, d, **kw))
     boot, boot_delays = _bootstrap(fits, costs, counts)
-    r = fits[delay][1]
+    r, J = fits[delay][1], fits[delay][2]
+    flat_J = J.reshape(-1, 3)
+    dof = max(r.size - 3, 1)
+    s2 = float(np.sum(r * r)) / dof
+    cov = s2 * np.linalg.pinv(flat_J.T @ flat_J)
+    naive = student_t.ppf(0.5 + CONFIDENCE / 2, dof) * np.sqrt(np.maximum(np.diag(cov), 0.0))
     m1_first = recordings[0].m1
     p_first = params if m1_first is None else with_params(params, m1=m1_first)
     floor = np.array([[1 - MODEL_ERROR_FLOOR, 1 + MODEL_ERROR_FLOOR]])
@@ -425,13 +498,16 @@ def fit_recordings(recordings: Sequence[Recording], params: C80Parameters, *, se
     phys_corners = physical_of(corners, params, m1_first)
     physical = {name: _interval(float(phys_value[name]), phys_draws[name], phys_corners[name])
                 for name in IDENTIFIED_PARAMETERS}
+    delay_interval = _interval(delay * period, boot_delays * period)
+    if coefficients["P"].relative_half_width > POORLY_DETERMINED:
+        delay_interval = Interval(delay * period, 0.0, max_delay * period)
     ticks = encoder_ticks_of([rec.alpha for rec in recordings])
     return SteeringFit(
         coefficients=coefficients, physical=physical, delay_steps=delay,
-        delay=_interval(delay * period, boot_delays * period), period=period, encoder_ticks=ticks,
+        delay=delay_interval, period=period, encoder_ticks=ticks,
         noise_rad=noise_of(r, ticks), residual_rms_rad=float(np.sqrt(np.mean(r * r))), segments=int(r.shape[1]),
         segment_steps=steps, m1=tuple(float(rec.m1) if rec.m1 is not None else params.m1 for rec in recordings),
-        draws=boot)
+        draws=boot, jacobian_half_width=dict(zip(_COEFFICIENTS, naive.tolist())))
 
 
 #: The hold-out check's threshold: a normalised RMS error (:func:`holdout_error`) above it says the identified
