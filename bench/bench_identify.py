@@ -74,18 +74,37 @@ def main() -> int:
     t0 = time.perf_counter()
     rollout.rollout(m, d, state[None, :], ctrl)
     rollout_s = time.perf_counter() - t0
+    sysid_half = None
     try:
         import mujoco.sysid as sysid
 
-        sysid_note = "importable" if hasattr(sysid, "optimize") else "not usable (the mujoco[sysid] extra is missing)"
+        usable = hasattr(sysid, "calculate_intervals")
+        sysid_note = "importable" if usable else "not usable (the mujoco[sysid] extra is missing)"
     except ImportError:
-        sysid_note = "not importable"
+        usable, sysid_note = False, "not importable"
+    if usable:  # its intervals on our residuals and Jacobian at the fit (the same numbers it would be handed)
+        from wmr_mj.plant import output_error as oe
+
+        seg = oe._segments([rec], params, period=fit.period, steps=fit.segment_steps, max_delay=fit.delay_steps)
+        theta = np.array([fit.coefficients[k].value for k in ("P", "C_V", "F")])
+        r, J = oe._segment_jacobian(theta, seg, fit.delay_steps, period=fit.period, inv_l1=1.0 / params.l1)
+        sysid_half = sysid.calculate_intervals([r.ravel()], J.reshape(-1, 3))[1]
     print(f"{args.duration:g} s of 1 kHz recording ({n} samples; recorded in {record_s:.2f} s)")
     print(f"fit (identify --data):        {fit_s:7.2f} s  (delay {fit.delay_steps} periods, encoder "
           f"{fit.encoder_ticks}, P {fit.coefficients['P'].value:.5g})")
     print(f"regression (today's identify): {regression_s:7.3f} s")
     print(f"one MuJoCo rollout:            {rollout_s:7.2f} s  (x ~40 evaluations per fit: ~{40 * rollout_s:.0f} s); "
           f"mujoco.sysid {sysid_note}")
+    print("95 % intervals of P, C_V, F: ours (block bootstrap, 2 % model floor) | the Jacobian's (s^2)"
+          + (" | mujoco.sysid.calculate_intervals" if sysid_half is not None else ""))
+    for i, name in enumerate(("P", "C_V", "F")):
+        iv = fit.coefficients[name]
+        cells = f"{name:4s} {iv.value:.5g} [{iv.lo:.5g}, {iv.hi:.5g}] | +-{fit.jacobian_half_width[name]:.2g}"
+        if sysid_half is not None:
+            cells += f" | +-{float(sysid_half[i]):.2g}"
+        print(cells)
+    truth = params.coefficients("nonholonomic")
+    print(f"truth: P {truth.P:.5g}, C_V {truth.C_V:.5g}, F {truth.F:.5g}")
     return 0
 
 
