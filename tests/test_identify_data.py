@@ -261,3 +261,26 @@ def test_a_recording_that_does_not_excite_the_inertia_leaves_it_wide(tmp_path):
     assert iv.contains(truth.front_axle_mass) or iv.relative_half_width > 0.5
     assert iv.relative_half_width > POORLY_DETERMINED  # identify warns
     assert fit.delay.contains(DELAY_S)  # the delay, which trades with the inertia, is left open too
+
+
+def test_a_ros2_bag_with_topics(recordings, tmp_path, capsys):
+    """A ROS 2 bag (std_msgs/Float64 on two topics, written by mcap-ros2-support) identifies as its CSV does."""
+    from mcap_ros2.writer import Writer
+
+    rec = read_csv(recordings["lane_short"])
+    bag = tmp_path / "bag.mcap"
+    with open(bag, "wb") as f:
+        writer = Writer(f)
+        schema = writer.register_msgdef("std_msgs/Float64", "float64 data")
+        for t, u, a in zip(rec.t, rec.voltage, rec.alpha):
+            ns = int(round(t * 1e9)) + 1_000_000_000
+            writer.write_message("/steer/voltage", schema, {"data": float(u)}, log_time=ns)
+            writer.write_message("/steer/angle", schema, {"data": float(a)}, log_time=ns)
+        writer.finish()
+    argv = ["identify", "--cart", str(START), "--data", f"{bag}:m1=100", "--topics",
+            "u=/steer/voltage,alpha=/steer/angle", "--out", str(tmp_path / "bag.toml"), "--json"]
+    code, obj = _main_json(argv)
+    assert code == 0 and obj["encoder_ticks"] == TICKS and obj["m1_kg"] == [100.0]
+    missing = ["identify", "--cart", str(START), "--data", str(bag), "--topics", "u=/steer/voltage,alpha=/nope",
+               "--out", str(tmp_path / "x.toml")]
+    assert main(missing) == 2 and "topic /nope is missing" in capsys.readouterr().err

@@ -36,6 +36,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--report", metavar="DIR",
                    help="with --data: write identify.html and identify.png (recorded against simulated angle on the "
                         "hold-out, or the first recording; residuals; the table of intervals) into DIR")
+    p.add_argument("--topics", metavar="u=/T,alpha=/T[,speed=/T]",
+                   help="with --data BAG.mcap: a ROS 2 bag's topics of the voltage, the angle and the speed (a topic "
+                        "with .field or .field[i]; default field data), read through mcap-ros2-support")
     p.add_argument("--columns", metavar="KEY=NAME,...",
                    help="CSV column names of another header: t_s=...,u_V=...,alpha_rad=...,speed_m_per_s=...")
     add_json(p, help="print one JSON object")
@@ -54,10 +57,11 @@ def run(args: argparse.Namespace) -> int:
 
     if args.data:
         return run_data(args)
-    if args.holdout or args.columns or args.report:
+    if args.holdout or args.columns or args.report or args.topics:
         from wmr_mj.errors import ParameterError
 
-        raise ParameterError("--holdout, --columns and --report need --data (recordings of the cart to identify from)")
+        raise ParameterError("--holdout, --columns, --topics and --report need --data (recordings of the cart to "
+                             "identify from)")
     if args.out:  # before the identification, which takes a while
         check_output_path(args.out, kind="file", option="--out")
     base = cart_parameters(args)
@@ -109,11 +113,15 @@ def _split_data(item: str) -> tuple[str, float | None]:
     return path, m1
 
 
-def _read_recording(item: str, columns: dict[str, str], params):
+def _read_recording(item: str, columns: dict[str, str], params, topics: dict[str, str] | None = None):
     from wmr_mj.plant.recordings import check_recording, read_csv
 
     path, m1 = _split_data(item)
-    if path.endswith(".mcap"):
+    if topics:
+        from wmr_mj.logs.recordings import read_ros2_bag
+
+        rec = read_ros2_bag(path, topics, m1=m1)
+    elif path.endswith(".mcap"):
         from wmr_mj.logs.recordings import read_run_log
 
         rec = read_run_log(path, m1=m1)
@@ -146,8 +154,11 @@ def run_data(args: argparse.Namespace) -> int:
     start = load_cart(args.cart or "c80")
     params = parameters_of_cart(start)
     columns = parse_columns(args.columns)
-    recordings = [_read_recording(item, columns, params) for item in args.data]
-    holdout = _read_recording(args.holdout, columns, params) if args.holdout else None
+    from wmr_mj.logs.recordings import parse_topics
+
+    topics = parse_topics(args.topics) if args.topics else None
+    recordings = [_read_recording(item, columns, params, topics) for item in args.data]
+    holdout = _read_recording(args.holdout, columns, params, topics) if args.holdout else None
     fit = fit_recordings(recordings, params, seed=args.seed)
     date = datetime.datetime.now(datetime.UTC).date().isoformat()
     command = "wmr-mj identify " + " ".join(sys.argv[2:]) if len(sys.argv) > 2 else "wmr-mj identify"
