@@ -284,3 +284,17 @@ def test_a_ros2_bag_with_topics(recordings, tmp_path, capsys):
     missing = ["identify", "--cart", str(START), "--data", str(bag), "--topics", "u=/steer/voltage,alpha=/nope",
                "--out", str(tmp_path / "x.toml")]
     assert main(missing) == 2 and "topic /nope is missing" in capsys.readouterr().err
+
+
+def test_encoder_and_noise_read_through_noise(tmp_path):
+    """Uniform noise of 0.5 mrad after a 12-bit quantisation (a third of a tick): no reading on the grid, yet the
+    readings concentrate on it; the noise is their distance to it, standard deviation B/sqrt(3)."""
+    log = tmp_path / "noisy.mcap"
+    assert main(["run", "--cart", str(TRUTH), "--controller", f"{LAW}:DitheredPD", "--sensing",
+                 SENSING + ",noise=uniform:0.0005,seed=4", "--path", "lane-change", "--duration", "6",
+                 "--out", str(log), "--no-progress"]) == 0
+    code, obj = _main_json(["identify", "--cart", str(START), "--data", str(log), "--out", str(tmp_path / "n.toml"),
+                            "--json"])
+    assert code == 0 and obj["encoder_ticks"] == TICKS
+    assert obj["noise_rad"] == pytest.approx(0.0005 / np.sqrt(3), rel=0.03)  # 6000 draws: 1 % standard error
+    assert "noise=uniform:" in load_cart(tmp_path / "n.toml").defaults["sensing"]

@@ -136,8 +136,9 @@ def identified_cart_text(start: CartFile, fit: SteeringFit, recordings: Sequence
             box["m1"]["source"] += f"; widened to hold the recordings' m1 ({', '.join(f'{m:g}' for m in m1s)} kg)"
     sensing = sensing_of_fit(start, fit)
     encoder = ("not readable (the angle is not on one grid)" if fit.encoder_ticks is None
-               else f"{fit.encoder_ticks} ticks per revolution read from the angle's quantisation (every reading a "
-                    "whole number of ticks)")
+               else f"{fit.encoder_ticks} ticks per revolution read from the angle's quantisation ("
+                    + ("every reading a whole number of ticks)" if fit.noise_rad == 0.0
+                       else "the readings concentrate on its grid through the noise)"))
     document["defaults"]["sensing"] = {
         "value": _spec_text(sensing),
         "source": (f"measured from {made_of}: encoder {encoder}; delay {fit.delay_steps} control periods of "

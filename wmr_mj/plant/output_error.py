@@ -53,7 +53,7 @@ from wmr_mj.plant.recordings import Recording
 __all__ = ["Interval", "SteeringFit", "fit_recordings", "simulate_recording", "encoder_ticks_of", "noise_of",
            "SEGMENT_S", "RATE_WINDOW_S", "MAX_DELAY_S", "BOOTSTRAP_DRAWS", "CONFIDENCE", "physical_of",
            "IDENTIFIED_PARAMETERS", "holdout_error", "HOLDOUT_NRMSE_MAX", "BURN_IN_S", "MODEL_ERROR_FLOOR",
-           "POORLY_DETERMINED"]
+           "POORLY_DETERMINED", "ENCODER_BITS", "QUADRATURE_LINES", "GRID_CONCENTRATION"]
 
 #: Segment length, s: long enough for the slowest response (stick-slip under a PD law, a few hundred ms) to
 #: show in it, short enough that a simulation from the recorded state does not drift on a few per cent of error.
@@ -273,33 +273,59 @@ def _residuals(theta: np.ndarray, seg: _Segments, delay: int, *, period: float, 
 # ------------------------------------------------------------------------------------------- the fit
 
 
-def encoder_ticks_of(alphas: Sequence[np.ndarray], *, max_ticks: int = 2**24) -> int | None:
-    """The encoder's ticks per revolution of the angle read, from its quantisation; None where the readings are
-    not on one grid 2 pi/N (within 1e-6 of a tick) for an N up to ``max_ticks``.
+#: Encoders whose grid is looked for where noise after the quantisation hides it (readings off the grid): absolute
+#: encoders of 8 to 24 bits on the axis, and quadrature encoders (4 x lines per motor revolution) of the common
+#: line counts on the motor, x i2 at the axis (wmr_mj.hardware.presets.quadrature_encoder_spec).
+ENCODER_BITS = tuple(range(8, 25))
+QUADRATURE_LINES = (100, 200, 250, 256, 360, 400, 500, 512, 1000, 1024, 2000, 2048, 2500, 4096, 5000)
+#: The concentration |mean exp(i N alpha)| a grid of N ticks must reach to be read through noise: a uniform noise
+#: of bound B gives sinc(2 pi B N / 2 pi) = sin(B N)/(B N), 0.43 at B = a third of a tick; readings spread over many
+#: ticks give about 1/sqrt(samples) on a grid that is not theirs (0.003 at 100k samples).
+GRID_CONCENTRATION = 0.2
 
-    The smallest step between distinct readings is one tick where the steering moved slowly enough to be read
-    at neighbouring ticks (a recording at 1 kHz always is); every reading is then a whole number of them.
+
+def encoder_ticks_of(alphas: Sequence[np.ndarray], *, gear_ratio: float | None = None,
+                     max_ticks: int = 2**30) -> int | None:
+    """The encoder's ticks per revolution of the steering axis, from the angle's quantisation; None where no grid
+    is found.
+
+    Every reading on one grid 2 pi/N (within 1e-6 of a tick): N exactly, from the smallest step between distinct
+    readings (one tick where the steering moved slowly enough to be read at neighbouring ticks; a recording at
+    1 kHz always is). Readings off every grid (noise after the quantisation): the candidate N of
+    :data:`ENCODER_BITS` and :data:`QUADRATURE_LINES` (x ``gear_ratio`` where given) whose grid the readings
+    concentrate on most (|mean exp(i N alpha)|, at least :data:`GRID_CONCENTRATION`; a finer grid than the true
+    one concentrates them less, a coarser one spreads the ticks over its phases).
     """
-    values = np.unique(np.concatenate([np.asarray(a, float).ravel() for a in alphas]))
-    if values.size < 2:
+    values = np.concatenate([np.asarray(a, float).ravel() for a in alphas])
+    distinct = np.unique(values)
+    if distinct.size < 2:
         return None
-    steps = np.diff(values)
-    tick = float(steps.min())
-    ticks = int(round(2 * math.pi / tick))
-    if ticks < 1 or ticks > max_ticks:
-        return None
-    counts = values * ticks / (2 * math.pi)
-    if float(np.max(np.abs(counts - np.rint(counts)))) <= 1e-6:
-        return ticks
-    return None
+    ticks = int(round(2 * math.pi / float(np.diff(distinct).min())))
+    if 1 <= ticks <= max_ticks:
+        counts = distinct * ticks / (2 * math.pi)
+        if float(np.max(np.abs(counts - np.rint(counts)))) <= 1e-6:
+            return ticks
+    candidates = {2**b for b in ENCODER_BITS}
+    if gear_ratio is not None and float(gear_ratio).is_integer():
+        candidates |= {4 * lines * int(gear_ratio) for lines in QUADRATURE_LINES}
+    score = {n: abs(complex(np.mean(np.exp(1j * n * values)))) for n in sorted(candidates)}
+    best = max(score, key=score.__getitem__)
+    return best if score[best] >= GRID_CONCENTRATION else None
 
 
-def noise_of(residuals: np.ndarray, encoder_ticks: int | None) -> float:
-    """The noise on the angle beyond the quantisation, rad: 0 where every reading is on the encoder's grid
-    (``encoder_ticks`` found); else the white part of the residuals: for white noise of variance s^2 the
-    difference of successive residuals has variance 2 s^2 (the model's error, smooth, adds little to it)."""
+def noise_of(alphas: Sequence[np.ndarray], residuals: np.ndarray, encoder_ticks: int | None) -> float:
+    """The noise on the angle beyond the quantisation, rad (standard deviation).
+
+    With the encoder's grid known: the readings' distance to their nearest tick (0 where every reading is on the
+    grid; the noise itself where it stays within half a tick). Without: the white part of the output error's
+    residuals (white noise of variance s^2 gives successive differences of variance 2 s^2; the model's error,
+    smooth, adds little to it, the quantisation some)."""
     if encoder_ticks is not None:
-        return 0.0
+        values = np.concatenate([np.asarray(a, float).ravel() for a in alphas])
+        tick = 2 * math.pi / encoder_ticks
+        off = values - tick * np.rint(values / tick)
+        sd = float(np.sqrt(np.mean(off * off)))
+        return 0.0 if sd <= 1e-9 * tick else sd
     d = np.diff(residuals, axis=0)
     return float(math.sqrt(0.5 * float(np.mean(d * d))))
 
@@ -480,11 +506,12 @@ def fit_recordings(recordings: Sequence[Recording], params: C80Parameters, *, se
     delay_interval = _interval(delay * period, boot_delays * period)
     if coefficients["P"].relative_half_width > POORLY_DETERMINED:
         delay_interval = Interval(delay * period, 0.0, max_delay * period)
-    ticks = encoder_ticks_of([rec.alpha for rec in recordings])
+    ticks = encoder_ticks_of([rec.alpha for rec in recordings], gear_ratio=params.i2)
     return SteeringFit(
         coefficients=coefficients, physical=physical, delay_steps=delay,
         delay=delay_interval, period=period, encoder_ticks=ticks,
-        noise_rad=noise_of(r, ticks), residual_rms_rad=float(np.sqrt(np.mean(r * r))), segments=int(r.shape[1]),
+        noise_rad=noise_of([rec.alpha for rec in recordings], r, ticks),
+        residual_rms_rad=float(np.sqrt(np.mean(r * r))), segments=int(r.shape[1]),
         segment_steps=steps, m1=tuple(float(rec.m1) if rec.m1 is not None else params.m1 for rec in recordings),
         draws=boot, jacobian_half_width=_jacobian_half_width(r, J))
 
