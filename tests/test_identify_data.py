@@ -298,3 +298,19 @@ def test_encoder_and_noise_read_through_noise(tmp_path):
     assert code == 0 and obj["encoder_ticks"] == TICKS
     assert obj["noise_rad"] == pytest.approx(0.0005 / np.sqrt(3), rel=0.03)  # 6000 draws: 1 % standard error
     assert "noise=uniform:" in load_cart(tmp_path / "n.toml").defaults["sensing"]
+
+
+def test_a_speed_column_is_the_speed_the_gyro_term_sees(recordings, tmp_path):
+    """speed_m_per_s, where recorded, enters gyro V alpha'/cos^2: the cart's V_A written as a column gives the fit
+    without it, to rounding; twice V_A another fit."""
+    start = parameters_of_cart(load_cart(START))
+    rec = read_csv(recordings["lane_short"])
+    same = dataclasses.replace(rec, speed=np.full(rec.samples, start.V_A))
+    double = dataclasses.replace(rec, speed=np.full(rec.samples, 2 * start.V_A))
+    fits = [fit_recordings([r], start, draws=20) for r in (rec, same, double)]
+    values = [np.array([f.coefficients[k].value for k in ("P", "C_V", "F")]) for f in fits]
+    np.testing.assert_allclose(values[1], values[0], rtol=1e-9)
+    assert not np.allclose(values[2], values[0], rtol=1e-3)
+    path = tmp_path / "speed.csv"
+    path.write_text("t_s,u_V,alpha_rad,speed_m_per_s\n0,1,0.1,0.2\n0.001,2,0.2,0.3\n", encoding="utf-8")
+    assert read_csv(path).speed.tolist() == [0.2, 0.3]
