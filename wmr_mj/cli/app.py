@@ -23,7 +23,7 @@ from collections.abc import Collection, Sequence
 from wmr_mj.errors import WmrMjError
 
 COMMANDS = ("identify", "robustness", "run", "replay", "sweep", "falsify", "compare", "validate", "figures", "model",
-            "cart", "design")
+            "cart", "design", "excite")
 
 
 class _OneLineParser(argparse.ArgumentParser):

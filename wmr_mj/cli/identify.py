@@ -1,4 +1,11 @@
-"""``wmr-mj identify``: fit the steering model to the driving MuJoCo plant."""
+"""``wmr-mj identify``: fit the steering model to the driving MuJoCo plant, or to a cart's own recordings.
+
+Without ``--data``: excite the simulated plant and fit P, C_V, F, K, gyro by least squares (as before).
+With ``--data FILE[:m1=KG]`` (repeatable): output-error identification from the cart's recordings
+(:mod:`wmr_mj.plant.output_error`), written as a cart file (``--out NEW.toml``) with 95 % intervals; a
+``--holdout`` recording is predicted by the identified model, and a normalised RMS error above
+:data:`wmr_mj.plant.output_error.HOLDOUT_NRMSE_MAX` exits 1. Bad data: one line, exit 2.
+"""
 
 from __future__ import annotations
 
@@ -19,7 +26,24 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--duration", type=positive_float, default=60.0, help="excitation length, s (default 60)")
     add_seed(p, help="seed of the excitation signal (default 0)")
     p.add_argument("--param", action="append", metavar="NAME=VALUE", help="override a plant parameter (repeatable)")
-    add_out(p, metavar="PATH", help="also write the result as JSON (used by --model identified)")
+    add_out(p, metavar="PATH", help="also write the result as JSON (used by --model identified); with --data: the "
+            "identified cart file NEW.toml")
+    p.add_argument("--data", action="append", metavar="FILE[:m1=KG]",
+                   help="a recording of the cart (CSV with the header t_s,u_V,alpha_rad[,speed_m_per_s], or a "
+                        "wmr-mj run's MCAP log); :m1= gives the chassis mass during it (default: the cart's); "
+                        "repeatable. Identifies P, C_V, F (as front_axle_mass, k_i = k_b, mu), the delay, the "
+                        "encoder and the noise, and writes --out NEW.toml")
+    p.add_argument("--holdout", metavar="FILE[:m1=KG]",
+                   help="a recording the fit never sees: the identified model must predict it (normalised RMS error "
+                        "at most 0.1, else exit 1)")
+    p.add_argument("--report", metavar="DIR",
+                   help="with --data: write identify.html and identify.png (recorded against simulated angle on the "
+                        "hold-out, or the first recording; residuals; the table of intervals) into DIR")
+    p.add_argument("--topics", metavar="u=/T,alpha=/T[,speed=/T]",
+                   help="with --data BAG.mcap: a ROS 2 bag's topics of the voltage, the angle and the speed (a topic "
+                        "with .field or .field[i]; default field data), read through mcap-ros2-support")
+    p.add_argument("--columns", metavar="KEY=NAME,...",
+                   help="CSV column names of another header: t_s=...,u_V=...,alpha_rad=...,speed_m_per_s=...")
     add_json(p, help="print one JSON object")
     from wmr_mj.cli.run_options import add_option
 
@@ -34,6 +58,13 @@ def run(args: argparse.Namespace) -> int:
     from wmr_mj.params import COEFFICIENT_MODELS, COEFFICIENT_NAMES, with_params
     from wmr_mj.plant.identify import identify_plant
 
+    if args.data:
+        return run_data(args)
+    if args.holdout or args.columns or args.report or args.topics:
+        from wmr_mj.errors import ParameterError
+
+        raise ParameterError("--holdout, --columns, --topics and --report need --data (recordings of the cart to "
+                             "identify from)")
     if args.out:  # before the identification, which takes a while
         check_output_path(args.out, kind="file", option="--out")
     base = cart_parameters(args)
@@ -69,3 +100,137 @@ def run(args: argparse.Namespace) -> int:
     if args.out:
         print(f"wrote {args.out}")
     return 0
+
+
+def _split_data(item: str) -> tuple[str, float | None]:
+    """'FILE[:m1=KG]' -> (FILE, KG or None)."""
+    from wmr_mj.errors import ParameterError
+
+    path, sep, rest = item.rpartition(":m1=")
+    if not sep:
+        return item, None
+    try:
+        m1 = float(rest)
+    except ValueError:
+        raise ParameterError(f"--data {item!r}: m1={rest!r} is not a number; accepted: FILE or FILE:m1=KG") from None
+    return path, m1
+
+
+def _read_recording(item: str, columns: dict[str, str], params, topics: dict[str, str] | None = None):
+    from wmr_mj.plant.recordings import check_recording, read_csv
+
+    path, m1 = _split_data(item)
+    if topics:
+        from wmr_mj.logs.recordings import read_ros2_bag
+
+        rec = read_ros2_bag(path, topics, m1=m1)
+    elif path.endswith(".mcap"):
+        from wmr_mj.logs.recordings import read_run_log
+
+        rec = read_run_log(path, m1=m1)
+    else:
+        rec = read_csv(path, m1=m1, columns=columns)
+    check_recording(rec, voltage_limit=params.voltage_limit, steering_range=params.steering_range)
+    return rec
+
+
+def run_data(args: argparse.Namespace) -> int:
+    """``identify --data``: recordings -> NEW.toml, intervals, the hold-out's check."""
+    import datetime
+    import sys
+    from pathlib import Path
+
+    from wmr_mj._util.files import check_output_path
+    from wmr_mj.carts import load_cart
+    from wmr_mj.cli._common import print_json
+    from wmr_mj.errors import ParameterError
+    from wmr_mj.params import parameters_of_cart
+    from wmr_mj.plant.identified_cart import identified_cart_text
+    from wmr_mj.plant.output_error import HOLDOUT_NRMSE_MAX, fit_recordings, holdout_error
+    from wmr_mj.plant.recordings import parse_columns
+
+    if not args.out:
+        raise ParameterError("identify --data needs --out NEW.toml: the identified cart file")
+    out = check_output_path(args.out, kind="file", option="--out")
+    if args.report:
+        check_output_path(args.report, kind="dir", option="--report")
+    start = load_cart(args.cart or "c80")
+    params = parameters_of_cart(start)
+    columns = parse_columns(args.columns)
+    from wmr_mj.logs.recordings import parse_topics
+
+    topics = parse_topics(args.topics) if args.topics else None
+    recordings = [_read_recording(item, columns, params, topics) for item in args.data]
+    holdout = _read_recording(args.holdout, columns, params, topics) if args.holdout else None
+    fit = fit_recordings(recordings, params, seed=args.seed)
+    date = datetime.datetime.now(datetime.UTC).date().isoformat()
+    command = "wmr-mj identify " + " ".join(sys.argv[2:]) if len(sys.argv) > 2 else "wmr-mj identify"
+    text = identified_cart_text(start, fit, recordings, date=date, command=command)
+    Path(out).write_text(text, encoding="utf-8")
+    nrmse = holdout_error(fit, holdout, params) if holdout is not None else None
+    report_files: list[str] = []
+    if args.report:
+        from wmr_mj.report.identify import IdentifyReport
+
+        report = IdentifyReport.of(fit, recordings, params, holdout=holdout)
+        report_files = [str(p) for p in report.write(args.report)]
+    failed = nrmse is not None and not nrmse <= HOLDOUT_NRMSE_MAX
+    obj = {
+        "coefficients": {k: v.as_dict() for k, v in fit.coefficients.items()},
+        "fixed_from_structure": {"K": "0: absent from the plant (non-holonomic model)",
+                                 "gyro": "P / l1: moves with C_V at constant speed, not separable"},
+        "physical": {k: v.as_dict() for k, v in fit.physical.items()},
+        "sensing_delay_s": fit.delay.as_dict(),
+        "actuation_delay_s": {"value": 0.0, "interval": [0.0, 0.0], "note": (
+            "not separable from the sensing delay when the voltage is recorded as applied: the whole "
+            "voltage-to-angle delay is in sensing_delay_s")},
+        "encoder_ticks": fit.encoder_ticks,
+        "noise_rad": fit.noise_rad,
+        "residual_rms_rad": fit.residual_rms_rad,
+        "segments": fit.segments,
+        "m1_kg": list(fit.m1),
+        "data": [{"file": r.name, "sha256": r.sha256, "m1_kg": m, "duration_s": r.duration}
+                 for r, m in zip(recordings, fit.m1)],
+        "holdout": None if holdout is None else {"file": holdout.name, "nrmse": nrmse,
+                                                 "nrmse_max": HOLDOUT_NRMSE_MAX, "passed": not failed},
+        "cart": str(out),
+        "report": report_files,
+    }
+    if args.json:
+        print_json(obj)
+    else:
+        _print_fit(fit, recordings, holdout, nrmse, out)
+        for path in report_files:
+            print(f"wrote {path}")
+    if failed and holdout is not None:
+        print(f"hold-out {holdout.name}: the identified model does not predict it: normalised RMS error {nrmse:.3g} "
+              f"above {HOLDOUT_NRMSE_MAX:g}", file=sys.stderr)
+        return 1
+    return 0
+
+
+def _print_fit(fit, recordings, holdout, nrmse, out) -> None:
+    units = {"P": "V s^2/rad", "C_V": "V s/rad", "F": "V", "K": "V", "gyro": "V s/m", "front_axle_mass": "kg",
+             "k_i": "N m/A", "k_b": "V s/rad", "mu": "-"}
+    total = sum(r.duration for r in recordings)
+    print(f"Output-error identification from {len(recordings)} recording(s), {total:.4g} s, {fit.segments} segments of "
+          f"{fit.segment_steps * fit.period:g} s; residual {fit.residual_rms_rad:.3g} rad rms")
+    print(f"{'name':16s} {'value':>12s} {'95 % interval':>26s}  unit")
+    for name, iv in {**fit.coefficients, **fit.physical}.items():
+        fixed = "  (fixed: K = 0)" if name == "K" else ("  (fixed: P / l1)" if name == "gyro" else "")
+        print(f"{name:16s} {iv.value:12.5g} [{iv.lo:11.5g}, {iv.hi:11.5g}]  {units[name]}{fixed}")
+    print(f"delay: {fit.delay_steps} control periods = {fit.delay.value * 1e3:g} ms, 95 % interval "
+          f"[{fit.delay.lo * 1e3:g}, {fit.delay.hi * 1e3:g}] ms (voltage to angle: sensing and actuation together)")
+    enc = ("not readable (the angle is not on one grid)" if fit.encoder_ticks is None
+           else f"{fit.encoder_ticks} ticks/rev")
+    print(f"encoder: {enc}; noise beyond the quantisation: {fit.noise_rad:.3g} rad")
+    from wmr_mj.plant.output_error import POORLY_DETERMINED
+
+    wide = [n for n, iv in fit.physical.items() if iv.relative_half_width > POORLY_DETERMINED]
+    if wide:
+        print(f"warning: {', '.join(wide)} poorly determined (95 % half-width above {100 * POORLY_DETERMINED:g} %): "
+              "the recordings do not excite them (the delay's interval is then the whole search); a box this wide "
+              "may decide the certificate (wmr-mj excite writes an experiment that excites them)")
+    if holdout is not None:
+        print(f"hold-out {holdout.name}: normalised RMS error {nrmse:.3g}")
+    print(f"wrote {out}")
