@@ -16,7 +16,8 @@ from wmr_mj.cli.options import add_json, add_out, add_seed
 from wmr_mj.params import M1_NOMINAL
 
 #: the command's line in ``wmr-mj --help`` (read without registering the command: wmr_mj/cli/app.py)
-HELP = "excite the plant's steering and fit P, C_V, F, K, gyro by least squares"
+HELP = ("fit the steering model: the simulated plant excited (P, C_V, F, K, gyro by least squares), or a cart's "
+        "recordings (--data) into a cart file with intervals")
 
 
 def register(sub: argparse._SubParsersAction) -> None:
