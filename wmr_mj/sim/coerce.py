@@ -111,6 +111,9 @@ def check_fields(config: Any) -> None:
             raise ParameterError(f"{kind}_params = {params!r} is not accepted: a mapping NAME -> value")
     _check_plugin_form(config, "controller")
     _check_plugin_form(config, "tracker")
+    if _is_inline(config.signals):
+        signals_from(config.signals)  # a mapping or JSON text: refused here (a file is read where it is coerced)
+    reference_bounds_from(config.reference_bounds)  # 'paper', a mapping or a spec: no file
     parts = {name: _part_without_io(getattr(config, name), cls) for name, cls in _PARTS}
     if config.cart is None and all(part is not None for part in parts.values()):
         # parts that need no file (typed, a KEY=VALUE spec, a preset, None: ideal) on the C80: their limits are
@@ -119,6 +122,12 @@ def check_fields(config: Any) -> None:
                                 plant_overrides=config.plant_overrides)
         m1 = M1_NOMINAL if config.m1 is None else config.m1
         _check_parts(typed, C80, with_params(C80, m1_inertia=config.m1_inertia, m1=m1, **dict(config.plant_overrides)))
+
+
+def _is_inline(signals: Any) -> bool:
+    """Whether signals are given inline (a Signals, a mapping, JSON text), not as a file to read."""
+    return (signals is None or isinstance(signals, (Signals, Mapping))
+            or (isinstance(signals, str) and signals.lstrip().startswith("{")))
 
 
 def _part_without_io(given: Any, cls: Any) -> Any:
@@ -265,7 +274,9 @@ def coerced(config: Any) -> Any:
 
 def _check_typed(config: Any) -> None:
     """The checks that need the typed fields (:func:`_check_parts`) on the config's base and plant."""
-    _check_parts(config, base_for(config), plant_parameters(config))
+    base = _base_of_record(config.cart, C80)
+    _check_parts(config, base, with_params(base, m1_inertia=config.m1_inertia, m1=config.m1,
+                                           **dict(config.plant_overrides)))
 
 
 def _check_parts(config: Any, base: C80Parameters, plant: C80Parameters) -> None:
@@ -331,7 +342,11 @@ def cart_file(config: Any) -> Any:
 def base_for(config: Any, base: C80Parameters = C80) -> C80Parameters:
     """The base parameter set of a run: the config's cart's where ``base`` is the default (the C80) and the
     config names a cart; else ``base``."""
-    record = coerced(config).cart
+    return _base_of_record(coerced(config).cart, base)
+
+
+def _base_of_record(record: Mapping[str, str] | None, base: C80Parameters) -> C80Parameters:
+    """:func:`base_for` of a typed config's cart record."""
     if record is None or base is not C80:
         return base
     return _parameters_of_text(record["text"], record["path"])
@@ -409,7 +424,7 @@ def _plugin_fresh(config: Any, kind: str) -> bool:
         return source.spec == given.strip() and dict(source.params) == describe_params(
             getattr(config, f"{kind}_params"))
     if not isinstance(given, SteeringController if kind == "controller" else PathTracker):
-        return False  # a factory: what it builds names the plug-in, built again
+        return source.origin == "instance"  # a factory: its record, made by calling it once when coerced
     cls = type(given)
     return (source.origin == "instance" and source.import_path == f"{cls.__module__}:{cls.__qualname__}"
             and dict(source.params) == _described(given, kind))

@@ -40,10 +40,19 @@ from wmr_mj.sim.builders import (
     reference_bounds_of,
     tracker_for,
 )
-from wmr_mj.sim.coerce import PATH_NAMES, base_for, coerce_with_classes, controller_name, plant_parameters, route_of
+from wmr_mj.sim.coerce import (
+    PATH_NAMES,
+    base_for,
+    coerce_with_classes,
+    coerced,
+    controller_name,
+    plant_parameters,
+    route_of,
+)
 from wmr_mj.sim.run_config import RunConfig
 
-__all__ = ["RunParts", "RunLabels", "resolve_run", "control_substeps", "signal_inputs"]
+__all__ = ["RunParts", "RunLabels", "resolve_run", "run_reference", "plant_and_claim", "control_substeps",
+           "signal_inputs"]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -189,7 +198,7 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
     substeps = control_substeps(config)
     period = substeps * TIMESTEP
     n = int(round(config.duration / period))
-    reference, settle_s = build_reference(config.path, estimate, dt=period, duration=n * period)
+    reference, settle_s = run_reference(config.path, estimate, period=period, duration=config.duration)
     paper_estimate = estimate_of(controller)  # None: not the paper's law, whose region then says nothing of it
     analysis = analysis_for(config, reference, estimate, estimate=paper_estimate)
     measurement = measurement_errors_of(config, plant)  # once: the claim and the run's parts share it
@@ -211,6 +220,28 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
                                     else manoeuvre_length(config.path)),  # lane-change's
                     measurement=measurement, labels=RunLabels.of(config, name=name),
                     record=config.as_dict())
+
+
+def run_reference(path: str, estimate: C80Parameters, *, period: float, duration: float) -> tuple[Any, float]:
+    """(reference, settle_s): C's reference of a run on its control grid, as :func:`resolve_run` builds it --
+    ``round(duration / period)`` control steps of ``period`` [s] on the controller's belief ``estimate``
+    (:func:`wmr_mj.sim.builders.build_reference`). A log's replay and a result made elsewhere build theirs here."""
+    n = int(round(duration / period))
+    return build_reference(path, estimate, dt=period, duration=n * period)
+
+
+def plant_and_claim(config: RunConfig, shared: RunParts, *, base: C80Parameters = C80
+                    ) -> tuple[C80Parameters, Certificate | None]:
+    """A batch's further run: its own plant, and the claim of ``shared``'s law (the batch's parts, which it shares
+    but for the plant: law, tracker, reference, belief) on that plant -- a plant outside the box fails its
+    assumption. ``base``: the batch's base parameter set, as :func:`wmr_mj.sim.batch.run_batch` is given it."""
+    from wmr_mj.sim.certify import certificate_of
+
+    config = coerced(config)
+    plant = plant_parameters(config, base)
+    claim = certificate_of(config, shared.reference, base=base, estimate=shared.estimate, plant=plant,
+                           controller=shared.controller, tracker=shared.tracker)
+    return plant, claim
 
 
 def signal_inputs(signals: Any, plant: C80Parameters, options: dict[str, Any], *, n: int, period: float,
