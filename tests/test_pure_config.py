@@ -171,3 +171,26 @@ def test_a_run_from_a_direct_config_is_the_run_from_inputs(tmp_path):
     timing = ("wall_s", "realtime_factor")  # the machine's clock, not the run's numbers
     assert ({k: v for k, v in a.summary.to_dict().items() if k not in timing}
             == {k: v for k, v in b.summary.to_dict().items() if k not in timing})
+
+
+def test_measurement_errors_are_derived_once_per_resolution(monkeypatch):
+    """resolve_run derives the cart's measurement errors once and hands them to the law's claim (issue 41 item 3);
+    the claim is the one certificate_for derives alone (which computes the errors itself)."""
+    import wmr_mj.sim.certify as certify
+    from wmr_mj.analysis.measurement import MeasurementErrors
+
+    config = RunConfig(sensing="magnetic-12bit-axis", actuation="delay=0.002", path="lane-change", duration=5.0)
+    calls = []
+    real = certify.measurement_errors_of
+
+    def counting(*args, **kwargs):
+        calls.append(args[0])
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(certify, "measurement_errors_of", counting)
+    parts = resolve_run(config)
+    assert len(calls) == 1
+    assert parts.measurement != MeasurementErrors.exact()
+    alone = certify.certificate_for(config, parts.reference)
+    assert len(calls) == 2  # certificate_for derives its own
+    assert parts.claim.E_max == alone.E_max and parts.claim.inputs == alone.inputs
