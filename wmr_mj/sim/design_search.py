@@ -41,6 +41,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from wmr_mj.errors import ParameterError
+from wmr_mj.sim.coerce import coerced
 
 __all__ = ["DesignProblem", "DesignResult", "OBJECTIVES", "METHODS", "LAWS", "DEFAULT_SEED", "DEFAULT_BUDGET",
            "DESIGN_FIELDS", "law_changes", "uncovered", "search_design", "evaluate_design", "write_design",
@@ -355,6 +356,7 @@ def search_design(problem: DesignProblem) -> DesignResult:
         raise ParameterError(f"--objective {problem.objective!r} is not accepted; one of {', '.join(OBJECTIVES)}")
     if problem.method not in METHODS:
         raise ParameterError(f"--method {problem.method!r} is not accepted; one of {', '.join(METHODS)}")
+    problem = dataclasses.replace(problem, base=coerced(problem.base))  # a base given directly: typed once, here
     periods = check_periods(problem.periods, problem.base.duration)
     _check_law(problem.base.controller)
     best: tuple[float, Any] | None = None

@@ -101,6 +101,7 @@ import numpy as np
 from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE, VERDICTS
 from wmr_mj.errors import ParameterError, UnknownNameError, WmrMjError
 from wmr_mj.params import parameter_names
+from wmr_mj.sim.coerce import coerced
 from wmr_mj.sim.config import RunConfig
 from wmr_mj.sim.records import BrokenRun, Record, UnmetAssumption
 
@@ -207,6 +208,7 @@ def shares_the_base_certificate(base: RunConfig, names: Sequence[str]) -> bool:
     each run its own."""
     from wmr_mj.sim.search_space import hardware_axis, path_axis, signal_axis
 
+    base = coerced(base)  # a base given directly: its parts typed (wmr_mj.sim.coerce)
     reaching = {"voltage_limit", "steering_range"}
     if not base.sensing.is_ideal or not base.transmission.is_ideal:
         reaching.add("i2")
