@@ -183,6 +183,7 @@ def config_for(base: RunConfig, names: Sequence[str], x: Sequence[float]) -> Run
     """
     if len(names) != len(x):
         raise ParameterError(f"{len(names)} names for {len(x)} values")
+    base = coerced(base)  # a base given directly: its signals, bounds and parts typed (wmr_mj.sim.coerce)
     template = base.signals if base.signals is not None else Signals()
     dist = template.disturbance
     d_changes: dict[str, Any] = {}
