@@ -37,6 +37,7 @@ from wmr_mj.sim.config import (
     RunConfig,
     analysis_for,
     build_reference,
+    coerce,
     controller_for,
     estimate_of,
     estimate_parameters,
@@ -61,6 +62,7 @@ def reference_run(
     receives a block of rows every simulated second and is closed with the summary,
     also when the run is interrupted (KeyboardInterrupt or SIGTERM).
     """
+    config = coerce(config)  # as resolve_run does: a config given directly, its references read
     params = plant_parameters(config, base)
     estimate = estimate_parameters(base)
     controller = controller_for(config, estimate)

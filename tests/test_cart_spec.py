@@ -74,7 +74,8 @@ def test_the_noise_has_one_name_in_python_the_spec_a_file_and_an_axis(tmp_path):
 
 def test_a_logs_recorded_config_still_loads():
     """A log records RunConfig.as_dict(); its sensing is the spec form, whose keys did not change."""
-    config = RunConfig(sensing="encoder_bits=12,velocity=tachometer,noise=uniform:0.0005,velocity_noise=gaussian:0.01")
+    config = RunConfig.from_inputs(
+        sensing="encoder_bits=12,velocity=tachometer,noise=uniform:0.0005,velocity_noise=gaussian:0.01")
     recorded = json.loads(json.dumps(config.as_dict()))
     assert recorded["sensing"]["noise"] == "uniform:0.0005" and recorded["sensing"]["encoder_ticks"] == 4096
     assert config_from_dict(recorded).sensing == config.sensing
@@ -179,11 +180,11 @@ def test_the_hardware_guide_shows_the_noise_syntax_and_a_file_in_run_blocks():
 def test_the_inductance_limit_is_the_electrical_time_constant_against_its_datasheet_range(capsys):
     limit = MAX_ELECTRICAL_TIME_CONSTANT_S * C80.R_a  # tau_e = L_a / R_a <= 0.1 s
     assert limit == pytest.approx(0.1)
-    RunConfig(actuation=Actuation(inductance=limit))  # the limit itself is accepted
-    with pytest.raises(ParameterError, match="L_a/R_a"):
-        RunConfig(actuation=Actuation(inductance=limit * (1 + 1e-12)))
+    RunConfig.from_inputs(actuation=Actuation(inductance=limit))  # the limit itself is accepted
+    with pytest.raises(ParameterError, match="L_a/R_a"):  # checked where the config is coerced (on the plant)
+        RunConfig.from_inputs(actuation=Actuation(inductance=limit * (1 + 1e-12)))
     # R_a read from the plant's parameter set: twice the resistance, twice the inductance
-    RunConfig(actuation=Actuation(inductance=2 * limit), plant_overrides={"R_a": 2 * C80.R_a})
+    RunConfig.from_inputs(actuation=Actuation(inductance=2 * limit), plant_overrides={"R_a": 2 * C80.R_a})
     _refused(capsys, ["run", *SHORT, "--actuation", "inductance=1e6"],
              ["inductance = 1e+06 H", "L_a/R_a", "0.1 s", "datasheet", "inductance <= 0.1 H"])
 

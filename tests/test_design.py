@@ -61,9 +61,9 @@ def test_design_file_round_trip_is_the_same_config(designed):
     add_run_options(p)
     config = config_from_args(p.parse_args(["--design", str(out)]))
     s = printed["settings"]
-    expected = RunConfig(controller="computed-torque", model=s["model"], kp=s["kp"], kd=s["kd"],
-                         friction_sign=s["friction_sign"], friction_width=s["friction_width"],
-                         control_period=s["control_period"], sensing=Sensing.from_spec(CART))
+    expected = RunConfig.from_inputs(controller="computed-torque", model=s["model"], kp=s["kp"], kd=s["kd"],
+                                     friction_sign=s["friction_sign"], friction_width=s["friction_width"],
+                                     control_period=s["control_period"], sensing=Sensing.from_spec(CART))
     for name in ("controller", "model", "kp", "kd", "friction_sign", "friction_width", "control_period",
                  "sensing", "actuation", "transmission"):
         assert getattr(config, name) == getattr(expected, name), name

@@ -122,8 +122,8 @@ def test_a_bad_controller_param_is_one_line(law_file, capsys, param, words):
 def test_params_for_a_built_in_configured_by_fields_are_refused():
     with pytest.raises(ParameterError, match="RunConfig fields"):
         RunConfig(controller="computed-torque", controller_params={"kp": 5})
-    with pytest.raises(UnknownNameError):
-        RunConfig(controller="no-such-law")
+    with pytest.raises(UnknownNameError):  # a name read where it is coerced (an entry point is looked up)
+        RunConfig.from_inputs(controller="no-such-law")
     with pytest.raises(ParameterError, match="not accepted"):
         RunConfig(controller=42)
 

@@ -14,7 +14,7 @@ from wmr_mj.cli.app import main
 from wmr_mj.errors import InfeasiblePathError, ParameterError
 from wmr_mj.reference.paths import circle, join, line
 from wmr_mj.reference.route import load_route, route_names, route_reference
-from wmr_mj.sim.config import RunConfig, build_reference
+from wmr_mj.sim.config import RunConfig, build_reference, coerce
 
 S_BEND = """
 [route]
@@ -77,7 +77,7 @@ def test_route_runs_closed_loop_and_config_stays_json(tmp_path):
     f = tmp_path / "s-bend.toml"
     f.write_text(S_BEND)
     by_file = RunConfig(**CERTIFIED.config_changes(), path=str(f), duration=5.0)
-    by_path = by_file.replace(path=load_route(f).path)  # a Path object: stored as its canonical JSON
+    by_path = coerce(by_file.replace(path=load_route(f).path))  # a Path object: coerced to its canonical JSON
     assert isinstance(by_path.path, str) and by_path.path.startswith("{")
     for cfg in (by_file, by_path):
         json.dumps(cfg.as_dict())
@@ -158,8 +158,8 @@ def test_bad_route_in_the_library(tmp_path):
     f.write_text(BAD["infeasible"][0])
     with pytest.raises(InfeasiblePathError, match=r"segment 1 \(arc\).*below the wheelbase"):
         build_reference(str(f), C80, dt=1e-3, duration=20.0)
-    with pytest.raises(Exception, match="unknown path 'nowhere'"):
-        RunConfig(path="nowhere")
+    with pytest.raises(Exception, match="unknown path 'nowhere'"):  # refused where the config is coerced
+        RunConfig.from_inputs(path="nowhere")
 
 
 def _run_json(capsys, *argv) -> dict:

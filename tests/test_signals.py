@@ -20,7 +20,8 @@ SIGNALS = {"disturbance": {"kind": "noise", "amplitude": 0.8, "t1": 0.5, "bandwi
 
 
 def _config(**changes):
-    return RunConfig(**{**CERTIFIED.config_changes(), "duration": 2.5, "path": "lane-change", **changes})
+    """Coerced (from_inputs): a signals file is read where a config is coerced, not where it is constructed."""
+    return RunConfig.from_inputs(**{**CERTIFIED.config_changes(), "duration": 2.5, "path": "lane-change", **changes})
 
 
 def test_signals_round_trip_through_json():

@@ -68,9 +68,10 @@ def test_a_run_builds_each_law_once_and_computes_each_claim_once(counted, option
     assert set(claims) <= set(builds), f"a claim of a law never built: {dict(claims)}"
 
 
-def test_a_plugin_is_imported_and_hashed_once_per_config(monkeypatch):
-    """A plug-in's source is hashed once when its config is built: as_dict, controller_name and resolving the
-    run read what was found, and the record stays the one a fresh resolution gives."""
+def test_a_plugin_is_imported_and_hashed_once_per_resolution(monkeypatch):
+    """A plug-in given by name is a reference: constructing its config hashes nothing, resolve_run finds it once
+    (imported, its source hashed), and as_dict, controller_name and the run's record read what was found; the
+    record is the one a fresh resolution gives."""
     import controllers.registry as registry
     from wmr_mj.sim.config import RunConfig, controller_name, controller_source
     from wmr_mj.sim.parts import resolve_run
@@ -84,13 +85,14 @@ def test_a_plugin_is_imported_and_hashed_once_per_config(monkeypatch):
 
     monkeypatch.setattr(registry, "source_hash", counting)
     config = RunConfig(controller=MY_PID, controller_params={"ki": 20.0}, duration=10.0)
-    first = config.as_dict()
-    assert len(hashed) == 1
-    assert config.as_dict() == first and controller_name(config) == "my-pid"
-    resolve_run(config)
+    assert hashed == []
+    parts = resolve_run(config)
+    assert len(hashed) == 1, f"hashed again: {hashed}"
+    first = parts.config.as_dict()
+    assert first == parts.record and controller_name(parts.config) == "my-pid"
     assert len(hashed) == 1, f"hashed again: {hashed}"
     _, fresh = resolve(MY_PID, {"ki": 20.0})
-    assert first["controller_plugin"] == fresh.as_dict() == controller_source(config)
+    assert first["controller_plugin"] == fresh.as_dict() == controller_source(parts.config)
 
 
 class _Reads:

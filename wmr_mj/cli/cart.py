@@ -135,7 +135,7 @@ def design_on_cart(cart: Any, *, seed: int | None = None, budget: int | None = N
     command = (f"wmr-mj design --cart {cart.path} --seed {seed}"
                + ("" if budget == DEFAULT_BUDGET else f" --budget {budget}"))
     out: dict[str, Any] = {"budget": budget, "seed": seed, "command": command}
-    base = RunConfig(**law_changes("computed-torque"), cart=cart)
+    base = RunConfig.from_inputs(**law_changes("computed-torque"), cart=cart)
     why_not = uncovered(base)
     if why_not:  # design refuses such a cart's sensing (no certificate can cover it)
         return {**out, "certified": False, "evaluations": 0,

@@ -97,7 +97,7 @@ def problem_from_args(args: argparse.Namespace) -> Any:
     except ValueError:
         raise ParameterError(f"--periods {args.periods!r} is not a list of numbers (s), e.g. 0.001,0.002") from None
     check_periods(periods, args.duration)
-    base = RunConfig(**law, m1_range=m1_range, box_ranges=ranges, duration=args.duration,
+    base = RunConfig.from_inputs(**law, m1_range=m1_range, box_ranges=ranges, duration=args.duration,
                      reference_bounds=args.reference_bounds, cart=getattr(args, "cart", None),
                      **hardware_from_args(args))
     why_not = uncovered(base)

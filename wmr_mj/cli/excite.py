@@ -7,7 +7,6 @@ import argparse
 from wmr_mj.cli._common import positive_float
 from wmr_mj.cli.options import add_seed
 
-
 #: the command's line in ``wmr-mj --help`` (read without registering the command: wmr_mj/cli/app.py)
 HELP = "write an excitation plan (target angle + voltage dither) for identify --data"
 

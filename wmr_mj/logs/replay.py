@@ -109,7 +109,8 @@ def path_of_log(log: RunLog, settle_s: float | None = None) -> LogPath:
     from wmr_mj.analysis.path_bound import guaranteed_E_max, path_bound, path_verdict, without_guarantee
     from wmr_mj.analysis.path_error import path_error_series, summarize_series
     from wmr_mj.params import C80
-    from wmr_mj.sim.config import build_reference, estimate_parameters
+    from wmr_mj.sim.config import estimate_parameters
+    from wmr_mj.sim.parts import run_reference
 
     sig, cfg = log.signals, log.config or {}
     missing = [k for k in ("t", "C_pos", "heading") if sig.get(k) is None or not np.asarray(sig[k]).size]
@@ -121,9 +122,8 @@ def path_of_log(log: RunLog, settle_s: float | None = None) -> LogPath:
     period = log.timestep * log.control_substeps
     if not (math.isfinite(period) and period > 0):
         return LogPath(reason="the log has no control period")
-    n = int(round(duration / period))
-    try:
-        reference, _ = build_reference(path, estimate_parameters(_base_of(cfg, C80)), dt=period, duration=n * period)
+    try:  # C's reference as the run built it (resolve_run's run_reference)
+        reference, _ = run_reference(path, estimate_parameters(_base_of(cfg, C80)), period=period, duration=duration)
         t, C, h = np.asarray(sig["t"], float), np.asarray(sig["C_pos"], float), np.asarray(sig["heading"], float)
         ok = np.isfinite(t) & np.isfinite(C).all(axis=1) & np.isfinite(h)
         series = path_error_series(reference, t[ok], C[ok], h[ok])

@@ -136,10 +136,11 @@ def design_problem(settings: ValidateSettings, *, sensing: str = DESIGN_SENSING,
     """The :class:`~wmr_mj.sim.design_search.DesignProblem` of the section: the certified design's run of these
     settings (their box, path, duration and cart) on ``sensing``, searched as ``wmr-mj design`` searches
     (the 1 ms period, the E_max objective, CMA-ES)."""
+    from wmr_mj.sim.coerce import coerce
     from wmr_mj.sim.design_search import DesignProblem
     from wmr_mj.sim.designs import CERTIFIED
 
-    base = settings.config(CERTIFIED).replace(sensing=sensing)
+    base = coerce(settings.config(CERTIFIED).replace(sensing=sensing))  # the sensing's spec typed
     return DesignProblem(base=base, paths=(settings.path,), seed=seed, budget=budget)
 
 

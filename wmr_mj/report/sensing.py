@@ -107,6 +107,7 @@ def sensing_stage(settings: ValidateSettings, st: Stages, *,
         (``F_estimate`` [V], ``P_estimate`` [V s^2/rad], ``kp`` [1/s^2], ``dead_band`` [rad], ``ideal_E_max``
         [rad]), ``runs`` (one per sensing, 'ideal' first: see the module docstring), ``certified_outside``.
     """
+    from wmr_mj.sim.coerce import coerce
     from wmr_mj.sim.designs import CERTIFIED
     from wmr_mj.sim.parts import resolve_run
 
@@ -118,7 +119,7 @@ def sensing_stage(settings: ValidateSettings, st: Stages, *,
     prediction = _dead_band_prediction(base_parts)
     runs = []
     for name in ("ideal", *presets):
-        config = base.replace(sensing=name)
+        config = coerce(base.replace(sensing=name))  # the preset typed, so that 'ideal' is the base itself
         parts = base_parts if config == base else resolve_run(config)  # the base run resolved once
         runs.append(_one_run(parts, name, prediction["ideal_E_max"]))
     n_out = sum(r["verdict"] == CERTIFIED_OUTSIDE for r in runs)

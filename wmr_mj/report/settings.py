@@ -80,7 +80,7 @@ class ValidateSettings:
     def __post_init__(self) -> None:
         from wmr_mj.sim.sweep import SAMPLINGS
 
-        on_cart = RunConfig(cart=self.cart)  # a missing file, an unknown name: one line, before any run
+        on_cart = RunConfig.from_inputs(cart=self.cart)  # a missing file, an unknown name: one line, before any run
         object.__setattr__(self, "cart", on_cart.cart)
         if self.m1_range is None:
             object.__setattr__(self, "m1_range", on_cart.m1_range)

@@ -48,7 +48,6 @@ from wmr_mj.errors import ParameterError
 from wmr_mj.params import C80, M1_NOMINAL, C80Parameters
 from wmr_mj.plant.mjcf import TIMESTEP
 from wmr_mj.sim import compiled_law
-from wmr_mj.sim.certify import certificate_of
 from wmr_mj.sim.closed_loop import (
     PathJudgement,
     RunMeasures,
@@ -58,13 +57,10 @@ from wmr_mj.sim.closed_loop import (
     report,
     run_closed_loop,
 )
-from wmr_mj.sim.config import (
-    RunConfig,
-    has_tracker,
-    plant_parameters,
-)
+from wmr_mj.sim.coerce import coerced
+from wmr_mj.sim.config import RunConfig, has_tracker
 from wmr_mj.sim.engine import LAW_BACKENDS, batch_law_backend, batch_model
-from wmr_mj.sim.parts import RunLabels, RunParts, resolve_run
+from wmr_mj.sim.parts import RunLabels, RunParts, plant_and_claim, resolve_run
 from wmr_mj.sim.summary import BatchFigures, RunSummary, voltage_effort
 
 __all__ = ["run_batch", "shares_one_batch", "batch_model", "batch_law_backend", "LAW_BACKENDS", "thread_count",
@@ -347,6 +343,7 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
     """
     if not configs:
         return []
+    configs = [coerced(c) for c in configs]  # each config's references read once, here (a config already typed: none)
     first = configs[0]
     if requirements or not shares_one_batch(configs):
         return _run_one_by_one(configs, base=base, progress=progress, law=law, nthread=nthread,
@@ -356,7 +353,10 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
     if controller.stateful:  # a law with state (or time) has no batch form: each run on the engine
         return _run_one_by_one(configs, base=base, progress=progress, law=law, nthread=nthread)
     backend = batch_law_backend(controller, law)
-    plants = [parts.plant] + [plant_parameters(c, base) for c in configs[1:]]
+    # each further run's plant and the shared law's claim on it (parts.plant_and_claim), the first's from its parts
+    further = [plant_and_claim(c, parts, base=base) for c in configs[1:]]
+    plants = [parts.plant] + [plant for plant, _ in further]
+    claims = [parts.claim] + [claim for _, claim in further]
     options = parts.options
     model = batch_model(plants[0], **options)
     nsim = len(configs)
@@ -422,13 +422,14 @@ def run_batch(configs: Sequence[RunConfig], *, nthread: int = 0, base: C80Parame
     wall = time.perf_counter() - wall0
     return _summaries(configs, plants, stats, _BatchRun(base=base, reference=reference, settle_s=settle_s,
                                                        analysis=analysis, loop=loop, backend=backend, wall=wall,
-                                                       threads=threads, parts=parts))
+                                                       threads=threads, parts=parts, claims=tuple(claims)))
 
 
 def shares_one_batch(configs: Sequence[RunConfig]) -> bool:
     """Whether ``configs`` run as one batch: no signals, no tracker, an ideal cart (no sensor, actuation or
     play: the batch's loops read the state and drive the axle), and nothing but m1 and plant_overrides differs
     (the batch's simulations share one reference and one law)."""
+    configs = [coerced(c) for c in configs]  # typed parts to compare (a config already typed: itself)
     if any(c.signals is not None or has_tracker(c) or not _ideal_cart(c) for c in configs):
         return False
     shared = configs[0].replace(m1=M1_NOMINAL, plant_overrides={})
@@ -472,6 +473,7 @@ class _BatchRun:
     wall: float
     threads: int  # the batch's threads, which also judge C's paths
     parts: RunParts  # the first config's, which the batch's simulations share but for the plant
+    claims: tuple[Any, ...]  # each simulation's claim: the shared law on its own plant (plant_and_claim)
 
 
 def _summaries(configs: Sequence[RunConfig], plants: Sequence[C80Parameters], stats: _BatchStats,
@@ -482,10 +484,7 @@ def _summaries(configs: Sequence[RunConfig], plants: Sequence[C80Parameters], st
     n, substeps, period, path_at = run.loop.n, run.loop.substeps, run.loop.period, run.loop.path_at
     backend, wall, nsim = run.backend, run.wall, len(configs)
     parts = run.parts
-    # each simulation's claim: the shared law on its own plant (a plant outside the box fails its assumption)
-    certificates = [parts.claim] + [certificate_of(c, reference, base=base, estimate=parts.estimate, plant=p,
-                                                   controller=parts.controller, tracker=parts.tracker)
-                                    for c, p in zip(configs[1:], plants[1:])]
+    certificates = run.claims  # each simulation's claim: the shared law on its own plant (plant_and_claim)
 
     def path_of(i: int) -> PathJudgement | None:
         return judge_path(reference, path_at * period, stats.C_xy[i], stats.heading[i], settle_s=settle_s,

@@ -42,6 +42,7 @@ from wmr_mj.analysis.verdicts import OUTSIDE_THE_BOX
 from wmr_mj.errors import ParameterError
 from wmr_mj.params import C80, COEFFICIENT_NAMES, C80Parameters
 from wmr_mj.plant.mjcf import TIMESTEP
+from wmr_mj.sim.coerce import coerced
 from wmr_mj.sim.config import (
     controller_for,
     estimate_parameters,
@@ -188,6 +189,7 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
     """
     from wmr_mj.sim.config import base_for
 
+    config = coerced(config)  # a config given directly: its references read here
     params = base_for(config, params)  # the config's cart, where it names one
     estimate_params = estimate_parameters(params)
     return certificate_of(config, reference, base=params, estimate=estimate_params,
@@ -232,6 +234,7 @@ def measurement_errors_of(config: Any, plant: C80Parameters) -> MeasurementError
     Returns:
         :meth:`MeasurementErrors.exact` for an ideal cart (every number as before).
     """
+    config = coerced(config)  # a config given directly: its parts typed here
     sensing, transmission = config.sensing, config.transmission
     actuation = config.actuation.on_motor(L_a=plant.L_a)  # the cart's armature inductance where the run sets none
     if sensing.is_ideal and actuation.is_ideal and transmission.is_ideal:
@@ -252,9 +255,12 @@ def measurement_errors_of(config: Any, plant: C80Parameters) -> MeasurementError
 def certificate_of(config: Any, reference: Any, *, base: C80Parameters, estimate: C80Parameters,
                    plant: C80Parameters, controller: Any, tracker: Any, k_band: float = PLANT_K_BAND,
                    gyro_band: tuple[float, float] = GYRO_BAND,
-                   measurement: MeasurementErrors | None = None) -> Certificate | None:
+                   measurement: MeasurementErrors | None = None,
+                   cart_measurement: MeasurementErrors | None = None) -> Certificate | None:
     """:func:`certificate_for` on parts already resolved (:func:`wmr_mj.sim.parts.resolve_run`): the plant's
-    parameters, the controller's belief, the law and the tracker of the run."""
+    parameters, the controller's belief, the law and the tracker of the run. ``cart_measurement``: the cart's own
+    errors (:func:`measurement_errors_of`), already derived: taken as ``measurement`` None takes them."""
+    config = coerced(config)  # a config given directly (a batch's further runs): typed here
     k_band = finite_number("k_band", k_band, minimum=0.0)
     gyro_band = interval("gyro_band", gyro_band, positive=True)
     estimate_params = estimate
@@ -278,8 +284,8 @@ def certificate_of(config: Any, reference: Any, *, base: C80Parameters, estimate
     # the cart's own errors (None): the sampled-data certificate, derived from the cart's parts, may be computed
     # too; bounds given in their place are a what-if that the cart's parts do not describe, so the law's claim alone
     derived = measurement is None
-    if measurement is None:
-        measurement = measurement_errors_of(config, plant)
+    if measurement is None:  # cart_measurement: the cart's own, already derived (resolve_run's), not derived again
+        measurement = measurement_errors_of(config, plant) if cart_measurement is None else cart_measurement
     context = ClaimContext(plant=plant_box, reference=bounds,
                            limits=PlantLimits(steering_range=plant.steering_range, voltage_limit=plant.voltage_limit),
                            control_period=period, initial_error=initial, stated=stated, estimate=estimate_params,

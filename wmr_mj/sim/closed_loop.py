@@ -46,7 +46,6 @@ from wmr_mj.params import C80, C80Parameters
 from wmr_mj.plant.mjcf import TIMESTEP, scene_xml
 from wmr_mj.sim.config import (
     RunConfig,
-    build_reference,
     estimate_parameters,
 )
 from wmr_mj.sim.engine import (
@@ -58,7 +57,7 @@ from wmr_mj.sim.engine import (
 )
 from wmr_mj.sim.log_header import LogHeader
 from wmr_mj.sim.measured_errors import with_measured_errors
-from wmr_mj.sim.parts import RunLabels, RunParts, control_substeps, resolve_run
+from wmr_mj.sim.parts import RunLabels, RunParts, control_substeps, resolve_run, run_reference
 from wmr_mj.sim.summary import RunSummary, voltage_effort
 
 __all__ = ["RunResult", "RunMeasures", "run_closed_loop", "report", "run_on_reduced_model", "ROW_FIELDS", "judge_path",
@@ -135,8 +134,7 @@ def requirement_rows(result: RunResult, requirements: Sequence[Any], *, base: C8
     period = control_substeps(config, TIMESTEP) * TIMESTEP
     reference = result.reference
     if reference is None:  # a result made elsewhere: the run's reference built again, as resolve_run builds it
-        reference, _ = build_reference(config.path, estimate_parameters(base), dt=period,
-                                       duration=int(round(config.duration / period)) * period)
+        reference, _ = run_reference(config.path, estimate_parameters(base), period=period, duration=config.duration)
     block = {"t": result.rows["t"], "C_pos": result.C_xy[:n], "heading": result.rows["heading"]}
     return {**result.rows, "cross_track": _PathRows(reference, period)(block, 1)["path_cross_track"]}
 

@@ -43,6 +43,7 @@ from wmr_mj.params import uncertainty_ranges
 from wmr_mj.plant.mjcf import TIMESTEP
 from wmr_mj.sim.config import (
     RunConfig,
+    coerce,
     config_from_dict,
     controller_name,
     controller_source,
@@ -306,7 +307,7 @@ def adversary_spec(design: Design, suite: Suite, *, budget: int, seed: int, meth
     t1 = adv.pulse_t1[0]
     signals = {"disturbance": {"kind": "pulse", "amplitude": adv.pulse_amplitude[1], "t1": t1, "t2": t1 + width},
                "d_max": suite.d_max}
-    base = design.config.replace(path=adv.path, signals=signals, reference_bounds=suite.reference_bounds)
+    base = coerce(design.config.replace(path=adv.path, signals=signals, reference_bounds=suite.reference_bounds))
     box: dict[str, tuple[float, float]] = {"m1": (float(base.m1_range[0]), float(base.m1_range[1])),
                                            **{k: (float(v[0]), float(v[1])) for k, v in base.box_ranges.items()}}
     if adv.path_knots:

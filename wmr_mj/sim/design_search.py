@@ -43,6 +43,7 @@ from typing import Any
 import numpy as np
 
 from wmr_mj.errors import ParameterError
+from wmr_mj.sim.coerce import coerced
 from wmr_mj.sim.design_options import DEFAULT_BUDGET, DEFAULT_SEED, LAWS, METHODS, OBJECTIVES
 from wmr_mj.sim.optimisers import CMAES, Chain, DifferentialEvolution, Optimiser, Points, drive
 
@@ -350,6 +351,7 @@ def search_design(problem: DesignProblem) -> DesignResult:
         raise ParameterError(f"--objective {problem.objective!r} is not accepted; one of {', '.join(OBJECTIVES)}")
     if problem.method not in METHODS:
         raise ParameterError(f"--method {problem.method!r} is not accepted; one of {', '.join(METHODS)}")
+    problem = dataclasses.replace(problem, base=coerced(problem.base))  # a base given directly: typed once, here
     periods = check_periods(problem.periods, problem.base.duration)
     _check_law(problem.base.controller)
     best: tuple[float, Any] | None = None

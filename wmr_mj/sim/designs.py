@@ -146,7 +146,7 @@ def _cart_record(cart: Any) -> dict[str, Any] | None:
     """The cart's record as RunConfig keeps it (None: the C80)."""
     from wmr_mj.sim.config import RunConfig
 
-    return RunConfig(cart=cart).cart
+    return RunConfig.from_inputs(cart=cart).cart
 
 
 def certified_design(cart: Any = None) -> Design:
@@ -194,7 +194,7 @@ def certified_omega_r(*, error_spec: float = ERROR_SPEC, grid: tuple[float, ...]
     from wmr_mj.sim.certify import certificate_for
     from wmr_mj.sim.config import RunConfig, base_for, build_reference
 
-    on_cart = RunConfig(cart=cart)
+    on_cart = RunConfig.from_inputs(cart=cart)
     reference, _ = build_reference("paper-circle", base_for(on_cart), dt=1e-3, duration=35.0)
     for w in grid:
         config = RunConfig(model=CERTIFIED.model, kp=w * w / 4.0, kd=w, friction_sign=CERTIFIED.friction_sign,

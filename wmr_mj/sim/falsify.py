@@ -78,7 +78,7 @@ Usage::
     from wmr_mj.params import uncertainty_ranges
     from wmr_mj.sim.closed_loop import RunConfig
     box = uncertainty_ranges("full")  # the certificate covers the declared box: give the base the same ranges
-    base = RunConfig(model="nonholonomic", box_ranges={k: v for k, v in box.items() if k != "m1"})
+    base = RunConfig.from_inputs(model="nonholonomic", box_ranges={k: v for k, v in box.items() if k != "m1"})
     spec = FalsifySpec(base=base, box=box, budget=256)
     result = falsify(spec)
     print(result.worst.params, result.worst.objective, result.random_worst.objective)

@@ -23,6 +23,7 @@ from typing import Any
 
 from controllers import SteeringController
 from wmr_mj.errors import ParameterError, UnknownNameError
+from wmr_mj.sim.coerce import coerced
 from wmr_mj.sim.config import RunConfig, estimate_of
 from wmr_mj.sim.search_space import hardware_axis, path_axis, signal_axis
 
@@ -88,6 +89,7 @@ def shares_the_base_certificate(base: RunConfig, names: Sequence[str]) -> bool:
     ideal (their coverage reads them:
     :func:`wmr_mj.sim.certify.measurement_errors_of`). The cart's, the signals' and the path's axes give
     each run its own."""
+    base = coerced(base)  # a base given directly: its parts typed (wmr_mj.sim.coerce)
     reaching = {"voltage_limit", "steering_range", "L_a"}  # L_a: the armature's lag, in the sampled loop
     if not base.sensing.is_ideal or not base.transmission.is_ideal:
         reaching.add("i2")

@@ -30,22 +30,29 @@ from wmr_mj.errors import ParameterError
 from wmr_mj.hardware import Actuation, Sensing, Transmission
 from wmr_mj.params import C80, C80Parameters
 from wmr_mj.plant.mjcf import TIMESTEP
-from wmr_mj.sim.config import (
-    RunConfig,
+from wmr_mj.sim.builders import (
     analysis_for,
-    base_for,
     build_reference,
     controller_and_settings,
-    controller_name,
     estimate_of,
     estimate_parameters,
     manoeuvre_length,
-    plant_parameters,
     reference_bounds_of,
     tracker_for,
 )
+from wmr_mj.sim.coerce import (
+    PATH_NAMES,
+    base_for,
+    coerce_with_classes,
+    coerced,
+    controller_name,
+    plant_parameters,
+    route_of,
+)
+from wmr_mj.sim.run_config import RunConfig
 
-__all__ = ["RunParts", "RunLabels", "resolve_run", "control_substeps", "signal_inputs"]
+__all__ = ["RunParts", "RunLabels", "resolve_run", "run_reference", "plant_and_claim", "control_substeps",
+           "signal_inputs"]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -165,34 +172,38 @@ class RunParts:
 def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
     """``config`` resolved once into its parts (:class:`RunParts`).
 
+    The config is coerced first (:func:`wmr_mj.sim.coerce.coerce_with_classes`): a reference it holds (a cart's
+    name or file, a plug-in by name, a route file) is read here, once, and ``RunParts.config`` is the typed config.
+
     base: the base parameter set; where it is the default (the C80) and the config names a cart
     (``RunConfig.cart``), the cart's (:func:`wmr_mj.sim.config.base_for`).
 
     Raises:
         WmrMjError: what the config cannot build (a plug-in, a path too short, a period that does not fit).
     """
-    from wmr_mj.reference.route import route_length
     from wmr_mj.sim.certify import certificate_of, measurement_errors_of
     from wmr_mj.sim.engine import plant_options
 
+    config, classes = coerce_with_classes(config)  # the one read of the config's files and plug-ins
     base = base_for(config, base)  # the config's cart, where it names one
     plant = plant_parameters(config, base)
     estimate = estimate_parameters(base)
-    controller, law_settings = controller_and_settings(config, estimate)
+    controller, law_settings = controller_and_settings(config, estimate, classes=classes)
     if config.sensing.velocity == "none" and getattr(controller, "reads_velocity", True):
         raise ParameterError(f"controller {controller.name!r} reads alpha', which --sensing velocity=none does not "
                              "give it; accepted: a law that estimates alpha' from the angle (reads_velocity = False, "
                              "docs/guides/plugins.md), or a velocity estimate (exact, tachometer, difference, "
                              "filtered)")
-    tracker = tracker_for(config, estimate)
+    tracker = tracker_for(config, estimate, classes=classes)
     substeps = control_substeps(config)
     period = substeps * TIMESTEP
     n = int(round(config.duration / period))
-    reference, settle_s = build_reference(config.path, estimate, dt=period, duration=n * period)
+    reference, settle_s = run_reference(config.path, estimate, period=period, duration=config.duration)
     paper_estimate = estimate_of(controller)  # None: not the paper's law, whose region then says nothing of it
     analysis = analysis_for(config, reference, estimate, estimate=paper_estimate)
+    measurement = measurement_errors_of(config, plant)  # once: the claim and the run's parts share it
     law_claim = certificate_of(config, reference, base=base, estimate=estimate, plant=plant,
-                           controller=controller, tracker=tracker)
+                               controller=controller, tracker=tracker, cart_measurement=measurement)
     options = plant_options(config)
     disturbance, loads = signal_inputs(config.signals, plant, options, n=n, period=period,
                                        m1_inertia=config.m1_inertia)
@@ -205,9 +216,32 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
                     actuation=config.actuation, transmission=config.transmission,
                     reference_bounds=reference_bounds_of(config, reference), signals=config.signals,
                     disturbance=disturbance, loads=loads,
-                    route_length_m=route_length(config.path) or manoeuvre_length(config.path),  # lane-change's
-                    measurement=measurement_errors_of(config, plant), labels=RunLabels.of(config, name=name),
+                    route_length_m=(float(route_of(config.path).path.length) if config.path not in PATH_NAMES
+                                    else manoeuvre_length(config.path)),  # lane-change's
+                    measurement=measurement, labels=RunLabels.of(config, name=name),
                     record=config.as_dict())
+
+
+def run_reference(path: str, estimate: C80Parameters, *, period: float, duration: float) -> tuple[Any, float]:
+    """(reference, settle_s): C's reference of a run on its control grid, as :func:`resolve_run` builds it --
+    ``round(duration / period)`` control steps of ``period`` [s] on the controller's belief ``estimate``
+    (:func:`wmr_mj.sim.builders.build_reference`). A log's replay and a result made elsewhere build theirs here."""
+    n = int(round(duration / period))
+    return build_reference(path, estimate, dt=period, duration=n * period)
+
+
+def plant_and_claim(config: RunConfig, shared: RunParts, *, base: C80Parameters = C80
+                    ) -> tuple[C80Parameters, Certificate | None]:
+    """A batch's further run: its own plant, and the claim of ``shared``'s law (the batch's parts, which it shares
+    but for the plant: law, tracker, reference, belief) on that plant -- a plant outside the box fails its
+    assumption. ``base``: the batch's base parameter set, as :func:`wmr_mj.sim.batch.run_batch` is given it."""
+    from wmr_mj.sim.certify import certificate_of
+
+    config = coerced(config)
+    plant = plant_parameters(config, base)
+    claim = certificate_of(config, shared.reference, base=base, estimate=shared.estimate, plant=plant,
+                           controller=shared.controller, tracker=shared.tracker)
+    return plant, claim
 
 
 def signal_inputs(signals: Any, plant: C80Parameters, options: dict[str, Any], *, n: int, period: float,

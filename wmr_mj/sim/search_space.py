@@ -39,6 +39,7 @@ from typing import Any
 
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import parameter_names
+from wmr_mj.sim.coerce import coerced
 from wmr_mj.sim.config import RunConfig
 from wmr_mj.sim.signals import Signals
 
@@ -121,6 +122,7 @@ def with_hardware(base: RunConfig, values: Mapping[str, float]) -> RunConfig:
     """
     if not values:
         return base
+    base = coerced(base)  # a base given directly: its parts typed (wmr_mj.sim.coerce)
     changes: dict[str, dict[str, Any]] = {"sensing": {}, "actuation": {}, "transmission": {}}
     for name, v in hardware_values(base, values).items():
         part, _, key = name.partition(".")
@@ -181,6 +183,7 @@ def config_for(base: RunConfig, names: Sequence[str], x: Sequence[float]) -> Run
     """
     if len(names) != len(x):
         raise ParameterError(f"{len(names)} names for {len(x)} values")
+    base = coerced(base)  # a base given directly: its signals, bounds and parts typed (wmr_mj.sim.coerce)
     template = base.signals if base.signals is not None else Signals()
     dist = template.disturbance
     d_changes: dict[str, Any] = {}

@@ -28,6 +28,7 @@ from typing import Any
 
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import parameter_names
+from wmr_mj.sim.coerce import coerce
 from wmr_mj.sim.config import RunConfig
 
 __all__ = ["Suite", "Scenario", "Adversary", "load_suite", "suite_names", "SUITES_DIR", "versions"]
@@ -68,7 +69,7 @@ class Scenario:
             changes["m1"] = float(m1)
         if self.hardware is not None:
             changes.update(sensing=self.sensing, actuation=self.actuation, transmission=self.transmission)
-        return base.replace(**changes)
+        return coerce(base.replace(**changes))  # the scenario's signals, route and parts typed (wmr_mj.sim.coerce)
 
 
 @dataclass(frozen=True)

@@ -23,6 +23,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from wmr_mj.sim.coerce import coerced
+
 __all__ = ["CartTightness", "cart_tightness", "certificate_columns"]
 
 
@@ -137,6 +139,7 @@ def cart_tightness(base: Any, *, box: Mapping[str, tuple[float, float]] | None =
     """
     from wmr_mj.sim.falsify import FalsifySpec, check_runnable, falsify
 
+    base = coerced(base)  # a base given directly: its cart's m1 box read here
     if box is None:
         box = {"m1": (float(base.m1_range[0]), float(base.m1_range[1]))}
     spec = FalsifySpec(base=base, box=dict(box), objective="sup-E", budget=budget, seed=seed, method=method)

@@ -1,0 +1,298 @@
+"""What follows from a run's configuration before any step: the controller's belief, the law and the tracker
+(fresh instances), C's reference on the control grid, the paper's analysis for the run's box.
+
+Each builder reads a :class:`~wmr_mj.sim.run_config.RunConfig`'s typed fields (:mod:`wmr_mj.sim.coerce`) and
+reads no file of its own: :func:`wmr_mj.sim.parts.resolve_run` calls them once per run.
+
+Usage::
+
+    from wmr_mj.sim.builders import build_reference, controller_for, estimate_parameters
+    controller = controller_for(config, estimate_parameters())
+    reference, settle_s = build_reference(config.path, estimate_parameters(), dt=1e-3, duration=35.0)
+"""
+
+from __future__ import annotations
+
+import copy
+import functools
+import inspect
+import os
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from controllers import PathTracker, SteeringController, make_controller, model_from_source
+from controllers.base import BuildContext
+from controllers.computed_torque import CONTROLLER_NAMES
+from controllers.registry import build, resolve
+from wmr_mj._util.checks import as_pair
+from wmr_mj.analysis.plant_box import derived_box
+from wmr_mj.analysis.robustness import ParameterBox, analyse
+from wmr_mj.errors import ParameterError, UnknownNameError
+from wmr_mj.params import C80, C80Parameters
+from wmr_mj.reference import paths as ref
+from wmr_mj.reference.bounds import ReferenceBounds
+from wmr_mj.reference.route import is_route_spec, route_names, route_reference
+from wmr_mj.sim.coerce import PATH_NAMES, coerced, route_of
+from wmr_mj.sim.run_config import RunConfig
+
+__all__ = ["estimate_parameters", "build_reference", "manoeuvre_length", "analysis_box", "analysis_for",
+           "reference_bounds_of", "controller_for", "controller_and_settings", "LAW_SETTINGS", "declared_parameters",
+           "tracker_for", "has_tracker", "estimate_of", "config_from_dict"]
+
+
+def estimate_parameters(base: C80Parameters = C80) -> C80Parameters:
+    """The controller's belief: the nominal parameter set (m1 = 650 kg)."""
+    return base
+
+
+def build_reference(path: str, params: C80Parameters, *, dt: float, duration: float):
+    """(reference, settle_s) for a path of C on a grid of step dt: a named path (PATH_NAMES) or
+    a route (a packaged route name, a route file, canonical route JSON; a closed route is
+    repeated lap after lap to fill the duration).
+
+    settle_s is when the entry transient ends: for the paper's circle, the
+    time C enters the circle; 0 for the other paths.
+
+    The last :data:`REFERENCE_CACHE_SIZE` references are kept (a Reference's arrays are read-only):
+    runs that share a path, as a comparison's scenarios on one path or a sweep's chunks do, build it
+    once (it costs about a quarter of a 35 s run's physics). A route file is keyed by its
+    modification time and size as well as its name, so an edited file is read again.
+    """
+    file_key = None
+    if path not in PATH_NAMES and not path.lstrip().startswith("{") and os.path.isfile(path):
+        st = os.stat(path)
+        file_key = (os.path.abspath(path), st.st_mtime_ns, st.st_size)
+    return _cached_reference(path, file_key, params, float(dt), float(duration))
+
+
+#: references kept by :func:`build_reference`
+REFERENCE_CACHE_SIZE = 16
+
+
+@functools.lru_cache(maxsize=REFERENCE_CACHE_SIZE)
+def _cached_reference(path: str, file_key: tuple | None, params: C80Parameters, dt: float, duration: float):
+    return _build_reference(path, params, dt=dt, duration=duration)
+
+
+#: the named path lane-change: a lead-in line, the lane change (lateral offset over a length), then a line that
+#: fills the duration [m]
+LANE_CHANGE_LEAD_IN_M, LANE_CHANGE_OFFSET_M, LANE_CHANGE_LENGTH_M = 0.5, 0.5, 4.0
+
+
+def manoeuvre_length(path: str) -> float | None:
+    """The length [m] of C's reference a run of the named ``path`` must drive for its verdict to judge the whole
+    manoeuvre: lane-change's lead-in and lane change (the line after it only fills the duration); None for a
+    path that refuses a duration too short for it (paper-circle), a closed one (figure-eight) or a route (whose
+    own length :func:`wmr_mj.reference.route.route_length` gives)."""
+    if path == "lane-change":
+        return LANE_CHANGE_LEAD_IN_M + LANE_CHANGE_LENGTH_M
+    return None
+
+
+def _build_reference(path: str, params: C80Parameters, *, dt: float, duration: float):
+    """:func:`build_reference` without the cache."""
+    if path not in PATH_NAMES:
+        if not is_route_spec(path):
+            raise UnknownNameError("path", path, PATH_NAMES + route_names() + ("<route file .toml/.json>",))
+        return route_reference(route_of(path), params, dt=dt, duration=duration), 0.0
+    if path == "paper-circle":
+        p = ref.paper_circle(params, duration=duration)
+    elif path == "lane-change":
+        p = (ref.line(LANE_CHANGE_LEAD_IN_M) + ref.lane_change(LANE_CHANGE_OFFSET_M, LANE_CHANGE_LENGTH_M)
+             + ref.line(max(duration * params.V_A, 1.0)))
+    elif path == "figure-eight":
+        p = ref.line(0.5) + ref.figure_eight(1.5, laps=max(1, int(duration * params.V_A / 20.0) + 1))
+    else:
+        raise UnknownNameError("path", path, PATH_NAMES)
+    reference = ref.make_reference(p, params, dt=dt, duration=duration)
+    settle_s = 0.0
+    if path == "paper-circle":
+        circle_start = float(p.starts[-2])  # starts ends with the total length
+        reached = np.nonzero(np.asarray(reference.s) >= circle_start)[0]
+        settle_s = float(reference.t[reached[0]]) if reached.size else float(reference.t[-1])
+    return reference, settle_s
+
+
+def analysis_box(config: RunConfig, params: C80Parameters = C80):
+    """The parameter box of the analysis: the paper's (5.1), or derived from ``params`` over
+    the config's m1 range (and box ranges) with the model the controller's source stands on
+    ('nonholonomic' for nonholonomic and identified, 'paper' otherwise)."""
+    config = coerced(config)
+    if config.box == "paper":
+        return ParameterBox.paper()
+    box_model = "nonholonomic" if config.model in ("nonholonomic", "identified") else "paper"
+    return derived_box(params, as_pair(config.m1_range), config.m1_inertia,
+                       tuple((k, as_pair(v)) for k, v in config.box_ranges.items()), model=box_model)
+
+
+def analysis_for(config: RunConfig, reference, params: C80Parameters = C80, *, estimate=None):
+    """The robustness analysis (4.17)-(4.23) for the run's box, gains and reference bounds.
+
+    estimate: the controller's coefficients (P^, C_V^, F^, K^); the parameter
+    errors are then truth-anywhere-in-the-box minus this estimate. None: the
+    estimate is anywhere in the box too, as in the paper's (4.2).
+    """
+    config = coerced(config)
+    box = analysis_box(config, params)
+    b = reference_bounds_of(config, reference)
+    bounds = ReferenceBounds(alpha_ddot_max=max(b.alpha_ddot_max, 1e-12), alpha_dot_max=max(b.alpha_dot_max, 1e-12),
+                             sin_cos3_max=max(b.sin_cos3_max, 1e-12))
+    return analyse(box, kp=config.kp, kd=config.kd, bounds=bounds, estimate=estimate)
+
+
+
+def reference_bounds_of(config: RunConfig, reference):
+    """The reference bounds the run's analyses are computed for: the declared ones
+    (``config.reference_bounds``), else the run's own reference's (``reference.bounds()``)."""
+    return reference.bounds() if config.reference_bounds is None else config.reference_bounds
+
+
+def controller_for(config: RunConfig, params: C80Parameters, *, classes: Mapping[str, type] | None = None
+                   ) -> SteeringController:
+    """A fresh instance of the controller ``config`` runs, built on ``params`` (the controller's belief,
+    see :func:`estimate_parameters`): the computed-torque and PD laws from the config's fields, a plug-in
+    from its name and ``controller_params`` (``from_context``), an object as a deep copy (a run never
+    shares a law's state with another), a factory by calling it.
+
+    Raises:
+        UnknownNameError: an unknown controller or model source.
+        ParameterError: a plug-in that cannot be built (a parameter it does not take, a factory that
+            returns no SteeringController).
+    """
+    return controller_and_settings(config, params, classes=classes)[0]
+
+
+#: The RunConfig fields that configure a steering law beside its own parameters (``--model``, ``--kp``,
+#: ``--kd``, ``--friction-sign``, ``--friction-width``): the computed-torque law reads them all.
+LAW_SETTINGS = ("model", "kp", "kd", "friction_sign", "friction_width")
+#: The ones the PD law reads (it has no Coulomb compensation).
+_PD_SETTINGS = ("model", "kp", "kd")
+
+
+def controller_and_settings(config: RunConfig, params: C80Parameters, *, classes: Mapping[str, type] | None = None
+                            ) -> tuple[SteeringController, frozenset[str]]:
+    """:func:`controller_for`, and the names of :data:`LAW_SETTINGS` the law reads: all of them for the
+    computed-torque law, model, kp and kd for PD; for a law built by name, those of its build context
+    (``controllers.base.BuildContext``) its ``from_context`` read; none for an object or a factory.
+    Only these describe the law in its outputs (the others' values were never used). ``classes``: the plug-ins'
+    classes already found (``coerce_with_classes``), kind -> class; a plug-in not there is resolved by name."""
+    config = coerced(config)
+    given = config.controller
+    model = model_from_source(str(config.model), params=params, identified=config.identified,
+                              coefficients=config.coefficients)
+    if isinstance(given, str) and given in CONTROLLER_NAMES:
+        law = make_controller(given, model, kp=config.kp, kd=config.kd,
+                              friction_sign=config.friction_sign, friction_width=config.friction_width)
+        return law, frozenset(_PD_SETTINGS if given == "pd" else LAW_SETTINGS)
+    read: set[str] = set()
+    law = _plugin_for(config, params, "controller", given, config.controller_params, SteeringController, model,
+                      read=read, classes=classes)
+    return law, frozenset(read)
+
+
+def declared_parameters(spec: str) -> frozenset[str]:
+    """The keyword parameters the law named ``spec`` (a built-in name, FILE.py:Class, module:Class) declares
+    in its constructor or its ``from_context`` (which a run's ``controller_params`` may set)."""
+    cls, _ = resolve(spec, kind="controller")
+    names: set[str] = set()
+    for fn in (cls, getattr(cls, "from_context", cls)):
+        try:
+            sig = inspect.signature(fn)
+        except (TypeError, ValueError):
+            continue
+        names.update(n for n, p in sig.parameters.items()
+                     if p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY) and n not in ("self", "cls", "context"))
+    return frozenset(names)
+
+
+def tracker_for(config: RunConfig, params: C80Parameters, *, classes: Mapping[str, type] | None = None):
+    """A fresh instance of the run's path tracker (:class:`controllers.tracking.PathTracker`), None without one;
+    built as :func:`controller_for` builds a plug-in."""
+    config = coerced(config)
+    given = "stanley-at-C" if config.tracker is None and config.correction else config.tracker
+    if given is None:
+        return None
+    return _plugin_for(config, params, "tracker", given, config.tracker_params, PathTracker, classes=classes)
+
+
+def _plugin_for(config: RunConfig, params: C80Parameters, kind: str, given: Any, plugin_params: Mapping[str, Any],
+                base: type, model: Any = None, read: set[str] | None = None,
+                classes: Mapping[str, type] | None = None) -> Any:
+    """A fresh instance of a plug-in (law or tracker): an object deep-copied, a name resolved and built with its
+    parameters on the run's context (``model``: the run's reduced model, built here where None), a factory
+    called; checked to be a ``base``. ``read``: a set given here receives the context's settings the build
+    read (``BuildContext.read``)."""
+    if isinstance(given, base):
+        return copy.deepcopy(given)
+    if isinstance(given, str):
+        found = (classes or {}).get(kind) if given == getattr(config, kind) else None
+        cls = found if found is not None else resolve(given, plugin_params, kind=kind)[0]
+        if model is None:
+            model = model_from_source(str(config.model), params=params, identified=config.identified,
+                                      coefficients=config.coefficients)
+        context = BuildContext(model=model, estimate=params, voltage_limit=params.voltage_limit, kp=config.kp,
+                               kd=config.kd)
+        built = build(cls, plugin_params, context, spec=given, kind=kind)
+        if read is not None:
+            read.update(context.read)
+    else:
+        built = given()
+    if not isinstance(built, base):
+        raise ParameterError(f"{kind} {given!r} built {type(built).__name__}, not a controllers.{base.__name__}")
+    return built
+
+
+def has_tracker(config: RunConfig) -> bool:
+    """Whether the run has an outer loop on C (a tracker, or the correction)."""
+    return config.tracker is not None or bool(config.correction)
+
+
+def estimate_of(controller: SteeringController) -> dict[str, float] | None:
+    """The coefficients the paper's analysis takes as the law's estimate (P^, C_V^, F^, K^), where the law
+    is the paper's family (:meth:`~controllers.computed_torque.ComputedTorque.paper_estimate`); None: the
+    paper's (4.2), the estimate anywhere in the box."""
+    method = getattr(controller, "paper_estimate", None)
+    return method() if callable(method) else None
+
+
+def config_from_dict(obj: Mapping[str, Any]) -> RunConfig:
+    """The RunConfig of ``RunConfig.as_dict()`` (after a JSON round trip: lists back to tuples).
+
+    A plug-in (``controller_plugin``, ``tracker_plugin``) is found again by its name, else by the
+    absolute import path the record holds (a file named relative to another folder), and its source
+    must be the one recorded.
+
+    Raises:
+        ParameterError: a plug-in given as an object (it cannot be rebuilt from JSON), one whose file
+            or module is gone, or whose source has changed since the record was written (its SHA-256).
+    """
+    d = dict(obj)
+    d["m1_range"] = tuple(d["m1_range"])  # a record always holds m1 and m1_range, the cart's where not given
+    d["box_ranges"] = {k: tuple(v) for k, v in d.get("box_ranges", {}).items()}
+    for kind in ("controller", "tracker"):
+        record = d.pop(f"{kind}_plugin", None)
+        if record is not None:
+            d[kind] = _plugin_again(kind, record)
+    return RunConfig.from_inputs(**d)
+
+
+def _plugin_again(kind: str, record: Mapping[str, Any]) -> str:
+    """The name a recorded plug-in is found by now, its source checked against the record."""
+    if record.get("origin") == "instance":
+        raise ParameterError(f"the {kind} {record.get('name')!r} was given as an object "
+                             f"({record.get('import_path')}); it cannot be rebuilt from the record: give it by "
+                             "name, FILE.py:Class or module:Class to make runs that can be replayed and resumed")
+    spec = str(record.get("spec"))
+    if record.get("origin") == "file":
+        where = spec.rpartition(":")[0]
+        if not os.path.isfile(where):
+            spec = str(record.get("import_path"))  # the absolute path it was imported from
+    params = record.get("params") or {}
+    _, now = resolve(spec, params, kind=kind)
+    if record.get("source_sha256") and now.source_sha256 != record["source_sha256"]:
+        raise ParameterError(f"the {kind} {record.get('name')!r} ({now.import_path}) has changed since it ran: its "
+                             f"source's SHA-256 is {str(now.source_sha256)[:12]}..., the record's "
+                             f"{str(record['source_sha256'])[:12]}...; restore that source to reproduce the run")
+    return spec

@@ -1,0 +1,495 @@
+"""The coercer: what a user gives a run (names, files, plug-ins) as a :class:`~wmr_mj.sim.config.RunConfig`'s
+typed fields -- the one place a config reads a file or imports user code.
+
+A ``RunConfig`` is data: constructing or ``replace``-ing one checks its values and reads nothing. A field may
+hold a reference that needs a file or an import to become its typed value (a cart's name or file, a plug-in's
+``FILE.py:Class``, a route file, a signals or sensing file); :func:`coerce` reads each once and returns the
+config with every field typed: the cart as its record (name, version, path, text), m1 and the m1 box the cart's
+where not given, each plug-in's :class:`~controllers.registry.PluginSource` (name, import path, SHA-256 of its
+source), the law's default model, the sensing, actuation and play as their parts, the signals and the reference
+bounds. ``RunConfig.from_inputs`` and :func:`wmr_mj.sim.parts.resolve_run` call it; on a config already coerced
+it reads nothing again (a route file is kept by its modification time and size).
+
+This module sits below ``sim.config`` (which calls it): it takes a config as ``Any`` and never imports it.
+
+Usage::
+
+    from wmr_mj.sim.coerce import coerce
+    config = coerce(RunConfig(cart="c80-magmotor", controller="examples/my_pid.py:MyPID"))
+    config.cart["name"], config.m1, config.controller_plugin.source_sha256
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import math
+import os
+import sys
+from collections.abc import Mapping
+from types import SimpleNamespace
+from typing import Any
+
+from controllers import SteeringController
+from controllers.base import describe_params
+from controllers.computed_torque import CONTROLLER_NAMES, FRICTION_SIGNS, MODEL_SOURCES
+from controllers.registry import BUILTIN_CONTROLLERS, BUILTIN_TRACKERS, PluginSource, is_builtin, resolve, source_hash
+from controllers.tracking import PathTracker
+from wmr_mj.carts import CartFile, load_cart, load_cart_text
+from wmr_mj.carts.cartfile import MOTOR_CONSTANT_RTOL
+from wmr_mj.errors import ParameterError, UnknownNameError
+from wmr_mj.hardware import Actuation, Sensing, Transmission, check_cart, is_ideal_cart
+from wmr_mj.params import (
+    C80,
+    C80_CART,
+    M1_NOMINAL,
+    M1_RANGE,
+    C80Parameters,
+    parameter_names,
+    parameters_of_cart,
+    with_params,
+)
+from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS, TIMESTEP, TYRE_CONTACT_MODELS
+from wmr_mj.reference.bounds import ReferenceBounds, reference_bounds_from
+from wmr_mj.reference.paths import Path as PathOfC
+from wmr_mj.reference.route import Route, is_route_spec, load_route, route_from_path, route_names
+from wmr_mj.sim.signals import Signals, signals_from
+
+__all__ = ["PATH_NAMES", "coerce", "coerce_with_classes", "is_coerced", "check_fields", "route_of", "cart_file",
+           "base_for", "plant_parameters", "plugin_source", "controller_source", "controller_name", "default_model",
+           "check_motor_constant", "coerced"]
+
+PATH_NAMES = ("paper-circle", "lane-change", "figure-eight")
+
+#: the cart's parts: field name -> its typed class
+_PARTS: tuple[tuple[str, Any], ...] = (("sensing", Sensing), ("actuation", Actuation),
+                                        ("transmission", Transmission))
+
+
+# --------------------------------------------------------------------------- the checks of construction (no I/O)
+def check_fields(config: Any) -> None:
+    """The config's values checked as they are, with no file read and no module imported (``__post_init__``).
+
+    A value still a reference (a cart's name, m1 or the law's model left to the cart or the law, a part's spec)
+    is checked where :func:`coerce` types it.
+
+    Raises:
+        ParameterError, UnknownNameError: an unknown name or a value out of range, in one line.
+    """
+    if config.model is not None and config.model not in MODEL_SOURCES:
+        raise UnknownNameError("model source", str(config.model), MODEL_SOURCES)
+    if config.friction_sign not in FRICTION_SIGNS:
+        raise UnknownNameError("friction sign", config.friction_sign, FRICTION_SIGNS)
+    if not isinstance(config.correction, bool):
+        raise ParameterError(f"correction = {config.correction!r} is not accepted: True or False")
+    if config.box not in ("derived", "paper"):
+        raise UnknownNameError("box", config.box, ("derived", "paper"))
+    if config.steering_friction not in STEERING_FRICTION_MODELS:
+        raise UnknownNameError("steering friction model", config.steering_friction, STEERING_FRICTION_MODELS)
+    if config.tyre_contact not in TYRE_CONTACT_MODELS:
+        raise UnknownNameError("tyre contact model", config.tyre_contact, TYRE_CONTACT_MODELS)
+    for name in ("m1", "duration", "kp", "kd"):
+        value = getattr(config, name)
+        if name == "m1" and value is None:
+            continue  # the cart's, filled by coerce
+        if not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
+            raise ParameterError(f"{name} = {value!r} is not accepted; a finite number > 0 is required")
+    if config.control_period is not None and (not math.isfinite(config.control_period) or config.control_period <= 0):
+        raise ParameterError(f"control_period = {config.control_period!r} s must be finite and > 0")
+    check_period_fits(config.control_period, config.duration)
+    if config.m1_range is not None:
+        lo, hi = config.m1_range
+        if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo < hi):
+            raise ParameterError(f"m1_range = {config.m1_range!r} must be (lo, hi) with 0 < lo < hi")
+    names = parameter_names()
+    for name in config.plant_overrides:
+        if name not in names:
+            raise UnknownNameError("parameter", name, names)
+    for kind in ("controller", "tracker"):
+        params = getattr(config, f"{kind}_params")
+        if not isinstance(params, Mapping):
+            raise ParameterError(f"{kind}_params = {params!r} is not accepted: a mapping NAME -> value")
+    _check_plugin_form(config, "controller")
+    _check_plugin_form(config, "tracker")
+    if _is_inline(config.signals):
+        signals_from(config.signals)  # a mapping or JSON text: refused here (a file is read where it is coerced)
+    reference_bounds_from(config.reference_bounds)  # 'paper', a mapping or a spec: no file
+    parts = {name: _part_without_io(getattr(config, name), cls) for name, cls in _PARTS}
+    if config.cart is None and all(part is not None for part in parts.values()):
+        # parts that need no file (typed, a KEY=VALUE spec, a preset, None: ideal) on the C80: their limits are
+        # refused here, as coerce would (the typed parts are not kept: coerce types them)
+        typed = SimpleNamespace(**parts, duration=config.duration, control_period=config.control_period,
+                                plant_overrides=config.plant_overrides)
+        m1 = M1_NOMINAL if config.m1 is None else config.m1
+        _check_parts(typed, C80, with_params(C80, m1_inertia=config.m1_inertia, m1=m1, **dict(config.plant_overrides)))
+
+
+def _is_inline(signals: Any) -> bool:
+    """Whether signals are given inline (a Signals, a mapping, JSON text), not as a file to read."""
+    return (signals is None or isinstance(signals, (Signals, Mapping))
+            or (isinstance(signals, str) and signals.lstrip().startswith("{")))
+
+
+def _part_without_io(given: Any, cls: Any) -> Any:
+    """A cart part as its typed value where that reads no file (a part, None: ideal, a number, a mapping, a spec or
+    preset that names no .json/.toml file); None where it would read one."""
+    if given is None:
+        return cls()
+    if isinstance(given, cls):
+        return given
+    if isinstance(given, str) and (".json" in given.lower() or ".toml" in given.lower()):
+        return None
+    if not isinstance(given, (str, int, float, Mapping)):
+        return None  # a path object: a file
+    return cls.from_spec(given)
+
+
+def _check_plugin_form(config: Any, kind: str) -> None:
+    """A controller (or tracker) of an accepted form, parameters only where a plug-in takes them (no import)."""
+    given, params = getattr(config, kind), getattr(config, f"{kind}_params")
+    base = SteeringController if kind == "controller" else PathTracker
+    if kind == "tracker" and given is None:
+        if params:
+            raise ParameterError("tracker_params given without a tracker")
+        return
+    if kind == "tracker" and config.correction and given != "stanley-at-C":
+        raise ParameterError(f"correction=True is the tracker stanley-at-C; it cannot run beside tracker {given!r}")
+    if isinstance(given, str):
+        if kind == "controller" and given in CONTROLLER_NAMES and params:
+            raise ParameterError(f"controller {given!r} takes its settings as RunConfig fields (kp, kd, model, "
+                                 f"friction_sign, friction_width), not controller_params {sorted(params)}")
+        return
+    if isinstance(given, base):
+        if params:
+            raise ParameterError(f"{kind}_params are for a {kind} given by name; this {kind} is an object")
+        return
+    if callable(given):
+        return  # a factory: called (and checked) where the run builds its parts
+    raise ParameterError(f"{kind} = {given!r} is not accepted: a name, FILE.py:Class, module:Class, a "
+                         f"{base.__name__} or a factory of one")
+
+
+def check_period_fits(control_period: float | None, duration: float) -> None:
+    """A control period the run holds a whole number of times (at least once), else ParameterError.
+
+    A longer period would run one control step for the whole duration (sup|E| = 0: judged
+    inside), and one that does not divide it would silently change the run's length.
+    control_period None: the physics step.
+    """
+    period = TIMESTEP if control_period is None else control_period
+    what = (f"control_period = {period:g} s" if control_period is not None
+            else f"the physics step ({period:g} s, the default control period)")
+    if period > duration:
+        raise ParameterError(f"{what} is longer than the run (duration = {duration:g} s); give --control-period "
+                             f"<= --duration and a whole fraction of it (e.g. 0.001-0.1 s)")
+    n = round(duration / period)
+    if abs(n * period - duration) > 1e-9 * max(1.0, duration):
+        fix = f"give --duration {n * period:g}" + (" or a --control-period that divides it"
+                                                   if control_period is not None else "")
+        raise ParameterError(f"the run's duration = {duration:g} s is not a whole multiple of {what} "
+                             f"({duration / period:.6g} periods); {fix}")
+
+
+def check_motor_constant(k_i: float, k_b: float) -> None:
+    """k_b equal to k_i, as a cart file must have them (:mod:`wmr_mj.carts.cartfile`): one flux in SI units, and
+    MuJoCo's dcmotor has one constant (it would silently use their geometric mean). Every command that takes
+    ``--param`` checks it after its overrides.
+
+    Args:
+        k_i: the torque constant, N m/A. k_b: the back-EMF constant, V s/rad.
+
+    Raises:
+        ParameterError: they differ by more than a rounding (one line naming both and what is accepted).
+    """
+    if abs(k_b - k_i) > MOTOR_CONSTANT_RTOL * abs(k_i):
+        raise ParameterError(f"--param: k_b = {k_b!r} V s/rad and k_i = {k_i!r} N m/A differ; accepted: k_b equal to "
+                             "k_i (one flux in SI units; MuJoCo's dcmotor has one constant), e.g. --param "
+                             f"k_i={k_i!r} --param k_b={k_i!r}")
+
+
+# --------------------------------------------------------------------------- the coercer
+def coerce(config: Any) -> Any:
+    """``config`` with every field typed (the module docstring): each reference read once, here.
+
+    Raises:
+        ParameterError, UnknownNameError: a cart, plug-in, route, signals or part that cannot be read or is
+            refused, in one line.
+    """
+    return coerce_with_classes(config, classes=False)[0]
+
+
+def coerce_with_classes(config: Any, *, classes: bool = True) -> tuple[Any, dict[str, type]]:
+    """:func:`coerce`, and the class of each plug-in given by name (kind -> class), found in the same pass: a run
+    builds its law from it without importing it again (:func:`wmr_mj.sim.parts.resolve_run`). ``classes``
+    False: a plug-in whose source the config already holds is not looked up again (none returned)."""
+    changes: dict[str, Any] = {}
+    cart = _cart_record(config.cart)
+    changes["cart"] = cart
+    if config.m1 is None:
+        changes["m1"] = M1_NOMINAL if cart is None else _cart_of_text(cart["text"], cart["path"]).parameters["m1"]
+    if config.m1_range is None:
+        changes["m1_range"] = (M1_RANGE if cart is None
+                               else _cart_of_text(cart["text"], cart["path"]).uncertainty["m1"]["m1"])
+    found: dict[str, type] = {}
+    for kind in ("controller", "tracker"):
+        changes[f"{kind}_params"] = dict(getattr(config, f"{kind}_params"))
+        if classes or not _plugin_fresh(config, kind):
+            source, cls = _plugin_of(config, kind)
+            changes[f"{kind}_plugin"] = source
+            if cls is not None:
+                found[kind] = cls
+    if config.model is None:
+        changes["model"] = default_model(config.controller, config.controller_params, cls=found.get("controller"))
+    changes["path"] = _checked_path(config.path)
+    changes["signals"] = signals_from(config.signals)
+    changes["reference_bounds"] = reference_bounds_from(config.reference_bounds)
+    cart_file_ = None if cart is None else _cart_of_text(cart["text"], cart["path"])
+    for name, cls_ in _PARTS:
+        given = getattr(config, name)
+        if given is None and cart_file_ is not None:  # the cart's default sensing, actuation and play
+            default = cart_file_.defaults["backlash" if name == "transmission" else name]
+            given = Transmission(backlash=default) if name == "transmission" else default
+        changes[name] = given if isinstance(given, cls_) else cls_.from_spec(given)
+    coerced = dataclasses.replace(config, **changes)
+    _check_typed(coerced)
+    return coerced, found
+
+
+def is_coerced(config: Any) -> bool:
+    """Whether every field of ``config`` is typed (no reference left for :func:`coerce` to read)."""
+    return (config.m1 is not None and config.m1_range is not None and config.model is not None
+            and (config.cart is None or (isinstance(config.cart, Mapping) and isinstance(config.cart.get("text"), str)
+                                         and "version" in config.cart))
+            and all(isinstance(getattr(config, name), cls) for name, cls in _PARTS)
+            and (config.signals is None or isinstance(config.signals, Signals))
+            and (config.reference_bounds is None or isinstance(config.reference_bounds, ReferenceBounds))
+            and isinstance(config.path, str)
+            and all(_plugin_fresh(config, kind) for kind in ("controller", "tracker")))
+
+
+def coerced(config: Any) -> Any:
+    """``config`` itself where it is typed, else :func:`coerce`'d (a convenience for a config built directly)."""
+    return config if is_coerced(config) else coerce(config)
+
+
+def _check_typed(config: Any) -> None:
+    """The checks that need the typed fields (:func:`_check_parts`) on the config's base and plant."""
+    base = _base_of_record(config.cart, C80)
+    _check_parts(config, base, with_params(base, m1_inertia=config.m1_inertia, m1=config.m1,
+                                           **dict(config.plant_overrides)))
+
+
+def _check_parts(config: Any, base: C80Parameters, plant: C80Parameters) -> None:
+    """The cart's parts against their grids and the plant (``hardware.cart.check_cart``), and k_b = k_i after the
+    overrides of ``base``."""
+    config.sensing.delay_steps(TIMESTEP if config.control_period is None else config.control_period)
+    config.actuation.delay_steps(TIMESTEP)
+    if not is_ideal_cart(config):  # the limits that need the plant and the duration (hardware.cart.check_cart)
+        check_cart(config, plant)
+    overrides = config.plant_overrides
+    if "k_i" in overrides or "k_b" in overrides:
+        check_motor_constant(overrides.get("k_i", base.k_i), overrides.get("k_b", base.k_b))
+
+
+# --------------------------------------------------------------------------- the cart
+def _cart_record(given: Any) -> dict[str, str] | None:
+    """The cart's record ({"name", "version", "path", "text"}), None for the C80 (or a cart of its numbers).
+
+    Raises:
+        ParameterError: a missing file, an unknown name, a file its schema or rules refuse (one line).
+    """
+    cart: CartFile | None
+    if given is None:
+        return None
+    if isinstance(given, CartFile):
+        cart = given
+    elif isinstance(given, Mapping):
+        if not isinstance(given.get("text"), str):
+            raise ParameterError(f"cart = {dict(given)!r} is not accepted: a cart record holds the file's 'text'")
+        cart = _cart_of_text(given["text"], str(given.get("path", "<text>")))
+    elif isinstance(given, (str, os.PathLike)):
+        cart = load_cart(given)
+    else:
+        raise ParameterError(f"cart = {given!r} is not accepted: a shipped cart's name, a .toml cart file or a "
+                             "wmr_mj.carts.CartFile")
+    if _numbers_of(cart) == _numbers_of(C80_CART):
+        return None  # the C80's numbers: the C80, and its record unchanged
+    parameters_of_cart(cart)  # a value the parameter set refuses: one line now
+    return {"name": cart.name, "version": cart.version, "path": str(cart.path), "text": cart.text}
+
+
+def _numbers_of(cart: Any) -> tuple[dict, dict, dict]:
+    """What a run reads of a cart: its parameters, its boxes and its defaults."""
+    return (dict(cart.parameters), {k: dict(v) for k, v in cart.uncertainty.items()}, dict(cart.defaults))
+
+
+@functools.lru_cache(maxsize=8)
+def _cart_of_text(text: str, path: str) -> CartFile:
+    return load_cart_text(text, path=path)
+
+
+@functools.lru_cache(maxsize=8)
+def _parameters_of_text(text: str, path: str) -> C80Parameters:
+    return parameters_of_cart(_cart_of_text(text, path))
+
+
+def cart_file(config: Any) -> Any:
+    """The config's cart (:class:`wmr_mj.carts.CartFile`), read from its record; None for the C80."""
+    record = coerced(config).cart
+    return None if record is None else _cart_of_text(record["text"], record["path"])
+
+
+def base_for(config: Any, base: C80Parameters = C80) -> C80Parameters:
+    """The base parameter set of a run: the config's cart's where ``base`` is the default (the C80) and the
+    config names a cart; else ``base``."""
+    return _base_of_record(coerced(config).cart, base)
+
+
+def _base_of_record(record: Mapping[str, str] | None, base: C80Parameters) -> C80Parameters:
+    """:func:`base_for` of a typed config's cart record."""
+    if record is None or base is not C80:
+        return base
+    return _parameters_of_text(record["text"], record["path"])
+
+
+def plant_parameters(config: Any, base: C80Parameters = C80) -> C80Parameters:
+    """The plant's parameter set: base (the config's cart's where it is the C80, :func:`base_for`) with m1 and the
+    overrides (mass and inertia consistent)."""
+    config = coerced(config)
+    base = base_for(config, base)
+    return with_params(base, m1_inertia=config.m1_inertia, m1=config.m1, **dict(config.plant_overrides))
+
+
+# --------------------------------------------------------------------------- the path
+def _checked_path(p: Any) -> str:
+    """A path name, a route (name, file, canonical JSON) as given, a Path or Route object as its canonical JSON
+    (or its file); a malformed route raises here.
+
+    Raises:
+        UnknownNameError: neither a path name nor a route. ParameterError: a malformed route, another type.
+    """
+    if isinstance(p, str) and p in PATH_NAMES:
+        return p  # a named path: nothing to read
+    if isinstance(p, PathOfC):
+        return route_from_path(p).text
+    if isinstance(p, Route):
+        return p.text if p.source == "<text>" or not os.path.isfile(p.source) else p.source
+    if not isinstance(p, str):
+        raise ParameterError(f"path = {p!r} is not accepted: a path name, a route file or a Path")
+    if not is_route_spec(p):
+        raise UnknownNameError("path", p, PATH_NAMES + route_names() + ("<route file .toml/.json>",))
+    route_of(p)  # malformed: ParameterError naming the file and the segment
+    return p
+
+
+def route_of(spec: str) -> Route:
+    """The route ``spec`` names (a packaged name, a .toml/.json file, canonical JSON), read once per version of
+    its file: kept by the file's modification time and size, so an edited file is read again."""
+    file_key = None
+    if not spec.lstrip().startswith("{") and os.path.isfile(spec):
+        st = os.stat(spec)
+        file_key = (os.path.abspath(spec), st.st_mtime_ns, st.st_size)
+    return _route_of(spec, file_key)
+
+
+@functools.lru_cache(maxsize=16)
+def _route_of(spec: str, file_key: tuple | None) -> Route:
+    return load_route(spec)
+
+
+# --------------------------------------------------------------------------- plug-ins
+def _plugin_of(config: Any, kind: str) -> tuple[PluginSource | None, type | None]:
+    """(source, class) of the config's law (or tracker): None for a law built from the config's fields and for no
+    tracker; a name resolved (imported, its source hashed) unless the config already holds its source, whose
+    class is then found again; an object's or factory's source from its class."""
+    given = getattr(config, kind)
+    if kind == "tracker" and given is None:
+        return None, None
+    if isinstance(given, str):
+        if kind == "controller" and given in CONTROLLER_NAMES:
+            return None, None
+        cls, source = resolve(given, getattr(config, f"{kind}_params"), kind=kind)
+        return source, cls
+    return _instance_source(given, kind), None
+
+
+def _plugin_fresh(config: Any, kind: str) -> bool:
+    """Whether the config's plug-in source is the one of its law (or tracker) as given now."""
+    given, source = getattr(config, kind), getattr(config, f"{kind}_plugin")
+    if given is None or (kind == "controller" and isinstance(given, str) and given in CONTROLLER_NAMES):
+        return source is None
+    if source is None:
+        return False
+    if isinstance(given, str):
+        return source.spec == given.strip() and dict(source.params) == describe_params(
+            getattr(config, f"{kind}_params"))
+    if not isinstance(given, SteeringController if kind == "controller" else PathTracker):
+        return source.origin == "instance"  # a factory: its record, made by calling it once when coerced
+    cls = type(given)
+    return (source.origin == "instance" and source.import_path == f"{cls.__module__}:{cls.__qualname__}"
+            and dict(source.params) == _described(given, kind))
+
+
+def _described(given: Any, kind: str) -> dict[str, Any]:
+    """The parameters an object's ``describe()`` gives, as its PluginSource records them."""
+    describe = getattr(given, "describe", None)
+    params = {}
+    if callable(describe):
+        params = {k: v for k, v in describe().items() if k not in (kind, "law")}
+    return describe_params(params)
+
+
+def _instance_source(given: Any, kind: str) -> PluginSource:
+    """The PluginSource of a law (or tracker) given as an object or a factory."""
+    if callable(given) and not hasattr(given, "describe"):
+        given = given()  # a factory (a class or a function): what it builds names the plug-in
+    cls = type(given)
+    return PluginSource(spec=f"{cls.__module__}:{cls.__qualname__}", name=str(getattr(given, "name", cls.__name__)),
+                        origin="instance", import_path=f"{cls.__module__}:{cls.__qualname__}",
+                        params=_described(given, kind), source_sha256=source_hash(cls))
+
+
+def builtin_class(name: str, kind: str) -> type:
+    """The class of a built-in law or tracker (``controllers.registry.BUILTIN_CONTROLLERS``/``BUILTIN_TRACKERS``),
+    read from its module, which the ``controllers`` package imports: nothing is imported here."""
+    builtins = BUILTIN_CONTROLLERS if kind == "controller" else BUILTIN_TRACKERS
+    module_name, _, class_name = builtins[name].partition(":")
+    return getattr(sys.modules[module_name], class_name)
+
+
+def default_model(controller: Any, params: Mapping[str, Any] | None = None, *, cls: type | None = None) -> str:
+    """The model source a law runs with where the run names none: its class's ``default_model``
+    (:attr:`controllers.base.SteeringController.default_model`); 'paper' for computed-torque, pd and a
+    factory (its class is known only once built). ``cls``: the plug-in's class, already found."""
+    if cls is None and isinstance(controller, str) and is_builtin(controller):
+        cls = builtin_class(controller, "controller")
+    elif cls is None and isinstance(controller, str) and controller not in CONTROLLER_NAMES:
+        cls = resolve(controller, params, kind="controller")[0]
+    elif cls is None and isinstance(controller, SteeringController):
+        cls = type(controller)
+    model = getattr(cls, "default_model", "paper")
+    if model not in MODEL_SOURCES:
+        raise UnknownNameError(f"default_model of controller {getattr(cls, 'name', controller)!r}", str(model),
+                               MODEL_SOURCES)
+    return str(model)
+
+
+def plugin_source(config: Any, kind: str = "controller") -> PluginSource | None:
+    """Where the run's controller (or tracker) comes from (:class:`controllers.registry.PluginSource`),
+    as its log records it; None for the computed-torque and PD laws built from the config's fields and
+    for no tracker. Held by the coerced config (``controller_plugin``, ``tracker_plugin``)."""
+    return getattr(coerced(config), f"{kind}_plugin")
+
+
+def controller_source(config: Any) -> dict[str, Any] | None:
+    """Where the run's law comes from as JSON (:func:`plugin_source`'s record, as the MCAP log keeps it: spec,
+    name, origin, import path, parameters, the SHA-256 of its source); None for computed-torque and pd, built
+    from the config's fields. The ``controller_source`` of every command's JSON."""
+    source = plugin_source(config, "controller")
+    return None if source is None else source.as_dict()
+
+
+def controller_name(config: Any) -> str:
+    """What every output calls the run's steering law: a built-in's name, a plug-in's ``name``."""
+    source = plugin_source(config, "controller")
+    return str(config.controller) if source is None else source.name
