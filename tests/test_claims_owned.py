@@ -74,8 +74,11 @@ def test_a_computed_torque_subclass_gets_the_sampled_data_certificate_too(plug_i
 
 @pytest.mark.parametrize("cls", ["Impostor", "Inherits"])
 def test_a_plug_in_cannot_take_a_built_ins_name(plug_ins, cls):
+    # refused where the plug-in is imported: the coercer (a config's construction imports nothing)
     with pytest.raises(ParameterError, match="takes the built-in name 'sliding-mode'"):
-        RunConfig(controller=f"{plug_ins}:{cls}", **BASE)
+        RunConfig.from_inputs(controller=f"{plug_ins}:{cls}", **BASE)
+    with pytest.raises(ParameterError, match="takes the built-in name 'sliding-mode'"):
+        resolve_run(RunConfig(controller=f"{plug_ins}:{cls}", **BASE))
 
 
 def test_a_plug_in_object_with_a_built_ins_name_is_refused(plug_ins):
