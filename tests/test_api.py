@@ -37,7 +37,7 @@ def test_controllers_first_then_wmr_mj_in_a_fresh_interpreter(first):
     code = f"{first}\nimport wmr_mj\nprint(wmr_mj.RunConfig.__name__, wmr_mj.controller_for.__module__)"
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr
-    assert proc.stdout.split() == ["RunConfig", "wmr_mj.sim.config"]
+    assert proc.stdout.split() == ["RunConfig", "wmr_mj.sim.builders"]  # where the law is built (sim/builders.py)
 
 
 def test_importing_wmr_mj_loads_no_simulation():

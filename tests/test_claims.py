@@ -134,18 +134,19 @@ def _run_config(argv: list[str]) -> RunConfig:
 
 
 def test_each_law_s_default_estimate_is_its_own_and_the_paper_default_is_unchanged(paper_reference):
-    # the paper's design: RunConfig(), run with no option, run --controller computed-torque, compare's token
+    # the paper's design: RunConfig.from_inputs(), run with no option, run --controller computed-torque, compare's token
     from wmr_mj.sim.designs import PAPER, design_changes
 
-    paper = RunConfig(**PAPER.config_changes())
-    assert RunConfig() == paper == RunConfig(controller="computed-torque") == _run_config([])
-    assert _run_config(["--controller", "computed-torque"]) == paper == RunConfig(**design_changes("computed-torque"))
-    assert RunConfig().as_dict()["model"] == "paper"
+    paper = RunConfig.from_inputs(**PAPER.config_changes())
+    assert RunConfig.from_inputs() == paper == RunConfig.from_inputs(controller="computed-torque") == _run_config([])
+    assert (_run_config(["--controller", "computed-torque"]) == paper
+            == RunConfig.from_inputs(**design_changes("computed-torque")))
+    assert RunConfig.from_inputs().as_dict()["model"] == "paper"
     # sliding-mode: the non-holonomic model by default everywhere; an explicit paper model stays the paper's
-    smc = RunConfig(controller="sliding-mode")
+    smc = RunConfig.from_inputs(controller="sliding-mode")
     assert smc.model == "nonholonomic" == _run_config(["--controller", "sliding-mode"]).model
-    assert RunConfig(**design_changes("sliding-mode")) == smc
-    assert RunConfig(controller="sliding-mode", model="paper").model == "paper"
+    assert RunConfig.from_inputs(**design_changes("sliding-mode")) == smc
+    assert RunConfig.from_inputs(controller="sliding-mode", model="paper").model == "paper"
     assert _run_config(["--controller", "sliding-mode", "--model", "paper"]).model == "paper"
     assert _run_config(["--preset", "paper", "--controller", "sliding-mode"]).model == "paper"  # the preset's
     # under its default estimate the claim holds on the paper circle; under the paper's (K^ = 5.33 V) it cannot

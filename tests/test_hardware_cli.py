@@ -122,7 +122,7 @@ def test_hardware_axes_round_to_what_a_run_can_have():
     assert with_hardware(base, {"sensing.encoder_ticks": 1000.5}).sensing.encoder_ticks == 1000  # ties to even
     gauss = RunConfig(sensing="noise=gaussian:0.0001")
     assert with_hardware(gauss, {"sensing.noise": 0.0003}).sensing.noise_kind == "gaussian"  # the base's kind
-    plain = RunConfig(m1=700.0)
+    plain = RunConfig.from_inputs(m1=700.0)  # config_for coerces a direct config (wmr_mj.sim.coerce)
     assert config_for(plain, ["m1"], [700.0]) == plain  # no hardware axis: the config as before
     with pytest.raises(UnknownNameError, match="sensing.delay"):
         with_hardware(base, {"sensing.lag": 0.001})

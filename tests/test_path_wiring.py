@@ -13,7 +13,7 @@ from wmr_mj.sim.config import RunConfig
 from wmr_mj.sim.designs import CERTIFIED
 from wmr_mj.sim.sweep import RESULT_COLUMNS, SweepSummary, flat_row
 
-BASE = RunConfig(**CERTIFIED.config_changes()).replace(duration=10.0)
+BASE = RunConfig.from_inputs(**CERTIFIED.config_changes()).replace(duration=10.0)
 
 
 def test_path_sample_index_spacing_and_last():

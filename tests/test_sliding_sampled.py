@@ -156,7 +156,7 @@ def test_runs_are_certified_inside_or_uncertified(sensing):
     from wmr_mj.sim.sweep import SweepSpec, run_sweep
 
     spec = Sensing.from_spec(sensing)
-    base = RunConfig(**{**BASE, "duration": 10.0, "controller_params": dict(CERTIFYING), "sensing": spec})
+    base = RunConfig.from_inputs(**{**BASE, "duration": 10.0, "controller_params": dict(CERTIFYING), "sensing": spec})
     runs = run_sweep(SweepSpec(n=4, seed=0, sampling="lhs", m1_range=tuple(base.m1_range), ranges={}, base=base))
     verdicts = [r["verdict"] for r in runs]
     assert len(verdicts) == 4 and CERTIFIED_OUTSIDE not in verdicts

@@ -33,7 +33,7 @@ CERTIFICATE_KEYS = {"C_V_term", "E_max", "E_ratio", "Edot_max", "Edot_ratio", "K
 
 @pytest.fixture(scope="module")
 def summary(certified_run_10s):
-    config = RunConfig(model="nonholonomic", kp=100.0, kd=20.0, friction_width=0.01, duration=10.0)
+    config = RunConfig.from_inputs(model="nonholonomic", kp=100.0, kd=20.0, friction_width=0.01, duration=10.0)
     assert certified_run_10s.config == config  # the certified design, 10 s: the session's run
     return certified_run_10s.summary
 

@@ -305,9 +305,12 @@ def command_line(config: Any, replay: Replay, *, command: str = "wmr-mj run") ->
     """The ``wmr-mj run`` line that builds ``config`` again: each row of the table writes its own field.
 
     Args:
-        config: the run's RunConfig.
+        config: the run's RunConfig (a direct one is coerced first: its defaults resolved, as the run resolves them).
         replay: what the config does not record (:class:`Replay`).
     """
+    from wmr_mj.sim.coerce import coerced  # the coercer: this module's table is read by --help, which stays light
+
+    config = coerced(config)
     return " ".join([command, *(w for row in run_options() for w in row.write(config, replay))])
 
 
