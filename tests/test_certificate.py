@@ -509,6 +509,8 @@ def test_cli_run_outside_the_box_is_uncertified(tmp_path):
     assert "UNCERTIFIED-" in out and "plant inside the box: m1 (800 vs 750)" in out and "--m1-range 550 800" in out
     s = json.loads(run("--m1", "800", "--json"))
     assert s["verdict"].startswith("uncertified-")
-    assert s["certificate"]["E_max"] == pytest.approx(0.046334, rel=1e-4)  # the declared box's, not hulled
+    # the declared box's, not hulled: the sampled-data certificate a run takes, section 4's beside it (issue 44)
+    assert s["certificate"]["E_max"] == pytest.approx(0.092223, rel=1e-4)
+    assert s["certificate"]["inputs"]["certificates"]["section-4"]["E_max"] == pytest.approx(0.046334, rel=1e-4)
     assert json.loads(run("--m1", "800", "--m1-range", "550", "800", "--json"))["verdict"] == "certified-inside"
     assert json.loads(run("--m1", "750", "--json"))["verdict"] == "certified-inside"
