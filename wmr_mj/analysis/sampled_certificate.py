@@ -1,11 +1,13 @@
-"""The sampled-data certificate: the computed-torque law as it runs on a sensed cart (issue 35 item 1).
+"""The sampled-data certificate: the computed-torque law as it runs, on every cart (issue 35 item 1; the ideal cart,
+e_alpha = e_v = 0 and no delay, since issue 44, where it is the certificate a run is judged by).
 
 Section 4's certificate (:mod:`wmr_mj.analysis.small_gain`) bounds a continuous loop and charges every
 measurement error at every instant as if it were free. Here the linear part of the law runs as it does: at
 the control period T under zero-order hold, with the sensing and actuation delays and the velocity estimate
 inside the loop (:mod:`wmr_mj.analysis.sampled_data`), and each bounded error is priced by its l1 gain, so a
 differenced encoder's error telescopes. What the linear loop does not hold (model mismatch over the box,
-friction against its compensation, the gyroscopic and K S(alpha) terms, the reference's own terms, the
+friction against its compensation (F_max + F^, or for a smoothed sign of the measured rate max(F_max, F^) +
+F^ eps_v/w, whichever bound is smaller), the gyroscopic and K S(alpha) terms, the reference's own terms, the
 back-EMF's hold) is a bounded disturbance w through the same kind of small-gain fixed point as section 4,
 with the sampled loop's l1 gains in place of gamma1, gamma2. Derivation, step by step:
 ``docs/guides/certificates.md``, "The sampled-data certificate".
