@@ -34,7 +34,7 @@ from typing import Literal, get_args
 import numpy as np
 
 from controllers.base import SteeringController
-from controllers.sampled_claim import named, with_sampled_data
+from controllers.sampled_claim import with_sampled_data
 from wmr_mj.analysis.certificate import Certificate, Compensation, Estimate, Gains, certify
 from wmr_mj.analysis.claim import ClaimContext
 from wmr_mj.analysis.sampled_certificate import sampled_certificate
@@ -293,10 +293,10 @@ class ComputedTorque(SteeringController):
 
     def claim(self, context: ClaimContext) -> Certificate:
         """The section-4 analysis redone for this law on the run's plant box
-        (:func:`wmr_mj.analysis.certificate.certify`), named 'section-4'; on a cart that is not ideal
-        (``context.wants_sampled_data``) beside the sampled-data certificate of its loop on the cart's parts
-        (:func:`wmr_mj.analysis.sampled_certificate.sampled_certificate`), the certified one with the smaller E_max
-        taken (:func:`controllers.sampled_claim.with_sampled_data`)."""
+        (:func:`wmr_mj.analysis.certificate.certify`), named 'section-4', beside the sampled-data certificate of
+        its loop on the cart's parts (``context.wants_sampled_data``, the ideal cart included;
+        :func:`wmr_mj.analysis.sampled_certificate.sampled_certificate`), which is taken: the law runs sampled
+        (:func:`controllers.sampled_claim.with_sampled_data`)."""
         c = self.model.coefficients
         sign = self.friction_sign
         estimate = Estimate(P=c.P, C_V=c.C_V, F=0.0 if sign == "none" else c.F, K=c.K, gyro=c.gyro,
@@ -365,11 +365,17 @@ class PDController(SteeringController):
         return {"P": self.model.coefficients.P, "C_V": 0.0, "F": 0.0, "K": 0.0}
 
     def claim(self, context: ClaimContext) -> Certificate:
-        """The section-4 analysis for a law without feedforward or compensation."""
+        """The section-4 analysis for a law without feedforward or compensation, named 'section-4', beside the
+        sampled-data certificate of its loop on the cart's parts, which is taken
+        (:func:`controllers.sampled_claim.with_sampled_data`)."""
         c = self.model.coefficients
         estimate = Estimate(P=c.P, C_V=0.0, F=0.0, K=0.0, gyro=0.0, V_A=self.model.V_A)
-        return named(_section4(context, estimate, Compensation(friction_sign="none", friction_width=0.0,
-                                                               feedforward=False), kp=self.kp, kd=self.kd), SECTION_4)
+        compensation = Compensation(friction_sign="none", friction_width=0.0, feedforward=False)
+        own = _section4(context, estimate, compensation, kp=self.kp, kd=self.kd)
+        return with_sampled_data(own, SECTION_4, context, lambda cart: sampled_certificate(
+            plant=context.plant, estimate=estimate, gains=Gains(kp=self.kp, kd=self.kd), reference=context.reference,
+            limits=context.limits, compensation=compensation, control_period=context.control_period, cart=cart,
+            initial_error=context.initial_error, stated=context.stated))
 
     def describe(self) -> dict:
         return {"controller": self.name, "model": self.model.name, "kp": self.kp, "kd": self.kd,

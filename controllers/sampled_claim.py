@@ -1,10 +1,12 @@
 """A law's sampled-data certificate beside its continuous claim: the cart it is computed on, and the pair judged.
 
-On a cart that is not ideal (``ClaimContext.wants_sampled_data``), the computed-torque and sliding-mode laws
-compute, beside their continuous claim (section 4's, the boundary layer), the sampled-data certificate of their
-loop on the cart's own parts (:mod:`wmr_mj.analysis.sampled_certificate`, :mod:`wmr_mj.analysis.sliding_sampled`),
-and claim the certified one with the smaller E_max (:func:`wmr_mj.analysis.claim.best_certificate`). A subclass
-inherits its parent's pair with its :meth:`~controllers.base.SteeringController.claim`.
+On every cart the run's parts describe (``ClaimContext.wants_sampled_data``, the ideal cart included), the
+computed-torque, PD and sliding-mode laws compute, beside their continuous claim (section 4's, the boundary
+layer), the sampled-data certificate of their loop on the cart's own parts
+(:mod:`wmr_mj.analysis.sampled_certificate`, :mod:`wmr_mj.analysis.sliding_sampled`), and claim it, the
+continuous one recorded beside it as a second opinion (:func:`wmr_mj.analysis.claim.best_certificate`: a
+sampled law is never certified by a bound that assumes sampling away). A subclass inherits its parent's pair
+with its :meth:`~controllers.base.SteeringController.claim`.
 
 Usage::
 
@@ -30,7 +32,7 @@ __all__ = ["MAX_SAMPLED_DELAY_PERIODS", "sampled_cart", "with_sampled_data", "na
 #: the longest delay, in control periods (sensing plus actuation), for which the sampled-data certificate is computed:
 #: its loop carries one state per period of delay, so a delay of seconds at a 1 ms period would cost minutes; far
 #: beyond the delay margin of any gains the designs use (64 periods for K_P = 100, K_D = 20 at 1 ms). A longer
-#: delay leaves the continuous claim alone (no sampled-data bound is claimed: never a looser verdict).
+#: delay leaves the continuous claim alone, uncertified (the assumption 'sampling bounded' unmet).
 MAX_SAMPLED_DELAY_PERIODS = 256
 
 
@@ -61,9 +63,10 @@ def named(cert: Certificate, analysis: str) -> Certificate:
 
 def with_sampled_data(own: Certificate, own_name: str, context: ClaimContext,
                       sampled: Callable[[SampledCart], Certificate]) -> Certificate:
-    """The law's claim: ``own`` (named ``own_name``) alone where the run asks for no sampled-data analysis, else
-    the better of ``own`` and ``sampled(cart)`` (:func:`wmr_mj.analysis.claim.best_certificate`; ``own`` with the
-    reason where the cart cannot be evaluated).
+    """The law's claim: ``own`` (named ``own_name``) alone where the run asks for no sampled-data analysis (a
+    what-if measurement the cart's parts do not describe), else ``sampled(cart)`` with ``own`` beside it
+    (:func:`wmr_mj.analysis.claim.best_certificate`; ``own`` with the assumption 'sampling bounded' unmet and
+    the reason where the cart cannot be evaluated).
 
     Args:
         own: the law's continuous claim. own_name: its name ('section-4', 'boundary-layer').

@@ -39,11 +39,11 @@ claim states the check that one period moves s by a small part of the layer: wit
 period (T k/(P_min phi) <= 1). Under measurement errors or a delay the same check is named for
 what it measures, :data:`MEASURED_STEP`: D grows by the law's measured-input terms, T does not.
 These are a stated margin, not a sampled-data proof; the tests
-(tests/test_sliding_mode.py) check the bound on a zero-order-hold simulation. On a cart that is not ideal a run
+(tests/test_sliding_mode.py) check the bound on a zero-order-hold simulation. On every cart a run
 also computes the layer as a sampled loop (:mod:`wmr_mj.analysis.sliding_sampled`: inside the layer the law is
 computed torque at K_P = lam k/(P^ phi), K_D = lam + k/(P^ phi), and the law's measured s is bounded by its l1
-gains), and is judged by the certified one with the smaller E_max (:meth:`SlidingMode.claim`,
-:func:`controllers.sampled_claim.with_sampled_data`; this claim is named 'boundary-layer').
+gains), and is judged by it, the ideal cart included (:meth:`SlidingMode.claim`,
+:func:`controllers.sampled_claim.with_sampled_data`; this claim is named 'boundary-layer' and recorded beside it).
 
 Usage::
 
@@ -344,10 +344,10 @@ class SlidingMode(SteeringController):
                              voltage_max=voltage, uncertainty=unc, reason="")
 
     def claim(self, context: ClaimContext) -> Certificate:
-        """The boundary layer (:meth:`layer_claim`), named 'boundary-layer'; on a cart that is not ideal
-        (``context.wants_sampled_data``) beside the layer as a sampled loop on the cart's parts
-        (:func:`wmr_mj.analysis.sliding_sampled.sliding_sampled_certificate`), the certified one with the smaller
-        E_max taken (:func:`controllers.sampled_claim.with_sampled_data`)."""
+        """The boundary layer (:meth:`layer_claim`), named 'boundary-layer', beside the layer as a sampled loop
+        on the cart's parts (``context.wants_sampled_data``, the ideal cart included;
+        :func:`wmr_mj.analysis.sliding_sampled.sliding_sampled_certificate`), which is taken: the law runs sampled
+        (:func:`controllers.sampled_claim.with_sampled_data`)."""
         m = self.model
         c = m.coefficients
         estimate = Estimate(P=c.P, C_V=c.C_V, F=0.0 if self.friction_sign == "none" else c.F, K=c.K, gyro=c.gyro,

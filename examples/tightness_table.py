@@ -8,10 +8,15 @@ of the error term alone where one applies (``docs/guides/certificates.md``, "Tig
 0.071 for an encoder's quantised angle), and the verdicts of every run. The carts no claim covers are listed
 below the table with what is unmet. Built on :func:`wmr_mj.sim.tightness.cart_tightness`.
 
+With ``--binding`` it runs nothing: per cart and path, the certificate the run takes and which term of it binds
+(the Coulomb sign's charge, its share of W0 and of E_max, the largest other term; ``docs/guides/certificates.md``,
+"Sampling bounded on every cart").
+
 Usage::
 
     python examples/tightness_table.py                       # budget 64, 35 s, 2 paths: about 15 min on 1 core
     python examples/tightness_table.py --budget 5 --duration 10 --cart ideal --json out.json   # seconds
+    python examples/tightness_table.py --binding             # the binding terms, no run: about a minute
 """
 
 from __future__ import annotations
@@ -59,6 +64,28 @@ def row(name: str, t: CartTightness, old: float | None) -> str:
             f"{verdicts} |")
 
 
+#: the parts of the sampled-data certificate's W0 (SampledDataTerms), rad/s^2
+W0_PARTS = ("friction_term", "P_term", "feedforward_hold_term", "C_V_term", "K_term", "gyro_term", "disturbance_term")
+BINDING_HEADER = ("| cart | path | E_max taken [rad] | certified | friction term [rad/s^2] | share of W0 | "
+                  "friction's part of E_max [rad] | the largest other term of W0 [rad/s^2] |")
+
+
+def binding_row(name: str, path: str, claim) -> str:
+    """The markdown row of one cart on one path: which term of the claim taken binds. The friction's part of E_max
+    is g_E,w x friction term / (1 - lambda): what the Coulomb sign's charge alone drives through the sampled loop."""
+    terms = claim.inputs.get("terms") if claim is not None else None
+    if terms is None:
+        reason = claim.reason if claim is not None else "no claim"
+        return f"| {name} | {path} | none | no | - | - | - | {reason} |"
+    t = terms.to_dict() if hasattr(terms, "to_dict") else dict(terms)
+    parts = {k: t[k] or 0.0 for k in W0_PARTS}
+    other = max((k for k in W0_PARTS if k != "friction_term"), key=lambda k: parts[k])
+    friction = t["gain_E_w"] * t["friction_term"] / (1.0 - t["loop_gain"])
+    return (f"| {name} | {path} | {claim.E_max:.4f} | {'yes' if claim.certified else 'no'} | "
+            f"{t['friction_term']:.3f} | {t['friction_term'] / sum(parts.values()):.2f} | {friction:.4f} "
+            f"({friction / claim.E_max:.2f} of E_max) | {other.removesuffix('_term')} {parts[other]:.3f} |")
+
+
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--budget", type=int, default=64, help="falsify's budget per cart and path (default 64)")
@@ -68,12 +95,20 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--nthread", type=int, default=1)
     ap.add_argument("--cart", action="append", help="only this cart of the table (repeatable; default: all)")
     ap.add_argument("--json", metavar="FILE", help="also write every number to FILE")
+    ap.add_argument("--binding", action="store_true", help="run nothing: which term of each certificate binds")
     args = ap.parse_args(argv)
     cases = [c for c in CASES if args.cart is None or c[0] in args.cart]
     if args.cart is not None and len(cases) != len(set(args.cart)):
         known = ", ".join(repr(c[0]) for c in CASES)
         ap.error(f"--cart: {sorted(set(args.cart) - {c[0] for c in cases})} not in the table; one of {known}")
     base = wm.RunConfig(**wm.CERTIFIED.config_changes(), duration=args.duration)
+    if args.binding:
+        print(BINDING_HEADER)
+        print("|---|---|---|---|---|---|---|---|")
+        for name, changes in cases:
+            for path in args.paths.split(","):
+                print(binding_row(name, path, resolve_run(base.replace(**changes, path=path)).claim), flush=True)
+        return
     print(HEADER)
     print("|---|---|---|---|---|---|---|---|---|", flush=True)
     out, uncovered = [], []

@@ -10,9 +10,11 @@ from __future__ import annotations
 import pytest
 
 from tests.helpers import one_error_line
+from wmr_mj.analysis.measurement import MeasurementErrors
 from wmr_mj.cli.app import main
 from wmr_mj.errors import ParameterError
-from wmr_mj.sim.config import RunConfig
+from wmr_mj.sim.certify import certificate_for
+from wmr_mj.sim.config import RunConfig, build_reference, estimate_parameters
 from wmr_mj.sim.parts import resolve_run
 
 #: the sliding-mode parameters where the sampled layer certifies on the 12-bit axis encoder (test_sliding_sampled.py)
@@ -120,9 +122,12 @@ def test_each_claimant_writes_only_its_own_terms():
     out = sampled.as_dict()
     assert not set(SECTION_4_KEYS) & set(out), sorted(set(SECTION_4_KEYS) & set(out))
     assert out["inputs"]["kp"] == design.kp and "terms" in out["inputs"]  # its own record: the gains, its terms
-    layer = resolve_run(RunConfig(controller="sliding-mode", **{**BASE, "sensing": "ideal"})).claim
+    exact = MeasurementErrors.exact()  # the what-if 'exact measurement': the law's continuous claim alone
+    reference = build_reference(design.path, estimate_parameters(), dt=1e-3, duration=design.duration)[0]
+    layer = certificate_for(RunConfig(controller="sliding-mode", **{**BASE, "sensing": "ideal"}), reference,
+                            measurement=exact)
     assert layer.analysis == "boundary-layer" and not set(SECTION_4_KEYS) & set(layer.as_dict())
-    section4 = resolve_run(design).claim
+    section4 = certificate_for(design, reference, measurement=exact)
     out = section4.as_dict()
     assert section4.analysis == "section-4" and set(SECTION_4_KEYS) <= set(out)
     assert out["kp"] == design.kp and out["kd"] == design.kd

@@ -58,15 +58,19 @@ def test_an_unknown_law_is_one_line_exit_2(tmp_path, capsys):
     assert not (tmp_path / "d.json").exists()
 
 
-def test_on_the_ideal_cart_the_sliding_design_is_judged_by_its_boundary_layer(tmp_path, capsys):
-    """No sampled certificate on the ideal cart: the design's certificate is the law's continuous claim,
-    E_max = phi/lam exactly, and the file names it."""
+def test_on_the_ideal_cart_the_sliding_design_is_judged_by_its_sampled_layer(tmp_path, capsys):
+    """Since issue 44 the ideal cart computes the sampled layer too and the design is judged by it (the boundary
+    layer's phi/lam is never taken alone), and the file names it; run reads the file back to the same bound."""
+    from wmr_mj.sim.compare import design_file_changes
+    from wmr_mj.sim.config import RunConfig
+    from wmr_mj.sim.parts import resolve_run
+
     out = tmp_path / "ideal.json"
     assert main(["design", "--controller", "sliding-mode", "--budget", "30", "--out", str(out), "--json"]) == 0
     printed = json.loads(capsys.readouterr().out)
-    c = printed["settings"]["controller_params"]
-    assert printed["certificates"]["paper-circle"]["certificate"] == "boundary-layer"
-    assert printed["E_max"] == c["phi"] / c["lam"]
+    assert printed["certificates"]["paper-circle"]["certificate"] == "sampled-data"
+    claim = resolve_run(RunConfig(**design_file_changes(str(out)))).claim
+    assert claim.inputs["certificate"] == "sampled-data" and printed["E_max"] == claim.E_max
 
 
 def test_compare_and_validate_read_a_sliding_design_file_as_run_does(designed):

@@ -127,10 +127,28 @@ def test_uncovered_cart_is_uncertified():
     assert cert.valid and not cert.certified and cert.unmet == ("sensing and actuation covered",)
 
 
-def test_the_ideal_cart_keeps_section_4():
+def test_the_ideal_cart_takes_the_sampled_bound():
+    """Issue 44 item 1: on the ideal cart (exact sensing, no delay) the sampled-data certificate is computed at the
+    run's 1 ms period and taken; section 4's continuous bound (0.0463 rad, the paper's analysis) is recorded
+    beside it, never taken alone, though it is the smaller."""
     cert = _certified_design(Sensing())
-    assert cert.claimant == "" and "certificate" not in cert.inputs and "certificates" not in cert.inputs
-    assert round(cert.E_max, 4) == 0.0463
+    assert cert.claimant == SAMPLED_DATA and cert.inputs["certificate"] == SAMPLED_DATA and cert.certified
+    record = cert.inputs["certificates"]
+    assert round(record["section-4"]["E_max"], 4) == 0.0463 and record["section-4"]["certified"]
+    assert record["sampled-data"]["E_max"] == cert.E_max > record["section-4"]["E_max"]
+    law = cert.inputs.law
+    assert (law.cart.velocity, law.cart.sensing_delay, law.cart.actuation_delay) == ("exact", 0, 0)
+    assert law.cart.angle_error == law.cart.velocity_noise == 0.0 and law.control_period == T
+    terms = law.terms
+    # critically damped (K_D^2 = 4 K_P) with the exact rate: the impulse response of 1/(s^2 + K_D s + K_P) is
+    # positive, so its l1 norm is the DC gain 1/K_P; the hold and the back-EMF in the loop move it by O(K_D T)
+    assert terms.gain_E_w == pytest.approx(1.0 / law.kp, rel=2 * law.kd * T)
+    # no measurement channel: E_max is the remainder through the loop alone, at least the friction's share
+    assert terms.angle_channel == terms.velocity_channel == terms.initial_transient_E == 0.0
+    assert cert.E_max >= terms.gain_E_w * terms.friction_term
+    # the ideal cart is the 12-bit cart without its quantum: a smaller bound (0.109 rad there)
+    assert cert.E_max < _certified_design(Sensing.from_spec("magnetic-12bit-axis")).E_max
+    assert round(cert.E_max, 4) == 0.0974  # paper bounds, m1 = 750 kg (0.0922 rad with the circle's own bounds)
 
 
 @pytest.mark.parametrize("sensing, E_max", [("magnetic-12bit-axis", 0.109), ("delay=0.02", 0.1079)])

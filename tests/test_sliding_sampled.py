@@ -134,10 +134,17 @@ def test_monotone_in_the_quantum_the_noise_and_the_delay():
         assert seq == sorted(seq) and seq[0] < seq[-1]
 
 
-def test_ideal_cart_keeps_the_continuous_claim():
+def test_ideal_cart_takes_the_sampled_layer():
+    """Issue 44 item 1: on the ideal cart too the layer is judged as a sampled loop; the boundary layer's
+    phi/lam (a continuous-time bound) is recorded beside it, never taken alone."""
     cert = _claim(controller_params=dict(CERTIFYING))
-    assert cert.E_max == CERTIFYING["phi"] / CERTIFYING["lam"] and "certificates" not in cert.inputs
-    assert all(a.name != LAYER_NOT_SATURATED for a in cert.assumptions)
+    assert cert.inputs["certificate"] == "sampled-data" and cert.certified
+    record = cert.inputs["certificates"]
+    assert record["boundary-layer"]["E_max"] == CERTIFYING["phi"] / CERTIFYING["lam"]
+    assert record["sampled-data"]["E_max"] == cert.E_max < CERTIFYING["phi"] / CERTIFYING["lam"]
+    assert any(a.name == LAYER_NOT_SATURATED and a.met for a in cert.assumptions)
+    # the ideal cart has no quantum: a smaller bound than the 12-bit cart's (0.0526 rad there)
+    assert cert.E_max < _claim(sensing="magnetic-12bit-axis", controller_params=dict(CERTIFYING)).E_max
 
 
 @pytest.mark.parametrize("sensing", ["magnetic-12bit-axis", Sensing(delay=0.02)])

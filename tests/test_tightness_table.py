@@ -7,6 +7,7 @@ bit by ``run_closed_loop``), and the printed tightness against worst / E_max of 
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import subprocess
@@ -84,14 +85,10 @@ def test_E_max_columns_are_what_a_run_computes(quick):
         claim = resolve_run(config).claim
         assert row["E_max"] == claim.E_max  # the certificate run takes, to the bit
         assert row["certificate"] == claim.inputs.get("certificate", "section-4")
-        both = claim.inputs.get("certificates")
-        if both is None:  # the ideal cart: section 4's alone
-            assert row["cart"] == "ideal" and row["E_max_sampled"] is None
-            assert row["E_max_section4"] == claim.E_max
-        else:
-            assert row["E_max_section4"] == both["section-4"]["E_max"]
-            assert row["E_max_sampled"] == both["sampled-data"]["E_max"]
-            assert row["E_max"] == min(e for e in (row["E_max_section4"], row["E_max_sampled"]) if e is not None)
+        both = claim.inputs["certificates"]  # every cart, the ideal one included (issue 44 item 1)
+        assert row["E_max_section4"] == both["section-4"]["E_max"]
+        assert row["E_max_sampled"] == both["sampled-data"]["E_max"] == row["E_max"]  # the sampled one is taken
+        assert row["certificate"] == "sampled-data"
 
 
 def test_the_worst_found_is_a_run_and_no_run_is_certified_outside(quick):
@@ -110,9 +107,15 @@ def test_certificate_columns_without_a_claim_or_a_sampled_certificate():
     assert certificate_columns(None) == {"certificate": "", "certified": False, "E_max": None,
                                          "E_max_section4": None, "E_max_sampled": None}
     ideal = resolve_run(wm.RunConfig(**wm.CERTIFIED.config_changes(), duration=DURATION_S)).claim
-    cols = certificate_columns(ideal)
-    assert cols["E_max"] == cols["E_max_section4"] == ideal.E_max and cols["E_max_sampled"] is None
+    cols = certificate_columns(ideal)  # the ideal cart: the sampled-data certificate taken, section 4's beside it
+    assert cols["E_max"] == cols["E_max_sampled"] == ideal.E_max and cols["certificate"] == "sampled-data"
+    assert cols["E_max_section4"] == ideal.inputs["certificates"]["section-4"]["E_max"] < cols["E_max"]
     assert math.isfinite(cols["E_max"]) and cols["certified"]
+    # a law's own claim alone (no sampled-data record: a what-if measurement) is taken as section 4's
+    alone = dataclasses.replace(ideal, inputs=ideal.inputs.with_record({"certificate": "section-4",
+                                                                        "certificates": None}))
+    cols = certificate_columns(alone)
+    assert cols["E_max"] == cols["E_max_section4"] == ideal.E_max and cols["E_max_sampled"] is None
 
 
 def test_an_unknown_cart_is_refused_in_one_line():

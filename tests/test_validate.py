@@ -135,7 +135,9 @@ def test_the_ladder_has_four_rungs_changing_one_thing_each(validated):
     first, last = ladder[0]["certificate"], ladder[-1]["certificate"]
     assert not first["certified"] and first["unmet"] and last["certified"] and not last["unmet"]
     md = (folder / "index.md").read_text()
-    assert "Against its own certificate: there is none" in md and f"{first['dead_band']:.3g} rad" in md
+    # since issue 44 the sampled-data certificate (the paper's K_D = 9 is below C_V^/P^: no damping of its own);
+    # the report names its reason
+    assert "Against its own certificate: there is none" in md and first["reason"] and first["reason"] in md
 
 
 def test_ladder_changes_and_summarise_rung_units():

@@ -51,13 +51,15 @@ from wmr_mj.reference.bounds import ReferenceBounds
 
 __all__ = ["ClaimContext", "box_claim", "run_assumptions", "RunAssumptions", "shared_assumptions", "fixed_point",
            "with_measured", "covers_measurement", "best_certificate", "replace_inputs", "SAMPLED_DATA_NAME",
-           "INITIAL_TOLERANCE", "least_fixed_point", "tangent_reason"]
+           "INITIAL_TOLERANCE", "least_fixed_point", "tangent_reason", "SAMPLING_BOUNDED"]
 
 #: The tolerance on |E(0)|, |E'(0)| of the assumption 'zero initial error' (the reference's rounding at t = 0).
 INITIAL_TOLERANCE = 1e-9
 _FIXED_POINT_ITERATIONS = 10000
 #: The sampled-data certificate's name in a run's ``inputs['certificate']`` and ``inputs['certificates']``.
 SAMPLED_DATA_NAME = "sampled-data"
+#: The assumption a sampled law's continuous claim carries, unmet, where no sampled-data certificate was computed.
+SAMPLING_BOUNDED = "sampling bounded"
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -89,9 +91,10 @@ class ClaimContext:
         play: the gear's play b [rad at the axis] (0 without play; never covered today: see ``measurement``).
         sampled_data: whether ``measurement`` is the cart's own, derived from its parts (``sensing``,
             ``actuation_delay``, ``play``): a law with a sampled-data analysis then computes it beside its
-            continuous claim (:func:`best_certificate`); False where the bounds are a what-if that the parts do
-            not describe (or the run computes no such analysis). On an ideal cart (exact measurement) none is
-            computed either way.
+            continuous claim and is judged by it (:func:`best_certificate`), on the ideal cart too (exact
+            sensing, no delay, the run's control period: the zero-order hold is bounded, not assumed away);
+            False where the bounds are a what-if that the parts do not describe (or the run computes no such
+            analysis).
     """
 
     plant: PlantBox
@@ -112,8 +115,8 @@ class ClaimContext:
     @property
     def wants_sampled_data(self) -> bool:
         """Whether a law with a sampled-data analysis computes it for this run: the cart's own measurement
-        (``sampled_data``) on a cart that is not ideal."""
-        return self.sampled_data and not self.measurement.is_exact
+        (``sampled_data``), the ideal cart's (exact) included (issue 44 item 1)."""
+        return self.sampled_data
 
     def __post_init__(self) -> None:
         if not isinstance(self.measurement, MeasurementErrors):
@@ -297,29 +300,35 @@ def covers_measurement(cert: Certificate, measurement: MeasurementErrors) -> Cer
 
 
 def best_certificate(own: Certificate, own_name: str, sampled: Certificate | str) -> Certificate:
-    """A law's claim on a cart that is not ideal: its continuous claim ``own`` (named ``own_name``: 'section-4',
-    'boundary-layer') or its sampled-data certificate ``sampled``, whichever is certified with the smaller E_max
-    (a certified one before one that is not; ``own`` on a tie). The other one's E_max, whether it is certified and
-    its reason are recorded under ``inputs['certificates']``, and ``inputs['certificate']`` names the one taken.
+    """A sampled law's claim: its sampled-data certificate ``sampled``, with its continuous claim ``own`` (named
+    ``own_name``: 'section-4', 'boundary-layer') beside it as a second opinion (issue 44 item 1).
+
+    The law runs sampled: its command is held over each control period. ``own`` bounds the continuous law, with
+    the hold assumed away; it could count only with a proven bound on what the hold adds, and no sound one
+    smaller than the sampled-data certificate's is known (the held sign of alpha' alone is charged
+    F_max + F^, as there: ``docs/guides/certificates.md``, "Sampling bounded on every cart"). So ``sampled``
+    is taken, certified or not, whichever E_max is the smaller; where it was not computed (``sampled`` is the
+    reason), ``own`` is taken with the assumption :data:`SAMPLING_BOUNDED` unmet: never certified by a bound
+    that assumes sampling away. Both E_max, whether each is certified and its reason are recorded under
+    ``inputs['certificates']``, and ``inputs['certificate']`` names the one taken.
 
     Args:
         own: the law's continuous claim, as it covers the run's measurement (:func:`covers_measurement`).
         own_name: its name.
-        sampled: the sampled-data certificate, or why it was not computed (one line): ``own`` is then taken.
+        sampled: the sampled-data certificate, or why it was not computed (one line).
     """
     if isinstance(sampled, str):
+        unbounded = Assumption(SAMPLING_BOUNDED, "the sampled-data certificate is computed (a continuous-time "
+                               "bound alone assumes the zero-order hold away)", False, 1.0, 0.0, sampled,
+                               kind="checked")
+        own = dataclasses.replace(own, assumptions=(*own.assumptions, unbounded))
         return replace_inputs(own, {**dict(own.inputs), "certificate": own_name,
                                   "certificates": {SAMPLED_DATA_NAME: {"E_max": None, "reason": sampled}}})
-
-    def rank(c: Certificate) -> tuple[bool, float]:
-        return (not c.certified, c.E_max if c.valid else math.inf)
-
-    taken = sampled if rank(sampled) < rank(own) else own
     record = {own_name if c is own else SAMPLED_DATA_NAME: {"E_max": c.E_max if c.valid else None,
                                                              "certified": c.certified, "reason": c.reason}
               for c in (own, sampled)}
-    return replace_inputs(taken, {**dict(taken.inputs), "certificate": SAMPLED_DATA_NAME if taken is sampled
-                                else own_name, "certificates": record})
+    return replace_inputs(sampled, {**dict(sampled.inputs), "certificate": SAMPLED_DATA_NAME,
+                                    "certificates": record})
 
 
 def replace_inputs(cert: Certificate, inputs: Mapping[str, Any]) -> Certificate:

@@ -1,11 +1,13 @@
-"""The sampled-data certificate: the computed-torque law as it runs on a sensed cart (issue 35 item 1).
+"""The sampled-data certificate: the computed-torque law as it runs, on every cart (issue 35 item 1; the ideal cart,
+e_alpha = e_v = 0 and no delay, since issue 44, where it is the certificate a run is judged by).
 
 Section 4's certificate (:mod:`wmr_mj.analysis.small_gain`) bounds a continuous loop and charges every
 measurement error at every instant as if it were free. Here the linear part of the law runs as it does: at
 the control period T under zero-order hold, with the sensing and actuation delays and the velocity estimate
 inside the loop (:mod:`wmr_mj.analysis.sampled_data`), and each bounded error is priced by its l1 gain, so a
 differenced encoder's error telescopes. What the linear loop does not hold (model mismatch over the box,
-friction against its compensation, the gyroscopic and K S(alpha) terms, the reference's own terms, the
+friction against its compensation (F_max + F^, or for a smoothed sign of the measured rate max(F_max, F^) +
+F^ eps_v/w, whichever bound is smaller), the gyroscopic and K S(alpha) terms, the reference's own terms, the
 back-EMF's hold) is a bounded disturbance w through the same kind of small-gain fixed point as section 4,
 with the sampled loop's l1 gains in place of gamma1, gamma2. Derivation, step by step:
 ``docs/guides/certificates.md``, "The sampled-data certificate".
@@ -314,8 +316,16 @@ class _Solved:
     Wt: float = math.nan  # sup|w + rho| [rad/s^2], what drives the loop (the sliding-mode layer check reads it)
 
 
-def _solve_at(bound: _Bound, lin: _Linear, cart: SampledCart, T: float, c_hat: float, x: float, y: float) -> _Solved:
-    """One step of the fixed point: the coefficients at (x, y), the linear small gain solved for W."""
+def _solve_at(bound: _Bound, lin: _Linear, cart: SampledCart, T: float, c_hat: float, x: float, y: float,
+              friction_width: float = 0.0) -> _Solved:
+    """One step of the fixed point: the coefficients at (x, y), the linear small gain solved for W.
+
+    The Coulomb sign's mismatch has two sound charges (``docs/guides/certificates.md``, "The Coulomb sign"): any
+    |s| <= 1 of either sign, F_max + F^ per P; and, for the law's smoothed sign of its measured alpha'
+    (``friction_width`` w > 0), max(F_max, F^) + F^ eps_v/w per P, x/sqrt(x^2 + w^2) being 1/w-Lipschitz and
+    eps_v >= |alpha'(t) - alpha_m'[k']| linear in sup|E''|. Both are solved; each bound (E, E', u, w, E'') is the
+    smaller of the two, each coordinate being a bound under either charge.
+    """
     inf = math.inf
     b, est = bound, bound.estimate
     # t - t_{k - d_a - d_s} < span; the current's lag weighs the law's past outputs at mean age tau_e beyond it
@@ -331,27 +341,56 @@ def _solve_at(bound: _Bound, lin: _Linear, cart: SampledCart, T: float, c_hat: f
     F, r = b.plant.box.F, b.plant.friction_over_P
     hold_dd = 2.0 * b.a0dd  # alpha0''(t) - alpha0''(t_k'): no jerk bound
     hold_d = (cart.actuation_delay + 1) * T * b.a0dd  # alpha0'(t) - alpha0'(t_k')
+    # the law's velocity outside the loop (gyro^, the smoothed sign): its static error and its age times sup|alpha''|
+    lag = cart.velocity_lag + span
+    lipschitz = (b.friction_sign == "measured" and friction_width > 0.0 and b.F_comp > 0.0
+                 and math.isfinite(cart.velocity_error))
 
-    def parts(p: float) -> tuple[float, ...]:
+    def parts(p: float, smoothed: bool) -> tuple[float, ...]:
         F_p = F[1] if r is None else min(F[1], r * p)
-        phi = F_p + b.F_comp  # any |s| <= 1 of either sign: today's term (no sound argument for less)
+        if smoothed:  # max(F_max, F^) + F^ (e_v + lag max|alpha0''|)/w; the lag times sup|E''| in k_A below
+            phi = max(F_p, b.F_comp) + b.F_comp * (cart.velocity_error + lag * b.a0dd) / friction_width
+        else:
+            phi = F_p + b.F_comp  # any |s| <= 1 of either sign
         return (phi / p, abs(p - b.P_ff) * b.a0dd / p, b.P_ff * hold_dd / p,
                 (b.dC * b.a0d + abs(est.C_V) * hold_d) / p, b.dK * S / p, b.dG * b.a0d / c2 / p,
                 (b.dist_at(p) if b.plant.disturbance else 0.0) / p)
 
-    worst = max((parts(p) for p in corners), key=sum)
-    W0 = sum(worst)
-    # the law's velocity outside the loop (gyro^): its static error and its age times sup|alpha''|
-    lag = cart.velocity_lag + span
     gam = abs(b.Gam_hat) / P_lo
-    W0 += abs(est.K) / P_lo * sin_cos3_slope(A_m) * eps_a
-    W0 += gam * ((cart.velocity_error + lag * b.a0dd) / c2m + (b.a0d + y) * inv_cos2_slope(A_m) * eps_a)
+    K_slope = abs(est.K) / P_lo * sin_cos3_slope(A_m) * eps_a
+    gyro_age = gam * ((cart.velocity_error + lag * b.a0dd) / c2m + (b.a0d + y) * inv_cos2_slope(A_m) * eps_a)
     C_V_lo, C_V_hi = b.plant.box.C_V
     delta_u = max(abs(m) for m in b.mis.values())
     delta_c = max(abs(c_hat - cv / p) for cv in (C_V_lo, C_V_hi) for p in corners)
     k_y = delta_c + b.dG / (c2 * P_lo)
     k_A = gam * lag / c2m  # the gyro compensation's age times sup|E''|
     k_A += c_hat * cart.electrical_time_constant  # c^ |E' - H[E']| <= c^ tau_e sup|E''| (the current's back-EMF lag)
+
+    def solve(smoothed: bool) -> _Solved:
+        worst = max((parts(p, smoothed) for p in corners), key=sum)
+        W0 = sum(worst)
+        W0 += K_slope
+        W0 += gyro_age
+        kA = k_A + (b.F_comp * lag / (friction_width * P_lo) if smoothed else 0.0)
+        return _close(lin, cart, T, c_hat, x, y, eps_a, A_m, lag, W0, worst, delta_u, k_y, kA, b.a0dd)
+
+    first = solve(False)
+    if not lipschitz:
+        return first
+    second = solve(True)
+    if first.failure or second.failure:
+        return second if first.failure and not second.failure else first
+    taken = first if first.x <= second.x else second
+    return dataclasses.replace(taken, x=min(first.x, second.x), y=min(first.y, second.y), U=min(first.U, second.U),
+                               W=min(first.W, second.W), A2=min(first.A2, second.A2),
+                               eps_v=min(first.eps_v, second.eps_v), Wt=min(first.Wt, second.Wt))
+
+
+def _close(lin: _Linear, cart: SampledCart, T: float, c_hat: float, x: float, y: float, eps_a: float, A_m: float,
+           lag: float, W0: float, worst: tuple[float, ...], delta_u: float, k_y: float, k_A: float,
+           a0dd: float) -> _Solved:
+    """The linear small gain at one iterate: |w| <= W0 + delta_u U + k_y sup|E'| + k_A sup|E''| through the loop."""
+    inf = math.inf
     (gE, gV, gU), (ME, MV, MU) = lin.g, lin.M
     # unknowns: W = sup|w| (the remainder), Wt = sup|w + rho| (what the loop is driven by), A2 = sup|E''|
     q = 1.0 / (1.0 - c_hat * T)
@@ -378,7 +417,7 @@ def _solve_at(bound: _Bound, lin: _Linear, cart: SampledCart, T: float, c_hat: f
     A2 = q * (U + c_hat * Ys + W)
     y_new = Ys + T * A2
     x_new = Es + T * Ys + 0.5 * T * T * A2
-    eps_v = cart.velocity_error + lag * (b.a0dd + A2)
+    eps_v = cart.velocity_error + lag * (a0dd + A2)
     return _Solved(x_new, y_new, U, W, A2, eps_a, eps_v, A_m, dataclasses.replace(terms, W=W, U=U), Wt=Wt)
 
 
@@ -447,7 +486,9 @@ def sampled_certificate(*, plant: PlantBox, estimate: Estimate, gains: Gains, re
     if not lin.gains.stable:
         return _invalid(f"the sampled loop is unstable: {lin.gains.reason}", T, cart, bound, c_hat, limits,
                         initial_error, stated, reference)
-    solved, iterations, reason = _fixed_point(lambda x, y: _solve_at(bound, lin, cart, T, c_hat, x, y), bound.a0)
+    width = compensation.friction_width
+    solved, iterations, reason = _fixed_point(lambda x, y: _solve_at(bound, lin, cart, T, c_hat, x, y, width),
+                                              bound.a0)
     if solved is None:
         return _invalid(reason, T, cart, bound, c_hat, limits, initial_error, stated, reference,
                         loop_gain=None)

@@ -93,7 +93,7 @@ def layer_loop(loop: SampledLoop, *, lam: float) -> SampledLoop:
 
 
 def _layer_bound(bound: _Bound, cart: SampledCart, T: float, c_hat: float, lam: float, E_max: float,
-                 Edot_max: float) -> tuple[float, dict[str, float]]:
+                 Edot_max: float, friction_width: float) -> tuple[float, dict[str, float]]:
     """S^ = sup_k |s^[k]| (rad/s) at the certificate's fixed point, and its parts.
 
     The remainder's bound W~ is taken from one step of the fixed point at (E_max, Edot_max), which lie at or above
@@ -101,7 +101,7 @@ def _layer_bound(bound: _Bound, cart: SampledCart, T: float, c_hat: float, lam: 
     (every coefficient of the step increases with the angle and the rate reached).
     """
     lin = _linear(bound, cart, T, c_hat)
-    solved = _solve_at(bound, lin, cart, T, c_hat, E_max, Edot_max)
+    solved = _solve_at(bound, lin, cart, T, c_hat, E_max, Edot_max, friction_width)
     loop = layer_loop(damped_loop(kp=bound.kp, kd=bound.kd, c_hat=c_hat, control_period=T, cart=cart), lam=lam)
     gains: PeakGains = peak_gains(loop)
     if solved.failure or not gains.stable or not math.isfinite(solved.Wt):
@@ -147,7 +147,7 @@ def sliding_sampled_certificate(*, plant: PlantBox, estimate: Estimate, lam: flo
         assert reference.alpha_max is not None  # sampled_certificate checked it
         bound = _Bound.of(plant, estimate, gains, reference, compensation, reference.alpha_max)
         s_hat, parts = _layer_bound(bound, cart, float(control_period), estimate.C_V / estimate.P, lam,
-                                    cert.E_max, cert.Edot_max)
+                                    cert.E_max, cert.Edot_max, compensation.friction_width)
     layer = Assumption(LAYER_NOT_SATURATED, "sup_k |s^[k]| <= phi, s^ = E^' + lam E^ as the law forms it (l1 gains "
                        "into s^ at the sampled certificate's fixed point): sat(s^/phi) is linear at every sample, so "
                        "the law is the servo K_P = lam k/(P^ phi), K_D = lam + k/(P^ phi)",

@@ -433,6 +433,22 @@ def certificate_breakdown(cert) -> dict:
     return out
 
 
+def _section_4_beside(parts, cert):
+    """Section 4's certificate of the run where the one taken is the sampled-data certificate and section 4's is
+    recorded beside it (issue 44: the paper's analysis, a second opinion): the law's continuous claim alone, as
+    :func:`wmr_mj.sim.certify.certificate_of` gives it for the cart's own measurement as a what-if; else None."""
+    from wmr_mj.analysis.regions import SmallGainRegion
+    from wmr_mj.sim.certify import certificate_of, measurement_errors_of
+
+    if "section-4" not in (cert.inputs.get("certificates") or {}):
+        return None
+    config = parts.config
+    alone = certificate_of(config, parts.reference, base=parts.base, estimate=parts.estimate, plant=parts.plant,
+                           controller=parts.controller, tracker=parts.tracker,
+                           measurement=measurement_errors_of(config, parts.plant))
+    return alone if alone is not None and isinstance(alone.region, SmallGainRegion) else None
+
+
 def run_certificate(args: argparse.Namespace) -> int:
     """``wmr-mj robustness --certificate [run options]``."""
     from wmr_mj.cli._common import print_json
@@ -459,6 +475,7 @@ def run_certificate(args: argparse.Namespace) -> int:
         raise ParameterError(f"controller {parts.controller_name!r} states no claim: there is no certificate to "
                              "print; judge its runs by requirements (wmr-mj run --require ...)")
     paper = parts.analysis
+    second = _section_4_beside(parts, cert)
     if as_json:
         out = cert.as_dict()
         if parts.paper_law:  # the paper's region says nothing of a law outside its family (run: not applicable)
@@ -467,9 +484,15 @@ def run_certificate(args: argparse.Namespace) -> int:
                                    "condition": paper.condition, "stable": bool(paper.stable)}
         out["config"] = config.as_dict()
         out.update(certificate_breakdown(cert))
+        if second is not None:
+            out["section_4"] = {**second.as_dict(), **certificate_breakdown(second)}
         print_json(out)
         return 0
     print(_certificate_table(cert, config, paper))
+    if second is not None:
+        print("Second opinion, not taken (the continuous law: the zero-order hold is not bounded there; "
+              "docs/guides/certificates.md, 'Sampling bounded on every cart'):")
+        print(_certificate_table(second, config, paper))
     from wmr_mj.hardware import cart_line, is_ideal_cart
 
     if not is_ideal_cart(config):

@@ -87,14 +87,16 @@ def _one_run(parts, name: str, ideal_E_max: float | None) -> dict[str, Any]:
 
 
 def _dead_band_prediction(parts) -> dict[str, float]:
-    """F^ / (P^ K_P) [rad] from the certified design's certificate (its estimate's F and P, its K_P): the claim
-    of its run resolved (``parts``, :func:`wmr_mj.sim.parts.resolve_run`)."""
+    """F^ / (P^ K_P) [rad] from the certified design's law (its estimate's F and P, its K_P) and the E_max of the
+    certificate its run is judged by (the sampled-data one since issue 44): the run resolved (``parts``,
+    :func:`wmr_mj.sim.parts.resolve_run`)."""
     cert = parts.claim
     if cert is None:  # the certified design's computed-torque law always states one
         raise RuntimeError("the certified design states no certificate")
-    est = cert.inputs["estimate"]
-    return {"F_estimate": float(est["F"]), "P_estimate": float(est["P"]), "kp": float(cert.kp),
-            "dead_band": float(est["F"]) / (float(est["P"]) * float(cert.kp)),
+    law = parts.controller
+    est = law.model.coefficients
+    return {"F_estimate": float(est.F), "P_estimate": float(est.P), "kp": float(law.kp),
+            "dead_band": float(est.F) / (float(est.P) * float(law.kp)),
             "ideal_E_max": float(cert.E_max) if cert.valid else float("nan")}
 
 

@@ -109,9 +109,10 @@ def _why_no_certificate(cert: Mapping[str, Any]) -> str:
                       (("K~ term", "K_term"), ("friction", "friction_term"), ("gyro", "gyro_term"),
                        ("P~", "P_term"), ("C_V~", "C_V_term"), ("disturbance", "disturbance_term")) if cert.get(key))
     reason = cert.get("reason") or "an assumption fails"
-    text = (f"{reason[:1].upper() + reason[1:]}. Not met: {_unmet_text(cert)}. "
-            f"delta1 = {_fmt(cert.get('delta1'), '.3g')} rad/s^2 ({terms}), gamma1 = {_fmt(cert.get('gamma1'), '.3g')} "
-            f"s^2, (4.23) = {_fmt(cert.get('condition'), '.4f')}.")
+    text = f"{reason[:1].upper() + reason[1:]}. Not met: {_unmet_text(cert)}."
+    if "delta1" in cert:  # section 4's terms (a sampled-data certificate records its own under inputs)
+        text += (f" delta1 = {_fmt(cert.get('delta1'), '.3g')} rad/s^2 ({terms}), gamma1 = "
+                 f"{_fmt(cert.get('gamma1'), '.3g')} s^2, (4.23) = {_fmt(cert.get('condition'), '.4f')}.")
     band = cert.get("dead_band")
     if band is not None and margin is not None and band > margin:
         text += (f" The static dead band F_max/(P^ K_P) = {band:.3g} rad alone exceeds the {margin:.3g} rad "
@@ -268,6 +269,14 @@ def _rule_line(summary: ValidateSummary, brief: bool) -> str:
     return f"Rule, written before any run (wmr_mj/sim/designs.py): {rule.text} Now " + now
 
 
+def _limit(cert: Mapping[str, Any], key: str, assumption: str) -> Any:
+    """The cert's ``key`` (section 4 records 'voltage_limit' and 'steering_range'), else the limit of its assumption
+    ``assumption`` (every claim checks the supply and the stops: :func:`wmr_mj.analysis.claim.shared_assumptions`)."""
+    if cert.get(key) is not None:
+        return cert[key]
+    return next((a.get("limit") for a in cert.get("assumptions") or () if a.get("name") == assumption), None)
+
+
 def certified_lines(summary: Summary, *, brief: bool = False) -> list[str]:
     summary = ValidateSummary.of(summary)
     rung = summary.ladder[-1]
@@ -276,8 +285,10 @@ def certified_lines(summary: Summary, *, brief: bool = False) -> list[str]:
     if cert.get("certified"):
         lines.append(f"Certificate: |E| <= {_fmt(cert['E_max'], '.4g')} rad, |E'| <= "
                      f"{_fmt(cert['Edot_max'], '.4g')} rad/s, at most {_fmt(cert['voltage_max'])} V of the "
-                     f"{_fmt(cert['voltage_limit'], 'g')} V supply, reachable |alpha| <= {_fmt(cert['alpha_max'])} "
-                     f"rad (stops at {_fmt(cert['steering_range'], 'g')} rad); all {len(cert['assumptions'])} "
+                     f"{_fmt(_limit(cert, 'voltage_limit', 'within the supply'), 'g')} V supply, reachable |alpha| <= "
+                     f"{_fmt(cert['alpha_max'])} rad (stops at "
+                     f"{_fmt(_limit(cert, 'steering_range', 'inside the steering stops'), 'g')} rad); all "
+                     f"{len(cert['assumptions'])} "
                      "assumptions met (table below).")
     else:
         lines.append("Certificate: NOT valid. " + _why_no_certificate(cert))
@@ -386,7 +397,7 @@ def _search_bound_sentence(s: Mapping[str, Any], summary: ValidateSummary) -> st
     elif cert.get("valid") and cert.get("unmet") == [WITHIN_THE_SUPPLY]:
         head = (f"Over the full box ({names}) the certified design has no certificate: its bound |E| <= "
                 f"{_fmt(cert.get('E_max'), '.4g')} rad needs {_fmt(cert.get('voltage_max'), '.4g')} V, more than the "
-                f"{_fmt(cert.get('voltage_limit'), 'g')} V supply.")
+                f"{_fmt(_limit(cert, 'voltage_limit', 'within the supply'), 'g')} V supply.")
     else:
         head = f"Over the full box ({names}) the certified design has no certificate: not met: {_unmet_text(cert)}."
     ratio = _div(w.get("sup_E"), m1_cert.get("E_max"))
