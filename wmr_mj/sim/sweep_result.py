@@ -15,12 +15,13 @@ Usage::
 
 from __future__ import annotations
 
+import json
 import os
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from wmr_mj.sim.sweep import SweepSpec, SweepSummary, run_sweep
+from wmr_mj.sim.sweep import SweepSpec, SweepSummary, run_sweep, spec_from_json, spec_to_json
 
 __all__ = ["SweepResult", "sweep", "parameter_units"]
 
@@ -50,6 +51,18 @@ class SweepResult:
     spec: SweepSpec
     rows: tuple[Mapping[str, Any], ...]
     summary: SweepSummary
+
+    def to_dict(self) -> dict[str, Any]:
+        """The sweep's JSON: ``spec`` (as sweep.json and the workers read it: its base as ``RunConfig.as_dict``),
+        ``rows`` (each run's row, in run order) and ``summary`` (:meth:`SweepSummary.to_dict`)."""
+        return {"spec": json.loads(spec_to_json(self.spec)), "rows": [dict(row) for row in self.rows],
+                "summary": self.summary.to_dict()}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> SweepResult:
+        """The result of its JSON ``d`` (what :meth:`to_dict` wrote)."""
+        return cls(spec=spec_from_json(json.dumps(d["spec"])), rows=tuple(dict(row) for row in d["rows"]),
+                   summary=SweepSummary.from_dict(d["summary"]))
 
     def to_pandas(self) -> Any:
         """One row per run: the values each run used (m1 and every ranged parameter, with units), its verdict,
