@@ -123,8 +123,8 @@ def run(args: argparse.Namespace) -> int:
         summary["fixed_m1"] = fixed_m1
     if base.signals is not None:
         summary["signals"] = base.signals.as_dict()  # every run's, with every parameter
-    from wmr_mj.cli._common import add_controller_source
     from wmr_mj.hardware import cart_dict, cart_line, is_ideal_cart
+    from wmr_mj.sim.run_report import add_controller_source
     from wmr_mj.sim.search_space import HARDWARE_AXES
 
     add_controller_source(summary, base)
