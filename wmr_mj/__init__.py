@@ -55,7 +55,7 @@ if TYPE_CHECKING:
     from wmr_mj.sim.parts import RunParts, resolve_run
     from wmr_mj.sim.signals import Disturbance, LoadChange, Signals
     from wmr_mj.sim.suite import load_suite
-    from wmr_mj.sim.sweep import SweepSpec, SweepSummary, run_sweep
+    from wmr_mj.sim.sweep import SweepSpec, SweepSummary
     from wmr_mj.sim.sweep_result import SweepResult, sweep
     from wmr_mj.sim.tightness import CartTightness, cart_tightness
 
