@@ -194,10 +194,10 @@ _DEPRECATED = {
 
 def __getattr__(name: str) -> Any:
     if name in _DEPRECATED:  # not cached: every use warns
-        module, instead = _DEPRECATED[name]
+        where, instead = _DEPRECATED[name]
         warnings.warn(f"wmr_mj.{name} is deprecated and leaves the top level in the next release; use {instead}",
                       DeprecationWarning, stacklevel=2)
-        return getattr(importlib.import_module(module), name)
+        return getattr(importlib.import_module(where), name)
     module = _LAZY.get(name)
     if module is None:
         raise AttributeError(f"module 'wmr_mj' has no attribute {name!r}")
