@@ -32,6 +32,22 @@ def test_an_unknown_name_is_an_attribute_error():
         exec("from wmr_mj import nope", {})
 
 
+def test_run_sweep_at_the_top_level_is_a_deprecated_alias():
+    """The list-of-rows ``run_sweep`` leaves the top level (issue 41): kept one release, it warns on every use and
+    names what replaces it; ``wm.sweep`` and the module's own ``run_sweep`` do not warn."""
+    import warnings
+
+    from wmr_mj.sim.sweep import run_sweep
+
+    assert "run_sweep" not in wmr_mj.__all__ and "sweep" in wmr_mj.__all__
+    for _ in range(2):  # not cached: the second use warns too
+        with pytest.warns(DeprecationWarning, match=r"wmr_mj\.run_sweep is deprecated.*wm\.sweep\(spec\)"):
+            assert wmr_mj.run_sweep is run_sweep
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert wmr_mj.sweep is not None
+
+
 @pytest.mark.parametrize("first", ["import controllers", "import wmr_mj.params", "pass"])
 def test_controllers_first_then_wmr_mj_in_a_fresh_interpreter(first):
     code = f"{first}\nimport wmr_mj\nprint(wmr_mj.RunConfig.__name__, wmr_mj.controller_for.__module__)"

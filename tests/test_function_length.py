@@ -69,3 +69,21 @@ def test_the_engines_entry_point_is_short(name):
     lengths = dict(_functions(REPO / "wmr_mj" / "sim" / "engine.py"))
     (n,) = [v for k, v in lengths.items() if k.endswith(f" {name}")]
     assert n <= 60
+
+
+#: a command's ``run`` parses, calls the library and prints (issue 41: a thin CLI)
+CLI_RUN_LIMIT = 60
+
+
+def test_no_commands_run_is_over_60_code_lines():
+    """Each ``wmr_mj/cli/*.py``'s top-level ``run`` is at most 60 code lines (sweep's was 96, run's 70, model's 88):
+    what a command computes is the library's, its JSON the result's ``to_dict``."""
+    runs = {}
+    for path in sorted((REPO / "wmr_mj" / "cli").glob("*.py")):
+        source = path.read_text(encoding="utf-8")
+        for node in ast.parse(source).body:
+            if isinstance(node, ast.FunctionDef) and node.name == "run":
+                runs[path.name] = code_lines(node, source.splitlines())
+    assert {"run.py", "sweep.py", "cart.py", "falsify.py", "model.py"} <= set(runs)  # the commands were found
+    over = {name: n for name, n in runs.items() if n > CLI_RUN_LIMIT}
+    assert not over, f"cli run functions over {CLI_RUN_LIMIT} code lines (move the work into the library): {over}"

@@ -62,6 +62,32 @@ def test_a_tightness_row_as_a_table_and_a_few_lines(found):
     assert f"{row.tightness:.4g}" in lines and f"{row.runs} runs" in lines
 
 
+def test_a_design_round_trips_through_its_json(found):
+    """``DesignResult.to_dict`` is the design file's content (what ``design --json`` and ``--out`` write), and
+    ``from_dict`` reads it back: the certificates as the file records them, the settings as the run's parts."""
+    from wmr_mj.sim.design_search import DesignResult, design_dict
+
+    _, result = found
+    d = result.to_dict()
+    assert d == design_dict(result)
+    back = DesignResult.from_dict(d)
+    assert back.to_dict() == d
+    assert back.E_max == result.E_max and back.settings["sensing"] == result.settings["sensing"]
+    assert [c.certified for c in back.certificates.values()] == [c.certified for c in result.certificates.values()]
+    assert list(back.to_pandas()["E_max [rad]"]) == list(result.to_pandas()["E_max [rad]"])
+
+
+def test_a_tightness_row_round_trips_through_its_json(found):
+    from wmr_mj.sim.tightness import CartTightness
+
+    base, result = found
+    row = wm.cart_tightness(base.replace(**result.settings), budget=5)
+    d = row.to_dict()
+    assert d["tightness"] == row.tightness and d["worst_sup_E"] == row.worst_sup_E
+    back = CartTightness.from_dict(d)
+    assert back == row and back.to_dict() == d
+
+
 @pytest.fixture(scope="module")
 def twenty_volt_run(tmp_path_factory):
     """A 9 s run of the certified design on a copy of c80.toml whose supply is 20 V."""

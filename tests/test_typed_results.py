@@ -156,6 +156,26 @@ def test_sweep_summary_is_typed_and_round_trips():
     assert SweepSummary.from_dict(d) == s
 
 
+def test_sweep_result_round_trips():
+    """A sweep's one result carries its spec, its rows and their summary in its JSON (no run needed: the rows
+    above, added up as :func:`wmr_mj.sweep` adds them)."""
+    from wmr_mj.sim.sweep import SweepSpec, SweepSummary
+    from wmr_mj.sim.sweep_result import SweepResult
+
+    spec = SweepSpec(n=2, seed=3, ranges={"mu": (0.01, 0.03)}, base=RunConfig(duration=5.0))
+    rows = ({"run": 0, "m1": 600.0, "mu": 0.02, "verdict": "certified-inside", "certificate": _CERT_OUT,
+             "cert_E_ratio": 0.5, "cert_E_max": 0.05, "sup_E": 0.025, "sup_Edot": 0.1, "inside": None,
+             "left_steering_range": False, "saturated_fraction": 0.0, "steps": 10, "batch_law": "compiled"},)
+    result = SweepResult(spec=spec, rows=rows, summary=SweepSummary.of(rows, names=spec.names))
+    d = result.to_dict()
+    assert d["spec"]["n"] == 2 and d["spec"]["ranges"] == {"mu": [0.01, 0.03]} and d["rows"] == [rows[0]]
+    assert d["summary"] == result.summary.to_dict()
+    back = SweepResult.from_dict(d)
+    assert back.to_dict() == d
+    assert back.spec.ranges == spec.ranges and back.spec.base.duration == 5.0  # the base as the workers read it
+    assert back.rows == rows and back.summary == result.summary
+
+
 def test_compare_report_is_typed_and_round_trips():
     from wmr_mj.sim.compare import CompareReport, CompareResult, DesignRow
     from wmr_mj.sim.suite import load_suite

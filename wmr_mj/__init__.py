@@ -18,6 +18,7 @@ the search, logs, the certificate) on first use (PEP 562), because ``controllers
 from __future__ import annotations
 
 import importlib
+import warnings
 from typing import TYPE_CHECKING, Any
 
 from wmr_mj.errors import (
@@ -54,7 +55,7 @@ if TYPE_CHECKING:
     from wmr_mj.sim.parts import RunParts, resolve_run
     from wmr_mj.sim.signals import Disturbance, LoadChange, Signals
     from wmr_mj.sim.suite import load_suite
-    from wmr_mj.sim.sweep import SweepSpec, SweepSummary, run_sweep
+    from wmr_mj.sim.sweep import SweepSpec, SweepSummary
     from wmr_mj.sim.sweep_result import SweepResult, sweep
     from wmr_mj.sim.tightness import CartTightness, cart_tightness
 
@@ -66,7 +67,6 @@ _LAZY: dict[str, str] = {
     "RunResult": "wmr_mj.sim.closed_loop",
     "certificate_for": "wmr_mj.sim.certify",
     "SweepSpec": "wmr_mj.sim.sweep",
-    "run_sweep": "wmr_mj.sim.sweep",
     "SweepSummary": "wmr_mj.sim.sweep",
     "sweep": "wmr_mj.sim.sweep_result",
     "SweepResult": "wmr_mj.sim.sweep_result",
@@ -148,7 +148,6 @@ __all__ = [
     "preset",
     # many runs and the search for the worst, and what they add up to (frozen, read by attribute; to_dict/from_dict)
     "SweepSpec",
-    "run_sweep",
     "SweepSummary",
     "sweep",
     "SweepResult",
@@ -187,7 +186,18 @@ __all__ = [
 ]
 
 
+#: names kept at the top level for one release, each with its module and what to use instead: a warning on use
+_DEPRECATED = {
+    "run_sweep": ("wmr_mj.sim.sweep", "wm.sweep(spec), whose .rows are these rows (or wmr_mj.sim.sweep.run_sweep)"),
+}
+
+
 def __getattr__(name: str) -> Any:
+    if name in _DEPRECATED:  # not cached: every use warns
+        where, instead = _DEPRECATED[name]
+        warnings.warn(f"wmr_mj.{name} is deprecated and leaves the top level in the next release; use {instead}",
+                      DeprecationWarning, stacklevel=2)
+        return getattr(importlib.import_module(where), name)
     module = _LAZY.get(name)
     if module is None:
         raise AttributeError(f"module 'wmr_mj' has no attribute {name!r}")

@@ -22,19 +22,6 @@ from wmr_mj.cli.options import (  # noqa: F401  (importable from here, as before
 CLAIM_BROKEN_EXIT = 3
 
 
-def add_controller_source(out: dict[str, Any], config: Any) -> dict[str, Any]:
-    """``out`` with ``controller_source``: where the run's law comes from, as its MCAP log records it
-    (:class:`controllers.registry.PluginSource`: spec, name, origin, import path of the file or module and
-    class, parameters, the SHA-256 of its source), for every law but those built from the config's fields
-    (computed-torque, pd), whose JSON keeps the keys it always had. The JSON of run, sweep and falsify."""
-    from wmr_mj.sim.config import controller_source
-
-    source = controller_source(config)
-    if source is not None:
-        out["controller_source"] = source
-    return out
-
-
 def parse_assignments(items: list[str] | None, *, option: str = "--param",
                       example: str = "mu=0.02") -> dict[str, Any]:
     """``NAME=VALUE`` pairs (``--param l3=0.15``) into a dict; bad syntax raises ParameterError."""

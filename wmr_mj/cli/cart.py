@@ -51,107 +51,6 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-def _default_parts(cart: Any) -> dict[str, str]:
-    """The cart's default sensing, actuation and play built as their parts (a bad spec raises one line)."""
-    from wmr_mj.errors import ParameterError, WmrMjError
-    from wmr_mj.hardware import Actuation, Sensing, Transmission
-
-    built = {}
-    for key, cls in (("sensing", Sensing), ("actuation", Actuation), ("backlash", Transmission)):
-        value = cart.defaults[key]
-        try:
-            part = cls(backlash=value) if cls is Transmission else cls.from_spec(value)
-        except WmrMjError as exc:
-            raise ParameterError(f"cart file {str(cart.path)!r}: defaults.{key}.value = {value!r}: {exc}") from None
-        built[key] = part.label()
-    return built
-
-
-def _answer(cart: Any, steps: Any, ident: Any, ident_error: str | None) -> str:
-    """The first line: passes, or what failed (``ident`` None: the fit was impossible, ``ident_error`` says why)."""
-    where = f"cart {cart.name} {cart.version} ({cart.path})"
-    failed = []
-    if not steps.passed:
-        what = ", ".join(f"{name} x{n}" for name, n in steps.warnings.items()) or "no warning"
-        failed.append(f"1 s of random controls: {what}" + ("" if steps.finite else ", a non-finite state"))
-    if ident is None:
-        failed.append(f"no identification: {ident_error}")
-    elif ident.warnings:
-        failed.append(f"{ident.warnings} MuJoCo warnings in the excitation")
-    if ident is not None:
-        failed += [f"{row.name} identified {row.identified:.4g}, implied {row.implied:.4g} +- {row.allowed:.2g}"
-                   for row in ident.rows if not row.passed]
-    if failed:
-        return f"{where}: FAILS: " + "; ".join(failed)
-    return (f"{where}: passes: compiles and steps 1 s of random controls with no MuJoCo warning; the identified "
-            "P, C_V, F, K, gyro are those the file implies")
-
-
-def certified_on_cart(cart: Any) -> dict[str, Any]:
-    """The certified design on ``cart`` (a checked CartFile) and its certificate on the paper circle with the cart's
-    default sensing, actuation and play: omega_r [rad/s], kp, kd, certified, E_max [rad], Edot_max [rad/s],
-    voltage_max [V], voltage_limit [V], met, unmet (assumption names); or omega_r None and 'reason' where the rule
-    finds no omega_r on its grid."""
-    from wmr_mj.errors import InfeasiblePathError, ParameterError
-    from wmr_mj.sim.config import RunConfig
-    from wmr_mj.sim.designs import certified_design
-    from wmr_mj.sim.parts import resolve_run
-
-    try:  # a paper circle the cart's supply or stops cannot follow: the cart's answer, not the user's input
-        design = certified_design(cart)
-        claim = resolve_run(RunConfig(**design.config_changes(), cart=cart)).claim
-    except (ParameterError, InfeasiblePathError) as exc:
-        return {"omega_r": None, "reason": str(exc)}
-    assert claim is not None  # the computed-torque law always states its certificate
-    return {"omega_r": design.kd, "kp": design.kp, "kd": design.kd, "certified": claim.certified,
-            "E_max": claim.E_max, "Edot_max": claim.Edot_max, "voltage_max": claim.voltage_max,
-            "voltage_limit": float(cart.parameters["voltage_limit"]),
-            "met": [a.name for a in claim.assumptions if a.met], "unmet": list(claim.unmet)}
-
-
-def design_on_cart(cart: Any, *, seed: int | None = None, budget: int | None = None) -> dict[str, Any]:
-    """Can ``wmr-mj design`` certify ``cart`` (a checked CartFile) on its default sensing, actuation and play? The
-    design search on the paper circle over the cart's m1 box, computed-torque law, 1 ms period, E_max minimised.
-
-    Returns:
-        certified; where certified: E_max [rad], voltage_max [V], kp [1/s^2], kd [1/s], friction_width [rad/s];
-        else binding (the assumption, or why no certificate covers the cart's sensing); budget, seed, evaluations,
-        and the ``wmr-mj design`` command that runs the same search. seed, budget: None, design's defaults
-        (:data:`~wmr_mj.sim.design_search.DEFAULT_SEED`, :data:`~wmr_mj.sim.design_search.DEFAULT_BUDGET`).
-    """
-    from wmr_mj.errors import InfeasiblePathError
-    from wmr_mj.sim.config import RunConfig
-    from wmr_mj.sim.design_search import (
-        DEFAULT_BUDGET,
-        DEFAULT_SEED,
-        DesignProblem,
-        law_changes,
-        search_design,
-        uncovered,
-    )
-
-    seed = DEFAULT_SEED if seed is None else seed
-    budget = DEFAULT_BUDGET if budget is None else budget
-    command = (f"wmr-mj design --cart {cart.path} --seed {seed}"
-               + ("" if budget == DEFAULT_BUDGET else f" --budget {budget}"))
-    out: dict[str, Any] = {"budget": budget, "seed": seed, "command": command}
-    base = RunConfig.from_inputs(**law_changes("computed-torque"), cart=cart)
-    why_not = uncovered(base)
-    if why_not:  # design refuses such a cart's sensing (no certificate can cover it)
-        return {**out, "certified": False, "evaluations": 0,
-                "binding": f"the default sensing ({why_not}: no certificate covers it)"}
-    try:
-        result = search_design(DesignProblem(base=base, seed=seed, budget=budget))
-    except InfeasiblePathError as exc:  # the cart cannot follow the paper circle: no gains certify it
-        return {**out, "certified": False, "evaluations": 0, "binding": f"the paper circle's feasibility ({exc})"}
-    out.update(certified=result.certified, evaluations=result.evaluations)
-    if not result.certified:
-        return {**out, "binding": result.binding}
-    s = result.settings
-    return {**out, "E_max": result.E_max, "voltage_max": result.certificates["paper-circle"].voltage_max,
-            "kp": s["kp"], "kd": s["kd"], "friction_width": s["friction_width"]}
-
-
 def _design_line(d: dict[str, Any], wall: float) -> str:
     """The third line: can ``design`` certify the cart on its default sensing."""
     how = f"{d['command']}: {d['evaluations']} certificates in {wall:.1f} s"
@@ -174,13 +73,14 @@ def _certified_line(c: dict[str, Any]) -> str:
     return head + f"NOT certified: {', '.join(c['unmet']) or 'no valid bound'} not met; " + numbers
 
 
-def _print_text(cart: Any, parts: dict[str, str], steps: Any, ident: Any, ident_error: str | None,
-                certified: dict[str, Any], design: tuple[dict[str, Any], float]) -> None:
+def _print_text(check: Any) -> None:
+    """``cart check``'s report as text (``--json`` prints ``check.to_dict()``)."""
     from wmr_mj.plant.cartcheck import COEFFICIENT_UNITS
 
-    print(_answer(cart, steps, ident, ident_error))
-    print(_certified_line(certified))
-    print(_design_line(*design))
+    parts, steps, ident = check.defaults, check.steps, check.identification
+    print(check.answer)
+    print(_certified_line(check.certified_design))
+    print(_design_line(check.design, check.design_wall_s))
     print(f"defaults: sensing {parts['sensing']}; actuation {parts['actuation']}; play {parts['backlash']}")
     print(f"steps: {steps.steps} steps ({steps.duration:g} s) of uniform random controls, seed {steps.seed}: "
           f"{sum(steps.warnings.values())} MuJoCo warnings, state {'finite' if steps.finite else 'NOT finite'}")
@@ -197,46 +97,22 @@ def _print_text(cart: Any, parts: dict[str, str], steps: Any, ident: Any, ident_
 
 
 def run(args: argparse.Namespace) -> int:
-    import time
-
     from wmr_mj.carts import load_cart
     from wmr_mj.cli._common import print_json
-    from wmr_mj.errors import InfeasiblePathError, ParameterError, StiffReferenceError
     from wmr_mj.params import parameters_of_cart
-    from wmr_mj.plant.cartcheck import check_identification, step_with_random_controls
-    from wmr_mj.sim.config import build_reference
+    from wmr_mj.sim.cart_check import cart_check, default_parts
 
     cart = load_cart(args.cart)
-    params = parameters_of_cart(cart)
-    parts = _default_parts(cart)
-    if args.action == "card":
+    if args.action == "card":  # a parameter set or default part that cannot be built: one line, before the card
+        parameters_of_cart(cart)
+        default_parts(cart)
         return _write_card(cart, args.out)
-    try:  # a reference that cannot be built in bounded time is an absurd cart: refused before any step
-        build_reference("paper-circle", params, dt=1e-3, duration=35.0)
-    except StiffReferenceError as exc:
-        raise ParameterError(f"cart file {str(cart.path)!r}: {exc}") from None
-    except InfeasiblePathError:  # a circle the cart cannot steer: the cart's answer, reported below
-        pass
-    certified = certified_on_cart(cart)
-    t0 = time.perf_counter()
-    design = design_on_cart(cart, seed=args.seed)
-    design_wall = time.perf_counter() - t0
-    steps = step_with_random_controls(params, seed=args.seed)
-    ident, ident_error = None, None
-    try:
-        ident = check_identification(params, duration=args.duration, seed=args.seed)
-    except ParameterError as exc:  # too few sliding samples: the cart's answer, not the user's input
-        ident_error = str(exc)
-    passed = steps.passed and ident is not None and ident.passed
-    answer = _answer(cart, steps, ident, ident_error)
+    check = cart_check(cart, seed=args.seed, duration=args.duration)
     if args.json:
-        print_json({"answer": answer, "passed": passed, "cart": cart.name, "version": cart.version,
-                    "path": str(cart.path), "defaults": parts, "steps": steps.as_dict(),
-                    "identification": None if ident is None else ident.as_dict(), "identification_error": ident_error,
-                    "certified_design": certified, "design": design})
+        print_json(check.to_dict())
     else:
-        _print_text(cart, parts, steps, ident, ident_error, certified, (design, design_wall))
-    return 0 if passed else 1
+        _print_text(check)
+    return 0 if check.passed else 1
 
 
 def _write_card(cart: Any, out: str | None) -> int:

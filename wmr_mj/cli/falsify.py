@@ -223,11 +223,11 @@ def _write_outputs(result, base, args: argparse.Namespace, out, *, law_settings)
     the history plot, the worst run's signals and searched path where it has them): (the JSON, the re-run's
     sup|E| [rad]). ``base``: the command's base run (its controller, cart, path and reference bounds)."""
     from wmr_mj._util.files import write_json_atomic, write_text_atomic
-    from wmr_mj.cli._common import add_controller_source
     from wmr_mj.figures.plots import falsify_history, save_figure
     from wmr_mj.hardware import cart_dict
     from wmr_mj.logs.writer import run_logged
     from wmr_mj.sim.falsify import worst_config
+    from wmr_mj.sim.run_report import add_controller_source
 
     worst, log_path = result.worst, out / "worst.mcap"
     config = worst_config(result)

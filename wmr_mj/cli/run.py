@@ -244,32 +244,10 @@ def default_log_path(config) -> str:
     return f"logs/run-{stamp}-{config.model}-m{config.m1:g}.mcap"
 
 
-def measurement_cause(s: RunSummary, measurement: Any = None):
-    """The measurement errors the run's certificate assumed, and which binds
-    (:class:`~wmr_mj.analysis.claim_types.MeasurementCause`); None on an ideal cart or for another claim.
-
-    Args:
-        s: the run's summary.
-        measurement: the run's :class:`~wmr_mj.analysis.measurement.MeasurementErrors` (``RunParts.measurement``):
-            where the claim taken is the sampled-data certificate (it has a bound, so nothing binds), the errors it
-            assumed are these.
-    """
-    from wmr_mj.analysis.claim_types import MeasurementCause
-
-    judged = s.certificate
-    terms = None if judged is None else judged.certificate.terms
-    if terms is not None:
-        return terms.measurement_cause
-    sampled = judged is not None and judged.certificate.inputs.get("certificate") == "sampled-data"
-    if not sampled or measurement is None or measurement.is_exact:
-        return None
-    return MeasurementCause(e_a=measurement.alpha_error_max, e_v=measurement.alpha_dot_error_max,
-                            tau=measurement.delay_s)
-
-
 def format_report(s: RunSummary, *, measurement: Any = None) -> str:
     """Human-readable run report of the summary ``s`` (``measurement``: as :func:`measurement_cause` takes it)."""
     from wmr_mj.analysis.verdicts import format_measurement_cause, format_verdict
+    from wmr_mj.sim.run_report import measurement_cause
 
     def ratio(x):
         return "n/a" if x is None else f"{x:.3f}"
@@ -326,13 +304,50 @@ def format_report(s: RunSummary, *, measurement: Any = None) -> str:
     return "\n".join(lines)
 
 
+def _law_note(result: Any, config: Any) -> str | None:
+    """The stderr line on which law ran: the Python law's fallback, or a plug-in's compiled or Python path."""
+    from wmr_mj.sim.config import plugin_source
+    from wmr_mj.sim.engine import law_path
+
+    plugin = plugin_source(config) is not None
+    if result.law_note:
+        if not plugin:
+            return f"the Python law ran ({result.law_note}); the numbers are the same, the run slower"
+        return f"controller {result.summary.controller!r} runs {law_path(result.law)} ({result.law_note})"
+    if result.law == "compiled" and plugin:  # a plug-in in the callback: its pure law function, compiled
+        return (f"controller {result.summary.controller!r} compiled by numba into MuJoCo's control "
+                "callback, no Python per control step")
+    return None
+
+
+def _print_text(result: Any, parts: Any, report: dict[str, Any], path: str | None) -> None:
+    """The run's report as text (``--json`` prints ``report`` instead)."""
+    import json
+
+    from wmr_mj.hardware import cart_line, is_ideal_cart
+
+    config = result.config
+    print(format_report(result.summary, measurement=parts.measurement))
+    if not is_ideal_cart(config):
+        print(cart_line(config))
+    if report.get("requirements"):
+        print("\n".join(format_requirements(report["requirements"])))
+    if config.signals is not None:
+        print(f"signals: {json.dumps(report['signals'], separators=(',', ':'))}")
+        print(f"reproduce: add --signals '{json.dumps(report['signals'], separators=(',', ':'))}'")
+    if path:
+        print(f"log: {path}")
+
+
 def run(args: argparse.Namespace) -> int:
     import functools
     import sys
 
     from wmr_mj._util.files import check_output_path
     from wmr_mj._util.memory import require_run_memory
-    from wmr_mj.cli._common import print_json
+    from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE
+    from wmr_mj.cli._common import CLAIM_BROKEN_EXIT, print_json
+    from wmr_mj.logs.writer import LogOptions, RunLogger, terminate_as_interrupt
     from wmr_mj.plant.mjcf import TIMESTEP
     from wmr_mj.sim.closed_loop import run_parts
     from wmr_mj.sim.parts import resolve_run
@@ -349,76 +364,26 @@ def run(args: argparse.Namespace) -> int:
     requirements = requirements_from_args(args, period)
     factory = None
     if path is not None:
-        from wmr_mj.logs.writer import LogOptions, RunLogger
-
         factory = functools.partial(RunLogger, path, options=LogOptions(log_every=args.log_every, background=True))
-    from wmr_mj.logs.writer import terminate_as_interrupt
-
     parts = resolve_run(config)  # the run's law, reference and claim, built once
     note = no_estimate_note(parts)
     if note:
         print(f"wmr-mj: note: {note}", file=sys.stderr)
     with terminate_as_interrupt():
         result = run_parts(parts, logger_factory=factory, progress=args.progress)
-    if result.law_note:
-        from wmr_mj.sim.config import plugin_source
-
-        if plugin_source(config) is None:
-            print(f"wmr-mj: the Python law ran ({result.law_note}); the numbers are the same, the run slower",
-                  file=sys.stderr)
-        else:
-            from wmr_mj.sim.engine import law_path
-
-            print(f"wmr-mj: controller {result.summary.controller!r} runs {law_path(result.law)} ({result.law_note})",
-                  file=sys.stderr)
-    elif result.law == "compiled":
-        from wmr_mj.sim.config import plugin_source
-
-        if plugin_source(config) is not None:  # a plug-in in the callback: its pure law function, compiled
-            print(f"wmr-mj: controller {result.summary.controller!r} compiled by numba into MuJoCo's control "
-                  "callback, no Python per control step", file=sys.stderr)
+    law_note = _law_note(result, config)
+    if law_note:
+        print(f"wmr-mj: {law_note}", file=sys.stderr)
     if result.summary.failure is not None:
         print(f"wmr-mj: the run failed: {result.summary.failure}", file=sys.stderr)
-    judged = None
-    if requirements:
-        from wmr_mj.analysis.requirements import evaluate_run
-        from wmr_mj.sim.closed_loop import requirement_rows
-
-        judged = [r.as_dict() for r in evaluate_run(requirements, requirement_rows(result, requirements),
-                                                    result.summary.to_dict(),
-                                                    period=period)]
-    report = {**result.summary.to_dict(), "log": path, **({"requirements": judged} if judged else {})}
-    cause = measurement_cause(result.summary, parts.measurement)
-    if cause is not None:  # the errors the claim assumed, and which keeps its fixed point open (an ideal cart: none)
-        report["measurement_errors"] = cause.to_dict()
-    if config.signals is not None:
-        report["signals"] = config.signals.as_dict()  # every parameter: --signals takes it back
-    from wmr_mj.cli._common import add_controller_source
-    from wmr_mj.hardware import cart_dict, cart_line, is_ideal_cart
-
-    add_controller_source(report, config)
-    report.update(cart_dict(config))  # the parts that are not ideal: an ideal run's JSON keeps its keys
+    report = result.to_dict(measurement=parts.measurement, log=path, requirements=requirements, period=period)
     if args.json:
         print_json(report)
     else:
-        print(format_report(result.summary, measurement=parts.measurement))
-        if not is_ideal_cart(config):
-            print(cart_line(config))
-        if judged:
-            print("\n".join(format_requirements(judged)))
-        if config.signals is not None:
-            import json
-
-            print(f"signals: {json.dumps(report['signals'], separators=(',', ':'))}")
-            print(f"reproduce: add --signals '{json.dumps(report['signals'], separators=(',', ':'))}'")
-        if path:
-            print(f"log: {path}")
+        _print_text(result, parts, report, path)
     if result.status == "interrupted":
         print("wmr-mj: interrupted; the log holds what was simulated", file=sys.stderr)
         return 130
     if result.status == "failed":
         return 1  # the law failed mid-run: the report and the log hold what ran before it
-    from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE
-    from wmr_mj.cli._common import CLAIM_BROKEN_EXIT
-
     return CLAIM_BROKEN_EXIT if result.summary.verdict == CERTIFIED_OUTSIDE else 0

@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 import argparse
+from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from wmr_mj.cli._common import CLAIM_BROKEN_EXIT, positive_int
 from wmr_mj.cli.options import add_json, add_out, add_seed, add_threads
@@ -83,79 +84,86 @@ def fixed_m1_from_args(args: argparse.Namespace) -> float | None:
     return lo
 
 
-def run(args: argparse.Namespace) -> int:
-    import functools
-    import time
-
-    from wmr_mj._util.files import check_output_path, write_json_atomic
-    from wmr_mj._util.progress import counter_callback, progress_bar
-    from wmr_mj.cli._common import box_ranges_from_args, hardware_ranges_from_args, print_json
+def _spec_from_args(args: argparse.Namespace) -> tuple[Any, Any]:
+    """The sweep of the options, and its base's resolved parts (what the runs would raise, a law's claim() that
+    raises, is one line here, before any output)."""
+    from wmr_mj.cli._common import box_ranges_from_args, hardware_ranges_from_args
     from wmr_mj.cli.run import config_from_args, requirements_from_args
     from wmr_mj.errors import ParameterError
     from wmr_mj.plant.mjcf import TIMESTEP
-    from wmr_mj.sim.sweep import SweepSpec, SweepSummary, run_sweep
+    from wmr_mj.sim.parts import resolve_run
+    from wmr_mj.sim.sweep import SweepSpec
 
     if args.n < 1:
         raise ParameterError(f"--n {args.n} is not accepted; the number of runs must be >= 1")
     fixed_m1 = fixed_m1_from_args(args)  # --m1 or a zero-width --m1-range: m1 not drawn
     # --uncertainty (default m1), then --range: the plant's, then the cart's axes (drawn, not in the box)
     ranges = {**box_ranges_from_args(args), **hardware_ranges_from_args(args)}
-    out = check_output_path(args.out or f"logs/sweep-{time.strftime('%Y%m%d-%H%M%S')}", kind="dir", option="--out")
     base = config_from_args(args)
-    from wmr_mj.sim.parts import resolve_run
-
-    # what the runs would raise (a law's claim() that raises): one line, before any output
     base_parts = resolve_run(base)
     requirements = tuple(r.text for r in requirements_from_args(args, args.control_period or TIMESTEP))
     spec = SweepSpec(n=args.n, seed=args.seed, sampling=args.sampling, m1_range=tuple(args.m1_range),
                      ranges=ranges, base=base, requirements=requirements, m1=fixed_m1)
+    return spec, base_parts
+
+
+def _log_runs(spec: Any, rows: Any, logs_dir: Path) -> None:
+    """--log: each run again with its MCAP log, ``run-NNNNN.mcap`` in ``logs_dir``."""
+    import functools
+
+    from wmr_mj.logs.writer import RunLogger
+    from wmr_mj.sim.closed_loop import run_closed_loop
+
+    for r in rows:
+        cfg = spec.config_at([r[k] for k in spec.names])
+        run_closed_loop(cfg, logger_factory=functools.partial(RunLogger, logs_dir / f"run-{r['run']:05d}.mcap"),
+                        progress=False)
+
+
+def run(args: argparse.Namespace) -> int:
+    import time
+
+    from wmr_mj._util.files import check_output_path, write_json_atomic
+    from wmr_mj._util.progress import counter_callback, progress_bar
+    from wmr_mj.cli._common import print_json
+    from wmr_mj.sim.sweep_result import sweep
+
+    out = check_output_path(args.out or f"logs/sweep-{time.strftime('%Y%m%d-%H%M%S')}", kind="dir", option="--out")
+    spec, base_parts = _spec_from_args(args)
     t0 = time.perf_counter()
     with progress_bar(spec.n, desc="sweep", unit="runs", fractional=True) as bar:
-        results = run_sweep(spec, out_dir=out, chunk=args.chunk, nthread=args.nthread, scheduler=args.scheduler,
-                            progress=counter_callback(bar))
+        result = sweep(spec, out_dir=out, chunk=args.chunk, nthread=args.nthread, scheduler=args.scheduler,
+                       progress=counter_callback(bar))
     wall = time.perf_counter() - t0
-    runs = SweepSummary.of(results, spec.requirements, names=spec.names)  # the one aggregator of sweep and validate
-    summary = runs.sweep_dict(wall)
-    summary.update({"folder": str(out), "model": base.model, "controller": base.controller, "seed": args.seed,
-                    "sampling": args.sampling,
-                    "ranges": {"m1": list(args.m1_range), **{k: list(v) for k, v in ranges.items()}}})
-    if fixed_m1 is not None:  # every run's m1 (ranges' m1: the certificate's box)
-        summary["fixed_m1"] = fixed_m1
-    if base.signals is not None:
-        summary["signals"] = base.signals.as_dict()  # every run's, with every parameter
-    from wmr_mj.cli._common import add_controller_source
-    from wmr_mj.hardware import cart_dict, cart_line, is_ideal_cart
-    from wmr_mj.sim.search_space import HARDWARE_AXES
-
-    add_controller_source(summary, base)
-    summary.update(cart_dict(base))  # the cart every run shares, where not ideal
-    if spec.hardware_names:  # and the cart's axes each run draws, with what a drawn value becomes
-        summary["hardware_axes"] = {n: HARDWARE_AXES[n] for n in spec.hardware_names}
-    plot_path = _plot(results, runs, out / "region")
+    runs = result.summary  # the one aggregator of sweep and validate
+    summary = result.report(wall_s=wall, folder=out)
+    plot_path = _plot(result.rows, runs, out / "region")
     summary["plot"] = str(plot_path)
     if args.log:
-        from wmr_mj.logs.writer import RunLogger
-        from wmr_mj.sim.closed_loop import run_closed_loop
-
-        logs_dir = out / "mcap"
-        for r in results:
-            cfg = spec.config_at([r[k] for k in spec.names])
-            run_closed_loop(cfg, logger_factory=functools.partial(RunLogger, logs_dir / f"run-{r['run']:05d}.mcap"),
-                            progress=False)
-        summary["mcap_dir"] = str(logs_dir)
+        _log_runs(spec, result.rows, out / "mcap")
+        summary["mcap_dir"] = str(out / "mcap")
     write_json_atomic(out / "summary.json", summary)
     status = CLAIM_BROKEN_EXIT if runs.claim_broken is not None else 0
     if args.json:
         print_json(summary)
-        return status
-    fmt = lambda x: "n/a" if x is None else f"{x:.3f}"  # noqa: E731
-    from wmr_mj.sim.config import estimate_of
+    else:
+        _print_text(spec, runs, base_parts.controller, summary, wall)
+        print(f"table: {out / 'runs.csv'}\nplot:  {plot_path}")
+    return status
 
-    law = base_parts.controller
-    label = law.label()
-    m1_text = (f"m1 fixed at {fixed_m1:g} kg" if fixed_m1 is not None
-               else f"m1 over {args.m1_range[0]:g}-{args.m1_range[1]:g} kg")
-    print(f"{runs.n} runs ({label}, {m1_text}, {args.sampling}, seed {args.seed}):")
+
+def _print_text(spec: Any, runs: SweepSummary, law: Any, summary: dict[str, Any], wall: float) -> None:
+    """The sweep's report as text (``--json`` prints ``summary`` instead)."""
+    from wmr_mj.analysis.verdicts import PAPER_CLAIM_NOT_APPLICABLE
+    from wmr_mj.hardware import cart_line, is_ideal_cart
+    from wmr_mj.sim.config import estimate_of
+    from wmr_mj.sim.engine import law_path
+
+    fmt = lambda x: "n/a" if x is None else f"{x:.3f}"  # noqa: E731
+    base = spec.base
+    m1_text = (f"m1 fixed at {spec.m1:g} kg" if spec.m1 is not None
+               else f"m1 over {spec.m1_range[0]:g}-{spec.m1_range[1]:g} kg")
+    print(f"{runs.n} runs ({law.label()}, {m1_text}, {spec.sampling}, seed {spec.seed}):")
     if not is_ideal_cart(base) or spec.hardware_names:
         drawn = f" (drawn per run: {', '.join(spec.hardware_names)})" if spec.hardware_names else ""
         print(cart_line(base) + drawn)
@@ -165,8 +173,6 @@ def run(args: argparse.Namespace) -> int:
           f"worst sup|E'|/Edot_max = {fmt(runs.certificate_Edot_ratio.value)}; "
           f"{runs.growing} runs with |E| still growing at the end")
     if estimate_of(law) is None or runs.paper_inside is None:
-        from wmr_mj.analysis.verdicts import PAPER_CLAIM_NOT_APPLICABLE
-
         print(f"paper's claim: {PAPER_CLAIM_NOT_APPLICABLE}")
     else:
         print(f"paper's claim: {runs.paper_inside} inside, {runs.n - runs.paper_inside} outside its region; "
@@ -183,12 +189,8 @@ def run(args: argparse.Namespace) -> int:
                  else f"{req.min_robustness:+.5g} (run {req.run}, m1 = {req.m1:g} kg)")
         print(f"requirement {req.requirement}: {req.satisfied} hold, {req.violated} violated"
               + (f", {req.undefined} without a region" if req.undefined else "") + f"; least robustness {least}")
-    from wmr_mj.sim.engine import law_path
-
     backend = f"; the law ran {' and '.join(law_path(b) for b in runs.batch_law)}" if runs.batch_law else ""
     print(f"{runs.steps} steps in {wall:.1f} s ({summary['steps_per_s']:.3g} steps/s{backend})")
-    print(f"table: {out / 'runs.csv'}\nplot:  {plot_path}")
-    return status
 
 
 def effort_lines(runs: SweepSummary) -> list[str]:
@@ -228,7 +230,7 @@ def claim_lines(runs: SweepSummary) -> list[str]:
     return lines
 
 
-def _plot(results: list[dict], runs: SweepSummary, stem: Path) -> Path:
+def _plot(results: Sequence[Mapping[str, Any]], runs: SweepSummary, stem: Path) -> Path:
     """Fig.-7-style plot ``<stem>.png``: the bounds a run is judged by (sup|E| <= E_max and
     sup|E'| <= E'_max, the sweep's inside/outside) and every run's (sup|E|, sup|E'|)."""
     import math

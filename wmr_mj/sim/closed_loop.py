@@ -58,6 +58,7 @@ from wmr_mj.sim.engine import (
 from wmr_mj.sim.log_header import LogHeader
 from wmr_mj.sim.measured_errors import with_measured_errors
 from wmr_mj.sim.parts import RunLabels, RunParts, control_substeps, resolve_run, run_reference
+from wmr_mj.sim.run_report import run_report
 from wmr_mj.sim.summary import RunSummary, voltage_effort
 
 __all__ = ["RunResult", "RunMeasures", "run_closed_loop", "report", "run_on_reduced_model", "ROW_FIELDS", "judge_path",
@@ -84,6 +85,20 @@ class RunResult:
     # every claim of the run (RunParts.claims), with what the run measured of it, judged against its sup|E|,
     # sup|E'|, by name; the law's (LAW_CLAIM) is summary.certificate. Empty where the law failed.
     claims: Mapping[str, CertificateJudgement] = dataclasses.field(default_factory=dict)
+
+    def to_dict(self, *, measurement: Any = None, log: str | None = None, requirements: Sequence[Any] = (),
+                period: float | None = None) -> dict[str, Any]:
+        """The run's JSON, as ``wmr-mj run --json`` prints it (:func:`wmr_mj.sim.run_report.run_report`).
+
+        Args:
+            measurement: the run's measurement errors (``RunParts.measurement``): its claim's assumed errors.
+            log: the run's MCAP log (the JSON's ``log``), or None.
+            requirements: parsed requirements judged on the run (:func:`judge_requirements`) at the control
+                period ``period`` [s] (None: the config's, else the physics step).
+        """
+        period = (self.config.control_period or TIMESTEP) if period is None else period
+        judged = judge_requirements(self, requirements, period=period) if requirements else []
+        return run_report(self, measurement=measurement, log=log, judged=judged)
 
     # -- in a notebook (wmr_mj.sim.notebook): the rows as a table, the figure, the verdict in a few lines
     def to_pandas(self) -> Any:

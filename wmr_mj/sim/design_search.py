@@ -42,10 +42,13 @@ from typing import Any
 
 import numpy as np
 
+from wmr_mj.analysis.claim_types import Assumption
 from wmr_mj.errors import ParameterError
+from wmr_mj.hardware import Actuation, Sensing, Transmission
 from wmr_mj.sim.coerce import coerced
 from wmr_mj.sim.design_options import DEFAULT_BUDGET, DEFAULT_SEED, LAWS, METHODS, OBJECTIVES
 from wmr_mj.sim.optimisers import CMAES, Chain, DifferentialEvolution, Optimiser, Points, drive
+from wmr_mj.sim.records import Record
 
 __all__ = ["DesignProblem", "DesignResult", "OBJECTIVES", "METHODS", "LAWS", "DEFAULT_SEED", "DEFAULT_BUDGET",
            "DESIGN_FIELDS", "law_changes", "uncovered", "search_design", "evaluate_design", "write_design",
@@ -98,6 +101,77 @@ class DesignProblem:
 
 
 @dataclass(frozen=True, kw_only=True)
+class DesignCertificate(Record):
+    """A path's certificate as the design file records it (:meth:`DesignResult.from_dict` reads it back in place
+    of the live :class:`~wmr_mj.analysis.certificate.Certificate`; it answers the same attributes a design reads).
+
+    Attributes:
+        certified: every assumption met.
+        E_max: the bound on |E| [rad]; None where the certificate has no valid bound.
+        voltage_max: the bound on |u| [V]; None likewise.
+        reason: why there is no valid bound ('' where there is one).
+        certificate: which analysis gave it (:func:`wmr_mj.sim.certify.certificate_name`).
+        assumptions: its assumptions, each with its value and limit.
+    """
+
+    certified: bool
+    E_max: float | None
+    voltage_max: float | None
+    reason: str
+    certificate: str
+    assumptions: tuple[Assumption, ...] = ()
+
+    @property
+    def valid(self) -> bool:
+        """The certificate has a bound (the file records E_max only then)."""
+        return self.E_max is not None
+
+    @property
+    def Edot_max(self) -> None:
+        """Not recorded in the design file: None."""
+        return None
+
+    @property
+    def inputs(self) -> dict[str, str]:
+        """What :func:`~wmr_mj.sim.certify.certificate_name` reads: the analysis that gave it."""
+        return {"certificate": self.certificate}
+
+    @property
+    def analysis(self) -> str:
+        """The analysis that gave it (as :attr:`inputs` says)."""
+        return self.certificate
+
+    @classmethod
+    def of(cls, cert: Any) -> DesignCertificate:
+        """The record of a live certificate (a record is itself)."""
+        from wmr_mj.sim.certify import certificate_name
+
+        if isinstance(cert, DesignCertificate):
+            return cert
+        return cls(certified=cert.certified, E_max=cert.E_max if cert.valid else None,
+                   voltage_max=cert.voltage_max if cert.valid else None, reason=cert.reason,
+                   certificate=certificate_name(cert), assumptions=tuple(cert.assumptions))
+
+    def to_dict(self) -> dict[str, Any]:
+        """The design file's ``certificates[path]``."""
+        return {"certified": self.certified, "E_max": self.E_max, "voltage_max": self.voltage_max,
+                "reason": self.reason, "certificate": self.certificate,
+                "assumptions": [a.as_dict() for a in self.assumptions]}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> DesignCertificate:
+        """The record of ``certificates[path]`` (an assumption's None value or limit: NaN, as it was written)."""
+        def number(value: Any) -> float:
+            return math.nan if value is None else float(value)
+
+        assumptions = tuple(Assumption(name=a["name"], equation=a["equation"], met=a["met"], value=number(a["value"]),
+                                       limit=number(a["limit"]), note=a["note"], kind=a["kind"])
+                            for a in d["assumptions"])
+        return cls(certified=d["certified"], E_max=d["E_max"], voltage_max=d["voltage_max"], reason=d["reason"],
+                   certificate=d["certificate"], assumptions=assumptions)
+
+
+@dataclass(frozen=True, kw_only=True)
 class DesignResult:
     """The design found.
 
@@ -134,6 +208,35 @@ class DesignResult:
     def E_max(self) -> float:
         """The worst E_max over the paths, rad (inf where a certificate has none)."""
         return max((c.E_max if c is not None and c.valid else math.inf) for c in self.certificates.values())
+
+    def to_dict(self) -> dict[str, Any]:
+        """The design file's content (:func:`design_dict`: what ``design --out`` writes and ``run --design``
+        reads)."""
+        return design_dict(self)
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> DesignResult:
+        """The design of its file's content ``d`` (:meth:`to_dict`): the settings as the run's parts, each path's
+        certificate as the file records it (:class:`DesignCertificate`)."""
+        settings = dict(d["settings"])
+        law_parameters: tuple[Any, ...] = ()
+        if "controller_params" in settings:  # the law's own parameters: the sign's shape among them, as a run has it
+            law_parameters = tuple(settings["controller_params"])
+            settings["controller_params"] = {**settings["controller_params"],
+                                             "friction_sign": settings["friction_sign"],
+                                             "friction_width": settings["friction_width"]}
+        else:
+            settings["controller_params"] = {}
+        settings.update(sensing=Sensing.from_spec(settings["sensing"]),
+                        actuation=Actuation.from_spec(settings["actuation"]),
+                        transmission=Transmission(backlash=settings.pop("backlash")))
+        search = d["search"]
+        return cls(settings={k: settings[k] for k in DESIGN_FIELDS}, certified=d["certified"], score=search["score"],
+                   certificates={p: None if c is None else DesignCertificate.from_dict(c)
+                                 for p, c in d["certificates"].items()},
+                   binding=d["binding"], evaluations=search["evaluations"], objective=search["objective"],
+                   seed=search["seed"], periods=tuple(search["periods"]), paths=tuple(search["paths"]), box=d["box"],
+                   cart=d.get("cart"), law_parameters=law_parameters)
 
     # -- in a notebook (wmr_mj.sim.notebook): each path's certificate as a table, the design in a few lines
     def to_pandas(self) -> Any:
@@ -458,14 +561,7 @@ def design_lines(result: DesignResult) -> list[str]:
 
 
 def _certificate_dict(cert: Any) -> dict[str, Any] | None:
-    from wmr_mj.sim.certify import certificate_name
-
-    if cert is None:
-        return None
-    return {"certified": cert.certified, "E_max": cert.E_max if cert.valid else None,
-            "voltage_max": cert.voltage_max if cert.valid else None, "reason": cert.reason,
-            "certificate": certificate_name(cert),
-            "assumptions": [a.as_dict() for a in cert.assumptions]}
+    return None if cert is None else DesignCertificate.of(cert).to_dict()
 
 
 def design_dict(result: DesignResult) -> dict[str, Any]:

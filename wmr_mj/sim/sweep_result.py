@@ -15,20 +15,22 @@ Usage::
 
 from __future__ import annotations
 
+import json
 import os
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from wmr_mj.sim.sweep import SweepSpec, SweepSummary, run_sweep
+from wmr_mj.hardware import cart_dict
+from wmr_mj.sim.run_report import add_controller_source
+from wmr_mj.sim.search_space import HARDWARE_AXES
+from wmr_mj.sim.sweep import SweepSpec, SweepSummary, run_sweep, spec_from_json, spec_to_json
 
 __all__ = ["SweepResult", "sweep", "parameter_units"]
 
 
 def parameter_units(names: tuple[str, ...]) -> dict[str, str]:
     """Each ranged parameter -> its unit (m1 in kg, a cart axis as ``HARDWARE_AXES`` says); others none."""
-    from wmr_mj.sim.search_space import HARDWARE_AXES
-
     units = {"m1": "kg"}
     for name in names:
         text = HARDWARE_AXES.get(name)
@@ -50,6 +52,45 @@ class SweepResult:
     spec: SweepSpec
     rows: tuple[Mapping[str, Any], ...]
     summary: SweepSummary
+
+    def to_dict(self) -> dict[str, Any]:
+        """The sweep's JSON: ``spec`` (as sweep.json and the workers read it: its base as ``RunConfig.as_dict``),
+        ``rows`` (each run's row, in run order) and ``summary`` (:meth:`SweepSummary.to_dict`)."""
+        return {"spec": json.loads(spec_to_json(self.spec)), "rows": [dict(row) for row in self.rows],
+                "summary": self.summary.to_dict()}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> SweepResult:
+        """The result of its JSON ``d`` (what :meth:`to_dict` wrote)."""
+        return cls(spec=spec_from_json(json.dumps(d["spec"])), rows=tuple(dict(row) for row in d["rows"]),
+                   summary=SweepSummary.from_dict(d["summary"]))
+
+    def report(self, *, wall_s: float, folder: str | os.PathLike) -> dict[str, Any]:
+        """``wmr-mj sweep --json`` (summary.json of the sweep's folder, before the CLI adds its figure's ``plot``
+        and ``mcap_dir``): :meth:`SweepSummary.sweep_dict`, then the sweep's folder, law, seed, sampling and
+        ranges, its fixed m1, signals, the law's source, the cart and the cart's axes drawn per run.
+
+        It is not :meth:`to_dict`: the CLI's JSON keeps the keys it always had (no rows: runs.csv holds them), and
+        ``to_dict`` is the whole result, which ``from_dict`` reads back.
+
+        Args:
+            wall_s: the sweep's wall time [s] (its steps per second).
+            folder: the sweep's folder (runs.csv, summary.json).
+        """
+        spec, base = self.spec, self.spec.base
+        out = self.summary.sweep_dict(wall_s)
+        out.update({"folder": str(folder), "model": base.model, "controller": base.controller, "seed": spec.seed,
+                    "sampling": spec.sampling,
+                    "ranges": {"m1": list(spec.m1_range), **{k: list(v) for k, v in spec.ranges.items()}}})
+        if spec.m1 is not None:  # every run's m1 (ranges' m1: the certificate's box)
+            out["fixed_m1"] = spec.m1
+        if base.signals is not None:
+            out["signals"] = base.signals.as_dict()  # every run's, with every parameter
+        add_controller_source(out, base)
+        out.update(cart_dict(base))  # the cart every run shares, where not ideal
+        if spec.hardware_names:  # and the cart's axes each run draws, with what a drawn value becomes
+            out["hardware_axes"] = {n: HARDWARE_AXES[n] for n in spec.hardware_names}
+        return out
 
     def to_pandas(self) -> Any:
         """One row per run: the values each run used (m1 and every ranged parameter, with units), its verdict,

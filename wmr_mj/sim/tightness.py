@@ -20,16 +20,17 @@ from __future__ import annotations
 import math
 from collections import Counter
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 from wmr_mj.sim.coerce import coerced
+from wmr_mj.sim.records import Record
 
 __all__ = ["CartTightness", "cart_tightness", "certificate_columns"]
 
 
 @dataclass(frozen=True, kw_only=True)
-class CartTightness:
+class CartTightness(Record):
     """One cart on one path: the run's certificate and the worst the adversary found.
 
     Attributes:
@@ -67,6 +68,16 @@ class CartTightness:
     def tightness(self) -> float | None:
         """worst_sup_E / E_max (None where there is no E_max)."""
         return None if self.E_max is None else self.worst_sup_E / self.E_max
+
+    def to_dict(self) -> dict[str, Any]:
+        """Its fields in order (the box's ranges as lists), then ``tightness``."""
+        return {**super().to_dict(), "tightness": self.tightness}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> CartTightness:
+        """The row of its JSON ``d`` (:meth:`to_dict`'s; ``tightness`` is computed again, not read)."""
+        row = super().from_dict(d)
+        return replace(row, box={k: (float(lo), float(hi)) for k, (lo, hi) in row.box.items()})
 
     # -- in a notebook (wmr_mj.sim.notebook): a one-row table (rows of several carts concatenate), a few lines
     def to_pandas(self) -> Any:
