@@ -20,6 +20,7 @@ import importlib
 import sys
 from collections.abc import Collection, Sequence
 
+from wmr_mj.cli._common import m1_of_param
 from wmr_mj.errors import WmrMjError
 
 COMMANDS = ("identify", "robustness", "run", "replay", "sweep", "falsify", "compare", "validate", "figures", "model",
@@ -85,6 +86,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     args = build_parser(_commands_of(argv)).parse_args(argv)
     try:
+        m1_of_param(args)  # --param m1=KG is --m1 KG wherever --m1 is an option
         return int(args.func(args) or 0)
     except WmrMjError as exc:
         print(f"wmr-mj: error: {exc}", file=sys.stderr)

@@ -309,6 +309,13 @@ def format_report(s: RunSummary, *, measurement: Any = None) -> str:
         f"{num(cert_Edot_max):>12s} {ratio(cert_Edot_ratio):>8s}" + paper(s.Edot_max, s.Edot_ratio),
         f"voltage saturated {100 * s.saturated_fraction:.1f}% of the time",
     ]
+    if s.mujoco_warnings:  # counted over the run and said once here (MuJoCo's console printing is held)
+        from wmr_mj.sim.closed_loop import MUJOCO_WITHOUT_WARNINGS
+
+        said = next((a.note for a in (cert.assumptions if cert is not None else ())
+                     if a.name == MUJOCO_WITHOUT_WARNINGS), "")
+        lines.append(f"MuJoCo warned {s.mujoco_warnings} time(s) during the run; the run is not certified "
+                     f"(its steps MuJoCo warned of are not the plant the claim is of){': ' + said if said else ''}")
     if s.path_error is not None:
         pe = s.path_error
         lines.append(f"path of C: cross-track max {pe.cross_track_max:.4g} m, rms {pe.cross_track_rms:.4g} m; "

@@ -55,9 +55,9 @@ from wmr_mj.reference.paths import Path as PathOfC
 from wmr_mj.reference.route import Route, is_route_spec, load_route, route_from_path, route_names
 from wmr_mj.sim.signals import Signals, signals_from
 
-__all__ = ["PATH_NAMES", "coerce", "coerce_with_classes", "is_coerced", "check_fields", "route_of", "cart_file",
-           "base_for", "plant_parameters", "plugin_source", "controller_source", "controller_name", "default_model",
-           "check_motor_constant", "coerced"]
+__all__ = ["PATH_NAMES", "coerce", "m1_of_overrides", "coerce_with_classes", "is_coerced", "check_fields", "route_of",
+           "cart_file", "base_for", "plant_parameters", "plugin_source", "controller_source", "controller_name",
+           "default_model", "check_motor_constant", "coerced"]
 
 PATH_NAMES = ("paper-circle", "lane-change", "figure-eight")
 
@@ -122,6 +122,25 @@ def check_fields(config: Any) -> None:
                                 plant_overrides=config.plant_overrides)
         m1 = M1_NOMINAL if config.m1 is None else config.m1
         _check_parts(typed, C80, with_params(C80, m1_inertia=config.m1_inertia, m1=m1, **dict(config.plant_overrides)))
+
+
+def m1_of_overrides(m1: Any, overrides: Any) -> tuple[Any, Any]:
+    """(m1, the other overrides): a plant override of m1 (``plant_overrides={"m1": 700}``, ``--param m1=700``) is the
+    config's m1 (the one mass of the run: ``with_params`` takes m1 once); ``overrides`` unchanged where it names no m1.
+
+    Raises:
+        ParameterError: m1 given as a field and as an override with different values (one line).
+    """
+    if not isinstance(overrides, Mapping) or "m1" not in overrides:
+        return m1, overrides
+    try:
+        mass = float(overrides["m1"])
+    except (TypeError, ValueError):
+        raise ParameterError(f"plant_overrides m1 = {overrides['m1']!r} is not accepted; a number of kg") from None
+    if m1 is not None and m1 != mass:
+        raise ParameterError(f"m1 = {m1!r} kg and plant_overrides m1 = {mass!r} kg (--m1 and --param m1=) give two "
+                             "masses; give one of them")
+    return mass, {k: v for k, v in overrides.items() if k != "m1"}
 
 
 def _is_inline(signals: Any) -> bool:
