@@ -89,7 +89,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         m1_of_param(args)  # --param m1=KG is --m1 KG wherever --m1 is an option
         return int(args.func(args) or 0)
     except WmrMjError as exc:
-        print(f"wmr-mj: error: {exc}", file=sys.stderr)
+        print(f"wmr-mj: error: {_with_where_duration_came_from(str(exc), args)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("wmr-mj: interrupted", file=sys.stderr)
@@ -103,3 +103,13 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 if __name__ == "__main__":
     sys.exit(main())
+
+
+def _with_where_duration_came_from(message: str, args: argparse.Namespace) -> str:
+    """``message``, and where a refused duration came from when the user gave none: the default --duration."""
+    from wmr_mj.cli.run_options import DEFAULT_DURATION
+
+    if "duration = " in message and getattr(args, "duration", None) is DEFAULT_DURATION:
+        return (f"{message} (the duration is --duration's default, {DEFAULT_DURATION:g} s, as none was given; "
+                "give --duration)")
+    return message

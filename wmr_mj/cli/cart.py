@@ -46,6 +46,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="length of the identification's excitation, s (default 20)")
     p.add_argument("--seed", type=int, default=0, help="seed of the random controls and the excitation (default 0)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--path", metavar="NAME|FILE", default=None,
+                   help="check: the path the certified design and the design search answer for (a path name, a "
+                        "packaged route or a route file; default: the cart's own, [paths] default in its file, "
+                        "else paper-circle)")
     p.add_argument("--out", metavar="PATH", default=None,
                    help="card: the Markdown file to write (default: logs/<cart file's stem>-card.md)")
     p.set_defaults(func=run)
@@ -87,8 +91,8 @@ def _answer(cart: Any, steps: Any, ident: Any, ident_error: str | None) -> str:
             "P, C_V, F, K, gyro are those the file implies")
 
 
-def certified_on_cart(cart: Any) -> dict[str, Any]:
-    """The certified design on ``cart`` (a checked CartFile) and its certificate on the paper circle with the cart's
+def certified_on_cart(cart: Any, path: str = "paper-circle") -> dict[str, Any]:
+    """The certified design on ``cart`` (a checked CartFile) and its certificate on ``path`` with the cart's
     default sensing, actuation and play: omega_r [rad/s], kp, kd, certified, E_max [rad], Edot_max [rad/s],
     voltage_max [V], voltage_limit [V], met, unmet (assumption names); or omega_r None and 'reason' where the rule
     finds no omega_r on its grid."""
@@ -98,20 +102,21 @@ def certified_on_cart(cart: Any) -> dict[str, Any]:
     from wmr_mj.sim.parts import resolve_run
 
     try:  # a paper circle the cart's supply or stops cannot follow: the cart's answer, not the user's input
-        design = certified_design(cart)
-        claim = resolve_run(RunConfig(**design.config_changes(), cart=cart)).claim
+        design = certified_design(cart, path=path)
+        claim = resolve_run(RunConfig(**design.config_changes(), cart=cart, path=path)).claim
     except (ParameterError, InfeasiblePathError) as exc:
-        return {"omega_r": None, "reason": str(exc)}
+        return {"omega_r": None, "reason": str(exc), "path": path}
     assert claim is not None  # the computed-torque law always states its certificate
     return {"omega_r": design.kd, "kp": design.kp, "kd": design.kd, "certified": claim.certified,
             "E_max": claim.E_max, "Edot_max": claim.Edot_max, "voltage_max": claim.voltage_max,
             "voltage_limit": float(cart.parameters["voltage_limit"]),
-            "met": [a.name for a in claim.assumptions if a.met], "unmet": list(claim.unmet)}
+            "met": [a.name for a in claim.assumptions if a.met], "unmet": list(claim.unmet), "path": path}
 
 
-def design_on_cart(cart: Any, *, seed: int | None = None, budget: int | None = None) -> dict[str, Any]:
+def design_on_cart(cart: Any, *, seed: int | None = None, budget: int | None = None,
+                   path: str = "paper-circle") -> dict[str, Any]:
     """Can ``wmr-mj design`` certify ``cart`` (a checked CartFile) on its default sensing, actuation and play? The
-    design search on the paper circle over the cart's m1 box, computed-torque law, 1 ms period, E_max minimised.
+    design search on ``path`` over the cart's m1 box, computed-torque law, 1 ms period, E_max minimised.
 
     Returns:
         certified; where certified: E_max [rad], voltage_max [V], kp [1/s^2], kd [1/s], friction_width [rad/s];
@@ -120,6 +125,7 @@ def design_on_cart(cart: Any, *, seed: int | None = None, budget: int | None = N
         (:data:`~wmr_mj.sim.design_search.DEFAULT_SEED`, :data:`~wmr_mj.sim.design_search.DEFAULT_BUDGET`).
     """
     from wmr_mj.errors import InfeasiblePathError
+    from wmr_mj.sim.coerce import default_path
     from wmr_mj.sim.config import RunConfig
     from wmr_mj.sim.design_search import (
         DEFAULT_BUDGET,
@@ -133,22 +139,23 @@ def design_on_cart(cart: Any, *, seed: int | None = None, budget: int | None = N
     seed = DEFAULT_SEED if seed is None else seed
     budget = DEFAULT_BUDGET if budget is None else budget
     command = (f"wmr-mj design --cart {cart.path} --seed {seed}"
-               + ("" if budget == DEFAULT_BUDGET else f" --budget {budget}"))
-    out: dict[str, Any] = {"budget": budget, "seed": seed, "command": command}
+               + ("" if budget == DEFAULT_BUDGET else f" --budget {budget}")
+               + ("" if path == default_path(cart) else f" --path {path}"))
+    out: dict[str, Any] = {"budget": budget, "seed": seed, "command": command, "path": path}
     base = RunConfig.from_inputs(**law_changes("computed-torque"), cart=cart)
     why_not = uncovered(base)
     if why_not:  # design refuses such a cart's sensing (no certificate can cover it)
         return {**out, "certified": False, "evaluations": 0,
                 "binding": f"the default sensing ({why_not}: no certificate covers it)"}
     try:
-        result = search_design(DesignProblem(base=base, seed=seed, budget=budget))
-    except InfeasiblePathError as exc:  # the cart cannot follow the paper circle: no gains certify it
-        return {**out, "certified": False, "evaluations": 0, "binding": f"the paper circle's feasibility ({exc})"}
+        result = search_design(DesignProblem(base=base, seed=seed, budget=budget, paths=(path,)))
+    except InfeasiblePathError as exc:  # the cart cannot follow the path: no gains certify it
+        return {**out, "certified": False, "evaluations": 0, "binding": f"the path {path}'s feasibility ({exc})"}
     out.update(certified=result.certified, evaluations=result.evaluations)
     if not result.certified:
         return {**out, "binding": result.binding}
     s = result.settings
-    return {**out, "E_max": result.E_max, "voltage_max": result.certificates["paper-circle"].voltage_max,
+    return {**out, "E_max": result.E_max, "voltage_max": result.certificates[path].voltage_max,
             "kp": s["kp"], "kd": s["kd"], "friction_width": s["friction_width"]}
 
 
@@ -168,7 +175,7 @@ def _certified_line(c: dict[str, Any]) -> str:
     head = (f"certified design on this cart: omega_r = {c['omega_r']:g} rad/s (K_P = {c['kp']:g}, K_D = {c['kd']:g}, "
             "the rule of wmr_mj/sim/designs.py run on the cart): ")
     numbers = (f"E_max = {c['E_max']:.4g} rad, |E'| <= {c['Edot_max']:.4g} rad/s, |u| <= {c['voltage_max']:.4g} V "
-               f"of the {c['voltage_limit']:g} V supply, on the cart's default sensing")
+               f"of the {c['voltage_limit']:g} V supply, on the cart's default sensing, path {c['path']}")
     if c["certified"]:
         return head + f"CERTIFIED, all {len(c['met'])} assumptions met; " + numbers
     return head + f"NOT certified: {', '.join(c['unmet']) or 'no valid bound'} not met; " + numbers
@@ -204,6 +211,7 @@ def run(args: argparse.Namespace) -> int:
     from wmr_mj.errors import InfeasiblePathError, ParameterError, StiffReferenceError
     from wmr_mj.params import parameters_of_cart
     from wmr_mj.plant.cartcheck import check_identification, step_with_random_controls
+    from wmr_mj.sim.coerce import default_path
     from wmr_mj.sim.config import build_reference
 
     cart = load_cart(args.cart)
@@ -211,15 +219,16 @@ def run(args: argparse.Namespace) -> int:
     parts = _default_parts(cart)
     if args.action == "card":
         return _write_card(cart, args.out)
+    path = default_path(cart) if args.path is None else args.path  # the cart's own, named in the answer
     try:  # a reference that cannot be built in bounded time is an absurd cart: refused before any step
-        build_reference("paper-circle", params, dt=1e-3, duration=35.0)
+        build_reference(path, params, dt=1e-3, duration=35.0)
     except StiffReferenceError as exc:
         raise ParameterError(f"cart file {str(cart.path)!r}: {exc}") from None
     except InfeasiblePathError:  # a circle the cart cannot steer: the cart's answer, reported below
         pass
-    certified = certified_on_cart(cart)
+    certified = certified_on_cart(cart, path)
     t0 = time.perf_counter()
-    design = design_on_cart(cart, seed=args.seed)
+    design = design_on_cart(cart, seed=args.seed, path=path)
     design_wall = time.perf_counter() - t0
     steps = step_with_random_controls(params, seed=args.seed)
     ident, ident_error = None, None

@@ -61,7 +61,7 @@ def config_from_args(args: argparse.Namespace, **extra):
     from wmr_mj.sim.spec import LawChoice, law_fields
 
     if getattr(args, "design", None) is not None:
-        args = with_design_file(args)
+        with_design_file(args)
     tracker = getattr(args, "tracker", None)
     if bool(getattr(args, "correction", False)) and tracker not in (None, "stanley-at-C"):
         raise ParameterError(f"--correction is the tracker stanley-at-C; give it or --tracker {tracker}, not both")
@@ -75,7 +75,7 @@ def config_from_args(args: argparse.Namespace, **extra):
                        controller_params=parse_params(getattr(args, "controller_param", None)), model=args.model,
                        kp=args.kp, kd=args.kd, omega_r=args.omega_r, friction_sign=args.friction_sign,
                        friction_width=args.friction_width, identified=args.identified,
-                       coefficients=parse_assignments(args.coef) if args.coef else None)
+                       coefficients=parse_assignments(args.coef) if args.coef else None, path=args.path)
     signals = signals_from_args(args)
     if signals is not None:
         extra.setdefault("signals", signals)
@@ -84,7 +84,8 @@ def config_from_args(args: argparse.Namespace, **extra):
         extra["m1"] = None  # --m1 not given: the cart's nominal m1
     given_range: Any = None if m1_range is M1_RANGE else tuple(m1_range)  # None: the cart's m1 box
     config = RunConfig.from_inputs(**law_fields(choice), cart=cart, tracker=tracker, tracker_params=tracker_params,
-                                   duration=args.duration, control_period=args.control_period, path=args.path,
+                                   duration=args.duration, control_period=args.control_period,
+                                   path=args.path,  # None: the design's, else the cart's own (coerce)
                                    plant_overrides=parse_assignments(args.param), m1_inertia=args.m1_inertia,
                                    box=args.box, m1_range=given_range, steering_friction=args.steering_friction,
                                    tyre_contact=args.tyre_contact, box_ranges=box_ranges_from_args(args),
@@ -96,30 +97,99 @@ def config_from_args(args: argparse.Namespace, **extra):
 
 
 def with_design_file(args: argparse.Namespace) -> argparse.Namespace:
-    """``args`` with each option that --design FILE sets and was not given taken from the file
-    (:func:`wmr_mj.sim.design_search.design_file_settings`), as a preset's are; --omega-r keeps the file's gains
-    out.
+    """``args`` with each option that --design FILE sets and was not given taken from the file, in place (the
+    command reads them from ``args`` after this): its settings (:func:`wmr_mj.sim.design_search.design_file_settings`)
+    as a preset's are, its cart (:func:`~wmr_mj.sim.design_search.design_cart`), and what it was found on
+    (:func:`~wmr_mj.sim.design_search.design_file_box`): its m1 box, reference bounds and path. --omega-r keeps the
+    file's gains out. A --cart other than the design's runs the gains on that cart with the cart's own sensing,
+    actuation and play; it, and an --m1-range beyond the design's box, print one note naming both.
 
     Raises:
         ParameterError: --design with --preset, a file that is not a design file, a design found on a cart
             file that is no longer there (and no --cart given).
     """
+    import sys
+
     from wmr_mj.errors import ParameterError
-    from wmr_mj.sim.design_search import design_cart, design_file_settings, read_design
+    from wmr_mj.params import M1_RANGE
+    from wmr_mj.sim.design_search import (
+        design_cart,
+        design_cart_name,
+        design_file_box,
+        design_file_settings,
+        read_design,
+    )
 
     if args.preset is not None:
         raise ParameterError("give --design FILE or --preset, not both (a design file is a preset of its own)")
+    if getattr(args, "design_applied", None) == args.design:
+        return args  # read once: a command that builds its config twice reads the same options
     data = read_design(args.design)
     settings = design_file_settings(args.design, data)
+    found_on = design_file_box(args.design, data)
+    notes = []
     if hasattr(args, "cart"):  # the cart the design was found on, unless --cart names one
-        settings["cart"] = design_cart(args.design, args.cart, data=data)
+        given = args.cart
+        settings["cart"] = design_cart(args.design, given, data=data)
+        if given is not None and not _same_cart(given, data.get("cart")):
+            notes.append(f"--cart {given} is not the cart the design {args.design} was found on "
+                         f"({design_cart_name(args.design, data)}): its gains run on {given} with that cart's own "
+                         "sensing, actuation, play and m1 box")
+            for name in ("sensing", "actuation", "backlash"):
+                settings.pop(name)
+            found_on.pop("m1_range", None)
     if args.omega_r is not None:
         settings.pop("kp"), settings.pop("kd")
-    merged = argparse.Namespace(**vars(args))
     for name, value in settings.items():
-        if getattr(merged, name, None) is None:
-            setattr(merged, name, value)
-    return merged
+        if getattr(args, name, None) is None:
+            setattr(args, name, value)
+    box = found_on.get("m1_range")
+    given_box = getattr(args, "m1_range", M1_RANGE)
+    if box is not None and hasattr(args, "m1_range"):
+        if given_box is M1_RANGE:  # --m1-range not given: the design's box
+            args.m1_range = box
+        elif not box[0] <= float(given_box[0]) <= float(given_box[1]) <= box[1]:
+            notes.append(f"--m1-range {float(given_box[0]):g} {float(given_box[1]):g} goes beyond the m1 box the "
+                         f"design {args.design} was found on ({box[0]:g}-{box[1]:g} kg): its certificate is "
+                         "computed again on the box given")
+    if getattr(args, "uncertainty", "given") is None and not getattr(args, "range", None) and "box_ranges" in found_on:
+        args.uncertainty = _box_name(found_on["box_ranges"], args.cart)  # the design's box (None: no such box)
+    if getattr(args, "reference_bounds", None) is None and "reference_bounds" in found_on:
+        args.reference_bounds = found_on["reference_bounds"]
+    if getattr(args, "path", None) is None and "path" in found_on:
+        args.path = found_on["path"]
+    for note in notes:
+        print(f"wmr-mj: note: {note}", file=sys.stderr)
+    args.design_applied = args.design
+    return args
+
+
+def _box_name(ranges: dict[str, tuple[float, float]], cart: Any) -> str | None:
+    """The name of the cart's uncertainty box (--uncertainty NAME) whose ranges besides m1 are ``ranges`` (a design
+    file's box_ranges); None where no box of the cart is that."""
+    from wmr_mj.params import uncertainty_ranges
+
+    if cart is not None:
+        from wmr_mj.carts import load_cart
+
+        boxes = {name: dict(box) for name, box in load_cart(cart).uncertainty.items()}
+    else:
+        boxes = {name: uncertainty_ranges(name) for name in ("m1", "full")}
+    for name, box in boxes.items():
+        if {k: tuple(v) for k, v in box.items() if k != "m1"} == {k: tuple(v) for k, v in ranges.items()}:
+            return name
+    return None
+
+
+def _same_cart(given: Any, recorded: Any) -> bool:
+    """Whether the cart ``given`` (--cart) is the one a design file records (None: the C80): the same text, or
+    both the C80's numbers."""
+    from wmr_mj.sim.config import RunConfig
+
+    record = RunConfig.from_inputs(cart=given).cart
+    if record is None or not isinstance(recorded, dict):
+        return record is None and not isinstance(recorded, dict)
+    return record["text"] == recorded.get("text")
 
 
 #: the command's line in ``wmr-mj --help`` (read without registering the command: wmr_mj/cli/app.py)

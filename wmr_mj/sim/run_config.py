@@ -50,6 +50,8 @@ class RunConfig:
     friction_width: float = 0.0  # rad/s, tanh smoothing of the Coulomb sign (0: exact sign)
     # C's path: one of PATH_NAMES, a packaged route name (wmr_mj.reference.route.route_names()), a
     # .toml/.json route file, or canonical route JSON; a Path or Route object is stored as its canonical JSON
+    # None: the cart's own (its file's [paths] default), else the paper circle (resolved where the config is
+    # coerced; the commands give None where --path is not given)
     path: str = "paper-circle"
     plant_overrides: Mapping[str, float] = field(default_factory=dict)  # other plant parameters
     m1_inertia: str = "payload"
