@@ -337,8 +337,10 @@ def measurement_cause(s: RunSummary, measurement: Any = None):
                             tau=measurement.delay_s)
 
 
-def format_report(s: RunSummary, *, measurement: Any = None) -> str:
-    """Human-readable run report of the summary ``s`` (``measurement``: as :func:`measurement_cause` takes it)."""
+def format_report(s: RunSummary, *, measurement: Any = None, cart: str | None = None) -> str:
+    """Human-readable run report of the summary ``s`` (``measurement``: as :func:`measurement_cause` takes it).
+    ``cart``: the name of the cart the run is on where it is not the paper's C80 (None: the C80): the paper's claim,
+    which the paper makes for its C80 only, is then not printed (its numbers stay in --json, as the paper's)."""
     from wmr_mj.analysis.verdicts import format_measurement_cause, format_verdict
 
     def ratio(x):
@@ -362,8 +364,11 @@ def format_report(s: RunSummary, *, measurement: Any = None) -> str:
     rate = "" if s.realtime_factor is None else f" ({s.realtime_factor:.0f}x real time)"
     # a run that ended before the entry transient did has no samples after it: n/a, not the empty sup's 0
     settled = s.duration > s.settle_s
-    paper = (lambda bound, r: f" {bound:12.5g} {ratio(r):>8s}") if s.paper_law else (lambda bound, r: "")
+    paper_columns = s.paper_law and cart is None  # the paper's claim: the C80's, printed on the C80 only
+    paper = (lambda bound, r: f" {bound:12.5g} {ratio(r):>8s}") if paper_columns else (lambda bound, r: "")
     verdict = format_verdict(s.to_dict())
+    if cart is not None:  # the paper's claim is the C80's: never printed as if it were this cart's
+        verdict = [line for line in verdict if not line.startswith("paper's claim:")]
     cause = measurement_cause(s, measurement)
     if cause is not None:  # beside the certificate's line: what it assumed the law reads, and what binds
         at = next((i + 1 for i, line in enumerate(verdict) if line.startswith("certificate:")), len(verdict))
@@ -372,7 +377,7 @@ def format_report(s: RunSummary, *, measurement: Any = None) -> str:
         f"{who}, {s.duration:g} s, {s.steps} steps in {s.wall_s:.2f} s{rate}",
         *verdict,
         f"{'':22s} {'whole run':>12s} {after:>12s} {'certificate':>12s} {'ratio':>8s}"
-        + (f" {'paper':>12s} {'ratio':>8s}" if s.paper_law else ""),
+        + (f" {'paper':>12s} {'ratio':>8s}" if paper_columns else ""),
         f"{'sup|E|   [rad]':22s} {s.sup_E:12.5g} {num(s.sup_E_settled if settled else None):>12s} "
         f"{num(cert_E_max):>12s} {ratio(cert_E_ratio):>8s}" + paper(s.E_max, s.E_ratio),
         f"{'sup|E|dot [rad/s]':22s} {s.sup_Edot:12.5g} {num(s.sup_Edot_settled if settled else None):>12s} "
@@ -478,7 +483,9 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print_json(report)
     else:
-        print(format_report(result.summary, measurement=parts.measurement))
+        record = parts.config.cart  # None: the C80
+        print(format_report(result.summary, measurement=parts.measurement,
+                            cart=None if record is None else f"{record['name']} {record['version']}"))
         if not is_ideal_cart(config):
             print(cart_line(config))
         if judged:
