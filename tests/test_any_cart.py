@@ -157,3 +157,5 @@ def test_validate_on_the_cart_asks_of_its_box_and_path(folder):
                             "80-120 kg?") and "on the path anycart-loop.toml" in first
     for word in ("550", "750", "paper-circle", "paper circle", "C80"):
         assert word not in proc.stdout, word
+    rule = certified_design(str(folder / "anycart.toml"))  # the rung's gains are the rule's on this cart
+    assert f"K_P = {rule.kp:g}, K_D = {rule.kd:g}" in proc.stdout.splitlines()[3]
