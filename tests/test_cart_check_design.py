@@ -77,5 +77,5 @@ def test_cart_check_answers_where_the_cart_cannot_follow_the_paper_circle(tmp_pa
     lines = capsys.readouterr().out.splitlines()
     assert ": passes: " in lines[0]
     assert lines[1] == f"certified design: none on this cart ({reason})"
-    assert lines[2].startswith(f"no gains in the box certify this cart: the paper circle's feasibility ({reason}) "
+    assert lines[2].startswith(f"no gains in the box certify this cart: the path paper-circle's feasibility ({reason}) "
                                "binds (")

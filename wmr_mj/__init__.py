@@ -49,7 +49,7 @@ if TYPE_CHECKING:
     from wmr_mj.sim.compare import CompareReport, CompareResult, Design, DesignRow, compare, design_from_token
     from wmr_mj.sim.config import RunConfig, controller_for
     from wmr_mj.sim.design_search import DesignProblem, DesignResult, search_design, write_design
-    from wmr_mj.sim.designs import CERTIFIED, PAPER, PRESETS, preset
+    from wmr_mj.sim.designs import CERTIFIED, CERTIFIED_C80, PAPER, PRESETS, preset
     from wmr_mj.sim.falsify import FalsifyReport, FalsifyResult, FalsifySpec, falsify
     from wmr_mj.sim.log_header import LogHeader
     from wmr_mj.sim.parts import RunParts, resolve_run
@@ -77,6 +77,7 @@ _LAZY: dict[str, str] = {
     "ValidateSummary": "wmr_mj.report.results",
     "PAPER": "wmr_mj.sim.designs",
     "CERTIFIED": "wmr_mj.sim.designs",
+    "CERTIFIED_C80": "wmr_mj.sim.designs",
     "PRESETS": "wmr_mj.sim.designs",
     "preset": "wmr_mj.sim.designs",
     "load_log": "wmr_mj.logs.reader",
@@ -144,6 +145,7 @@ __all__ = [
     # the design presets
     "PAPER",
     "CERTIFIED",
+    "CERTIFIED_C80",
     "PRESETS",
     "preset",
     # many runs and the search for the worst, and what they add up to (frozen, read by attribute; to_dict/from_dict)

@@ -85,6 +85,8 @@ class CartFile:
         defaults: 'sensing', 'actuation' (a preset name or KEY=VALUE spec), 'backlash' (rad) -> value.
         default_sources: the same keys -> where the default comes from.
         text: the file's text as read (a run's record and its log carry it; :func:`load_cart_text` reads it back).
+        default_path: the path the cart declares its own (``[paths] default``): a path or packaged route's name as
+            written, a route file as its path beside the cart file; None: the cart declares none.
     """
 
     name: str
@@ -100,6 +102,7 @@ class CartFile:
     defaults: Mapping[str, Any]
     default_sources: Mapping[str, str]
     text: str = ""
+    default_path: str | None = None
 
     def __reduce__(self) -> tuple[Any, ...]:
         # the mappings are read-only proxies, which pickle refuses: a copy (a sweep's worker) reads the text again
@@ -218,7 +221,18 @@ def _cart_of(document: Mapping[str, Any], path: Path, text: str) -> CartFile:
                           for k, e in document["defaults"].items()}),
         default_sources=_frozen({k: e["source"] for k, e in document["defaults"].items()}),
         text=text,
+        default_path=None if "paths" not in document else _declared_path(document["paths"]["default"], path),
     )
+
+
+def _declared_path(declared: str, path: Path) -> str:
+    """The cart's declared default path: a route file (a name ending .toml/.json) as its path beside the cart file
+    where it is there (else as written: a route file's own check then names it); any other name as written."""
+    if declared.lower().endswith((".toml", ".json")) and not Path(declared).is_absolute():
+        beside = path.parent / declared
+        if beside.is_file():
+            return str(beside)
+    return declared
 
 
 def load_cart(source: str | os.PathLike[str]) -> CartFile:

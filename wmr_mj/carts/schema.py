@@ -207,6 +207,10 @@ def schema_table(schema: Mapping[str, Any] | None = None) -> str:
     for section, section_schema in root["properties"].items():
         if section in ("name", "version", "changelog"):
             continue
+        if section == "paths":  # optional: a table of strings, not of entries
+            rows.append(f"| `paths.default` | | a non-empty string (and its `paths.source`); optional | "
+                        f"{section_schema['description']} |")
+            continue
         for name, sub in section_schema["properties"].items():
             entry = resolve(sub, root)
             props = entry.get("properties", {})

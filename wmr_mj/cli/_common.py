@@ -4,6 +4,7 @@ argparse types and range readers are also importable from here)."""
 from __future__ import annotations
 
 import json
+import math
 import sys
 from typing import Any
 
@@ -37,6 +38,37 @@ def parse_assignments(items: list[str] | None, *, option: str = "--param",
         except ValueError:
             raise ParameterError(f"{option} {item!r}: {value!r} is not a number") from None
     return out
+
+
+def m1_of_param(args: Any) -> Any:
+    """``args`` with ``--param m1=KG`` taken as ``--m1 KG`` (the one mass of the run; ``with_params`` takes m1 once),
+    for every command that has both options; ``--m1`` and ``--param m1=`` given with different masses is refused.
+
+    Raises:
+        ParameterError: two different masses, or a malformed --param (one line).
+    """
+    from wmr_mj.errors import ParameterError
+    from wmr_mj.params import M1_NOMINAL
+
+    items = getattr(args, "param", None)
+    if not items or not hasattr(args, "m1"):
+        return args
+    masses = [item for item in items if item.partition("=")[0].strip() == "m1"]
+    if not masses:
+        return args
+    values = {parse_assignments([item])["m1"] for item in masses}
+    given = args.m1 if args.m1 is not None and args.m1 is not M1_NOMINAL else None  # --m1 as given (its default: not)
+    if given is not None:
+        values.add(float(given))
+    if len(values) > 1:
+        shown = " and ".join(f"{v:g} kg" for v in sorted(values))
+        raise ParameterError(f"--m1 and --param m1= give two masses ({shown}); give one of them")
+    (mass,) = values
+    if not (math.isfinite(mass) and mass > 0):
+        raise ParameterError(f"--param m1={mass!r} is not accepted; a finite mass > 0 kg is required")
+    args.m1 = mass
+    args.param = [item for item in items if item not in masses]
+    return args
 
 
 def print_json(obj: Any) -> None:

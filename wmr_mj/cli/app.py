@@ -20,6 +20,7 @@ import importlib
 import sys
 from collections.abc import Collection, Sequence
 
+from wmr_mj.cli._common import m1_of_param
 from wmr_mj.errors import WmrMjError
 
 COMMANDS = ("identify", "robustness", "run", "replay", "sweep", "falsify", "compare", "validate", "figures", "model",
@@ -85,9 +86,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     args = build_parser(_commands_of(argv)).parse_args(argv)
     try:
+        m1_of_param(args)  # --param m1=KG is --m1 KG wherever --m1 is an option
         return int(args.func(args) or 0)
     except WmrMjError as exc:
-        print(f"wmr-mj: error: {exc}", file=sys.stderr)
+        print(f"wmr-mj: error: {_with_where_duration_came_from(str(exc), args)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("wmr-mj: interrupted", file=sys.stderr)
@@ -101,3 +103,13 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 if __name__ == "__main__":
     sys.exit(main())
+
+
+def _with_where_duration_came_from(message: str, args: argparse.Namespace) -> str:
+    """``message``, and where a refused duration came from when the user gave none: the default --duration."""
+    from wmr_mj.cli.run_options import DEFAULT_DURATION
+
+    if "duration = " in message and getattr(args, "duration", None) is DEFAULT_DURATION:
+        return (f"{message} (the duration is --duration's default, {DEFAULT_DURATION:g} s, as none was given; "
+                "give --duration)")
+    return message

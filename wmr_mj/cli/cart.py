@@ -46,6 +46,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="length of the identification's excitation, s (default 20)")
     p.add_argument("--seed", type=int, default=0, help="seed of the random controls and the excitation (default 0)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--path", metavar="NAME|FILE", default=None,
+                   help="check: the path the certified design and the design search answer for (a path name, a "
+                        "packaged route or a route file; default: the cart's own, [paths] default in its file, "
+                        "else paper-circle)")
     p.add_argument("--out", metavar="PATH", default=None,
                    help="card: the Markdown file to write (default: logs/<cart file's stem>-card.md)")
     p.set_defaults(func=run)
@@ -67,7 +71,7 @@ def _certified_line(c: dict[str, Any]) -> str:
     head = (f"certified design on this cart: omega_r = {c['omega_r']:g} rad/s (K_P = {c['kp']:g}, K_D = {c['kd']:g}, "
             "the rule of wmr_mj/sim/designs.py run on the cart): ")
     numbers = (f"E_max = {c['E_max']:.4g} rad, |E'| <= {c['Edot_max']:.4g} rad/s, |u| <= {c['voltage_max']:.4g} V "
-               f"of the {c['voltage_limit']:g} V supply, on the cart's default sensing")
+               f"of the {c['voltage_limit']:g} V supply, on the cart's default sensing, path {c['path']}")
     if c["certified"]:
         return head + f"CERTIFIED, all {len(c['met'])} assumptions met; " + numbers
     return head + f"NOT certified: {', '.join(c['unmet']) or 'no valid bound'} not met; " + numbers
@@ -107,7 +111,7 @@ def run(args: argparse.Namespace) -> int:
         parameters_of_cart(cart)
         default_parts(cart)
         return _write_card(cart, args.out)
-    check = cart_check(cart, seed=args.seed, duration=args.duration)
+    check = cart_check(cart, seed=args.seed, duration=args.duration, path=args.path)
     if args.json:
         print_json(check.to_dict())
     else:

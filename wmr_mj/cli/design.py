@@ -36,7 +36,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="the law searched: computed-torque (default: omega_n, zeta) or sliding-mode (lam, phi, k, eta "
                         "on the non-holonomic model); both with the sign's width, tau_f and the period")
     p.add_argument("--path", action="append", metavar="NAME|FILE",
-                   help="a path every certificate must hold on (repeatable; default paper-circle)")
+                   help="a path every certificate must hold on (repeatable; default: the cart's own, [paths] default "
+                        "in its file, else paper-circle)")
     p.add_argument("--uncertainty", default=None, help="the plant box: m1 (default) or full (wmr_mj/params.py)")
     p.add_argument("--m1-range", nargs=2, type=float, metavar=("LO", "HI"), default=M1_RANGE,
                    help="m1 range of the box, kg (default: the cart's m1 box, 550 750 on the C80)")
@@ -104,7 +105,10 @@ def problem_from_args(args: argparse.Namespace) -> Any:
     if why_not:
         raise ParameterError(f"{why_not}: no certificate can cover it (--sensing, --actuation, --backlash); a "
                              "bounded error is accepted")
-    return DesignProblem(base=base, paths=tuple(args.path or ("paper-circle",)), periods=periods,
+    from wmr_mj.sim.coerce import cart_file_of_record, default_path
+
+    paths = tuple(args.path or (default_path(cart_file_of_record(base.cart)),))  # none given: the cart's own
+    return DesignProblem(base=base, paths=paths, periods=periods,
                          objective=args.objective, method=args.method, seed=args.seed,
                          budget=args.budget)
 

@@ -194,6 +194,10 @@ def run(args: argparse.Namespace) -> int:
     )
 
     objective = _objective(args)
+    if args.design is not None:  # the design's box before falsify's own default (the full box)
+        from wmr_mj.cli.run import with_design_file
+
+        with_design_file(args)
     args.uncertainty = args.uncertainty or "full"
     base, box = _base_and_box(args)
     spec = FalsifySpec(base=base, box=box, objective=objective, budget=args.budget, seed=args.seed,

@@ -61,7 +61,7 @@ def config_from_args(args: argparse.Namespace, **extra):
     from wmr_mj.sim.spec import LawChoice, law_fields
 
     if getattr(args, "design", None) is not None:
-        args = with_design_file(args)
+        with_design_file(args)
     tracker = getattr(args, "tracker", None)
     if bool(getattr(args, "correction", False)) and tracker not in (None, "stanley-at-C"):
         raise ParameterError(f"--correction is the tracker stanley-at-C; give it or --tracker {tracker}, not both")
@@ -75,7 +75,7 @@ def config_from_args(args: argparse.Namespace, **extra):
                        controller_params=parse_params(getattr(args, "controller_param", None)), model=args.model,
                        kp=args.kp, kd=args.kd, omega_r=args.omega_r, friction_sign=args.friction_sign,
                        friction_width=args.friction_width, identified=args.identified,
-                       coefficients=parse_assignments(args.coef) if args.coef else None)
+                       coefficients=parse_assignments(args.coef) if args.coef else None, path=args.path)
     signals = signals_from_args(args)
     if signals is not None:
         extra.setdefault("signals", signals)
@@ -84,7 +84,8 @@ def config_from_args(args: argparse.Namespace, **extra):
         extra["m1"] = None  # --m1 not given: the cart's nominal m1
     given_range: Any = None if m1_range is M1_RANGE else tuple(m1_range)  # None: the cart's m1 box
     config = RunConfig.from_inputs(**law_fields(choice), cart=cart, tracker=tracker, tracker_params=tracker_params,
-                                   duration=args.duration, control_period=args.control_period, path=args.path,
+                                   duration=args.duration, control_period=args.control_period,
+                                   path=args.path,  # None: the design's, else the cart's own (coerce)
                                    plant_overrides=parse_assignments(args.param), m1_inertia=args.m1_inertia,
                                    box=args.box, m1_range=given_range, steering_friction=args.steering_friction,
                                    tyre_contact=args.tyre_contact, box_ranges=box_ranges_from_args(args),
@@ -96,30 +97,99 @@ def config_from_args(args: argparse.Namespace, **extra):
 
 
 def with_design_file(args: argparse.Namespace) -> argparse.Namespace:
-    """``args`` with each option that --design FILE sets and was not given taken from the file
-    (:func:`wmr_mj.sim.design_search.design_file_settings`), as a preset's are; --omega-r keeps the file's gains
-    out.
+    """``args`` with each option that --design FILE sets and was not given taken from the file, in place (the
+    command reads them from ``args`` after this): its settings (:func:`wmr_mj.sim.design_search.design_file_settings`)
+    as a preset's are, its cart (:func:`~wmr_mj.sim.design_search.design_cart`), and what it was found on
+    (:func:`~wmr_mj.sim.design_search.design_file_box`): its m1 box, reference bounds and path. --omega-r keeps the
+    file's gains out. A --cart other than the design's runs the gains on that cart with the cart's own sensing,
+    actuation and play; it, and an --m1-range beyond the design's box, print one note naming both.
 
     Raises:
         ParameterError: --design with --preset, a file that is not a design file, a design found on a cart
             file that is no longer there (and no --cart given).
     """
+    import sys
+
     from wmr_mj.errors import ParameterError
-    from wmr_mj.sim.design_search import design_cart, design_file_settings, read_design
+    from wmr_mj.params import M1_RANGE
+    from wmr_mj.sim.design_search import (
+        design_cart,
+        design_cart_name,
+        design_file_box,
+        design_file_settings,
+        read_design,
+    )
 
     if args.preset is not None:
         raise ParameterError("give --design FILE or --preset, not both (a design file is a preset of its own)")
+    if getattr(args, "design_applied", None) == args.design:
+        return args  # read once: a command that builds its config twice reads the same options
     data = read_design(args.design)
     settings = design_file_settings(args.design, data)
+    found_on = design_file_box(args.design, data)
+    notes = []
     if hasattr(args, "cart"):  # the cart the design was found on, unless --cart names one
-        settings["cart"] = design_cart(args.design, args.cart, data=data)
+        given = args.cart
+        settings["cart"] = design_cart(args.design, given, data=data)
+        if given is not None and not _same_cart(given, data.get("cart")):
+            notes.append(f"--cart {given} is not the cart the design {args.design} was found on "
+                         f"({design_cart_name(args.design, data)}): its gains run on {given} with that cart's own "
+                         "sensing, actuation, play and m1 box")
+            for name in ("sensing", "actuation", "backlash"):
+                settings.pop(name)
+            found_on.pop("m1_range", None)
     if args.omega_r is not None:
         settings.pop("kp"), settings.pop("kd")
-    merged = argparse.Namespace(**vars(args))
     for name, value in settings.items():
-        if getattr(merged, name, None) is None:
-            setattr(merged, name, value)
-    return merged
+        if getattr(args, name, None) is None:
+            setattr(args, name, value)
+    box = found_on.get("m1_range")
+    given_box = getattr(args, "m1_range", M1_RANGE)
+    if box is not None and hasattr(args, "m1_range"):
+        if given_box is M1_RANGE:  # --m1-range not given: the design's box
+            args.m1_range = box
+        elif not box[0] <= float(given_box[0]) <= float(given_box[1]) <= box[1]:
+            notes.append(f"--m1-range {float(given_box[0]):g} {float(given_box[1]):g} goes beyond the m1 box the "
+                         f"design {args.design} was found on ({box[0]:g}-{box[1]:g} kg): its certificate is "
+                         "computed again on the box given")
+    if getattr(args, "uncertainty", "given") is None and not getattr(args, "range", None) and "box_ranges" in found_on:
+        args.uncertainty = _box_name(found_on["box_ranges"], args.cart)  # the design's box (None: no such box)
+    if getattr(args, "reference_bounds", None) is None and "reference_bounds" in found_on:
+        args.reference_bounds = found_on["reference_bounds"]
+    if getattr(args, "path", None) is None and "path" in found_on:
+        args.path = found_on["path"]
+    for note in notes:
+        print(f"wmr-mj: note: {note}", file=sys.stderr)
+    args.design_applied = args.design
+    return args
+
+
+def _box_name(ranges: dict[str, tuple[float, float]], cart: Any) -> str | None:
+    """The name of the cart's uncertainty box (--uncertainty NAME) whose ranges besides m1 are ``ranges`` (a design
+    file's box_ranges); None where no box of the cart is that."""
+    from wmr_mj.params import uncertainty_ranges
+
+    if cart is not None:
+        from wmr_mj.carts import load_cart
+
+        boxes = {name: dict(box) for name, box in load_cart(cart).uncertainty.items()}
+    else:
+        boxes = {name: uncertainty_ranges(name) for name in ("m1", "full")}
+    for name, box in boxes.items():
+        if {k: tuple(v) for k, v in box.items() if k != "m1"} == {k: tuple(v) for k, v in ranges.items()}:
+            return name
+    return None
+
+
+def _same_cart(given: Any, recorded: Any) -> bool:
+    """Whether the cart ``given`` (--cart) is the one a design file records (None: the C80): the same text, or
+    both the C80's numbers."""
+    from wmr_mj.sim.config import RunConfig
+
+    record = RunConfig.from_inputs(cart=given).cart
+    if record is None or not isinstance(recorded, dict):
+        return record is None and not isinstance(recorded, dict)
+    return record["text"] == recorded.get("text")
 
 
 #: the command's line in ``wmr-mj --help`` (read without registering the command: wmr_mj/cli/app.py)
@@ -244,8 +314,10 @@ def default_log_path(config) -> str:
     return f"logs/run-{stamp}-{config.model}-m{config.m1:g}.mcap"
 
 
-def format_report(s: RunSummary, *, measurement: Any = None) -> str:
-    """Human-readable run report of the summary ``s`` (``measurement``: as :func:`measurement_cause` takes it)."""
+def format_report(s: RunSummary, *, measurement: Any = None, cart: str | None = None) -> str:
+    """Human-readable run report of the summary ``s`` (``measurement``: as :func:`measurement_cause` takes it).
+    ``cart``: the name of the cart the run is on where it is not the paper's C80 (None: the C80): the paper's claim,
+    which the paper makes for its C80 only, is then not printed (its numbers stay in --json, as the paper's)."""
     from wmr_mj.analysis.verdicts import format_measurement_cause, format_verdict
     from wmr_mj.sim.run_report import measurement_cause
 
@@ -270,8 +342,11 @@ def format_report(s: RunSummary, *, measurement: Any = None) -> str:
     rate = "" if s.realtime_factor is None else f" ({s.realtime_factor:.0f}x real time)"
     # a run that ended before the entry transient did has no samples after it: n/a, not the empty sup's 0
     settled = s.duration > s.settle_s
-    paper = (lambda bound, r: f" {bound:12.5g} {ratio(r):>8s}") if s.paper_law else (lambda bound, r: "")
+    paper_columns = s.paper_law and cart is None  # the paper's claim: the C80's, printed on the C80 only
+    paper = (lambda bound, r: f" {bound:12.5g} {ratio(r):>8s}") if paper_columns else (lambda bound, r: "")
     verdict = format_verdict(s.to_dict())
+    if cart is not None:  # the paper's claim is the C80's: never printed as if it were this cart's
+        verdict = [line for line in verdict if not line.startswith("paper's claim:")]
     cause = measurement_cause(s, measurement)
     if cause is not None:  # beside the certificate's line: what it assumed the law reads, and what binds
         at = next((i + 1 for i, line in enumerate(verdict) if line.startswith("certificate:")), len(verdict))
@@ -280,13 +355,20 @@ def format_report(s: RunSummary, *, measurement: Any = None) -> str:
         f"{who}, {s.duration:g} s, {s.steps} steps in {s.wall_s:.2f} s{rate}",
         *verdict,
         f"{'':22s} {'whole run':>12s} {after:>12s} {'certificate':>12s} {'ratio':>8s}"
-        + (f" {'paper':>12s} {'ratio':>8s}" if s.paper_law else ""),
+        + (f" {'paper':>12s} {'ratio':>8s}" if paper_columns else ""),
         f"{'sup|E|   [rad]':22s} {s.sup_E:12.5g} {num(s.sup_E_settled if settled else None):>12s} "
         f"{num(cert_E_max):>12s} {ratio(cert_E_ratio):>8s}" + paper(s.E_max, s.E_ratio),
         f"{'sup|E|dot [rad/s]':22s} {s.sup_Edot:12.5g} {num(s.sup_Edot_settled if settled else None):>12s} "
         f"{num(cert_Edot_max):>12s} {ratio(cert_Edot_ratio):>8s}" + paper(s.Edot_max, s.Edot_ratio),
         f"voltage saturated {100 * s.saturated_fraction:.1f}% of the time",
     ]
+    if s.mujoco_warnings:  # counted over the run and said once here (MuJoCo's console printing is held)
+        from wmr_mj.sim.closed_loop import MUJOCO_WITHOUT_WARNINGS
+
+        said = next((a.note for a in (cert.assumptions if cert is not None else ())
+                     if a.name == MUJOCO_WITHOUT_WARNINGS), "")
+        lines.append(f"MuJoCo warned {s.mujoco_warnings} time(s) during the run; the run is not certified "
+                     f"(its steps MuJoCo warned of are not the plant the claim is of){': ' + said if said else ''}")
     if s.path_error is not None:
         pe = s.path_error
         lines.append(f"path of C: cross-track max {pe.cross_track_max:.4g} m, rms {pe.cross_track_rms:.4g} m; "
@@ -327,7 +409,9 @@ def _print_text(result: Any, parts: Any, report: dict[str, Any], path: str | Non
     from wmr_mj.hardware import cart_line, is_ideal_cart
 
     config = result.config
-    print(format_report(result.summary, measurement=parts.measurement))
+    record = parts.config.cart  # None: the C80
+    print(format_report(result.summary, measurement=parts.measurement,
+                        cart=None if record is None else f"{record['name']} {record['version']}"))
     if not is_ideal_cart(config):
         print(cart_line(config))
     if report.get("requirements"):

@@ -29,6 +29,10 @@ from wmr_mj.cli.options import add_argument_with_help_of, positive_float
 
 __all__ = ["RunOption", "Replay", "run_options", "add_options", "add_option", "command_line", "GROUPS"]
 
+#: --duration's default, s: the very object argparse keeps where --duration is not given (a message about the
+#: duration then says that it is the default: wmr_mj.cli.app)
+DEFAULT_DURATION = 35.0
+
 
 @dataclass(frozen=True, kw_only=True)
 class Replay:
@@ -180,9 +184,9 @@ def _law_rows() -> tuple[RunOption, ...]:
         R(flag="--friction-width", group="run", sets="friction_width", settings=dict(type=float, default=None),
           help="smoothing of that sign, rad/s: x/sqrt(x^2+w^2) (0: exact sign; default: the preset's)",
           write=_law("friction_width")),
-        R(flag="--path", group="run", sets="path", settings=dict(default="paper-circle", metavar="NAME|FILE"),
+        R(flag="--path", group="run", sets="path", settings=dict(default=None, metavar="NAME|FILE"),
           help=_path_help, write=lambda c, r: ["--path", shlex.quote(r.path_file or c.path)]),
-        R(flag="--duration", group="run", sets="duration", settings=dict(type=positive_float, default=35.0),
+        R(flag="--duration", group="run", sets="duration", settings=dict(type=positive_float, default=DEFAULT_DURATION),
           help="simulated time, s (default 35)", write=lambda c, r: ["--duration", repr(c.duration)]),
         R(flag="--m1", group="command", sets="m1", write=lambda c, r: ["--m1", repr(c.m1)]),
         R(flag="--identified", group="run", sets="identified", settings=dict(metavar="PATH"),
@@ -354,7 +358,8 @@ def _path_help() -> str:
     from wmr_mj.sim.config import PATH_NAMES
 
     return (f"reference path of point C: one of {', '.join(PATH_NAMES)}, a packaged route (agv-loop), or a route "
-            "file (.toml/.json: segments or waypoints; see wmr_mj/reference/route.py)")
+            "file (.toml/.json: segments or waypoints; see wmr_mj/reference/route.py); default: the --design file's "
+            "path, else the cart's own ([paths] default in its file), else paper-circle")
 
 
 def _steering_friction_help() -> str:

@@ -51,9 +51,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--uncertainty", default="m1",
                    help="uncertainty box the ladder samples and its certificates cover: m1 (the paper's, default) or "
                         "full (m1, steering and tyre friction, R_a, V_A; see wmr_mj/params.py)")
-    p.add_argument("--path", default="paper-circle", metavar="NAME|FILE",
-                   help="path of C every run follows: a named path (paper-circle, the default), a packaged route "
-                        "(agv-loop) or a route file, as for wmr-mj run")
+    p.add_argument("--path", default=None, metavar="NAME|FILE",
+                   help="path of C every run follows: a named path (paper-circle), a packaged route (agv-loop) or a "
+                        "route file, as for wmr-mj run (default: the cart's own, [paths] default in its file, else "
+                        "paper-circle)")
     p.add_argument("--design", action="append", metavar="DESIGN", default=None,
                    help="a design of your own, judged beside the ladder (its rung and its nominal run): a preset, "
                         "a law's name, FILE.py:Class or module:Class, with ,key=value settings as for wmr-mj "
@@ -89,6 +90,11 @@ def run(args: argparse.Namespace) -> int:
     from wmr_mj.report.validate import ValidateSettings, run_validate, write_pointer
 
     t0 = time.perf_counter()
+    if args.path is None:  # the cart's own path (the paper circle on the C80)
+        from wmr_mj.sim.coerce import cart_file_of_record, default_path
+        from wmr_mj.sim.config import RunConfig
+
+        args.path = default_path(cart_file_of_record(RunConfig.from_inputs(cart=getattr(args, "cart", None)).cart))
     settings = ValidateSettings(n=args.n, seed=args.seed, sampling=args.sampling, duration=args.duration,
                                 identify_duration=args.identify_duration, search_budget=args.search_budget,
                                 nthread=args.nthread, uncertainty=args.uncertainty, path=args.path,

@@ -116,7 +116,7 @@ def sensing_stage(settings: ValidateSettings, st: Stages, *,
     m1 = float(settings.m1_range[1])
     st.start("sensing", f"the certified design on realistic sensing ({', '.join(presets)}; m1 = {m1:g} kg, "
                         f"{settings.duration:g} s each)")
-    base = settings.config(CERTIFIED).replace(m1=m1)
+    base = settings.config(CERTIFIED).replace(m1=m1, sensing="ideal")  # exact sensing, whatever the cart's default
     base_parts = resolve_run(base)
     prediction = _dead_band_prediction(base_parts)
     runs = []

@@ -166,6 +166,8 @@ def run_rung(settings: ValidateSettings, k: int, design: DesignLike, folder: Pat
                             f"{settings.m1_range[0]:g}-{settings.m1_range[1]:g} kg ({settings.sampling})")
     run_sweep(spec, out_dir=sweep_dir, nthread=settings.nthread, progress=stage_progress(st))
     rung = summarise_rung(read_runs(sweep_dir))  # full precision: runs.csv is rounded
+    if isinstance(design, Design) and (base.kp, base.kd) != (design.kp, design.kd):
+        design = dataclasses.replace(design, kp=base.kp, kd=base.kd)  # the gains it ran: the rule's on the cart
     rung.update(index=k, name=design.name, label=design.label, design=design.describe(),
                 config=design.config_changes(), changed=[] if before is None else ladder_changes(before, design),
                 change="" if before is None else _change_text(before, design),

@@ -59,7 +59,7 @@ from wmr_mj.sim.closed_loop import (
 )
 from wmr_mj.sim.coerce import coerced
 from wmr_mj.sim.config import RunConfig, has_tracker
-from wmr_mj.sim.engine import LAW_BACKENDS, batch_law_backend, batch_model
+from wmr_mj.sim.engine import LAW_BACKENDS, batch_law_backend, batch_model, held_mujoco_warnings
 from wmr_mj.sim.parts import RunLabels, RunParts, plant_and_claim, resolve_run
 from wmr_mj.sim.summary import BatchFigures, RunSummary, voltage_effort
 
@@ -246,7 +246,8 @@ def _run_group_compiled(loop: _Loop, models: Sequence[mujoco.MjModel], idx: np.n
         count = min(loop.block, loop.n - k0)
         out = records.setdefault(count, {})
         # the record after each physics step; a control step's values hold over its substeps
-        rec = batch.rollout(count * substeps, record=("userdata", "site_xpos"), out=out)
+        with held_mujoco_warnings():  # not printed per step: the run re-run alone counts and reports them
+            rec = batch.rollout(count * substeps, record=("userdata", "site_xpos"), out=out)
         out.update(rec)
         userdata = rec["userdata"][:, ::substeps]
         a_buf, E_buf, Ed_buf, u_buf = (userdata[:, :, j].T for j in range(4))  # (count, g) views

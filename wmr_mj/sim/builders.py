@@ -29,7 +29,7 @@ from controllers.registry import build, resolve
 from wmr_mj._util.checks import as_pair
 from wmr_mj.analysis.plant_box import derived_box
 from wmr_mj.analysis.robustness import ParameterBox, analyse
-from wmr_mj.errors import ParameterError, UnknownNameError
+from wmr_mj.errors import InfeasiblePathError, ParameterError, StiffReferenceError, UnknownNameError, WmrMjError
 from wmr_mj.params import C80, C80Parameters
 from wmr_mj.reference import paths as ref
 from wmr_mj.reference.bounds import ReferenceBounds
@@ -73,7 +73,24 @@ REFERENCE_CACHE_SIZE = 16
 
 @functools.lru_cache(maxsize=REFERENCE_CACHE_SIZE)
 def _cached_reference(path: str, file_key: tuple | None, params: C80Parameters, dt: float, duration: float):
-    return _build_reference(path, params, dt=dt, duration=duration)
+    try:
+        return _build_reference(path, params, dt=dt, duration=duration)
+    except StiffReferenceError:
+        raise
+    except InfeasiblePathError as exc:  # the path, the stops and the option that changes it, named
+        raise InfeasiblePathError(f"{exc} -- on path {path_label(path)}, with the cart's steering stops at "
+                                  f"+-{params.steering_range:g} rad; --path changes it (a path this cart steers: "
+                                  "e.g. a route of larger radius, or the cart file's [paths] default)") from None
+
+
+def path_label(path: str) -> str:
+    """What a message calls the path ``path``: its name, a route file's path, a route's own name for canonical JSON."""
+    if path in PATH_NAMES or not path.lstrip().startswith("{"):
+        return repr(path)
+    try:
+        return f"route {route_of(path).name!r}"
+    except WmrMjError:
+        return "a route given as JSON"
 
 
 #: the named path lane-change: a lead-in line, the lane change (lateral offset over a length), then a line that

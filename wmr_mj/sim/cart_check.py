@@ -25,6 +25,7 @@ from wmr_mj.errors import InfeasiblePathError, ParameterError, StiffReferenceErr
 from wmr_mj.hardware import Actuation, Sensing, Transmission
 from wmr_mj.params import parameters_of_cart
 from wmr_mj.plant.cartcheck import check_identification, step_with_random_controls
+from wmr_mj.sim.coerce import default_path
 from wmr_mj.sim.config import RunConfig, build_reference
 from wmr_mj.sim.design_search import (
     DEFAULT_BUDGET,
@@ -85,10 +86,11 @@ class CartCheck:
                 "certified_design": dict(self.certified_design), "design": dict(self.design)}
 
 
-def cart_check(cart: Any, *, seed: int = 0, duration: float = 20.0) -> CartCheck:
+def cart_check(cart: Any, *, seed: int = 0, duration: float = 20.0, path: str | None = None) -> CartCheck:
     """Check ``cart`` (a :class:`wmr_mj.carts.CartFile`): its default parts, the certified design's certificate
     on it, the design search, 1 s of random controls, and the identification over a ``duration`` s excitation,
-    each seeded with ``seed``.
+    each seeded with ``seed``. ``path``: the path the certified design and the design search answer for (None: the
+    cart's own, ``[paths] default`` in its file, else paper-circle; named in the answer).
 
     Raises:
         ParameterError: a default part that cannot be built, or a reference that cannot be built in bounded time
@@ -96,15 +98,16 @@ def cart_check(cart: Any, *, seed: int = 0, duration: float = 20.0) -> CartCheck
     """
     params = parameters_of_cart(cart)
     parts = default_parts(cart)
+    path = default_path(cart) if path is None else path
     try:  # a reference that cannot be built in bounded time is an absurd cart: refused before any step
-        build_reference("paper-circle", params, dt=1e-3, duration=35.0)
+        build_reference(path, params, dt=1e-3, duration=35.0)
     except StiffReferenceError as exc:
         raise ParameterError(f"cart file {str(cart.path)!r}: {exc}") from None
     except InfeasiblePathError:  # a circle the cart cannot steer: the cart's answer, reported below
         pass
-    certified = certified_on_cart(cart)
+    certified = certified_on_cart(cart, path)
     t0 = time.perf_counter()
-    design = design_on_cart(cart, seed=seed)
+    design = design_on_cart(cart, seed=seed, path=path)
     design_wall = time.perf_counter() - t0
     steps = step_with_random_controls(params, seed=seed)
     ident, ident_error = None, None
@@ -150,27 +153,28 @@ def _answer(cart: Any, steps: Any, ident: Any, ident_error: str | None) -> str:
             "P, C_V, F, K, gyro are those the file implies")
 
 
-def certified_on_cart(cart: Any) -> dict[str, Any]:
-    """The certified design on ``cart`` (a checked CartFile) and its certificate on the paper circle with the cart's
+def certified_on_cart(cart: Any, path: str = "paper-circle") -> dict[str, Any]:
+    """The certified design on ``cart`` (a checked CartFile) and its certificate on ``path`` with the cart's
     default sensing, actuation and play: omega_r [rad/s], kp, kd, certified, E_max [rad], Edot_max [rad/s],
     voltage_max [V], voltage_limit [V], met, unmet (assumption names); or omega_r None and 'reason' where the rule
     finds no omega_r on its grid."""
 
     try:  # a paper circle the cart's supply or stops cannot follow: the cart's answer, not the user's input
-        design = certified_design(cart)
-        claim = resolve_run(RunConfig(**design.config_changes(), cart=cart)).claim
+        design = certified_design(cart, path=path)
+        claim = resolve_run(RunConfig(**design.config_changes(), cart=cart, path=path)).claim
     except (ParameterError, InfeasiblePathError) as exc:
-        return {"omega_r": None, "reason": str(exc)}
+        return {"omega_r": None, "reason": str(exc), "path": path}
     assert claim is not None  # the computed-torque law always states its certificate
     return {"omega_r": design.kd, "kp": design.kp, "kd": design.kd, "certified": claim.certified,
             "E_max": claim.E_max, "Edot_max": claim.Edot_max, "voltage_max": claim.voltage_max,
             "voltage_limit": float(cart.parameters["voltage_limit"]),
-            "met": [a.name for a in claim.assumptions if a.met], "unmet": list(claim.unmet)}
+            "met": [a.name for a in claim.assumptions if a.met], "unmet": list(claim.unmet), "path": path}
 
 
-def design_on_cart(cart: Any, *, seed: int | None = None, budget: int | None = None) -> dict[str, Any]:
+def design_on_cart(cart: Any, *, seed: int | None = None, budget: int | None = None,
+                   path: str = "paper-circle") -> dict[str, Any]:
     """Can ``wmr-mj design`` certify ``cart`` (a checked CartFile) on its default sensing, actuation and play? The
-    design search on the paper circle over the cart's m1 box, computed-torque law, 1 ms period, E_max minimised.
+    design search on ``path`` over the cart's m1 box, computed-torque law, 1 ms period, E_max minimised.
 
     Returns:
         certified; where certified: E_max [rad], voltage_max [V], kp [1/s^2], kd [1/s], friction_width [rad/s];
@@ -182,20 +186,21 @@ def design_on_cart(cart: Any, *, seed: int | None = None, budget: int | None = N
     seed = DEFAULT_SEED if seed is None else seed
     budget = DEFAULT_BUDGET if budget is None else budget
     command = (f"wmr-mj design --cart {cart.path} --seed {seed}"
-               + ("" if budget == DEFAULT_BUDGET else f" --budget {budget}"))
-    out: dict[str, Any] = {"budget": budget, "seed": seed, "command": command}
+               + ("" if budget == DEFAULT_BUDGET else f" --budget {budget}")
+               + ("" if path == default_path(cart) else f" --path {path}"))
+    out: dict[str, Any] = {"budget": budget, "seed": seed, "command": command, "path": path}
     base = RunConfig.from_inputs(**law_changes("computed-torque"), cart=cart)
     why_not = uncovered(base)
     if why_not:  # design refuses such a cart's sensing (no certificate can cover it)
         return {**out, "certified": False, "evaluations": 0,
                 "binding": f"the default sensing ({why_not}: no certificate covers it)"}
     try:
-        result = search_design(DesignProblem(base=base, seed=seed, budget=budget))
-    except InfeasiblePathError as exc:  # the cart cannot follow the paper circle: no gains certify it
-        return {**out, "certified": False, "evaluations": 0, "binding": f"the paper circle's feasibility ({exc})"}
+        result = search_design(DesignProblem(base=base, seed=seed, budget=budget, paths=(path,)))
+    except InfeasiblePathError as exc:  # the cart cannot follow the path: no gains certify it
+        return {**out, "certified": False, "evaluations": 0, "binding": f"the path {path}'s feasibility ({exc})"}
     out.update(certified=result.certified, evaluations=result.evaluations)
     if not result.certified:
         return {**out, "binding": result.binding}
     s = result.settings
-    return {**out, "E_max": result.E_max, "voltage_max": result.certificates["paper-circle"].voltage_max,
+    return {**out, "E_max": result.E_max, "voltage_max": result.certificates[path].voltage_max,
             "kp": s["kp"], "kd": s["kd"], "friction_width": s["friction_width"]}

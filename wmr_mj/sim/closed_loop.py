@@ -37,7 +37,7 @@ from controllers.tracking import within_declared
 from wmr_mj._util.memory import require_run_memory
 from wmr_mj._util.progress import progress_bar
 from wmr_mj.analysis.claim import with_measured
-from wmr_mj.analysis.claim_types import LAW_CLAIM, CertificateJudgement, judge
+from wmr_mj.analysis.claim_types import LAW_CLAIM, Assumption, CertificateJudgement, judge
 from wmr_mj.analysis.path_bound import PathBound, PathVerdict
 from wmr_mj.analysis.path_error import PathErrors, PathErrorSeries
 from wmr_mj.analysis.verdicts import Drift
@@ -458,6 +458,8 @@ def run_parts(parts: RunParts, *, logger_factory: Callable[..., Any] | None = No
             raise ControllerFailure(run.failure)  # nothing simulated: nothing to judge
         raise KeyboardInterrupt  # nothing simulated: nothing to report
     claims = _measured_claims(parts, done)
+    if run.warnings and LAW_CLAIM in claims:  # a run MuJoCo warned of is not the plant any claim is of
+        claims[LAW_CLAIM] = with_mujoco_warnings(claims[LAW_CLAIM], run.warnings, run.warning_text)
     certificate = claims.get(LAW_CLAIM)  # the run's verdict is the law's claim's
     after = done["t"] >= settle_s
     at = path_sample_index(k, period)
@@ -495,6 +497,20 @@ def run_parts(parts: RunParts, *, logger_factory: Callable[..., Any] | None = No
         else judge(cert, summary.sup_E, summary.sup_Edot) for name, cert in claims.items()}
     return RunResult(config=config, rows=done, summary=summary, status=status, law=run.law, law_note=run.law_note,
                      C_xy=run.C_xy, cpu_s=run.cpu_s, reference=reference, path_samples=path_samples, claims=judged)
+
+
+#: the assumption a run with MuJoCo warnings does not meet (:func:`with_mujoco_warnings`)
+MUJOCO_WITHOUT_WARNINGS = "MuJoCo stepped without a warning"
+
+
+def with_mujoco_warnings(certificate: Any, count: int, text: str | None) -> Any:
+    """``certificate`` with the assumption :data:`MUJOCO_WITHOUT_WARNINGS` unmet: MuJoCo warned ``count`` times
+    during the run (``text``: its first warning, as MuJoCo words it), so the steps it warned of (a NaN, an
+    unstable acceleration, a singular inertia) are not the plant the claim is of, and the run is not certified."""
+    first = f"MuJoCo's first: {text.strip()}" if text else "MuJoCo's warning counters rose"
+    return with_measured(certificate, Assumption(
+        name=MUJOCO_WITHOUT_WARNINGS, equation="MuJoCo's warnings during the run = 0", met=False,
+        value=float(count), limit=0.0, note=f"{count} warning(s); {first}"))
 
 
 def _measured_claims(parts: RunParts, rows: Mapping[str, np.ndarray]) -> dict[str, Any]:

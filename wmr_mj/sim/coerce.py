@@ -55,11 +55,13 @@ from wmr_mj.reference.paths import Path as PathOfC
 from wmr_mj.reference.route import Route, is_route_spec, load_route, route_from_path, route_names
 from wmr_mj.sim.signals import Signals, signals_from
 
-__all__ = ["PATH_NAMES", "coerce", "coerce_with_classes", "is_coerced", "check_fields", "route_of", "cart_file",
-           "base_for", "plant_parameters", "plugin_source", "controller_source", "controller_name", "default_model",
-           "check_motor_constant", "coerced"]
+__all__ = ["PATH_NAMES", "DEFAULT_PATH", "default_path", "cart_file_of_record", "coerce", "m1_of_overrides",
+           "coerce_with_classes", "is_coerced", "check_fields", "route_of", "cart_file", "base_for", "plant_parameters",
+           "plugin_source", "controller_source", "controller_name", "default_model", "check_motor_constant", "coerced"]
 
 PATH_NAMES = ("paper-circle", "lane-change", "figure-eight")
+#: the path of a run that names none, on a cart that declares none (``[paths] default`` declares a cart's own)
+DEFAULT_PATH = "paper-circle"
 
 #: the cart's parts: field name -> its typed class
 _PARTS: tuple[tuple[str, Any], ...] = (("sensing", Sensing), ("actuation", Actuation),
@@ -122,6 +124,25 @@ def check_fields(config: Any) -> None:
                                 plant_overrides=config.plant_overrides)
         m1 = M1_NOMINAL if config.m1 is None else config.m1
         _check_parts(typed, C80, with_params(C80, m1_inertia=config.m1_inertia, m1=m1, **dict(config.plant_overrides)))
+
+
+def m1_of_overrides(m1: Any, overrides: Any) -> tuple[Any, Any]:
+    """(m1, the other overrides): a plant override of m1 (``plant_overrides={"m1": 700}``, ``--param m1=700``) is the
+    config's m1 (the one mass of the run: ``with_params`` takes m1 once); ``overrides`` unchanged where it names no m1.
+
+    Raises:
+        ParameterError: m1 given as a field and as an override with different values (one line).
+    """
+    if not isinstance(overrides, Mapping) or "m1" not in overrides:
+        return m1, overrides
+    try:
+        mass = float(overrides["m1"])
+    except (TypeError, ValueError):
+        raise ParameterError(f"plant_overrides m1 = {overrides['m1']!r} is not accepted; a number of kg") from None
+    if m1 is not None and m1 != mass:
+        raise ParameterError(f"m1 = {m1!r} kg and plant_overrides m1 = {mass!r} kg (--m1 and --param m1=) give two "
+                             "masses; give one of them")
+    return mass, {k: v for k, v in overrides.items() if k != "m1"}
 
 
 def _is_inline(signals: Any) -> bool:
@@ -240,7 +261,7 @@ def coerce_with_classes(config: Any, *, classes: bool = True) -> tuple[Any, dict
                 found[kind] = cls
     if config.model is None:
         changes["model"] = default_model(config.controller, config.controller_params, cls=found.get("controller"))
-    changes["path"] = _checked_path(config.path)
+    changes["path"] = _checked_path(default_path(cart_file_of_record(cart)) if config.path is None else config.path)
     changes["signals"] = signals_from(config.signals)
     changes["reference_bounds"] = reference_bounds_from(config.reference_bounds)
     cart_file_ = None if cart is None else _cart_of_text(cart["text"], cart["path"])
@@ -318,9 +339,10 @@ def _cart_record(given: Any) -> dict[str, str] | None:
     return {"name": cart.name, "version": cart.version, "path": str(cart.path), "text": cart.text}
 
 
-def _numbers_of(cart: Any) -> tuple[dict, dict, dict]:
-    """What a run reads of a cart: its parameters, its boxes and its defaults."""
-    return (dict(cart.parameters), {k: dict(v) for k, v in cart.uncertainty.items()}, dict(cart.defaults))
+def _numbers_of(cart: Any) -> tuple[dict, dict, dict, str | None]:
+    """What a run reads of a cart: its parameters, its boxes, its defaults and its default path."""
+    return (dict(cart.parameters), {k: dict(v) for k, v in cart.uncertainty.items()}, dict(cart.defaults),
+            cart.default_path)
 
 
 @functools.lru_cache(maxsize=8)
@@ -331,6 +353,18 @@ def _cart_of_text(text: str, path: str) -> CartFile:
 @functools.lru_cache(maxsize=8)
 def _parameters_of_text(text: str, path: str) -> C80Parameters:
     return parameters_of_cart(_cart_of_text(text, path))
+
+
+def cart_file_of_record(record: Mapping[str, str] | None) -> CartFile | None:
+    """The cart (:class:`wmr_mj.carts.CartFile`) of a typed config's cart record; None for the C80."""
+    return None if record is None else _cart_of_text(record["text"], record["path"])
+
+
+def default_path(cart: CartFile | None) -> str:
+    """The path a run on ``cart`` takes where it names none: the one the cart declares (``[paths] default``), else
+    the paper circle (:data:`DEFAULT_PATH`)."""
+    declared = None if cart is None else cart.default_path
+    return DEFAULT_PATH if declared is None else declared
 
 
 def cart_file(config: Any) -> Any:

@@ -626,6 +626,37 @@ def design_file_settings(path: str | os.PathLike, data: Mapping[str, Any] | None
     return out
 
 
+def design_file_box(path: str | os.PathLike, data: Mapping[str, Any] | None = None) -> dict[str, Any]:
+    """What the design of file ``path`` was found on besides its settings: ``m1_range`` (kg, the m1 box its
+    certificates were computed for), ``box_ranges`` (the other ranged parameters), ``reference_bounds`` (None:
+    the run's own) and ``path`` (the first path it was certified on). A run of the design judges against these
+    unless an option overrides one. A key the file lacks (a file written before it was recorded) is left out."""
+    data = read_design(path) if data is None else data
+    box, search = data.get("box") or {}, data.get("search") or {}
+    out: dict[str, Any] = {}
+    if isinstance(box.get("m1_range"), list) and len(box["m1_range"]) == 2:
+        out["m1_range"] = (float(box["m1_range"][0]), float(box["m1_range"][1]))
+    if isinstance(box.get("box_ranges"), Mapping):
+        out["box_ranges"] = {k: (float(v[0]), float(v[1])) for k, v in box["box_ranges"].items()}
+    if box.get("reference_bounds") is not None:
+        out["reference_bounds"] = dict(box["reference_bounds"])
+    if search.get("paths"):
+        first = str(search["paths"][0])
+        beside = os.path.join(os.path.dirname(os.fspath(path)), first)  # a route file found where the design is
+        if first.lower().endswith((".toml", ".json")) and not os.path.isfile(first) and os.path.isfile(beside):
+            first = beside
+        out["path"] = first
+    return out
+
+
+def design_cart_name(path: str | os.PathLike, data: Mapping[str, Any] | None = None) -> str:
+    """The cart the design of file ``path`` was found on, as its outputs name it ('C80' where it records none)."""
+    recorded = (read_design(path) if data is None else data).get("cart")
+    if not isinstance(recorded, Mapping):
+        return "C80"
+    return f"{recorded.get('name')} {recorded.get('version', '')}".strip()
+
+
 
 def design_cart(path: str | os.PathLike, given: Any = None, *, data: Mapping[str, Any] | None = None) -> Any:
     """The cart a run of the design file ``path`` is on: ``given`` where a cart is named (an explicit --cart

@@ -59,6 +59,7 @@ __all__ = [
     "OMEGA_R_GRID",
     "certified_omega_r",
     "certified_design",
+    "CERTIFIED_C80",
     "on_cart",
     "preset",
 ]
@@ -92,6 +93,14 @@ class Design:
             out["correction"] = True
         return out
 
+    def on(self, cart: Any = None, *, path: str | None = None) -> Design:
+        """This design on ``cart`` (anything ``RunConfig(cart=...)`` takes; None: the C80): the certified design's
+        gain rule run on the cart (and ``path``; None: the cart's own default path) for :data:`CERTIFIED`, as
+        ``--preset certified --cart`` runs it; any other design as it is (its gains are the cart's as given)."""
+        if self.name != "certified":
+            return self
+        return certified_design(cart, path=path)
+
     def describe(self) -> str:
         sign = "exact sign" if self.friction_width == 0 else f"sign smoothed w = {self.friction_width:g} rad/s"
         if self.friction_sign == "reference":
@@ -103,8 +112,13 @@ class Design:
 
 
 PAPER = Design(name="paper", label="the paper's design")
+#: the certified design: the gain rule (:func:`certified_omega_r`) on a cart -- ``CERTIFIED.on(cart)`` runs it on
+#: ``cart`` (``--preset certified --cart``); as a value, CERTIFIED is the rule's answer on the C80
+#: (:data:`CERTIFIED_C80`, omega_r = 20 rad/s: K_P = 100, K_D = 20), never another cart's
 CERTIFIED = Design(name="certified", label="certified design", model="nonholonomic", kp=100.0, kd=20.0,
                    friction_sign="measured", friction_width=SMOOTHING_WIDTH)
+#: the certified design's gains on the C80 (the rule on the C80 and the paper circle), by its C80 name
+CERTIFIED_C80 = CERTIFIED
 PRESETS: dict[str, Design] = {"paper": PAPER, "certified": CERTIFIED}
 PRESET_NAMES = tuple(PRESETS)
 
@@ -124,7 +138,7 @@ CORRECTION_RUNG = Design(name="correction", label="+ Cartesian correction", mode
                          friction_width=CERTIFIED.friction_width, correction=True)
 
 
-def preset(name: str, *, cart: Any = None) -> Design:
+def preset(name: str, *, cart: Any = None, path: str | None = None) -> Design:
     """The design called ``name``; unknown names raise UnknownNameError listing the valid ones.
 
     cart: the cart the design is for (anything ``RunConfig(cart=...)`` takes; None: the C80). The paper's
@@ -138,7 +152,7 @@ def preset(name: str, *, cart: Any = None) -> Design:
     if name not in PRESETS:
         raise UnknownNameError("preset", name, PRESET_NAMES)
     if name == "certified" and cart is not None:
-        return certified_design(cart)
+        return certified_design(cart, path=path)
     return PRESETS[name]
 
 
@@ -149,28 +163,39 @@ def _cart_record(cart: Any) -> dict[str, Any] | None:
     return RunConfig.from_inputs(cart=cart).cart
 
 
-def certified_design(cart: Any = None) -> Design:
-    """The certified design on ``cart`` (None: the C80, :data:`CERTIFIED`): the rule run on the cart.
+def certified_design(cart: Any = None, *, path: str | None = None) -> Design:
+    """The certified design on ``cart`` (None, or the C80's numbers: the C80, :data:`CERTIFIED_C80`): the rule run
+    on the cart and on ``path`` (None: the cart's own default path, :func:`wmr_mj.sim.coerce.default_path`).
 
     Raises:
         ParameterError: no omega_r of :data:`OMEGA_R_GRID` gives a valid certificate within
-            :data:`ERROR_SPEC` on the cart (one line naming the cart).
+            :data:`ERROR_SPEC` on the cart (one line naming the cart and the path).
+        InfeasiblePathError: the cart cannot steer the path (one line naming the path, the stops and --path).
     """
     record = _cart_record(cart)
     if record is None:
-        return CERTIFIED
-    return _certified_on(record["text"], record["path"])
+        return CERTIFIED_C80
+    return _certified_on(record["text"], record["path"], path)
 
 
 @functools.lru_cache(maxsize=8)
-def _certified_on(text: str, path: str) -> Design:
-    record = {"text": text, "path": path}
-    w = certified_omega_r(cart=record)
+def _certified_on(text: str, cart_path: str, path: str | None) -> Design:
+    record = {"text": text, "path": cart_path}
+    w = certified_omega_r(cart=record, path=path)
     if w is None:
-        raise ParameterError(f"cart file {path!r}: the certified design's rule finds no omega_r in "
+        raise ParameterError(f"cart file {cart_path!r}: the certified design's rule finds no omega_r in "
                              f"{OMEGA_R_GRID[0]:g}-{OMEGA_R_GRID[-1]:g} rad/s whose certificate is valid with "
-                             f"E_max <= {ERROR_SPEC:g} rad on this cart; give the gains with --kp/--kd or --omega-r")
+                             f"E_max <= {ERROR_SPEC:g} rad on this cart and path {_path_of(record, path)}; give the "
+                             "gains with --kp/--kd or --omega-r, or another --path")
     return dataclasses.replace(CERTIFIED, kp=w * w / 4.0, kd=w)
+
+
+def _path_of(cart: Any, path: str | None) -> str:
+    """The path the rule runs on: ``path``, else the cart's own default."""
+    from wmr_mj.sim.coerce import cart_file_of_record, default_path
+    from wmr_mj.sim.config import RunConfig
+
+    return path if path is not None else default_path(cart_file_of_record(RunConfig.from_inputs(cart=cart).cart))
 
 
 def on_cart(changes: dict[str, Any], cart: Any) -> dict[str, Any]:
@@ -184,7 +209,7 @@ def on_cart(changes: dict[str, Any], cart: Any) -> dict[str, Any]:
 
 
 def certified_omega_r(*, error_spec: float = ERROR_SPEC, grid: tuple[float, ...] = OMEGA_R_GRID,
-                      cart: Any = None) -> float | None:
+                      cart: Any = None, path: str | None = None) -> float | None:
     """The rule of the certified design: the smallest omega_r of ``grid`` whose certificate
     (non-holonomic model, smoothed sign, paper circle, m1 over the cart's m1 box: 550-750 kg on the C80)
     is valid with E_max <= error_spec. None when no grid point qualifies. No simulation is run.
@@ -195,7 +220,7 @@ def certified_omega_r(*, error_spec: float = ERROR_SPEC, grid: tuple[float, ...]
     from wmr_mj.sim.config import RunConfig, base_for, build_reference
 
     on_cart = RunConfig.from_inputs(cart=cart)
-    reference, _ = build_reference("paper-circle", base_for(on_cart), dt=1e-3, duration=35.0)
+    reference, _ = build_reference(_path_of(cart, path), base_for(on_cart), dt=1e-3, duration=35.0)
     for w in grid:
         config = RunConfig(model=CERTIFIED.model, kp=w * w / 4.0, kd=w, friction_sign=CERTIFIED.friction_sign,
                            friction_width=CERTIFIED.friction_width, cart=on_cart.cart)

@@ -42,10 +42,12 @@ not), shared with ``wmr_mj.sim.batch``; :func:`batch_law_backend` chooses the la
 
 from __future__ import annotations
 
+import contextlib
 import copy
+import dataclasses
 import math
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, cast
 
@@ -196,6 +198,21 @@ class EngineRun:
     cpu_s: float  # the block loop's CPU time on the calling thread (the batch of one steps on it)
     C_xy: np.ndarray = field(default_factory=lambda: np.empty((0, 2)))  # (steps, 2) xy of site C [m], as C_pos
     failure: str | None = None  # status 'failed': why (the law or tracker raised, returned NaN or a bad shape)
+    warning_text: str | None = None  # MuJoCo's first warning of the run, as it words it (None: it warned not)
+
+
+@contextlib.contextmanager
+def held_mujoco_warnings() -> Iterator[list[str]]:
+    """MuJoCo's warnings (its C warning callback, ``mju_user_warning``) collected in the list this yields
+    instead of printed on the console; the handler before restored on leaving. A run counts its warnings
+    from ``mjData.warning`` and reports them once (:class:`EngineRun`), never once per step."""
+    texts: list[str] = []
+    previous = mujoco.get_mju_user_warning()
+    mujoco.set_mju_user_warning(texts.append)
+    try:
+        yield texts
+    finally:
+        mujoco.set_mju_user_warning(previous)
 
 
 class _Plant:
@@ -548,7 +565,9 @@ def run_engine(*, params: C80Parameters, controller: Any, options: dict[str, Any
     loop = _BlockLoop(first, python_stepper, schedule=schedule, plain=plain, where=where, reference=reference,
                       loads=loads, sensed=chain is not None, k_i=params.k_i, on_block=on_block, lawful=lawful,
                       ref_adr=ref_adr, note=note, signal_names=names)
-    return loop.run(on_progress)
+    with held_mujoco_warnings() as texts:  # counted and reported once (EngineRun), never printed per step
+        run = loop.run(on_progress)
+    return dataclasses.replace(run, warning_text=texts[0]) if texts else run
 
 
 class _BlockLoop:

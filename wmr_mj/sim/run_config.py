@@ -22,7 +22,7 @@ from typing import Any
 from controllers.registry import PluginSource
 from wmr_mj.hardware.cart import CART_PARTS, cart_dict
 from wmr_mj.params import PAPER_KD, PAPER_KP
-from wmr_mj.sim.coerce import check_fields, coerce, is_coerced
+from wmr_mj.sim.coerce import check_fields, coerce, is_coerced, m1_of_overrides
 
 __all__ = ["RunConfig"]
 
@@ -50,6 +50,8 @@ class RunConfig:
     friction_width: float = 0.0  # rad/s, tanh smoothing of the Coulomb sign (0: exact sign)
     # C's path: one of PATH_NAMES, a packaged route name (wmr_mj.reference.route.route_names()), a
     # .toml/.json route file, or canonical route JSON; a Path or Route object is stored as its canonical JSON
+    # None: the cart's own (its file's [paths] default), else the paper circle (resolved where the config is
+    # coerced; the commands give None where --path is not given)
     path: str = "paper-circle"
     plant_overrides: Mapping[str, float] = field(default_factory=dict)  # other plant parameters
     m1_inertia: str = "payload"
@@ -94,6 +96,10 @@ class RunConfig:
     tracker_plugin: PluginSource | None = None
 
     def __post_init__(self) -> None:
+        m1, overrides = m1_of_overrides(self.m1, self.plant_overrides)
+        if overrides is not self.plant_overrides:  # an override of m1 is the field m1 (one mass per run)
+            object.__setattr__(self, "m1", m1)
+            object.__setattr__(self, "plant_overrides", overrides)
         check_fields(self)  # the values as given: no file read, no module imported (coerce reads the references)
 
     @classmethod

@@ -42,6 +42,7 @@ class LawChoice:
         coefficients: the estimate's coefficients for model 'explicit'.
         cart: the cart the preset is derived for (``RunConfig.cart``; None: the C80): the certified design's
             rule run on it (:func:`wmr_mj.sim.designs.preset`), the identification done on it.
+        path: the run's path where given: the certified design's rule runs on it (None: the cart's own path).
     """
 
     preset: str | None = None
@@ -56,6 +57,7 @@ class LawChoice:
     identified: Any = None
     coefficients: Mapping[str, float] | None = None
     cart: Any = None
+    path: str | None = None  # the run's path, where given: the certified design's rule runs on it (None: the cart's)
 
     def given(self) -> dict[str, tuple[str, ...]]:
         """The law options given explicitly (:data:`LAW_OPTIONS`' keys) and the fields each sets."""
@@ -75,7 +77,7 @@ def law_fields(choice: LawChoice) -> dict[str, Any]:
     from controllers import gains_from_omega_r
     from wmr_mj.sim.designs import preset
 
-    design = preset("paper" if choice.preset is None else choice.preset, cart=choice.cart)
+    design = preset("paper" if choice.preset is None else choice.preset, cart=choice.cart, path=choice.path)
     if choice.omega_r is not None and (choice.kp is not None or choice.kd is not None):
         raise ParameterError("give either --omega-r or --kp/--kd, not both")
     if choice.omega_r is not None:

@@ -41,8 +41,9 @@ import numpy as np
 
 from wmr_mj._util.checks import positive_range
 from wmr_mj.errors import ParameterError, SchedulerError, UnknownNameError
-from wmr_mj.params import M1_RANGE, parameter_names
+from wmr_mj.params import parameter_names
 from wmr_mj.sim.batch import run_batch
+from wmr_mj.sim.coerce import coerced
 from wmr_mj.sim.config import RunConfig, config_from_dict
 from wmr_mj.sim.records import BrokenRun, Record, UnmetAssumption
 from wmr_mj.sim.summary import RunSummary
@@ -130,7 +131,9 @@ class SweepSpec:
     n: int = 200
     seed: int = 0
     sampling: str = "lhs"
-    m1_range: tuple[float, float] = M1_RANGE
+    # the m1 box, kg: drawn over (m1 not fixed) and the certificate's; None: the base's (its cart's m1 box, the C80's
+    # 550-750 kg where it names none)
+    m1_range: tuple[float, float] = None  # type: ignore[assignment]
     m1: float | None = None  # a fixed m1 [kg]: every run's; None: drawn over m1_range
     ranges: Mapping[str, tuple[float, float]] = field(default_factory=dict)
     base: RunConfig = field(default_factory=RunConfig)
@@ -140,6 +143,8 @@ class SweepSpec:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "requirements", tuple(self.requirements))
+        if self.m1_range is None:  # the base's box: its cart's (RunConfig(cart=...)), read where the base names one
+            object.__setattr__(self, "m1_range", tuple(coerced(self.base).m1_range))
         if not isinstance(self.n, int) or self.n < 1:
             raise ParameterError(f"n = {self.n!r} is not accepted; the number of runs must be an integer >= 1")
         if self.sampling not in SAMPLINGS:

@@ -1,0 +1,161 @@
+"""Issue 42's done-when, as the new user does it: a cart that is not the C80 (tests/data/anycart.toml: a 100 kg
+chassis with an 80-120 kg box, a 0.9 m wheelbase, a 50:1 gear, stops at +-0.7 rad, a 12-bit axis encoder read 10 ms
+late, and its own path, a loop of 2.5 m corners, since the paper's 1 m circle needs more than its stops) runs
+through ``cart check``, ``design``, ``run --design``, ``sweep --design`` and ``falsify --design`` with no option
+beyond the cart and the design: no ``--m1-range``, no ``--path``.
+
+The independent truth is the cart file itself: every run judges against its 80-120 kg box and on its declared path,
+and no C80 box (550-750 kg), path (the paper circle) or wording (the paper's claim) appears. Before: the design's
+box silently became the C80's 550-750 kg in sweep and falsify (17 of 24 runs uncertified, falsify "1.26 times the
+claimed bound"), and the paper circle was every command's path, which this cart cannot steer.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from wmr_mj.carts import load_cart
+from wmr_mj.sim.config import RunConfig, coerce
+from wmr_mj.sim.designs import CERTIFIED, CERTIFIED_C80, certified_design
+from wmr_mj.sim.sweep import SweepSpec
+
+DATA = Path(__file__).resolve().parent / "data"
+CART_BOX = (80.0, 120.0)  # the file's [uncertainty.m1.m1] range, kg
+C80_WORDS = ("550", "750", "paper-circle", "paper circle", "paper's claim")
+
+
+def _cli(*args: str, cwd: Path) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "wmr_mj.cli", *args], capture_output=True, text=True, timeout=300,
+                          cwd=cwd, env={**os.environ, "MPLBACKEND": "Agg"})
+
+
+def _no_c80(proc: subprocess.CompletedProcess) -> None:
+    text = proc.stdout + proc.stderr
+    for word in C80_WORDS:
+        assert word not in text, (word, text)
+
+
+@pytest.fixture(scope="module")
+def folder(tmp_path_factory) -> Path:
+    where = tmp_path_factory.mktemp("newuser")
+    for name in ("anycart.toml", "anycart-loop.toml"):
+        shutil.copy(DATA / name, where / name)
+    return where
+
+
+@pytest.fixture(scope="module")
+def design(folder) -> dict:
+    proc = _cli("design", "--cart", "anycart.toml", "--budget", "10", "--duration", "10", "--out", "d.json",
+                cwd=folder)
+    assert proc.returncode == 0, proc.stderr
+    _no_c80(proc)
+    return json.loads((folder / "d.json").read_text())
+
+
+def test_the_cart_file_is_the_users_and_declares_its_path():
+    cart = load_cart(DATA / "anycart.toml")
+    assert cart.uncertainty["m1"]["m1"] == CART_BOX and cart.parameters["m1"] == 100.0
+    assert (cart.parameters["l1"], cart.parameters["i2"], cart.parameters["steering_range"]) == (0.9, 50.0, 0.7)
+    assert Path(cart.default_path) == DATA / "anycart-loop.toml"
+    config = coerce(RunConfig(cart=str(DATA / "anycart.toml"), path=None))
+    assert config.path == cart.default_path and config.m1_range == CART_BOX
+
+
+def test_cart_check_passes_and_names_the_carts_own_path(folder):
+    proc = _cli("cart", "check", "anycart.toml", cwd=folder)
+    assert proc.returncode == 0, proc.stderr
+    lines = proc.stdout.splitlines()
+    assert lines[0].startswith("cart anycart 1.0.0 (anycart.toml): passes")
+    assert "CERTIFIED" in lines[1] and lines[1].endswith("path anycart-loop.toml")
+    assert lines[2].startswith("design certifies it")
+    _no_c80(proc)
+
+
+def test_cart_check_path_answers_for_the_paper_circle_naming_it_the_stops_and_the_option(folder):
+    proc = _cli("cart", "check", "anycart.toml", "--path", "paper-circle", cwd=folder)
+    assert proc.returncode == 0, proc.stderr
+    line = proc.stdout.splitlines()[1]
+    assert line.startswith("certified design: none on this cart (path infeasible")
+    assert "on path 'paper-circle'" in line and "+-0.7 rad" in line and "--path" in line
+
+
+def test_the_design_file_records_the_carts_box_and_path(design):
+    assert design["box"]["m1_range"] == list(CART_BOX)
+    assert design["search"]["paths"] == ["anycart-loop.toml"]
+    assert design["cart"]["name"] == "anycart"
+    assert design["settings"]["sensing"]["delay"] == 0.01 and design["settings"]["sensing"]["encoder_ticks"] == 4096
+
+
+def test_run_design_runs_on_the_designs_cart_box_and_path(folder, design):
+    proc = _cli("run", "--design", "d.json", "--no-log", "--duration", "10", "--json", cwd=folder)
+    assert proc.returncode == 0, proc.stderr
+    summary = json.loads(proc.stdout)
+    assert summary["m1"] == 100.0 and summary["verdict"] == "certified-inside"
+    assert summary["path"].endswith("anycart-loop.toml")
+    assert summary["certificate"]["E_max"] == pytest.approx(design["E_max"], rel=1e-12)  # the design's certificate
+    text = _cli("run", "--design", "d.json", "--no-log", "--duration", "10", cwd=folder)
+    assert text.returncode == 0, text.stderr
+    _no_c80(text)
+
+
+def test_sweep_design_draws_over_the_designs_box(folder):
+    proc = _cli("sweep", "--design", "d.json", "--n", "4", "--duration", "10", "--out", "sweep", cwd=folder)
+    assert proc.returncode == 0, proc.stderr
+    assert "m1 over 80-120 kg" in proc.stdout
+    assert "certified-inside 4" in proc.stdout
+    _no_c80(proc)
+    summary = json.loads((folder / "sweep" / "summary.json").read_text())
+    assert summary["ranges"]["m1"] == list(CART_BOX)
+
+
+def test_falsify_design_searches_the_designs_box(folder):
+    proc = _cli("falsify", "--design", "d.json", "--budget", "8", "--duration", "10", "--out", "falsify", cwd=folder)
+    assert proc.returncode == 0, proc.stderr
+    assert "box m1" in proc.stdout and "uncertified" not in proc.stdout
+    worst = next(line for line in proc.stdout.splitlines() if line.startswith("worst parameters:"))
+    assert CART_BOX[0] <= float(worst.split("m1 = ")[1].split(",")[0]) <= CART_BOX[1]
+    _no_c80(proc)
+
+
+def test_a_cart_beyond_the_designs_says_so_in_one_note_and_runs_on_its_own_sensing(folder, design):
+    proc = _cli("run", "--design", "d.json", "--cart", "c80", "--no-log", "--duration", "10", "--json", cwd=folder)
+    notes = [line for line in proc.stderr.splitlines() if "not the cart the design" in line]
+    assert len(notes) == 1 and "anycart 1.0.0" in notes[0] and "--cart c80" in notes[0]
+    box = _cli("run", "--design", "d.json", "--m1-range", "60", "130", "--no-log", "--duration", "10", cwd=folder)
+    assert box.returncode == 0, box.stderr
+    notes = [line for line in box.stderr.splitlines() if "beyond the m1 box" in line]
+    assert len(notes) == 1 and "60 130" in notes[0] and "80-120 kg" in notes[0]
+
+
+def test_a_sweep_spec_on_a_cart_takes_the_carts_box():
+    spec = SweepSpec(n=2, base=RunConfig(cart=str(DATA / "anycart.toml")))
+    assert spec.m1_range == CART_BOX
+    assert SweepSpec(n=2).m1_range == (550.0, 750.0)  # the C80's (5.1) box, as before
+
+
+def test_certified_is_the_rule_on_the_cart_and_the_c80s_gains_a_named_value():
+    assert CERTIFIED_C80 is CERTIFIED and CERTIFIED.on(None) == CERTIFIED_C80
+    on_cart = CERTIFIED.on(str(DATA / "anycart.toml"))
+    assert on_cart == certified_design(str(DATA / "anycart.toml"))
+    assert (on_cart.kp, on_cart.kd) != (CERTIFIED_C80.kp, CERTIFIED_C80.kd)
+    assert on_cart.kp == on_cart.kd ** 2 / 4.0  # the rule's gains: K_P = omega_r^2/4, K_D = omega_r
+
+
+def test_validate_on_the_cart_asks_of_its_box_and_path(folder):
+    proc = _cli("validate", "--cart", "anycart.toml", "--n", "2", "--duration", "10", "--identify-duration", "10",
+                "--search-budget", "5", "--seed", "3", "--out", "report", cwd=folder)
+    assert proc.returncode == 0, proc.stderr
+    first = proc.stdout.splitlines()[0]
+    assert first.startswith("Question: does the paper's robustness region hold for the cart anycart 1.0.0 under m1 in "
+                            "80-120 kg?") and "on the path anycart-loop.toml" in first
+    for word in ("550", "750", "paper-circle", "paper circle", "C80"):
+        assert word not in proc.stdout, word
+    rule = certified_design(str(folder / "anycart.toml"))  # the rung's gains are the rule's on this cart
+    assert f"K_P = {rule.kp:g}, K_D = {rule.kd:g}" in proc.stdout.splitlines()[3]
