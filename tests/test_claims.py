@@ -48,7 +48,12 @@ def test_robustness_certificate_prints_a_law_s_own_claim(controller, capsys):
     for a in cert.assumptions:
         assert re.search(rf"\[{'met    ' if a.met else 'NOT met'}\] {re.escape(a.name)}\s", text), a.name
     assert bool(re.search(r"^\s+CERTIFIED:", text, re.M)) == cert.certified  # not the 'NOT CERTIFIED:' line
-    assert f"Claim of controller {cert.claimant}" in text
+    # the law is named as the controller; its claimant (sliding mode's: the sampled-data certificate, issue 44) as
+    # the claim's, not as the controller
+    law = cert.inputs["controller"]
+    assert f"Claim of controller {law} " in text and _printed(text, "controller").split()[1] == law
+    by = "the law's own" if cert.claimant == law else f"the {cert.claimant} certificate's"
+    assert f"({by} box claim)" in _printed(text, "claim")
 
 
 @pytest.mark.parametrize("controller", ["sliding-mode", CLAIMED])

@@ -339,7 +339,11 @@ def test_cli_falsify_sup_E_prints_and_writes_the_worst_runs_certificate(tmp_path
     # its certificate, computed again for the worst run by the run's own resolution
     config = RunConfig(**CERTIFIED.config_changes(), path="lane-change", duration=3.0, m1=w["params"]["m1"])
     claim = resolve_run(config).claim
-    terms = {n: getattr(claim.terms, n) for n in ("friction_term", "gyro_term", "K_term", "P_term", "C_V_term")}
+    # judged by the sampled-data certificate (issue 44 item 1): its binding term is the largest part of its W0
+    # (SampledDataTerms: each part at the P corner where W0 is largest)
+    assert claim.claimant == "sampled-data"
+    terms = {n: claim.inputs["terms"][n] for n in ("friction_term", "P_term", "feedforward_hold_term", "C_V_term",
+                                                   "K_term", "gyro_term", "disturbance_term")}
     assert w["E_max"] == claim.E_max and w["binding_term"]["name"] == max(terms, key=lambda n: terms[n])
     assert summary["tightness"]["ratio"] == pytest.approx(w["sup_E"] / claim.E_max, rel=1e-12)  # E_ratio, 1 ulp
     assert main([*argv, "--out", str(tmp_path / "t")]) == 0

@@ -141,7 +141,9 @@ def test_a_law_with_its_own_claim_is_titled_by_it(tmp_path, capsys):
     fig = replay_figure(read, rep)
     title = fig._suptitle.get_text()
     cert = read.summary["certificate"]
-    assert title.endswith(f"{'inside' if cert['inside'] else 'outside'} sliding-mode's claim"), title
+    # the law's claim, named after the law; the sampled-data certificate it is judged by (issue 44) in brackets
+    assert cert["claimant"] == "sampled-data"
+    assert title.endswith(f"{'inside' if cert['inside'] else 'outside'} sliding-mode's claim (sampled-data)"), title
     assert "paper" not in title and "model=nonholonomic" in title  # the model is the law's own (from_context)
 
 

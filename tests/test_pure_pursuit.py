@@ -112,11 +112,14 @@ def test_declared_bounds_are_its_own_and_the_filter_keeps_them():
 def test_lane_change_on_mujoco_is_certified_with_the_tracker_measured():
     """10 s of the lane change with pure pursuit over the sliding-mode law (its claim computed for
     the tracker's declared bounds): the tracker's assumption is measured and met, the run is
-    certified-inside, and C's cross-track error is reported (measured 0.013 m, bound asserted 0.05 m)."""
+    certified-inside, and C's cross-track error is reported (measured 0.013 m, bound asserted 0.05 m).
+    The law's layer is one its sampled-data certificate proves on the ideal cart (lam 20, phi 6, k 24:
+    docs/guides/certificates.md, "Sampling bounded on every cart"; the default phi 0.2 is not, issue 44)."""
     from wmr_mj.sim.closed_loop import RunConfig, run_closed_loop
 
     result = run_closed_loop(RunConfig(controller="sliding-mode", model="nonholonomic", tracker="pure-pursuit",
-                                       path="lane-change", duration=10.0), progress=False)
+                                       path="lane-change", duration=10.0,
+                                       controller_params={"lam": 20.0, "phi": 6.0, "k": 24.0}), progress=False)
     s = result.summary
     cert = s.certificate.certificate
     tracked = [a for a in cert.assumptions if a.name == TRACKER_BOUNDS_ASSUMPTION]

@@ -8,7 +8,11 @@ import json
 
 import pytest
 
+from wmr_mj import C80
+from wmr_mj.analysis.measurement import MeasurementErrors
+from wmr_mj.sim.certify import certificate_for
 from wmr_mj.sim.closed_loop import RunConfig
+from wmr_mj.sim.config import build_reference
 from wmr_mj.sim.sweep import RESULT_COLUMNS, flat_row
 
 # the keys `wmr-mj run --json` wrote before the summary was typed (less "log", which the command adds)
@@ -24,11 +28,25 @@ PAPER_KEYS = {"paper_E_max", "paper_Edot_max", "paper_condition", "paper_inside"
               "paper_Edot_ratio", "deprecated_keys"}
 # added with the applied voltage's effort (wmr_mj.sim.summary.VoltageEffort; issue 36)
 EFFORT_KEYS = {"peak_voltage", "rms_voltage", "tv_voltage"}
-CERTIFICATE_KEYS = {"C_V_term", "E_max", "E_ratio", "Edot_max", "Edot_ratio", "K_term", "P_term", "alpha_max",
-                    "assumptions", "certified", "condition", "dead_band", "delta1", "delta2", "delta3",
-                    "friction_sign", "friction_term", "friction_width", "gamma1", "gamma2", "gyro_Edot_term",
-                    "gyro_term", "inputs", "inside", "iterations", "kd", "kp", "reason", "regime", "region_ratio",
-                    "sup_E", "sup_Edot", "unmet", "valid", "verdict", "vertices", "voltage_max"}
+# every claim's keys (the Interface's and the claim's own bounds), whichever claimant's
+CLAIM_KEYS = {"E_max", "Edot_max", "alpha_max", "assumptions", "certified", "inputs", "iterations", "reason", "unmet",
+              "valid", "vertices", "voltage_max"}
+# the run's judgement of the claim it is judged by (the summary's certificate)
+JUDGEMENT_KEYS = {"E_ratio", "Edot_ratio", "inside", "region_ratio", "sup_E", "sup_Edot", "verdict"}
+# section 4's own (its region's (4.23) and gains, its terms and regime): written by section 4's certificate only
+SECTION_4_KEYS = {"C_V_term", "K_term", "P_term", "condition", "dead_band", "delta1", "delta2", "delta3",
+                  "friction_sign", "friction_term", "friction_width", "gamma1", "gamma2", "gyro_Edot_term",
+                  "gyro_term", "kd", "kp", "regime"}
+# a box claim's (the sampled-data certificate's): its region's kind and whose claim it is
+BOX_CLAIM_KEYS = {"claimant", "region"}
+# what the sampled-data certificate rests on (its own, then the run's record and the second opinion beside it)
+SAMPLED_DATA_INPUT_KEYS = {"certificate", "control_period", "kp", "kd", "c_hat", "friction_sign", "cart", "reference",
+                           "terms", "certificates", "model", "controller", "box_rule", "m1_range", "box_ranges",
+                           "plant_m1", "notes", "steering_friction"}
+SAMPLED_DATA_TERM_KEYS = {"gain_E_w", "gain_Edot_w", "gain_u_w", "gain_E_angle", "gain_E_velocity", "angle_channel",
+                          "velocity_channel", "initial_transient_E", "friction_term", "P_term", "feedforward_hold_term",
+                          "C_V_term", "K_term", "gyro_term", "disturbance_term", "delta_u", "k_y", "k_A", "loop_gain",
+                          "W", "U", "spectral_radius"}
 
 
 @pytest.fixture(scope="module")
@@ -38,10 +56,21 @@ def summary(certified_run_10s):
     return certified_run_10s.summary
 
 
-def test_the_json_keeps_every_key(summary):
+def test_the_json_keeps_every_key(summary, certified_run_10s):
     d = summary.to_dict()
     assert set(d) == RUN_KEYS | PATH_KEYS | PAPER_KEYS | EFFORT_KEYS  # new keys added: every key before is kept
-    assert set(d["certificate"]) == CERTIFICATE_KEYS
+    # the run is judged by the sampled-data certificate (issue 44 item 1), which writes its own keys only
+    assert d["certificate"]["claimant"] == "sampled-data"
+    assert set(d["certificate"]) == CLAIM_KEYS | JUDGEMENT_KEYS | BOX_CLAIM_KEYS
+    assert set(d["certificate"]["inputs"]) == SAMPLED_DATA_INPUT_KEYS
+    assert set(d["certificate"]["inputs"]["terms"]) == SAMPLED_DATA_TERM_KEYS
+    assert set(d["certificate"]["inputs"]["certificates"]) == {"section-4", "sampled-data"}  # the second opinion
+    # section 4's certificate of the same run (the what-if 'exact measurement': the law's continuous claim alone)
+    # keeps every key it wrote
+    config = certified_run_10s.config
+    reference = build_reference(config.path, C80, dt=1e-3, duration=config.duration)[0]
+    section_4 = certificate_for(config, reference, measurement=MeasurementErrors.exact())
+    assert set(section_4.as_dict()) == CLAIM_KEYS | SECTION_4_KEYS
     assert set(d["paper_region"]) == {"E_max", "Edot_max", "condition", "inside"}
     assert set(d["drift"]) == {"final_alpha_dot", "growing", "E_last_window", "E_prev_window", "window_s",
                                "tolerance"}

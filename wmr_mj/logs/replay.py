@@ -684,9 +684,15 @@ def replay_figure(log: RunLog, rep: dict[str, Any]):
         if verdict and key == "inside_after_settle":
             verdict += " after settling"
         if (log.summary or {}).get("paper_claim_applies") is False:  # judged by its own claim only
-            claim = f"{cert['claimant']}'s" if cert.get("claimant") else "its own"
+            # the law owns its claim; a claimant other than the law (the sampled-data certificate a built-in
+            # sampled law is judged by, issue 44) is how it certifies, named after it
+            claimant = cert.get("claimant") or ""
+            inputs = cert.get("inputs")
+            law = (inputs.get("controller") if isinstance(inputs, dict) else None) or claimant
+            claim = (f"{law}'s claim" + (f" ({claimant})" if claimant not in ("", law) else "")
+                     if law else "its own claim")
             inside = cert.get("inside")
-            verdict = "" if inside is None else f"{'inside' if inside else 'outside'} {claim} claim"
+            verdict = "" if inside is None else f"{'inside' if inside else 'outside'} {claim}"
         extra = [v for v in (rep.get("verdict"), verdict, "TRUNCATED" if log.truncated else "") if v]
         hw = rep.get("hardware") or hardware_labels(log.config)
         cart = ("" if all(v == "ideal" for v in hw.values())  # an ideal cart's title as it was
