@@ -1,13 +1,18 @@
 """What follows from a run's configuration before any step: the controller's belief, the law and the tracker
 (fresh instances), C's reference on the control grid, the paper's analysis for the run's box.
 
-Each builder reads a :class:`~wmr_mj.sim.run_config.RunConfig`'s typed fields (:mod:`wmr_mj.sim.coerce`) and
-reads no file of its own: :func:`wmr_mj.sim.parts.resolve_run` calls them once per run.
+Each builder takes typed values, not the config: the law and tracker a :class:`LawSpec` (:func:`law_and_settings`,
+:func:`tracker_of`), the analysis a :class:`BoxSpec` and the reference bounds (:func:`analysis_of`), the reference
+a path and the belief (:func:`build_reference`). :func:`wmr_mj.sim.parts.resolve_run` reads a typed
+:class:`~wmr_mj.sim.run_config.RunConfig` (:mod:`wmr_mj.sim.coerce`) into them once and calls each once per run;
+the functions that take a config (:func:`controller_for`, :func:`controller_and_settings`, :func:`tracker_for`,
+:func:`analysis_box`, :func:`analysis_for`) unpack it and call them. No builder reads a file of its own.
 
 Usage::
 
-    from wmr_mj.sim.builders import build_reference, controller_for, estimate_parameters
+    from wmr_mj.sim.builders import LawSpec, build_reference, controller_for, estimate_parameters, law_and_settings
     controller = controller_for(config, estimate_parameters())
+    controller, settings = law_and_settings(LawSpec.of(config), estimate_parameters())   # a typed config's law
     reference, settle_s = build_reference(config.path, estimate_parameters(), dt=1e-3, duration=35.0)
 """
 
@@ -182,10 +187,11 @@ def analysis_of(box: BoxSpec, bounds: ReferenceBounds, params: C80Parameters = C
     errors are then truth-anywhere-in-the-box minus this estimate. None: the
     estimate is anywhere in the box too, as in the paper's (4.2).
     """
+    over = parameter_box(box, params)
     floored = ReferenceBounds(alpha_ddot_max=max(bounds.alpha_ddot_max, 1e-12),
                               alpha_dot_max=max(bounds.alpha_dot_max, 1e-12),
                               sin_cos3_max=max(bounds.sin_cos3_max, 1e-12))
-    return analyse(parameter_box(box, params), kp=kp, kd=kd, bounds=floored, estimate=estimate)
+    return analyse(over, kp=kp, kd=kd, bounds=floored, estimate=estimate)
 
 
 def reference_bounds_of(config: RunConfig, reference):
@@ -252,11 +258,6 @@ class LawSpec:
                    tracker="stanley-at-C" if config.tracker is None and config.correction else config.tracker,
                    tracker_params=config.tracker_params)
 
-    def model_on(self, params: C80Parameters) -> Any:
-        """The law's reduced model on the belief ``params`` (:func:`controllers.model_from_source`)."""
-        return model_from_source(self.model, params=params, identified=self.identified,
-                                 coefficients=self.coefficients)
-
 
 def controller_and_settings(config: RunConfig, params: C80Parameters, *, classes: Mapping[str, type] | None = None
                             ) -> tuple[SteeringController, frozenset[str]]:
@@ -272,7 +273,7 @@ def law_and_settings(law: LawSpec, params: C80Parameters, *, classes: Mapping[st
     Only these describe the law in its outputs (the others' values were never used). ``classes``: the plug-ins'
     classes already found (``coerce_with_classes``), kind -> class; a plug-in not there is resolved by name."""
     given = law.controller
-    model = law.model_on(params)
+    model = model_from_source(law.model, params=params, identified=law.identified, coefficients=law.coefficients)
     if isinstance(given, str) and given in CONTROLLER_NAMES:
         built = make_controller(given, model, kp=law.kp, kd=law.kd, friction_sign=law.friction_sign,
                                 friction_width=law.friction_width)
@@ -324,7 +325,8 @@ def _plugin_for(law: LawSpec, params: C80Parameters, kind: str, given: Any, plug
         found = (classes or {}).get(kind) if given == getattr(law, kind) else None
         cls = found if found is not None else resolve(given, plugin_params, kind=kind)[0]
         if model is None:
-            model = law.model_on(params)
+            model = model_from_source(law.model, params=params, identified=law.identified,
+                                      coefficients=law.coefficients)
         context = BuildContext(model=model, estimate=params, voltage_limit=params.voltage_limit, kp=law.kp,
                                kd=law.kd)
         built = build(cls, plugin_params, context, spec=given, kind=kind)

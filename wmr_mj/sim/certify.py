@@ -223,7 +223,8 @@ def claim_on_estimate(parts: Any, model: str) -> Certificate | None:
 
 
 def measurement_errors_of(config: Any, plant: C80Parameters) -> MeasurementErrors:
-    """:func:`measurement_errors` of the config's cart parts and control period."""
+    """What the run's law reads instead of the true state, as the certificates take it:
+    :func:`measurement_errors` of the config's cart parts (sensing, actuation, transmission) and control period."""
     config = coerced(config)  # a config given directly: its parts typed here
     return measurement_errors(config.sensing, config.actuation, config.transmission, plant,
                               period=config.control_period if config.control_period is not None else TIMESTEP)

@@ -81,17 +81,18 @@ class RunLabels:
                    kp=config.kp, kd=config.kd, path=config.path)
 
 
-def control_substeps(config: RunConfig, timestep: float = TIMESTEP) -> int:
-    """Physics steps per control step of ``config`` (1 where it sets no control period).
+def control_substeps(control_period: float | None, timestep: float = TIMESTEP) -> int:
+    """Physics steps per control step for a control period [s] (``RunConfig.control_period``; None: every
+    physics step, 1).
 
     Raises:
         ParameterError: a control period that is not a whole multiple of the physics step.
     """
-    if config.control_period is None:
+    if control_period is None:
         return 1
-    n = round(config.control_period / timestep)
-    if n < 1 or abs(n * timestep - config.control_period) > 1e-9:
-        raise ParameterError(f"control_period = {config.control_period} s must be a multiple of the "
+    n = round(control_period / timestep)
+    if n < 1 or abs(n * timestep - control_period) > 1e-9:
+        raise ParameterError(f"control_period = {control_period} s must be a multiple of the "
                              f"physics step {timestep} s")
     return n
 
@@ -175,6 +176,11 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
 
     The config is coerced first (:func:`wmr_mj.sim.coerce.coerce_with_classes`): a reference it holds (a cart's
     name or file, a plug-in by name, a route file) is read here, once, and ``RunParts.config`` is the typed config.
+    It is then read once into typed values -- the control grid, the law's :class:`~wmr_mj.sim.builders.LawSpec`,
+    the analysis' :class:`~wmr_mj.sim.builders.BoxSpec`, the cart's parts, the labels and the record -- and each
+    part is built once from those, in layer order: the parameter sets, the law and the tracker, C's reference, the
+    paper's analysis, the cart's measurement errors, the law's claim (:func:`wmr_mj.sim.certify.law_certificate`).
+    No builder below is handed the config.
 
     base: the base parameter set; where it is the default (the C80) and the config names a cart
     (``RunConfig.cart``), the cart's (:func:`wmr_mj.sim.config.base_for`).
@@ -187,7 +193,7 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
 
     config, classes = coerce_with_classes(config)  # the one read of the config's files and plug-ins
     # the typed config read once, here in the sim layer, into what each part is built from
-    substeps = control_substeps(config)
+    substeps = control_substeps(config.control_period)
     period = substeps * TIMESTEP
     n = int(round(config.duration / period))
     claim_period = config.control_period if config.control_period is not None else TIMESTEP  # the law's, as given
@@ -219,12 +225,13 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
                                 actuation=config.actuation, transmission=config.transmission,
                                 steering_friction=config.steering_friction, measurement=measurement,
                                 sampled_data=True)
+    claims = claim_set(**{LAW_CLAIM: law_claim})
     disturbance, loads = signal_inputs(config.signals, plant, options, n=n, period=period,
                                        m1_inertia=config.m1_inertia)
     return RunParts(config=config, base=base, plant=plant, estimate=estimate, controller=controller,
                     controller_name=labels.controller, tracker=tracker, reference=reference,
                     settle_s=settle_s, substeps=substeps, period=period, n=n, options=options,
-                    analysis=analysis, claims=claim_set(**{LAW_CLAIM: law_claim}),
+                    analysis=analysis, claims=claims,
                     paper_law=paper_estimate is not None, law_settings=law_settings, sensing=config.sensing,
                     actuation=config.actuation, transmission=config.transmission,
                     reference_bounds=bounds, signals=config.signals,
