@@ -44,8 +44,8 @@ from wmr_mj.sim.coerce import PATH_NAMES, coerced, route_of
 from wmr_mj.sim.run_config import RunConfig
 
 __all__ = ["BoxSpec", "LawSpec", "estimate_parameters", "build_reference", "manoeuvre_length", "analysis_box",
-           "parameter_box", "analysis_for", "analysis_of", "reference_bounds_of", "law_and_settings", "tracker_of",
-           "controller_for", "controller_and_settings", "LAW_SETTINGS", "declared_parameters",
+           "parameter_box", "analysis_for", "analysis_of", "reference_bounds_of", "run_bounds", "law_and_settings",
+           "tracker_of", "controller_for", "controller_and_settings", "LAW_SETTINGS", "declared_parameters",
            "tracker_for", "has_tracker", "estimate_of", "config_from_dict"]
 
 
@@ -195,9 +195,14 @@ def analysis_of(box: BoxSpec, bounds: ReferenceBounds, params: C80Parameters = C
 
 
 def reference_bounds_of(config: RunConfig, reference):
-    """The reference bounds the run's analyses are computed for: the declared ones
-    (``config.reference_bounds``), else the run's own reference's (``reference.bounds()``)."""
-    return reference.bounds() if config.reference_bounds is None else config.reference_bounds
+    """:func:`run_bounds` of ``reference`` and the config's declared bounds (``config.reference_bounds``)."""
+    return run_bounds(reference, config.reference_bounds)
+
+
+def run_bounds(reference, declared: ReferenceBounds | None) -> ReferenceBounds:
+    """The reference bounds the run's analyses are computed for: the ``declared`` ones, else the run's own
+    reference's (``reference.bounds()``)."""
+    return reference.bounds() if declared is None else declared
 
 
 def controller_for(config: RunConfig, params: C80Parameters, *, classes: Mapping[str, type] | None = None

@@ -43,7 +43,7 @@ from wmr_mj.errors import ParameterError
 from wmr_mj.hardware import Actuation, Sensing, Transmission
 from wmr_mj.params import C80, COEFFICIENT_NAMES, C80Parameters
 from wmr_mj.plant.mjcf import TIMESTEP
-from wmr_mj.sim.builders import BoxSpec
+from wmr_mj.sim.builders import BoxSpec, run_bounds
 from wmr_mj.sim.coerce import coerced
 from wmr_mj.sim.config import (
     controller_for,
@@ -317,7 +317,7 @@ def law_certificate(reference: Any, *, controller: Any, tracker: Any, box: BoxSp
     stated = _stated_assumptions(k_band, gyro_band) + outside_of(box, plant, base)
     if signals is not None:
         stated = stated + tuple(_signal_assumptions(signals, plant.m1, m1_range))
-    bounds = reference.bounds() if declared_bounds is None else declared_bounds
+    bounds = run_bounds(reference, declared_bounds)
     if declared_bounds is not None:
         stated = stated + (reference_within(reference.bounds(), declared_bounds),)
     if tracker is not None:

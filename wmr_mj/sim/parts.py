@@ -39,6 +39,7 @@ from wmr_mj.sim.builders import (
     estimate_parameters,
     law_and_settings,
     manoeuvre_length,
+    run_bounds,
     tracker_of,
 )
 from wmr_mj.sim.coerce import (
@@ -214,7 +215,7 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
                              "filtered)")
     tracker = tracker_of(law, estimate, classes=classes)
     reference, settle_s = run_reference(config.path, estimate, period=period, duration=config.duration)
-    bounds = reference.bounds() if config.reference_bounds is None else config.reference_bounds
+    bounds = run_bounds(reference, config.reference_bounds)
     paper_estimate = estimate_of(controller)  # None: not the paper's law, whose region then says nothing of it
     analysis = analysis_of(box, bounds, estimate, kp=law.kp, kd=law.kd, estimate=paper_estimate)
     measurement = measurement_errors(config.sensing, config.actuation, config.transmission, plant,
