@@ -69,7 +69,7 @@ def reference_run(
     plant = Plant(params, steering_friction=config.steering_friction, tyre_contact=config.tyre_contact)
     m, d = plant.model, plant.data
     dt = m.opt.timestep
-    substeps = control_substeps(config, dt)
+    substeps = control_substeps(config.control_period, dt)
     period = substeps * dt
     n = int(round(config.duration / period))
     require_run_memory(duration_s=n * period, control_period_s=period)  # before the arrays

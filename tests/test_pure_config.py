@@ -181,13 +181,13 @@ def test_measurement_errors_are_derived_once_per_resolution(monkeypatch):
 
     config = RunConfig(sensing="magnetic-12bit-axis", actuation="delay=0.002", path="lane-change", duration=5.0)
     calls = []
-    real = certify.measurement_errors_of
+    real = certify.measurement_errors  # the typed core that measurement_errors_of unpacks a config into
 
     def counting(*args, **kwargs):
         calls.append(args[0])
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(certify, "measurement_errors_of", counting)
+    monkeypatch.setattr(certify, "measurement_errors", counting)
     parts = resolve_run(config)
     assert len(calls) == 1
     assert parts.measurement != MeasurementErrors.exact()

@@ -1,13 +1,18 @@
 """What follows from a run's configuration before any step: the controller's belief, the law and the tracker
 (fresh instances), C's reference on the control grid, the paper's analysis for the run's box.
 
-Each builder reads a :class:`~wmr_mj.sim.run_config.RunConfig`'s typed fields (:mod:`wmr_mj.sim.coerce`) and
-reads no file of its own: :func:`wmr_mj.sim.parts.resolve_run` calls them once per run.
+Each builder takes typed values, not the config: the law and tracker a :class:`LawSpec` (:func:`law_and_settings`,
+:func:`tracker_of`), the analysis a :class:`BoxSpec` and the reference bounds (:func:`analysis_of`), the reference
+a path and the belief (:func:`build_reference`). :func:`wmr_mj.sim.parts.resolve_run` reads a typed
+:class:`~wmr_mj.sim.run_config.RunConfig` (:mod:`wmr_mj.sim.coerce`) into them once and calls each once per run;
+the functions that take a config (:func:`controller_for`, :func:`controller_and_settings`, :func:`tracker_for`,
+:func:`analysis_box`, :func:`analysis_for`) unpack it and call them. No builder reads a file of its own.
 
 Usage::
 
-    from wmr_mj.sim.builders import build_reference, controller_for, estimate_parameters
+    from wmr_mj.sim.builders import LawSpec, build_reference, controller_for, estimate_parameters, law_and_settings
     controller = controller_for(config, estimate_parameters())
+    controller, settings = law_and_settings(LawSpec.of(config), estimate_parameters())   # a typed config's law
     reference, settle_s = build_reference(config.path, estimate_parameters(), dt=1e-3, duration=35.0)
 """
 
@@ -18,6 +23,7 @@ import functools
 import inspect
 import os
 from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -37,8 +43,9 @@ from wmr_mj.reference.route import is_route_spec, route_names, route_reference
 from wmr_mj.sim.coerce import PATH_NAMES, coerced, route_of
 from wmr_mj.sim.run_config import RunConfig
 
-__all__ = ["estimate_parameters", "build_reference", "manoeuvre_length", "analysis_box", "analysis_for",
-           "reference_bounds_of", "controller_for", "controller_and_settings", "LAW_SETTINGS", "declared_parameters",
+__all__ = ["BoxSpec", "LawSpec", "estimate_parameters", "build_reference", "manoeuvre_length", "analysis_box",
+           "parameter_box", "analysis_for", "analysis_of", "reference_bounds_of", "run_bounds", "law_and_settings",
+           "tracker_of", "controller_for", "controller_and_settings", "LAW_SETTINGS", "declared_parameters",
            "tracker_for", "has_tracker", "estimate_of", "config_from_dict"]
 
 
@@ -132,38 +139,87 @@ def _build_reference(path: str, params: C80Parameters, *, dt: float, duration: f
     return reference, settle_s
 
 
+@dataclass(frozen=True, kw_only=True)
+class BoxSpec:
+    """The parameter box a run's analyses are computed over, as its config declares it (the config's fields of
+    the same names, read once by :meth:`of`): the paper's analysis (:func:`analysis_of`) and the law's claim
+    (:func:`wmr_mj.sim.certify.law_certificate`) take this, not the config.
+
+    Attributes:
+        box: 'derived' (from the parameter set over the ranges) or 'paper' ((5.1)).
+        model: the controller's model source: the derived box stands on the nonholonomic model for
+            'nonholonomic' and 'identified', on the paper's otherwise; 'identified' hulls in its spread.
+        identified: the identification (a path or mapping from ``wmr-mj identify``) for model 'identified'.
+        m1_range: the m1 range [kg]; m1_inertia: how m1 changes the chassis inertia.
+        box_ranges: the other ranged parameters, NAME -> (lo, hi), in the config's order.
+        plant_overrides: the names of the parameters the run's plant overrides (at the base value in the box).
+    """
+
+    box: str
+    model: str
+    identified: Any
+    m1_range: tuple[float, float]
+    m1_inertia: str
+    box_ranges: Mapping[str, tuple[float, float]]
+    plant_overrides: tuple[str, ...]
+
+    @classmethod
+    def of(cls, config: RunConfig) -> BoxSpec:
+        """The box of a typed config (:func:`wmr_mj.sim.coerce.coerced`)."""
+        return cls(box=config.box, model=str(config.model), identified=config.identified,
+                   m1_range=config.m1_range, m1_inertia=config.m1_inertia, box_ranges=config.box_ranges,
+                   plant_overrides=tuple(config.plant_overrides))
+
+
 def analysis_box(config: RunConfig, params: C80Parameters = C80):
+    """The parameter box of the analysis (:func:`parameter_box` of the config's :class:`BoxSpec`)."""
+    return parameter_box(BoxSpec.of(coerced(config)), params)
+
+
+def parameter_box(box: BoxSpec, params: C80Parameters = C80):
     """The parameter box of the analysis: the paper's (5.1), or derived from ``params`` over
-    the config's m1 range (and box ranges) with the model the controller's source stands on
+    the box's m1 range (and box ranges) with the model the controller's source stands on
     ('nonholonomic' for nonholonomic and identified, 'paper' otherwise)."""
-    config = coerced(config)
-    if config.box == "paper":
+    if box.box == "paper":
         return ParameterBox.paper()
-    box_model = "nonholonomic" if config.model in ("nonholonomic", "identified") else "paper"
-    return derived_box(params, as_pair(config.m1_range), config.m1_inertia,
-                       tuple((k, as_pair(v)) for k, v in config.box_ranges.items()), model=box_model)
+    box_model = "nonholonomic" if box.model in ("nonholonomic", "identified") else "paper"
+    return derived_box(params, as_pair(box.m1_range), box.m1_inertia,
+                       tuple((k, as_pair(v)) for k, v in box.box_ranges.items()), model=box_model)
 
 
 def analysis_for(config: RunConfig, reference, params: C80Parameters = C80, *, estimate=None):
-    """The robustness analysis (4.17)-(4.23) for the run's box, gains and reference bounds.
+    """The robustness analysis (4.17)-(4.23) for the run's box, gains and reference bounds
+    (:func:`analysis_of` on the config's box, gains and :func:`reference_bounds_of`)."""
+    config = coerced(config)
+    return analysis_of(BoxSpec.of(config), reference_bounds_of(config, reference), params, kp=config.kp,
+                       kd=config.kd, estimate=estimate)
+
+
+def analysis_of(box: BoxSpec, bounds: ReferenceBounds, params: C80Parameters = C80, *, kp: float, kd: float,
+                estimate=None):
+    """The robustness analysis (4.17)-(4.23) over ``box`` (:func:`parameter_box` on ``params``), for the gains
+    kp [1/s^2], kd [1/s] and the reference bounds the run's analyses take (:func:`reference_bounds_of`).
 
     estimate: the controller's coefficients (P^, C_V^, F^, K^); the parameter
     errors are then truth-anywhere-in-the-box minus this estimate. None: the
     estimate is anywhere in the box too, as in the paper's (4.2).
     """
-    config = coerced(config)
-    box = analysis_box(config, params)
-    b = reference_bounds_of(config, reference)
-    bounds = ReferenceBounds(alpha_ddot_max=max(b.alpha_ddot_max, 1e-12), alpha_dot_max=max(b.alpha_dot_max, 1e-12),
-                             sin_cos3_max=max(b.sin_cos3_max, 1e-12))
-    return analyse(box, kp=config.kp, kd=config.kd, bounds=bounds, estimate=estimate)
-
+    over = parameter_box(box, params)
+    floored = ReferenceBounds(alpha_ddot_max=max(bounds.alpha_ddot_max, 1e-12),
+                              alpha_dot_max=max(bounds.alpha_dot_max, 1e-12),
+                              sin_cos3_max=max(bounds.sin_cos3_max, 1e-12))
+    return analyse(over, kp=kp, kd=kd, bounds=floored, estimate=estimate)
 
 
 def reference_bounds_of(config: RunConfig, reference):
-    """The reference bounds the run's analyses are computed for: the declared ones
-    (``config.reference_bounds``), else the run's own reference's (``reference.bounds()``)."""
-    return reference.bounds() if config.reference_bounds is None else config.reference_bounds
+    """:func:`run_bounds` of ``reference`` and the config's declared bounds (``config.reference_bounds``)."""
+    return run_bounds(reference, config.reference_bounds)
+
+
+def run_bounds(reference, declared: ReferenceBounds | None) -> ReferenceBounds:
+    """The reference bounds the run's analyses are computed for: the ``declared`` ones, else the run's own
+    reference's (``reference.bounds()``)."""
+    return reference.bounds() if declared is None else declared
 
 
 def controller_for(config: RunConfig, params: C80Parameters, *, classes: Mapping[str, type] | None = None
@@ -188,25 +244,66 @@ LAW_SETTINGS = ("model", "kp", "kd", "friction_sign", "friction_width")
 _PD_SETTINGS = ("model", "kp", "kd")
 
 
+@dataclass(frozen=True, kw_only=True)
+class LawSpec:
+    """What a run's law and tracker are built from, as its config declares them (the config's fields of the same
+    names, read once by :meth:`of`): :func:`law_and_settings` and :func:`tracker_of` take this, not the config.
+
+    Attributes:
+        controller: the law as given (a name, ``FILE.py:Class``, ``module:Class``, an object, a factory);
+            controller_params: its parameters.
+        model: the estimate's model source; identified, coefficients: its data ('identified', 'explicit').
+        kp [1/s^2], kd [1/s], friction_sign, friction_width [rad/s]: the settings a law may read.
+        tracker: the path tracker as given, "stanley-at-C" for the correction, None without one;
+            tracker_params: its parameters.
+    """
+
+    controller: Any
+    controller_params: Mapping[str, Any]
+    model: str
+    identified: Any
+    coefficients: Mapping[str, float] | None
+    kp: float
+    kd: float
+    friction_sign: str
+    friction_width: float
+    tracker: Any
+    tracker_params: Mapping[str, Any]
+
+    @classmethod
+    def of(cls, config: RunConfig) -> LawSpec:
+        """The law and tracker of a typed config (:func:`wmr_mj.sim.coerce.coerced`)."""
+        return cls(controller=config.controller, controller_params=config.controller_params,
+                   model=str(config.model), identified=config.identified, coefficients=config.coefficients,
+                   kp=config.kp, kd=config.kd, friction_sign=config.friction_sign,
+                   friction_width=config.friction_width,
+                   tracker="stanley-at-C" if config.tracker is None and config.correction else config.tracker,
+                   tracker_params=config.tracker_params)
+
+
 def controller_and_settings(config: RunConfig, params: C80Parameters, *, classes: Mapping[str, type] | None = None
                             ) -> tuple[SteeringController, frozenset[str]]:
+    """:func:`law_and_settings` of the config's :class:`LawSpec`."""
+    return law_and_settings(LawSpec.of(coerced(config)), params, classes=classes)
+
+
+def law_and_settings(law: LawSpec, params: C80Parameters, *, classes: Mapping[str, type] | None = None
+                     ) -> tuple[SteeringController, frozenset[str]]:
     """:func:`controller_for`, and the names of :data:`LAW_SETTINGS` the law reads: all of them for the
     computed-torque law, model, kp and kd for PD; for a law built by name, those of its build context
     (``controllers.base.BuildContext``) its ``from_context`` read; none for an object or a factory.
     Only these describe the law in its outputs (the others' values were never used). ``classes``: the plug-ins'
     classes already found (``coerce_with_classes``), kind -> class; a plug-in not there is resolved by name."""
-    config = coerced(config)
-    given = config.controller
-    model = model_from_source(str(config.model), params=params, identified=config.identified,
-                              coefficients=config.coefficients)
+    given = law.controller
+    model = model_from_source(law.model, params=params, identified=law.identified, coefficients=law.coefficients)
     if isinstance(given, str) and given in CONTROLLER_NAMES:
-        law = make_controller(given, model, kp=config.kp, kd=config.kd,
-                              friction_sign=config.friction_sign, friction_width=config.friction_width)
-        return law, frozenset(_PD_SETTINGS if given == "pd" else LAW_SETTINGS)
+        built = make_controller(given, model, kp=law.kp, kd=law.kd, friction_sign=law.friction_sign,
+                                friction_width=law.friction_width)
+        return built, frozenset(_PD_SETTINGS if given == "pd" else LAW_SETTINGS)
     read: set[str] = set()
-    law = _plugin_for(config, params, "controller", given, config.controller_params, SteeringController, model,
-                      read=read, classes=classes)
-    return law, frozenset(read)
+    built = _plugin_for(law, params, "controller", given, law.controller_params, SteeringController, model,
+                        read=read, classes=classes)
+    return built, frozenset(read)
 
 
 def declared_parameters(spec: str) -> frozenset[str]:
@@ -225,16 +322,19 @@ def declared_parameters(spec: str) -> frozenset[str]:
 
 
 def tracker_for(config: RunConfig, params: C80Parameters, *, classes: Mapping[str, type] | None = None):
+    """:func:`tracker_of` the config's :class:`LawSpec`."""
+    return tracker_of(LawSpec.of(coerced(config)), params, classes=classes)
+
+
+def tracker_of(law: LawSpec, params: C80Parameters, *, classes: Mapping[str, type] | None = None):
     """A fresh instance of the run's path tracker (:class:`controllers.tracking.PathTracker`), None without one;
     built as :func:`controller_for` builds a plug-in."""
-    config = coerced(config)
-    given = "stanley-at-C" if config.tracker is None and config.correction else config.tracker
-    if given is None:
+    if law.tracker is None:
         return None
-    return _plugin_for(config, params, "tracker", given, config.tracker_params, PathTracker, classes=classes)
+    return _plugin_for(law, params, "tracker", law.tracker, law.tracker_params, PathTracker, classes=classes)
 
 
-def _plugin_for(config: RunConfig, params: C80Parameters, kind: str, given: Any, plugin_params: Mapping[str, Any],
+def _plugin_for(law: LawSpec, params: C80Parameters, kind: str, given: Any, plugin_params: Mapping[str, Any],
                 base: type, model: Any = None, read: set[str] | None = None,
                 classes: Mapping[str, type] | None = None) -> Any:
     """A fresh instance of a plug-in (law or tracker): an object deep-copied, a name resolved and built with its
@@ -244,13 +344,13 @@ def _plugin_for(config: RunConfig, params: C80Parameters, kind: str, given: Any,
     if isinstance(given, base):
         return copy.deepcopy(given)
     if isinstance(given, str):
-        found = (classes or {}).get(kind) if given == getattr(config, kind) else None
+        found = (classes or {}).get(kind) if given == getattr(law, kind) else None
         cls = found if found is not None else resolve(given, plugin_params, kind=kind)[0]
         if model is None:
-            model = model_from_source(str(config.model), params=params, identified=config.identified,
-                                      coefficients=config.coefficients)
-        context = BuildContext(model=model, estimate=params, voltage_limit=params.voltage_limit, kp=config.kp,
-                               kd=config.kd)
+            model = model_from_source(law.model, params=params, identified=law.identified,
+                                      coefficients=law.coefficients)
+        context = BuildContext(model=model, estimate=params, voltage_limit=params.voltage_limit, kp=law.kp,
+                               kd=law.kd)
         built = build(cls, plugin_params, context, spec=given, kind=kind)
         if read is not None:
             read.update(context.read)

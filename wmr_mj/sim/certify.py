@@ -40,18 +40,20 @@ from wmr_mj.analysis.plant_box import hull as _hull
 from wmr_mj.analysis.robustness import ParameterBox
 from wmr_mj.analysis.verdicts import OUTSIDE_THE_BOX
 from wmr_mj.errors import ParameterError
+from wmr_mj.hardware import Actuation, Sensing, Transmission
 from wmr_mj.params import C80, COEFFICIENT_NAMES, C80Parameters
 from wmr_mj.plant.mjcf import TIMESTEP
+from wmr_mj.sim.builders import BoxSpec, run_bounds
 from wmr_mj.sim.coerce import coerced
 from wmr_mj.sim.config import (
     controller_for,
     estimate_parameters,
     plant_parameters,
-    reference_bounds_of,
     tracker_for,
 )
 
-__all__ = ["certificate_for", "certificate_of", "claim_on_estimate", "identified_spread",
+__all__ = ["certificate_for", "certificate_of", "law_certificate", "measurement_errors", "outside_of",
+           "claim_on_estimate", "identified_spread",
            "box_spans", "outside_the_box", "reference_within", "certificate_name", "MAX_SAMPLED_DELAY_PERIODS"]
 
 
@@ -81,7 +83,8 @@ def identified_spread(identified: Any) -> dict[str, tuple[float, float]]:
 def box_spans(config: Any, base: C80Parameters = C80) -> dict[str, tuple[float, float]]:
     """The box the certificate covers, per plant parameter that the run sets or ranges: m1 over
     config.m1_range, each of config.box_ranges over its range, every other parameter the run
-    overrides (--param) at the base value only (the box does not range it)."""
+    overrides (--param) at the base value only (the box does not range it). ``config``: a config or its
+    :class:`~wmr_mj.sim.builders.BoxSpec`."""
     spans = {"m1": (float(config.m1_range[0]), float(config.m1_range[1]))}
     spans.update({k: (float(v[0]), float(v[1])) for k, v in config.box_ranges.items()})
     for name in config.plant_overrides:
@@ -99,6 +102,11 @@ def _widen_hint(name: str, value: float, lo: float, hi: float) -> str:
 
 
 def outside_the_box(config: Any, plant: C80Parameters, base: C80Parameters = C80) -> tuple[Assumption, ...]:
+    """:func:`outside_of` the config's box (:class:`~wmr_mj.sim.builders.BoxSpec`)."""
+    return outside_of(BoxSpec.of(coerced(config)), plant, base)
+
+
+def outside_of(box: BoxSpec, plant: C80Parameters, base: C80Parameters = C80) -> tuple[Assumption, ...]:
     """A failed assumption 'plant inside the box' per parameter of the run's plant that lies
     outside the box the certificate covers (:func:`box_spans`); () when the plant is inside.
 
@@ -106,7 +114,7 @@ def outside_the_box(config: Any, plant: C80Parameters, base: C80Parameters = C80
     (Listed only when failed, so the assumptions of a run inside the box are unchanged.)
     """
     out = []
-    for name, (lo, hi) in box_spans(config, base).items():
+    for name, (lo, hi) in box_spans(box, base).items():
         value = float(getattr(plant, name))
         if lo <= value <= hi:
             continue
@@ -215,10 +223,20 @@ def claim_on_estimate(parts: Any, model: str) -> Certificate | None:
 
 
 def measurement_errors_of(config: Any, plant: C80Parameters) -> MeasurementErrors:
+    """What the run's law reads instead of the true state, as the certificates take it:
+    :func:`measurement_errors` of the config's cart parts (sensing, actuation, transmission) and control period."""
+    config = coerced(config)  # a config given directly: its parts typed here
+    return measurement_errors(config.sensing, config.actuation, config.transmission, plant,
+                              period=config.control_period if config.control_period is not None else TIMESTEP)
+
+
+def measurement_errors(sensing: Sensing, actuation: Actuation, transmission: Transmission, plant: C80Parameters, *,
+                       period: float) -> MeasurementErrors:
     """What the run's law reads instead of the true state, as the certificates take it
     (:mod:`wmr_mj.analysis.measurement`),
-    from the cart as it is built: the sum of each part's own coverage (``config.sensing.coverage``,
-    ``transmission.coverage``, ``actuation.coverage``; :class:`wmr_mj.hardware.Coverage`).
+    from the cart as it is built: the sum of each part's own coverage (``sensing.coverage``,
+    ``transmission.coverage``, ``actuation.coverage``; :class:`wmr_mj.hardware.Coverage`); ``period``: the
+    control period [s].
 
     Bounded, and so covered: the encoder's quantisation, a uniform noise, a differenced or filtered velocity's
     error (:func:`wmr_mj.hardware.sensing.measurement_error_bounds`); its lag, the sensing delay and the
@@ -234,12 +252,9 @@ def measurement_errors_of(config: Any, plant: C80Parameters) -> MeasurementError
     Returns:
         :meth:`MeasurementErrors.exact` for an ideal cart (every number as before).
     """
-    config = coerced(config)  # a config given directly: its parts typed here
-    sensing, transmission = config.sensing, config.transmission
-    actuation = config.actuation.on_motor(L_a=plant.L_a)  # the cart's armature inductance where the run sets none
+    actuation = actuation.on_motor(L_a=plant.L_a)  # the cart's armature inductance where the run sets none
     if sensing.is_ideal and actuation.is_ideal and transmission.is_ideal:
         return MeasurementErrors.exact()
-    period = config.control_period if config.control_period is not None else TIMESTEP
     # each part declares its coverage (wmr_mj.hardware.coverage); the play's rigid-stop b enters the sensor's
     # bounds where the encoder reads the motor shaft
     play = transmission.coverage(encoder_on_motor=sensing.reads_motor_side)
@@ -259,38 +274,66 @@ def certificate_of(config: Any, reference: Any, *, base: C80Parameters, estimate
                    cart_measurement: MeasurementErrors | None = None) -> Certificate | None:
     """:func:`certificate_for` on parts already resolved (:func:`wmr_mj.sim.parts.resolve_run`): the plant's
     parameters, the controller's belief, the law and the tracker of the run. ``cart_measurement``: the cart's own
-    errors (:func:`measurement_errors_of`), already derived: taken as ``measurement`` None takes them."""
+    errors (:func:`measurement_errors_of`), already derived: taken as ``measurement`` None takes them.
+    :func:`law_certificate` on the config's box, period, signals, declared bounds and cart parts."""
     config = coerced(config)  # a config given directly (a batch's further runs): typed here
+    derived = measurement is None
+    if measurement is None:  # cart_measurement: the cart's own, already derived (resolve_run's), not derived again
+        measurement = measurement_errors_of(config, plant) if cart_measurement is None else cart_measurement
+    return law_certificate(reference, controller=controller, tracker=tracker, box=BoxSpec.of(config), base=base,
+                           estimate=estimate, plant=plant,
+                           period=config.control_period if config.control_period is not None else TIMESTEP,
+                           signals=getattr(config, "signals", None), declared_bounds=config.reference_bounds,
+                           sensing=config.sensing, actuation=config.actuation, transmission=config.transmission,
+                           steering_friction=getattr(config, "steering_friction", None), measurement=measurement,
+                           sampled_data=derived, k_band=k_band, gyro_band=gyro_band)
+
+
+def law_certificate(reference: Any, *, controller: Any, tracker: Any, box: BoxSpec, base: C80Parameters,
+                    estimate: C80Parameters, plant: C80Parameters, period: float, signals: Any,
+                    declared_bounds: Any, sensing: Sensing, actuation: Actuation, transmission: Transmission,
+                    steering_friction: str | None, measurement: MeasurementErrors, sampled_data: bool,
+                    k_band: float = PLANT_K_BAND, gyro_band: tuple[float, float] = GYRO_BAND) -> Certificate | None:
+    """The law's claim (``controller.claim``) on the run's typed parts, with the run's inputs recorded: what
+    :func:`certificate_for` computes, from what :func:`wmr_mj.sim.parts.resolve_run` resolved once.
+
+    Args:
+        reference: C's reference on the control grid; declared_bounds: the reference bounds the run declares
+            (None: the reference's own).
+        controller, tracker: the run's law and path tracker (None without one).
+        box: the declared parameter box (:class:`~wmr_mj.sim.builders.BoxSpec`); base, estimate, plant: the
+            base parameter set, the controller's belief and the run's plant.
+        period: the control period [s]; signals: the run's :class:`~wmr_mj.sim.signals.Signals` or None.
+        sensing, actuation, transmission: the cart's parts; measurement: the bounds the claim takes
+            (:func:`measurement_errors`); sampled_data: they are the cart's own, derived from those parts.
+        steering_friction: the plant's steering friction law, as the inputs record it.
+        k_band [V], gyro_band: the plant K and gyro bands (:data:`PLANT_K_BAND`, :data:`GYRO_BAND`).
+    """
     k_band = finite_number("k_band", k_band, minimum=0.0)
     gyro_band = interval("gyro_band", gyro_band, positive=True)
-    estimate_params = estimate
-    ranges = {k: (float(v[0]), float(v[1])) for k, v in config.box_ranges.items()}
-    plant_box, notes = _plant_box(config, base, estimate_params, ranges, k_band, gyro_band)
-    period = config.control_period if config.control_period is not None else TIMESTEP
-    initial = (float(reference.alpha0[0]), float(reference.alpha0_dot[0]))  # the plant starts at alpha = alpha' = 0
-    stated = _stated_assumptions(k_band, gyro_band) + tuple(outside_the_box(config, plant, base))
-    signals = getattr(config, "signals", None)
+    ranges = {k: (float(v[0]), float(v[1])) for k, v in box.box_ranges.items()}
+    m1_range = (float(box.m1_range[0]), float(box.m1_range[1]))
+    # what the run states, read from its own parts first; then the box the claim covers, down in the analysis
+    stated = _stated_assumptions(k_band, gyro_band) + outside_of(box, plant, base)
     if signals is not None:
-        plant_box, extra = _signal_terms(config, signals, plant_box, estimate_params, plant, ranges)
-        stated = stated + extra
-    bounds = reference_bounds_of(config, reference)
-    if config.reference_bounds is not None:
-        stated = stated + (reference_within(reference.bounds(), config.reference_bounds),)
+        stated = stated + tuple(_signal_assumptions(signals, plant.m1, m1_range))
+    bounds = run_bounds(reference, declared_bounds)
+    if declared_bounds is not None:
+        stated = stated + (reference_within(reference.bounds(), declared_bounds),)
     if tracker is not None:
         # the reference the law receives is the tracker's: the claim is computed for the bounds it
         # declares, which every run measures (controllers.tracking.within_declared)
         bounds = tracker.declared_bounds(bounds)
         stated = stated + tracker.stated_assumptions()
-    # the cart's own errors (None): the sampled-data certificate, derived from the cart's parts, may be computed
-    # too; bounds given in their place are a what-if that the cart's parts do not describe, so the law's claim alone
-    derived = measurement is None
-    if measurement is None:  # cart_measurement: the cart's own, already derived (resolve_run's), not derived again
-        measurement = measurement_errors_of(config, plant) if cart_measurement is None else cart_measurement
+    initial = (float(reference.alpha0[0]), float(reference.alpha0_dot[0]))  # the plant starts at alpha = alpha' = 0
+    plant_box, notes = _plant_box(box, base, estimate, ranges, k_band, gyro_band)
+    if signals is not None:
+        plant_box = _with_disturbance(box, signals, plant_box, estimate, plant, ranges)
     context = ClaimContext(plant=plant_box, reference=bounds,
                            limits=PlantLimits(steering_range=plant.steering_range, voltage_limit=plant.voltage_limit),
-                           control_period=period, initial_error=initial, stated=stated, estimate=estimate_params,
-                           measurement=measurement, sensing=config.sensing, actuation_delay=config.actuation.delay,
-                           gear_ratio=plant.i2, play=config.transmission.backlash, sampled_data=derived)
+                           control_period=period, initial_error=initial, stated=stated, estimate=estimate,
+                           measurement=measurement, sensing=sensing, actuation_delay=actuation.delay,
+                           gear_ratio=plant.i2, play=transmission.backlash, sampled_data=sampled_data)
     try:
         cert = controller.claim(context)
     except Exception as exc:  # noqa: BLE001  (any error of a law's own claim: one line naming the law, before any step)
@@ -303,9 +346,9 @@ def certificate_of(config: Any, reference: Any, *, base: C80Parameters, estimate
                              "Certificate (see wmr_mj.analysis.claim.box_claim) or None")
     cert = covers_measurement(cert, measurement)
     inputs = dict(cert.inputs)
-    inputs.update(model=config.model, controller=controller.name, box_rule=config.box,
-                  m1_range=list(config.m1_range), box_ranges={k: list(v) for k, v in ranges.items()},
-                  plant_m1=plant.m1, notes=notes, steering_friction=getattr(config, "steering_friction", None))
+    inputs.update(model=box.model, controller=controller.name, box_rule=box.box,
+                  m1_range=list(box.m1_range), box_ranges={k: list(v) for k, v in ranges.items()},
+                  plant_m1=plant.m1, notes=notes, steering_friction=steering_friction)
     if signals is not None:
         inputs.update(signals=signals.as_dict(), d_max=signals.declared_d_max)
     return replace_inputs(cert, inputs)
@@ -318,13 +361,15 @@ def certificate_name(cert: Certificate) -> str:
     return str(cert.inputs.get("certificate", cert.analysis or "section-4"))
 
 
-def _plant_box(config: Any, base: C80Parameters, estimate_params: C80Parameters,
+def _plant_box(spec: BoxSpec, base: C80Parameters, estimate_params: C80Parameters,
                ranges: Mapping[str, tuple[float, float]], k_band: float,
                gyro_band: tuple[float, float]) -> tuple[PlantBox, list[str]]:
-    """The plant box of :func:`certificate_for` (no disturbance yet) and its notes."""
-    derived = derived_box(estimate_params, tuple(float(v) for v in config.m1_range), config.m1_inertia,
+    """The plant box of :func:`law_certificate` (no disturbance yet) and its notes."""
+    # an identified model's +-2 sigma, read before the box is derived down in the analysis
+    spread: dict[str, Any] = identified_spread(spec.identified) if spec.model == "identified" else {}
+    derived = derived_box(estimate_params, tuple(float(v) for v in spec.m1_range), spec.m1_inertia,
                           tuple(sorted(ranges.items())))
-    box = ParameterBox.paper() if config.box == "paper" else derived
+    box = ParameterBox.paper() if spec.box == "paper" else derived
     P = _hull(box.P, *derived.P)
     C_V = _hull(box.C_V, *derived.C_V)
     F = _hull(box.F, *derived.F)
@@ -333,9 +378,7 @@ def _plant_box(config: Any, base: C80Parameters, estimate_params: C80Parameters,
     gyro = (gyro_band[0] * P[0] / l1_hi, gyro_band[1] * P[1] / l1_lo)
     V_A = ranges.get("V_A", (base.V_A, base.V_A))
     notes = []
-    spread: dict[str, Any] = {}
-    if config.model == "identified":
-        spread = identified_spread(config.identified)
+    if spec.model == "identified":
         P = _hull(P, *spread.get("P", P))
         C_V = _hull(C_V, *spread.get("C_V", C_V))
         F = _hull(F, *spread.get("F", F))
@@ -344,12 +387,12 @@ def _plant_box(config: Any, base: C80Parameters, estimate_params: C80Parameters,
         notes.append("identified +-2 sigma hulled in")
     plant_box = ParameterBox(P=P, C_V=C_V, F=(max(F[0], 0.0), F[1]), K=K)
     # F and P both scale with R_a: bound F/P over the same plants
-    ratio = friction_over_P_max(estimate_params, tuple(float(v) for v in config.m1_range), config.m1_inertia,
+    ratio = friction_over_P_max(estimate_params, tuple(float(v) for v in spec.m1_range), spec.m1_inertia,
                                 tuple(sorted(ranges.items())))
     if ratio is not None:
-        if config.model == "identified" and "F" in spread and "P" in spread:
+        if spec.model == "identified" and "F" in spread and "P" in spread:
             ratio = max(ratio, spread["F"][1] / spread["P"][0])
-        if config.box == "paper":
+        if spec.box == "paper":
             ratio = None  # (5.1)'s printed intervals come with no such relation
     return PlantBox(box=plant_box, gyro=gyro, V_A=V_A, friction_over_P=ratio, disturbance=0.0,
                     disturbance_over_P=None), notes
@@ -373,18 +416,16 @@ def _stated_assumptions(k_band: float, gyro_band: tuple[float, float]) -> tuple[
     )
 
 
-def _signal_terms(config: Any, signals: Any, plant_box: PlantBox, estimate_params: C80Parameters,
-                  plant: C80Parameters, ranges: Mapping[str, tuple[float, float]]
-                  ) -> tuple[PlantBox, tuple[Assumption, ...]]:
-    """The plant box with the declared disturbance bound in it, and the signals' box-membership assumptions."""
+def _with_disturbance(box: BoxSpec, signals: Any, plant_box: PlantBox, estimate_params: C80Parameters,
+                      plant: C80Parameters, ranges: Mapping[str, tuple[float, float]]) -> PlantBox:
+    """The plant box with the signals' declared disturbance bound in it."""
     d_V = disturbance_voltage(signals.declared_d_max, plant, ranges)
     d_over_P = None
-    m1_range = (float(config.m1_range[0]), float(config.m1_range[1]))
-    if d_V and config.box != "paper":  # (5.1)'s printed P interval comes with no inertia behind it
+    m1_range = (float(box.m1_range[0]), float(box.m1_range[1]))
+    if d_V and box.box != "paper":  # (5.1)'s printed P interval comes with no inertia behind it
         d_over_P = disturbance_over_P_max(signals.declared_d_max, estimate_params, plant, m1_range,
-                                          config.m1_inertia, tuple(sorted(ranges.items())))
-    boxed = dataclasses.replace(plant_box, disturbance=d_V, disturbance_over_P=d_over_P)
-    return boxed, tuple(_signal_assumptions(signals, plant.m1, m1_range))
+                                          box.m1_inertia, tuple(sorted(ranges.items())))
+    return dataclasses.replace(plant_box, disturbance=d_V, disturbance_over_P=d_over_P)
 
 
 def disturbance_voltage(d_max: float, plant: C80Parameters, ranges: Mapping[str, tuple[float, float]]) -> float:
@@ -413,8 +454,9 @@ def disturbance_over_P_max(d_max: float, params: C80Parameters, plant: C80Parame
     """
     if any(name in F_OVER_P_NOT_MONOTONE for name, _ in ranges):
         return None
+    corners = list(box_corners(params, m1_range, m1_inertia, ranges))
     worst = plant.steering_torque_voltage(d_max) / plant.coefficients("nonholonomic").P
-    for p in box_corners(params, m1_range, m1_inertia, ranges):
+    for p in corners:
         worst = max(worst, p.steering_torque_voltage(d_max) / p.coefficients("nonholonomic").P)
     return worst
 

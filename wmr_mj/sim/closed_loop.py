@@ -146,7 +146,7 @@ def requirement_rows(result: RunResult, requirements: Sequence[Any], *, base: C8
         at, cross_track = result.path_samples
         return {**result.rows, "cross_track": np.interp(np.arange(n, dtype=float), at.astype(float), cross_track)}
     config = result.config
-    period = control_substeps(config, TIMESTEP) * TIMESTEP
+    period = control_substeps(config.control_period, TIMESTEP) * TIMESTEP
     reference = result.reference
     if reference is None:  # a result made elsewhere: the run's reference built again, as resolve_run builds it
         reference, _ = run_reference(config.path, estimate_parameters(base), period=period, duration=config.duration)

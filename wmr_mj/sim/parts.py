@@ -31,14 +31,16 @@ from wmr_mj.hardware import Actuation, Sensing, Transmission
 from wmr_mj.params import C80, C80Parameters
 from wmr_mj.plant.mjcf import TIMESTEP
 from wmr_mj.sim.builders import (
-    analysis_for,
+    BoxSpec,
+    LawSpec,
+    analysis_of,
     build_reference,
-    controller_and_settings,
     estimate_of,
     estimate_parameters,
+    law_and_settings,
     manoeuvre_length,
-    reference_bounds_of,
-    tracker_for,
+    run_bounds,
+    tracker_of,
 )
 from wmr_mj.sim.coerce import (
     PATH_NAMES,
@@ -80,17 +82,18 @@ class RunLabels:
                    kp=config.kp, kd=config.kd, path=config.path)
 
 
-def control_substeps(config: RunConfig, timestep: float = TIMESTEP) -> int:
-    """Physics steps per control step of ``config`` (1 where it sets no control period).
+def control_substeps(control_period: float | None, timestep: float = TIMESTEP) -> int:
+    """Physics steps per control step for a control period [s] (``RunConfig.control_period``; None: every
+    physics step, 1).
 
     Raises:
         ParameterError: a control period that is not a whole multiple of the physics step.
     """
-    if config.control_period is None:
+    if control_period is None:
         return 1
-    n = round(config.control_period / timestep)
-    if n < 1 or abs(n * timestep - config.control_period) > 1e-9:
-        raise ParameterError(f"control_period = {config.control_period} s must be a multiple of the "
+    n = round(control_period / timestep)
+    if n < 1 or abs(n * timestep - control_period) > 1e-9:
+        raise ParameterError(f"control_period = {control_period} s must be a multiple of the "
                              f"physics step {timestep} s")
     return n
 
@@ -174,6 +177,11 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
 
     The config is coerced first (:func:`wmr_mj.sim.coerce.coerce_with_classes`): a reference it holds (a cart's
     name or file, a plug-in by name, a route file) is read here, once, and ``RunParts.config`` is the typed config.
+    It is then read once into typed values -- the control grid, the law's :class:`~wmr_mj.sim.builders.LawSpec`,
+    the analysis' :class:`~wmr_mj.sim.builders.BoxSpec`, the cart's parts, the labels and the record -- and each
+    part is built once from those, in layer order: the parameter sets, the law and the tracker, C's reference, the
+    paper's analysis, the cart's measurement errors, the law's claim (:func:`wmr_mj.sim.certify.law_certificate`).
+    No builder below is handed the config.
 
     base: the base parameter set; where it is the default (the C80) and the config names a cart
     (``RunConfig.cart``), the cart's (:func:`wmr_mj.sim.config.base_for`).
@@ -181,45 +189,55 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
     Raises:
         WmrMjError: what the config cannot build (a plug-in, a path too short, a period that does not fit).
     """
-    from wmr_mj.sim.certify import certificate_of, measurement_errors_of
+    from wmr_mj.sim.certify import law_certificate, measurement_errors
     from wmr_mj.sim.engine import plant_options
 
     config, classes = coerce_with_classes(config)  # the one read of the config's files and plug-ins
+    # the typed config read once, here in the sim layer, into what each part is built from
+    substeps = control_substeps(config.control_period)
+    period = substeps * TIMESTEP
+    n = int(round(config.duration / period))
+    claim_period = config.control_period if config.control_period is not None else TIMESTEP  # the law's, as given
+    law, box, options = LawSpec.of(config), BoxSpec.of(config), plant_options(config)
+    labels, record = RunLabels.of(config), config.as_dict()
+    route_length_m = (float(route_of(config.path).path.length) if config.path not in PATH_NAMES
+                      else manoeuvre_length(config.path))  # lane-change's
+    # then each part, built once and handed on in layer order: the parameter sets, the law and the tracker on the
+    # belief, C's reference, the paper's analysis, the cart's measurement errors, the law's claim
     base = base_for(config, base)  # the config's cart, where it names one
     plant = plant_parameters(config, base)
     estimate = estimate_parameters(base)
-    controller, law_settings = controller_and_settings(config, estimate, classes=classes)
+    controller, law_settings = law_and_settings(law, estimate, classes=classes)
     if config.sensing.velocity == "none" and getattr(controller, "reads_velocity", True):
         raise ParameterError(f"controller {controller.name!r} reads alpha', which --sensing velocity=none does not "
                              "give it; accepted: a law that estimates alpha' from the angle (reads_velocity = False, "
                              "docs/guides/plugins.md), or a velocity estimate (exact, tachometer, difference, "
                              "filtered)")
-    tracker = tracker_for(config, estimate, classes=classes)
-    substeps = control_substeps(config)
-    period = substeps * TIMESTEP
-    n = int(round(config.duration / period))
+    tracker = tracker_of(law, estimate, classes=classes)
     reference, settle_s = run_reference(config.path, estimate, period=period, duration=config.duration)
+    bounds = run_bounds(reference, config.reference_bounds)
     paper_estimate = estimate_of(controller)  # None: not the paper's law, whose region then says nothing of it
-    analysis = analysis_for(config, reference, estimate, estimate=paper_estimate)
-    measurement = measurement_errors_of(config, plant)  # once: the claim and the run's parts share it
-    law_claim = certificate_of(config, reference, base=base, estimate=estimate, plant=plant,
-                               controller=controller, tracker=tracker, cart_measurement=measurement)
-    options = plant_options(config)
+    analysis = analysis_of(box, bounds, estimate, kp=law.kp, kd=law.kd, estimate=paper_estimate)
+    measurement = measurement_errors(config.sensing, config.actuation, config.transmission, plant,
+                                     period=claim_period)  # once: the claim and the run's parts share it
+    law_claim = law_certificate(reference, controller=controller, tracker=tracker, box=box, base=base,
+                                estimate=estimate, plant=plant, period=claim_period, signals=config.signals,
+                                declared_bounds=config.reference_bounds, sensing=config.sensing,
+                                actuation=config.actuation, transmission=config.transmission,
+                                steering_friction=config.steering_friction, measurement=measurement,
+                                sampled_data=True)
+    claims = claim_set(**{LAW_CLAIM: law_claim})
     disturbance, loads = signal_inputs(config.signals, plant, options, n=n, period=period,
                                        m1_inertia=config.m1_inertia)
-    name = controller_name(config)
     return RunParts(config=config, base=base, plant=plant, estimate=estimate, controller=controller,
-                    controller_name=name, tracker=tracker, reference=reference,
+                    controller_name=labels.controller, tracker=tracker, reference=reference,
                     settle_s=settle_s, substeps=substeps, period=period, n=n, options=options,
-                    analysis=analysis, claims=claim_set(**{LAW_CLAIM: law_claim}),
+                    analysis=analysis, claims=claims,
                     paper_law=paper_estimate is not None, law_settings=law_settings, sensing=config.sensing,
                     actuation=config.actuation, transmission=config.transmission,
-                    reference_bounds=reference_bounds_of(config, reference), signals=config.signals,
-                    disturbance=disturbance, loads=loads,
-                    route_length_m=(float(route_of(config.path).path.length) if config.path not in PATH_NAMES
-                                    else manoeuvre_length(config.path)),  # lane-change's
-                    measurement=measurement, labels=RunLabels.of(config, name=name),
-                    record=config.as_dict())
+                    reference_bounds=bounds, signals=config.signals,
+                    disturbance=disturbance, loads=loads, route_length_m=route_length_m,
+                    measurement=measurement, labels=labels, record=record)
 
 
 def run_reference(path: str, estimate: C80Parameters, *, period: float, duration: float) -> tuple[Any, float]:
