@@ -286,7 +286,7 @@ class ComputedTorque(SteeringController):
     def paper_estimate(self) -> dict[str, float]:
         """The coefficients the paper's analysis takes as this law's estimate: P^, C_V^, F^ (0 with
         friction_sign 'none'), K^."""
-        c = self.model.coefficients.as_dict()
+        c = self.model.coefficients.to_dict()
         if self.friction_sign == "none":
             c["F"] = 0.0
         return {k: c[k] for k in ("P", "C_V", "F", "K")}
@@ -312,7 +312,7 @@ class ComputedTorque(SteeringController):
     def describe(self) -> dict:
         return {"controller": self.name, "model": self.model.name, "kp": self.kp, "kd": self.kd,
                 "friction_sign": self.friction_sign, "friction_width": self.friction_width,
-                "estimate": self.model.coefficients.as_dict()}
+                "estimate": self.model.coefficients.to_dict()}
 
 
 class PDController(SteeringController):

@@ -82,7 +82,7 @@ class PluginSource:
     def __post_init__(self) -> None:
         refuse_builtin_name(self.name, self.import_path, origin=self.origin)
 
-    def as_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, Any]:
         return {"spec": self.spec, "name": self.name, "origin": self.origin, "import_path": self.import_path,
                 "params": dict(self.params), "source_sha256": self.source_sha256}
 

@@ -126,7 +126,7 @@ class Uncertainty:
         return (self.P_term + self.C_V_term + self.friction_term + self.K_term + self.gyro_term
                 + self.disturbance)
 
-    def as_dict(self) -> dict[str, float]:
+    def to_dict(self) -> dict[str, float]:
         return {"P_term": self.P_term, "C_V_term": self.C_V_term, "friction_term": self.friction_term,
                 "K_term": self.K_term, "gyro_term": self.gyro_term, "disturbance": self.disturbance,
                 "total": self.total, "alpha_max": self.alpha_max}
@@ -375,7 +375,7 @@ class SlidingMode(SteeringController):
         own = (
             Assumption("switching gain above the uncertainty", "k >= D + eta, D = sup|Delta| over the box "
                        "inside the layer (Slotine & Li (7.5))", self.k >= D + self.eta, D + self.eta, self.k,
-                       "D [V] = " + ", ".join(f"{n} {v:.4g}" for n, v in unc.as_dict().items()
+                       "D [V] = " + ", ".join(f"{n} {v:.4g}" for n, v in unc.to_dict().items()
                                               if n not in ("total", "alpha_max"))
                        + f"; k = {self.k:g} V, eta = {self.eta:g} V", kind="checked"),
             Assumption("control period", f"T (D + k)/P_min <= {SAMPLING_FRACTION:g} phi (s moves a small part "
@@ -389,7 +389,7 @@ class SlidingMode(SteeringController):
         return box_claim(claimant=self.name, E_max=E_max, Edot_max=2.0 * self.phi, context=context,
                          alpha_max=unc.alpha_max, voltage_max=self.voltage_bound(context), own=own,
                          inputs={"lam": self.lam, "phi": self.phi, "k": self.k, "eta": self.eta,
-                                 "uncertainty_V": unc.as_dict(), "estimate": self.model.coefficients.as_dict(),
+                                 "uncertainty_V": unc.to_dict(), "estimate": self.model.coefficients.to_dict(),
                                  "friction_sign": self.friction_sign, "friction_width": self.friction_width})
 
     def _measured_claim(self, context: ClaimContext) -> Certificate:
@@ -425,10 +425,10 @@ class SlidingMode(SteeringController):
                          alpha_max=a0 + E_max if math.isfinite(E_max) else math.inf, voltage_max=lay.voltage_max,
                          own=own, reason=lay.reason,
                          inputs={"lam": self.lam, "phi": self.phi, "k": self.k, "eta": self.eta,
-                                 "layer": lay.layer, "measurement": {**meas.as_dict(), "eps_alpha": lay.e_alpha,
+                                 "layer": lay.layer, "measurement": {**meas.to_dict(), "eps_alpha": lay.e_alpha,
                                                                      "eps_alpha_dot": lay.e_alpha_dot, "rho": lay.rho},
-                                 "uncertainty_V": unc.as_dict() if unc is not None else None,
-                                 "estimate": self.model.coefficients.as_dict(),
+                                 "uncertainty_V": unc.to_dict() if unc is not None else None,
+                                 "estimate": self.model.coefficients.to_dict(),
                                  "friction_sign": self.friction_sign, "friction_width": self.friction_width})
 
     def _step_note(self, T: float, ds: float, D: float, unc: Uncertainty | None, layer_gain: float) -> str:
@@ -440,4 +440,4 @@ class SlidingMode(SteeringController):
     def describe(self) -> dict:
         return {"controller": self.name, "model": self.model.name, "lam": self.lam, "phi": self.phi, "k": self.k,
                 "eta": self.eta, "friction_sign": self.friction_sign, "friction_width": self.friction_width,
-                "estimate": self.model.coefficients.as_dict()}
+                "estimate": self.model.coefficients.to_dict()}

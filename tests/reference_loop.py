@@ -94,7 +94,7 @@ def reference_run(
         state = np.empty(mujoco.mj_stateSize(m, mujoco.mjtState.mjSTATE_INTEGRATION))
         mujoco.mj_getState(m, d, state, mujoco.mjtState.mjSTATE_INTEGRATION)
         logger = logger_factory(LogHeader(
-            mjcf_xml=plant.xml, config=config.as_dict(), parameters=params.as_dict(),
+            mjcf_xml=plant.xml, config=config.to_dict(), parameters=params.to_dict(),
             initial_state=state, timestep=dt, control_substeps=substeps,
             bounds={"E_max": certificate.E_max, "Edot_max": certificate.Edot_max}, model=m,
             reference_path=np.asarray(reference.C_xy)[::max(1, len(reference.C_xy) // 2000)]))
@@ -195,7 +195,7 @@ def reference_run(
                      path=judge_path(reference, done["t"][at], r_C[:k][at], done["heading"][at], settle_s=settle_s,
                                      certificate=certificate, steering_range=params.steering_range))
     summary = dataclasses.replace(summary, mujoco_warnings=int(sum(w.number for w in d.warning)),
-                                  analysis=analysis.as_dict(), controller_config=controller.describe())
+                                  analysis=analysis.to_dict(), controller_config=controller.describe())
     from wmr_mj.reference.route import RouteProgress, route_length
     from wmr_mj.sim.config import manoeuvre_length
 

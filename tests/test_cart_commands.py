@@ -63,8 +63,8 @@ def test_cart_c80_gives_the_run_without_cart_to_the_bit(tmp_path, capsys):
 def test_run_config_cart_c80_is_the_c80_record():
     # coerced (RunConfig(cart=...) keeps the name as a reference until from_inputs or resolve_run reads it)
     c80 = RunConfig.from_inputs(cart="c80")
-    assert c80 == RunConfig.from_inputs() and "cart" not in c80.as_dict()
-    assert c80.as_dict() == RunConfig().as_dict() == RunConfig(cart="c80").as_dict()
+    assert c80 == RunConfig.from_inputs() and "cart" not in c80.to_dict()
+    assert c80.to_dict() == RunConfig().to_dict() == RunConfig(cart="c80").to_dict()
 
 
 # -- the cart's box, stops and design -----------------------------------------------------------------------------
@@ -80,7 +80,7 @@ def test_a_cart_with_another_m1_box_changes_the_certificate_box(tmp_path):
     assert (claim.E_max, claim.Edot_max, claim.voltage_max) == (explicit.E_max, explicit.Edot_max,
                                                                  explicit.voltage_max)
     assert claim.E_max > c80.E_max  # a wider box: a larger bound (the same gains)
-    assert config.as_dict()["cart"]["text"] == (_wide_box_cart(tmp_path)).read_text(encoding="utf-8")
+    assert config.to_dict()["cart"]["text"] == (_wide_box_cart(tmp_path)).read_text(encoding="utf-8")
 
 
 def test_a_carts_stops_refuse_a_path_that_needs_more_steering(tmp_path, capsys):

@@ -80,8 +80,8 @@ def _write(tmp_path: Path, document: dict, name: str = "cart.toml") -> Path:
 
 # -- the C80 to the bit ---------------------------------------------------------------------------------------
 def test_c80_file_gives_todays_parameter_set_bit_for_bit():
-    from_file = parameters_of_cart(load_cart("c80")).as_dict()
-    for params in (from_file, C80.as_dict()):
+    from_file = parameters_of_cart(load_cart("c80")).to_dict()
+    for params in (from_file, C80.to_dict()):
         assert list(params) == list(TODAY)
         for name, value in TODAY.items():
             assert type(params[name]) is float and _bits(params[name]) == _bits(value), name

@@ -62,7 +62,7 @@ def test_the_noise_has_one_name_in_python_the_spec_a_file_and_an_axis(tmp_path):
     file = Sensing.from_spec(_write(tmp_path / "s.toml", 'noise = "uniform:0.0005"\n'))
     axis = with_hardware(RunConfig(), {"sensing.noise": 0.0005}).sensing
     assert python == spec == file == axis
-    assert python.noise == 0.0005 and python.as_dict()["noise"] == "uniform:0.0005"
+    assert python.noise == 0.0005 and python.to_dict()["noise"] == "uniform:0.0005"
     velocity = Sensing(velocity="tachometer", velocity_noise_kind="uniform", velocity_noise=0.2)
     assert Sensing.from_spec("velocity=tachometer,velocity_noise=uniform:0.2") == velocity
     assert with_hardware(RunConfig(sensing="velocity=tachometer"), {"sensing.velocity_noise": 0.2}).sensing == velocity
@@ -73,10 +73,10 @@ def test_the_noise_has_one_name_in_python_the_spec_a_file_and_an_axis(tmp_path):
 
 
 def test_a_logs_recorded_config_still_loads():
-    """A log records RunConfig.as_dict(); its sensing is the spec form, whose keys did not change."""
+    """A log records RunConfig.to_dict(); its sensing is the spec form, whose keys did not change."""
     config = RunConfig.from_inputs(
         sensing="encoder_bits=12,velocity=tachometer,noise=uniform:0.0005,velocity_noise=gaussian:0.01")
-    recorded = json.loads(json.dumps(config.as_dict()))
+    recorded = json.loads(json.dumps(config.to_dict()))
     assert recorded["sensing"]["noise"] == "uniform:0.0005" and recorded["sensing"]["encoder_ticks"] == 4096
     assert config_from_dict(recorded).sensing == config.sensing
     # the form written before this change (main's efa4efa) reads back the same
@@ -142,7 +142,7 @@ def test_a_file_takes_changes_as_a_preset_does(tmp_path, capsys):
     assert Sensing.from_spec(f"preset={toml},delay=0.003") == Sensing(
         encoder_ticks=8192, velocity="tachometer", noise_kind="uniform", noise=0.0005, delay=0.003)
     assert Sensing.from_spec(f"preset={toml},encoder_ticks=4096").encoder_ticks == 4096  # the change wins
-    as_json = _write(tmp_path / "my.json", json.dumps(mine.as_dict()))
+    as_json = _write(tmp_path / "my.json", json.dumps(mine.to_dict()))
     assert Sensing.from_spec({"preset": as_json, "delay": 0.003}) == Sensing.from_spec(f"preset={toml},delay=0.003")
     # a file may itself start from a named preset
     based = _write(tmp_path / "based.toml", 'preset = "magnetic-12bit-axis"\ndelay = 0.002\n')

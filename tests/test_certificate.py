@@ -235,7 +235,7 @@ def test_paper_design_is_not_certified(circle):
     assert c.K_term == pytest.approx((5.3336 + PLANT_K_BAND) * 1.2372 / 0.385, rel=2e-3)
     assert c.dead_band == pytest.approx(c.inputs["box"]["F"][1] / (0.385 * 6.0), rel=1e-3)  # 0.746 rad
     assert c.verdict(0.001, 0.001) == "uncertified-outside"
-    d = c.as_dict()
+    d = c.to_dict()
     json.dumps(d, allow_nan=False)
     assert d["E_max"] is None and d["valid"] is False
 
@@ -417,7 +417,7 @@ def test_extreme_gains_certify_or_refuse_cleanly():
             c = _certify(kp=kp, kd=kd)
         except WmrMjError:
             continue
-        json.dumps(c.as_dict(), allow_nan=False)
+        json.dumps(c.to_dict(), allow_nan=False)
         assert c.verdict(0.01, 0.01) in VERDICTS
         made += 1
     assert made > 100

@@ -147,7 +147,7 @@ def test_each_law_s_default_estimate_is_its_own_and_the_paper_default_is_unchang
     assert RunConfig.from_inputs() == paper == RunConfig.from_inputs(controller="computed-torque") == _run_config([])
     assert (_run_config(["--controller", "computed-torque"]) == paper
             == RunConfig.from_inputs(**design_changes("computed-torque")))
-    assert RunConfig.from_inputs().as_dict()["model"] == "paper"
+    assert RunConfig.from_inputs().to_dict()["model"] == "paper"
     # sliding-mode: the non-holonomic model by default everywhere; an explicit paper model stays the paper's
     smc = RunConfig.from_inputs(controller="sliding-mode")
     assert smc.model == "nonholonomic" == _run_config(["--controller", "sliding-mode"]).model

@@ -119,15 +119,15 @@ def test_each_claimant_writes_only_its_own_terms():
     design = RunConfig(**CERTIFIED.config_changes()).replace(m1=750.0, reference_bounds="paper", duration=12.0)
     sampled = resolve_run(design.replace(sensing="magnetic-12bit-axis")).claim
     assert sampled.inputs["certificate"] == "sampled-data"
-    out = sampled.as_dict()
+    out = sampled.to_dict()
     assert not set(SECTION_4_KEYS) & set(out), sorted(set(SECTION_4_KEYS) & set(out))
     assert out["inputs"]["kp"] == design.kp and "terms" in out["inputs"]  # its own record: the gains, its terms
     exact = MeasurementErrors.exact()  # the what-if 'exact measurement': the law's continuous claim alone
     reference = build_reference(design.path, estimate_parameters(), dt=1e-3, duration=design.duration)[0]
     layer = certificate_for(RunConfig(controller="sliding-mode", **{**BASE, "sensing": "ideal"}), reference,
                             measurement=exact)
-    assert layer.analysis == "boundary-layer" and not set(SECTION_4_KEYS) & set(layer.as_dict())
+    assert layer.analysis == "boundary-layer" and not set(SECTION_4_KEYS) & set(layer.to_dict())
     section4 = certificate_for(design, reference, measurement=exact)
-    out = section4.as_dict()
+    out = section4.to_dict()
     assert section4.analysis == "section-4" and set(SECTION_4_KEYS) <= set(out)
     assert out["kp"] == design.kp and out["kd"] == design.kd

@@ -134,7 +134,7 @@ def test_standard_v2_is_v1_then_the_cart_as_built_and_v1_stays_pinned():
 
     v1, v2 = load_suite("standard-v1"), load_suite("standard-v2")
     assert (v2.name, v2.version) == ("standard-v2", 2) and [s.id for s in v2.scenarios] == STANDARD_V2_IDS
-    assert v1.sha256[:12] == STANDARD_V1_SHA256 and "hardware" not in v1.as_dict()  # v1's JSON keys as before
+    assert v1.sha256[:12] == STANDARD_V1_SHA256 and "hardware" not in v1.to_dict()  # v1's JSON keys as before
     design = design_from_token("certified", v2)
     for a, b in zip(v1.scenarios, v2.scenarios):  # v1's scenarios, unchanged: the same configs to the field
         assert a == b and a.hardware is None
@@ -149,7 +149,7 @@ def test_standard_v2_is_v1_then_the_cart_as_built_and_v1_stays_pinned():
     assert built["backlash-2mrad"].sensing.encoder_side == "motor"  # the play is seen from the motor side
     cfg = built["inductance-1.5mH"].config(design.config)
     assert cfg.actuation == Actuation(inductance=0.0015) and cfg.sensing.is_ideal and cfg.m1 == 650.0
-    assert set(v2.as_dict()["hardware"]) == set(STANDARD_V2_IDS[30:])
+    assert set(v2.to_dict()["hardware"]) == set(STANDARD_V2_IDS[30:])
 
 
 @pytest.mark.parametrize("table, words", [

@@ -46,8 +46,8 @@ def test_corrected_bounds_add_the_limits():
 
 
 def test_config_without_the_correction_is_written_as_before():
-    assert "correction" not in BASE.as_dict()
-    assert BASE.replace(correction=True).as_dict()["correction"] is True
+    assert "correction" not in BASE.to_dict()
+    assert BASE.replace(correction=True).to_dict()["correction"] is True
     with pytest.raises(ParameterError):
         BASE.replace(correction="yes")
 

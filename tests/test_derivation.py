@@ -126,7 +126,7 @@ def test_voltage_coefficients_match_params_symbolically():
     sub = _body_substitution(p)
     for model in ("paper", "nonholonomic"):
         derived = d.voltage_coefficients_symbolic(model)
-        closed = C80Parameters.coefficients(p, model).as_dict()
+        closed = C80Parameters.coefficients(p, model).to_dict()
         for k, v in closed.items():
             assert _exact_equal(derived[k].subs(sub), v), (model, k)
 
@@ -138,8 +138,8 @@ def test_coefficients_from_derivation_numeric(params):
     for k in "ABCD":
         assert math.isclose(ke_d[k], ke[k], rel_tol=1e-12), k
     for model in ("paper", "nonholonomic"):
-        got = d.coefficients_from_derivation(params, model).as_dict()
-        want = params.coefficients(model).as_dict()
+        got = d.coefficients_from_derivation(params, model).to_dict()
+        want = params.coefficients(model).to_dict()
         for k in want:
             if want[k] == 0.0:
                 assert got[k] == 0.0, (model, k)

@@ -105,7 +105,7 @@ def test_validate_judges_a_design_file_on_its_own_cart(design_file):
     config = settings.config(FileDesign(str(design_file)))
     written = json.loads(design_file.read_text())["settings"]
     assert (config.kp, config.kd, config.friction_width) == (written["kp"], written["kd"], written["friction_width"])
-    assert config.sensing.as_dict() == written["sensing"] and config.duration == DURATION
+    assert config.sensing.to_dict() == written["sensing"] and config.duration == DURATION
     # validate's own --sensing replaces the file's: the option given wins, as for run --design FILE --sensing
     other = ValidateSettings(n=1, duration=DURATION, search_budget=0, sensing="magnetic-14bit-axis")
     assert other.config(FileDesign(str(design_file))).sensing.encoder_ticks == 16384

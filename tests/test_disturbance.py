@@ -71,8 +71,8 @@ def test_pd_steady_error_under_constant_disturbance_is_the_closed_form(d, P_plan
     assert cert.disturbance_term == pytest.approx(abs(d_V) / P_plant, rel=1e-15)
     assert cert.E_max >= abs(E_ss)
     assert np.max(np.abs(r["E"])) <= cert.E_max and np.max(np.abs(r["E_dot"])) <= cert.Edot_max
-    assert cert.as_dict()["disturbance_term"] == cert.disturbance_term
-    assert cert.as_dict()["inputs"]["disturbance_V"] == abs(d_V)
+    assert cert.to_dict()["disturbance_term"] == cert.disturbance_term
+    assert cert.to_dict()["inputs"]["disturbance_V"] == abs(d_V)
 
 
 def test_computed_torque_exact_model_certificate_is_tight_on_the_closed_form():
@@ -112,7 +112,7 @@ def test_no_disturbance_leaves_the_certificate_as_it_was():
     plant = SteeringModel(P=0.385, C_V=4.77, F=0.0, K=0.0, gyro=0.0, V_A=0.2)
     est = Estimate(P=0.4, C_V=4.7, F=0.0, K=0.0, gyro=0.0, V_A=0.2)
     a, b = _certificate(plant, est, 0.0, feedforward=True), _certificate(plant, est, 1e-3, feedforward=True)
-    assert "disturbance_term" not in a.as_dict() and "disturbance_V" not in a.as_dict()["inputs"]
+    assert "disturbance_term" not in a.to_dict() and "disturbance_V" not in a.to_dict()["inputs"]
     assert b.delta1 > a.delta1 and b.E_max > a.E_max
     assert math.isclose(b.delta1 - a.delta1, 1e-3 / 0.385, rel_tol=1e-9)
 
@@ -144,4 +144,4 @@ def test_disturbance_term_over_an_R_a_box_is_d_max_over_the_steering_inertia(pap
     assert cert.disturbance_term < d_V_max / plain.inputs["box"]["P"][0]
     assert cert.delta1 > plain.delta1 and cert.certified
     # without signals the certificate is the one it always was: no new keys
-    assert "disturbance_term" not in plain.as_dict() and "disturbance_V" not in plain.as_dict()["inputs"]
+    assert "disturbance_term" not in plain.to_dict() and "disturbance_V" not in plain.to_dict()["inputs"]

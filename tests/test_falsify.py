@@ -153,7 +153,7 @@ def test_the_reported_worst_run_reproduces_exactly():
     again = run_closed_loop(base.replace(m1=float(repr(worst.params["m1"])),
                                          plant_overrides={"mu": float(repr(worst.params["mu"]))}), progress=False)
     assert again.summary.sup_E == worst.sup_E
-    out = result.as_dict(log="x.mcap")
+    out = result.to_dict(log="x.mcap")
     assert set(out["worst"]["params"]) == {"m1", "mu"} and out["evaluations"] == 10 and out["budget"] == 10
     assert out["random"]["worst_objective"] == result.random_worst.objective
 
@@ -228,7 +228,7 @@ def test_a_requirement_is_falsified_on_serial_runs():
     (req,) = worst.summary["requirements"]
     assert worst.objective == -req["robustness"] > 0 and not req["satisfied"]  # falsified
     assert req["robustness"] == pytest.approx(0.001 - worst.sup_E, abs=1e-15)  # min(0.001 - |E|)
-    assert result.as_dict()["falsified"] is True and result.as_dict()["method"] == "portfolio"
+    assert result.to_dict()["falsified"] is True and result.to_dict()["method"] == "portfolio"
     with pytest.raises(ParameterError, match="requirement"):
         FalsifySpec(base=base, box={"m1": (550.0, 750.0)}, objective="requirement", budget=6)
     with pytest.raises(UnknownNameError, match="signal"):

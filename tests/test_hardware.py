@@ -220,10 +220,10 @@ def test_the_issues_string_a_mapping_and_files_give_one_sensing(tmp_path):
     s = Sensing.from_spec(text)
     assert (s.encoder_ticks, s.encoder_side, s.velocity, s.delay, s.noise_kind, s.noise, s.seed) == (
         4096, "axis", "difference", 0.005, "uniform", 0.0005, 3)
-    (tmp_path / "s.json").write_text(json.dumps(s.as_dict()))
+    (tmp_path / "s.json").write_text(json.dumps(s.to_dict()))
     (tmp_path / "s.toml").write_text('encoder_ticks = 4096\nvelocity = "difference"\ndelay = 0.005\n'
                                      'noise = "uniform:0.0005"\nseed = 3\n')
-    assert Sensing.from_spec(s.as_dict()) == s
+    assert Sensing.from_spec(s.to_dict()) == s
     assert Sensing.from_spec(tmp_path / "s.json") == s
     assert Sensing.from_spec(str(tmp_path / "s.toml")) == s
     assert Sensing.from_spec("preset=magnetic-12bit-axis,delay=0.005,noise=uniform:0.0005,seed=3") == s
@@ -259,7 +259,7 @@ def test_actuation_and_transmission_parts():
     a = Actuation.from_spec("delay=0.002,inductance=0.0005,current_limit=20")
     assert (a.delay, a.inductance, a.current_limit) == (0.002, 0.0005, 20.0) and not a.is_ideal
     assert a.electrical_time_constant(1.0) == 0.0005 and a.delay_steps(0.001) == 2
-    assert Actuation.from_spec(a.as_dict()) == a and Actuation.from_spec("ideal") == Actuation()
+    assert Actuation.from_spec(a.to_dict()) == a and Actuation.from_spec("ideal") == Actuation()
     assert Actuation().is_ideal and Actuation().label() == "ideal"
     for bad, fragment in (("delay=-0.001", "delay = -0.001 s is not accepted"),
                           ("inductance=-1e-3", "inductance = -0.001 H is not accepted"),

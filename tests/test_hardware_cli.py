@@ -184,7 +184,7 @@ def test_compare_runs_every_design_on_the_cart_given(tmp_path, capsys):
     assert main(argv) == 0
     result = _json(capsys)
     row = result["rows"][0]
-    assert row["cart"] == {"sensing": Sensing.from_spec("magnetic-12bit-axis").as_dict()}
+    assert row["cart"] == {"sensing": Sensing.from_spec("magnetic-12bit-axis").to_dict()}
     assert row["uncertified"] == 1  # the claim does not derive a bound for a differenced 12-bit alpha' here
     md = (tmp_path / "c" / "compare.md").read_text()
     assert "Cart of every design" in md and "encoder 4096/rev axis round" in md
@@ -200,8 +200,8 @@ def test_robustness_certificate_and_validate_take_the_cart(capsys):
     settings = ValidateSettings(sensing="magnetic-12bit-axis", transmission=0.001)
     assert settings.config(CERTIFIED).sensing == Sensing.from_spec("magnetic-12bit-axis")
     assert settings.config(CERTIFIED).transmission.backlash == 0.001
-    assert settings.as_dict()["sensing"]["encoder_ticks"] == 4096 and "actuation" not in settings.as_dict()
-    assert not {"sensing", "actuation", "transmission"} & set(ValidateSettings().as_dict())
+    assert settings.to_dict()["sensing"]["encoder_ticks"] == 4096 and "actuation" not in settings.to_dict()
+    assert not {"sensing", "actuation", "transmission"} & set(ValidateSettings().to_dict())
     assert main(["validate", "--n", "1", "--sensing", "delay=0.0007"]) == 2
     assert "0.0007" in one_error_line(capsys)
     assert math.isclose(Sensing.from_spec("delay=0.002").delay, 0.002)
@@ -213,8 +213,8 @@ def test_validate_s_report_names_a_built_cart_and_keeps_today_s_line():
     from wmr_mj.report.settings import ValidateSettings
     from wmr_mj.report.text import _settings_line
 
-    ideal = _settings_line({"settings": ValidateSettings().as_dict()})
-    built = _settings_line({"settings": ValidateSettings(sensing="magnetic-12bit-axis", transmission=0.002).as_dict()})
+    ideal = _settings_line({"settings": ValidateSettings().to_dict()})
+    built = _settings_line({"settings": ValidateSettings(sensing="magnetic-12bit-axis", transmission=0.002).to_dict()})
     assert "cart" not in ideal and built.startswith(ideal)
     assert built[len(ideal):] == ("; cart: sensing " + Sensing.from_spec("magnetic-12bit-axis").label()
                                   + ", transmission backlash +-2 mrad")

@@ -138,8 +138,8 @@ def test_reference_bounds_from_reads_and_round_trips():
     assert reference_bounds_from(PAPER_BOUNDS) is PAPER_BOUNDS
     b = reference_bounds_from("alpha_dot_max=0.23, alpha_ddot_max=0.4, alpha_max=0.6")
     assert b == ReferenceBounds(alpha_ddot_max=0.4, alpha_dot_max=0.23, sin_cos3_max=sin_cos3(0.6), alpha_max=0.6)
-    assert reference_bounds_from(b.as_dict()) == b
-    assert reference_bounds_from(",".join(f"{k}={v!r}" for k, v in b.as_dict().items())) == b
+    assert reference_bounds_from(b.to_dict()) == b
+    assert reference_bounds_from(",".join(f"{k}={v!r}" for k, v in b.to_dict().items())) == b
     partial = reference_bounds_from({"alpha_ddot_max": 0.1})
     assert partial.alpha_dot_max == PAPER_BOUNDS.alpha_dot_max and partial.alpha_max == PAPER.alpha_max
     assert reference_bounds_from(f"sin_cos3_max=0.5,alpha_max={angle_of_sin_cos3(0.5)!r}").sin_cos3_max == 0.5

@@ -141,7 +141,7 @@ def test_an_object_and_a_factory_run_as_themselves_and_each_run_gets_its_own_cop
         assert r.summary.controller == "tmp-law" and r.summary.verdict == NO_CLAIM and r.law == "python"
         assert r.rows["voltage"].tobytes() == by_name.rows["voltage"].tobytes()
     assert controller_for(config, estimate_parameters()) is not law  # a fresh copy: no state shared between runs
-    d = config.as_dict()
+    d = config.to_dict()
     assert d["controller"] == "tmp-law" and d["controller_plugin"]["origin"] == "instance"
     with pytest.raises(ParameterError, match="given as an object"):
         config_from_dict(d)
@@ -232,7 +232,7 @@ def test_the_example_plug_in_through_run_sweep_falsify_require_and_replay(tmp_pa
 def test_a_recorded_plug_in_is_found_again_from_another_folder(law_file, tmp_path, monkeypatch):
     monkeypatch.chdir(law_file.parent)
     config = RunConfig(controller="law.py:Law", controller_params={"k": 30.0}, duration=10.0)
-    d = json.loads(json.dumps(config.as_dict()))
+    d = json.loads(json.dumps(config.to_dict()))
     elsewhere = tmp_path / "elsewhere"
     elsewhere.mkdir()
     monkeypatch.chdir(elsewhere)
@@ -243,7 +243,7 @@ def test_a_recorded_plug_in_is_found_again_from_another_folder(law_file, tmp_pat
 def test_plugin_source_is_json():
     s = PluginSource(spec="a.py:B", name="b", origin="file", import_path="/x/a.py:B", params={"k": 1.0},
                      source_sha256="0" * 64)
-    assert json.loads(json.dumps(s.as_dict())) == s.as_dict()
+    assert json.loads(json.dumps(s.to_dict())) == s.to_dict()
 
 
 def test_a_stateful_law_is_reset_before_every_run(tmp_path):

@@ -123,7 +123,7 @@ def test_from_inputs_is_the_coerced_config(tmp_path):
     assert coerced.signals == RunConfig.from_inputs(signals=signals).signals
     assert coerced.cart["name"] == "C80 with a Magmotor C40-A-200FX and a Beckhoff NP045 32:1"
     assert coerced.controller_plugin.name == "my-pid"
-    assert given.as_dict() == coerced.as_dict()  # as_dict of a direct config coerces it first
+    assert given.to_dict() == coerced.to_dict()  # to_dict of a direct config coerces it first
 
 
 def test_a_replaced_plug_in_is_found_again():

@@ -347,7 +347,7 @@ def test_reference_fields(paper_ref: Reference) -> None:
     assert paper_ref.A_xy.shape == (n, 2) and paper_ref.C_xy.shape == (n, 2)
     assert np.allclose(np.diff(paper_ref.t), 1e-3)
     assert np.allclose(np.hypot(*(paper_ref.C_xy - paper_ref.A_xy).T), L1)
-    assert set(paper_ref.bounds().as_dict()) == {"alpha_dot_max", "alpha_ddot_max", "sin_cos3_max", "alpha_max"}
+    assert set(paper_ref.bounds().to_dict()) == {"alpha_dot_max", "alpha_ddot_max", "sin_cos3_max", "alpha_max"}
 
 
 def test_pose_and_duration_options() -> None:

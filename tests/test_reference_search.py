@@ -55,12 +55,12 @@ def test_a_reference_beyond_the_declared_bounds_is_uncertified():
 
 def test_reference_bounds_round_trip_through_the_config_json():
     config = BASE.replace(reference_bounds="paper")
-    d = config.as_dict()
-    assert d["reference_bounds"] == reference_bounds_from("paper").as_dict()
+    d = config.to_dict()
+    assert d["reference_bounds"] == reference_bounds_from("paper").to_dict()
     from wmr_mj.sim.sweep import config_from_dict
 
     assert config_from_dict(json.loads(json.dumps(d))) == coerce(config)  # the record is of the coerced config
-    assert "reference_bounds" not in BASE.as_dict()  # configs without them keep the keys they had
+    assert "reference_bounds" not in BASE.to_dict()  # configs without them keep the keys they had
     with pytest.raises(ParameterError, match="alpha_dot_max"):
         BASE.replace(reference_bounds="alpha_dot=0.2")
 
@@ -112,7 +112,7 @@ def test_falsify_over_paths_reports_a_worst_path_that_reproduces_to_the_bit(tmp_
             "--path-knots", "2", "--out", str(tmp_path / "f"), "--json"]
     assert main(argv) == 0
     found = json.loads(capsys.readouterr().out)
-    assert found["reproduced"] is True and found["reference_bounds"] == reference_bounds_from("paper").as_dict()
+    assert found["reproduced"] is True and found["reference_bounds"] == reference_bounds_from("paper").to_dict()
     assert set(found["box"]) == {"m1", "path.k1", "path.k2", "path.hold"}
     worst = found["worst"]
     assert worst["verdict"] == "certified-inside"  # every searched path within the declared bounds

@@ -138,7 +138,7 @@ def test_a_third_region_needs_no_change_to_the_claim():
     # (0.03, 0.3): inside the rectangle, outside the disk (hypot(0.75, 0.75) = 1.06)
     assert claim.verdict(0.03, 0.3) == "certified-outside"
     assert judge(claim, 0.02, 0.2).region_ratio == pytest.approx(math.hypot(0.5, 0.5), rel=REL)
-    out = claim.as_dict()
+    out = claim.to_dict()
     assert out["region"] == "disk" and "condition" not in out and len(out["vertices"]) == 5
 
 

@@ -44,7 +44,7 @@ def test_bounded_always_is_the_window_min_of_the_margin():
 def test_result_is_frozen_and_reports_satisfaction():
     r = evaluate(parse_requirement("always[0,2](abs(x) <= 1)", period=1.0, signals=("x",)), {"x": X}, period=1.0)
     assert isinstance(r, RequirementResult) and r.satisfied
-    assert r.as_dict() == {"formula": "always[0,2](abs(x) <= 1)", "robustness": 0.5, "satisfied": True}
+    assert r.to_dict() == {"formula": "always[0,2](abs(x) <= 1)", "robustness": 0.5, "satisfied": True}
     with pytest.raises(AttributeError):
         r.robustness = 0.0  # type: ignore[misc]
     assert not evaluate(parse_requirement("always(abs(x) <= 1)", period=1.0, signals=("x",)), {"x": X},
@@ -106,7 +106,7 @@ def test_presets_resolve_against_the_run_bounds():
     cert, paper = evaluate_run(reqs, rows, summary, period=1e-3)
     assert cert.robustness == pytest.approx(min(0.05 - 0.03, 0.3 - 0.2)) and cert.satisfied
     assert paper.robustness == pytest.approx(0.02 - 0.03) and not paper.satisfied
-    assert cert.as_dict()["requirement"] == "certificate" and "0.05" in cert.formula
+    assert cert.to_dict()["requirement"] == "certificate" and "0.05" in cert.formula
     # no certificate (an unbounded region): nothing to satisfy, no robustness
     (none,) = evaluate_run(reqs[:1], rows, {"certificate": {"E_max": None, "Edot_max": None}}, period=1e-3)
     assert none.robustness is None and not none.satisfied

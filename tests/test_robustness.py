@@ -202,7 +202,7 @@ def test_unstable_gives_nulls(capsys):
     r = analyse(ParameterBox.paper(), kp=100.0, kd=1.0)
     assert not r.stable and r.condition > 1
     assert math.isinf(r.E_max) and math.isinf(r.Edot_max) and r.vertices == ()
-    d = r.as_dict()
+    d = r.to_dict()
     json.dumps(d, allow_nan=False)
     assert d["E_max"] is None and d["Edot_max"] is None and d["stable"] is False
     assert main(["robustness", "--json", "--kp", "100", "--kd", "1"]) == 0

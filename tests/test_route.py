@@ -80,7 +80,7 @@ def test_route_runs_closed_loop_and_config_stays_json(tmp_path):
     by_path = coerce(by_file.replace(path=load_route(f).path))  # a Path object: coerced to its canonical JSON
     assert isinstance(by_path.path, str) and by_path.path.startswith("{")
     for cfg in (by_file, by_path):
-        json.dumps(cfg.as_dict())
+        json.dumps(cfg.to_dict())
     a = run_closed_loop(by_file, progress=False)
     b = run_closed_loop(by_path, progress=False)
     assert a.status == "completed" and a.summary.steps == 5000
@@ -103,7 +103,7 @@ def test_waypoints_and_the_packaged_agv_loop():
     ref = route_reference(r, C80, dt=1e-2, duration=T)
     assert ref.duration == pytest.approx(T, abs=1e-2) and np.max(np.abs(ref.alpha0)) < C80.steering_range
     cfg = RunConfig(path="agv-loop")
-    assert cfg.as_dict()["path"] == "agv-loop"
+    assert cfg.to_dict()["path"] == "agv-loop"
 
 
 def test_waypoint_corners_close_an_open_polyline():

@@ -27,9 +27,9 @@ def _config(**changes):
 def test_signals_round_trip_through_json():
     s = signals_from(SIGNALS)
     assert isinstance(s, Signals)
-    again = signals_from(json.dumps(s.as_dict()))
-    assert again == s and again.as_dict() == s.as_dict()
-    assert s.as_dict() == {**SIGNALS, "disturbance": {**SIGNALS["disturbance"]}}
+    again = signals_from(json.dumps(s.to_dict()))
+    assert again == s and again.to_dict() == s.to_dict()
+    assert s.to_dict() == {**SIGNALS, "disturbance": {**SIGNALS["disturbance"]}}
     assert signals_from({}) is None and signals_from(None) is None
     assert s.load_steps(650.0)[0] == (1.0, 560.0) and s.load_steps(650.0)[-1] == (2.0, 740.0)
     assert s.m1_values(650.0)[:2] == [650.0, 560.0]
@@ -70,9 +70,9 @@ def test_bad_signals_raise_one_line(bad, word):
 
 
 def test_runs_without_signals_keep_their_config_keys():
-    assert "signals" not in RunConfig().as_dict()
-    assert "signals" not in RunConfig(signals={}).as_dict()
-    assert RunConfig(signals=SIGNALS).as_dict()["signals"] == signals_from(SIGNALS).as_dict()
+    assert "signals" not in RunConfig().to_dict()
+    assert "signals" not in RunConfig(signals={}).to_dict()
+    assert RunConfig(signals=SIGNALS).to_dict()["signals"] == signals_from(SIGNALS).to_dict()
 
 
 @pytest.mark.parametrize("period", [None, 0.005])
@@ -85,7 +85,7 @@ def test_signals_run_alike_on_both_steppers_and_reproduce_from_their_report(peri
         assert np.array_equal(compiled.rows[key], python.rows[key]), key
     plain = run_closed_loop(_config())
     assert not np.array_equal(plain.rows["E"], compiled.rows["E"])  # the signals act
-    again = run_closed_loop(RunConfig(**{**config.as_dict(), "m1_range": tuple(config.m1_range)}))
+    again = run_closed_loop(RunConfig(**{**config.to_dict(), "m1_range": tuple(config.m1_range)}))
     assert all(np.array_equal(again.rows[k], compiled.rows[k]) for k in compiled.rows)
 
 
@@ -205,7 +205,7 @@ def test_replay_verify_reapplies_the_signals(tmp_path):
     out = tmp_path / "signals.mcap"
     run_closed_loop(_config(signals=SIGNALS), logger_factory=functools.partial(RunLogger, str(out)))
     log = load_log(str(out))
-    assert log.config["signals"] == signals_from(SIGNALS).as_dict()
+    assert log.config["signals"] == signals_from(SIGNALS).to_dict()
     assert verify(log)["identical"]
 
 

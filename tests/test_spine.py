@@ -70,7 +70,7 @@ def test_a_run_builds_each_law_once_and_computes_each_claim_once(counted, option
 
 def test_a_plugin_is_imported_and_hashed_once_per_resolution(monkeypatch):
     """A plug-in given by name is a reference: constructing its config hashes nothing, resolve_run finds it once
-    (imported, its source hashed), and as_dict, controller_name and the run's record read what was found; the
+    (imported, its source hashed), and to_dict, controller_name and the run's record read what was found; the
     record is the one a fresh resolution gives."""
     import controllers.registry as registry
     from wmr_mj.sim.config import RunConfig, controller_name, controller_source
@@ -88,11 +88,11 @@ def test_a_plugin_is_imported_and_hashed_once_per_resolution(monkeypatch):
     assert hashed == []
     parts = resolve_run(config)
     assert len(hashed) == 1, f"hashed again: {hashed}"
-    first = parts.config.as_dict()
+    first = parts.config.to_dict()
     assert first == parts.record and controller_name(parts.config) == "my-pid"
     assert len(hashed) == 1, f"hashed again: {hashed}"
     _, fresh = resolve(MY_PID, {"ki": 20.0})
-    assert first["controller_plugin"] == fresh.as_dict() == controller_source(parts.config)
+    assert first["controller_plugin"] == fresh.to_dict() == controller_source(parts.config)
 
 
 class _Reads:
@@ -122,7 +122,7 @@ class _Header:
         pass
 
 
-#: what run_parts may read of the config: nothing (its labels and its record, ``as_dict``, are read once by
+#: what run_parts may read of the config: nothing (its labels and its record, ``to_dict``, are read once by
 #: resolve_run: RunParts.labels, RunParts.record)
 RECORDED: set[str] = set()
 
@@ -130,7 +130,7 @@ RECORDED: set[str] = set()
 @pytest.mark.slow
 def test_below_resolve_run_the_config_is_only_recorded():
     """run_parts reads the typed parts (sensing, signals, reference bounds, route, labels, the config's record,
-    ...) and no field of the config, nor its as_dict; the run's numbers are the same as run_closed_loop's."""
+    ...) and no field of the config, nor its to_dict; the run's numbers are the same as run_closed_loop's."""
     import dataclasses
 
     import numpy as np
@@ -148,7 +148,7 @@ def test_below_resolve_run_the_config_is_only_recorded():
     spy = _Reads(config)
     seen = run_parts(dataclasses.replace(parts, config=spy), progress=False, logger_factory=_Header)
     assert spy.read <= RECORDED, f"read below resolve_run: {sorted(spy.read - RECORDED)}"
-    assert _Header.last.config == config.as_dict()  # the log's record of the config, taken by resolve_run
+    assert _Header.last.config == config.to_dict()  # the log's record of the config, taken by resolve_run
     plain = run_closed_loop(config, progress=False)
     timing = ("wall_s", "realtime_factor")  # the two runs' clocks, the only keys that differ
 

@@ -114,7 +114,7 @@ def test_the_reproduce_line_parses_back_into_the_same_config(argv):
     words = shlex.split(line)
     assert words[:2] == ["wmr-mj", "run"], line
     again, _ = _run_config(words[2:])
-    assert again.as_dict() == config.as_dict(), line
+    assert again.to_dict() == config.to_dict(), line
     assert reproduce_command(again, {}, args) == line  # a fixed point: the line of the line is the line
 
 

@@ -70,7 +70,7 @@ def test_the_json_keeps_every_key(summary, certified_run_10s):
     config = certified_run_10s.config
     reference = build_reference(config.path, C80, dt=1e-3, duration=config.duration)[0]
     section_4 = certificate_for(config, reference, measurement=MeasurementErrors.exact())
-    assert set(section_4.as_dict()) == CLAIM_KEYS | SECTION_4_KEYS
+    assert set(section_4.to_dict()) == CLAIM_KEYS | SECTION_4_KEYS
     assert set(d["paper_region"]) == {"E_max", "Edot_max", "condition", "inside"}
     assert set(d["drift"]) == {"final_alpha_dot", "growing", "E_last_window", "E_prev_window", "window_s",
                                "tolerance"}

@@ -124,7 +124,7 @@ def test_falsify_report_is_typed_and_round_trips():
                                  "sup_Edot": 0.2, "E_max": 0.05, "ratio": 1.5, "count": 1}
     assert d["box"] == {"m1": [550.0, 750.0]} and d["worst"]["unmet"] == []
     assert list(d["tightness"]) == ["ratio", "factor", "found_sup_E", "E_max", "text"]
-    assert d == result.as_dict(log="worst.mcap")  # the earlier name, kept for scripts
+    assert d == result.to_dict(log="worst.mcap")  # the earlier name, kept for scripts
     assert FalsifyReport.from_dict(d).to_dict() == d
     assert FalsifyReport.from_dict(d) == report
 
@@ -191,7 +191,7 @@ def test_compare_report_is_typed_and_round_trips():
                                   "sup_E": 0.075, "E_max": 0.05, "ratio": 1.5, "count": 1},
                     unmet=({"name": "within the supply", "value": 25.0, "limit": 24.0, "runs": 1},))
     d = row.to_dict()
-    assert "cart" not in d and d == row.as_dict() and DesignRow.from_dict(d).to_dict() == d
+    assert "cart" not in d and d == row.to_dict() and DesignRow.from_dict(d).to_dict() == d
     assert d["unmet"] == [{"name": "within the supply", "value": 25.0, "limit": 24.0, "runs": 1}]
     suite = load_suite("standard-v1")
     result = CompareResult(suite=suite, scenarios=suite.select(["circle/*"]), rows=(row,), runs=(), budget=4,

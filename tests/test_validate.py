@@ -330,7 +330,7 @@ def test_validate_runs_every_rung_on_the_path_it_is_given():
     from wmr_mj.sim.designs import CERTIFIED
 
     settings = ValidateSettings(path="agv-loop", duration=40.0)
-    assert settings.config(CERTIFIED).path == "agv-loop" and settings.as_dict()["path"] == "agv-loop"
+    assert settings.config(CERTIFIED).path == "agv-loop" and settings.to_dict()["path"] == "agv-loop"
     route = build_reference("agv-loop", C80, dt=1e-3, duration=40.0)[0]
     circle = build_reference("paper-circle", C80, dt=1e-3, duration=40.0)[0]
     assert (reference_of(settings).alpha0 == route.alpha0).all()

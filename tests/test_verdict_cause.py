@@ -228,7 +228,7 @@ def test_sliding_mode_under_a_delay_names_the_step_of_s_not_the_control_period()
 # --------------------------------------------------------------------------- 5. "no certificate", not OUTSIDE
 def _summary(cert, verdict):
     return {"verdict": verdict, "sup_E": 0.0383, "controller": "computed-torque",
-            "certificate": {**cert.as_dict(), "inside": False}, "paper_region": {}}
+            "certificate": {**cert.to_dict(), "inside": False}, "paper_region": {}}
 
 
 def test_no_region_reads_no_certificate_and_keeps_the_verdict_name():

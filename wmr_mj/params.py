@@ -100,7 +100,7 @@ class Coefficients:
     K: float  # V, coefficient of sin/cos^3
     gyro: float  # V s/m, coefficient of V_A alpha'/cos^2
 
-    def as_dict(self) -> dict[str, float]:
+    def to_dict(self) -> dict[str, float]:
         return dataclasses.asdict(self)
 
 
@@ -337,7 +337,7 @@ class C80Parameters:
         """
         return self.R_a * float(torque) / (self.k_i * self.i2)
 
-    def as_dict(self) -> dict[str, float]:
+    def to_dict(self) -> dict[str, float]:
         return dataclasses.asdict(self)
 
 
@@ -381,7 +381,7 @@ def check_physical_sense(p: C80Parameters) -> None:
             "warns that the inertia matrix is singular)")
     for model in COEFFICIENT_MODELS:
         c = p.coefficients(model)
-        for name, value in c.as_dict().items():
+        for name, value in c.to_dict().items():
             positive = name in ("P", "C_V")
             if not math.isfinite(value) or (value <= 0.0 if positive else value < 0.0):
                 raise ParameterError(

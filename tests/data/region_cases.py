@@ -1,6 +1,6 @@
 """Certificates of a few configurations, built through the public API only, for tests/test_regions.py.
 
-``python tests/data/region_cases.py OUT.json`` writes ``{name: cert.as_dict()}`` of every case;
+``python tests/data/region_cases.py OUT.json`` writes ``{name: cert.to_dict()}`` of every case;
 ``tests/data/regions_golden.json`` was written so at commit b6fcf5d, before claims held typed regions
 (run with ``PYTHONPATH`` set to a checkout of that commit), and the test compares today's JSON with it.
 """
@@ -67,7 +67,7 @@ def cases():
 
 def as_json(cert) -> str:
     """The certificate's JSON as the commands write it (key order kept, inf/NaN as null)."""
-    return json.dumps(cert.as_dict())
+    return json.dumps(cert.to_dict())
 
 
 if __name__ == "__main__":

@@ -108,7 +108,7 @@ def write_text_atomic(path: str | os.PathLike, text: str) -> Path:
 def json_safe(obj: Any) -> Any:
     """``obj`` as plain JSON values: NumPy scalars and arrays made Python numbers and lists,
     NaN/inf replaced by None (standard JSON), paths as strings, dataclasses and objects with
-    ``as_dict()`` as dicts, anything else as ``str(obj)``. The one sanitizer of the package."""
+    ``to_dict()`` as dicts, anything else as ``str(obj)``. The one sanitizer of the package."""
     if isinstance(obj, Mapping):
         return {str(k): json_safe(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple, set, frozenset)):
@@ -123,8 +123,8 @@ def json_safe(obj: Any) -> Any:
         return json_safe(obj.tolist())
     if isinstance(obj, os.PathLike):
         return os.fspath(obj)
-    if hasattr(obj, "as_dict") and callable(obj.as_dict):
-        return json_safe(obj.as_dict())
+    if hasattr(obj, "to_dict") and callable(obj.to_dict):
+        return json_safe(obj.to_dict())
     if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
         return json_safe(dataclasses.asdict(obj))
     return str(obj)

@@ -72,7 +72,7 @@ class Assumption:
     note: str = ""
     kind: str = "checked"
 
-    def as_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, Any]:
         return {"name": self.name, "equation": self.equation, "met": bool(self.met),
                 "value": finite_or_none(self.value), "limit": finite_or_none(self.limit),
                 "note": self.note, "kind": self.kind}
@@ -127,7 +127,7 @@ class SmallGainTerms:
             its smoothing.
         delta1_parts: every term of delta1 [rad/s^2] as (name, value), at the plant corner P where delta1 is
             reached, so that they add up to delta1 (to rounding); the measurement's terms, with a delay's loop
-            gain 1/(1 - tau c_v) as the part it adds. Not in :meth:`Certificate.as_dict` (whose keys stay as
+            gain 1/(1 - tau c_v) as the part it adds. Not in :meth:`Certificate.to_dict` (whose keys stay as
             they were); ``robustness --certificate`` prints and writes them.
         measurement_cause: the measurement errors assumed and which binds (:class:`MeasurementCause`); None
             for a law that reads the true state at once.
@@ -150,7 +150,7 @@ class SmallGainTerms:
     measurement_cause: MeasurementCause | None = None
 
     def json_items(self) -> dict[str, Any]:
-        """The terms as :meth:`Certificate.as_dict` writes them (inf -> None): :data:`_TERM_KEYS` in order, then
+        """The terms as :meth:`Certificate.to_dict` writes them (inf -> None): :data:`_TERM_KEYS` in order, then
         disturbance_term and measurement_term where not 0, then friction_sign."""
         out: dict[str, Any] = {name: finite_or_none(getattr(self, name)) for name in _TERM_KEYS}
         if self.disturbance_term:
@@ -162,7 +162,7 @@ class SmallGainTerms:
 
 
 #: What the term properties of a claim without section 4's terms read (a law's box claim, the sampled-data
-#: certificate): placeholders, no claim of the law's; its JSON writes none of them (:meth:`Certificate.as_dict`).
+#: certificate): placeholders, no claim of the law's; its JSON writes none of them (:meth:`Certificate.to_dict`).
 _NO_TERMS = SmallGainTerms(friction_term=math.nan, gyro_term=math.nan, friction_sign="none")
 
 #: The terms' keys in the JSON, in order (disturbance_term, measurement_term and friction_sign follow).
@@ -345,7 +345,7 @@ class Certificate:
         where = "inside" if self.inside(sup_E, sup_Edot) else "outside"
         return f"{'certified' if self.certified else 'uncertified'}-{where}"
 
-    def as_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, Any]:
         """JSON-ready (inf -> None): the Interface keys E_max, Edot_max, valid, assumptions [{name, met, value,
         limit, ...}], and what the claimant itself has: section 4's region writes condition and gamma1 ... delta3,
         section 4's terms (:meth:`SmallGainTerms.json_items`) their keys and the regime; a claim without them (a box
@@ -355,7 +355,7 @@ class Certificate:
         if small_gain:  # section 4's region: (4.23) and the gains of (4.14), (4.18); no other claim has them
             out["condition"] = finite_or_none(self.condition)
         out.update(valid=bool(self.valid), certified=self.certified, reason=self.reason,
-                   assumptions=[a.as_dict() for a in self.assumptions], unmet=list(self.unmet))
+                   assumptions=[a.to_dict() for a in self.assumptions], unmet=list(self.unmet))
         for name in ("gamma1", "gamma2", "delta1", "delta2", "delta3") if small_gain else ():
             out[name] = finite_or_none(getattr(self, name))
         out.update(alpha_max=finite_or_none(self.alpha_max), voltage_max=finite_or_none(self.voltage_max))
@@ -485,9 +485,9 @@ class CertificateJudgement:
         return self.certificate.unmet
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready: the certificate's :meth:`Certificate.as_dict` with inside, E_ratio, Edot_ratio,
+        """JSON-ready: the certificate's :meth:`Certificate.to_dict` with inside, E_ratio, Edot_ratio,
         region_ratio, verdict, sup_E and sup_Edot added (the keys of the run summary's certificate)."""
-        out = self.certificate.as_dict()
+        out = self.certificate.to_dict()
         out.update(inside=self.inside, E_ratio=self.E_ratio, Edot_ratio=self.Edot_ratio,
                    region_ratio=self.region_ratio, verdict=self.verdict, sup_E=self.sup_E, sup_Edot=self.sup_Edot)
         return out

@@ -98,7 +98,7 @@ class MeasurementErrors:
         return (self.covered and self.alpha_error_max == 0.0 and self.alpha_dot_error_max == 0.0
                 and self.delay_s == 0.0 and self.electrical_time_constant_s == 0.0)
 
-    def as_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, Any]:
         """JSON-ready: the fields (the electrical time constant only where there is one: no key changes elsewhere)."""
         out = {"alpha_error_max": self.alpha_error_max, "alpha_dot_error_max": self.alpha_dot_error_max,
                "delay_s": self.delay_s, "covered": self.covered, "why_not": self.why_not}

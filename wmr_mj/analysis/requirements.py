@@ -363,7 +363,7 @@ class RequirementResult:
     satisfied: bool
     note: str = ""
 
-    def as_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, Any]:
         d = {"formula": self.formula if self.formula is not None else self.requirement,
              "robustness": self.robustness, "satisfied": self.satisfied}
         if self.formula != self.requirement:

@@ -354,7 +354,7 @@ class ParameterBox:
         lo, hi = getattr(self, name)
         return hi - lo
 
-    def as_dict(self) -> dict[str, list[float]]:
+    def to_dict(self) -> dict[str, list[float]]:
         return {n: list(getattr(self, n)) for n in BOX_COEFFICIENTS}
 
 
@@ -433,7 +433,7 @@ class RobustnessResult:
             lower = (-d1 / d2, (1.0 - g2 * d3) / (g2 * d2))
         return {"upper": upper, "lower": lower}
 
-    def as_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, Any]:
         """JSON-ready (no NaN/inf: unbounded values are None)."""
         g1p, g2p = paper_gammas(self.kp, self.kd)
         out: dict[str, Any] = {
@@ -462,9 +462,9 @@ class RobustnessResult:
             "vertices": [list(v) for v in self.vertices],
         }
         if self.box is not None:
-            out["box"] = self.box.as_dict()
+            out["box"] = self.box.to_dict()
         if self.bounds is not None:
-            out["bounds"] = self.bounds.as_dict()
+            out["bounds"] = self.bounds.to_dict()
         out["estimate"] = dict(self.estimate) if self.estimate is not None else None
         return out
 
@@ -473,8 +473,8 @@ class RobustnessResult:
 def _normalise_estimate(estimate: Any) -> dict[str, float]:
     if estimate is None:
         return {}
-    if hasattr(estimate, "as_dict") and not isinstance(estimate, Mapping):
-        estimate = estimate.as_dict()
+    if hasattr(estimate, "to_dict") and not isinstance(estimate, Mapping):
+        estimate = estimate.to_dict()
     if not isinstance(estimate, Mapping):
         raise ParameterError(
             f"estimate must be a mapping {{name: value}} of {', '.join(BOX_COEFFICIENTS)}, got {estimate!r}"
@@ -482,7 +482,7 @@ def _normalise_estimate(estimate: Any) -> dict[str, float]:
     out: dict[str, float] = {}
     for name, value in estimate.items():
         if name not in BOX_COEFFICIENTS:
-            if name == "gyro":  # Coefficients.as_dict() carries it; the analysis has no gyro term
+            if name == "gyro":  # Coefficients.to_dict() carries it; the analysis has no gyro term
                 continue
             raise UnknownNameError("estimate name", name, BOX_COEFFICIENTS)
         try:

@@ -183,7 +183,7 @@ class SampledDataInputs:
                          "sensing_delay_periods": cart.sensing_delay, "actuation_delay_periods": cart.actuation_delay,
                          "angle_error": cart.angle_error, "velocity_noise": cart.velocity_noise,
                          "velocity_error": cart.velocity_error, "velocity_lag": cart.velocity_lag,
-                         "measurement": cart.measurement.as_dict(),
+                         "measurement": cart.measurement.to_dict(),
                          "electrical_time_constant": cart.electrical_time_constant},
                 "reference": {"alpha0_max": self.reference.alpha_max, "alpha0_dot_max": self.reference.alpha_dot_max,
                               "alpha0_ddot_max": self.reference.alpha_ddot_max},

@@ -664,7 +664,7 @@ class _Measured:
     def record(self, at: _MeasuredAt, E_max: float, Edot_max: float) -> dict[str, Any]:
         """The measurement's bounds and the errors they give in the region (``inputs['measurement']``)."""
         eps_v = self.eps_alpha_dot(at, E_max, Edot_max) if math.isfinite(E_max) else math.inf
-        return {**self.measurement.as_dict(), "eps_alpha": at.eps_alpha, "eps_alpha_dot": eps_v,
+        return {**self.measurement.to_dict(), "eps_alpha": at.eps_alpha, "eps_alpha_dot": eps_v,
                 "alpha_m_max": at.alpha_m, "rho": at.rho, "c_v": at.c_v, "c_a": at.c_a}
 
     @staticmethod
@@ -697,7 +697,7 @@ class _Measured:
         without = []
         for name, field_name in _ERRORS:
             if getattr(m, field_name) != 0.0:
-                zeroed = MeasurementErrors(**{**m.as_dict(), field_name: 0.0})
+                zeroed = MeasurementErrors(**{**m.to_dict(), field_name: 0.0})
                 path: _Path = (_Exact(self.bound, self.friction_width) if zeroed.is_exact
                                else _Measured(self.bound, zeroed, self.friction_width))
                 without.append((name, path.solve()[0]))
@@ -889,10 +889,10 @@ class SmallGainInputs:
     measurement: Mapping[str, Any] | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        """The JSON record (not cleaned of inf: :meth:`Certificate.as_dict` does it)."""
+        """The JSON record (not cleaned of inf: :meth:`Certificate.to_dict` does it)."""
         plant, estimate, ref = self.plant, self.estimate, self.reference
         out = {
-            "box": plant.box.as_dict(), "gyro": list(plant.gyro), "V_A": list(plant.V_A),
+            "box": plant.box.to_dict(), "gyro": list(plant.gyro), "V_A": list(plant.V_A),
             "estimate": {"P": estimate.P, "C_V": estimate.C_V, "F": estimate.F, "K": estimate.K,
                          "gyro": estimate.gyro, "V_A": estimate.V_A},
             "feedforward": bool(self.compensation.feedforward),

@@ -255,7 +255,7 @@ def unmet_assumptions(certificate: Mapping[str, Any] | None) -> list[dict[str, A
     JSON of a run on an ideal cart keeps its keys).
 
     Args:
-        certificate: a certificate's JSON (``Certificate.as_dict()``, a run summary's ``certificate``);
+        certificate: a certificate's JSON (``Certificate.to_dict()``, a run summary's ``certificate``);
             None or one without ``assumptions`` (a slim summary, a law without a claim): [].
     """
     return [{"name": str(a.get("name")), "value": a.get("value"), "limit": a.get("limit"),

@@ -243,8 +243,8 @@ def _write_outputs(result, base, args: argparse.Namespace, out, *, law_settings)
     signals_file = path_file = None
     if config.signals is not None:  # the worst run's signals, every parameter: --signals takes them back
         signals_file = str(out / "worst-signals.json")
-        write_json_atomic(signals_file, config.signals.as_dict())
-        summary["worst"]["signals"] = config.signals.as_dict()
+        write_json_atomic(signals_file, config.signals.to_dict())
+        summary["worst"]["signals"] = config.signals.to_dict()
         summary["signals_file"] = signals_file
     if config.path != base.path:  # a searched path: its canonical route, which --path takes back exactly
         path_file = str(out / "worst-path.json")
@@ -254,7 +254,7 @@ def _write_outputs(result, base, args: argparse.Namespace, out, *, law_settings)
         "reproduced": logged.sup_E == worst.sup_E,  # the serial re-run gives the batch's bits
         "reproduce": reproduce_command(config, worst.params, args, signals_file=signals_file, path_file=path_file,
                                        law_settings=law_settings),
-        "reference_bounds": None if base.reference_bounds is None else base.reference_bounds.as_dict(),
+        "reference_bounds": None if base.reference_bounds is None else base.reference_bounds.to_dict(),
         "uncertainty": args.uncertainty,
         "folder": str(out),
         "table": str(out / "evaluations.csv"),

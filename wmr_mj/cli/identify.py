@@ -77,7 +77,7 @@ def run(args: argparse.Namespace) -> int:
 
         check_motor_constant(params.k_i, params.k_b)
     result = identify_plant(params, duration=args.duration, seed=args.seed)
-    obj = result.as_dict()
+    obj = result.to_dict()
     if args.out:
         write_json_atomic(args.out, obj)
     if args.json:
@@ -177,11 +177,11 @@ def run_data(args: argparse.Namespace) -> int:
         report_files = [str(p) for p in report.write(args.report)]
     failed = nrmse is not None and not nrmse <= HOLDOUT_NRMSE_MAX
     obj = {
-        "coefficients": {k: v.as_dict() for k, v in fit.coefficients.items()},
+        "coefficients": {k: v.to_dict() for k, v in fit.coefficients.items()},
         "fixed_from_structure": {"K": "0: absent from the plant (non-holonomic model)",
                                  "gyro": "P / l1: moves with C_V at constant speed, not separable"},
-        "physical": {k: v.as_dict() for k, v in fit.physical.items()},
-        "sensing_delay_s": fit.delay.as_dict(),
+        "physical": {k: v.to_dict() for k, v in fit.physical.items()},
+        "sensing_delay_s": fit.delay.to_dict(),
         "actuation_delay_s": {"value": 0.0, "interval": [0.0, 0.0], "note": (
             "not separable from the sensing delay when the voltage is recorded as applied: the whole "
             "voltage-to-angle delay is in sensing_delay_s")},

@@ -102,7 +102,7 @@ def _friction(args: argparse.Namespace, params: Any) -> int:
 
     laws = {name: measure_friction_law(params, steering_friction=name) for name in STEERING_FRICTION_MODELS}
     if args.json:
-        print_json({name: law.as_dict() for name, law in laws.items()})
+        print_json({name: law.to_dict() for name, law in laws.items()})
         return 0
     any_law = laws["stiction"]
     print(f"steering friction: F = {any_law.friction_voltage:.5g} V "
@@ -143,7 +143,7 @@ def _params(args: argparse.Namespace, params: Any) -> int:
 
     paper, nonholonomic = params.coefficients("paper"), params.coefficients("nonholonomic")
     if args.json:
-        print_json({"parameters": params.as_dict(), "paper": paper.as_dict(), "nonholonomic": nonholonomic.as_dict(),
+        print_json({"parameters": params.to_dict(), "paper": paper.to_dict(), "nonholonomic": nonholonomic.to_dict(),
                     "kinetic_energy": params.kinetic_energy_coefficients()})
         return 0
     sources = PARAMETER_SOURCES
@@ -151,7 +151,7 @@ def _params(args: argparse.Namespace, params: Any) -> int:
         from wmr_mj.carts import load_cart
 
         sources = dict(load_cart(args.cart).sources)
-    for name, value in params.as_dict().items():
+    for name, value in params.to_dict().items():
         print(f"{name:22s} {value:12.6g}  {sources[name]}")
     print()
     for key in COEFFICIENT_NAMES:

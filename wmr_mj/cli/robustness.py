@@ -134,7 +134,7 @@ def run(args: argparse.Namespace) -> int:
     estimate = parse_assignments(args.estimate, option="--estimate", example="P=0.385") if args.estimate else None
     result = analyse(box, kp=kp, kd=kd, bounds=bounds, reading=args.reading, gammas=args.gammas, estimate=estimate)
     if args.json:
-        print_json(result.as_dict())
+        print_json(result.to_dict())
         return 0
     paper_example = (
         args.box == "paper" and kp == PAPER_KP and kd == PAPER_KD and estimate is None and bounds == ReferenceBounds()
@@ -390,7 +390,7 @@ def _small_gain_table(cert, config, paper) -> str:
     sign = cert.friction_sign + (f", smoothed w = {cert.friction_width:g} rad/s" if cert.friction_width > 0 else "")
     rows = [
         ("controller", f"{inp['controller']} ({inp['model']} model), K_P = {cert.kp:g}, K_D = {cert.kd:g} "
-                       f"({cert.as_dict()['regime']}), Coulomb sign {sign}"),
+                       f"({cert.to_dict()['regime']}), Coulomb sign {sign}"),
         ("plant box P, C_V", f"{span(box.P)} V s^2/rad, {span(box.C_V)} V s/rad"),
         ("plant box F, K", f"{span(box.F)} V, {span(box.K)} V"),
         ("plant gyro, V_A", f"{span(law.plant.gyro)} V s/m, {span(law.plant.V_A)} m/s"),
@@ -425,7 +425,7 @@ def _small_gain_table(cert, config, paper) -> str:
 
 
 def certificate_breakdown(cert) -> dict:
-    """The JSON keys section 4's certificate adds beside :meth:`Certificate.as_dict`: ``delta1_parts``
+    """The JSON keys section 4's certificate adds beside :meth:`Certificate.to_dict`: ``delta1_parts``
     ({term: rad/s^2}, adding up to delta1) and, with measurement errors, ``measurement_errors``
     (:meth:`~wmr_mj.analysis.claim_types.MeasurementCause.to_dict`); {} for a claim without section 4's terms."""
     from wmr_mj.analysis.claim_types import finite_or_none
@@ -483,15 +483,15 @@ def run_certificate(args: argparse.Namespace) -> int:
     paper = parts.analysis
     second = _section_4_beside(parts, cert)
     if as_json:
-        out = cert.as_dict()
+        out = cert.to_dict()
         if parts.paper_law:  # the paper's region says nothing of a law outside its family (run: not applicable)
             out["paper_region"] = {"E_max": paper.E_max if paper.stable else None,
                                    "Edot_max": paper.Edot_max if paper.stable else None,
                                    "condition": paper.condition, "stable": bool(paper.stable)}
-        out["config"] = config.as_dict()
+        out["config"] = config.to_dict()
         out.update(certificate_breakdown(cert))
         if second is not None:
-            out["section_4"] = {**second.as_dict(), **certificate_breakdown(second)}
+            out["section_4"] = {**second.to_dict(), **certificate_breakdown(second)}
         print_json(out)
         return 0
     print(_certificate_table(cert, config, paper))

@@ -292,7 +292,7 @@ def signals_from_args(args: argparse.Namespace):
     data: dict = {}
     if getattr(args, "signals", None):
         s = signals_from(args.signals)
-        data = {} if s is None else s.as_dict()
+        data = {} if s is None else s.to_dict()
     if getattr(args, "disturbance", None):
         if "disturbance" in data:
             raise ParameterError("give the disturbance by --signals or by --disturbance, not both")

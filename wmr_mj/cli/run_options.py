@@ -144,7 +144,7 @@ def _write_part(option: str, part: str) -> Callable[[Any, Replay], list[str]]:
         value = getattr(config, part)
         if value.is_ideal:
             return []
-        spec = {k: repr(v) if isinstance(v, float) else v for k, v in value.as_dict().items()}
+        spec = {k: repr(v) if isinstance(v, float) else v for k, v in value.to_dict().items()}
         return [option, shlex.quote(spec_string(spec))]
 
     return write
@@ -251,11 +251,11 @@ def _plant_and_outer_rows() -> tuple[RunOption, ...]:
         R(flag="--signals", group="signals", sets="signals", settings=dict(metavar="FILE|JSON"),
           help="a .json file or JSON text: {\"disturbance\": {...}, \"d_max\": N m, \"loads\": [...]}",
           write=_if(lambda c, r: c.signals is not None, lambda c, r: [
-              "--signals", shlex.quote(r.signals_file or json.dumps(c.signals.as_dict()))])),
+              "--signals", shlex.quote(r.signals_file or json.dumps(c.signals.to_dict()))])),
         R(flag="--reference-bounds", group="run", sets="reference_bounds",
           settings=dict(metavar="paper|KEY=VALUE,...", default=None), help=_reference_bounds_help,
           write=_if(lambda c, r: c.reference_bounds is not None, lambda c, r: [
-              "--reference-bounds", ",".join(f"{k}={v!r}" for k, v in c.reference_bounds.as_dict().items())])),
+              "--reference-bounds", ",".join(f"{k}={v!r}" for k, v in c.reference_bounds.to_dict().items())])),
         R(flag="--sensing", group="cart", sets="sensing", settings=dict(metavar="KEY=VALUE,...|PRESET|FILE",
                                                                           default=None),
           help=_sensing_help, write=_write_part("--sensing", "sensing")),

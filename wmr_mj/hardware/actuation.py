@@ -99,7 +99,7 @@ class Actuation:
         """
         return whole_periods("actuation delay", self.delay, timestep)
 
-    def as_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, Any]:
         """The spec form (JSON-ready; :meth:`from_spec` reads it back)."""
         return {"delay": self.delay, "inductance": self.inductance, "current_limit": self.current_limit}
 

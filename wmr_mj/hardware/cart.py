@@ -10,7 +10,7 @@ Usage::
 
 ``config`` is anything with the attributes ``sensing``, ``actuation`` and ``transmission`` holding the typed
 parts (a :class:`wmr_mj.sim.config.RunConfig`). A part that is ideal is left out of :func:`cart_dict`, as
-``RunConfig.as_dict()`` leaves it out, so the JSON of a run on today's plant keeps the keys it always had.
+``RunConfig.to_dict()`` leaves it out, so the JSON of a run on today's plant keeps the keys it always had.
 
 :func:`check_cart` refuses a cart that cannot be built on the run's plant (each part alone checks only its
 own ranges; these limits need the plant's parameter set and the run's duration):
@@ -53,9 +53,9 @@ def is_ideal_cart(config: Any) -> bool:
 
 
 def cart_dict(config: Any) -> dict[str, dict[str, Any]]:
-    """The parts of ``config``'s cart that are not ideal, each in its spec form (``part.as_dict()``), under
+    """The parts of ``config``'s cart that are not ideal, each in its spec form (``part.to_dict()``), under
     the keys ``sensing``, ``actuation``, ``transmission``; {} for an ideal cart."""
-    return {name: getattr(config, name).as_dict() for name in CART_PARTS if not getattr(config, name).is_ideal}
+    return {name: getattr(config, name).to_dict() for name in CART_PARTS if not getattr(config, name).is_ideal}
 
 
 def cart_line(config: Any) -> str:

@@ -292,7 +292,7 @@ class Sensing:
                         delay=bounds.delay, lag=bounds.alpha_dot_lag,
                         why_not=() if bounds.covered else (str(bounds.why_not),))
 
-    def as_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, Any]:
         """The spec form (JSON-ready; :meth:`from_spec` reads it back to an equal Sensing)."""
         return {"encoder_ticks": self.encoder_ticks, "encoder_side": self.encoder_side,
                 "encoder_rounding": self.encoder_rounding, "velocity": self.velocity,
@@ -370,9 +370,9 @@ _SPEC_KEYS: dict[str, Converter] = {
     "noise": _noise_key("noise_kind", "noise", "rad"),
     "velocity_noise": _noise_key("velocity_noise_kind", "velocity_noise", "rad/s"),
 }
-#: The keys of the spec form, in :meth:`Sensing.as_dict`'s order, with ``encoder_bits`` (a second way to give
+#: The keys of the spec form, in :meth:`Sensing.to_dict`'s order, with ``encoder_bits`` (a second way to give
 #: ``encoder_ticks``: 2**bits) after ``encoder_ticks``.
-SENSING_SPEC_KEYS: tuple[str, ...] = tuple(k for key in Sensing().as_dict()
+SENSING_SPEC_KEYS: tuple[str, ...] = tuple(k for key in Sensing().to_dict()
                                            for k in ((key, "encoder_bits") if key == "encoder_ticks" else (key,)))
 assert set(SENSING_SPEC_KEYS) == set(_SPEC_KEYS)  # the two lists are one list
 
@@ -565,7 +565,7 @@ class MeasurementBounds:
     covered: bool
     why_not: str | None
 
-    def as_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, Any]:
         """JSON-ready (inf stays a float: JSON writers spell it Infinity)."""
         return {"alpha_error_max": self.alpha_error_max, "alpha_dot_error_max": self.alpha_dot_error_max,
                 "alpha_dot_lag": self.alpha_dot_lag, "delay": self.delay, "covered": self.covered,

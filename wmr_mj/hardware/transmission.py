@@ -55,7 +55,7 @@ class Transmission:
         """True without play (today's plant)."""
         return self.backlash == 0.0
 
-    def as_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, Any]:
         """The spec form (JSON-ready)."""
         return {"backlash": self.backlash}
 

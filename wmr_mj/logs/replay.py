@@ -165,7 +165,7 @@ def hardware_labels(config: dict[str, Any] | None) -> dict[str, str]:
     """The cart a logged run simulated, as one short line per part: ``{"sensing", "actuation", "gear"}``, each
     the ``label()`` of :class:`wmr_mj.hardware.Sensing`, :class:`~wmr_mj.hardware.Actuation` and
     :class:`~wmr_mj.hardware.Transmission` (the gear's backlash) read from the config in the header; "ideal"
-    where it names none (``RunConfig.as_dict`` leaves an ideal part out), "not read (...)" where wmr_mj does
+    where it names none (``RunConfig.to_dict`` leaves an ideal part out), "not read (...)" where wmr_mj does
     not accept what it names. Never raises."""
     from wmr_mj.hardware import Actuation, Sensing, Transmission
 

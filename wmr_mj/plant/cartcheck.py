@@ -83,7 +83,7 @@ class RandomStepCheck:
     def passed(self) -> bool:
         return self.finite and not self.warnings
 
-    def as_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, Any]:
         return {"duration": self.duration, "steps": self.steps, "seed": self.seed, "warnings": dict(self.warnings),
                 "finite": self.finite, "passed": self.passed}
 
@@ -141,7 +141,7 @@ class CoefficientCheck:
     def passed(self) -> bool:
         return math.isfinite(self.identified) and abs(self.identified - self.implied) <= self.allowed
 
-    def as_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, Any]:
         return {"identified": self.identified, "implied": self.implied, "paper": self.paper, "allowed": self.allowed,
                 "unit": COEFFICIENT_UNITS[self.name], "passed": self.passed}
 
@@ -161,11 +161,11 @@ class IdentificationCheck:
     def passed(self) -> bool:
         return self.warnings == 0 and all(row.passed for row in self.rows)
 
-    def as_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, Any]:
         diag = self.result.diagnostics
         return {"duration": self.result.duration, "seed": self.result.seed, "samples": diag["samples"],
                 "residual_rms_V": diag["residual_rms_V"], "mujoco_warnings": self.warnings,
-                "coefficients": {row.name: row.as_dict() for row in self.rows}, "passed": self.passed}
+                "coefficients": {row.name: row.to_dict() for row in self.rows}, "passed": self.passed}
 
 
 def check_identification(params: C80Parameters, *, duration: float = 20.0, seed: int = 0) -> IdentificationCheck:

@@ -83,7 +83,7 @@ class FrictionLaw:
         return (all(abs(r) <= self.hold_rate for r in self.creep_rates.values())
                 and all(r > self.hold_rate for r in self.slide_rates.values()))
 
-    def as_dict(self) -> dict:
+    def to_dict(self) -> dict:
         d = asdict(self)
         for key in ("creep_rates", "slide_rates", "predicted_slide_rates", "predicted_slide_rates_gyro"):
             d[key] = {f"{k:g}": v for k, v in d[key].items()}
@@ -186,7 +186,7 @@ class ContactSoftness:
     P: float  # V s^2/rad, identified
     mujoco_warnings: int  # raised during the identification
 
-    def as_dict(self) -> dict:
+    def to_dict(self) -> dict:
         return asdict(self)
 
 

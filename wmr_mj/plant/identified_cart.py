@@ -49,7 +49,7 @@ def sensing_of_fit(start: CartFile, fit: SteeringFit) -> Sensing:
 
 def _spec_text(sensing: Sensing) -> str:
     pairs = []
-    for key, value in sensing.as_dict().items():
+    for key, value in sensing.to_dict().items():
         if value is None or value == "none" or (key == "delay" and value == 0.0) or (key == "seed" and value == 0):
             continue
         pairs.append(f"{key}={value!r}" if isinstance(value, float) else f"{key}={value}")

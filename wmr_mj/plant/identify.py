@@ -166,15 +166,15 @@ class IdentificationResult:
 
     def relative_difference(self, model: str) -> dict[str, float | None]:
         """(identified - predicted) / |predicted|; None where the prediction is 0."""
-        pred = self.predicted[model].as_dict()
-        ident = self.identified.as_dict()
+        pred = self.predicted[model].to_dict()
+        ident = self.identified.to_dict()
         return {k: (None if pred[k] == 0 else (ident[k] - pred[k]) / abs(pred[k])) for k in COEFFICIENT_NAMES}
 
-    def as_dict(self) -> dict:
+    def to_dict(self) -> dict:
         return {
-            **self.identified.as_dict(),
-            "identified": self.identified.as_dict(),
-            "predicted": {name: c.as_dict() for name, c in self.predicted.items()},
+            **self.identified.to_dict(),
+            "identified": self.identified.to_dict(),
+            "predicted": {name: c.to_dict() for name, c in self.predicted.items()},
             "relative_difference": {name: self.relative_difference(name) for name in self.predicted},
             "diagnostics": self.diagnostics,
             "m1": self.m1,

@@ -147,7 +147,7 @@ def _parameter_section(w, p: C80Parameters, cart: Any = None) -> None:
     w("")
     w("| parameter | value | unit | source |")
     w("|---|---:|---|---|")
-    for name, value in p.as_dict().items():
+    for name, value in p.to_dict().items():
         w(f"| `{name}` | {value:g} | {units[name]} | {sources[name]} |")
     w("")
     w("Derived: "

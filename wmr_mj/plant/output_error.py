@@ -114,7 +114,7 @@ class Interval:
     def contains(self, x: float) -> bool:
         return self.lo <= x <= self.hi
 
-    def as_dict(self) -> dict[str, object]:
+    def to_dict(self) -> dict[str, object]:
         return {"value": self.value, "interval": [self.lo, self.hi]}
 
 
@@ -156,12 +156,12 @@ class SteeringFit:
     draws: np.ndarray = field(repr=False)
     jacobian_half_width: dict[str, float] = field(default_factory=dict)
 
-    def as_dict(self) -> dict[str, object]:
+    def to_dict(self) -> dict[str, object]:
         return {
-            "coefficients": {k: v.as_dict() for k, v in self.coefficients.items()},
-            "physical": {k: v.as_dict() for k, v in self.physical.items()},
+            "coefficients": {k: v.to_dict() for k, v in self.coefficients.items()},
+            "physical": {k: v.to_dict() for k, v in self.physical.items()},
             "delay_steps": self.delay_steps,
-            "sensing_delay_s": self.delay.as_dict(),
+            "sensing_delay_s": self.delay.to_dict(),
             "period_s": self.period,
             "encoder_ticks": self.encoder_ticks,
             "noise_rad": self.noise_rad,

@@ -97,7 +97,7 @@ class ReferenceBounds:
         a = angle_of_sin_cos3(self.sin_cos3_max)
         return a if self.alpha_max is None else min(self.alpha_max, a)
 
-    def as_dict(self) -> dict[str, float]:
+    def to_dict(self) -> dict[str, float]:
         """JSON-ready: alpha_ddot_max, alpha_dot_max, sin_cos3_max (and alpha_max when known)."""
         out = dataclasses.asdict(self)
         if self.alpha_max is None:

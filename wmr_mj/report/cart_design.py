@@ -150,9 +150,9 @@ def design_command(settings: ValidateSettings, problem: Any) -> str:
 
     sensing = problem.base.sensing
     words = ["wmr-mj", "design", "--sensing", shlex.quote(DESIGN_SENSING if sensing == _preset(DESIGN_SENSING)
-                                                          else _spec(sensing.as_dict()))]
+                                                          else _spec(sensing.to_dict()))]
     if not problem.base.actuation.is_ideal:
-        words += ["--actuation", shlex.quote(_spec(problem.base.actuation.as_dict()))]
+        words += ["--actuation", shlex.quote(_spec(problem.base.actuation.to_dict()))]
     if problem.base.transmission.backlash:
         words += ["--backlash", repr(problem.base.transmission.backlash)]
     if settings.cart is not None:  # the cart file the search ran on (its parameter set, box and stops)

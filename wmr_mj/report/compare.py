@@ -167,7 +167,7 @@ def csv_text(result: CompareResult) -> str:
 
     from wmr_mj.analysis.verdicts import format_unmet
 
-    rows = [r.as_dict() for r in result.rows]
+    rows = [r.to_dict() for r in result.rows]
     buf = io.StringIO()
     names = list(dict.fromkeys(k for r in rows for k in r))  # "cart" only where a design's cart is not ideal
     w = csv.DictWriter(buf, fieldnames=names, lineterminator="\n")
@@ -213,6 +213,6 @@ def write_report(result: CompareResult, out: Path) -> dict[str, str]:
     write_text_atomic(paths["csv"], csv_text(result))
     write_text_atomic(paths["html"], html_page(result))
     write_text_atomic(paths["runs"], runs_json(result))
-    write_json_atomic(paths["json"], json.loads(json.dumps(result.as_dict(), default=str)))
+    write_json_atomic(paths["json"], json.loads(json.dumps(result.to_dict(), default=str)))
     (png,) = save_figure(figure_compare(result), out / "compare", formats=("png",))
     return {**{k: str(v) for k, v in paths.items()}, "figure": str(png)}

@@ -123,7 +123,7 @@ class ValidateSummary(Record):
     Attributes:
         folder: the report's folder.
         created: when (local time, with its offset).
-        settings: the settings (``ValidateSettings.as_dict()``).
+        settings: the settings (``ValidateSettings.to_dict()``).
         seed: the settings' seed.
         ladder: the rungs from the paper's design to the certified design, in order.
         certified_rule: how the certified design was chosen.

@@ -99,7 +99,7 @@ def _search_spec(plan: SearchPlan, settings: ValidateSettings):
 
 
 def _fingerprint(spec) -> str:
-    obj = {"base": spec.base.as_dict(), "box": {k: list(v) for k, v in spec.box.items()}, "objective": spec.objective,
+    obj = {"base": spec.base.to_dict(), "box": {k: list(v) for k, v in spec.box.items()}, "objective": spec.objective,
            "budget": spec.budget, "seed": spec.seed, "population": spec.population_size, "method": spec.method}
     return hashlib.sha256(json.dumps(obj, sort_keys=True, default=str).encode()).hexdigest()[:16]
 

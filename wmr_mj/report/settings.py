@@ -68,12 +68,12 @@ class ValidateSettings:
     path: str = "paper-circle"
     designs: tuple[str, ...] = ()  # designs of the user's, each judged beside the ladder (validate --design)
     # the cart every run of the report runs on (wmr_mj.hardware parts or their specs, as RunConfig takes them;
-    # validate --sensing/--actuation/--backlash); None: ideal (as_dict then has none of these keys)
+    # validate --sensing/--actuation/--backlash); None: ideal (to_dict then has none of these keys)
     sensing: Any = None
     actuation: Any = None
     transmission: Any = None
     # the cart (RunConfig.cart: a shipped cart's name, a .toml file; validate --cart), kept as its record; None: the
-    # C80 (as_dict then has no "cart" key). Its parameter set, boxes and defaults; the certified design's gains are
+    # C80 (to_dict then has no "cart" key). Its parameter set, boxes and defaults; the certified design's gains are
     # derived on it by their rule (wmr_mj.sim.designs.on_cart)
     cart: Any = None
 
@@ -172,7 +172,7 @@ class ValidateSettings:
                                      m1_range=as_pair(self.m1_range), box_ranges=self.ranges, seed=self.seed,
                                      cart=self.cart, **hardware)
 
-    def as_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, Any]:
         d = asdict(self)
         d["m1_range"] = list(self.m1_range)
         if not self.designs:
@@ -188,12 +188,12 @@ class ValidateSettings:
 
 
 def certificate_summary(cert: Any) -> dict[str, Any]:
-    """A certificate's numbers for the report: ``Certificate.as_dict()`` without the bulky
+    """A certificate's numbers for the report: ``Certificate.to_dict()`` without the bulky
     inputs, plus the reference's max|alpha0|, the steering range, the supply and the box."""
     if cert is None:  # a law that states no claim
         return {"certified": False, "valid": False, "unmet": ["no claim (the law states none)"], "E_max": None,
                 "Edot_max": None, "voltage_max": None, "reason": "the law states no claim"}
-    d = {k: v for k, v in cert.as_dict().items() if k != "inputs"}
+    d = {k: v for k, v in cert.to_dict().items() if k != "inputs"}
     inputs = cert.inputs
     d["alpha0_max"] = inputs.get("reference", {}).get("alpha0_max")
     d["steering_range"] = inputs.get("steering_range")

@@ -111,13 +111,13 @@ def _change_text(before: DesignLike, after: DesignLike) -> str:
 def _paper_region(parts: Any) -> dict[str, Any]:
     """The paper's claim for a resolved run (:class:`wmr_mj.sim.parts.RunParts`): the region (4.21)-(4.23)
     its runs are judged by."""
-    d = parts.analysis.as_dict()
+    d = parts.analysis.to_dict()
     return {k: d[k] for k in ("E_max", "Edot_max", "condition", "stable", "vertices")}
 
 
 # --------------------------------------------------------------------------- stages 1-2
 def identify_stage(settings: ValidateSettings, folder: Path, st: Stages) -> dict[str, Any]:
-    """Identify the plant at the nominal m1; writes identified.json; its ``as_dict`` and verdict."""
+    """Identify the plant at the nominal m1; writes identified.json; its ``to_dict`` and verdict."""
     from wmr_mj._util.files import write_json_atomic
     from wmr_mj.params import with_params
     from wmr_mj.plant.identify import identify_plant
@@ -126,7 +126,7 @@ def identify_stage(settings: ValidateSettings, folder: Path, st: Stages) -> dict
                          "excitation)")
     ident = identify_plant(with_params(settings.base, m1=settings.nominal_m1), duration=settings.identify_duration,
                            seed=settings.seed)
-    out = ident.as_dict()
+    out = ident.to_dict()
     write_json_atomic(folder / "identified.json", out)
     out["verdict"] = ident.verdict()
     st.done(f"K = {ident.identified.K:.3g} V, gyro = {ident.identified.gyro:.3g} V s/m, "
@@ -142,7 +142,7 @@ def friction_stage(settings: ValidateSettings, st: Stages) -> dict[str, dict[str
 
     st.start("friction", "the steering joint's friction law (stiction, soft): constant voltages")
     plant = with_params(settings.base, m1=settings.nominal_m1)
-    laws = {name: measure_friction_law(plant, steering_friction=name).as_dict() for name in STEERING_FRICTION_MODELS}
+    laws = {name: measure_friction_law(plant, steering_friction=name).to_dict() for name in STEERING_FRICTION_MODELS}
     st.done(", ".join(f"{name}: break-away {law['breakaway_voltage']:.3g} V, "
                       f"{'holds' if law['holds'] else 'creeps'} below it" for name, law in laws.items()))
     return laws
@@ -355,7 +355,7 @@ def run_validate(settings: ValidateSettings, out_dir: str | os.PathLike, *, log:
     figures, fig7 = figures_stage(settings, folder, st, rungs, searches, nominal)
     st.start("report", "summary.json, summary.csv, index.md, index.html")
     summary = ValidateSummary(
-        folder=str(folder), created=time.strftime("%Y-%m-%d %H:%M:%S %z"), settings=settings.as_dict(),
+        folder=str(folder), created=time.strftime("%Y-%m-%d %H:%M:%S %z"), settings=settings.to_dict(),
         seed=settings.seed, ladder=tuple(rungs), certified_rule=_certified_rule(settings.cart),
         searches=tuple(searches),
         nominal={name: _nominal_summary(run) for name, run in nominal.items()}, friction=friction,

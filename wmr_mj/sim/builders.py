@@ -375,7 +375,7 @@ def estimate_of(controller: SteeringController) -> dict[str, float] | None:
 
 
 def config_from_dict(obj: Mapping[str, Any]) -> RunConfig:
-    """The RunConfig of ``RunConfig.as_dict()`` (after a JSON round trip: lists back to tuples).
+    """The RunConfig of ``RunConfig.to_dict()`` (after a JSON round trip: lists back to tuples).
 
     A plug-in (``controller_plugin``, ``tracker_plugin``) is found again by its name, else by the
     absolute import path the record holds (a file named relative to another folder), and its source

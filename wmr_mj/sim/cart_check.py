@@ -80,8 +80,8 @@ class CartCheck:
         """``wmr-mj cart check --json``."""
         cart, ident = self.cart, self.identification
         return {"answer": self.answer, "passed": self.passed, "cart": cart.name, "version": cart.version,
-                "path": str(cart.path), "defaults": dict(self.defaults), "steps": self.steps.as_dict(),
-                "identification": None if ident is None else ident.as_dict(),
+                "path": str(cart.path), "defaults": dict(self.defaults), "steps": self.steps.to_dict(),
+                "identification": None if ident is None else ident.to_dict(),
                 "identification_error": self.identification_error,
                 "certified_design": dict(self.certified_design), "design": dict(self.design)}
 

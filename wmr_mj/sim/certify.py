@@ -350,7 +350,7 @@ def law_certificate(reference: Any, *, controller: Any, tracker: Any, box: BoxSp
                   m1_range=list(box.m1_range), box_ranges={k: list(v) for k, v in ranges.items()},
                   plant_m1=plant.m1, notes=notes, steering_friction=steering_friction)
     if signals is not None:
-        inputs.update(signals=signals.as_dict(), d_max=signals.declared_d_max)
+        inputs.update(signals=signals.to_dict(), d_max=signals.declared_d_max)
     return replace_inputs(cert, inputs)
 
 

@@ -408,7 +408,7 @@ def _labels(parts: RunParts) -> RunLabels:
 
 def _record(parts: RunParts) -> dict[str, Any]:
     """The config as the run's log records it, as ``resolve_run`` took it (a copy: the log may keep it)."""
-    return dict(parts.record) if parts.record is not None else parts.config.as_dict()
+    return dict(parts.record) if parts.record is not None else parts.config.to_dict()
 
 
 def run_parts(parts: RunParts, *, logger_factory: Callable[..., Any] | None = None, progress: bool | None = None,
@@ -432,7 +432,7 @@ def run_parts(parts: RunParts, *, logger_factory: Callable[..., Any] | None = No
         mujoco.mj_getState(m, d, state, mujoco.mjtState.mjSTATE_INTEGRATION)
         # the log carries the scene's MJCF as the plant compiles it, sky included
         logger = logger_factory(LogHeader(
-            mjcf_xml=scene_xml(params, **options), config=_record(parts), parameters=params.as_dict(),
+            mjcf_xml=scene_xml(params, **options), config=_record(parts), parameters=params.to_dict(),
             initial_state=state, timestep=dt, control_substeps=substeps, model=m,
             bounds=({"E_max": parts.claim.E_max, "Edot_max": parts.claim.Edot_max} if parts.claim is not None
                     else {"E_max": math.inf, "Edot_max": math.inf}),
@@ -481,7 +481,7 @@ def run_parts(parts: RunParts, *, logger_factory: Callable[..., Any] | None = No
         summary = dataclasses.replace(summary, correction=outer.describe(done))
     summary = dataclasses.replace(summary, mujoco_warnings=run.warnings, failure=run.failure,
                                   paper_law=parts.paper_law, law_settings=parts.law_settings,
-                                  analysis=analysis.as_dict(), controller_config=controller.describe())
+                                  analysis=analysis.to_dict(), controller_config=controller.describe())
     if parts.route_length_m is not None:
         from wmr_mj.reference.route import RouteProgress
 

@@ -520,7 +520,7 @@ def controller_source(config: Any) -> dict[str, Any] | None:
     name, origin, import path, parameters, the SHA-256 of its source); None for computed-torque and pd, built
     from the config's fields. The ``controller_source`` of every command's JSON."""
     source = plugin_source(config, "controller")
-    return None if source is None else source.as_dict()
+    return None if source is None else source.to_dict()
 
 
 def controller_name(config: Any) -> str:

@@ -350,7 +350,7 @@ class DesignRow(Record):
     cross_track_max: float | None  # [m] worst over scenarios
     cpu_us_per_step: float  # [us] median over scenarios
     law: str
-    # where the law comes from, as its log records it (controllers.registry.PluginSource.as_dict: file or
+    # where the law comes from, as its log records it (controllers.registry.PluginSource.to_dict: file or
     # module, class, parameters, source SHA-256); None for the laws built from RunConfig fields
     controller_source: Mapping[str, Any] | None = None
     # the run that breaks the law's claim most (a certified-outside run of a scenario or of the adversary,
@@ -359,7 +359,7 @@ class DesignRow(Record):
     # the claim's assumptions not met over the scenarios: {name, value, limit, runs} (value and limit of the first)
     unmet: tuple[Mapping[str, Any], ...] = ()
     # the design's cart where not ideal (wmr_mj.hardware.cart_dict: sensing, actuation, transmission in spec
-    # form); a scenario that names its own cart runs with that one. {}: ideal (as_dict then has no "cart")
+    # form); a scenario that names its own cart runs with that one. {}: ideal (to_dict then has no "cart")
     cart: Mapping[str, Any] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
@@ -369,7 +369,6 @@ class DesignRow(Record):
             del out["cart"]  # a comparison on the ideal cart keeps the keys it always had
         return out
 
-    as_dict = to_dict  # the name of earlier versions (wmr_mj.report.compare calls it)
 
 
 @dataclass(frozen=True)
@@ -398,7 +397,7 @@ class CompareResult:
 
     def report(self) -> CompareReport:
         """What the comparison found, as compare.json holds it, typed (the suite as its JSON, scenarios by id)."""
-        return CompareReport(suite=self.suite.as_dict(), versions=dict(self.versions), budget=self.budget,
+        return CompareReport(suite=self.suite.to_dict(), versions=dict(self.versions), budget=self.budget,
                              seed=self.seed, scenarios=tuple(s.id for s in self.scenarios), rows=self.rows,
                              claims_broken=tuple(self.claims_broken), wall_s=self.wall_s, steps=self.steps)
 
@@ -406,7 +405,6 @@ class CompareResult:
         """compare.json's object (``wmr-mj compare --json`` without its files): :meth:`report`'s JSON."""
         return self.report().to_dict()
 
-    as_dict = to_dict  # the name of earlier versions (wmr_mj.report.compare calls it)
 
     # -- in a notebook (wmr_mj.sim.notebook): one row per design and scenario, the table's figure, a few lines
     def to_pandas(self) -> Any:
@@ -439,7 +437,7 @@ class CompareReport(Record):
     """A comparison as compare.json holds it, read by attribute (:meth:`CompareResult.report`).
 
     Attributes:
-        suite: the suite's JSON (``Suite.as_dict()``).
+        suite: the suite's JSON (``Suite.to_dict()``).
         versions: the software's.
         budget: the adversary's simulations per design.
         seed: the adversary's seed.
@@ -508,7 +506,7 @@ def compare(designs: Sequence[Design], suite: Suite, *, scenarios: Sequence[str]
 
         client = connect(scheduler)
         try:
-            futures = [client.submit(_scenario_task, cfg.as_dict(), dict(suite.requirements), pure=False)
+            futures = [client.submit(_scenario_task, cfg.to_dict(), dict(suite.requirements), pure=False)
                        for _, _, cfg in jobs]
             results = []
             for fut in futures:

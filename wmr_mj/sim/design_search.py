@@ -156,7 +156,7 @@ class DesignCertificate(Record):
         """The design file's ``certificates[path]``."""
         return {"certified": self.certified, "E_max": self.E_max, "voltage_max": self.voltage_max,
                 "reason": self.reason, "certificate": self.certificate,
-                "assumptions": [a.as_dict() for a in self.assumptions]}
+                "assumptions": [a.to_dict() for a in self.assumptions]}
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> DesignCertificate:
@@ -529,7 +529,7 @@ def _finish(problem: DesignProblem, config: Any, found: float, evaluations: int,
     settings = {name: getattr(config, name) for name in DESIGN_FIELDS}
     bounds = config.reference_bounds
     box = {"m1_range": list(config.m1_range), "box_ranges": {k: list(v) for k, v in config.box_ranges.items()},
-           "box": config.box, "reference_bounds": None if bounds is None else bounds.as_dict(),
+           "box": config.box, "reference_bounds": None if bounds is None else bounds.to_dict(),
            "duration": config.duration}
     return DesignResult(box=box, settings=settings, certified=value < PENALTY, score=value, certificates=certificates,
                         binding=binding_of(certificates), evaluations=evaluations, objective=problem.objective,
@@ -576,7 +576,7 @@ def design_dict(result: DesignResult) -> dict[str, Any]:
     else:
         settings = {k: s[k] for k in ("controller", "model", "kp", "kd", "friction_sign", "friction_width",
                                       "control_period")}
-    settings.update(sensing=s["sensing"].as_dict(), actuation=s["actuation"].as_dict(),
+    settings.update(sensing=s["sensing"].to_dict(), actuation=s["actuation"].to_dict(),
                     backlash=s["transmission"].backlash)
     return {"format": FORMAT, "version": 1, "settings": settings, "certified": result.certified,
             "E_max": result.E_max if math.isfinite(result.E_max) else None, "binding": result.binding,

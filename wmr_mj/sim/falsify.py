@@ -613,7 +613,6 @@ class FalsifyResult:
 
         return notebook.falsify_html(self.report())
 
-    as_dict = to_dict  # the name of earlier versions (tests and scripts call it)
 
 
 def falsify(spec: FalsifySpec, *, chunk: int = 128, nthread: int = 0, scheduler: str | None = None,

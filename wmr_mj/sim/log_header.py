@@ -29,9 +29,9 @@ class LogHeader:
 
     Attributes:
         mjcf_xml: the scene's MJCF as the plant compiles it (attached as c80.xml).
-        config: the run's configuration, ``RunConfig.as_dict()`` (any other value is stored
+        config: the run's configuration, ``RunConfig.to_dict()`` (any other value is stored
             under the key "config").
-        parameters: the plant parameters, ``C80Parameters.as_dict()`` (SI units; its
+        parameters: the plant parameters, ``C80Parameters.to_dict()`` (SI units; its
             "voltage_limit" [V] feeds /bounds).
         initial_state: mjSTATE_INTEGRATION of the model at t = 0, (mj_stateSize,) float64.
         timestep: the physics timestep [s].

@@ -133,7 +133,7 @@ class RunParts:
         measurement: the error bounds on what the law reads, from the cart's parts
             (:func:`wmr_mj.sim.certify.measurement_errors_of`; exact on an ideal cart).
         labels: what the summary calls the law, estimate, gains and path (:class:`RunLabels`).
-        record: the config as its log records it (``RunConfig.as_dict()``, taken once here).
+        record: the config as its log records it (``RunConfig.to_dict()``, taken once here).
     """
 
     config: RunConfig
@@ -199,7 +199,7 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
     n = int(round(config.duration / period))
     claim_period = config.control_period if config.control_period is not None else TIMESTEP  # the law's, as given
     law, box, options = LawSpec.of(config), BoxSpec.of(config), plant_options(config)
-    labels, record = RunLabels.of(config), config.as_dict()
+    labels, record = RunLabels.of(config), config.to_dict()
     route_length_m = (float(route_of(config.path).path.length) if config.path not in PATH_NAMES
                       else manoeuvre_length(config.path))  # lane-change's
     # then each part, built once and handed on in layer order: the parameter sets, the law and the tracker on the

@@ -29,7 +29,7 @@ __all__ = ["RunConfig"]
 
 @dataclass(frozen=True, kw_only=True)
 class RunConfig:
-    """Everything that defines a closed-loop run (JSON-able via ``as_dict``)."""
+    """Everything that defines a closed-loop run (JSON-able via ``to_dict``)."""
 
     # the steering law: a name (controllers.registry.controller_names(): computed-torque, pd, sliding-mode,
     # adaptive-computed-torque, an installed entry point), "FILE.py:Class" or "module:Class" (a plug-in, built
@@ -65,7 +65,7 @@ class RunConfig:
     steering_friction: str = "stiction"  # plant's steering friction law: one of STEERING_FRICTION_MODELS
     tyre_contact: str = "stiff"  # plant's tyre-floor contact law: one of TYRE_CONTACT_MODELS
     # a steering disturbance torque and chassis load changes (wmr_mj.sim.signals.Signals, or its JSON
-    # form, a mapping or a .json file); None: none (as_dict then has no "signals" key)
+    # form, a mapping or a .json file); None: none (to_dict then has no "signals" key)
     signals: Any = None
     # the Cartesian correction at C (controllers.tracking.StanleyAtC): an outer loop that corrects alpha0;
     # the same as tracker="stanley-at-C"
@@ -81,14 +81,14 @@ class RunConfig:
     # the cart as it is built (wmr_mj.hardware): the steering sensor between the plant and the law (a Sensing,
     # its 'KEY=VALUE,...' form, a mapping, a .json/.toml file or a preset name), the motor's actuation (delay,
     # inductance, current limit) and the gear's play (a Transmission, or its backlash half-width in rad);
-    # None: ideal, today's plant (as_dict then has none of these keys)
+    # None: ideal, today's plant (to_dict then has none of these keys)
     sensing: Any = None
     actuation: Any = None
     transmission: Any = None
     # the cart the run is on (wmr_mj.carts): a shipped cart's name, a .toml cart file, a CartFile, or the record
-    # as_dict writes ({"name", "version", "path", "text"}); it gives the base parameter set (geometry, masses,
+    # to_dict writes ({"name", "version", "path", "text"}); it gives the base parameter set (geometry, masses,
     # motor, supply, stops), the m1 box and the default sensing, actuation and play. None, or a cart whose
-    # numbers are the C80's: the C80 (as_dict then has no "cart" key). Kept as that record (the file's text).
+    # numbers are the C80's: the C80 (to_dict then has no "cart" key). Kept as that record (the file's text).
     cart: Any = None
     # where each plug-in came from (controllers.registry.PluginSource: its name, import path and the SHA-256 of its
     # source), filled by coerce for a law or tracker that is not built from the config's fields; None until then
@@ -119,17 +119,17 @@ class RunConfig:
         """
         return coerce(cls(**user_input))
 
-    def as_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, Any]:
         """The config as JSON-able data (its record in a log and every command's output); a config given a
         reference (a cart's name, a plug-in by name, ...) is coerced first (:func:`wmr_mj.sim.coerce.coerce`)."""
         if not is_coerced(self):
-            return coerce(self).as_dict()
+            return coerce(self).to_dict()
         d = dataclasses.asdict(self)
         del d["controller_plugin"], d["tracker_plugin"]
         if self.signals is None:
             del d["signals"]  # a run without signals keeps the keys it always had
         else:
-            d["signals"] = self.signals.as_dict()
+            d["signals"] = self.signals.to_dict()
         if not self.correction:
             del d["correction"]  # the configs written before the correction existed, unchanged
         # likewise the plug-in keys, only where a plug-in runs
@@ -141,7 +141,7 @@ class RunConfig:
                 d[f"{kind}_params"] = dict(getattr(self, f"{kind}_params"))
             source = getattr(self, f"{kind}_plugin")
             if source is not None:
-                d[f"{kind}_plugin"] = source.as_dict()
+                d[f"{kind}_plugin"] = source.to_dict()
                 if not isinstance(given, str):
                     d[kind] = source.name  # an object: its name (the plugin record says where it came from)
         if self.tracker is None:
@@ -154,7 +154,7 @@ class RunConfig:
         if self.reference_bounds is None:
             del d["reference_bounds"]  # likewise
         else:
-            d["reference_bounds"] = self.reference_bounds.as_dict()
+            d["reference_bounds"] = self.reference_bounds.to_dict()
         d["plant_overrides"] = dict(self.plant_overrides)
         d["m1_range"] = list(self.m1_range)
         d["box_ranges"] = {k: list(v) for k, v in self.box_ranges.items()}

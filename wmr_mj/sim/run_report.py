@@ -78,13 +78,13 @@ def run_report(result: Any, *, measurement: Any = None, log: str | None = None,
         ``controller_source`` and the cart's parts where each applies.
     """
     config = result.config
-    rows = [r.as_dict() for r in judged]
+    rows = [r.to_dict() for r in judged]
     report = {**result.summary.to_dict(), "log": log, **({"requirements": rows} if rows else {})}
     cause = measurement_cause(result.summary, measurement)
     if cause is not None:  # the errors the claim assumed, and which keeps its fixed point open (an ideal cart: none)
         report["measurement_errors"] = cause.to_dict()
     if config.signals is not None:
-        report["signals"] = config.signals.as_dict()  # every parameter: --signals takes it back
+        report["signals"] = config.signals.to_dict()  # every parameter: --signals takes it back
     add_controller_source(report, config)
     report.update(cart_dict(config))  # the parts that are not ideal: an ideal run's JSON keeps its keys
     return report

@@ -21,13 +21,13 @@ Each name is
 
 so a search over plants, signals, paths and the cart at once is a box over these names (``wmr-mj falsify
 --range disturbance.amplitude=-1.5:1.5 --path-knots 3``). The config of a point carries its signals with every
-parameter, so its ``as_dict()["signals"]`` is the ``--signals`` that reproduces the run::
+parameter, so its ``to_dict()["signals"]`` is the ``--signals`` that reproduces the run::
 
     from wmr_mj.sim.search_space import config_for
     from wmr_mj.sim.signals import Signals, Disturbance
     template = Signals(disturbance=Disturbance("pulse", 1.0, t1=10.0, t2=11.0), d_max=1.0)
     cfg = config_for(base.replace(signals=template), ["m1", "disturbance.t1"], [700.0, 12.5])
-    cfg.as_dict()["signals"]   # {"disturbance": {"kind": "pulse", "amplitude": 1.0, "t1": 12.5, "t2": 13.5}, ...}
+    cfg.to_dict()["signals"]   # {"disturbance": {"kind": "pulse", "amplitude": 1.0, "t1": 12.5, "t2": 13.5}, ...}
 """
 
 from __future__ import annotations

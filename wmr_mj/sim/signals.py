@@ -2,7 +2,7 @@
 
 A run's :class:`Signals` (``RunConfig.signals``; ``wmr-mj run --signals FILE.json``,
 ``--disturbance``, ``--load``) is plain data: frozen, every parameter explicit (the noise's seed
-included), and its :meth:`Signals.as_dict` is the JSON that :func:`signals_from` reads back, so a
+included), and its :meth:`Signals.to_dict` is the JSON that :func:`signals_from` reads back, so a
 reported signal reproduces its run to the bit. The forms::
 
     {"disturbance": {"kind": "step", "amplitude": 1.0, "t1": 5.0},     # N m on the steering joint
@@ -126,7 +126,7 @@ class Disturbance:
         w = 0.5 * (1.0 - np.cos(math.pi * (x - j)))
         return np.where(on, knots[j] * (1.0 - w) + knots[j + 1] * w, 0.0)
 
-    def as_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, Any]:
         out: dict[str, Any] = {"kind": self.kind, "amplitude": self.amplitude, "t1": self.t1}
         for name in ("t2", "bandwidth", "seed"):
             if getattr(self, name) is not None:
@@ -184,7 +184,7 @@ class LoadChange:
         out = [(t1 + (t2 - t1) * i / n, m1_before + (self.m1 - m1_before) * i / n) for i in range(1, n)]
         return out + [(t2, self.m1)]
 
-    def as_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, Any]:
         names = ("t",) if self.kind == "step" else ("t1", "t2", "every")
         return {"kind": self.kind, **{n: getattr(self, n) for n in names}, "m1": self.m1}
 
@@ -245,14 +245,14 @@ class Signals:
         """Every chassis mass [kg] the run has: the initial one and each change's."""
         return [m1, *(m for _, m in self.load_steps(m1))]
 
-    def as_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, Any]:
         out: dict[str, Any] = {}
         if self.disturbance is not None:
-            out["disturbance"] = self.disturbance.as_dict()
+            out["disturbance"] = self.disturbance.to_dict()
         if self.d_max is not None:
             out["d_max"] = self.d_max
         if self.loads:
-            out["loads"] = [ld.as_dict() for ld in self.loads]
+            out["loads"] = [ld.to_dict() for ld in self.loads]
         return out
 
     @classmethod

@@ -98,7 +98,7 @@ def law_fields(choice: LawChoice) -> dict[str, Any]:
         from wmr_mj.plant.identify import identify_plant
         from wmr_mj.sim.config import RunConfig, base_for
 
-        identified = identify_plant(base_for(RunConfig(cart=choice.cart)), duration=30.0, seed=0).as_dict()
+        identified = identify_plant(base_for(RunConfig(cart=choice.cart)), duration=30.0, seed=0).to_dict()
     settings: dict[str, Any] = {"model": model, "kp": kp, "kd": kd, "friction_sign": friction_sign,
                                 "friction_width": friction_width}
     params = _route_law_options(choice, controller, dict(choice.controller_params), settings, design)

@@ -126,7 +126,7 @@ class Suite:
             out.extend(h for h in hits if h not in out)
         return tuple(out)
 
-    def as_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, Any]:
         """JSON form; ``hardware`` (scenario id -> its sensing, actuation and transmission labels) only where a
         scenario names hardware (a suite without, standard-v1, gives the keys it always gave)."""
         out = {"name": self.name, "version": self.version, "sha256": self.sha256, "duration": self.duration,

@@ -131,7 +131,7 @@ class RunSummary:
         certificate: the certificate, judged; None when the run was reported without one.
         drift: the end-of-run drift; None when the run was reported without a certificate.
         mujoco_warnings: MuJoCo's warning count (added by the runners).
-        analysis: the paper's region as ``RobustnessResult.as_dict()`` (the serial runner).
+        analysis: the paper's region as ``RobustnessResult.to_dict()`` (the serial runner).
         controller_config: the controller's ``describe()`` (the serial runner).
         batch: what a batch adds (``run_batch``).
         path_error: C's Cartesian errors against its desired path (cross-track, along-track,
@@ -328,7 +328,7 @@ class RunSummary:
         if self.correction is not None:
             out["correction"] = dict(self.correction)
         if self.requirements is not None:
-            out["requirements"] = [r.as_dict() for r in self.requirements]
+            out["requirements"] = [r.to_dict() for r in self.requirements]
         if self.route is not None:
             out.update(self.route.to_dict())
         if self.effort is not None:
@@ -337,7 +337,7 @@ class RunSummary:
 
 
 def shown_config(config: Mapping[str, Any], summary: Mapping[str, Any] | None) -> dict[str, Any]:
-    """A run's config (``RunConfig.as_dict()``) as its outputs show it: without the law settings (model, kp,
+    """A run's config (``RunConfig.to_dict()``) as its outputs show it: without the law settings (model, kp,
     kd, friction_sign, friction_width) that the run's law does not read, as its summary records them
     (``law_settings``); unchanged for the computed-torque and PD laws and for a summary that does not say."""
     read = (summary or {}).get("law_settings")

@@ -226,7 +226,7 @@ class SweepSpec:
     def fingerprint(self) -> str:
         """Identifies the sweep, so that resuming never mixes two different sweeps."""
         obj = {"n": self.n, "seed": self.seed, "sampling": self.sampling, "m1_range": list(self.m1_range),
-               "ranges": {k: list(v) for k, v in self.ranges.items()}, "base": self.base.as_dict()}
+               "ranges": {k: list(v) for k, v in self.ranges.items()}, "base": self.base.to_dict()}
         if self.requirements:  # a sweep without requirements keeps the fingerprint it always had
             obj["requirements"] = list(self.requirements)
         if self.m1 is not None:  # and one with m1 drawn too
@@ -316,7 +316,7 @@ def _other_law(state: Mapping[str, Any], spec: SweepSpec) -> str | None:
 
 
 def spec_to_json(spec: SweepSpec) -> str:
-    base = spec.base.as_dict()
+    base = spec.base.to_dict()
     obj = {"n": spec.n, "seed": spec.seed, "sampling": spec.sampling, "m1_range": list(spec.m1_range),
            "ranges": {k: list(v) for k, v in spec.ranges.items()}, "base": base}
     if spec.requirements:
@@ -335,7 +335,7 @@ def spec_from_json(text: str) -> SweepSpec:
 
 def _run_config_chunk(config_dicts: list[dict[str, Any]], nthread: int,
                       requirements: Sequence[str] = ()) -> list[RunSummary]:
-    """Summaries of configs given as ``as_dict()`` (a Dask task: plain data in, frozen records out)."""
+    """Summaries of configs given as ``to_dict()`` (a Dask task: plain data in, frozen records out)."""
     return run_batch([config_from_dict(d) for d in config_dicts], nthread=nthread, requirements=requirements)
 
 
@@ -354,7 +354,7 @@ def run_configs(configs: Sequence[RunConfig], *, chunk: int = 128, nthread: int 
     parts = [list(configs[i:i + chunk]) for i in range(0, len(configs), chunk)]
     reports: list[RunSummary] = []
     if client is not None:
-        futures = [client.submit(_run_config_chunk, [c.as_dict() for c in part], 1, requirements, pure=False)
+        futures = [client.submit(_run_config_chunk, [c.to_dict() for c in part], 1, requirements, pure=False)
                    for part in parts]
         for fut in futures:
             reports.extend(fut.result())

@@ -54,7 +54,7 @@ class SweepResult:
     summary: SweepSummary
 
     def to_dict(self) -> dict[str, Any]:
-        """The sweep's JSON: ``spec`` (as sweep.json and the workers read it: its base as ``RunConfig.as_dict``),
+        """The sweep's JSON: ``spec`` (as sweep.json and the workers read it: its base as ``RunConfig.to_dict``),
         ``rows`` (each run's row, in run order) and ``summary`` (:meth:`SweepSummary.to_dict`)."""
         return {"spec": json.loads(spec_to_json(self.spec)), "rows": [dict(row) for row in self.rows],
                 "summary": self.summary.to_dict()}
@@ -85,7 +85,7 @@ class SweepResult:
         if spec.m1 is not None:  # every run's m1 (ranges' m1: the certificate's box)
             out["fixed_m1"] = spec.m1
         if base.signals is not None:
-            out["signals"] = base.signals.as_dict()  # every run's, with every parameter
+            out["signals"] = base.signals.to_dict()  # every run's, with every parameter
         add_controller_source(out, base)
         out.update(cart_dict(base))  # the cart every run shares, where not ideal
         if spec.hardware_names:  # and the cart's axes each run draws, with what a drawn value becomes
