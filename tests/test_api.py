@@ -48,6 +48,14 @@ def test_run_sweep_at_the_top_level_is_a_deprecated_alias():
         assert wmr_mj.sweep is not None
 
 
+def test_run_configs_old_name_for_to_dict_warns_and_returns_the_same():
+    """RunConfig's dict had another name, documented in the api reference: kept one release with a warning."""
+    config = wmr_mj.RunConfig(duration=5.0)
+    with pytest.warns(DeprecationWarning, match=r"RunConfig\..*is deprecated.*use to_dict\(\)"):
+        old = config.as_dict()  # deprecated alias: keep
+    assert old == config.to_dict() and old["duration"] == 5.0
+
+
 @pytest.mark.parametrize("first", ["import controllers", "import wmr_mj.params", "pass"])
 def test_controllers_first_then_wmr_mj_in_a_fresh_interpreter(first):
     code = f"{first}\nimport wmr_mj\nprint(wmr_mj.RunConfig.__name__, wmr_mj.controller_for.__module__)"

@@ -15,7 +15,8 @@ Usage::
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Mapping
+import warnings
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -25,6 +26,18 @@ from wmr_mj.params import PAPER_KD, PAPER_KP
 from wmr_mj.sim.coerce import check_fields, coerce, is_coerced, m1_of_overrides
 
 __all__ = ["RunConfig"]
+
+
+def _deprecated_alias(old: str, new: str) -> Callable[..., Any]:
+    """A method named ``old`` that warns (DeprecationWarning) and calls the method ``new``."""
+    def alias(self: Any, *args: Any, **kwargs: Any) -> Any:
+        warnings.warn(f"{type(self).__name__}.{old}() is deprecated and goes in the next release; use {new}() (the "
+                      "same dict)", DeprecationWarning, stacklevel=2)
+        return getattr(self, new)(*args, **kwargs)
+
+    alias.__name__ = old
+    alias.__doc__ = f"Deprecated: :meth:`{new}` (this name warns)."
+    return alias
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -118,6 +131,9 @@ class RunConfig:
             ParameterError, UnknownNameError: what cannot be coerced or is refused, in one line.
         """
         return coerce(cls(**user_input))
+
+    # the name of earlier versions, documented in the api reference: one release, with a warning (issue 41)
+    as_dict = _deprecated_alias("as_dict", "to_dict")  # deprecated alias: keep
 
     def to_dict(self) -> dict[str, Any]:
         """The config as JSON-able data (its record in a log and every command's output); a config given a
