@@ -128,8 +128,9 @@ LADDER: tuple[Design, ...] = (
     Design(name="model", label="+ non-holonomic model", model="nonholonomic"),
     Design(name="compensation", label="+ smoothed compensation", model="nonholonomic",
            friction_width=SMOOTHING_WIDTH),
-    Design(name="gains", label="+ gains omega_r = 30 (= certified)", model=CERTIFIED.model, kp=CERTIFIED.kp,
-           kd=CERTIFIED.kd, friction_sign=CERTIFIED.friction_sign, friction_width=CERTIFIED.friction_width),
+    Design(name="gains", label=f"+ gains omega_r = {CERTIFIED.kd:g} (= certified)", model=CERTIFIED.model,
+           kp=CERTIFIED.kp, kd=CERTIFIED.kd, friction_sign=CERTIFIED.friction_sign,
+           friction_width=CERTIFIED.friction_width),
 )
 
 #: validate's rung after the ladder: the certified design with the Cartesian correction at C
