@@ -2,9 +2,9 @@
 
 Each row is one 35 s run of the certified design (``--preset certified``) on the paper's circle at
 m1 = 750 kg, the worst mass of the box: sup|E|, the claim's bound E_max for this cart (none where the
-extended certificate does not close), sup|E| over the ideal cart's bound (0.0922 rad, the sampled-data one
-since issue 44; 0.0463 before), the verdict, the unmet assumptions, and the voltage's activity (RMS u, total
-variation of u per second).
+extended certificate does not close), sup|E| over the ideal cart's bound (0.0408 rad for the certified design
+since 2026-11-28, omega_r 30; the sampled-data one since issue 44), the verdict, the unmet assumptions, and
+the voltage's activity (RMS u, total variation of u per second).
 
 Usage::
 

@@ -94,10 +94,16 @@ def test_a_carts_stops_refuse_a_path_that_needs_more_steering(tmp_path, capsys):
 
 def test_the_certified_rule_on_a_cart_gives_its_own_omega_r(tmp_path, capsys):
     """--preset certified on a cart runs the rule on it: omega_r from certified_omega_r(cart=) called directly.
-    On the wide-box cart the rule gives 25 rad/s, not the C80's 20; on c80-magmotor its value is the rule's too."""
+    On tests/data/anycart.toml the rule gives 15 rad/s, not the C80's 30 (so a copy of the C80's gains would fail
+    here); on the wide-box cart and on c80-magmotor (30 rad/s, as on the C80 since the sampled-data certificate)
+    its value is the rule's too."""
+    anycart = str(Path(__file__).parent / "data" / "anycart.toml")
+    assert certified_omega_r(cart=anycart) != CERTIFIED.kd
+    on_anycart = preset("certified", cart=anycart)
+    assert (on_anycart.kp, on_anycart.kd) != (CERTIFIED.kp, CERTIFIED.kd)
     wide = str(_wide_box_cart(tmp_path))
     omega_r = certified_omega_r(cart=wide)
-    assert omega_r is not None and omega_r != CERTIFIED.kd
+    assert omega_r is not None
     design = preset("certified", cart=wide)
     assert (design.kp, design.kd) == (omega_r * omega_r / 4.0, omega_r)
     summary = _run_json(capsys, "--preset", "certified", "--cart", wide)

@@ -129,12 +129,12 @@ def test_uncovered_cart_is_uncertified():
 
 def test_the_ideal_cart_takes_the_sampled_bound():
     """Issue 44 item 1: on the ideal cart (exact sensing, no delay) the sampled-data certificate is computed at the
-    run's 1 ms period and taken; section 4's continuous bound (0.0463 rad, the paper's analysis) is recorded
-    beside it, never taken alone, though it is the smaller."""
+    run's 1 ms period and taken; section 4's continuous bound (0.0205 rad for omega_r 30, the paper's analysis) is
+    recorded beside it, never taken alone, though it is the smaller."""
     cert = _certified_design(Sensing())
     assert cert.claimant == SAMPLED_DATA and cert.inputs["certificate"] == SAMPLED_DATA and cert.certified
     record = cert.inputs["certificates"]
-    assert round(record["section-4"]["E_max"], 4) == 0.0463 and record["section-4"]["certified"]
+    assert round(record["section-4"]["E_max"], 4) == 0.0205 and record["section-4"]["certified"]
     assert record["sampled-data"]["E_max"] == cert.E_max > record["section-4"]["E_max"]
     law = cert.inputs.law
     assert (law.cart.velocity, law.cart.sensing_delay, law.cart.actuation_delay) == ("exact", 0, 0)
@@ -146,18 +146,23 @@ def test_the_ideal_cart_takes_the_sampled_bound():
     # no measurement channel: E_max is the remainder through the loop alone, at least the friction's share
     assert terms.angle_channel == terms.velocity_channel == terms.initial_transient_E == 0.0
     assert cert.E_max >= terms.gain_E_w * terms.friction_term
-    # the ideal cart is the 12-bit cart without its quantum: a smaller bound (0.109 rad there)
+    # the ideal cart is the 12-bit cart without its quantum: a smaller bound (0.0486 rad there)
     assert cert.E_max < _certified_design(Sensing.from_spec("magnetic-12bit-axis")).E_max
-    assert round(cert.E_max, 4) == 0.0974  # paper bounds, m1 = 750 kg (0.0922 rad with the circle's own bounds)
+    # paper bounds, m1 = 750 kg; the regression pin is the library's value for the certified design, omega_r 30
+    # (2026-11-28; 0.0974 for omega_r 20 before the preset became the rule's answer)
+    assert round(cert.E_max, 4) == 0.0431
 
 
-@pytest.mark.parametrize("sensing, E_max", [("magnetic-12bit-axis", 0.109), ("delay=0.02", 0.1079)])
+@pytest.mark.parametrize("sensing, E_max", [("magnetic-12bit-axis", 0.0486), ("delay=0.02", 0.0505)])
 def test_the_certified_design_on_a_real_cart(sensing, E_max):
-    """Section 4 has none on either cart (issue 35's table); the sampled-data certificate is taken."""
+    """The sampled-data certificate is taken on either cart, and it is smaller than section 4's where section 4
+    has one (the 12-bit cart: 0.378 rad for omega_r 30; none with the 20 ms delay). E_max: regression pins of the
+    library's values for the certified design, omega_r 30 (2026-11-28; 0.109 and 0.1079 for omega_r 20)."""
     cert = _certified_design(Sensing.from_spec(sensing))
     assert cert.certified and cert.claimant == SAMPLED_DATA
     assert cert.inputs["certificate"] == SAMPLED_DATA
-    assert cert.inputs["certificates"]["section-4"]["E_max"] is None
+    section_4 = cert.inputs["certificates"]["section-4"]["E_max"]
+    assert section_4 is None or section_4 > cert.E_max
     assert round(cert.E_max, 4) == E_max
 
 

@@ -125,7 +125,7 @@ def test_the_reproduce_line_writes_what_falsify_wrote():
     config, args = _run_config(["--preset", "certified", "--uncertainty", "full", "--duration", "15",
                                 "--m1", "692.3300677526303", "--param", "mu=0.02054295349737046"])
     assert reproduce_command(config, {}, args) == (
-        "wmr-mj run --preset certified --controller computed-torque --model nonholonomic --kp 100.0 --kd 20.0 "
+        "wmr-mj run --preset certified --controller computed-torque --model nonholonomic --kp 225.0 --kd 30.0 "
         "--friction-sign measured --friction-width 0.01 --path paper-circle --duration 15.0 --m1 692.3300677526303 "
         "--param mu=0.02054295349737046 --steering-friction stiction --tyre-contact stiff --m1-inertia payload "
         "--box derived --m1-range 550.0 750.0 --uncertainty full")

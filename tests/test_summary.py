@@ -13,6 +13,7 @@ from wmr_mj.analysis.measurement import MeasurementErrors
 from wmr_mj.sim.certify import certificate_for
 from wmr_mj.sim.closed_loop import RunConfig
 from wmr_mj.sim.config import build_reference
+from wmr_mj.sim.designs import CERTIFIED
 from wmr_mj.sim.sweep import RESULT_COLUMNS, flat_row
 
 # the keys `wmr-mj run --json` wrote before the summary was typed (less "log", which the command adds)
@@ -51,7 +52,8 @@ SAMPLED_DATA_TERM_KEYS = {"gain_E_w", "gain_Edot_w", "gain_u_w", "gain_E_angle",
 
 @pytest.fixture(scope="module")
 def summary(certified_run_10s):
-    config = RunConfig.from_inputs(model="nonholonomic", kp=100.0, kd=20.0, friction_width=0.01, duration=10.0)
+    config = RunConfig.from_inputs(model="nonholonomic", kp=CERTIFIED.kp, kd=CERTIFIED.kd, friction_width=0.01,
+                                   duration=10.0)
     assert certified_run_10s.config == config  # the certified design, 10 s: the session's run
     return certified_run_10s.summary
 

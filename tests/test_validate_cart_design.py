@@ -21,7 +21,7 @@ from pathlib import Path
 import pytest
 
 from wmr_mj.analysis.verdicts import VERDICTS
-from wmr_mj.sim.designs import LADDER
+from wmr_mj.sim.designs import CERTIFIED, LADDER
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "my_pid.py"
 N = 2
@@ -78,7 +78,7 @@ def test_the_section_is_the_design_its_command_finds(validated, tmp_path):
     assert (designed["kp"], designed["kd"], designed["friction_width"]) == tuple(
         written["settings"][k] for k in ("kp", "kd", "friction_width"))
     assert designed["E_max"] == written["E_max"]
-    assert (certified["kp"], certified["kd"]) == (100.0, 20.0)
+    assert (certified["kp"], certified["kd"]) == (CERTIFIED.kp, CERTIFIED.kd)
     # the search scores the certified design's point first: its design is never above it
     assert designed["certified"] and designed["E_max"] <= certified["E_max"]
     assert designed["certificate"] in ("section-4", "sampled-data")

@@ -113,11 +113,11 @@ def test_run_prints_and_writes_the_errors_the_claim_assumed(capsys):
     assert errors["tau"] == T / 2
     assert errors["binding"] == [] and report["certificate"]["inputs"]["certificate"] == "sampled-data"
     section4 = report["certificate"]["inputs"]["certificates"]["section-4"]
-    assert section4["E_max"] is None and "no fixed point" in section4["reason"]
+    assert not section4["certified"]  # section 4 gives the 12-bit cart no pass (0.376 rad at omega_r 30, uncertified)
     assert main(argv) == 0
     text = capsys.readouterr().out
     assert "measurement errors assumed: |e_a| <= 0.000767 rad, |e_v| <= 1.534 rad/s, tau = 0.0005 s\n" in text
-    assert "the sampled-data certificate (section 4's: none: no fixed point" in text
+    assert "the sampled-data certificate (section 4's: " in text  # section 4's beside it, not taken
 
 
 def test_an_ideal_run_writes_no_measurement_errors(capsys):
@@ -182,7 +182,7 @@ def test_robustness_certificate_names_the_certificate_taken_on_a_sensed_cart(cap
     assert main(argv) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["inputs"]["certificate"] == "sampled-data"
-    assert "no fixed point" in out["inputs"]["certificates"]["section-4"]["reason"]
+    assert not out["inputs"]["certificates"]["section-4"]["certified"]  # section 4 gives it no pass
 
 
 # --------------------------------------------------------------------------- 3. no path guarantee without a certificate

@@ -18,9 +18,11 @@ Each point is scored by :func:`wmr_mj.sim.certify.certificate_of` on the parts a
 ``wmr-mj run --design FILE`` computes, to the bit, and the found design is checked again through
 ``resolve_run`` itself. A point whose certificate is not certified on every path is infeasible: it scores a
 penalty above every feasible point (ranked by how many assumptions it leaves unmet), never a value. The optimiser
-(:data:`METHODS`) is CMA-ES (``cmaes``, seeded) started at the certified preset's point, which it scores first, or
-scipy's differential evolution (seeded, one worker, no gradient polish) with that point in its first population:
-where the point lies in the space the design is never worse than that preset.
+(:data:`METHODS`) is CMA-ES (``cmaes``, seeded) started at :data:`START_POINT` (omega_n 10, zeta 1, w 0.01: the
+certified preset until 2026-11-28, omega_r 20), which it scores first, or scipy's differential evolution (seeded,
+one worker, no gradient polish) with that point in its first population: where the point lies in the space the
+design is never worse than it. The start is a fixed point of the search, not the preset (now omega_r 30), so a
+change of the preset moves no design.
 
 Usage::
 
@@ -427,17 +429,20 @@ def binding_of(certificates: Mapping[str, Any]) -> str:
     return ""
 
 
-def _preset_point(scorer: _Scorer, bounds: list[tuple[float, float]]) -> list[float] | None:
-    """The certified preset's point (omega_n 10, zeta 1, w 0.01, the cart's own tau_f) where it is in bounds; for
-    sliding mode the law's defaults with the narrowest width (module docstring)."""
-    from wmr_mj.sim.designs import CERTIFIED
+#: computed torque's start (omega_n 1/s, zeta, sign width w rad/s): critical damping at omega_r 20 (K_P 100, K_D 20),
+#: the certified preset's gains until 2026-11-28, kept so that the designs found stay those of before
+START_POINT = (10.0, 1.0, 0.01)
 
+
+def _preset_point(scorer: _Scorer, bounds: list[tuple[float, float]]) -> list[float] | None:
+    """The start point, :data:`START_POINT` (the cart's own tau_f beside it) where it is in bounds; for sliding
+    mode the law's defaults with the narrowest width (module docstring)."""
     if scorer.law_parameters:
         own = scorer.law_parameters
         x = [math.log(float(scorer.law_defaults[n])) for n in own] + [bounds[len(own)][0]]
     else:
-        omega_n = math.sqrt(CERTIFIED.kp)
-        x = [math.log(omega_n), CERTIFIED.kd / (2.0 * omega_n), math.log10(CERTIFIED.friction_width)]
+        omega_n, zeta, width = START_POINT
+        x = [math.log(omega_n), zeta, math.log10(width)]
     if scorer.filtered:
         x.append(math.log(scorer.template.sensing.filter_tau))
     return x if all(lo <= v <= hi for v, (lo, hi) in zip(x, bounds)) else None
@@ -473,9 +478,9 @@ def _optimiser(scorer: _Scorer, bounds: list[tuple[float, float]], problem: Desi
     """The optimiser of ``problem.method`` (:mod:`wmr_mj.sim.optimisers`), minimising the score.
 
     - ``cma``: CMA-ES (``cmaes``, falsify's optimiser: its own seeded generator, bounds kept by resampling),
-      started at the preset's point, which is scored first, or at the box's centre, with a step of 0.3 of the
+      started at :data:`START_POINT`, which is scored first, or at the box's centre, with a step of 0.3 of the
       narrowest range; whole generations until ``budget`` points are scored.
-    - ``de``: scipy's differential evolution (seeded, one worker, no gradient polish), the preset's point in its
+    - ``de``: scipy's differential evolution (seeded, one worker, no gradient polish), START_POINT in its
       first population, popsize 10, budget // (10 dimensions) - 1 generations (at least 1), one point at a time.
     """
     x0 = _preset_point(scorer, bounds)

@@ -32,9 +32,9 @@ what each of the paper's omissions costs.
 Usage::
 
     from wmr_mj.sim.designs import PRESETS, LADDER, certified_omega_r
-    PRESETS["certified"].config_changes()     # {'model': 'nonholonomic', 'kp': 100.0, ...}
+    PRESETS["certified"].config_changes()     # {'model': 'nonholonomic', 'kp': 225.0, ...}
     [rung.name for rung in LADDER]
-    certified_omega_r()                         # 20.0 (from certificates only)
+    certified_omega_r()                         # 30.0 (from certificates only)
 """
 
 from __future__ import annotations
@@ -114,8 +114,9 @@ class Design:
 PAPER = Design(name="paper", label="the paper's design")
 #: the certified design: the gain rule (:func:`certified_omega_r`) on a cart -- ``CERTIFIED.on(cart)`` runs it on
 #: ``cart`` (``--preset certified --cart``); as a value, CERTIFIED is the rule's answer on the C80
-#: (:data:`CERTIFIED_C80`, omega_r = 20 rad/s: K_P = 100, K_D = 20), never another cart's
-CERTIFIED = Design(name="certified", label="certified design", model="nonholonomic", kp=100.0, kd=20.0,
+#: (:data:`CERTIFIED_C80`, omega_r = 30 rad/s: K_P = 225, K_D = 30, the rule on the sampled-data certificate,
+#: issue 44), never another cart's; a test keeps it equal to :func:`certified_omega_r`
+CERTIFIED = Design(name="certified", label="certified design", model="nonholonomic", kp=225.0, kd=30.0,
                    friction_sign="measured", friction_width=SMOOTHING_WIDTH)
 #: the certified design's gains on the C80 (the rule on the C80 and the paper circle), by its C80 name
 CERTIFIED_C80 = CERTIFIED
@@ -127,8 +128,9 @@ LADDER: tuple[Design, ...] = (
     Design(name="model", label="+ non-holonomic model", model="nonholonomic"),
     Design(name="compensation", label="+ smoothed compensation", model="nonholonomic",
            friction_width=SMOOTHING_WIDTH),
-    Design(name="gains", label="+ gains omega_r = 20 (= certified)", model=CERTIFIED.model, kp=CERTIFIED.kp,
-           kd=CERTIFIED.kd, friction_sign=CERTIFIED.friction_sign, friction_width=CERTIFIED.friction_width),
+    Design(name="gains", label=f"+ gains omega_r = {CERTIFIED.kd:g} (= certified)", model=CERTIFIED.model,
+           kp=CERTIFIED.kp, kd=CERTIFIED.kd, friction_sign=CERTIFIED.friction_sign,
+           friction_width=CERTIFIED.friction_width),
 )
 
 #: validate's rung after the ladder: the certified design with the Cartesian correction at C
