@@ -7,11 +7,14 @@
 - :func:`plot_falsify`: the search beside random (:func:`wmr_mj.figures.plots.falsify_history`).
 - :func:`plot_compare`: compare's figure (:func:`figure_compare`, compare.png).
 - :func:`plot_validate`: the ladder's verdicts (:func:`wmr_mj.figures.plots.figure_ladder`).
+- :func:`plot_design`: each path's certificate of a design (E_max and the voltage bound), certified or not.
+- :func:`plot_tightness`: each cart's certificate beside the worst sup|E| the adversary found, and their ratio.
+- :func:`plot_cart_check`: each identified coefficient against the one the cart file implies, in its allowance.
 
-The results (``RunResult``, ``SweepResult``, ``FalsifyResult``, ``CompareResult`` in ``wmr_mj.sim``,
-``ValidateSummary`` in ``wmr_mj.report``) import these in their ``plot()``; this module is below them and
-imports none of them: each result is handed in and read by attribute, and what only its layer knows (a sweep's
-axis labels, a search's words) it hands in too.
+The results (``RunResult``, ``SweepResult``, ``FalsifyResult``, ``CompareResult``, ``DesignResult``,
+``CartTightness``, ``CartCheck`` in ``wmr_mj.sim``, ``ValidateSummary`` in ``wmr_mj.report``) import these in
+their ``plot()``; this module is below them and imports none of them: each result is handed in and read by
+attribute, and what only its layer knows (a sweep's axis labels, a search's words) it hands in too.
 """
 
 from __future__ import annotations
@@ -25,7 +28,11 @@ import numpy as np
 
 from wmr_mj.figures import plots
 
-__all__ = ["ResultPlot", "plot_run", "plot_sweep", "plot_falsify", "plot_compare", "plot_validate", "figure_compare"]
+__all__ = ["ResultPlot", "plot_run", "plot_sweep", "plot_falsify", "plot_compare", "plot_validate", "figure_compare",
+           "plot_design", "plot_tightness", "plot_cart_check"]
+
+#: a certified bar's colour and an uncertified one's (the verdicts' colours)
+_CERTIFIED_COLOUR, _UNCERTIFIED_COLOUR = plots.VERDICT_COLORS["certified-inside"], "0.6"
 
 
 @dataclass(frozen=True)
@@ -183,3 +190,91 @@ def plot_validate(summary: Any) -> ResultPlot:
     rungs = summary.rungs
     return _plot(plots.figure_ladder([f"{r.index}. {r.label}" for r in rungs], [r.verdicts for r in rungs],
                                      [r.paper_inside for r in rungs]))
+
+
+def _bound(cert: Any, name: str) -> float:
+    """A certificate's bound ``name`` (E_max [rad], voltage_max [V]); NaN where it has no valid one (no bar)."""
+    value = getattr(cert, name, None) if cert is not None and cert.valid else None
+    return math.nan if value is None else float(value)
+
+
+def plot_design(result: Any) -> ResultPlot:
+    """A design (``DesignResult``): each path's certificate at the design, (a) its E_max [rad] and (b) its
+    voltage bound [V], one bar per path, green where certified and grey where not (no bar: no valid bound).
+
+    Args:
+        result: the design (read by attribute: ``certificates`` path -> certificate or None, ``certified``,
+            ``E_max``, ``objective``).
+    """
+    paths = list(result.certificates)
+    certs = [result.certificates[p] for p in paths]
+    colours = [_CERTIFIED_COLOUR if c is not None and c.certified else _UNCERTIFIED_COLOUR for c in certs]
+    fig, (a, b) = plots.new_figure(3.2 * 2 + 0.6, 3.4, ncols=2)
+    for ax, name, label in ((a, "E_max", "E_max [rad]"), (b, "voltage_max", "voltage bound [V]")):
+        ax.bar(range(len(paths)), [_bound(c, name) for c in certs], color=colours)
+        ax.set_xticks(range(len(paths)), paths, fontsize=8)
+        ax.set_ylabel(label)
+    a.set_title("(a) the certificate's E_max, each path")
+    b.set_title("(b) the certificate's voltage bound")
+    worst = f"worst E_max {result.E_max:.4g} rad" if math.isfinite(result.E_max) else "no bound on some path"
+    fig.suptitle(f"design ({result.objective}): {'certified' if result.certified else 'nothing certifies'}, "
+                 f"{worst}", fontsize=10)
+    return _plot(fig)
+
+
+def plot_tightness(rows: Sequence[Any]) -> ResultPlot:
+    """Carts' tightness (``CartTightness`` rows): (a) each row's certificate E_max beside the worst sup|E| the
+    adversary found [rad], (b) their ratio, the tightness [-], against 1 (a ratio above 1 on a certified claim
+    is a broken claim). A row without a bound has no E_max bar and no tightness bar.
+
+    Args:
+        rows: the rows, each read by attribute (``path``, ``certificate``, ``E_max``, ``worst_sup_E``,
+            ``tightness``); labelled by their path (and certificate).
+    """
+    labels = [f"{r.path}\n{r.certificate or 'no certificate'}" for r in rows]
+    x = np.arange(len(rows), dtype=float)
+    fig, (a, b) = plots.new_figure(max(5.0, 1.6 * len(rows) + 3.0), 3.6, ncols=2)
+    a.bar(x - 0.2, [math.nan if r.E_max is None else r.E_max for r in rows], width=0.4, color="#1b4f72",
+          label="certificate's E_max (upper bound)")
+    a.bar(x + 0.2, [r.worst_sup_E for r in rows], width=0.4, color="#c0392b",
+          label="worst sup|E| found (lower bound)")
+    a.set_ylabel("[rad]")
+    a.set_title("(a) the bound and the worst found")
+    a.legend(fontsize=7, frameon=False)
+    b.bar(x, [math.nan if r.tightness is None else r.tightness for r in rows], color="0.35")
+    b.axhline(1.0, color="#e00000", ls="--", lw=1.0, label="1: the bound reached")
+    b.set_ylabel("tightness = worst sup|E| / E_max [-]")
+    b.set_title("(b) the tightness")
+    b.legend(fontsize=7, frameon=False)
+    for ax in (a, b):
+        ax.set_xticks(x, labels, fontsize=7)
+    return _plot(fig)
+
+
+def plot_cart_check(check: Any) -> ResultPlot:
+    """A cart check (``CartCheck``): each coefficient identified from the simulated excitation (the plant)
+    against the one the cart file implies (the model), as (identified - implied) / allowed: inside the shaded
+    band |.| <= 1 a coefficient passes (its allowance, in its own unit, is the check's).
+
+    Args:
+        check: the check (read by attribute: ``identification.rows``, each with ``name``, ``identified``,
+            ``implied``, ``allowed``; ``identification`` None: the fit was impossible, said on the
+            axes with ``identification_error``; ``answer`` titles the figure).
+    """
+    fig, ax = plots.new_figure(5.6, 3.4)
+    ident = check.identification
+    rows = () if ident is None else ident.rows
+    x = np.arange(len(rows), dtype=float)
+    ax.axhspan(-1.0, 1.0, color="#d5f5e3", label="allowed (passes)")
+    ax.axhline(0.0, color="0.55", lw=0.8)
+    ax.plot(x, [(r.identified - r.implied) / r.allowed for r in rows], "o", color="C0",
+            label="identified (the MuJoCo plant)")
+    ax.set_xticks(x, [r.name for r in rows])
+    ax.set_ylabel("(value - implied) / allowed [-]")
+    if ident is None:
+        ax.text(0.5, 0.5, f"no identification: {check.identification_error}", transform=ax.transAxes,
+                ha="center", va="center", fontsize=8, wrap=True)
+    ax.legend(fontsize=7, frameon=False, loc="best")
+    cart = check.cart
+    fig.suptitle(f"cart {cart.name} {cart.version}: {'passes' if check.passed else 'FAILS'}", fontsize=10)
+    return _plot(fig)

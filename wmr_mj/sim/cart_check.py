@@ -24,7 +24,8 @@ from typing import Any
 from wmr_mj.errors import InfeasiblePathError, ParameterError, StiffReferenceError, WmrMjError
 from wmr_mj.hardware import Actuation, Sensing, Transmission
 from wmr_mj.params import parameters_of_cart
-from wmr_mj.plant.cartcheck import check_identification, step_with_random_controls
+from wmr_mj.plant.cartcheck import COEFFICIENT_UNITS, check_identification, step_with_random_controls
+from wmr_mj.sim import notebook
 from wmr_mj.sim.coerce import default_path
 from wmr_mj.sim.config import RunConfig, build_reference
 from wmr_mj.sim.design_search import (
@@ -84,6 +85,41 @@ class CartCheck:
                 "identification": None if ident is None else ident.to_dict(),
                 "identification_error": self.identification_error,
                 "certified_design": dict(self.certified_design), "design": dict(self.design)}
+
+    # -- in a notebook (wmr_mj.sim.notebook): one row per coefficient, the coefficients' figure, a few lines
+    def to_pandas(self) -> Any:
+        """One row per identified coefficient (``P``, ``C_V``, ``F``, ``K``, ``gyro``): ``coefficient``, ``unit``,
+        ``identified`` (the MuJoCo plant's, least squares), ``implied`` (the cart file's non-holonomic model),
+        ``paper`` (the paper's (2.13)), ``allowed`` (the largest |identified - implied| accepted) and ``passed``;
+        no row where the fit was impossible.
+
+        Raises:
+            WmrMjError: pandas is not installed (``pip install 'wmr-mj[notebook]'``).
+        """
+        rows = () if self.identification is None else self.identification.rows
+        return notebook.records_frame([
+            {"coefficient": r.name, "unit": COEFFICIENT_UNITS[r.name], "identified": r.identified,
+             "implied": r.implied, "paper": r.paper, "allowed": r.allowed, "passed": r.passed} for r in rows])
+
+    def plot(self) -> Any:
+        """Each identified coefficient against the one the file implies, in its allowance
+        (:func:`wmr_mj.figures.results.plot_cart_check`, a :class:`~wmr_mj.figures.results.ResultPlot`)."""
+        from wmr_mj.figures.results import plot_cart_check  # matplotlib loads only when a figure is asked for
+
+        return plot_cart_check(self)
+
+    def _repr_html_(self) -> str:
+        """The answer's verdict, the default parts, the certified design's E_max and whether design certifies."""
+        cert, design = self.certified_design, self.design
+        lines = [self.answer,
+                 "defaults: " + ", ".join(f"{k} {v}" for k, v in self.defaults.items()),
+                 (f"the certified design (omega_r {notebook.number(cert['omega_r'], 'rad/s')}) on {cert['path']}: "
+                  f"E_max {notebook.number(cert['E_max'], 'rad')}, "
+                  f"{'certified' if cert['certified'] else 'not certified'}")
+                 if cert.get("omega_r") is not None else f"the certified design: {cert.get('reason')}",
+                 (f"design certifies it: E_max {notebook.number(design.get('E_max'), 'rad')}" if design.get("certified")
+                  else f"design certifies nothing: {design.get('binding')} binds")]
+        return notebook.html_lines("cart check", "passes" if self.passed else "FAILS", lines)
 
 
 def cart_check(cart: Any, *, seed: int = 0, duration: float = 20.0, path: str | None = None) -> CartCheck:

@@ -66,9 +66,10 @@ __all__ = ["RunResult", "RunMeasures", "run_closed_loop", "report", "run_on_redu
 
 
 
-@dataclass
+@dataclass(frozen=True)
 class RunResult:
-    """Time histories (one row per control step) and the run's summary (a :class:`RunSummary`)."""
+    """Time histories (one row per control step) and the run's summary (a :class:`RunSummary`); frozen: a run's
+    result is what it measured, built once (``dataclasses.replace`` for a changed copy)."""
 
     config: RunConfig
     rows: dict[str, np.ndarray]

@@ -262,6 +262,13 @@ class DesignResult:
                          "unmet": ", ".join(a.name for a in cert.assumptions if not a.met) if cert else ""})
         return notebook.records_frame(rows)
 
+    def plot(self) -> Any:
+        """Each path's certificate at the design: its E_max and its voltage bound, one bar per path, green where
+        certified (a :class:`wmr_mj.figures.results.ResultPlot`: ``.figure``, ``.axes``)."""
+        from wmr_mj.figures.results import plot_design  # matplotlib loads only when a figure is asked for
+
+        return plot_design(self)
+
     def _repr_html_(self) -> str:
         from wmr_mj.sim import notebook
 

@@ -95,6 +95,13 @@ class CartTightness(Record):
             "E_max_sampled [rad]": self.E_max_sampled, "worst_sup_E [rad]": self.worst_sup_E,
             "tightness [-]": self.tightness, "runs": self.runs, **dict(self.verdicts)}])
 
+    def plot(self) -> Any:
+        """The certificate's E_max beside the worst sup|E| found, and their ratio against 1
+        (:func:`wmr_mj.figures.results.plot_tightness` of this row; pass several rows there for several carts)."""
+        from wmr_mj.figures.results import plot_tightness  # matplotlib loads only when a figure is asked for
+
+        return plot_tightness([self])
+
     def _repr_html_(self) -> str:
         from wmr_mj.sim.notebook import html_lines, number, verdict_counts_text
 
