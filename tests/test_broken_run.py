@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import json
 
-from wmr_mj.sim.falsify import FalsifyReport
+from wmr_mj.sim.falsify import _FalsifyRecord
 from wmr_mj.sim.records import BrokenRun
 from wmr_mj.sim.sweep import SweepSummary
 
@@ -30,4 +30,4 @@ def test_a_sweeps_broken_run_has_no_phase():
 
 
 def test_both_results_hold_the_one_record():
-    assert FalsifyReport._records["claim_broken"] is BrokenRun and SweepSummary._records["claim_broken"] is BrokenRun
+    assert _FalsifyRecord._records["claim_broken"] is BrokenRun and SweepSummary._records["claim_broken"] is BrokenRun

@@ -16,7 +16,6 @@ from wmr_mj.sim.closed_loop import run_closed_loop
 from wmr_mj.sim.config import RunConfig
 from wmr_mj.sim.falsify import (
     Evaluation,
-    FalsifyReport,
     FalsifyResult,
     FalsifySpec,
     covering_design,
@@ -153,7 +152,7 @@ def test_the_reported_worst_run_reproduces_exactly():
     again = run_closed_loop(base.replace(m1=float(repr(worst.params["m1"])),
                                          plant_overrides={"mu": float(repr(worst.params["mu"]))}), progress=False)
     assert again.summary.sup_E == worst.sup_E
-    out = result.to_dict(log="x.mcap")
+    out = result.to_dict(log="x.mcap", runs=False)
     assert set(out["worst"]["params"]) == {"m1", "mu"} and out["evaluations"] == 10 and out["budget"] == 10
     assert out["random"]["worst_objective"] == result.random_worst.objective
 
@@ -300,28 +299,28 @@ def test_the_worst_by_sup_E_carries_its_certificate_its_largest_term_and_the_tig
     # section 4's terms at the certificate's top level (gyro_Edot_term is delta3's, 1/s: never the one)
     certs = [{"E_max": 0.1, "E_ratio": 0.01 * (i + 1) / 0.1, "friction_term": 4.0, "gyro_term": 0.5 + i,
               "K_term": 0.0, "gyro_Edot_term": 99.0} for i in range(3)]
-    report = _result_of("sup-E", certs).report()
+    report = _result_of("sup-E", certs)
     w = report.worst
     assert w.sup_E == 0.03 and w.E_max == 0.1  # the worst by sup|E| is the third run
     assert (w.binding_term.name, w.binding_term.value) == ("friction_term", 4.0)
     t = report.tightness
     assert t is not None and t.ratio == 0.03 / 0.1 and t.E_max == 0.1 and t.factor == 1.0 / t.ratio
     assert t.text.startswith("the worst found is 0.3 of the certificate's bound") and "by sup|E| [rad]" in t.text
-    out = report.to_dict()
+    out = report.to_dict(runs=False)
     assert out["worst"]["E_max"] == 0.1 and out["worst"]["binding_term"] == {"name": "friction_term", "value": 4.0}
     assert out["tightness"]["ratio"] == 0.3 * 0.1 / 0.1
-    assert FalsifyReport.from_dict(out).to_dict() == out
+    assert FalsifyResult.from_dict(report.to_dict()).to_dict(runs=False) == out
 
 
 def test_a_sampled_data_certificate_gives_its_largest_term_from_its_inputs_and_a_run_without_one_none():
     sampled = {"E_max": 0.1, "E_ratio": 0.3, "friction_term": None, "K_term": 0.0,
                "inputs": {"terms": {"friction_term": 8.4, "feedforward_hold_term": 0.3, "gyro_term": 0.04}}}
-    w = _result_of("sup-E", [sampled] * 3).report().worst
+    w = _result_of("sup-E", [sampled] * 3).worst
     assert (w.binding_term.name, w.binding_term.value) == ("friction_term", 8.4)
-    none = _result_of("sup-E", [None] * 3).report()
+    none = _result_of("sup-E", [None] * 3)
     assert none.worst.E_max is None and none.worst.binding_term is None and none.tightness is None
     # the certificate's own objective: the tightness as it always was, its sentence without the objective's note
-    t = _result_of("certificate", [{"E_max": 0.1, "E_ratio": 0.1 * (i + 1)} for i in range(3)]).report().tightness
+    t = _result_of("certificate", [{"E_max": 0.1, "E_ratio": 0.1 * (i + 1)} for i in range(3)]).tightness
     assert t.ratio == 0.30000000000000004 and "(the worst run by" not in t.text
 
 

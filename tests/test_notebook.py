@@ -226,7 +226,7 @@ def test_without_pandas_a_table_says_what_to_install(monkeypatch):
 
 
 def test_a_notebook_needs_nothing_below_the_top_level():
-    for name in ("sweep", "SweepResult", "design_from_token", "Design", "CompareReport", "DesignRow", "ResultPlot",
+    for name in ("sweep", "SweepResult", "design_from_token", "Design", "CompareResult", "DesignRow", "ResultPlot",
                  "load_suite", "compare", "falsify", "FalsifySpec", "SweepSpec", "run_closed_loop", "RunConfig"):
         assert name in wm.__all__ and getattr(wm, name) is not None
     from wmr_mj.figures import results  # the drawing, in the layer below the results

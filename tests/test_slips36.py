@@ -125,7 +125,8 @@ def test_falsify_records_the_encoder_bits_each_run_used(tmp_path):
         assert spec.config(e.point).sensing.encoder_ticks == 2 ** int(bits)
     assert any(e.point[0] != e.params["sensing.encoder_bits"] for e in result.random)  # the sample is fractional
     assert worst_config(result).sensing.encoder_ticks == 2 ** int(result.worst.params["sensing.encoder_bits"])
-    assert result.report().worst.params["sensing.encoder_bits"] == result.worst.params["sensing.encoder_bits"]
+    out = result.to_dict(runs=False)
+    assert out["worst"]["params"]["sensing.encoder_bits"] == result.worst.params["sensing.encoder_bits"]
 
     from wmr_mj.cli.falsify import _table
 
@@ -443,6 +444,6 @@ def test_a_random_sample_without_the_objective_is_no_error():
     result = FalsifyResult(spec=spec, search=_evaluations("search", [None, 0.4, None]),
                            random=_evaluations("random", [None, None, None]), objective_source="certificate.E_ratio")
     assert result.worst.objective == 0.4 and result.random_worst.index == 2  # sup_E 0.03, the largest
-    report = result.report()
-    assert report.random.worst_objective is None and report.random.sup_E == 0.03
+    random = result.to_dict(runs=False)["random"]
+    assert random["worst_objective"] is None and random["sup_E"] == 0.03
     assert undefined_objective_warning(result).startswith("WARNING: 2 of 3 search runs, 3 of 3 random runs")

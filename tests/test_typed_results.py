@@ -4,6 +4,7 @@ search that really ran, and the results of sweep, falsify, compare and validate 
 
 from __future__ import annotations
 
+import dataclasses
 import textwrap
 
 import numpy as np
@@ -11,6 +12,7 @@ import pytest
 
 import wmr_mj
 from wmr_mj.analysis.verdicts import VERDICTS
+from wmr_mj.errors import ParameterError
 from wmr_mj.sim import search_methods
 from wmr_mj.sim.config import RunConfig
 from wmr_mj.sim.falsify import METHOD_LABELS, METHODS, Evaluation, FalsifyResult, FalsifySpec
@@ -92,7 +94,9 @@ _CERT_UNMET = {"E_max": 0.05, "E_ratio": 0.5, "certified": False,
 
 
 def _falsify_result() -> FalsifyResult:
-    spec = FalsifySpec(base=RunConfig(), box={"m1": (550.0, 750.0)}, budget=12)
+    # the base coerced, as a command's is: its JSON reads back to an equal config (a config built directly is
+    # coerced when it runs, and reads back as that coerced config)
+    spec = FalsifySpec(base=RunConfig.from_inputs(), box={"m1": (550.0, 750.0)}, budget=12)
     search = [Evaluation(phase="search", index=0, generation=0, params={"m1": 600.0}, objective=0.5,
                          summary={"sup_E": 0.025, "sup_Edot": 0.1, "verdict": "uncertified-inside",
                                   "certificate": _CERT_UNMET}),
@@ -105,17 +109,15 @@ def _falsify_result() -> FalsifyResult:
     return FalsifyResult(spec=spec, search=search, random=random, objective_source="certificate of the run")
 
 
-def test_falsify_report_is_typed_and_round_trips():
-    from wmr_mj.sim.falsify import FalsifyReport
-
-    result = _falsify_result()
-    report = result.report(log="worst.mcap")
+def test_falsify_result_is_typed_and_round_trips():
+    result = dataclasses.replace(_falsify_result(), log="worst.mcap")
     # read by attribute: the run that breaks the claim, the worst run, the tightness
-    assert report.claim_broken.phase == "search" and report.claim_broken.run == 2 and report.claim_broken.count == 1
-    assert report.claim_broken.ratio == 1.5 and report.worst.params == {"m1": 700.0} and report.falsified is True
-    assert report.tightness.ratio == 1.5 and report.tightness.text.startswith("the worst run is 1.5 times")
-    assert report.random.worst_params == {"m1": 650.0} and report.box == {"m1": (550.0, 750.0)}
-    d = result.to_dict(log="worst.mcap")
+    assert result.claim_broken.phase == "search" and result.claim_broken.run == 2 and result.claim_broken.count == 1
+    assert result.claim_broken.ratio == 1.5 and result.worst.params == {"m1": 700.0} and result.falsified is True
+    assert result.tightness.ratio == 1.5 and result.tightness.text.startswith("the worst run is 1.5 times")
+    assert result.random_worst.params == {"m1": 650.0} and result.box == {"m1": (550.0, 750.0)}
+    assert result.worst.E_max == 0.05 and result.worst.unmet == () and result.evaluations == 2
+    d = result.to_dict(runs=False)
     # the JSON falsify wrote before: its keys in their order, the nested records as mappings
     assert list(d) == ["objective", "objective_label", "objective_source", "budget", "evaluations", "seed",
                        "method", "population", "generations", "requirement", "falsified", "claim_broken", "box",
@@ -124,9 +126,31 @@ def test_falsify_report_is_typed_and_round_trips():
                                  "sup_Edot": 0.2, "E_max": 0.05, "ratio": 1.5, "count": 1}
     assert d["box"] == {"m1": [550.0, 750.0]} and d["worst"]["unmet"] == []
     assert list(d["tightness"]) == ["ratio", "factor", "found_sup_E", "E_max", "text"]
-    assert d == result.to_dict(log="worst.mcap")  # the earlier name, kept for scripts
-    assert FalsifyReport.from_dict(d).to_dict() == d
-    assert FalsifyReport.from_dict(d) == report
+    assert d == _falsify_result().to_dict(log="worst.mcap", runs=False)  # the log given as the command gives it
+    # the whole result, every run of both phases with it, reads back as itself
+    full = result.to_dict()
+    assert {k: v for k, v in full.items() if k != "runs"} == d
+    assert [e["params"] for e in full["runs"]["search"]] == [{"m1": 600.0}, {"m1": 700.0}]
+    assert full["runs"]["spec"]["box"] == {"m1": [550.0, 750.0]} and full["runs"]["spec"]["budget"] == 12
+    back = FalsifyResult.from_dict(full)
+    assert back == result and back.to_dict() == full
+    # falsify --json holds no runs: refused in one line, not read as a result without them
+    with pytest.raises(ParameterError, match="no 'runs'"):
+        FalsifyResult.from_dict(d)
+
+
+def test_the_removed_record_names_warn_and_still_read_the_commands_json():
+    """FalsifyReport and CompareReport were the commands' JSON, typed, beside their results; each name is kept
+    one release, with a DeprecationWarning, and still reads that JSON."""
+    d = _falsify_result().to_dict(runs=False)
+    with pytest.warns(DeprecationWarning, match="FalsifyResult"):
+        old = wmr_mj.FalsifyReport
+    assert old.from_dict(d).to_dict() == d
+    with pytest.warns(DeprecationWarning, match="report"):
+        assert _falsify_result().report().to_dict() == d
+    with pytest.warns(DeprecationWarning, match="CompareResult"):
+        from wmr_mj.sim.compare import CompareReport  # noqa: F401
+    assert "FalsifyReport" not in wmr_mj.__all__ and "CompareReport" not in wmr_mj.__all__
 
 
 def test_sweep_summary_is_typed_and_round_trips():
@@ -176,8 +200,8 @@ def test_sweep_result_round_trips():
     assert back.rows == rows and back.summary == result.summary
 
 
-def test_compare_report_is_typed_and_round_trips():
-    from wmr_mj.sim.compare import CompareReport, CompareResult, DesignRow
+def test_compare_result_is_typed_and_round_trips():
+    from wmr_mj.sim.compare import CompareResult, DesignRow, ScenarioRun
     from wmr_mj.sim.suite import load_suite
 
     row = DesignRow(label="certified", controller="computed-torque", tracker=None, runs=2, requirements_passed=3,
@@ -194,15 +218,31 @@ def test_compare_report_is_typed_and_round_trips():
     assert "cart" not in d and d == row.to_dict() and DesignRow.from_dict(d).to_dict() == d
     assert d["unmet"] == [{"name": "within the supply", "value": 25.0, "limit": 24.0, "runs": 1}]
     suite = load_suite("standard-v1")
-    result = CompareResult(suite=suite, scenarios=suite.select(["circle/*"]), rows=(row,), runs=(), budget=4,
+    run = ScenarioRun(design="certified", scenario="circle/nominal", summary={"sup_E": 0.075, "verdict": "x"},
+                      requirements={"tracking": {"robustness": -0.01, "satisfied": False}}, rms_voltage=3.0,
+                      tv_voltage=9.0, cpu_us_per_step=4.0, law="compiled")
+    result = CompareResult(suite=suite, scenarios=suite.select(["circle/*"]), rows=(row,), runs=(run,), budget=4,
                            seed=0, versions={"wmr-mj": "x"}, wall_s=2.0, steps=10)
-    report = result.report()
-    assert report.claims_broken == ("certified",) and report.rows[0].tightness == 0.8
-    out = result.to_dict()
+    assert result.claims_broken == ["certified"] and result.rows[0].tightness == 0.8
+    out = result.to_dict(runs=False)
     assert list(out) == ["suite", "versions", "budget", "seed", "scenarios", "rows", "claims_broken", "wall_s",
                          "steps"]
     assert out["scenarios"] == [s.id for s in suite.select(["circle/*"])] and out["claims_broken"] == ["certified"]
-    assert CompareReport.from_dict(out).to_dict() == out
+    # the whole result: the suite read again from its file (its SHA-256 checked), the scenarios by id, every run
+    full = result.to_dict()
+    assert {k: v for k, v in full.items() if k != "runs"} == out
+    assert full["runs"]["scenarios"] == [{"design": "certified", "scenario": "circle/nominal",
+                                          "summary": {"sup_E": 0.075, "verdict": "x"},
+                                          "requirements": {"tracking": {"robustness": -0.01, "satisfied": False}},
+                                          "rms_voltage": 3.0, "tv_voltage": 9.0, "cpu_us_per_step": 4.0,
+                                          "law": "compiled"}]
+    back = CompareResult.from_dict(full)
+    assert back == result and back.to_dict() == full
+    with pytest.raises(ParameterError, match="no 'runs'"):
+        CompareResult.from_dict(out)
+    changed = {**full, "suite": {**full["suite"], "sha256": "0" * 64}}
+    with pytest.raises(ParameterError, match="has changed"):
+        CompareResult.from_dict(changed)
 
 
 def test_the_supply_assumption_is_named_by_its_constant():

@@ -46,11 +46,11 @@ if TYPE_CHECKING:
     from wmr_mj.report.results import ValidateSummary
     from wmr_mj.sim.certify import certificate_for
     from wmr_mj.sim.closed_loop import RunResult, run_closed_loop
-    from wmr_mj.sim.compare import CompareReport, CompareResult, Design, DesignRow, compare, design_from_token
+    from wmr_mj.sim.compare import CompareResult, Design, DesignRow, compare, design_from_token
     from wmr_mj.sim.config import RunConfig, controller_for
     from wmr_mj.sim.design_search import DesignProblem, DesignResult, search_design, write_design
     from wmr_mj.sim.designs import CERTIFIED, CERTIFIED_C80, PAPER, PRESETS, preset
-    from wmr_mj.sim.falsify import FalsifyReport, FalsifyResult, FalsifySpec, falsify
+    from wmr_mj.sim.falsify import FalsifyResult, FalsifySpec, falsify
     from wmr_mj.sim.log_header import LogHeader
     from wmr_mj.sim.parts import RunParts, resolve_run
     from wmr_mj.sim.signals import Disturbance, LoadChange, Signals
@@ -73,7 +73,6 @@ _LAZY: dict[str, str] = {
     "FalsifySpec": "wmr_mj.sim.falsify",
     "falsify": "wmr_mj.sim.falsify",
     "FalsifyResult": "wmr_mj.sim.falsify",
-    "FalsifyReport": "wmr_mj.sim.falsify",
     "ValidateSummary": "wmr_mj.report.results",
     "PAPER": "wmr_mj.sim.designs",
     "CERTIFIED": "wmr_mj.sim.designs",
@@ -92,7 +91,6 @@ _LAZY: dict[str, str] = {
     "load_suite": "wmr_mj.sim.suite",
     "compare": "wmr_mj.sim.compare",
     "CompareResult": "wmr_mj.sim.compare",
-    "CompareReport": "wmr_mj.sim.compare",
     "DesignRow": "wmr_mj.sim.compare",
     "Design": "wmr_mj.sim.compare",
     "design_from_token": "wmr_mj.sim.compare",
@@ -156,12 +154,10 @@ __all__ = [
     "FalsifySpec",
     "falsify",
     "FalsifyResult",
-    "FalsifyReport",
     # one yardstick for every controller
     "load_suite",
     "compare",
     "CompareResult",
-    "CompareReport",
     "DesignRow",
     "Design",
     "design_from_token",
@@ -191,6 +187,9 @@ __all__ = [
 #: names kept at the top level for one release, each with its module and what to use instead: a warning on use
 _DEPRECATED = {
     "run_sweep": ("wmr_mj.sim.sweep", "wm.sweep(spec), whose .rows are these rows (or wmr_mj.sim.sweep.run_sweep)"),
+    # one result per command: the search's and the comparison's records are their results' to_dict(runs=False)
+    "FalsifyReport": ("wmr_mj.sim.falsify", "wm.FalsifyResult, read by attribute (to_dict(runs=False) is its JSON)"),
+    "CompareReport": ("wmr_mj.sim.compare", "wm.CompareResult, read by attribute (to_dict(runs=False) is its JSON)"),
 }
 
 

@@ -114,7 +114,7 @@ def run(args: argparse.Namespace) -> int:
     paths = write_report(result, out)
     status = CLAIM_BROKEN_EXIT if result.claims_broken else 0
     if args.json:
-        print_json({**result.to_dict(), "files": paths})
+        print_json({**result.to_dict(runs=False), "files": paths})
         return status
     print(markdown(result).rstrip())  # compare.md: the banners, the table and what each column says
     print(f"\nreport: {paths['html']} (also {Path(paths['markdown']).name}, {Path(paths['csv']).name}, "

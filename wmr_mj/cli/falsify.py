@@ -10,7 +10,7 @@ from wmr_mj.cli._common import positive_int
 from wmr_mj.cli.options import add_json, add_out, add_seed, add_threads
 
 if TYPE_CHECKING:
-    from wmr_mj.sim.falsify import FalsifyReport
+    from wmr_mj.sim.falsify import FalsifyResult
 
 _AGAINST = ("certificate", "paper")
 _OBJECTIVE_KINDS = ("ratio", "sup-E")
@@ -236,7 +236,7 @@ def _write_outputs(result, base, args: argparse.Namespace, out, *, law_settings)
     worst, log_path = result.worst, out / "worst.mcap"
     config = worst_config(result)
     logged = run_logged(config, str(log_path))
-    summary = result.report(log=str(log_path)).to_dict()  # the JSON, with the files and the cart added below
+    summary = result.to_dict(log=str(log_path), runs=False)  # the JSON, with the files and the cart added below
     add_controller_source(summary, base)
     summary.update(cart_dict(base))  # the base's cart where not ideal; the worst run's beside its parameters
     summary["worst"].update(cart_dict(config))
@@ -271,8 +271,7 @@ def _print_text(result, base, summary: dict, args: argparse.Namespace, logged_su
     from wmr_mj.sim.falsify import OBJECTIVE_LABELS, worst_config
 
     spec, worst = result.spec, result.worst
-    report = result.report(log=summary["log"])
-    names, how = ", ".join(spec.names), _how_text(spec, result, report)
+    names, how = ", ".join(spec.names), _how_text(spec, result)
     print(f"worst-case search over {len(spec.names)} parameter(s) ({names}; box {args.uncertainty}): {how}, "
           f"seed {spec.seed}")
     print(f"objective: {OBJECTIVE_LABELS[spec.objective]}  [{result.objective_source}]")
@@ -281,12 +280,13 @@ def _print_text(result, base, summary: dict, args: argparse.Namespace, logged_su
           f"(sup|E| = {worst.sup_E:.6g} rad, sup|E'| = {worst.sup_Edot:.6g} rad/s, {worst.verdict})")
     rw = result.random_worst
     print(f"random : worst objective {fmt(rw.objective)} in {len(result.random)} runs (Latin hypercube, same seed)")
-    print("".join(f"{line}\n" for line in claim_lines(report)), end="")
-    certificate = certificate_line(report)
+    print("".join(f"{line}\n" for line in claim_lines(result)), end="")
+    certificate = certificate_line(result)
     if certificate is not None:
         print(certificate)
-    if report.tightness is not None:
-        print(f"tightness: {report.tightness.text}")
+    tightness = result.tightness
+    if tightness is not None:
+        print(f"tightness: {tightness.text}")
     if spec.objective == "requirement":
         first_s = next((e.index + 1 for e in result.search if e.objective is not None and e.objective > 0), None)
         first_r = next((e.index + 1 for e in result.random if e.objective is not None and e.objective > 0), None)
@@ -307,10 +307,10 @@ def _print_text(result, base, summary: dict, args: argparse.Namespace, logged_su
     print(f"log:   {summary['log']}\nplot:  {summary['plot'][0]}\ntable: {summary['table']}")
 
 
-def certificate_line(report: FalsifyReport) -> str | None:
+def certificate_line(result: FalsifyResult) -> str | None:
     """The worst run's certificate, whatever the objective: its E_max and the largest term of its delta1; None
     where the run has neither."""
-    w = report.worst
+    w = result.worst
     if w.E_max is None and w.binding_term is None:
         return None
     line = "worst run's certificate: " + ("no E_max" if w.E_max is None else f"E_max = {w.E_max:.6g} rad")
@@ -339,18 +339,18 @@ def _bounds_line(b) -> str:
             "reference within them)")
 
 
-def _how_text(spec, result, report: FalsifyReport) -> str:
+def _how_text(spec, result: FalsifyResult) -> str:
     """How the search spent its runs, for falsify's first line."""
     if spec.method == "de":
-        how = f"differential evolution, {report.population} per generation x {report.generations} generations"
+        how = f"differential evolution, {result.population} per generation x {result.generations} generations"
     elif spec.method in ("portfolio", "cma"):
         first = [e for e in result.search if e.generation == 0] if spec.method == "portfolio" else []
         kind = ("all vertices" if len(first) == 2 ** len(spec.names) else
                 "a fractional-factorial covering of the vertices")
-        cma = (f"CMA-ES from the box's centre ({len(result.search) - len(first)} runs, {report.population} per "
+        cma = (f"CMA-ES from the box's centre ({len(result.search) - len(first)} runs, {result.population} per "
                "generation)")
         if first:
-            cma = _portfolio_phases_text(spec, first, int(report.population or 0))  # CMA-ES: always set
+            cma = _portfolio_phases_text(spec, first, int(result.population or 0))  # CMA-ES: always set
         how = f"{kind} ({len(first)} runs), then {cma}" if first else cma
     else:
         first = [e for e in result.search if e.generation == 0]
@@ -371,21 +371,21 @@ def exit_status(summary: dict) -> int:
     return CLAIM_BROKEN_EXIT if summary["falsified"] else 0
 
 
-def claim_lines(report: FalsifyReport) -> list[str]:
+def claim_lines(result: FalsifyResult) -> list[str]:
     """Beside the verdict: the banner and the run that broke the claim (where one did), and the worst
     run's unmet assumptions (name, value vs limit)."""
     from wmr_mj.analysis.verdicts import certified_outside_banner, format_unmet
 
     lines = []
-    broken = report.claim_broken
+    broken = result.claim_broken
     if broken is not None:
         where = (f"{broken.count} run(s) break the claim; the worst, {broken.phase} run {broken.run} "
                  f"(sup|E| = {broken.sup_E:.6g} rad, {broken.ratio:.3g} times E_max = {broken.E_max:.4g} rad)")
         lines += [certified_outside_banner(where),
                   "broken by: " + ", ".join(f"{k} = {v!r}" for k, v in broken.params.items())]
-    unmet = report.worst.unmet
+    unmet = result.worst.unmet
     if unmet:
-        lines.append(f"worst run {report.worst.verdict}: assumptions not met: "
+        lines.append(f"worst run {result.worst.verdict}: assumptions not met: "
                      f"{format_unmet(a.to_dict() for a in unmet)}")
     return lines
 

@@ -213,6 +213,6 @@ def write_report(result: CompareResult, out: Path) -> dict[str, str]:
     write_text_atomic(paths["csv"], csv_text(result))
     write_text_atomic(paths["html"], html_page(result))
     write_text_atomic(paths["runs"], runs_json(result))
-    write_json_atomic(paths["json"], json.loads(json.dumps(result.to_dict(), default=str)))
+    write_json_atomic(paths["json"], json.loads(json.dumps(result.to_dict(runs=False), default=str)))
     (png,) = save_figure(figure_compare(result), out / "compare", formats=("png",))
     return {**{k: str(v) for k, v in paths.items()}, "figure": str(png)}

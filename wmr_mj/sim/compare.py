@@ -30,6 +30,7 @@ import math
 import re
 import threading
 import time
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -49,10 +50,10 @@ from wmr_mj.sim.config import (
     controller_source,
 )
 from wmr_mj.sim.records import Record, plain
-from wmr_mj.sim.suite import Scenario, Suite, versions
+from wmr_mj.sim.suite import Scenario, Suite, load_suite, versions
 
 __all__ = ["Design", "design_from_token", "is_design_file", "design_file_changes", "design_token_changes",
-           "FileDesign", "ScenarioRun", "DesignRow", "CompareResult", "CompareReport", "compare",
+           "FileDesign", "ScenarioRun", "DesignRow", "CompareResult", "compare",
            "run_scenario", "adversary_spec", "adversary_cart_box", "ADVERSARY_CART_AXES"]
 
 
@@ -194,8 +195,9 @@ class FileDesign:
 
 
 @dataclass(frozen=True)
-class ScenarioRun:
-    """One design on one scenario: the run's summary (JSON), what the requirements gave, the effort."""
+class ScenarioRun(Record):
+    """One design on one scenario: the run's summary (JSON), what the requirements gave, the effort (its JSON,
+    ``to_dict``, is a line of runs.jsonl)."""
 
     design: str
     scenario: str
@@ -373,7 +375,12 @@ class DesignRow(Record):
 
 @dataclass(frozen=True)
 class CompareResult:
-    """What ``compare`` measured: one row per design, every scenario run, the suite and the versions."""
+    """A comparison's one result (:func:`compare`): one row per design, every scenario run, the suite and the
+    versions, read by attribute.
+
+    :meth:`to_dict` is its JSON with every scenario run (``runs``), which :meth:`from_dict` reads back; with
+    ``runs=False`` it is compare.json's object (``wmr-mj compare --json`` without its files).
+    """
 
     suite: Suite
     scenarios: tuple[Scenario, ...]
@@ -395,15 +402,54 @@ class CompareResult:
         """The designs one of whose runs (a scenario's or the adversary's) breaks its claim, in order."""
         return [r.label for r in self.rows if r.claim_broken is not None]
 
-    def report(self) -> CompareReport:
-        """What the comparison found, as compare.json holds it, typed (the suite as its JSON, scenarios by id)."""
-        return CompareReport(suite=self.suite.to_dict(), versions=dict(self.versions), budget=self.budget,
-                             seed=self.seed, scenarios=tuple(s.id for s in self.scenarios), rows=self.rows,
-                             claims_broken=tuple(self.claims_broken), wall_s=self.wall_s, steps=self.steps)
+    def _record(self) -> _CompareRecord:
+        """compare.json's object, typed (the suite as its JSON, scenarios by id)."""
+        return _CompareRecord(suite=self.suite.to_dict(), versions=dict(self.versions), budget=self.budget,
+                              seed=self.seed, scenarios=tuple(s.id for s in self.scenarios), rows=self.rows,
+                              claims_broken=tuple(self.claims_broken), wall_s=self.wall_s, steps=self.steps)
 
-    def to_dict(self) -> dict[str, Any]:
-        """compare.json's object (``wmr-mj compare --json`` without its files): :meth:`report`'s JSON."""
-        return self.report().to_dict()
+    def report(self) -> _CompareRecord:
+        """Deprecated (kept one release): the result answers each of these by attribute, and
+        ``to_dict(runs=False)`` is their JSON."""
+        warnings.warn("CompareResult.report() is deprecated: read the result by attribute (result.rows, "
+                      "result.claims_broken); result.to_dict(runs=False) is compare.json's object",
+                      DeprecationWarning, stacklevel=2)
+        return self._record()
+
+    def to_dict(self, *, runs: bool = True) -> dict[str, Any]:
+        """The comparison's JSON: compare.json's keys (the suite, the versions, the adversary's budget and seed,
+        the scenario ids, each design's row, the claims broken, wall time and steps), then, with ``runs``,
+        ``runs``: the suite's file (``suite_source``) and every scenario run (``ScenarioRun.to_dict``), which
+        :meth:`from_dict` reads back.
+
+        Args:
+            runs: add ``runs``; False: compare.json's object exactly.
+        """
+        out = self._record().to_dict()
+        if runs:
+            out["runs"] = {"suite_source": self.suite.source, "scenarios": [r.to_dict() for r in self.runs]}
+        return out
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> CompareResult:
+        """The result of its JSON ``d`` (:meth:`to_dict`, with its ``runs``): the suite read again from its file
+        and checked against the SHA-256 the JSON records, the scenarios by id, the rows and the runs.
+
+        Raises:
+            ParameterError: ``d`` has no ``runs`` (compare.json), or the suite's file has changed: one line.
+        """
+        runs = d.get("runs")
+        if runs is None:
+            raise ParameterError("this JSON has no 'runs' (compare.json and compare --json hold the rows only): "
+                                 "CompareResult.to_dict() writes every run, and from_dict reads that back")
+        suite = load_suite(runs["suite_source"])
+        if suite.sha256 != d["suite"]["sha256"]:
+            raise ParameterError(f"suite {runs['suite_source']!r} has changed since the comparison (SHA-256 "
+                                 f"{suite.sha256[:12]}..., the comparison's {str(d['suite']['sha256'])[:12]}...)")
+        record = _CompareRecord.from_dict(d)
+        return cls(suite=suite, scenarios=tuple(suite.scenario(i) for i in record.scenarios), rows=record.rows,
+                   runs=tuple(ScenarioRun.from_dict(r) for r in runs["scenarios"]), budget=record.budget,
+                   seed=record.seed, versions=dict(record.versions), wall_s=record.wall_s, steps=record.steps)
 
 
     # -- in a notebook (wmr_mj.sim.notebook): one row per design and scenario, the table's figure, a few lines
@@ -433,8 +479,10 @@ class CompareResult:
 
 
 @dataclass(frozen=True, kw_only=True)
-class CompareReport(Record):
-    """A comparison as compare.json holds it, read by attribute (:meth:`CompareResult.report`).
+class _CompareRecord(Record):
+    """compare.json's object, typed (:meth:`CompareResult.to_dict` with ``runs=False`` writes it). Not a result of
+    its own: :class:`CompareResult` answers each of these by attribute; the deprecated name ``CompareReport``
+    still reads an old script's compare.json with :meth:`from_dict`.
 
     Attributes:
         suite: the suite's JSON (``Suite.to_dict()``).
@@ -459,6 +507,15 @@ class CompareReport(Record):
     claims_broken: tuple[str, ...]
     wall_s: float
     steps: int
+
+
+def __getattr__(name: str) -> Any:
+    if name == "CompareReport":  # deprecated alias: keep one release (CompareResult is compare's one result)
+        warnings.warn("wmr_mj.sim.compare.CompareReport is deprecated: CompareResult is the comparison's one result "
+                      "(read it by attribute; to_dict(runs=False) is compare.json's object)", DeprecationWarning,
+                      stacklevel=2)
+        return _CompareRecord
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def compare(designs: Sequence[Design], suite: Suite, *, scenarios: Sequence[str] = (), budget: int = 32,

@@ -92,6 +92,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -102,7 +103,7 @@ from wmr_mj._util.checks import positive_range
 from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE, VERDICTS, unmet_assumptions
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import parameter_names
-from wmr_mj.sim.config import RunConfig
+from wmr_mj.sim.config import RunConfig, config_from_dict
 from wmr_mj.sim.falsify_objectives import (
     OBJECTIVE_LABELS,
     OBJECTIVES,
@@ -152,7 +153,6 @@ __all__ = [
     "OBJECTIVE_LABELS",
     "FalsifySpec",
     "FalsifyResult",
-    "FalsifyReport",
     "WorstRun",
     "RandomWorst",
     "Tightness",
@@ -298,6 +298,20 @@ class FalsifySpec:
         parameters set (:func:`wmr_mj.sim.search_space.config_for`)."""
         return config_for(self.base, self.names, point)
 
+    def to_dict(self) -> dict[str, Any]:
+        """The search's JSON: its base (``RunConfig.to_dict``), the box (name -> [lo, hi]) and its settings."""
+        return {"base": self.base.to_dict(), "box": {k: [float(lo), float(hi)] for k, (lo, hi) in self.box.items()},
+                "objective": self.objective, "budget": self.budget, "seed": self.seed,
+                "population": self.population, "method": self.method, "requirement": self.requirement}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> FalsifySpec:
+        """The search of its JSON ``d`` (:meth:`to_dict`), checked as a new one is; its base read by
+        :func:`~wmr_mj.sim.builders.config_from_dict` (coerced, as a command's base is)."""
+        box = {k: (float(lo), float(hi)) for k, (lo, hi) in d["box"].items()}
+        return cls(base=config_from_dict(d["base"]), box=box, objective=d["objective"], budget=d["budget"],
+                   seed=d["seed"], population=d["population"], method=d["method"], requirement=d["requirement"])
+
 
 @dataclass(frozen=True)
 class Evaluation:
@@ -324,6 +338,33 @@ class Evaluation:
     @property
     def verdict(self) -> str:
         return verdict_of(self.summary)
+
+    @property
+    def E_max(self) -> float | None:
+        """Its certificate's E_max [rad], whatever the objective; None where the run has none."""
+        return certificate_E_max(self.summary)
+
+    @property
+    def unmet(self) -> tuple[UnmetAssumption, ...]:
+        """The claim's assumptions the run does not meet (its certificate's)."""
+        return tuple(UnmetAssumption.from_dict(a) for a in unmet_assumptions(self.summary.get("certificate")))
+
+    @property
+    def binding_term(self) -> BindingTerm | None:
+        """The largest term of its certificate's delta1 (:class:`BindingTerm`); None where it has none."""
+        binding = binding_term(self.summary)
+        return None if binding is None else BindingTerm(name=binding[0], value=binding[1])
+
+    def to_dict(self) -> dict[str, Any]:
+        """The run's JSON: its phase, index, generation, parameters, objective, summary and proposed point."""
+        return {"phase": self.phase, "index": self.index, "generation": self.generation, "params": dict(self.params),
+                "objective": self.objective, "summary": self.summary, "point": list(self.point)}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> Evaluation:
+        """The run of its JSON ``d`` (:meth:`to_dict`)."""
+        return cls(phase=d["phase"], index=d["index"], generation=d["generation"], params=dict(d["params"]),
+                   objective=d["objective"], summary=dict(d["summary"]), point=tuple(d["point"]))
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -394,9 +435,11 @@ class RandomWorst(Record):
 
 
 @dataclass(frozen=True, kw_only=True)
-class FalsifyReport(Record):
-    """What a search found, read by attribute: ``wmr-mj falsify --json``'s object (:meth:`to_dict`, before the
-    command adds its files, cart and reproduce line), from :meth:`FalsifyResult.report`.
+class _FalsifyRecord(Record):
+    """``wmr-mj falsify --json``'s object, typed (:meth:`FalsifyResult.to_dict` with ``runs=False`` writes it
+    before the command adds its files, cart and reproduce line). Not a result of its own: :class:`FalsifyResult`
+    answers each of these by attribute (``worst`` and ``random_worst`` as the runs themselves); the deprecated
+    name ``FalsifyReport`` still reads an old script's falsify.json with :meth:`from_dict`.
 
     Attributes:
         objective: one of :data:`OBJECTIVES`.
@@ -440,19 +483,33 @@ class FalsifyReport(Record):
     log: str | None = None
 
     @classmethod
-    def from_dict(cls, d: Mapping[str, Any]) -> FalsifyReport:
+    def from_dict(cls, d: Mapping[str, Any]) -> _FalsifyRecord:
         report = super().from_dict(d)
         return dataclasses.replace(report, box={k: (float(lo), float(hi)) for k, (lo, hi) in report.box.items()})
 
 
 @dataclass(frozen=True)
 class FalsifyResult:
-    """Every run of a search and of its random sample (:func:`falsify`); :meth:`report` is what they add up to."""
+    """A search's one result (:func:`falsify`): every run of the search and of its random sample, and what they
+    add up to, read by attribute (:attr:`worst`, :attr:`random_worst`, :attr:`tightness`, :attr:`claim_broken`,
+    :attr:`falsified`, ...).
+
+    :meth:`to_dict` is its JSON with every run (``runs``), which :meth:`from_dict` reads back; with
+    ``runs=False`` it is ``wmr-mj falsify --json``'s object before the command adds its files.
+
+    Attributes:
+        spec: the search.
+        search: the search's runs, in evaluation order.
+        random: the random sample's runs, in evaluation order.
+        objective_source: where the objective's bound comes from (:func:`objective_source`).
+        log: the MCAP log of the worst run's re-run (the command writes it); None where not written.
+    """
 
     spec: FalsifySpec
     search: list[Evaluation]
     random: list[Evaluation]
     objective_source: str
+    log: str | None = None
 
     @staticmethod
     def _worst(evals: list[Evaluation]) -> Evaluation:
@@ -482,6 +539,46 @@ class FalsifyResult:
     @property
     def generations(self) -> int:
         return 1 + max((e.generation for e in self.search), default=-1)
+
+    # -- the search's settings, as its JSON names them
+    @property
+    def objective(self) -> str:
+        """One of :data:`OBJECTIVES`."""
+        return self.spec.objective
+
+    @property
+    def budget(self) -> int:
+        """The search's simulations asked."""
+        return self.spec.budget
+
+    @property
+    def evaluations(self) -> int:
+        """The search's simulations run."""
+        return len(self.search)
+
+    @property
+    def seed(self) -> int:
+        return self.spec.seed
+
+    @property
+    def method(self) -> str:
+        """One of :data:`METHODS`."""
+        return self.spec.method
+
+    @property
+    def population(self) -> int | None:
+        """Members per generation; None for the polish methods."""
+        return self.spec.population_size
+
+    @property
+    def requirement(self) -> str | None:
+        """The STL requirement of the objective 'requirement'; None otherwise."""
+        return self.spec.requirement
+
+    @property
+    def box(self) -> dict[str, tuple[float, float]]:
+        """Each ranged parameter -> (lo, hi)."""
+        return {k: (float(lo), float(hi)) for k, (lo, hi) in self.spec.box.items()}
 
     @property
     def method_label(self) -> str:
@@ -555,31 +652,59 @@ class FalsifyResult:
         judged = any(e.verdict in VERDICTS for e in (*self.search, *self.random))
         return False if judged else None
 
-    def report(self, *, log: str | None = None) -> FalsifyReport:
-        """What the search found, typed (``log``: the worst run's MCAP log, where written)."""
+    def _record(self, log: str | None) -> _FalsifyRecord:
+        """``falsify --json``'s object, typed (``log``: the worst run's MCAP log, where written)."""
         w, r = self.worst, self.random_worst
-        binding = binding_term(w.summary)
-        return FalsifyReport(
-            objective=self.spec.objective, objective_label=OBJECTIVE_LABELS[self.spec.objective],
-            objective_source=self.objective_source, budget=self.spec.budget, evaluations=len(self.search),
-            seed=self.spec.seed, method=self.spec.method, population=self.spec.population_size,
-            generations=self.generations, requirement=self.spec.requirement, falsified=self.falsified,
-            claim_broken=self.claim_broken,
-            box={k: (float(lo), float(hi)) for k, (lo, hi) in self.spec.box.items()},
+        return _FalsifyRecord(
+            objective=self.objective, objective_label=self.objective_label, objective_source=self.objective_source,
+            budget=self.budget, evaluations=self.evaluations, seed=self.seed, method=self.method,
+            population=self.population, generations=self.generations, requirement=self.requirement,
+            falsified=self.falsified, claim_broken=self.claim_broken, box=self.box,
             worst=WorstRun(params=dict(w.params), objective=w.objective, sup_E=w.sup_E, sup_Edot=w.sup_Edot,
-                           verdict=w.verdict, generation=w.generation, index=w.index,
-                           unmet=tuple(UnmetAssumption.from_dict(a)
-                                       for a in unmet_assumptions(w.summary.get("certificate"))),
-                           E_max=certificate_E_max(w.summary),
-                           binding_term=None if binding is None else BindingTerm(name=binding[0], value=binding[1])),
+                           verdict=w.verdict, generation=w.generation, index=w.index, unmet=w.unmet, E_max=w.E_max,
+                           binding_term=w.binding_term),
             tightness=self.tightness,
             random=RandomWorst(worst_objective=r.objective, worst_params=dict(r.params), evaluations=len(self.random),
                                sup_E=r.sup_E, verdict=r.verdict),
             log=log)
 
-    def to_dict(self, *, log: str | None = None) -> dict[str, Any]:
-        """The ``wmr-mj falsify --json`` object (:meth:`report`'s JSON)."""
-        return self.report(log=log).to_dict()
+    def report(self, *, log: str | None = None) -> _FalsifyRecord:
+        """Deprecated (kept one release): the result answers each of these by attribute, and
+        ``to_dict(runs=False)`` is their JSON."""
+        warnings.warn("FalsifyResult.report() is deprecated: read the result by attribute (result.worst, "
+                      "result.tightness, result.claim_broken); result.to_dict(runs=False) is falsify --json's object",
+                      DeprecationWarning, stacklevel=2)
+        return self._record(self.log if log is None else log)
+
+    def to_dict(self, *, log: str | None = None, runs: bool = True) -> dict[str, Any]:
+        """The search's JSON: ``wmr-mj falsify --json``'s keys (the worst run, the random sample's worst, the
+        tightness, the claim broken, the log), then, with ``runs``, ``runs``: the spec (``FalsifySpec.to_dict``)
+        and every run of both phases (``Evaluation.to_dict``), which :meth:`from_dict` reads back.
+
+        Args:
+            log: the worst run's MCAP log, in place of :attr:`log` (None: :attr:`log`).
+            runs: add ``runs``; False: falsify --json's object exactly.
+        """
+        out = self._record(self.log if log is None else log).to_dict()
+        if runs:
+            out["runs"] = {"spec": self.spec.to_dict(), "search": [e.to_dict() for e in self.search],
+                           "random": [e.to_dict() for e in self.random]}
+        return out
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> FalsifyResult:
+        """The result of its JSON ``d`` (:meth:`to_dict`, with its ``runs``).
+
+        Raises:
+            ParameterError: ``d`` has no ``runs`` (falsify --json's object, falsify.json): one line.
+        """
+        runs = d.get("runs")
+        if runs is None:
+            raise ParameterError("this JSON has no 'runs' (falsify --json and falsify.json hold the worst run only): "
+                                 "FalsifyResult.to_dict() writes every run, and from_dict reads that back")
+        return cls(spec=FalsifySpec.from_dict(runs["spec"]), search=[Evaluation.from_dict(e) for e in runs["search"]],
+                   random=[Evaluation.from_dict(e) for e in runs["random"]], objective_source=d["objective_source"],
+                   log=d.get("log"))
 
     # -- in a notebook (wmr_mj.sim.notebook): every run as a table, the search beside random, a few lines
     def to_pandas(self) -> Any:
@@ -611,8 +736,17 @@ class FalsifyResult:
     def _repr_html_(self) -> str:
         from wmr_mj.sim import notebook
 
-        return notebook.falsify_html(self.report())
+        return notebook.falsify_html(self)
 
+
+
+def __getattr__(name: str) -> Any:
+    if name == "FalsifyReport":  # deprecated alias: keep one release (FalsifyResult is falsify's one result)
+        warnings.warn("wmr_mj.sim.falsify.FalsifyReport is deprecated: FalsifyResult is the search's one result "
+                      "(read it by attribute; to_dict(runs=False) is falsify --json's object)", DeprecationWarning,
+                      stacklevel=2)
+        return _FalsifyRecord
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def falsify(spec: FalsifySpec, *, chunk: int = 128, nthread: int = 0, scheduler: str | None = None,

@@ -230,18 +230,19 @@ def run_html(summary: Any) -> str:
     return html_lines("run", str(summary.verdict or "no verdict"), lines)
 
 
-def falsify_html(report: Any) -> str:
-    """A search's verdict and key numbers (``FalsifyReport``)."""
-    w, r = report.worst, report.random
-    verdict = {True: "FALSIFIED", False: "not falsified", None: "no claim to falsify"}[report.falsified]
+def falsify_html(result: Any) -> str:
+    """A search's verdict and key numbers (``FalsifyResult``)."""
+    w, r = result.worst, result.random_worst
+    verdict = {True: "FALSIFIED", False: "not falsified", None: "no claim to falsify"}[result.falsified]
     where = ", ".join(f"{k} = {v:.6g}" for k, v in w.params.items())
-    lines = [f"{report.objective_label}: {report.method}, {report.evaluations} runs over {', '.join(report.box)}",
+    lines = [f"{result.objective_label}: {result.method}, {result.evaluations} runs over {', '.join(result.box)}",
              f"worst {number(w.objective)} at {where} ({w.verdict}, sup|E| {number(w.sup_E, 'rad')})",
-             f"random sample's worst {number(r.worst_objective)} in {r.evaluations} runs"]
-    if report.tightness is not None:
-        lines.append(report.tightness.text)
-    if report.claim_broken is not None:
-        lines.append(f"claim broken in {report.claim_broken.count} runs")
+             f"random sample's worst {number(r.objective)} in {len(result.random)} runs"]
+    tightness, broken = result.tightness, result.claim_broken
+    if tightness is not None:
+        lines.append(tightness.text)
+    if broken is not None:
+        lines.append(f"claim broken in {broken.count} runs")
     return html_lines("falsify", verdict, lines)
 
 
