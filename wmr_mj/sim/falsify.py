@@ -693,7 +693,9 @@ class FalsifyResult:
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> FalsifyResult:
-        """The result of its JSON ``d`` (:meth:`to_dict`, with its ``runs``).
+        """The result of its JSON ``d`` (:meth:`to_dict`, with its ``runs``): equal to the result written where its
+        spec's base was coerced (a command's, or ``RunConfig.from_inputs``); a base built directly reads back as
+        the coerced config it ran as (the same JSON).
 
         Raises:
             ParameterError: ``d`` has no ``runs`` (falsify --json's object, falsify.json): one line.

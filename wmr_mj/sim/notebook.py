@@ -1,5 +1,6 @@
 """A result in a notebook: its table (``.to_pandas()``), its figure (``.plot()``) and its verdict in a few lines
-(``_repr_html_``), for a run, a sweep, a search, a comparison and the validation.
+(``_repr_html_``), for a run, a sweep, a search, a comparison and the validation (a design, a cart's tightness
+and a cart check build theirs from :func:`records_frame` and :func:`html_lines` in their own modules).
 
 The tables name every column once here, with its unit (:data:`ROW_UNITS` for a run's rows, :data:`RUN_COLUMNS`
 for the per-run tables of a sweep and a search), as python-control's ``TimeResponseData.to_pandas`` and
