@@ -118,7 +118,7 @@ def run(args: argparse.Namespace) -> int:
 
     from wmr_mj.cli._common import print_json
     from wmr_mj.errors import ParameterError
-    from wmr_mj.sim.design_search import design_dict, search_design, write_design
+    from wmr_mj.sim.design_search import search_design, write_design
 
     if args.check < 0:
         raise ParameterError(f"--check {args.check} is not accepted; a number of runs >= 0")
@@ -127,7 +127,7 @@ def run(args: argparse.Namespace) -> int:
     result = search_design(problem)
     wall = time.perf_counter() - t0
     write_design(result, args.out)
-    out = design_dict(result)
+    out = result.to_dict()  # the design file's content (design_dict), then what the command adds
     out.update(file=str(args.out), wall_s=wall, run=run_line(args))
     if result.certified and args.check > 0:
         out["check"] = check_design(problem, result, args.check)
