@@ -18,7 +18,6 @@ Usage::
 
 from __future__ import annotations
 
-import copy
 import functools
 import inspect
 import os
@@ -31,7 +30,7 @@ import numpy as np
 from controllers import PathTracker, SteeringController, make_controller, model_from_source
 from controllers.base import BuildContext
 from controllers.computed_torque import CONTROLLER_NAMES
-from controllers.registry import build, resolve
+from controllers.registry import build_plugin, resolve
 from wmr_mj._util.checks import as_pair
 from wmr_mj.analysis.plant_box import derived_box
 from wmr_mj.analysis.robustness import ParameterBox, analyse
@@ -45,7 +44,7 @@ from wmr_mj.sim.run_config import RunConfig
 
 __all__ = ["BoxSpec", "LawSpec", "estimate_parameters", "build_reference", "manoeuvre_length", "analysis_box",
            "parameter_box", "analysis_for", "analysis_of", "reference_bounds_of", "run_bounds", "law_and_settings",
-           "tracker_of", "controller_for", "controller_and_settings", "LAW_SETTINGS", "declared_parameters",
+           "tracker_of", "laws_of", "controller_for", "controller_and_settings", "LAW_SETTINGS", "declared_parameters",
            "tracker_for", "has_tracker", "estimate_of", "config_from_dict"]
 
 
@@ -300,10 +299,18 @@ def law_and_settings(law: LawSpec, params: C80Parameters, *, classes: Mapping[st
         built = make_controller(given, model, kp=law.kp, kd=law.kd, friction_sign=law.friction_sign,
                                 friction_width=law.friction_width)
         return built, frozenset(_PD_SETTINGS if given == "pd" else LAW_SETTINGS)
-    read: set[str] = set()
-    built = _plugin_for(law, params, "controller", given, law.controller_params, SteeringController, model,
-                        read=read, classes=classes)
-    return built, frozenset(read)
+    context = BuildContext(model=model, estimate=params, voltage_limit=params.voltage_limit, kp=law.kp, kd=law.kd)
+    built = build_plugin(given, law.controller_params, kind="controller", context=context,
+                         cls=(classes or {}).get("controller"))
+    return built, frozenset(context.read)  # none read for an object or a factory
+
+
+def laws_of(law: LawSpec, params: C80Parameters, *, classes: Mapping[str, type] | None = None
+            ) -> tuple[SteeringController, frozenset[str], PathTracker | None]:
+    """(law, the settings it reads, tracker): :func:`law_and_settings` and :func:`tracker_of` in one call, each a
+    fresh instance on the belief ``params`` (:func:`wmr_mj.sim.parts.resolve_run` builds a run's two laws here)."""
+    controller, settings = law_and_settings(law, params, classes=classes)
+    return controller, settings, tracker_of(law, params, classes=classes)
 
 
 def declared_parameters(spec: str) -> frozenset[str]:
@@ -328,37 +335,16 @@ def tracker_for(config: RunConfig, params: C80Parameters, *, classes: Mapping[st
 
 def tracker_of(law: LawSpec, params: C80Parameters, *, classes: Mapping[str, type] | None = None):
     """A fresh instance of the run's path tracker (:class:`controllers.tracking.PathTracker`), None without one;
-    built as :func:`controller_for` builds a plug-in."""
-    if law.tracker is None:
+    built as :func:`controller_for` builds a plug-in (:func:`controllers.registry.build_plugin`)."""
+    given = law.tracker
+    if given is None:
         return None
-    return _plugin_for(law, params, "tracker", law.tracker, law.tracker_params, PathTracker, classes=classes)
-
-
-def _plugin_for(law: LawSpec, params: C80Parameters, kind: str, given: Any, plugin_params: Mapping[str, Any],
-                base: type, model: Any = None, read: set[str] | None = None,
-                classes: Mapping[str, type] | None = None) -> Any:
-    """A fresh instance of a plug-in (law or tracker): an object deep-copied, a name resolved and built with its
-    parameters on the run's context (``model``: the run's reduced model, built here where None), a factory
-    called; checked to be a ``base``. ``read``: a set given here receives the context's settings the build
-    read (``BuildContext.read``)."""
-    if isinstance(given, base):
-        return copy.deepcopy(given)
-    if isinstance(given, str):
-        found = (classes or {}).get(kind) if given == getattr(law, kind) else None
-        cls = found if found is not None else resolve(given, plugin_params, kind=kind)[0]
-        if model is None:
-            model = model_from_source(law.model, params=params, identified=law.identified,
-                                      coefficients=law.coefficients)
+    context = None
+    if isinstance(given, str):  # built by name: on the run's reduced model
+        model = model_from_source(law.model, params=params, identified=law.identified, coefficients=law.coefficients)
         context = BuildContext(model=model, estimate=params, voltage_limit=params.voltage_limit, kp=law.kp,
                                kd=law.kd)
-        built = build(cls, plugin_params, context, spec=given, kind=kind)
-        if read is not None:
-            read.update(context.read)
-    else:
-        built = given()
-    if not isinstance(built, base):
-        raise ParameterError(f"{kind} {given!r} built {type(built).__name__}, not a controllers.{base.__name__}")
-    return built
+    return build_plugin(given, law.tracker_params, kind="tracker", context=context, cls=(classes or {}).get("tracker"))
 
 
 def has_tracker(config: RunConfig) -> bool:
