@@ -39,8 +39,8 @@ from importlib.metadata import entry_points
 from pathlib import Path
 from typing import Any
 
-from controllers.base import SteeringController, describe_params
-from controllers.computed_torque import CONTROLLER_NAMES, MODEL_SOURCES
+from controllers.base import BuildContext, SteeringController, describe_params
+from controllers.computed_torque import CONTROLLER_NAMES, MODEL_SOURCES, model_from_source
 from controllers.tracking import PathTracker
 from wmr_mj.errors import ParameterError, UnknownNameError
 
@@ -365,25 +365,39 @@ def _instance_source(given: Any, kind: str) -> PluginSource:
                         params=_described(given, kind), source_sha256=source_hash(cls))
 
 
-def build_plugin(given: Any, params: Mapping[str, Any], *, kind: str, context: Any, cls: type | None = None) -> Any:
-    """A fresh instance of a run's law (or tracker) that is not built from the config's fields: an object
-    deep-copied (a run never shares a law's state), a name built with its parameters on ``context`` (a
-    :class:`controllers.base.BuildContext`; ``cls``: its class, already found, else resolved here), a factory called.
+def build_plugin(given: Any, params: Mapping[str, Any], *, kind: str, estimate: Any, kp: float, kd: float,
+                 model: Any = None, model_source: str = "paper", identified: Any = None,
+                 coefficients: Mapping[str, float] | None = None, cls: type | None = None
+                 ) -> tuple[Any, frozenset[str]]:
+    """(instance, settings read): a fresh instance of a run's law (or tracker) that is not built from the config's
+    fields, on the run's build context, in one call. None for no tracker; an object deep-copied (a run never shares
+    a law's state); a name built with its parameters on a :class:`controllers.base.BuildContext` of the belief
+    ``estimate`` (its voltage limit), the gains kp [1/s^2], kd [1/s] and the reduced model ``model`` (else
+    :func:`controllers.computed_torque.model_from_source` of ``model_source``, ``identified``, ``coefficients``),
+    ``cls`` its class already found (else resolved here); a factory called. The settings read: the names of the
+    context's settings its ``from_context`` read (none for an object or a factory).
 
     Raises:
         ParameterError: a parameter it does not take, or what was built is not a law (or tracker).
     """
+    if given is None:
+        return None, frozenset()
     base = SteeringController if kind == "controller" else PathTracker
     if isinstance(given, base):
-        return copy.deepcopy(given)
+        return copy.deepcopy(given), frozenset()
+    read: frozenset[str] = frozenset()
     if isinstance(given, str):
         found = cls if cls is not None else resolve(given, params, kind=kind)[0]
+        if model is None:
+            model = model_from_source(model_source, params=estimate, identified=identified, coefficients=coefficients)
+        context = BuildContext(model=model, estimate=estimate, voltage_limit=estimate.voltage_limit, kp=kp, kd=kd)
         built = build(found, params, context, spec=given, kind=kind)
+        read = frozenset(context.read)
     else:
         built = given()
     if not isinstance(built, base):
         raise ParameterError(f"{kind} {given!r} built {type(built).__name__}, not a controllers.{base.__name__}")
-    return built
+    return built, read
 
 
 def builtin_class(name: str, kind: str) -> type:

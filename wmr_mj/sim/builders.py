@@ -28,7 +28,6 @@ from typing import Any
 import numpy as np
 
 from controllers import PathTracker, SteeringController, make_controller, model_from_source
-from controllers.base import BuildContext
 from controllers.computed_torque import CONTROLLER_NAMES
 from controllers.registry import build_plugin, resolve
 from wmr_mj._util.checks import as_pair
@@ -299,10 +298,8 @@ def law_and_settings(law: LawSpec, params: C80Parameters, *, classes: Mapping[st
         built = make_controller(given, model, kp=law.kp, kd=law.kd, friction_sign=law.friction_sign,
                                 friction_width=law.friction_width)
         return built, frozenset(_PD_SETTINGS if given == "pd" else LAW_SETTINGS)
-    context = BuildContext(model=model, estimate=params, voltage_limit=params.voltage_limit, kp=law.kp, kd=law.kd)
-    built = build_plugin(given, law.controller_params, kind="controller", context=context,
-                         cls=(classes or {}).get("controller"))
-    return built, frozenset(context.read)  # none read for an object or a factory
+    return build_plugin(given, law.controller_params, kind="controller", estimate=params, kp=law.kp, kd=law.kd,
+                        model=model, cls=(classes or {}).get("controller"))
 
 
 def laws_of(law: LawSpec, params: C80Parameters, *, classes: Mapping[str, type] | None = None
@@ -310,7 +307,10 @@ def laws_of(law: LawSpec, params: C80Parameters, *, classes: Mapping[str, type] 
     """(law, the settings it reads, tracker): :func:`law_and_settings` and :func:`tracker_of` in one call, each a
     fresh instance on the belief ``params`` (:func:`wmr_mj.sim.parts.resolve_run` builds a run's two laws here)."""
     controller, settings = law_and_settings(law, params, classes=classes)
-    return controller, settings, tracker_of(law, params, classes=classes)
+    tracker, _ = build_plugin(law.tracker, law.tracker_params, kind="tracker", estimate=params, kp=law.kp, kd=law.kd,
+                              model_source=law.model, identified=law.identified, coefficients=law.coefficients,
+                              cls=(classes or {}).get("tracker"))  # as tracker_of builds it
+    return controller, settings, tracker
 
 
 def declared_parameters(spec: str) -> frozenset[str]:
@@ -336,15 +336,10 @@ def tracker_for(config: RunConfig, params: C80Parameters, *, classes: Mapping[st
 def tracker_of(law: LawSpec, params: C80Parameters, *, classes: Mapping[str, type] | None = None):
     """A fresh instance of the run's path tracker (:class:`controllers.tracking.PathTracker`), None without one;
     built as :func:`controller_for` builds a plug-in (:func:`controllers.registry.build_plugin`)."""
-    given = law.tracker
-    if given is None:
-        return None
-    context = None
-    if isinstance(given, str):  # built by name: on the run's reduced model
-        model = model_from_source(law.model, params=params, identified=law.identified, coefficients=law.coefficients)
-        context = BuildContext(model=model, estimate=params, voltage_limit=params.voltage_limit, kp=law.kp,
-                               kd=law.kd)
-    return build_plugin(given, law.tracker_params, kind="tracker", context=context, cls=(classes or {}).get("tracker"))
+    tracker, _ = build_plugin(law.tracker, law.tracker_params, kind="tracker", estimate=params, kp=law.kp, kd=law.kd,
+                              model_source=law.model, identified=law.identified, coefficients=law.coefficients,
+                              cls=(classes or {}).get("tracker"))
+    return tracker
 
 
 def has_tracker(config: RunConfig) -> bool:

@@ -74,8 +74,12 @@ class RunLabels:
     @classmethod
     def of(cls, config: RunConfig, *, name: str | None = None) -> RunLabels:
         """The labels of ``config``; ``name``: the law's name where already known (else from the config)."""
-        return cls(controller=controller_name(config) if name is None else name, model=str(config.model),
-                   kp=config.kp, kd=config.kd, path=config.path)
+        return cls.named(config, controller_name(config) if name is None else name)
+
+    @classmethod
+    def named(cls, config: RunConfig, name: str) -> RunLabels:
+        """The labels of ``config``, whose law is called ``name``: read, nothing coerced."""
+        return cls(controller=name, model=str(config.model), kp=config.kp, kd=config.kd, path=config.path)
 
 
 def control_substeps(control_period: float | None, timestep: float = TIMESTEP) -> int:
@@ -196,7 +200,7 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
     n = int(round(config.duration / period))
     claim_period = config.control_period if config.control_period is not None else TIMESTEP  # the law's, as given
     law, box, options = LawSpec.of(config), BoxSpec.of(config), plant_options(config)
-    labels = RunLabels.of(config, name=law_name(config))
+    labels = RunLabels.named(config, law_name(config))
     route_length_m = (float(typed.route.path.length) if typed.route is not None
                       else manoeuvre_length(config.path))  # lane-change's
     # then each part, built once and handed on in layer order: the parameter sets, the law and the tracker on the
