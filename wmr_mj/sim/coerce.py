@@ -50,6 +50,7 @@ from wmr_mj.params import (
 )
 from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS, TIMESTEP, TYRE_CONTACT_MODELS
 from wmr_mj.reference.bounds import ReferenceBounds, reference_bounds_from
+from wmr_mj.reference.named import PATH_NAMES
 from wmr_mj.reference.route import Route, route_of, route_spec_of
 from wmr_mj.sim.signals import Signals, signals_from
 
@@ -58,7 +59,6 @@ __all__ = ["PATH_NAMES", "DEFAULT_PATH", "default_path", "cart_file_of_record", 
            "plant_parameters", "base_of_record", "plugin_source", "controller_source", "controller_name", "law_name",
            "default_model", "check_motor_constant", "coerced", "record_of"]
 
-PATH_NAMES = ("paper-circle", "lane-change", "figure-eight")
 #: the path of a run that names none, on a cart that declares none (``[paths] default`` declares a cart's own)
 DEFAULT_PATH = "paper-circle"
 

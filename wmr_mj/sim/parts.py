@@ -30,11 +30,11 @@ from wmr_mj.errors import ParameterError
 from wmr_mj.hardware import Actuation, Sensing, Transmission
 from wmr_mj.params import C80, C80Parameters, with_params
 from wmr_mj.plant.mjcf import TIMESTEP
+from wmr_mj.reference.named import build_reference
 from wmr_mj.sim.builders import (
     BoxSpec,
     LawSpec,
     analysis_of,
-    build_reference,
     estimate_of,
     estimate_parameters,
     laws_of,
@@ -212,7 +212,7 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
                              "give it; accepted: a law that estimates alpha' from the angle (reads_velocity = False, "
                              "docs/guides/plugins.md), or a velocity estimate (exact, tachometer, difference, "
                              "filtered)")
-    reference, settle_s = run_reference(config.path, estimate, period=period, duration=config.duration)
+    reference, settle_s = build_reference(config.path, estimate, dt=period, duration=n * period)  # run_reference's
     # the reference bounds the claims are computed for: the declared ones, else the reference's own
     bounds = reference.bounds() if config.reference_bounds is None else config.reference_bounds
     paper_estimate = estimate_of(controller)  # None: not the paper's law, whose region then says nothing of it
@@ -242,7 +242,7 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
 def run_reference(path: str, estimate: C80Parameters, *, period: float, duration: float) -> tuple[Any, float]:
     """(reference, settle_s): C's reference of a run on its control grid, as :func:`resolve_run` builds it --
     ``round(duration / period)`` control steps of ``period`` [s] on the controller's belief ``estimate``
-    (:func:`wmr_mj.sim.builders.build_reference`). A log's replay and a result made elsewhere build theirs here."""
+    (:func:`wmr_mj.reference.named.build_reference`). A log's replay and a result made elsewhere build theirs here."""
     n = int(round(duration / period))
     return build_reference(path, estimate, dt=period, duration=n * period)
 
