@@ -26,6 +26,7 @@ Usage::
 
 from __future__ import annotations
 
+import copy
 import hashlib
 import importlib
 import importlib.util
@@ -38,11 +39,15 @@ from importlib.metadata import entry_points
 from pathlib import Path
 from typing import Any
 
+from controllers.base import BuildContext, SteeringController, describe_params
+from controllers.computed_torque import CONTROLLER_NAMES, MODEL_SOURCES, model_from_source
+from controllers.tracking import PathTracker
 from wmr_mj.errors import ParameterError, UnknownNameError
 
 __all__ = ["PluginSource", "LocatedSource", "resolve", "parse_params", "locate_source", "check_recorded_source",
            "recorded_spec", "BUILTIN_CONTROLLERS", "BUILTIN_TRACKERS", "ENTRY_POINT_GROUPS",
-           "controller_names", "tracker_names", "source_hash", "is_builtin", "refuse_builtin_name"]
+           "controller_names", "tracker_names", "source_hash", "is_builtin", "refuse_builtin_name",
+           "plugin_of", "plugin_fresh", "build_plugin", "builtin_class", "default_model"]
 
 #: built-in steering laws: name -> "module:Class"
 BUILTIN_CONTROLLERS: dict[str, str] = {
@@ -301,6 +306,123 @@ def build(cls: type, params: Mapping[str, Any], context: Any, *, spec: str, kind
                              f"{', '.join(accepted) or 'none'}") from None
     except (ValueError, ArithmeticError) as exc:
         raise ParameterError(f"{kind} {spec!r}: a parameter is refused: {exc}") from None
+
+
+# --------------------------------------------------------------------------- a run's law and tracker, as given
+def plugin_of(given: Any, params: Mapping[str, Any], *, kind: str, recorded: PluginSource | None = None,
+              look_up: bool = True) -> tuple[PluginSource | None, type | None]:
+    """(source, class) of a run's law (or tracker) as its config gives it, in one call
+    (:func:`wmr_mj.sim.coerce.coerce`): (None, None) for a law built from the config's fields
+    (:data:`controllers.computed_torque.CONTROLLER_NAMES`) and for no tracker; a name resolved (imported, its
+    source hashed: :func:`resolve`); an object's or factory's source from its class (no class returned).
+
+    ``recorded``: the source the config already holds; with ``look_up`` False it is kept where it is still the
+    one of ``given`` (:func:`plugin_fresh`), and no class is returned.
+    """
+    if not look_up and plugin_fresh(given, params, recorded, kind=kind):
+        return recorded, None
+    if kind == "tracker" and given is None:
+        return None, None
+    if isinstance(given, str):
+        if kind == "controller" and given in CONTROLLER_NAMES:
+            return None, None
+        cls, source = resolve(given, params, kind=kind)
+        return source, cls
+    return _instance_source(given, kind), None
+
+
+def plugin_fresh(given: Any, params: Mapping[str, Any], recorded: PluginSource | None, *, kind: str) -> bool:
+    """Whether ``recorded`` is the source of the law (or tracker) ``given`` with ``params``, as given now."""
+    if given is None or (kind == "controller" and isinstance(given, str) and given in CONTROLLER_NAMES):
+        return recorded is None
+    if recorded is None:
+        return False
+    if isinstance(given, str):
+        return recorded.spec == given.strip() and dict(recorded.params) == describe_params(params)
+    if not isinstance(given, SteeringController if kind == "controller" else PathTracker):
+        return recorded.origin == "instance"  # a factory: its record, made by calling it once when coerced
+    cls = type(given)
+    return (recorded.origin == "instance" and recorded.import_path == f"{cls.__module__}:{cls.__qualname__}"
+            and dict(recorded.params) == _described(given, kind))
+
+
+def _described(given: Any, kind: str) -> dict[str, Any]:
+    """The parameters an object's ``describe()`` gives, as its PluginSource records them."""
+    describe = getattr(given, "describe", None)
+    params = {}
+    if callable(describe):
+        params = {k: v for k, v in describe().items() if k not in (kind, "law")}
+    return describe_params(params)
+
+
+def _instance_source(given: Any, kind: str) -> PluginSource:
+    """The PluginSource of a law (or tracker) given as an object or a factory."""
+    if callable(given) and not hasattr(given, "describe"):
+        given = given()  # a factory (a class or a function): what it builds names the plug-in
+    cls = type(given)
+    return PluginSource(spec=f"{cls.__module__}:{cls.__qualname__}", name=str(getattr(given, "name", cls.__name__)),
+                        origin="instance", import_path=f"{cls.__module__}:{cls.__qualname__}",
+                        params=_described(given, kind), source_sha256=source_hash(cls))
+
+
+def build_plugin(given: Any, params: Mapping[str, Any], *, kind: str, estimate: Any, kp: float, kd: float,
+                 model: Any = None, model_source: str = "paper", identified: Any = None,
+                 coefficients: Mapping[str, float] | None = None, cls: type | None = None
+                 ) -> tuple[Any, frozenset[str]]:
+    """(instance, settings read): a fresh instance of a run's law (or tracker) that is not built from the config's
+    fields, on the run's build context, in one call. None for no tracker; an object deep-copied (a run never shares
+    a law's state); a name built with its parameters on a :class:`controllers.base.BuildContext` of the belief
+    ``estimate`` (its voltage limit), the gains kp [1/s^2], kd [1/s] and the reduced model ``model`` (else
+    :func:`controllers.computed_torque.model_from_source` of ``model_source``, ``identified``, ``coefficients``),
+    ``cls`` its class already found (else resolved here); a factory called. The settings read: the names of the
+    context's settings its ``from_context`` read (none for an object or a factory).
+
+    Raises:
+        ParameterError: a parameter it does not take, or what was built is not a law (or tracker).
+    """
+    if given is None:
+        return None, frozenset()
+    base = SteeringController if kind == "controller" else PathTracker
+    if isinstance(given, base):
+        return copy.deepcopy(given), frozenset()
+    read: frozenset[str] = frozenset()
+    if isinstance(given, str):
+        found = cls if cls is not None else resolve(given, params, kind=kind)[0]
+        if model is None:
+            model = model_from_source(model_source, params=estimate, identified=identified, coefficients=coefficients)
+        context = BuildContext(model=model, estimate=estimate, voltage_limit=estimate.voltage_limit, kp=kp, kd=kd)
+        built = build(found, params, context, spec=given, kind=kind)
+        read = frozenset(context.read)
+    else:
+        built = given()
+    if not isinstance(built, base):
+        raise ParameterError(f"{kind} {given!r} built {type(built).__name__}, not a controllers.{base.__name__}")
+    return built, read
+
+
+def builtin_class(name: str, kind: str) -> type:
+    """The class of a built-in law or tracker (:data:`BUILTIN_CONTROLLERS`, :data:`BUILTIN_TRACKERS`), read from
+    its module, which the ``controllers`` package imports: nothing is imported here."""
+    builtins = BUILTIN_CONTROLLERS if kind == "controller" else BUILTIN_TRACKERS
+    module_name, _, class_name = builtins[name].partition(":")
+    return getattr(sys.modules[module_name], class_name)
+
+
+def default_model(controller: Any, params: Mapping[str, Any] | None = None, *, cls: type | None = None) -> str:
+    """The model source a law runs with where the run names none: its class's ``default_model``
+    (:attr:`controllers.base.SteeringController.default_model`); 'paper' for computed-torque, pd and a
+    factory (its class is known only once built). ``cls``: the plug-in's class, already found."""
+    if cls is None and isinstance(controller, str) and is_builtin(controller):
+        cls = builtin_class(controller, "controller")
+    elif cls is None and isinstance(controller, str) and controller not in CONTROLLER_NAMES:
+        cls = resolve(controller, params, kind="controller")[0]
+    elif cls is None and isinstance(controller, SteeringController):
+        cls = type(controller)
+    model = getattr(cls, "default_model", "paper")
+    if model not in MODEL_SOURCES:
+        raise UnknownNameError(f"default_model of controller {getattr(cls, 'name', controller)!r}", str(model),
+                               MODEL_SOURCES)
+    return str(model)
 
 
 def _accepted(cls: type) -> list[str]:

@@ -157,3 +157,27 @@ def test_below_resolve_run_the_config_is_only_recorded():
 
     assert numbers(seen) == numbers(plain)
     assert all(np.array_equal(seen.rows[k], plain.rows[k], equal_nan=True) for k in plain.rows)
+
+
+def test_the_coercer_hands_resolve_run_what_it_read():
+    """coerce_with_classes reads each reference once and hands on what it read: the plug-in's class, the route, the
+    cart's parameter set and the plant's, and the record to_dict writes -- each what the package that owns it
+    gives on its own; resolve_run's parts are built from them."""
+    from wmr_mj.carts import load_cart
+    from wmr_mj.params import parameters_of_cart, with_params
+    from wmr_mj.reference.route import load_route
+    from wmr_mj.sim.coerce import coerce_with_classes
+    from wmr_mj.sim.config import RunConfig
+    from wmr_mj.sim.parts import resolve_run
+
+    given = {"cart": "c80-magmotor", "path": "agv-loop", "controller": MY_PID, "controller_params": {"ki": 20.0},
+             "m1": 700.0, "duration": 5.0}
+    typed = coerce_with_classes(RunConfig(**given))
+    assert typed.classes["controller"] is resolve(MY_PID)[0]
+    assert typed.route.text == load_route("agv-loop").text
+    assert typed.base == parameters_of_cart(load_cart("c80-magmotor"))
+    assert typed.plant == with_params(typed.base, m1=700.0)
+    assert typed.record == RunConfig.from_inputs(**given).to_dict()
+    parts = resolve_run(RunConfig(**given))
+    assert (parts.base, parts.plant, parts.record) == (typed.base, typed.plant, typed.record)
+    assert parts.route_length_m == float(load_route("agv-loop").path.length)

@@ -17,11 +17,14 @@ from wmr_mj.carts.cartfile import (
     PARAMETER_SECTIONS,
     CartFile,
     cart_names,
+    cart_of,
+    cart_of_text,
     cart_path,
     load_cart,
     load_cart_text,
 )
 from wmr_mj.carts.schema import SCHEMA_PATH, load_schema
 
-__all__ = ["CARTS_DIR", "CartFile", "DEFAULT_KEYS", "PARAMETER_SECTIONS", "SCHEMA_PATH", "cart_names", "cart_path",
+__all__ = ["CARTS_DIR", "CartFile", "DEFAULT_KEYS", "PARAMETER_SECTIONS", "SCHEMA_PATH", "cart_names", "cart_of",
+           "cart_of_text", "cart_path",
            "load_cart", "load_cart_text", "load_schema"]

@@ -35,6 +35,7 @@ Usage::
 
 from __future__ import annotations
 
+import functools
 import os
 import tomllib
 from collections.abc import Mapping
@@ -46,8 +47,8 @@ from typing import Any
 from wmr_mj.carts.schema import check_against_schema, load_schema
 from wmr_mj.errors import ParameterError
 
-__all__ = ["CARTS_DIR", "CartFile", "cart_names", "cart_path", "load_cart", "load_cart_text", "PARAMETER_SECTIONS",
-           "DEFAULT_KEYS"]
+__all__ = ["CARTS_DIR", "CartFile", "cart_names", "cart_path", "load_cart", "load_cart_text", "cart_of",
+           "cart_of_text", "PARAMETER_SECTIONS", "DEFAULT_KEYS"]
 
 #: The shipped carts (``NAME.toml``), inside the package: found from any folder and by an installed wheel.
 CARTS_DIR = Path(__file__).resolve().parent
@@ -103,6 +104,12 @@ class CartFile:
     default_sources: Mapping[str, str]
     text: str = ""
     default_path: str | None = None
+
+    def numbers(self) -> tuple[dict, dict, dict, str | None]:
+        """What a run reads of the cart: its parameters, its boxes, its defaults and its default path (two carts
+        of the same numbers run alike, whatever their names)."""
+        return (dict(self.parameters), {k: dict(v) for k, v in self.uncertainty.items()}, dict(self.defaults),
+                self.default_path)
 
     def __reduce__(self) -> tuple[Any, ...]:
         # the mappings are read-only proxies, which pickle refuses: a copy (a sweep's worker) reads the text again
@@ -273,3 +280,30 @@ def load_cart_text(text: str, *, path: str | os.PathLike[str] = "<text>") -> Car
     except ParameterError as exc:
         raise ParameterError(f"cart file {str(path)!r}: {exc}") from None
     return _cart_of(document, path, text)
+
+
+@functools.lru_cache(maxsize=8)
+def cart_of_text(text: str, path: str) -> CartFile:
+    """:func:`load_cart_text` of a run's cart record (its text and path), the last few kept: a typed config's cart
+    is read back from its record each time it is coerced again."""
+    return load_cart_text(text, path=path)
+
+
+def cart_of(given: Any) -> CartFile | None:
+    """The cart a run's config names (``RunConfig.cart``), read and checked: None for none; a :class:`CartFile` as
+    it is; a cart record (the mapping a run's record holds: its ``text`` and ``path``) read back from its text; a
+    shipped cart's name or a .toml file read (:func:`load_cart`).
+
+    Raises:
+        ParameterError: a missing file, an unknown name, a file its schema or rules refuse, another type (one line).
+    """
+    if given is None or isinstance(given, CartFile):
+        return given
+    if isinstance(given, Mapping):
+        if not isinstance(given.get("text"), str):
+            raise ParameterError(f"cart = {dict(given)!r} is not accepted: a cart record holds the file's 'text'")
+        return cart_of_text(given["text"], str(given.get("path", "<text>")))
+    if isinstance(given, (str, os.PathLike)):
+        return load_cart(given)
+    raise ParameterError(f"cart = {given!r} is not accepted: a shipped cart's name, a .toml cart file or a "
+                         "wmr_mj.carts.CartFile")

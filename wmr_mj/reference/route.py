@@ -52,6 +52,7 @@ Usage::
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import os
@@ -70,7 +71,7 @@ from wmr_mj.reference.paths import Path, Reference, Segment, SegmentKind, _s5_in
 
 __all__ = ["Route", "ROUTES_DIR", "route_names", "load_route", "parse_route", "route_from_path",
            "is_route_spec", "route_reference", "RouteProgress", "route_progress",
-           "route_length"]
+           "route_length", "route_of", "route_spec_of"]
 
 #: Routes shipped with the package, selectable by name (the file's stem).
 ROUTES_DIR = DATA_DIR / "routes"
@@ -460,6 +461,44 @@ def load_route(spec: str | os.PathLike) -> Route:
         kind = "JSON" if file.suffix.lower() == ".json" else "TOML"
         raise ParameterError(f"route file {text_spec}: not valid {kind} ({exc})") from None
     return parse_route(data, text_spec)
+
+
+def route_of(spec: str) -> Route:
+    """The route ``spec`` names (a packaged name, a .toml/.json file, canonical JSON; :func:`load_route`), read once
+    per version of its file: kept by the file's modification time and size, so an edited file is read again."""
+    file_key = None
+    if not spec.lstrip().startswith("{") and os.path.isfile(spec):
+        st = os.stat(spec)
+        file_key = (os.path.abspath(spec), st.st_mtime_ns, st.st_size)
+    return _route_of(spec, file_key)
+
+
+@functools.lru_cache(maxsize=16)
+def _route_of(spec: str, file_key: tuple | None) -> Route:
+    return load_route(spec)
+
+
+def route_spec_of(given: Any, *, named: tuple[str, ...]) -> tuple[str, Route | None]:
+    """(spec, route): C's path as a run's config keeps it, and the route it names, read once (:func:`route_of`).
+
+    A name of ``named`` (a path built by name) is kept as given, with no route; a route (a packaged name, a file,
+    canonical JSON) as given; a :class:`~wmr_mj.reference.paths.Path` as its canonical JSON; a :class:`Route` as
+    its file where it has one, else its canonical JSON. A malformed route raises here.
+
+    Raises:
+        UnknownNameError: neither a name of ``named`` nor a route. ParameterError: a malformed route, another type.
+    """
+    if isinstance(given, str) and given in named:
+        return given, None  # a named path: nothing to read
+    if isinstance(given, Path):
+        given = route_from_path(given).text
+    elif isinstance(given, Route):
+        given = given.text if given.source == "<text>" or not os.path.isfile(given.source) else given.source
+    elif not isinstance(given, str):
+        raise ParameterError(f"path = {given!r} is not accepted: a path name, a route file or a Path")
+    elif not is_route_spec(given):
+        raise UnknownNameError("path", given, named + route_names() + ("<route file .toml/.json>",))
+    return given, route_of(given)  # malformed: ParameterError naming the file and the segment
 
 
 def route_reference(route: Route, params: C80Parameters, *, dt: float, duration: float | None = None) -> Reference:

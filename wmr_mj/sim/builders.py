@@ -1,9 +1,10 @@
 """What follows from a run's configuration before any step: the controller's belief, the law and the tracker
 (fresh instances), C's reference on the control grid, the paper's analysis for the run's box.
 
-Each builder takes typed values, not the config: the law and tracker a :class:`LawSpec` (:func:`law_and_settings`,
-:func:`tracker_of`), the analysis a :class:`BoxSpec` and the reference bounds (:func:`analysis_of`), the reference
-a path and the belief (:func:`build_reference`). :func:`wmr_mj.sim.parts.resolve_run` reads a typed
+Each builder takes typed values, not the config: the law and tracker a :class:`LawSpec` (:func:`laws_of`, both in
+one call; :func:`law_and_settings`, :func:`tracker_of`), the analysis a :class:`BoxSpec` and the reference bounds
+(:func:`analysis_of`); the reference is built in its own layer from a path and the belief
+(:func:`wmr_mj.reference.named.build_reference`, re-exported here). :func:`wmr_mj.sim.parts.resolve_run` reads a typed
 :class:`~wmr_mj.sim.run_config.RunConfig` (:mod:`wmr_mj.sim.coerce`) into them once and calls each once per run;
 the functions that take a config (:func:`controller_for`, :func:`controller_and_settings`, :func:`tracker_for`,
 :func:`analysis_box`, :func:`analysis_for`) unpack it and call them. No builder reads a file of its own.
@@ -18,91 +19,39 @@ Usage::
 
 from __future__ import annotations
 
-import copy
-import functools
 import inspect
 import os
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
-
 from controllers import PathTracker, SteeringController, make_controller, model_from_source
-from controllers.base import BuildContext
 from controllers.computed_torque import CONTROLLER_NAMES
-from controllers.registry import build, resolve
+from controllers.registry import build_plugin, resolve
 from wmr_mj._util.checks import as_pair
 from wmr_mj.analysis.plant_box import derived_box
 from wmr_mj.analysis.robustness import ParameterBox, analyse
-from wmr_mj.errors import InfeasiblePathError, ParameterError, StiffReferenceError, UnknownNameError, WmrMjError
+from wmr_mj.errors import ParameterError
 from wmr_mj.params import C80, C80Parameters
-from wmr_mj.reference import paths as ref
 from wmr_mj.reference.bounds import ReferenceBounds
-from wmr_mj.reference.route import is_route_spec, route_names, route_reference
-from wmr_mj.sim.coerce import PATH_NAMES, coerced, route_of
+from wmr_mj.reference.named import (
+    LANE_CHANGE_LEAD_IN_M,
+    LANE_CHANGE_LENGTH_M,
+    REFERENCE_CACHE_SIZE,
+    build_reference,
+)
+from wmr_mj.sim.coerce import coerced
 from wmr_mj.sim.run_config import RunConfig
 
-__all__ = ["BoxSpec", "LawSpec", "estimate_parameters", "build_reference", "manoeuvre_length", "analysis_box",
-           "parameter_box", "analysis_for", "analysis_of", "reference_bounds_of", "run_bounds", "law_and_settings",
-           "tracker_of", "controller_for", "controller_and_settings", "LAW_SETTINGS", "declared_parameters",
-           "tracker_for", "has_tracker", "estimate_of", "config_from_dict"]
+__all__ = ["BoxSpec", "LawSpec", "estimate_parameters", "build_reference", "REFERENCE_CACHE_SIZE", "manoeuvre_length",
+           "analysis_box", "parameter_box", "analysis_for", "analysis_of", "reference_bounds_of", "run_bounds",
+           "law_and_settings", "tracker_of", "laws_of", "controller_for", "controller_and_settings", "LAW_SETTINGS",
+           "declared_parameters", "tracker_for", "has_tracker", "estimate_of", "config_from_dict"]
 
 
 def estimate_parameters(base: C80Parameters = C80) -> C80Parameters:
     """The controller's belief: the nominal parameter set (m1 = 650 kg)."""
     return base
-
-
-def build_reference(path: str, params: C80Parameters, *, dt: float, duration: float):
-    """(reference, settle_s) for a path of C on a grid of step dt: a named path (PATH_NAMES) or
-    a route (a packaged route name, a route file, canonical route JSON; a closed route is
-    repeated lap after lap to fill the duration).
-
-    settle_s is when the entry transient ends: for the paper's circle, the
-    time C enters the circle; 0 for the other paths.
-
-    The last :data:`REFERENCE_CACHE_SIZE` references are kept (a Reference's arrays are read-only):
-    runs that share a path, as a comparison's scenarios on one path or a sweep's chunks do, build it
-    once (it costs about a quarter of a 35 s run's physics). A route file is keyed by its
-    modification time and size as well as its name, so an edited file is read again.
-    """
-    file_key = None
-    if path not in PATH_NAMES and not path.lstrip().startswith("{") and os.path.isfile(path):
-        st = os.stat(path)
-        file_key = (os.path.abspath(path), st.st_mtime_ns, st.st_size)
-    return _cached_reference(path, file_key, params, float(dt), float(duration))
-
-
-#: references kept by :func:`build_reference`
-REFERENCE_CACHE_SIZE = 16
-
-
-@functools.lru_cache(maxsize=REFERENCE_CACHE_SIZE)
-def _cached_reference(path: str, file_key: tuple | None, params: C80Parameters, dt: float, duration: float):
-    try:
-        return _build_reference(path, params, dt=dt, duration=duration)
-    except StiffReferenceError:
-        raise
-    except InfeasiblePathError as exc:  # the path, the stops and the option that changes it, named
-        raise InfeasiblePathError(f"{exc} -- on path {path_label(path)}, with the cart's steering stops at "
-                                  f"+-{params.steering_range:g} rad; --path changes it (a path this cart steers: "
-                                  "e.g. a route of larger radius, or the cart file's [paths] default)") from None
-
-
-def path_label(path: str) -> str:
-    """What a message calls the path ``path``: its name, a route file's path, a route's own name for canonical JSON."""
-    if path in PATH_NAMES or not path.lstrip().startswith("{"):
-        return repr(path)
-    try:
-        return f"route {route_of(path).name!r}"
-    except WmrMjError:
-        return "a route given as JSON"
-
-
-#: the named path lane-change: a lead-in line, the lane change (lateral offset over a length), then a line that
-#: fills the duration [m]
-LANE_CHANGE_LEAD_IN_M, LANE_CHANGE_OFFSET_M, LANE_CHANGE_LENGTH_M = 0.5, 0.5, 4.0
 
 
 def manoeuvre_length(path: str) -> float | None:
@@ -113,30 +62,6 @@ def manoeuvre_length(path: str) -> float | None:
     if path == "lane-change":
         return LANE_CHANGE_LEAD_IN_M + LANE_CHANGE_LENGTH_M
     return None
-
-
-def _build_reference(path: str, params: C80Parameters, *, dt: float, duration: float):
-    """:func:`build_reference` without the cache."""
-    if path not in PATH_NAMES:
-        if not is_route_spec(path):
-            raise UnknownNameError("path", path, PATH_NAMES + route_names() + ("<route file .toml/.json>",))
-        return route_reference(route_of(path), params, dt=dt, duration=duration), 0.0
-    if path == "paper-circle":
-        p = ref.paper_circle(params, duration=duration)
-    elif path == "lane-change":
-        p = (ref.line(LANE_CHANGE_LEAD_IN_M) + ref.lane_change(LANE_CHANGE_OFFSET_M, LANE_CHANGE_LENGTH_M)
-             + ref.line(max(duration * params.V_A, 1.0)))
-    elif path == "figure-eight":
-        p = ref.line(0.5) + ref.figure_eight(1.5, laps=max(1, int(duration * params.V_A / 20.0) + 1))
-    else:
-        raise UnknownNameError("path", path, PATH_NAMES)
-    reference = ref.make_reference(p, params, dt=dt, duration=duration)
-    settle_s = 0.0
-    if path == "paper-circle":
-        circle_start = float(p.starts[-2])  # starts ends with the total length
-        reached = np.nonzero(np.asarray(reference.s) >= circle_start)[0]
-        settle_s = float(reference.t[reached[0]]) if reached.size else float(reference.t[-1])
-    return reference, settle_s
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -300,10 +225,19 @@ def law_and_settings(law: LawSpec, params: C80Parameters, *, classes: Mapping[st
         built = make_controller(given, model, kp=law.kp, kd=law.kd, friction_sign=law.friction_sign,
                                 friction_width=law.friction_width)
         return built, frozenset(_PD_SETTINGS if given == "pd" else LAW_SETTINGS)
-    read: set[str] = set()
-    built = _plugin_for(law, params, "controller", given, law.controller_params, SteeringController, model,
-                        read=read, classes=classes)
-    return built, frozenset(read)
+    return build_plugin(given, law.controller_params, kind="controller", estimate=params, kp=law.kp, kd=law.kd,
+                        model=model, cls=(classes or {}).get("controller"))
+
+
+def laws_of(law: LawSpec, params: C80Parameters, *, classes: Mapping[str, type] | None = None
+            ) -> tuple[SteeringController, frozenset[str], PathTracker | None]:
+    """(law, the settings it reads, tracker): :func:`law_and_settings` and :func:`tracker_of` in one call, each a
+    fresh instance on the belief ``params`` (:func:`wmr_mj.sim.parts.resolve_run` builds a run's two laws here)."""
+    controller, settings = law_and_settings(law, params, classes=classes)
+    tracker, _ = build_plugin(law.tracker, law.tracker_params, kind="tracker", estimate=params, kp=law.kp, kd=law.kd,
+                              model_source=law.model, identified=law.identified, coefficients=law.coefficients,
+                              cls=(classes or {}).get("tracker"))  # as tracker_of builds it
+    return controller, settings, tracker
 
 
 def declared_parameters(spec: str) -> frozenset[str]:
@@ -328,37 +262,11 @@ def tracker_for(config: RunConfig, params: C80Parameters, *, classes: Mapping[st
 
 def tracker_of(law: LawSpec, params: C80Parameters, *, classes: Mapping[str, type] | None = None):
     """A fresh instance of the run's path tracker (:class:`controllers.tracking.PathTracker`), None without one;
-    built as :func:`controller_for` builds a plug-in."""
-    if law.tracker is None:
-        return None
-    return _plugin_for(law, params, "tracker", law.tracker, law.tracker_params, PathTracker, classes=classes)
-
-
-def _plugin_for(law: LawSpec, params: C80Parameters, kind: str, given: Any, plugin_params: Mapping[str, Any],
-                base: type, model: Any = None, read: set[str] | None = None,
-                classes: Mapping[str, type] | None = None) -> Any:
-    """A fresh instance of a plug-in (law or tracker): an object deep-copied, a name resolved and built with its
-    parameters on the run's context (``model``: the run's reduced model, built here where None), a factory
-    called; checked to be a ``base``. ``read``: a set given here receives the context's settings the build
-    read (``BuildContext.read``)."""
-    if isinstance(given, base):
-        return copy.deepcopy(given)
-    if isinstance(given, str):
-        found = (classes or {}).get(kind) if given == getattr(law, kind) else None
-        cls = found if found is not None else resolve(given, plugin_params, kind=kind)[0]
-        if model is None:
-            model = model_from_source(law.model, params=params, identified=law.identified,
-                                      coefficients=law.coefficients)
-        context = BuildContext(model=model, estimate=params, voltage_limit=params.voltage_limit, kp=law.kp,
-                               kd=law.kd)
-        built = build(cls, plugin_params, context, spec=given, kind=kind)
-        if read is not None:
-            read.update(context.read)
-    else:
-        built = given()
-    if not isinstance(built, base):
-        raise ParameterError(f"{kind} {given!r} built {type(built).__name__}, not a controllers.{base.__name__}")
-    return built
+    built as :func:`controller_for` builds a plug-in (:func:`controllers.registry.build_plugin`)."""
+    tracker, _ = build_plugin(law.tracker, law.tracker_params, kind="tracker", estimate=params, kp=law.kp, kd=law.kd,
+                              model_source=law.model, identified=law.identified, coefficients=law.coefficients,
+                              cls=(classes or {}).get("tracker"))
+    return tracker
 
 
 def has_tracker(config: RunConfig) -> bool:

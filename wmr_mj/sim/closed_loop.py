@@ -44,6 +44,7 @@ from wmr_mj.analysis.verdicts import Drift
 from wmr_mj.errors import ParameterError, WmrMjError
 from wmr_mj.params import C80, C80Parameters
 from wmr_mj.plant.mjcf import TIMESTEP, scene_xml
+from wmr_mj.reference.route import RouteProgress
 from wmr_mj.sim.config import (
     RunConfig,
     estimate_parameters,
@@ -56,7 +57,7 @@ from wmr_mj.sim.engine import (
     run_engine,
 )
 from wmr_mj.sim.log_header import LogHeader
-from wmr_mj.sim.measured_errors import with_measured_errors
+from wmr_mj.sim.measured_errors import measured_errors_assumption
 from wmr_mj.sim.parts import RunLabels, RunParts, control_substeps, resolve_run, run_reference
 from wmr_mj.sim.run_report import run_report
 from wmr_mj.sim.summary import RunSummary, voltage_effort
@@ -404,7 +405,7 @@ def run_closed_loop(
 
 def _labels(parts: RunParts) -> RunLabels:
     """The run's labels, as ``resolve_run`` read them (parts made elsewhere, without them: from the config)."""
-    return parts.labels if parts.labels is not None else RunLabels.of(parts.config, name=parts.controller_name)
+    return parts.labels if parts.labels is not None else RunLabels.named(parts.config, parts.controller_name)
 
 
 def _record(parts: RunParts) -> dict[str, Any]:
@@ -416,6 +417,7 @@ def run_parts(parts: RunParts, *, logger_factory: Callable[..., Any] | None = No
               law: str = "auto") -> RunResult:
     """:func:`run_closed_loop` of a config already resolved (:func:`wmr_mj.sim.parts.resolve_run`)."""
     config, params, controller, outer = parts.config, parts.plant, parts.controller, parts.tracker
+    labels = _labels(parts)
     dt, substeps, period, n = TIMESTEP, parts.substeps, parts.period, parts.n
     reference, settle_s, analysis = parts.reference, parts.settle_s, parts.analysis
     a0_all, a0d_all, a0dd_all = reference.alpha0, reference.alpha0_dot, reference.alpha0_ddot
@@ -458,9 +460,7 @@ def run_parts(parts: RunParts, *, logger_factory: Callable[..., Any] | None = No
                 logger.close({"status": "failed", "failure": run.failure}, status="failed")
             raise ControllerFailure(run.failure)  # nothing simulated: nothing to judge
         raise KeyboardInterrupt  # nothing simulated: nothing to report
-    claims = _measured_claims(parts, done)
-    if run.warnings and LAW_CLAIM in claims:  # a run MuJoCo warned of is not the plant any claim is of
-        claims[LAW_CLAIM] = with_mujoco_warnings(claims[LAW_CLAIM], run.warnings, run.warning_text)
+    claims = _measured_claims(parts, done, warnings=run.warnings, warning_text=run.warning_text)
     certificate = claims.get(LAW_CLAIM)  # the run's verdict is the law's claim's
     after = done["t"] >= settle_s
     at = path_sample_index(k, period)
@@ -474,18 +474,20 @@ def run_parts(parts: RunParts, *, logger_factory: Callable[..., Any] | None = No
                            effort=voltage_effort(done["voltage"], period))
     path = judge_path(reference, done["t"][at], run.C_xy[at], done["heading"][at], settle_s=settle_s,
                       certificate=certificate, steering_range=params.steering_range, corrected=outer is not None)
-    summary = report(_labels(parts), measured, analysis=analysis, params=params,
+    summary = report(labels, measured, analysis=analysis, params=params,
                      certificate=None if run.failure is not None else certificate, claims_nothing=certificate is None,
                      drift=_drift_of(done["E"], done["alpha0_dot"][-1] - done["E_dot"][-1], period),
                      path=path)
+    # every claim judged against the run's sup errors, beside the law's (the summary's verdict)
+    judged = {} if run.failure is not None else {
+        name: summary.certificate if name == LAW_CLAIM and summary.certificate is not None
+        else judge(cert, summary.sup_E, summary.sup_Edot) for name, cert in claims.items()}
     if outer is not None:
         summary = dataclasses.replace(summary, correction=outer.describe(done))
     summary = dataclasses.replace(summary, mujoco_warnings=run.warnings, failure=run.failure,
                                   paper_law=parts.paper_law, law_settings=parts.law_settings,
                                   analysis=analysis.to_dict(), controller_config=controller.describe())
     if parts.route_length_m is not None:
-        from wmr_mj.reference.route import RouteProgress
-
         summary = dataclasses.replace(summary, route=RouteProgress.along(parts.route_length_m, reference,
                                                                          summary.duration))
     if logger is not None:
@@ -493,9 +495,6 @@ def run_parts(parts: RunParts, *, logger_factory: Callable[..., Any] | None = No
     path_samples = None
     if path is not None and path.series is not None and path.series.t.size == at.size:  # every sample finite
         path_samples = (at, path.series.cross_track)
-    judged = {} if run.failure is not None else {
-        name: summary.certificate if name == LAW_CLAIM and summary.certificate is not None
-        else judge(cert, summary.sup_E, summary.sup_Edot) for name, cert in claims.items()}
     return RunResult(config=config, rows=done, summary=summary, status=status, law=run.law, law_note=run.law_note,
                      C_xy=run.C_xy, cpu_s=run.cpu_s, reference=reference, path_samples=path_samples, claims=judged)
 
@@ -508,23 +507,41 @@ def with_mujoco_warnings(certificate: Any, count: int, text: str | None) -> Any:
     """``certificate`` with the assumption :data:`MUJOCO_WITHOUT_WARNINGS` unmet: MuJoCo warned ``count`` times
     during the run (``text``: its first warning, as MuJoCo words it), so the steps it warned of (a NaN, an
     unstable acceleration, a singular inertia) are not the plant the claim is of, and the run is not certified."""
+    return with_measured(certificate, mujoco_warnings_assumption(count, text))
+
+
+def mujoco_warnings_assumption(count: int, text: str | None) -> Assumption:
+    """The assumption :data:`MUJOCO_WITHOUT_WARNINGS`, unmet: MuJoCo warned ``count`` times (``text``: its first
+    warning) during the run (:func:`with_mujoco_warnings`)."""
     first = f"MuJoCo's first: {text.strip()}" if text else "MuJoCo's warning counters rose"
-    return with_measured(certificate, Assumption(
-        name=MUJOCO_WITHOUT_WARNINGS, equation="MuJoCo's warnings during the run = 0", met=False,
-        value=float(count), limit=0.0, note=f"{count} warning(s); {first}"))
+    return Assumption(name=MUJOCO_WITHOUT_WARNINGS, equation="MuJoCo's warnings during the run = 0", met=False,
+                      value=float(count), limit=0.0, note=f"{count} warning(s); {first}")
 
 
-def _measured_claims(parts: RunParts, rows: Mapping[str, np.ndarray]) -> dict[str, Any]:
-    """Each of the run's claims (``parts.claims``, by name) with what the run measured of its assumptions: the
-    tracker's declared bounds on the reference the law received, and the sensing's error bounds on what the
-    law read (:func:`with_measured_errors`)."""
+def _measured_claims(parts: RunParts, rows: Mapping[str, np.ndarray], *, warnings: int = 0,
+                     warning_text: str | None = None) -> dict[str, Any]:
+    """Each of the run's claims (``parts.claims``, by name) with what the run measured of its assumptions, each
+    measured once and handed to every claim: the tracker's declared bounds on the reference the law received,
+    the sensing's error bounds on what the law read (:func:`measured_errors_assumption`, where its claim's
+    sensing was covered), and, for the law's claim, MuJoCo's warnings (:func:`with_mujoco_warnings`: a run MuJoCo
+    warned of is not the plant any claim is of)."""
+    sensing, measurement = parts.sensing, parts.measurement
+    errors = None
+    if not sensing.is_ideal and "alpha_measured" in rows and measurement.covered:
+        errors = measured_errors_assumption(rows, measurement, delay_steps=sensing.delay_steps(parts.period),
+                                            velocity_bounded=sensing.velocity in ("exact", "tachometer"))
+    warned = mujoco_warnings_assumption(warnings, warning_text) if warnings else None
+    declared = None
+    if parts.tracker is not None:
+        declared = within_declared(rows, parts.tracker.declared_bounds(parts.reference_bounds),
+                                   tracker=parts.tracker.name)
     out = {}
     for name, cert in parts.claims.items():
-        if parts.tracker is not None:
-            cert = with_measured(cert, within_declared(rows, parts.tracker.declared_bounds(parts.reference_bounds),
-                                                       tracker=parts.tracker.name))
-        out[name] = with_measured_errors(cert, sensing=parts.sensing, measurement=parts.measurement, rows=rows,
-                                         period=parts.period)
+        measured = (declared, errors, warned if name == LAW_CLAIM else None)
+        for assumption in measured:  # in this order: the claim's assumptions keep the order they always had
+            if assumption is not None:
+                cert = with_measured(cert, assumption)
+        out[name] = cert
     return out
 
 

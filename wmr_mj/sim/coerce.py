@@ -24,21 +24,20 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
-import os
-import sys
 from collections.abc import Mapping
+from dataclasses import dataclass
 from types import SimpleNamespace
 from typing import Any
 
 from controllers import SteeringController
-from controllers.base import describe_params
 from controllers.computed_torque import CONTROLLER_NAMES, FRICTION_SIGNS, MODEL_SOURCES
-from controllers.registry import BUILTIN_CONTROLLERS, BUILTIN_TRACKERS, PluginSource, is_builtin, resolve, source_hash
+from controllers.registry import PluginSource, default_model, plugin_fresh, plugin_of
 from controllers.tracking import PathTracker
-from wmr_mj.carts import CartFile, load_cart, load_cart_text
+from wmr_mj.carts import CartFile, cart_of, cart_of_text
 from wmr_mj.carts.cartfile import MOTOR_CONSTANT_RTOL
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.hardware import Actuation, Sensing, Transmission, check_cart, is_ideal_cart
+from wmr_mj.hardware.cart import CART_PARTS, cart_dict
 from wmr_mj.params import (
     C80,
     C80_CART,
@@ -51,15 +50,15 @@ from wmr_mj.params import (
 )
 from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS, TIMESTEP, TYRE_CONTACT_MODELS
 from wmr_mj.reference.bounds import ReferenceBounds, reference_bounds_from
-from wmr_mj.reference.paths import Path as PathOfC
-from wmr_mj.reference.route import Route, is_route_spec, load_route, route_from_path, route_names
+from wmr_mj.reference.named import PATH_NAMES
+from wmr_mj.reference.route import Route, route_of, route_spec_of
 from wmr_mj.sim.signals import Signals, signals_from
 
 __all__ = ["PATH_NAMES", "DEFAULT_PATH", "default_path", "cart_file_of_record", "coerce", "m1_of_overrides",
-           "coerce_with_classes", "is_coerced", "check_fields", "route_of", "cart_file", "base_for", "plant_parameters",
-           "plugin_source", "controller_source", "controller_name", "default_model", "check_motor_constant", "coerced"]
+           "coerce_with_classes", "Coerced", "is_coerced", "check_fields", "route_of", "cart_file", "base_for",
+           "plant_parameters", "base_of_record", "plugin_source", "controller_source", "controller_name", "law_name",
+           "default_model", "check_motor_constant", "coerced", "record_of"]
 
-PATH_NAMES = ("paper-circle", "lane-change", "figure-eight")
 #: the path of a run that names none, on a cart that declares none (``[paths] default`` declares a cart's own)
 DEFAULT_PATH = "paper-circle"
 
@@ -236,44 +235,126 @@ def coerce(config: Any) -> Any:
         ParameterError, UnknownNameError: a cart, plug-in, route, signals or part that cannot be read or is
             refused, in one line.
     """
-    return coerce_with_classes(config, classes=False)[0]
+    return coerce_with_classes(config, classes=False).config
 
 
-def coerce_with_classes(config: Any, *, classes: bool = True) -> tuple[Any, dict[str, type]]:
-    """:func:`coerce`, and the class of each plug-in given by name (kind -> class), found in the same pass: a run
-    builds its law from it without importing it again (:func:`wmr_mj.sim.parts.resolve_run`). ``classes``
-    False: a plug-in whose source the config already holds is not looked up again (none returned)."""
-    changes: dict[str, Any] = {}
-    cart = _cart_record(config.cart)
-    changes["cart"] = cart
-    if config.m1 is None:
-        changes["m1"] = M1_NOMINAL if cart is None else _cart_of_text(cart["text"], cart["path"]).parameters["m1"]
-    if config.m1_range is None:
-        changes["m1_range"] = (M1_RANGE if cart is None
-                               else _cart_of_text(cart["text"], cart["path"]).uncertainty["m1"]["m1"])
+@dataclass(frozen=True)
+class Coerced:
+    """What :func:`coerce_with_classes` read: the typed config, and what it found on the way that a run builds on.
+
+    Attributes:
+        config: the config with every field typed.
+        classes: the class of each plug-in given by name (kind -> class): the run builds its law from it without
+            importing it again.
+        route: the route C's path names (:class:`wmr_mj.reference.route.Route`), None for a named path.
+        base: the run's base parameter set: the cart's (the C80's without one), or the one the caller gave.
+        plant: the plant's parameter set: ``base`` with m1 and the overrides.
+        record: the config's record (:func:`record_of`: ``RunConfig.to_dict()``), as a run's log keeps it.
+    """
+
+    config: Any
+    classes: Mapping[str, type]
+    route: Route | None
+    base: C80Parameters
+    plant: C80Parameters
+    record: Mapping[str, Any]
+
+
+def coerce_with_classes(config: Any, *, classes: bool = True, base: C80Parameters = C80) -> Coerced:
+    """:func:`coerce`, with the class of each plug-in given by name and the route, found in the same pass
+    (:class:`Coerced`): a run builds its law from them without importing or reading again
+    (:func:`wmr_mj.sim.parts.resolve_run`). ``classes`` False: a plug-in whose source the config already holds is
+    not looked up again (none returned). ``base``: the base parameter set of the run; where it is the default (the
+    C80), the cart's (:func:`base_for`).
+
+    Each reference goes down once to the package that types it, which does its whole job: the signals
+    (:mod:`wmr_mj.sim.signals`), each plug-in and the law's default model (:mod:`controllers.registry`), the
+    reference bounds (:mod:`wmr_mj.reference.bounds`), the cart (:mod:`wmr_mj.carts`, its parameters checked by
+    :mod:`wmr_mj.params`), C's path (:mod:`wmr_mj.reference.route`), the cart's parts (:mod:`wmr_mj.hardware`).
+    """
+    changes: dict[str, Any] = {"signals": signals_from(config.signals)}
     found: dict[str, type] = {}
     for kind in ("controller", "tracker"):
-        changes[f"{kind}_params"] = dict(getattr(config, f"{kind}_params"))
-        if classes or not _plugin_fresh(config, kind):
-            source, cls = _plugin_of(config, kind)
-            changes[f"{kind}_plugin"] = source
-            if cls is not None:
-                found[kind] = cls
+        params = getattr(config, f"{kind}_params")
+        changes[f"{kind}_params"] = dict(params)
+        source, cls = plugin_of(getattr(config, kind), params, kind=kind, recorded=getattr(config, f"{kind}_plugin"),
+                                look_up=classes)
+        changes[f"{kind}_plugin"] = source
+        if cls is not None:
+            found[kind] = cls
     if config.model is None:
         changes["model"] = default_model(config.controller, config.controller_params, cls=found.get("controller"))
-    changes["path"] = _checked_path(default_path(cart_file_of_record(cart)) if config.path is None else config.path)
-    changes["signals"] = signals_from(config.signals)
     changes["reference_bounds"] = reference_bounds_from(config.reference_bounds)
-    cart_file_ = None if cart is None else _cart_of_text(cart["text"], cart["path"])
+    cart = cart_of(config.cart)
+    if cart is not None and cart.numbers() == C80_CART.numbers():
+        cart = None  # the C80's numbers: the C80, and its record unchanged
+    changes["cart"] = None if cart is None else {"name": cart.name, "version": cart.version, "path": str(cart.path),
+                                                 "text": cart.text}
+    if config.m1 is None:
+        changes["m1"] = M1_NOMINAL if cart is None else cart.parameters["m1"]
+    if config.m1_range is None:
+        changes["m1_range"] = M1_RANGE if cart is None else cart.uncertainty["m1"]["m1"]
+    path = default_path(cart) if config.path is None else config.path
+    path, route = route_spec_of(path, named=PATH_NAMES)
+    changes["path"] = path
     for name, cls_ in _PARTS:
         given = getattr(config, name)
-        if given is None and cart_file_ is not None:  # the cart's default sensing, actuation and play
-            default = cart_file_.defaults["backlash" if name == "transmission" else name]
+        if given is None and cart is not None:  # the cart's default sensing, actuation and play
+            default = cart.defaults["backlash" if name == "transmission" else name]
             given = Transmission(backlash=default) if name == "transmission" else default
         changes[name] = given if isinstance(given, cls_) else cls_.from_spec(given)
-    coerced = dataclasses.replace(config, **changes)
-    _check_typed(coerced)
-    return coerced, found
+    typed = dataclasses.replace(config, **changes)
+    # the parameter sets the cart's parts are checked against (the cart's, checked here: a value the parameter set
+    # refuses, one line), and the run's: the same where the run's base is the default
+    checked_base = base_of_record(typed.cart, C80)
+    checked_plant = with_params(checked_base, m1_inertia=typed.m1_inertia, m1=typed.m1, **dict(typed.plant_overrides))
+    _check_parts(typed, checked_base, checked_plant)
+    plant = checked_plant if base is C80 else with_params(base, m1_inertia=typed.m1_inertia, m1=typed.m1,
+                                                          **dict(typed.plant_overrides))
+    return Coerced(config=typed, classes=found, route=route, base=checked_base if base is C80 else base, plant=plant,
+                   record=record_of(typed))
+
+
+def record_of(config: Any) -> dict[str, Any]:
+    """:meth:`RunConfig.to_dict` of a typed config (:func:`coerce`): its fields as JSON-able data,
+    read with nothing coerced (:func:`coerce_with_classes` takes a run's record here, once)."""
+    d = dataclasses.asdict(config)
+    del d["controller_plugin"], d["tracker_plugin"]
+    if config.signals is None:
+        del d["signals"]  # a run without signals keeps the keys it always had
+    else:
+        d["signals"] = config.signals.to_dict()
+    if not config.correction:
+        del d["correction"]  # the configs written before the correction existed, unchanged
+    # likewise the plug-in keys, only where a plug-in runs
+    for kind in ("controller", "tracker"):
+        given = getattr(config, kind)
+        if not getattr(config, f"{kind}_params"):
+            del d[f"{kind}_params"]
+        else:
+            d[f"{kind}_params"] = dict(getattr(config, f"{kind}_params"))
+        source = getattr(config, f"{kind}_plugin")
+        if source is not None:
+            d[f"{kind}_plugin"] = source.to_dict()
+            if not isinstance(given, str):
+                d[kind] = source.name  # an object: its name (the plugin record says where it came from)
+    if config.tracker is None:
+        del d["tracker"]
+    for name in CART_PARTS:  # likewise: only the parts of the cart that are not ideal
+        del d[name]
+    d.update(cart_dict(config))
+    if config.cart is None:
+        del d["cart"]  # likewise: a C80 run's record as it always was
+    if config.reference_bounds is None:
+        del d["reference_bounds"]  # likewise
+    else:
+        d["reference_bounds"] = config.reference_bounds.to_dict()
+    d["plant_overrides"] = dict(config.plant_overrides)
+    d["m1_range"] = list(config.m1_range)
+    d["box_ranges"] = {k: list(v) for k, v in config.box_ranges.items()}
+    if config.identified is not None and not isinstance(config.identified, (str, bytes)):
+        d["identified"] = dict(config.identified.get("identified", config.identified))
+    return d
 
 
 def is_coerced(config: Any) -> bool:
@@ -285,19 +366,13 @@ def is_coerced(config: Any) -> bool:
             and (config.signals is None or isinstance(config.signals, Signals))
             and (config.reference_bounds is None or isinstance(config.reference_bounds, ReferenceBounds))
             and isinstance(config.path, str)
-            and all(_plugin_fresh(config, kind) for kind in ("controller", "tracker")))
+            and all(plugin_fresh(getattr(config, kind), getattr(config, f"{kind}_params"),
+                                 getattr(config, f"{kind}_plugin"), kind=kind) for kind in ("controller", "tracker")))
 
 
 def coerced(config: Any) -> Any:
     """``config`` itself where it is typed, else :func:`coerce`'d (a convenience for a config built directly)."""
     return config if is_coerced(config) else coerce(config)
-
-
-def _check_typed(config: Any) -> None:
-    """The checks that need the typed fields (:func:`_check_parts`) on the config's base and plant."""
-    base = _base_of_record(config.cart, C80)
-    _check_parts(config, base, with_params(base, m1_inertia=config.m1_inertia, m1=config.m1,
-                                           **dict(config.plant_overrides)))
 
 
 def _check_parts(config: Any, base: C80Parameters, plant: C80Parameters) -> None:
@@ -313,41 +388,7 @@ def _check_parts(config: Any, base: C80Parameters, plant: C80Parameters) -> None
 
 
 # --------------------------------------------------------------------------- the cart
-def _cart_record(given: Any) -> dict[str, str] | None:
-    """The cart's record ({"name", "version", "path", "text"}), None for the C80 (or a cart of its numbers).
-
-    Raises:
-        ParameterError: a missing file, an unknown name, a file its schema or rules refuse (one line).
-    """
-    cart: CartFile | None
-    if given is None:
-        return None
-    if isinstance(given, CartFile):
-        cart = given
-    elif isinstance(given, Mapping):
-        if not isinstance(given.get("text"), str):
-            raise ParameterError(f"cart = {dict(given)!r} is not accepted: a cart record holds the file's 'text'")
-        cart = _cart_of_text(given["text"], str(given.get("path", "<text>")))
-    elif isinstance(given, (str, os.PathLike)):
-        cart = load_cart(given)
-    else:
-        raise ParameterError(f"cart = {given!r} is not accepted: a shipped cart's name, a .toml cart file or a "
-                             "wmr_mj.carts.CartFile")
-    if _numbers_of(cart) == _numbers_of(C80_CART):
-        return None  # the C80's numbers: the C80, and its record unchanged
-    parameters_of_cart(cart)  # a value the parameter set refuses: one line now
-    return {"name": cart.name, "version": cart.version, "path": str(cart.path), "text": cart.text}
-
-
-def _numbers_of(cart: Any) -> tuple[dict, dict, dict, str | None]:
-    """What a run reads of a cart: its parameters, its boxes, its defaults and its default path."""
-    return (dict(cart.parameters), {k: dict(v) for k, v in cart.uncertainty.items()}, dict(cart.defaults),
-            cart.default_path)
-
-
-@functools.lru_cache(maxsize=8)
-def _cart_of_text(text: str, path: str) -> CartFile:
-    return load_cart_text(text, path=path)
+_cart_of_text = cart_of_text  # a cart record's CartFile, the last few kept (wmr_mj.carts.cart_of_text)
 
 
 @functools.lru_cache(maxsize=8)
@@ -376,11 +417,11 @@ def cart_file(config: Any) -> Any:
 def base_for(config: Any, base: C80Parameters = C80) -> C80Parameters:
     """The base parameter set of a run: the config's cart's where ``base`` is the default (the C80) and the
     config names a cart; else ``base``."""
-    return _base_of_record(coerced(config).cart, base)
+    return base_of_record(coerced(config).cart, base)
 
 
-def _base_of_record(record: Mapping[str, str] | None, base: C80Parameters) -> C80Parameters:
-    """:func:`base_for` of a typed config's cart record."""
+def base_of_record(record: Mapping[str, str] | None, base: C80Parameters = C80) -> C80Parameters:
+    """:func:`base_for` of a typed config's cart record (``config.cart``): read, nothing coerced."""
     if record is None or base is not C80:
         return base
     return _parameters_of_text(record["text"], record["path"])
@@ -395,119 +436,7 @@ def plant_parameters(config: Any, base: C80Parameters = C80) -> C80Parameters:
 
 
 # --------------------------------------------------------------------------- the path
-def _checked_path(p: Any) -> str:
-    """A path name, a route (name, file, canonical JSON) as given, a Path or Route object as its canonical JSON
-    (or its file); a malformed route raises here.
-
-    Raises:
-        UnknownNameError: neither a path name nor a route. ParameterError: a malformed route, another type.
-    """
-    if isinstance(p, str) and p in PATH_NAMES:
-        return p  # a named path: nothing to read
-    if isinstance(p, PathOfC):
-        return route_from_path(p).text
-    if isinstance(p, Route):
-        return p.text if p.source == "<text>" or not os.path.isfile(p.source) else p.source
-    if not isinstance(p, str):
-        raise ParameterError(f"path = {p!r} is not accepted: a path name, a route file or a Path")
-    if not is_route_spec(p):
-        raise UnknownNameError("path", p, PATH_NAMES + route_names() + ("<route file .toml/.json>",))
-    route_of(p)  # malformed: ParameterError naming the file and the segment
-    return p
-
-
-def route_of(spec: str) -> Route:
-    """The route ``spec`` names (a packaged name, a .toml/.json file, canonical JSON), read once per version of
-    its file: kept by the file's modification time and size, so an edited file is read again."""
-    file_key = None
-    if not spec.lstrip().startswith("{") and os.path.isfile(spec):
-        st = os.stat(spec)
-        file_key = (os.path.abspath(spec), st.st_mtime_ns, st.st_size)
-    return _route_of(spec, file_key)
-
-
-@functools.lru_cache(maxsize=16)
-def _route_of(spec: str, file_key: tuple | None) -> Route:
-    return load_route(spec)
-
-
 # --------------------------------------------------------------------------- plug-ins
-def _plugin_of(config: Any, kind: str) -> tuple[PluginSource | None, type | None]:
-    """(source, class) of the config's law (or tracker): None for a law built from the config's fields and for no
-    tracker; a name resolved (imported, its source hashed) unless the config already holds its source, whose
-    class is then found again; an object's or factory's source from its class."""
-    given = getattr(config, kind)
-    if kind == "tracker" and given is None:
-        return None, None
-    if isinstance(given, str):
-        if kind == "controller" and given in CONTROLLER_NAMES:
-            return None, None
-        cls, source = resolve(given, getattr(config, f"{kind}_params"), kind=kind)
-        return source, cls
-    return _instance_source(given, kind), None
-
-
-def _plugin_fresh(config: Any, kind: str) -> bool:
-    """Whether the config's plug-in source is the one of its law (or tracker) as given now."""
-    given, source = getattr(config, kind), getattr(config, f"{kind}_plugin")
-    if given is None or (kind == "controller" and isinstance(given, str) and given in CONTROLLER_NAMES):
-        return source is None
-    if source is None:
-        return False
-    if isinstance(given, str):
-        return source.spec == given.strip() and dict(source.params) == describe_params(
-            getattr(config, f"{kind}_params"))
-    if not isinstance(given, SteeringController if kind == "controller" else PathTracker):
-        return source.origin == "instance"  # a factory: its record, made by calling it once when coerced
-    cls = type(given)
-    return (source.origin == "instance" and source.import_path == f"{cls.__module__}:{cls.__qualname__}"
-            and dict(source.params) == _described(given, kind))
-
-
-def _described(given: Any, kind: str) -> dict[str, Any]:
-    """The parameters an object's ``describe()`` gives, as its PluginSource records them."""
-    describe = getattr(given, "describe", None)
-    params = {}
-    if callable(describe):
-        params = {k: v for k, v in describe().items() if k not in (kind, "law")}
-    return describe_params(params)
-
-
-def _instance_source(given: Any, kind: str) -> PluginSource:
-    """The PluginSource of a law (or tracker) given as an object or a factory."""
-    if callable(given) and not hasattr(given, "describe"):
-        given = given()  # a factory (a class or a function): what it builds names the plug-in
-    cls = type(given)
-    return PluginSource(spec=f"{cls.__module__}:{cls.__qualname__}", name=str(getattr(given, "name", cls.__name__)),
-                        origin="instance", import_path=f"{cls.__module__}:{cls.__qualname__}",
-                        params=_described(given, kind), source_sha256=source_hash(cls))
-
-
-def builtin_class(name: str, kind: str) -> type:
-    """The class of a built-in law or tracker (``controllers.registry.BUILTIN_CONTROLLERS``/``BUILTIN_TRACKERS``),
-    read from its module, which the ``controllers`` package imports: nothing is imported here."""
-    builtins = BUILTIN_CONTROLLERS if kind == "controller" else BUILTIN_TRACKERS
-    module_name, _, class_name = builtins[name].partition(":")
-    return getattr(sys.modules[module_name], class_name)
-
-
-def default_model(controller: Any, params: Mapping[str, Any] | None = None, *, cls: type | None = None) -> str:
-    """The model source a law runs with where the run names none: its class's ``default_model``
-    (:attr:`controllers.base.SteeringController.default_model`); 'paper' for computed-torque, pd and a
-    factory (its class is known only once built). ``cls``: the plug-in's class, already found."""
-    if cls is None and isinstance(controller, str) and is_builtin(controller):
-        cls = builtin_class(controller, "controller")
-    elif cls is None and isinstance(controller, str) and controller not in CONTROLLER_NAMES:
-        cls = resolve(controller, params, kind="controller")[0]
-    elif cls is None and isinstance(controller, SteeringController):
-        cls = type(controller)
-    model = getattr(cls, "default_model", "paper")
-    if model not in MODEL_SOURCES:
-        raise UnknownNameError(f"default_model of controller {getattr(cls, 'name', controller)!r}", str(model),
-                               MODEL_SOURCES)
-    return str(model)
-
-
 def plugin_source(config: Any, kind: str = "controller") -> PluginSource | None:
     """Where the run's controller (or tracker) comes from (:class:`controllers.registry.PluginSource`),
     as its log records it; None for the computed-torque and PD laws built from the config's fields and
@@ -525,5 +454,10 @@ def controller_source(config: Any) -> dict[str, Any] | None:
 
 def controller_name(config: Any) -> str:
     """What every output calls the run's steering law: a built-in's name, a plug-in's ``name``."""
-    source = plugin_source(config, "controller")
+    return law_name(coerced(config))
+
+
+def law_name(config: Any) -> str:
+    """:func:`controller_name` of a typed config (its ``controller_plugin`` found): read, nothing coerced."""
+    source = config.controller_plugin
     return str(config.controller) if source is None else source.name

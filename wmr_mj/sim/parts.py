@@ -28,28 +28,24 @@ from wmr_mj.analysis.claim_types import LAW_CLAIM, Claims, claim_set
 from wmr_mj.analysis.measurement import MeasurementErrors
 from wmr_mj.errors import ParameterError
 from wmr_mj.hardware import Actuation, Sensing, Transmission
-from wmr_mj.params import C80, C80Parameters
+from wmr_mj.params import C80, C80Parameters, with_params
 from wmr_mj.plant.mjcf import TIMESTEP
+from wmr_mj.reference.named import build_reference
 from wmr_mj.sim.builders import (
     BoxSpec,
     LawSpec,
     analysis_of,
-    build_reference,
     estimate_of,
     estimate_parameters,
-    law_and_settings,
+    laws_of,
     manoeuvre_length,
-    run_bounds,
-    tracker_of,
 )
 from wmr_mj.sim.coerce import (
-    PATH_NAMES,
-    base_for,
     coerce_with_classes,
     coerced,
     controller_name,
+    law_name,
     plant_parameters,
-    route_of,
 )
 from wmr_mj.sim.run_config import RunConfig
 
@@ -78,8 +74,12 @@ class RunLabels:
     @classmethod
     def of(cls, config: RunConfig, *, name: str | None = None) -> RunLabels:
         """The labels of ``config``; ``name``: the law's name where already known (else from the config)."""
-        return cls(controller=controller_name(config) if name is None else name, model=str(config.model),
-                   kp=config.kp, kd=config.kd, path=config.path)
+        return cls.named(config, controller_name(config) if name is None else name)
+
+    @classmethod
+    def named(cls, config: RunConfig, name: str) -> RunLabels:
+        """The labels of ``config``, whose law is called ``name``: read, nothing coerced."""
+        return cls(controller=name, model=str(config.model), kp=config.kp, kd=config.kd, path=config.path)
 
 
 def control_substeps(control_period: float | None, timestep: float = TIMESTEP) -> int:
@@ -192,30 +192,29 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
     from wmr_mj.sim.certify import law_certificate, measurement_errors
     from wmr_mj.sim.engine import plant_options
 
-    config, classes = coerce_with_classes(config)  # the one read of the config's files and plug-ins
+    typed = coerce_with_classes(config, base=base)  # the one read of the config's files and plug-ins
+    config, classes, base, plant, record = typed.config, typed.classes, typed.base, typed.plant, typed.record
     # the typed config read once, here in the sim layer, into what each part is built from
     substeps = control_substeps(config.control_period)
     period = substeps * TIMESTEP
     n = int(round(config.duration / period))
     claim_period = config.control_period if config.control_period is not None else TIMESTEP  # the law's, as given
     law, box, options = LawSpec.of(config), BoxSpec.of(config), plant_options(config)
-    labels, record = RunLabels.of(config), config.to_dict()
-    route_length_m = (float(route_of(config.path).path.length) if config.path not in PATH_NAMES
+    labels = RunLabels.named(config, law_name(config))
+    route_length_m = (float(typed.route.path.length) if typed.route is not None
                       else manoeuvre_length(config.path))  # lane-change's
     # then each part, built once and handed on in layer order: the parameter sets, the law and the tracker on the
     # belief, C's reference, the paper's analysis, the cart's measurement errors, the law's claim
-    base = base_for(config, base)  # the config's cart, where it names one
-    plant = plant_parameters(config, base)
     estimate = estimate_parameters(base)
-    controller, law_settings = law_and_settings(law, estimate, classes=classes)
+    controller, law_settings, tracker = laws_of(law, estimate, classes=classes)
     if config.sensing.velocity == "none" and getattr(controller, "reads_velocity", True):
         raise ParameterError(f"controller {controller.name!r} reads alpha', which --sensing velocity=none does not "
                              "give it; accepted: a law that estimates alpha' from the angle (reads_velocity = False, "
                              "docs/guides/plugins.md), or a velocity estimate (exact, tachometer, difference, "
                              "filtered)")
-    tracker = tracker_of(law, estimate, classes=classes)
-    reference, settle_s = run_reference(config.path, estimate, period=period, duration=config.duration)
-    bounds = run_bounds(reference, config.reference_bounds)
+    reference, settle_s = build_reference(config.path, estimate, dt=period, duration=n * period)  # run_reference's
+    # the reference bounds the claims are computed for: the declared ones, else the reference's own
+    bounds = reference.bounds() if config.reference_bounds is None else config.reference_bounds
     paper_estimate = estimate_of(controller)  # None: not the paper's law, whose region then says nothing of it
     analysis = analysis_of(box, bounds, estimate, kp=law.kp, kd=law.kd, estimate=paper_estimate)
     measurement = measurement_errors(config.sensing, config.actuation, config.transmission, plant,
@@ -243,7 +242,7 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
 def run_reference(path: str, estimate: C80Parameters, *, period: float, duration: float) -> tuple[Any, float]:
     """(reference, settle_s): C's reference of a run on its control grid, as :func:`resolve_run` builds it --
     ``round(duration / period)`` control steps of ``period`` [s] on the controller's belief ``estimate``
-    (:func:`wmr_mj.sim.builders.build_reference`). A log's replay and a result made elsewhere build theirs here."""
+    (:func:`wmr_mj.reference.named.build_reference`). A log's replay and a result made elsewhere build theirs here."""
     n = int(round(duration / period))
     return build_reference(path, estimate, dt=period, duration=n * period)
 
@@ -277,7 +276,6 @@ def signal_inputs(signals: Any, plant: C80Parameters, options: dict[str, Any], *
     """
     if signals is None:
         return None, ()
-    from wmr_mj.params import with_params
     from wmr_mj.sim.engine import load_fields
 
     disturbance = None

@@ -21,9 +21,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from controllers.registry import PluginSource
-from wmr_mj.hardware.cart import CART_PARTS, cart_dict
 from wmr_mj.params import PAPER_KD, PAPER_KP
-from wmr_mj.sim.coerce import check_fields, coerce, is_coerced, m1_of_overrides
+from wmr_mj.sim.coerce import check_fields, coerce, is_coerced, m1_of_overrides, record_of
 
 __all__ = ["RunConfig"]
 
@@ -138,45 +137,7 @@ class RunConfig:
     def to_dict(self) -> dict[str, Any]:
         """The config as JSON-able data (its record in a log and every command's output); a config given a
         reference (a cart's name, a plug-in by name, ...) is coerced first (:func:`wmr_mj.sim.coerce.coerce`)."""
-        if not is_coerced(self):
-            return coerce(self).to_dict()
-        d = dataclasses.asdict(self)
-        del d["controller_plugin"], d["tracker_plugin"]
-        if self.signals is None:
-            del d["signals"]  # a run without signals keeps the keys it always had
-        else:
-            d["signals"] = self.signals.to_dict()
-        if not self.correction:
-            del d["correction"]  # the configs written before the correction existed, unchanged
-        # likewise the plug-in keys, only where a plug-in runs
-        for kind in ("controller", "tracker"):
-            given = getattr(self, kind)
-            if not getattr(self, f"{kind}_params"):
-                del d[f"{kind}_params"]
-            else:
-                d[f"{kind}_params"] = dict(getattr(self, f"{kind}_params"))
-            source = getattr(self, f"{kind}_plugin")
-            if source is not None:
-                d[f"{kind}_plugin"] = source.to_dict()
-                if not isinstance(given, str):
-                    d[kind] = source.name  # an object: its name (the plugin record says where it came from)
-        if self.tracker is None:
-            del d["tracker"]
-        for name in CART_PARTS:  # likewise: only the parts of the cart that are not ideal
-            del d[name]
-        d.update(cart_dict(self))
-        if self.cart is None:
-            del d["cart"]  # likewise: a C80 run's record as it always was
-        if self.reference_bounds is None:
-            del d["reference_bounds"]  # likewise
-        else:
-            d["reference_bounds"] = self.reference_bounds.to_dict()
-        d["plant_overrides"] = dict(self.plant_overrides)
-        d["m1_range"] = list(self.m1_range)
-        d["box_ranges"] = {k: list(v) for k, v in self.box_ranges.items()}
-        if self.identified is not None and not isinstance(self.identified, (str, bytes)):
-            d["identified"] = dict(self.identified.get("identified", self.identified))
-        return d
+        return record_of(self if is_coerced(self) else coerce(self))
 
     def replace(self, **changes: Any) -> RunConfig:
         return dataclasses.replace(self, **changes)

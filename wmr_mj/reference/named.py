@@ -1,0 +1,103 @@
+"""C's reference of a run on its control grid: a named path (:data:`PATH_NAMES`) or a route, the last few kept.
+
+:func:`build_reference` is what every run's reference is built by (:func:`wmr_mj.sim.parts.resolve_run`, a log's
+replay, a result made elsewhere): the paper's circle, the lane change and the figure eight by name, a route (a
+packaged name, a .toml/.json file, canonical JSON) through :func:`wmr_mj.reference.route.route_reference`.
+
+Usage::
+
+    from wmr_mj.reference.named import build_reference
+    reference, settle_s = build_reference("paper-circle", C80, dt=1e-3, duration=35.0)
+"""
+
+from __future__ import annotations
+
+import functools
+import os
+
+import numpy as np
+
+from wmr_mj.errors import InfeasiblePathError, StiffReferenceError, UnknownNameError, WmrMjError
+from wmr_mj.params import C80Parameters
+from wmr_mj.reference import paths as ref
+from wmr_mj.reference.route import is_route_spec, route_names, route_of, route_reference
+
+__all__ = ["PATH_NAMES", "build_reference", "REFERENCE_CACHE_SIZE", "path_label", "LANE_CHANGE_LEAD_IN_M",
+           "LANE_CHANGE_OFFSET_M", "LANE_CHANGE_LENGTH_M"]
+
+#: the paths of C a run names (the others are routes)
+PATH_NAMES = ("paper-circle", "lane-change", "figure-eight")
+
+#: the named path lane-change: a lead-in line, the lane change (lateral offset over a length), then a line that
+#: fills the duration [m]
+LANE_CHANGE_LEAD_IN_M, LANE_CHANGE_OFFSET_M, LANE_CHANGE_LENGTH_M = 0.5, 0.5, 4.0
+
+
+def build_reference(path: str, params: C80Parameters, *, dt: float, duration: float):
+    """(reference, settle_s) for a path of C on a grid of step dt: a named path (PATH_NAMES) or
+    a route (a packaged route name, a route file, canonical route JSON; a closed route is
+    repeated lap after lap to fill the duration).
+
+    settle_s is when the entry transient ends: for the paper's circle, the
+    time C enters the circle; 0 for the other paths.
+
+    The last :data:`REFERENCE_CACHE_SIZE` references are kept (a Reference's arrays are read-only):
+    runs that share a path, as a comparison's scenarios on one path or a sweep's chunks do, build it
+    once (it costs about a quarter of a 35 s run's physics). A route file is keyed by its
+    modification time and size as well as its name, so an edited file is read again.
+    """
+    file_key = None
+    if path not in PATH_NAMES and not path.lstrip().startswith("{") and os.path.isfile(path):
+        st = os.stat(path)
+        file_key = (os.path.abspath(path), st.st_mtime_ns, st.st_size)
+    return _cached_reference(path, file_key, params, float(dt), float(duration))
+
+
+#: references kept by :func:`build_reference`
+REFERENCE_CACHE_SIZE = 16
+
+
+@functools.lru_cache(maxsize=REFERENCE_CACHE_SIZE)
+def _cached_reference(path: str, file_key: tuple | None, params: C80Parameters, dt: float, duration: float):
+    try:
+        return _build_reference(path, params, dt=dt, duration=duration)
+    except StiffReferenceError:
+        raise
+    except InfeasiblePathError as exc:  # the path, the stops and the option that changes it, named
+        raise InfeasiblePathError(f"{exc} -- on path {path_label(path)}, with the cart's steering stops at "
+                                  f"+-{params.steering_range:g} rad; --path changes it (a path this cart steers: "
+                                  "e.g. a route of larger radius, or the cart file's [paths] default)") from None
+
+
+def path_label(path: str) -> str:
+    """What a message calls the path ``path``: its name, a route file's path, a route's own name for canonical JSON."""
+    if path in PATH_NAMES or not path.lstrip().startswith("{"):
+        return repr(path)
+    try:
+        return f"route {route_of(path).name!r}"
+    except WmrMjError:
+        return "a route given as JSON"
+
+
+def _build_reference(path: str, params: C80Parameters, *, dt: float, duration: float):
+    """:func:`build_reference` without the cache."""
+    if path not in PATH_NAMES:
+        if not is_route_spec(path):
+            raise UnknownNameError("path", path, PATH_NAMES + route_names() + ("<route file .toml/.json>",))
+        return route_reference(route_of(path), params, dt=dt, duration=duration), 0.0
+    if path == "paper-circle":
+        p = ref.paper_circle(params, duration=duration)
+    elif path == "lane-change":
+        p = (ref.line(LANE_CHANGE_LEAD_IN_M) + ref.lane_change(LANE_CHANGE_OFFSET_M, LANE_CHANGE_LENGTH_M)
+             + ref.line(max(duration * params.V_A, 1.0)))
+    elif path == "figure-eight":
+        p = ref.line(0.5) + ref.figure_eight(1.5, laps=max(1, int(duration * params.V_A / 20.0) + 1))
+    else:
+        raise UnknownNameError("path", path, PATH_NAMES)
+    reference = ref.make_reference(p, params, dt=dt, duration=duration)
+    settle_s = 0.0
+    if path == "paper-circle":
+        circle_start = float(p.starts[-2])  # starts ends with the total length
+        reached = np.nonzero(np.asarray(reference.s) >= circle_start)[0]
+        settle_s = float(reference.t[reached[0]]) if reached.size else float(reference.t[-1])
+    return reference, settle_s
