@@ -366,6 +366,8 @@ def test_sysid_without_the_extra_is_one_line_exit_2(tmp_path, capsys, monkeypatc
     err = capsys.readouterr().err.strip()
     assert code == 2 and "pip install 'wmr-mj[sysid]'" in err and "\n" not in err
     assert not (tmp_path / "x.toml").exists()
+    assert main(["identify", "--sysid"]) == 2  # the simulated plant's identify has no recording to roll out
+    assert "--sysid need --data" in capsys.readouterr().err
 
 
 def test_identified_from_reads_the_files_and_hashes_a_cart_names(tmp_path):

@@ -65,11 +65,11 @@ def run(args: argparse.Namespace) -> int:
 
     if args.data:
         return run_data(args)
-    if args.holdout or args.columns or args.report or args.topics:
+    if args.holdout or args.columns or args.report or args.topics or args.sysid:
         from wmr_mj.errors import ParameterError
 
-        raise ParameterError("--holdout, --columns, --topics and --report need --data (recordings of the cart to "
-                             "identify from)")
+        raise ParameterError("--holdout, --columns, --topics, --report and --sysid need --data (recordings of the cart "
+                             "to identify from)")
     if args.out:  # before the identification, which takes a while
         check_output_path(args.out, kind="file", option="--out")
     base = cart_parameters(args)
