@@ -330,6 +330,7 @@ def _sysid_installed() -> bool:
     return True
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not _sysid_installed(), reason="the sysid extra (pip install 'wmr-mj[sysid]') is not installed")
 def test_sysid_rolls_out_the_identified_mjcf_on_the_holdout(recordings, tmp_path):
     """identify --sysid: the identified cart file's MJCF, rolled out by mujoco.sysid from each segment's recorded
