@@ -11,7 +11,7 @@ CORE_STAMP := $(VENV)/.installed-core
 
 # the editable install builds the compiled law and the projection's loop (the .c files) in place: rebuild when they change.
 # `make demo` needs the package and its core dependencies only (mujoco, numpy, scipy, matplotlib, mcap); the
-# extras (test tools, Dask, video, docs, notebook, numba) are installed by `make test`, `make venv` and the rest.
+# extras (test tools, Dask, video, docs, notebook, numba, mujoco.sysid) are installed by `make test`, `make venv` and the rest.
 $(CORE_STAMP): pyproject.toml setup.py wmr_mj/sim/_compiled_law.c wmr_mj/analysis/_nearest_chord.c
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
@@ -19,7 +19,7 @@ $(CORE_STAMP): pyproject.toml setup.py wmr_mj/sim/_compiled_law.c wmr_mj/analysi
 	touch $(CORE_STAMP)
 
 $(STAMP): $(CORE_STAMP)
-	$(PY) -m pip install -q -e '.[test,dask,video,docs,fast,notebook]'
+	$(PY) -m pip install -q -e '.[test,dask,video,docs,fast,notebook,sysid]'
 	touch $(STAMP)
 
 venv: $(STAMP)

@@ -315,3 +315,74 @@ def test_a_speed_column_is_the_speed_the_gyro_term_sees(recordings, tmp_path):
     path = tmp_path / "speed.csv"
     path.write_text("t_s,u_V,alpha_rad,speed_m_per_s\n0,1,0.1,0.2\n0.001,2,0.2,0.3\n", encoding="utf-8")
     assert read_csv(path).speed.tolist() == [0.2, 0.3]
+
+
+# ----------------------------------------------------------------------------------------------- mujoco.sysid
+
+
+def _sysid_installed() -> bool:
+    from wmr_mj.plant.mjcf_rollouts import import_sysid
+
+    try:
+        import_sysid()
+    except ParameterError:
+        return False
+    return True
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not _sysid_installed(), reason="the sysid extra (pip install 'wmr-mj[sysid]') is not installed")
+def test_sysid_rolls_out_the_identified_mjcf_on_the_holdout(recordings, tmp_path):
+    """identify --sysid: the identified cart file's MJCF, rolled out by mujoco.sysid from each segment's recorded
+    state, predicts the hold-out as the reduced model does; the start's MJCF does not (the same rollouts)."""
+    from wmr_mj.plant.mjcf_rollouts import mjcf_rollout_nrmse
+    from wmr_mj.plant.output_error import HOLDOUT_NRMSE_MAX
+
+    out = tmp_path / "s.toml"
+    code, obj = _main_json(["identify", "--cart", str(START), "--data", f"{recordings['lane_short']}:m1=100",
+                            "--holdout", str(recordings["hold"]), "--out", str(out), "--json", "--sysid"])
+    hold = str(recordings["hold"])
+    assert code == 0 and obj["mjcf_rollouts"]["nrmse"][hold] < HOLDOUT_NRMSE_MAX
+    rec = read_csv(recordings["hold"])
+    truth = mjcf_rollout_nrmse(parameters_of_cart(load_cart(TRUTH)), [rec], delay_steps=5)
+    start = mjcf_rollout_nrmse(parameters_of_cart(load_cart(START)), [rec], delay_steps=5)
+    assert truth < HOLDOUT_NRMSE_MAX < start  # the rollouts tell the true cart from the start
+    assert obj["mjcf_rollouts"]["nrmse"][hold] == pytest.approx(truth, rel=0.25)  # within the fit's spread
+
+
+def test_sysid_without_the_extra_is_one_line_exit_2(tmp_path, capsys, monkeypatch):
+    import importlib
+
+    real = importlib.import_module
+
+    def without_sysid(name, *args, **kwargs):
+        if name == "mujoco.sysid":
+            raise ImportError("No module named 'absl'")
+        return real(name, *args, **kwargs)
+
+    monkeypatch.setattr(importlib, "import_module", without_sysid)
+    path = tmp_path / "r.csv"
+    path.write_text("t_s,u_V,alpha_rad\n0,1,0.1\n0.001,2,0.2\n", encoding="utf-8")
+    code = main(["identify", "--cart", str(START), "--data", str(path), "--out", str(tmp_path / "x.toml"), "--sysid"])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and "pip install 'wmr-mj[sysid]'" in err and "\n" not in err
+    assert not (tmp_path / "x.toml").exists()
+    assert main(["identify", "--sysid"]) == 2  # the simulated plant's identify has no recording to roll out
+    assert "--sysid need --data" in capsys.readouterr().err
+
+
+def test_identified_from_reads_the_files_and_hashes_a_cart_names(tmp_path):
+    """wmr_mj.plant.cart_data: the recordings an identified cart's sources name, each once; none for a cart written
+    by hand. A file name with ' and ' in it stays whole."""
+    from wmr_mj.plant.cart_data import identified_from, identified_from_line
+
+    a, b = "0" * 64, "ab" * 32
+    text = START.read_text(encoding="utf-8")
+    assert identified_from(text) == () and identified_from_line(text, "lab cart") is None
+    source = f"identified from runs/lane and turn.csv (SHA-256 {a}) and eight.csv (SHA-256 {b}), 95 % interval [1, 2]"
+    named = text.replace('source = "the start the tests give identify (the truth\'s structure; front_axle_mass, k_i, '
+                          'k_b, mu written wrong), chosen"', f'source = "{source}"')
+    assert identified_from(named) == (("runs/lane and turn.csv", a), ("eight.csv", b))
+    line = identified_from_line(named, "lab cart")
+    assert line is not None and "runs/lane and turn.csv (SHA-256 000000000000...)" in line
+    assert identified_from("not = [toml") == ()

@@ -181,6 +181,12 @@ def _print(result: Any, args: argparse.Namespace, out: dict[str, Any], wall: flo
         c = out["check"]
         print(f"check: {c['n']} runs over the box on {c['path']}: "
               + ", ".join(f"{v} {n}" for v, n in c["verdicts"].items()))
+    if result.cart is not None:  # a cart identified from recordings: the data the design rests on
+        from wmr_mj.plant.cart_data import identified_from_line
+
+        rests_on = identified_from_line(str(result.cart.get("text", "")), str(result.cart.get("path", "")))
+        if rests_on is not None:
+            print(rests_on)
     print(f"wrote {args.out}: {run_line(args)}")
 
 

@@ -45,6 +45,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "with .field or .field[i]; default field data), read through mcap-ros2-support")
     p.add_argument("--columns", metavar="KEY=NAME,...",
                    help="CSV column names of another header: t_s=...,u_V=...,alpha_rad=...,speed_m_per_s=...")
+    p.add_argument("--sysid", action="store_true",
+                   help="with --data: also roll out the identified cart file's MJCF with mujoco.sysid on each segment "
+                        "of the hold-out (else of each recording) against the recorded angle and report its normalised "
+                        "RMS error (the hold-out's limit applies); needs the sysid extra: pip install 'wmr-mj[sysid]'")
     add_json(p, help="print one JSON object")
     from wmr_mj.cli.run_options import add_option
 
@@ -61,11 +65,11 @@ def run(args: argparse.Namespace) -> int:
 
     if args.data:
         return run_data(args)
-    if args.holdout or args.columns or args.report or args.topics:
+    if args.holdout or args.columns or args.report or args.topics or args.sysid:
         from wmr_mj.errors import ParameterError
 
-        raise ParameterError("--holdout, --columns, --topics and --report need --data (recordings of the cart to "
-                             "identify from)")
+        raise ParameterError("--holdout, --columns, --topics, --report and --sysid need --data (recordings of the cart "
+                             "to identify from)")
     if args.out:  # before the identification, which takes a while
         check_output_path(args.out, kind="file", option="--out")
     base = cart_parameters(args)
@@ -152,6 +156,10 @@ def run_data(args: argparse.Namespace) -> int:
 
     if not args.out:
         raise ParameterError("identify --data needs --out NEW.toml: the identified cart file")
+    if args.sysid:  # asked for: the extra must be there before any work (one line naming it, exit 2)
+        from wmr_mj.plant.mjcf_rollouts import import_sysid
+
+        import_sysid()
     out = check_output_path(args.out, kind="file", option="--out")
     if args.report:
         check_output_path(args.report, kind="dir", option="--report")
@@ -175,7 +183,10 @@ def run_data(args: argparse.Namespace) -> int:
 
         report = IdentifyReport.of(fit, recordings, params, holdout=holdout)
         report_files = [str(p) for p in report.write(args.report)]
+    rollouts = _mjcf_rollouts(text, holdout, recordings, fit) if args.sysid else None
     failed = nrmse is not None and not nrmse <= HOLDOUT_NRMSE_MAX
+    if rollouts is not None and holdout is not None:
+        failed = failed or not rollouts[holdout.name] <= HOLDOUT_NRMSE_MAX
     obj = {
         "coefficients": {k: v.to_dict() for k, v in fit.coefficients.items()},
         "fixed_from_structure": {"K": "0: absent from the plant (non-holonomic model)",
@@ -196,18 +207,35 @@ def run_data(args: argparse.Namespace) -> int:
                                                  "nrmse_max": HOLDOUT_NRMSE_MAX, "passed": not failed},
         "cart": str(out),
         "report": report_files,
+        **({} if rollouts is None else {"mjcf_rollouts": {"nrmse": rollouts, "nrmse_max": HOLDOUT_NRMSE_MAX}}),
     }
     if args.json:
         print_json(obj)
     else:
         _print_fit(fit, recordings, holdout, nrmse, out)
+        for name, value in (rollouts or {}).items():
+            print(f"MuJoCo rollouts of {out}'s MJCF (mujoco.sysid) on {name}: normalised RMS error {value:.3g}")
         for path in report_files:
             print(f"wrote {path}")
     if failed and holdout is not None:
-        print(f"hold-out {holdout.name}: the identified model does not predict it: normalised RMS error {nrmse:.3g} "
+        worst = max(v for v in (nrmse, (rollouts or {}).get(holdout.name)) if v is not None)
+        print(f"hold-out {holdout.name}: the identified model does not predict it: normalised RMS error {worst:.3g} "
               f"above {HOLDOUT_NRMSE_MAX:g}", file=sys.stderr)
         return 1
     return 0
+
+
+def _mjcf_rollouts(text, holdout, recordings, fit) -> dict[str, float]:
+    """File -> the normalised RMS error of the identified cart file's MJCF rolled out by mujoco.sysid on the
+    hold-out (else on each recording), at its m1 (wmr_mj.plant.mjcf_rollouts)."""
+    from wmr_mj.carts import load_cart_text
+    from wmr_mj.params import parameters_of_cart
+    from wmr_mj.plant.mjcf_rollouts import mjcf_rollout_nrmse
+
+    identified = parameters_of_cart(load_cart_text(text, path="<identified cart>"))
+    targets = [(holdout, holdout.m1)] if holdout is not None else list(zip(recordings, fit.m1))
+    return {rec.name: mjcf_rollout_nrmse(identified, [rec], delay_steps=fit.delay_steps, m1=m1)
+            for rec, m1 in targets}
 
 
 def _print_fit(fit, recordings, holdout, nrmse, out) -> None:

@@ -111,6 +111,12 @@ def run(args: argparse.Namespace) -> int:
     print(format_headline(summary))
     if settings.cart is not None:
         print(f"every run on the cart file {settings.cart['path']}")
+        from wmr_mj.plant.cart_data import identified_from_line
+
+        # a cart identified from recordings (wmr-mj identify --data): the data it rests on, and what that assumes
+        rests_on = identified_from_line(str(settings.cart.get("text", "")), str(settings.cart["path"]))
+        if rests_on is not None:
+            print(rests_on)
     from wmr_mj.hardware import cart_line, is_ideal_cart
 
     if not is_ideal_cart(settings):

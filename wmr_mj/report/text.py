@@ -41,11 +41,13 @@ import html
 import io
 import math
 from collections.abc import Mapping, Sequence
+from pathlib import PurePath
 from typing import Any
 
 from wmr_mj.analysis.certificate import VERDICTS
 from wmr_mj.analysis.verdicts import WITHIN_THE_SUPPLY
 from wmr_mj.params import COEFFICIENT_MODELS, COEFFICIENT_NAMES
+from wmr_mj.plant.cart_data import identified_from
 from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS
 from wmr_mj.report.results import Rung, ValidateSummary
 
@@ -194,6 +196,10 @@ def verdict_lines(summary: Summary) -> list[str]:
     lo, hi = s["m1_range"]
     cart = s.get("cart")  # validate --cart: the cart's name (settings without it: the C80)
     vehicle = "the C80" if not cart else f"the cart {cart['name']} {cart['version']}"
+    data = identified_from(str(cart.get("text", ""))) if cart else ()  # a cart identify --data wrote
+    if data:
+        files = " and ".join(PurePath(name).name for name, _sha256 in data)
+        vehicle += f" (identified from {files}; the answer assumes the real cart inside its identified box)"
     question = (f"Question: does the paper's robustness region hold for {vehicle} under m1 in {lo:g}-{hi:g} kg? "
                 f"({summary.ladder[0].n} MuJoCo runs per design on {_path_words(s)}, {s['duration']:g} s each)")
     report = (f"Report: {summary.folder}/index.html (also index.md, summary.json); the details follow: (a) the "

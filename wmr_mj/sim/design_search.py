@@ -47,6 +47,7 @@ import numpy as np
 from wmr_mj.analysis.claim_types import Assumption
 from wmr_mj.errors import ParameterError
 from wmr_mj.hardware import Actuation, Sensing, Transmission
+from wmr_mj.plant.cart_data import identified_from
 from wmr_mj.sim.coerce import coerced
 from wmr_mj.sim.design_options import DEFAULT_BUDGET, DEFAULT_SEED, LAWS, METHODS, OBJECTIVES
 from wmr_mj.sim.optimisers import CMAES, Chain, DifferentialEvolution, Optimiser, Points, drive
@@ -596,9 +597,18 @@ def design_dict(result: DesignResult) -> dict[str, Any]:
             "box": result.box, "search": {"objective": result.objective, "score": result.score, "seed": result.seed,
                        "periods": list(result.periods), "paths": list(result.paths),
                        "evaluations": result.evaluations},
-            # the cart searched on (name, version, path, the file's text: design_cart finds it again); a C80
-            # design's file has no "cart" key, as a C80 config's record has none
-            **({} if result.cart is None else {"cart": dict(result.cart)})}
+            # the cart searched on (name, version, path, the file's text: design_cart finds it again; a cart
+            # identified from recordings: identified_from, each file and its SHA-256); a C80 design's file has no
+            # "cart" key, as a C80 config's record has none
+            **({} if result.cart is None else {"cart": _cart_entry(result.cart)})}
+
+
+def _cart_entry(record: Mapping[str, Any]) -> dict[str, Any]:
+    """The design file's record of its cart: the config's record, with the recordings the cart file rests on
+    (``identified_from``: [{"file", "sha256"}], where its sources name any: wmr-mj identify --data)."""
+    named = identified_from(str(record.get("text", "")))
+    data = [{"file": name, "sha256": sha} for name, sha in named]
+    return {**record, **({"identified_from": data} if data else {})}
 
 
 def write_design(result: DesignResult, path: str | os.PathLike) -> None:
