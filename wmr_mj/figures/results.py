@@ -16,6 +16,7 @@ axis labels, a search's words) it hands in too.
 
 from __future__ import annotations
 
+import io
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -42,8 +43,6 @@ class ResultPlot:
     axes: tuple[Any, ...]
 
     def _repr_png_(self) -> bytes:  # a notebook shows the figure when the plot is a cell's value
-        import io
-
         buf = io.BytesIO()
         self.figure.savefig(buf, format="png", dpi=100, bbox_inches="tight")
         return buf.getvalue()

@@ -35,8 +35,10 @@ Usage::
 
 from __future__ import annotations
 
+import concurrent.futures
 import contextlib
 import datetime as _dt
+import functools
 import io
 import json
 import math
@@ -472,8 +474,6 @@ class RunLogger:
         if not self._pending:
             return
         if self._background:
-            import concurrent.futures
-
             if self._executor is None:
                 self._executor = concurrent.futures.ThreadPoolExecutor(1, thread_name_prefix="wmr-mj-log",
                                                                        initializer=_block_signals)
@@ -634,6 +634,4 @@ def measure_logging_overhead(run: Any, log_path: str | os.PathLike, *, repeats: 
 
 def run_logged(config: RunConfig, path: str) -> RunSummary:
     """Re-run ``config`` serially (``run_closed_loop``) with an MCAP log at ``path``; its summary."""
-    import functools
-
     return run_closed_loop(config, logger_factory=functools.partial(RunLogger, path), progress=False).summary

@@ -12,8 +12,10 @@ from __future__ import annotations
 import csv
 import html
 import io
+import json
 import math
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any
 
 from wmr_mj._util.files import write_json_atomic, write_text_atomic
@@ -125,8 +127,6 @@ def _heading(result: CompareResult) -> str:
 def cart_text(result: CompareResult) -> str:
     """'' where every design runs the ideal cart; else '. Cart (...): sensing ...; actuation ...; transmission
     ...', once where every design shares it, else per design (a scenario that names its own cart keeps it)."""
-    from types import SimpleNamespace
-
     carts = [dict(r.cart) for r in result.rows]
     if not any(carts):
         return ""
@@ -162,8 +162,6 @@ def markdown(result: CompareResult) -> str:
 
 def csv_text(result: CompareResult) -> str:
     """One CSV line per design with every figure of :class:`~wmr_mj.sim.compare.DesignRow` (full precision)."""
-    import json
-
     rows = [r.to_dict() for r in result.rows]
     buf = io.StringIO()
     names = list(dict.fromkeys(k for r in rows for k in r))  # "cart" only where a design's cart is not ideal
@@ -197,8 +195,6 @@ def html_page(result: CompareResult, figure_name: str = "compare.png") -> str:
 def write_report(result: CompareResult, out: Path) -> dict[str, str]:
     """compare.md, compare.csv, compare.html, compare.png and compare.json (and runs.jsonl) in ``out``,
     each written atomically; returns their paths by kind."""
-    import json
-
     out.mkdir(parents=True, exist_ok=True)
     paths = {"markdown": out / "compare.md", "csv": out / "compare.csv", "html": out / "compare.html",
              "json": out / "compare.json", "runs": out / "runs.jsonl"}

@@ -39,6 +39,8 @@ from __future__ import annotations
 
 import dataclasses
 import os
+import re
+import shutil
 import time
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -256,8 +258,6 @@ def write_pointer(folder: str | os.PathLike) -> Path:
     atomically (a temporary link, then ``os.replace``). Where symlinks are unavailable (``os.symlink``
     raises OSError) it is a folder holding a copy of the report instead. Either way
     ``validate-latest/summary.json`` reads the latest report."""
-    import shutil
-
     folder = Path(folder)
     link = folder.parent / "validate-latest"
     tmp = folder.parent / f".validate-latest.{os.getpid()}.tmp"
@@ -278,8 +278,6 @@ def write_pointer(folder: str | os.PathLike) -> Path:
 
 
 def _remove(path: Path) -> None:
-    import shutil
-
     if path.is_symlink() or path.is_file():
         path.unlink()
     elif path.is_dir():
@@ -300,8 +298,6 @@ def _path_summary(settings: ValidateSettings) -> PathSummary:
 
 def _certified_rule(cart: Any = None) -> CertifiedRule:
     """The certified design's rule as designs.py writes it, and the omega_r it gives now on the cart."""
-    import re
-
     doc = designs.__doc__ or ""
     rule = doc.split("``certified``:", 1)[-1].split("The ladder", 1)[0]
     rule = re.sub(r":\w+:`([^`]*)`", r"\1", rule).replace("``", "")
