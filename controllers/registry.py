@@ -39,9 +39,10 @@ from importlib.metadata import entry_points
 from pathlib import Path
 from typing import Any
 
-from controllers.base import BuildContext, SteeringController, describe_params
+from controllers.base import BuildContext, SteeringController, describe_params, law_methods_missing
 from controllers.computed_torque import CONTROLLER_NAMES, MODEL_SOURCES, model_from_source
 from controllers.tracking import PathTracker
+from wmr_mj._util.modules import ModuleNotLocated, find_module_file
 from wmr_mj.errors import ParameterError, UnknownNameError
 
 __all__ = ["PluginSource", "LocatedSource", "resolve", "parse_params", "locate_source", "check_recorded_source",
@@ -271,9 +272,6 @@ def resolve(spec: str, params: Mapping[str, Any] | None = None, *, kind: str = "
         ParameterError: a missing file, a file or module that fails to import, a missing class, a
             class that is not a law (or tracker).
     """
-    from controllers.base import law_methods_missing
-    from controllers.tracking import PathTracker
-
     if not isinstance(spec, str) or not spec.strip():
         raise ParameterError(f"{kind} {spec!r} is not accepted: a name, FILE.py:Class or module:Class")
     cls, origin, import_path = _class_of(spec.strip(), kind)
@@ -284,7 +282,6 @@ def resolve(spec: str, params: Mapping[str, Any] | None = None, *, kind: str = "
                f"{getattr(cls, '__name__', cls)!r} is not a path tracker: subclass controllers.PathTracker")
     if why is not None:
         raise ParameterError(f"{kind} {spec!r}: {why}")
-    from controllers.base import describe_params
 
     source = PluginSource(spec=spec.strip(), name=str(getattr(cls, "name", cls.__name__)), origin=origin,
                           import_path=import_path, params=describe_params(params or {}),
@@ -487,8 +484,6 @@ def locate_source(spec: str, *, kind: str = "controller") -> LocatedSource:
         ParameterError: a file that is gone, a module or entry point that cannot be found without running
             code, a malformed name.
     """
-    from wmr_mj._util.modules import ModuleNotLocated, find_module_file
-
     form, where, _ = _form_of(spec.strip(), kind)
     if form == "file":
         path = Path(where).expanduser()

@@ -73,7 +73,7 @@ from wmr_mj.analysis.measurement import (
 )
 from wmr_mj.analysis.sliding_sampled import sliding_sampled_certificate
 from wmr_mj.errors import ParameterError, UnknownNameError
-from wmr_mj.plant.reduced import SteeringModel
+from wmr_mj.plant.reduced import SteeringModel, smooth_sign
 
 __all__ = ["SlidingMode", "Uncertainty", "MeasuredLayer", "SAMPLING_FRACTION", "SLIDING_FRICTION_SIGNS",
            "MEASURED_STEP", "BOUNDARY_LAYER"]
@@ -223,8 +223,6 @@ class SlidingMode(SteeringController):
         return u
 
     def voltage(self, alpha, alpha_dot, alpha0, alpha0_dot, alpha0_ddot) -> np.ndarray:
-        from wmr_mj.plant.reduced import smooth_sign
-
         m = self.model
         a, ad = np.asarray(alpha, dtype=float), np.asarray(alpha_dot, dtype=float)
         E = np.asarray(alpha0, dtype=float) - a

@@ -3,10 +3,11 @@ against the three implementations that run or analyse them: the compiled law's C
 wmr_mj/sim/_compiled_law.c, driven through wmr_mj.sim.compiled_law on random inputs), the Python sensing chain
 (SensingChain.step) and the certificate's loop (sampled_data.sampled_loop, built from the matrices).
 
-The delay is a shift register: the C's reading is the matrices' output to the bit. The estimate runs in its
-factored form in C and Python ((alpha_m[k] - alpha_m[k-1]) / T, then a y + (1 - a) v) and as C x + D u here;
-the two round differently, so they are compared at each step from the C's own state (no accumulation) within
-the bound :func:`_rounding_bound` derives.
+Everything is compared to the last bit. The delay is a shift register. The estimate is the series of its stages
+(the difference Delta, the division by T, the low-pass L), each stage's matrices evaluated by
+DiscreteSystem.step, as the C and the chain evaluate them; the certificate's one system is those stages in
+series, entry by entry. (The series system's C x + D u itself rounds differently from the stages, since
+v (1/T) is not v / T for every v: hence the stages.)
 """
 
 from __future__ import annotations
@@ -20,14 +21,8 @@ import pytest
 from wmr_mj.analysis.sampled_data import sampled_loop
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.hardware import Sensing, SensingChain
-from wmr_mj.hardware.estimators import delay_line, velocity_estimator
-from wmr_mj.hardware.sensing import (
-    P_FILTER_A,
-    P_FILTER_ONE_MINUS_A,
-    P_PERIOD,
-    S_FILTER,
-    S_PREVIOUS_ALPHA,
-)
+from wmr_mj.hardware.estimators import DiscreteSystem, delay_line, velocity_estimator
+from wmr_mj.hardware.sensing import S_FILTER, S_PREVIOUS_ALPHA
 from wmr_mj.sim import compiled_law
 
 needs_compiled = pytest.mark.skipif(compiled_law.unavailable_reason() is not None,
@@ -39,7 +34,6 @@ _MODEL = """<mujoco><option timestep="0.001"/><worldbody>
 </worldbody><actuator><motor joint="steer"/></actuator></mujoco>"""
 _STATE = compiled_law.SENSING_STATE_ADR  # the chain's state in userdata (its layout: sensing.S_*)
 _MEASURED = len(compiled_law.USERDATA_FIELDS)  # alpha_m, alpha'_m in userdata
-EPS = float(np.finfo(float).eps)
 
 
 def _drive_c(sensing: Sensing, alpha: np.ndarray, alpha_dot: np.ndarray, motor: np.ndarray, *, gear_ratio: float):
@@ -73,58 +67,81 @@ def _inputs(n: int, seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return rng.uniform(-0.6, 0.6, n), rng.uniform(-3.0, 3.0, n), rng.uniform(-30.0, 30.0, n)
 
 
-def _rounding_bound(a: float, one_minus_a: float, T: float, y: float, u: float, p: float) -> float:
-    """|factored - matrix form| of one step from the same state (p = alpha_m[k-1], y = y[k-1]) and input u.
-
-    Both approximate z = a y + b (u - p)/T (b = 1 - a as stored; the difference: a = 0, b = 1). With u_r = eps/2
-    and gamma_n = n u_r / (1 - n u_r) (Higham, Accuracy and Stability of Numerical Algorithms, 2nd ed., Lemma
-    3.1): the factored form rounds u - p, / T, a y, b v and their sum, so it is within gamma_2 |a y| + gamma_4
-    |b| |u - p| / T of z; the matrix form rounds 1/T, g = b (1/T), the three products and two sums, so it is
-    within gamma_3 |a y| + gamma_5 |b| (|u| + |p|) / T. Their difference is at most (gamma_4 + gamma_5)
-    (|a y| + |b| (|u| + |p|) / T) <= 5 eps (...)."""
-    return 5.0 * EPS * (abs(a * y) + abs(one_minus_a) / T * (abs(u) + abs(p)))
-
-
 @needs_compiled
 @pytest.mark.parametrize("spec", [
+    "velocity=tachometer,velocity_noise=uniform:0.05,delay=0.002,seed=5",
     "encoder_ticks=4096,velocity=difference,delay=0.003,noise=uniform:0.0005,seed=3",
+    "velocity=difference",  # the unquantised angle: every step's difference is a full-width double
     "encoder_ticks=16384,encoder_rounding=floor,velocity=filtered,filter_tau=0.002,delay=0.002",
     "encoder_ticks=500,encoder_side=motor,encoder_rounding=floor,velocity=filtered,filter_tau=0.05",
-    "velocity=difference",  # the unquantised angle: every step's difference is a full-width double
+    "velocity=filtered,filter_tau=0.005,velocity_noise=gaussian:0.01,seed=8",
 ])
-def test_the_compiled_estimate_is_the_estimators_matrices_within_rounding(spec):
+def test_the_compiled_estimate_is_the_estimators_matrices_to_the_bit(spec):
+    """The C's estimate and its state, step by step over seeded random inputs, are those of the estimator's stages
+    (VelocityEstimator.step: each stage's matrices, the division by T between them) and of delay_line(d) for the
+    rate, to the last bit. The estimate's input is the C's measured angle (the encoder and the angle's noise sit
+    before it); a velocity noise is added after it, as the C adds it."""
     sensing = Sensing.from_spec(spec)
     alpha, alpha_dot, motor = _inputs(400, seed=len(spec))
-    chain, out, before, after = _drive_c(sensing, alpha, alpha_dot, motor, gear_ratio=60.0)
-    # the C reads the coefficients the matrices are built from
-    p = chain.parameters
-    est = velocity_estimator(sensing.velocity, control_period=float(p[P_PERIOD]), filter_tau=sensing.filter_tau)
-    system = est.system
+    chain, out, _, after = _drive_c(sensing, alpha, alpha_dot, motor, gear_ratio=60.0)
+    T = chain.control_period
+    est = velocity_estimator(sensing.velocity, control_period=T, filter_tau=sensing.filter_tau)
     assert chain.estimator == est
-    if est.filters:
-        assert (p[P_FILTER_A], p[P_FILTER_ONE_MINUS_A]) == (system.A[1, 1], est.one_minus_a)
-        assert system.D[0, 0] == p[P_FILTER_ONE_MINUS_A] * (1.0 / p[P_PERIOD])
-    else:
-        assert system.D[0, 0] == 1.0 / p[P_PERIOD]
+    if est.filters:  # the discretisation, from its definition (an independent truth for the coefficients)
+        assert (est.a, est.one_minus_a) == (math.exp(-T / sensing.filter_tau), 1.0 - math.exp(-T / sensing.filter_tau))
+    delay = delay_line(chain.delay_steps)
+    x_delay, x = np.full(delay.n_states, alpha_dot[0]), np.array([out[0, 0], 0.0])[:est.system.n_states]
+    estimate, state = np.empty(alpha.size), np.empty((alpha.size, est.system.n_states))
+    for k in range(alpha.size):
+        x_delay, (rate,) = delay.step(x_delay, [alpha_dot[k]])
+        x, (estimate[k],) = est.step(x, [out[k, 0], rate])
+        state[k] = x
+        if sensing.velocity_noise_kind != "none":
+            estimate[k] = estimate[k] + chain.alpha_dot_noise[k]
+    assert estimate.tobytes() == out[:, 1].tobytes()
+    assert state.tobytes() == after[:, :est.system.n_states].tobytes()
+    assert not np.array_equal(estimate, alpha_dot)  # the estimate (or its delay, or noise) acts
     # the Python chain is the C, to the bit
     py = np.array(chain.run(alpha, alpha_dot, 60.0 * motor)).T
     assert py.tobytes() == out.tobytes()
-    a, b = (est.a, est.one_minus_a) if est.filters else (0.0, 1.0)
-    worst = 0.0
-    for k in range(alpha.size):
-        u = out[k, 0]
-        # the chain's start (its first difference is 0) is the estimator started at x = (alpha_m[0], 0)
-        x = np.array([u, 0.0]) if k == 0 else before[k]
-        x = x[:system.n_states]
-        y_matrix = float(system.C[0] @ x + system.D[0, 0] * u)
-        x_next = system.A @ x + system.B[:, 0] * u
-        bound = _rounding_bound(a, b, est.control_period, x[1] if est.filters else 0.0, u, x[0])
-        assert abs(out[k, 1] - y_matrix) <= bound, (k, out[k, 1], y_matrix)
-        assert after[k, 0] == x_next[0] == u  # the previous angle is stored to the bit
-        if est.filters:
-            assert abs(after[k, 1] - x_next[1]) <= bound and after[k, 1] == out[k, 1]
-        worst = max(worst, abs(out[k, 1] - y_matrix))
-    assert worst > 0.0 or spec != "velocity=difference"  # the two forms do round differently: the bound is needed
+
+
+def test_the_estimators_system_is_its_stages_in_series():
+    """VelocityEstimator.system, the certificate's one system, is Delta, 1/T and L in series: each entry the
+    product of the stages' entries along its path (1/T times a coefficient first, as the certificate built g)."""
+    T, tau = 0.001, 0.005
+    inv_T = 1.0 / T
+    diff = velocity_estimator("difference", control_period=T)
+    d = diff.difference
+    assert (d.A.tolist(), d.B.tolist(), d.C.tolist(), d.D.tolist()) == ([[0.0]], [[1.0]], [[-1.0]], [[1.0]])
+    s = diff.system
+    assert (s.A.tolist(), s.B.tolist(), s.C.tolist(), s.D.tolist()) == ([[0.0]], [[1.0, 0.0]], [[-inv_T]],
+                                                                       [[inv_T, 0.0]])
+    filt = velocity_estimator("filtered", control_period=T, filter_tau=tau)
+    a = math.exp(-T / tau)
+    low = filt.low_pass
+    assert (low.A.tolist(), low.B.tolist(), low.C.tolist(), low.D.tolist()) == ([[a]], [[1.0 - a]], [[a]], [[1.0 - a]])
+    g = (1.0 - a) * inv_T
+    s = filt.system
+    assert s.A.tolist() == [[0.0, 0.0], [-g, a]] and s.B.tolist() == [[1.0, 0.0], [g, 0.0]]
+    assert s.C.tolist() == [[-g, a]] and s.D.tolist() == [[g, 0.0]]
+    with pytest.raises(ValueError, match="no low-pass"):
+        _ = diff.low_pass
+    with pytest.raises(ValueError, match="does not difference"):
+        _ = velocity_estimator("tachometer", control_period=T).difference
+
+
+def test_discrete_system_step_sums_the_nonzero_terms_in_order():
+    """A row is its nonzero terms summed left to right, state first, from the first term: -0 stays -0, and
+    (x0 + u0) + x1 rounds as written (not as x0 + (x1 + u0))."""
+    s = DiscreteSystem(A=[[0.0]], B=[[1.0]], C=[[-1.0]], D=[[1.0]])
+    _, y = s.step([0.0], [-0.0])
+    assert math.copysign(1.0, y[0]) == -1.0  # -0 + -0; 0.0 + ... would give +0
+    s = DiscreteSystem(A=np.zeros((2, 2)), B=np.zeros((2, 1)), C=[[1.0, 1.0]], D=[[1.0]])
+    _, y = s.step([1.0, 2.0**-53], [2.0**-53])
+    assert y[0] == (1.0 + 2.0**-53) + 2.0**-53 == 1.0  # state terms first, left to right
+    _, y = DiscreteSystem(A=np.zeros((0, 0)), B=np.zeros((0, 1)), C=np.zeros((1, 0)), D=[[0.0]]).step([], [math.inf])
+    assert y.tolist() == [0.0]  # a structural zero is no operation (0 * inf would be NaN)
 
 
 @needs_compiled

@@ -12,6 +12,8 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+from wmr_mj.errors import OutputPathError
+
 __all__ = [
     "write_bytes_atomic",
     "write_text_atomic",
@@ -31,8 +33,6 @@ def check_output_path(path: str | os.PathLike, *, kind: str = "file", option: st
     create their folders). Raises :class:`~wmr_mj.errors.OutputPathError` naming the path
     (and the ``option`` it came from, e.g. "--out") and why it cannot be written.
     """
-    from wmr_mj.errors import OutputPathError
-
     if kind not in ("file", "dir"):
         raise ValueError(f"kind = {kind!r}; 'file' or 'dir' is accepted")
     path = Path(path)

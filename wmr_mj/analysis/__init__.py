@@ -16,7 +16,7 @@ if TYPE_CHECKING:
 else:
     def __getattr__(name: str) -> Any:
         if name in __all__:
-            from wmr_mj.analysis import linear_part
+            from wmr_mj.analysis import linear_part  # on first use (PEP 562): numpy and scipy stay unimported
 
             return getattr(linear_part, name)
         raise AttributeError(f"module 'wmr_mj.analysis' has no attribute {name!r}")

@@ -24,7 +24,7 @@ from wmr_mj._util.checks import finite_number as _number
 from wmr_mj._util.checks import interval as _interval
 from wmr_mj.analysis.robustness import ParameterBox
 from wmr_mj.errors import ParameterError
-from wmr_mj.params import C80Parameters
+from wmr_mj.params import C80Parameters, with_params
 
 __all__ = [
     "PlantBox",
@@ -157,8 +157,6 @@ def box_corners(params: C80Parameters, m1_range: tuple[float, float], m1_inertia
 
     The corners come in :func:`itertools.product` order over (m1, *ranges).
     """
-    from wmr_mj.params import with_params
-
     axes = [("m1", m1_range), *ranges]
     names = [n for n, _ in axes]
     for corner in itertools.product(*(span for _, span in axes)):

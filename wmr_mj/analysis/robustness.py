@@ -92,7 +92,7 @@ from typing import Any, Literal
 
 from wmr_mj._util.checks import box_interval as _interval
 from wmr_mj.errors import ParameterError, UnknownNameError
-from wmr_mj.params import M1_RANGE, PAPER_KD, PAPER_KP
+from wmr_mj.params import M1_RANGE, PAPER_KD, PAPER_KP, parameter_names, with_params
 from wmr_mj.reference.bounds import PAPER_BOUNDS, ReferenceBounds
 
 __all__ = [
@@ -316,8 +316,6 @@ class ParameterBox:
         evaluated; at most 12 ranged parameters). Each coefficient's min/max over
         the grid gives its interval.
         """
-        from wmr_mj.params import parameter_names, with_params
-
         names = parameter_names()
         spans: dict[str, tuple[float, float]] = {}
         if m1_range is not None:

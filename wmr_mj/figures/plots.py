@@ -65,7 +65,9 @@ from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.patches import Patch, Polygon  # noqa: E402
 from matplotlib.ticker import MaxNLocator  # noqa: E402
 
+from wmr_mj._util.files import write_bytes_atomic
 from wmr_mj.params import M1_NOMINAL  # noqa: E402
+from wmr_mj.reference.bounds import PAPER_BOUNDS
 
 if TYPE_CHECKING:
     from matplotlib.typing import RcKeyType
@@ -175,8 +177,6 @@ def _metadata(fmt: str) -> dict[str, Any] | None:
 
 def save_figure(fig: Figure, stem: str | Path, formats: Sequence[str] = ("png", "svg")) -> list[Path]:
     """Write ``stem.<fmt>`` for each format (atomic: temporary file, then rename). Returns the paths."""
-    from wmr_mj._util.files import write_bytes_atomic
-
     stem = Path(stem)
     out = []
     for fmt in formats:
@@ -779,8 +779,6 @@ def fig7_series(example: Any) -> list[Series]:
 def paper_figures(example: Any) -> dict[str, Figure]:
     """{stem: Figure} of Figs. 4-7 (stems :data:`PAPER_FIGURE_NAMES`) of ``example``
     (:class:`wmr_mj.report.paper_example.PaperExample`, read by attribute)."""
-    from wmr_mj.reference.bounds import PAPER_BOUNDS
-
     ref = example.reference
     r = example.result
     figs = {

@@ -19,6 +19,7 @@ attribute, and what only its layer knows (a sweep's axis labels, a search's word
 
 from __future__ import annotations
 
+import io
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -49,8 +50,6 @@ class ResultPlot:
     axes: tuple[Any, ...]
 
     def _repr_png_(self) -> bytes:  # a notebook shows the figure when the plot is a cell's value
-        import io
-
         buf = io.BytesIO()
         self.figure.savefig(buf, format="png", dpi=100, bbox_inches="tight")
         return buf.getvalue()

@@ -32,9 +32,11 @@ The pipeline, once per control step k at t_k = k T (T the control period), in th
     1/(tau_f s + 1) for an input held over each period); ``none``: no velocity is read, alpha'_m[k] is NaN (the
     law reads the measured angle only and estimates alpha' itself; no velocity noise is accepted). Then
     ``alpha'_m[k] = v_k + n_alpha'[k]`` where set. Each estimate (and the delay of (a)) is defined once, as a
-    discrete linear system, in :mod:`wmr_mj.hardware.estimators`: the step runs it in the factored form above
-    with the coefficients a and 1 - a of its :class:`~wmr_mj.hardware.estimators.VelocityEstimator`
-    (:attr:`SensingChain.estimator`); the certificate's loop reads its matrices (``tests/test_estimators.py``).
+    discrete linear system, in :mod:`wmr_mj.hardware.estimators`: the step performs the operations of its
+    stages (:meth:`~wmr_mj.hardware.estimators.VelocityEstimator.step`: the difference, / T, the low-pass) with
+    the coefficients a and 1 - a of its :class:`~wmr_mj.hardware.estimators.VelocityEstimator`
+    (:attr:`SensingChain.estimator`), to the bit; the certificate's loop reads the stages in series
+    (``tests/test_estimators.py``).
 
 Noise, drawn up front: ``rng = numpy.random.default_rng(seed)``; first the n_steps noise values on alpha
 (``rng.uniform(-B, B, n_steps)`` or ``rng.normal(0.0, sigma, n_steps)``), only where noise on alpha is set;

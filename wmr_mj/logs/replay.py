@@ -39,8 +39,22 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from controllers.registry import check_recorded_source
+from wmr_mj.analysis.path_bound import guaranteed_E_max, path_bound, path_verdict, without_guarantee
+from wmr_mj.analysis.path_error import path_error_series, summarize_series
+from wmr_mj.analysis.verdicts import PAPER_CLAIM_NOT_APPLICABLE, format_verdict
+from wmr_mj.carts import load_cart_text
 from wmr_mj.errors import LogError, ParameterError, WmrMjError
+from wmr_mj.hardware import Actuation, Sensing, SensingChain, Transmission
 from wmr_mj.logs.reader import RunLog
+from wmr_mj.params import C80, C80Parameters, parameters_of_cart, with_params
+from wmr_mj.plant.mjcf import steering_joint_addresses
+from wmr_mj.sim.closed_loop import run_closed_loop
+from wmr_mj.sim.config import config_from_dict, controller_name, estimate_parameters
+from wmr_mj.sim.engine import load_fields
+from wmr_mj.sim.parts import run_reference
+from wmr_mj.sim.signals import signals_from
+from wmr_mj.sim.summary import PAPER_KEYS_DEPRECATED, PAPER_REGION_KEYS, shown_config
 
 if TYPE_CHECKING:
     from matplotlib.typing import RcKeyType
@@ -106,12 +120,6 @@ def path_of_log(log: RunLog, settle_s: float | None = None) -> LogPath:
     """C's Cartesian errors in ``log``: the desired path rebuilt as the run built it (its path, the
     controller's parameter set, its control period and duration), C's logged positions and the
     chassis heading. Never raises for a log without them: ``reason`` says why."""
-    from wmr_mj.analysis.path_bound import guaranteed_E_max, path_bound, path_verdict, without_guarantee
-    from wmr_mj.analysis.path_error import path_error_series, summarize_series
-    from wmr_mj.params import C80
-    from wmr_mj.sim.config import estimate_parameters
-    from wmr_mj.sim.parts import run_reference
-
     sig, cfg = log.signals, log.config or {}
     missing = [k for k in ("t", "C_pos", "heading") if sig.get(k) is None or not np.asarray(sig[k]).size]
     if missing:
@@ -155,8 +163,6 @@ def _base_of(cfg: Mapping[str, Any], default: Any) -> Any:
     cart = cfg.get("cart")
     if not isinstance(cart, Mapping) or not isinstance(cart.get("text"), str):
         return default
-    from wmr_mj.carts import load_cart_text
-    from wmr_mj.params import parameters_of_cart
 
     return parameters_of_cart(load_cart_text(cart["text"], path=str(cart.get("path", "<log>"))))
 
@@ -167,8 +173,6 @@ def hardware_labels(config: dict[str, Any] | None) -> dict[str, str]:
     :class:`~wmr_mj.hardware.Transmission` (the gear's backlash) read from the config in the header; "ideal"
     where it names none (``RunConfig.to_dict`` leaves an ideal part out), "not read (...)" where wmr_mj does
     not accept what it names. Never raises."""
-    from wmr_mj.hardware import Actuation, Sensing, Transmission
-
     out = {}
     for key, name, cls in (("sensing", "sensing", Sensing), ("actuation", "actuation", Actuation),
                            ("gear", "transmission", Transmission)):
@@ -255,9 +259,6 @@ def _signals_of(log: RunLog, n: int, substeps: int) -> tuple[np.ndarray | None, 
     config = log.config
     if not config.get("signals"):
         return None, {}
-    from wmr_mj.params import C80Parameters, with_params
-    from wmr_mj.sim.engine import load_fields
-    from wmr_mj.sim.signals import signals_from
 
     signals = signals_from(config["signals"])
     if signals is None:
@@ -366,9 +367,6 @@ def _verify_measured(log: RunLog, m: Any, qpos: np.ndarray, qvel: np.ndarray) ->
     Raises:
         LogError: a sensing spec in the header that wmr_mj does not accept.
     """
-    from wmr_mj.hardware import Sensing, SensingChain
-    from wmr_mj.plant.mjcf import steering_joint_addresses
-
     spec = (log.config or {}).get("sensing")
     if spec is None and not log.sensed:
         return None
@@ -447,8 +445,6 @@ def checked_plugins(log: RunLog) -> list[CheckedPlugin]:
             since the run (one line: the file, the recorded and the found SHA-256 prefix); a plug-in named in
             the configuration without its record (nothing to check it against).
     """
-    from controllers.registry import check_recorded_source
-
     cfg = log.config or {}
     out: list[CheckedPlugin] = []
     for kind in ("controller", "tracker"):
@@ -480,9 +476,6 @@ def verify_controller(log: RunLog) -> dict[str, Any]:
         recorded), False where the log holds no wmr-mj run configuration at all.
     """
     import mujoco
-
-    from wmr_mj.sim.closed_loop import run_closed_loop
-    from wmr_mj.sim.config import config_from_dict, controller_name
 
     cfg = log.config
     name = str(cfg.get("controller", "?")) if cfg else "?"
@@ -674,7 +667,6 @@ def replay_figure(log: RunLog, rep: dict[str, Any]):
         _path_panels(ax[0, 2], ax[1, 2], path_of_log(log, settle), settle)
         for axis in (a, b, c, d):
             axis.legend(loc="best", fontsize=7, frameon=False)
-        from wmr_mj.sim.summary import shown_config
 
         cfg = shown_config(log.config or {}, log.summary)  # the law's own settings only
         bits = [f"{k}={cfg[k]}" for k in ("controller", "path", "model", "seed")
@@ -722,7 +714,6 @@ def format_summary(rep: dict[str, Any]) -> str:
     if rep["truncated"]:
         lines.append(f"TRUNCATED  the file ends without its footer ({rep.get('truncated_reason')}): the run was "
                      "killed; what was flushed is shown")
-    from wmr_mj.sim.summary import shown_config
 
     cfg = shown_config(rep["config"] or {}, rep.get("summary"))  # the law's own settings only
     scalars = [f"{k}={v}" for k, v in cfg.items() if isinstance(v, (str, int, float, bool)) or v is None]
@@ -747,8 +738,6 @@ def format_summary(rep: dict[str, Any]) -> str:
         lines.append(f"voltage    max |u| = {_fmt(rep['max_abs_voltage'], 'V')}, saturated "
                      f"{100 * rep['voltage_saturated_fraction']:.1f}% of rows")
     if (rep.get("summary") or {}).get("paper_claim_applies") is False:
-        from wmr_mj.analysis.verdicts import PAPER_CLAIM_NOT_APPLICABLE
-
         lines.append(f"paper's claim {PAPER_CLAIM_NOT_APPLICABLE}")
     elif rep["E_max"] is not None or rep["Edot_max"] is not None:
         def verdict(inside: Any, count: Any) -> str:
@@ -763,8 +752,6 @@ def format_summary(rep: dict[str, Any]) -> str:
     else:
         lines.append("bounds     none in the log (no finite E_max / Edot_max in its summary or config)")
     if rep.get("summary"):
-        from wmr_mj.analysis.verdicts import format_verdict
-
         lines.extend(_verdict_block(format_verdict(rep["summary"])))
     pe = rep.get("path_errors")
     if pe:
@@ -784,8 +771,6 @@ def format_summary(rep: dict[str, Any]) -> str:
         lines.append(f"path of C  n/a: {rep['path_errors_note']}")
     if rep["summary"]:
         # the paper's region under its own names only (a log written before they existed keeps the old ones)
-        from wmr_mj.sim.summary import PAPER_KEYS_DEPRECATED, PAPER_REGION_KEYS
-
         renamed = set(PAPER_KEYS_DEPRECATED) if "paper_E_max" in rep["summary"] else set()
         # a law outside the paper's family: the keys it has no value for (the paper's region, settings it
         # does not read) are null with a reason; not printed

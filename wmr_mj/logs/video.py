@@ -44,7 +44,9 @@ from typing import Any
 
 import numpy as np
 
-from wmr_mj.errors import NoRenderBackendError, ParameterError, WmrMjError
+from wmr_mj._util.files import check_output_path
+from wmr_mj.errors import LogError, NoRenderBackendError, ParameterError, WmrMjError
+from wmr_mj.logs.reader import load_log
 
 __all__ = [
     "BACKENDS",
@@ -153,8 +155,6 @@ def render_video(
     """
     import importlib.util
 
-    from wmr_mj._util.files import check_output_path
-
     _check_options(fps, width, height)
     missing = [m for m in ("imageio", "imageio_ffmpeg") if importlib.util.find_spec(m) is None]
     if missing:
@@ -165,8 +165,6 @@ def render_video(
     out = check_output_path(out, option="--video")
     log_path = Path(log_path)
     if not log_path.is_file():
-        from wmr_mj.errors import LogError
-
         raise LogError(f"{str(log_path)!r} is not a file; give an MCAP run log written by `wmr-mj run`")
     chosen = os.environ.get("MUJOCO_GL", "").strip().lower()
     candidates = (chosen,) if chosen else BACKENDS
@@ -313,8 +311,6 @@ def _log_model(log: Any) -> tuple[Any, np.ndarray, np.ndarray]:
         LogError: no /sim/state rows, an MJCF that does not compile, or qpos rows of another size.
     """
     import mujoco
-
-    from wmr_mj.errors import LogError
 
     state = log.state
     t_state = np.asarray(state.get("t", np.empty(0)), float)
@@ -639,7 +635,6 @@ def _worker(argv: list[str]) -> int:
     except Exception as exc:
         print(f"{type(exc).__name__}: {exc}".splitlines()[0], file=sys.stderr)
         return _EXIT_NO_BACKEND
-    from wmr_mj.logs.reader import load_log
 
     try:
         width, height = parse_size(args.size)

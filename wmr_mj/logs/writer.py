@@ -35,8 +35,10 @@ Usage::
 
 from __future__ import annotations
 
+import concurrent.futures
 import contextlib
 import datetime as _dt
+import functools
 import io
 import json
 import math
@@ -55,6 +57,7 @@ from mcap.opcode import Opcode
 from mcap.records import MessageIndex
 
 from wmr_mj._util.files import json_safe, software_versions
+from wmr_mj._version import __version__
 from wmr_mj.errors import LogError, OutputPathError, ParameterError
 from wmr_mj.logs import logformat as lf
 from wmr_mj.logs.foxglove import (
@@ -65,6 +68,7 @@ from wmr_mj.logs.foxglove import (
     tf_schema_text,
     travelled_update,
 )
+from wmr_mj.sim.closed_loop import run_closed_loop
 from wmr_mj.sim.log_header import LogHeader
 
 if TYPE_CHECKING:
@@ -316,8 +320,6 @@ class RunLogger:
             # chunks are cut by flush() only: one block of full-rate data, one of Foxglove data
             self._w = Writer(self._f, chunk_size=1 << 62, compression=comp[compression])
             self._bulk = _BulkMessages.attach(self._w)  # None: one add_message per row
-            from wmr_mj._version import __version__
-
             self._w.start(profile="", library=f"wmr-mj/{__version__}; {LIBRARY_IDENTIFIER}")
             self._start(mjcf_xml, config, parameters, init, reference_path)
         except BaseException:
@@ -472,8 +474,6 @@ class RunLogger:
         if not self._pending:
             return
         if self._background:
-            import concurrent.futures
-
             if self._executor is None:
                 self._executor = concurrent.futures.ThreadPoolExecutor(1, thread_name_prefix="wmr-mj-log",
                                                                        initializer=_block_signals)
@@ -634,8 +634,4 @@ def measure_logging_overhead(run: Any, log_path: str | os.PathLike, *, repeats: 
 
 def run_logged(config: RunConfig, path: str) -> RunSummary:
     """Re-run ``config`` serially (``run_closed_loop``) with an MCAP log at ``path``; its summary."""
-    import functools
-
-    from wmr_mj.sim.closed_loop import run_closed_loop
-
     return run_closed_loop(config, logger_factory=functools.partial(RunLogger, path), progress=False).summary

@@ -37,7 +37,8 @@ from mujoco import rollout
 
 from wmr_mj.errors import ParameterError
 from wmr_mj.params import C80, C80Parameters
-from wmr_mj.plant.mjcf import Plant
+from wmr_mj.plant.identify import identify_plant
+from wmr_mj.plant.mjcf import Plant, measure_side_slip
 
 __all__ = [
     "HOLD_RATE",
@@ -212,9 +213,6 @@ def measure_contact_softness(params: C80Parameters = C80, *, tyre_contact: str =
     """Penetration (``wheel_penetration``), side slip on the 1 m circle (``measure_side_slip``) and
     the identified gyro, K, P (``identify_plant``, ``identify_duration`` s, ``seed``) for one
     contact model."""
-    from wmr_mj.plant.identify import identify_plant
-    from wmr_mj.plant.mjcf import measure_side_slip
-
     depth = wheel_penetration(params, tyre_contact=tyre_contact)
     slip = measure_side_slip(params, tyre_contact=tyre_contact)
     ident = identify_plant(params, duration=identify_duration, seed=seed, tyre_contact=tyre_contact)

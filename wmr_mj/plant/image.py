@@ -21,6 +21,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+from wmr_mj._util.resources import MODELS_DIR
 from wmr_mj.errors import NoRenderBackendError, WmrMjError
 from wmr_mj.params import C80, C80Parameters
 
@@ -44,10 +45,12 @@ def render_model_png(params: C80Parameters = C80, *, width: int = IMAGE_SIZE[0],
     Needs a working OpenGL backend in this process (``MUJOCO_GL`` set before ``mujoco`` was
     imported); :func:`write_model_image` arranges that.
     """
+    # MuJoCo (and so the model compiler, which imports it) is imported here, not at the top: it picks its OpenGL
+    # backend on import, and the child of write_model_image imports this module before it tries the backend
     import mujoco
-    from PIL import Image
+    from PIL import Image  # Pillow, imported where a picture is written
 
-    from wmr_mj.plant.mjcf import compile_model
+    from wmr_mj.plant.mjcf import compile_model  # imports mujoco (above)
 
     model, _ = compile_model(params)
     model.geom_rgba[model.geom("chassis_body").id, 3] = CHASSIS_ALPHA  # the picture only: the files keep 0.6
@@ -73,8 +76,6 @@ def write_model_image(directory: str | os.PathLike | None = None) -> Path:
         NoRenderBackendError: neither EGL nor OSMesa can render here (one line, each backend's reason).
         WmrMjError: the renderer failed for another reason.
     """
-    from wmr_mj._util.resources import MODELS_DIR
-
     out = Path(directory) if directory is not None else MODELS_DIR
     out.mkdir(parents=True, exist_ok=True)
     path = out / IMAGE_NAME

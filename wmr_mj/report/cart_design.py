@@ -35,9 +35,18 @@ from typing import Any
 
 from wmr_mj._util.checks import as_pair
 from wmr_mj._util.progress import Stages
+from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE
+from wmr_mj.hardware import Sensing
+from wmr_mj.params import M1_RANGE
 from wmr_mj.report.settings import ValidateSettings, loud, stage_progress
-from wmr_mj.sim.design_search import DEFAULT_BUDGET, DEFAULT_SEED
+from wmr_mj.sim.certify import certificate_name
+from wmr_mj.sim.coerce import coerce
+from wmr_mj.sim.compare import design_file_changes
+from wmr_mj.sim.design_search import DEFAULT_BUDGET, DEFAULT_SEED, DesignProblem, search_design, write_design
+from wmr_mj.sim.designs import CERTIFIED
+from wmr_mj.sim.parts import resolve_run
 from wmr_mj.sim.records import Record
+from wmr_mj.sim.sweep import SweepSpec, SweepSummary, read_runs, run_sweep
 
 __all__ = ["DESIGN_SENSING", "DESIGN_SEED", "DESIGN_BUDGET", "DESIGN_RUNS", "DesignOnCart", "CartDesign",
            "design_problem", "design_command", "cart_design_stage"]
@@ -136,18 +145,12 @@ def design_problem(settings: ValidateSettings, *, sensing: str = DESIGN_SENSING,
     """The :class:`~wmr_mj.sim.design_search.DesignProblem` of the section: the certified design's run of these
     settings (their box, path, duration and cart) on ``sensing``, searched as ``wmr-mj design`` searches
     (the 1 ms period, the E_max objective, CMA-ES)."""
-    from wmr_mj.sim.coerce import coerce
-    from wmr_mj.sim.design_search import DesignProblem
-    from wmr_mj.sim.designs import CERTIFIED
-
     base = coerce(settings.config(CERTIFIED).replace(sensing=sensing))  # the sensing's spec typed
     return DesignProblem(base=base, paths=(settings.path,), seed=seed, budget=budget)
 
 
 def design_command(settings: ValidateSettings, problem: Any) -> str:
     """The ``wmr-mj design`` command that searches ``problem`` (its options where they are not its defaults)."""
-    from wmr_mj.params import M1_RANGE
-
     sensing = problem.base.sensing
     words = ["wmr-mj", "design", "--sensing", shlex.quote(DESIGN_SENSING if sensing == _preset(DESIGN_SENSING)
                                                           else _spec(sensing.to_dict()))]
@@ -173,8 +176,6 @@ def design_command(settings: ValidateSettings, problem: Any) -> str:
 
 
 def _preset(name: str) -> Any:
-    from wmr_mj.hardware import Sensing
-
     return Sensing.from_spec(name)
 
 
@@ -185,11 +186,6 @@ def _spec(d: Mapping[str, Any]) -> str:
 def _design_on_cart(name: str, label: str, base: Any, settings: ValidateSettings, folder: Path, st: Stages,
                     n: int) -> DesignOnCart:
     """Sweep ``base`` over the m1 draws (resumable in cart-design-<name>/) and summarise it with its certificate."""
-    from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE
-    from wmr_mj.sim.certify import certificate_name
-    from wmr_mj.sim.parts import resolve_run
-    from wmr_mj.sim.sweep import SweepSpec, SweepSummary, read_runs, run_sweep
-
     cert = resolve_run(base).claim  # the certificate of the design on the cart, over the box (a run's own)
     spec = SweepSpec(n=n, seed=settings.seed, sampling=settings.sampling, m1_range=as_pair(settings.m1_range),
                      ranges=settings.ranges, base=base)
@@ -229,9 +225,6 @@ def cart_design_stage(settings: ValidateSettings, folder: Path, st: Stages, *, s
     Returns:
         summary.json's ``cart_design``.
     """
-    from wmr_mj.sim.compare import design_file_changes
-    from wmr_mj.sim.design_search import search_design, write_design
-
     problem = design_problem(settings, sensing=sensing, seed=seed, budget=budget)
     n = min(settings.n, DESIGN_RUNS)
     st.start("cart-design", f"the design wmr-mj design finds for {sensing} ({budget} certificates), then it and the "

@@ -12,10 +12,17 @@ from __future__ import annotations
 import csv
 import html
 import io
+import json
 import math
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any
 
+from wmr_mj._util.files import write_json_atomic, write_text_atomic
+from wmr_mj.analysis.verdicts import certified_outside_banner, format_unmet
+from wmr_mj.figures.plots import save_figure
+from wmr_mj.figures.results import figure_compare
+from wmr_mj.hardware import Actuation, Sensing, Transmission, cart_line
 from wmr_mj.sim.compare import CompareResult, DesignRow, runs_json
 
 __all__ = ["table_rows", "markdown", "csv_text", "html_page", "write_report", "COLUMNS", "legend_lines",
@@ -56,16 +63,12 @@ def _claim(r: DesignRow) -> str:
 
 
 def _not_met(r: DesignRow) -> str:
-    from wmr_mj.analysis.verdicts import format_unmet
-
     return "; ".join(f"{format_unmet([a])} in {a['runs']}/{r.runs}" for a in r.unmet) or "none"
 
 
 def banner_lines(result: CompareResult) -> list[str]:
     """``run``'s banner for each design whose claim a run breaks, with that run (its scenario or its
     plant and signal); [] when no claim is broken."""
-    from wmr_mj.analysis.verdicts import certified_outside_banner
-
     out = []
     for r in result.rows:
         b = r.claim_broken
@@ -124,10 +127,6 @@ def _heading(result: CompareResult) -> str:
 def cart_text(result: CompareResult) -> str:
     """'' where every design runs the ideal cart; else '. Cart (...): sensing ...; actuation ...; transmission
     ...', once where every design shares it, else per design (a scenario that names its own cart keeps it)."""
-    from types import SimpleNamespace
-
-    from wmr_mj.hardware import Actuation, Sensing, Transmission, cart_line
-
     carts = [dict(r.cart) for r in result.rows]
     if not any(carts):
         return ""
@@ -163,10 +162,6 @@ def markdown(result: CompareResult) -> str:
 
 def csv_text(result: CompareResult) -> str:
     """One CSV line per design with every figure of :class:`~wmr_mj.sim.compare.DesignRow` (full precision)."""
-    import json
-
-    from wmr_mj.analysis.verdicts import format_unmet
-
     rows = [r.to_dict() for r in result.rows]
     buf = io.StringIO()
     names = list(dict.fromkeys(k for r in rows for k in r))  # "cart" only where a design's cart is not ideal
@@ -200,12 +195,6 @@ def html_page(result: CompareResult, figure_name: str = "compare.png") -> str:
 def write_report(result: CompareResult, out: Path) -> dict[str, str]:
     """compare.md, compare.csv, compare.html, compare.png and compare.json (and runs.jsonl) in ``out``,
     each written atomically; returns their paths by kind."""
-    import json
-
-    from wmr_mj._util.files import write_json_atomic, write_text_atomic
-    from wmr_mj.figures.plots import save_figure
-    from wmr_mj.figures.results import figure_compare
-
     out.mkdir(parents=True, exist_ok=True)
     paths = {"markdown": out / "compare.md", "csv": out / "compare.csv", "html": out / "compare.html",
              "json": out / "compare.json", "runs": out / "runs.jsonl"}

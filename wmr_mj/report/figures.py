@@ -18,6 +18,7 @@ Usage::
 
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -25,16 +26,17 @@ from typing import Any
 import numpy as np
 
 from wmr_mj._util.progress import Stages
+from wmr_mj.figures import plots
+from wmr_mj.report.paper_example import paper_example
 from wmr_mj.report.results import Rung
 from wmr_mj.report.settings import ValidateSettings
+from wmr_mj.sim.config import plant_parameters
+from wmr_mj.sim.sweep import read_runs
 
 __all__ = ["figures_stage", "travelled_paths"]
 
 
 def _rung_figure(rung: Rung, folder: Path):
-    from wmr_mj.figures import plots
-    from wmr_mj.sim.sweep import read_runs
-
     rows = read_runs((folder / rung.runs_csv).parent)
     cert, paper = rung.certificate, rung.paper_region
     regions = [plots.Region(f"certificate: |E| <= {cert['E_max']:.3g} rad, |E'| <= {cert['Edot_max']:.3g} rad/s",
@@ -50,15 +52,10 @@ def _rung_figure(rung: Rung, folder: Path):
 
 
 def _wrap(text: str, width: int) -> str:
-    import textwrap
-
     return "\n".join(textwrap.wrap(text, width))
 
 
 def _history_figures(nominal: Mapping[str, Any]) -> dict[str, Any]:
-    from wmr_mj.figures import plots
-    from wmr_mj.sim.config import plant_parameters
-
     figs = {}
     for name, run in nominal.items():
         s = run.summary
@@ -73,8 +70,6 @@ def _history_figures(nominal: Mapping[str, Any]) -> dict[str, Any]:
 
 
 def _search_figure(searches: Sequence[Mapping[str, Any]], rungs: Sequence[Rung]):
-    from wmr_mj.figures import plots
-
     histories = []
     for s in searches:
         mc = s.get("mc") or {}
@@ -106,9 +101,6 @@ def figures_stage(settings: ValidateSettings, folder: Path, st: Stages, rungs: S
                   searches: Sequence[Mapping[str, Any]], nominal: Mapping[str, Any]
                   ) -> tuple[dict[str, list[str]], dict[str, Any]]:
     """Write every figure (PNG + SVG) into figures/: ({stem: [relative paths]}, Fig. 7's numbers)."""
-    from wmr_mj.figures import plots
-    from wmr_mj.report.paper_example import paper_example
-
     st.start("figures", "figures (PNG + SVG)")
     figs: dict[str, Any] = {"ladder": plots.figure_ladder(
         [f"{r.index}. {r.label}" for r in rungs], [r.verdicts for r in rungs],

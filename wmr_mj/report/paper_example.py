@@ -16,8 +16,15 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from wmr_mj.analysis.robustness import BOX_COEFFICIENTS
-from wmr_mj.params import PAPER_KD, PAPER_KP
+from controllers import ComputedTorque
+from wmr_mj.analysis.robustness import BOX_COEFFICIENTS, ParameterBox, analyse
+from wmr_mj.errors import ParameterError
+from wmr_mj.params import C80, PAPER_KD, PAPER_KP
+from wmr_mj.plant.reduced import SteeringModel
+from wmr_mj.reference.bounds import ReferenceBounds
+from wmr_mj.sim.closed_loop import run_closed_loop, run_on_reduced_model
+from wmr_mj.sim.config import RunConfig, build_reference
+from wmr_mj.sim.designs import CERTIFIED
 
 if TYPE_CHECKING:
     from wmr_mj.sim.summary import RunSummary
@@ -48,15 +55,6 @@ def paper_example(*, duration: float = 35.0, friction_width: float = 1e-3, mujoc
     law and plant (so the mismatch is (F - F^) s, as the analysis assumes).
     (b) ``run_closed_loop(RunConfig(model='paper'))`` on the MuJoCo plant.
     """
-    from controllers import ComputedTorque
-    from wmr_mj.analysis.robustness import ParameterBox, analyse
-    from wmr_mj.errors import ParameterError
-    from wmr_mj.params import C80
-    from wmr_mj.plant.reduced import SteeringModel
-    from wmr_mj.reference.bounds import ReferenceBounds
-    from wmr_mj.sim.closed_loop import run_closed_loop, run_on_reduced_model
-    from wmr_mj.sim.config import RunConfig, build_reference
-
     if not (isinstance(duration, (int, float)) and math.isfinite(duration) and duration > 0):
         raise ParameterError(f"duration = {duration!r} s is not accepted; a finite number > 0 is required")
     box = ParameterBox.paper()
@@ -78,7 +76,6 @@ def paper_example(*, duration: float = 35.0, friction_width: float = 1e-3, mujoc
         run = run_closed_loop(RunConfig(model="paper", duration=float(duration), kp=kp, kd=kd), progress=False)
         ex.mujoco_rows = run.rows
         ex.mujoco_summary = run.summary
-        from wmr_mj.sim.designs import CERTIFIED
 
         certified = run_closed_loop(RunConfig(**CERTIFIED.config_changes(), duration=float(duration)), progress=False)
         for label, r in (("the paper's design", run), ("the certified design", certified)):

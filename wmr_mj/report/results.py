@@ -22,7 +22,9 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+from wmr_mj.figures.results import plot_validate
 from wmr_mj.report.cart_design import CartDesign
+from wmr_mj.sim import notebook
 from wmr_mj.sim.records import Record
 
 __all__ = ["Rung", "CertifiedRule", "PathSummary", "ValidateSummary"]
@@ -202,17 +204,11 @@ class ValidateSummary(Record):
         Raises:
             WmrMjError: pandas is not installed (``pip install 'wmr-mj[notebook]'``).
         """
-        from wmr_mj.sim import notebook
-
         return notebook.validate_frame(self.rungs)
 
     def plot(self) -> Any:
         """The verdicts of each rung (the report's ladder figure), as a :class:`wmr_mj.figures.results.ResultPlot`."""
-        from wmr_mj.figures.results import plot_validate
-
         return plot_validate(self)
 
     def _repr_html_(self) -> str:
-        from wmr_mj.sim import notebook
-
         return notebook.validate_html(self)

@@ -37,7 +37,10 @@ from typing import Any
 import numpy as np
 
 from wmr_mj._util.checks import as_pair
+from wmr_mj._util.files import write_json_atomic, write_text_atomic
 from wmr_mj._util.progress import Stages
+from wmr_mj.analysis.verdicts import count_verdicts
+from wmr_mj.logs.writer import run_logged
 from wmr_mj.params import uncertainty_ranges
 from wmr_mj.report.settings import (
     FULL_BOX_FACTOR,
@@ -48,6 +51,9 @@ from wmr_mj.report.settings import (
     stage_progress,
 )
 from wmr_mj.sim.designs import CERTIFIED, LADDER, PAPER, Design
+from wmr_mj.sim.falsify import OBJECTIVE_LABELS, FalsifySpec, objective_value, search_worst
+from wmr_mj.sim.parts import resolve_run
+from wmr_mj.sim.sweep import read_runs, run_configs
 
 __all__ = ["SearchPlan", "search_plans", "run_search", "search_stage"]
 
@@ -90,8 +96,6 @@ def search_plans(settings: ValidateSettings) -> tuple[SearchPlan, ...]:
 
 
 def _search_spec(plan: SearchPlan, settings: ValidateSettings):
-    from wmr_mj.sim.falsify import FalsifySpec
-
     extra = {k: v for k, v in uncertainty_ranges(plan.box).items() if k != "m1"}
     base = settings.config(plan.design).replace(box_ranges=extra)
     return FalsifySpec(base=base, box={"m1": as_pair(settings.m1_range), **extra}, objective=plan.objective,
@@ -107,9 +111,6 @@ def _fingerprint(spec) -> str:
 def _evaluate_search(spec, *, nthread: int, progress: Callable[[float, int], None]) -> list[dict[str, Any]]:
     """Run the search of ``spec`` (no random sample: the ladder's sweep is the
     baseline); every evaluated run as {generation, params, objective, sup_E, sup_Edot, verdict}."""
-    from wmr_mj.sim.falsify import objective_value, search_worst
-    from wmr_mj.sim.sweep import run_configs
-
     runs: list[dict[str, Any]] = []
     generation = [0]
 
@@ -152,8 +153,6 @@ def _evaluations_csv(names: Sequence[str], runs: Sequence[Mapping[str, Any]]) ->
 
 def _compare(result: dict[str, Any], plan: SearchPlan, rungs: Sequence[Mapping[str, Any]], folder: Path) -> None:
     """Add the Monte-Carlo worst of the plan's rung (read from its runs.csv) beside the search's."""
-    from wmr_mj.sim.sweep import read_runs
-
     if plan.mc_rung is None or plan.mc_column is None:
         result["mc"] = None
         return
@@ -178,9 +177,6 @@ def _read_back(saved: Path, fingerprint: str) -> dict[str, Any] | None:
 
 def _result(plan: SearchPlan, spec, runs: Sequence[Mapping[str, Any]], worst: Mapping[str, Any] | None,
             reproduced: bool, certificate: Any, out: Path, folder: Path) -> dict[str, Any]:
-    from wmr_mj.analysis.verdicts import count_verdicts
-    from wmr_mj.sim.falsify import OBJECTIVE_LABELS
-
     return {
         "key": plan.key, "title": plan.title, "fingerprint": _fingerprint(spec), "design": plan.design.name,
         "design_text": plan.design.describe(), "box_name": plan.box,
@@ -202,11 +198,6 @@ def run_search(plan: SearchPlan, settings: ValidateSettings, folder: Path, st: S
     re-run its worst run with an MCAP log (worst.mcap: is the serial run's sup|E| the
     batch's?) and write evaluations.csv and search.json; its certificate is the base run's claim
     (:func:`wmr_mj.sim.parts.resolve_run`)."""
-    from wmr_mj._util.files import write_json_atomic, write_text_atomic
-    from wmr_mj.logs.writer import run_logged
-    from wmr_mj.sim.falsify import OBJECTIVE_LABELS
-    from wmr_mj.sim.parts import resolve_run
-
     spec = _search_spec(plan, settings)
     out = folder / f"search-{plan.key}"
     st.start(f"search-{plan.key}", f"search: {plan.title} ({len(spec.names)} parameter(s), budget {spec.budget} runs)")

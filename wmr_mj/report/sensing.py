@@ -30,6 +30,10 @@ import numpy as np
 from wmr_mj._util.progress import Stages
 from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE, unmet_assumptions
 from wmr_mj.report.settings import ValidateSettings
+from wmr_mj.sim.closed_loop import run_parts
+from wmr_mj.sim.coerce import coerce
+from wmr_mj.sim.designs import CERTIFIED
+from wmr_mj.sim.parts import resolve_run
 
 __all__ = ["REALISTIC_SENSING", "SETTLED_WINDOW_S", "sensing_stage", "voltage_activity", "settled_plateau"]
 
@@ -71,8 +75,6 @@ def settled_plateau(E: np.ndarray, control_period: float, window_s: float = SETT
 
 def _one_run(parts, name: str, ideal_E_max: float | None) -> dict[str, Any]:
     """The run of ``parts`` (resolved: :func:`wmr_mj.sim.parts.resolve_run`) under the sensing called ``name``."""
-    from wmr_mj.sim.closed_loop import run_parts
-
     config = parts.config
     run = run_parts(parts, progress=False)
     s = run.summary
@@ -109,10 +111,6 @@ def sensing_stage(settings: ValidateSettings, st: Stages, *,
         (``F_estimate`` [V], ``P_estimate`` [V s^2/rad], ``kp`` [1/s^2], ``dead_band`` [rad], ``ideal_E_max``
         [rad]), ``runs`` (one per sensing, 'ideal' first: see the module docstring), ``certified_outside``.
     """
-    from wmr_mj.sim.coerce import coerce
-    from wmr_mj.sim.designs import CERTIFIED
-    from wmr_mj.sim.parts import resolve_run
-
     m1 = float(settings.m1_range[1])
     st.start("sensing", f"the certified design on realistic sensing ({', '.join(presets)}; m1 = {m1:g} kg, "
                         f"{settings.duration:g} s each)")

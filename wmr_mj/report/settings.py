@@ -18,10 +18,17 @@ from wmr_mj._util.checks import as_pair, integer_at_least, positive_number
 from wmr_mj._util.progress import Stages
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.hardware.cart import CART_PARTS, cart_dict
+from wmr_mj.params import UNCERTAINTY_NAMES, uncertainty_ranges
 from wmr_mj.report.defaults import DEFAULT_DURATION, DEFAULT_N, DEFAULT_SEARCH_BUDGET, FULL_BOX_FACTOR
-from wmr_mj.sim.config import RunConfig, build_reference
-from wmr_mj.sim.designs import DesignLike
-from wmr_mj.sim.sweep import max_at  # noqa: F401  (re-exported: the report reads runs.csv with it)
+from wmr_mj.sim.compare import FileDesign, design_token_changes, is_design_file
+from wmr_mj.sim.config import RunConfig, base_for, build_reference, cart_file
+from wmr_mj.sim.designs import DesignLike, design_changes, on_cart
+from wmr_mj.sim.falsify import cma_population
+from wmr_mj.sim.parts import resolve_run
+from wmr_mj.sim.sweep import (
+    SAMPLINGS,
+    max_at,  # noqa: F401  (re-exported: the report reads runs.csv with it)
+)
 
 __all__ = [
     "DEFAULT_N",
@@ -78,8 +85,6 @@ class ValidateSettings:
     cart: Any = None
 
     def __post_init__(self) -> None:
-        from wmr_mj.sim.sweep import SAMPLINGS
-
         on_cart = RunConfig.from_inputs(cart=self.cart)  # a missing file, an unknown name: one line, before any run
         object.__setattr__(self, "cart", on_cart.cart)
         if self.m1_range is None:
@@ -99,7 +104,6 @@ class ValidateSettings:
         lo, hi = self.m1_range
         if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo < hi):
             raise ParameterError(f"m1_range = {self.m1_range!r} must be (lo, hi) with 0 < lo < hi")
-        from wmr_mj.params import UNCERTAINTY_NAMES
 
         if self.uncertainty not in UNCERTAINTY_NAMES:
             raise UnknownNameError("uncertainty box name", str(self.uncertainty), UNCERTAINTY_NAMES)
@@ -108,11 +112,8 @@ class ValidateSettings:
                                       transmission=self.transmission, cart=self.cart)
         for name in ("sensing", "actuation", "transmission"):
             object.__setattr__(self, name, getattr(probe, name))  # the typed part
-        from wmr_mj.sim.compare import design_token_changes, is_design_file
-        from wmr_mj.sim.designs import design_changes
 
         object.__setattr__(self, "designs", tuple(str(t) for t in self.designs))
-        from wmr_mj.sim.parts import resolve_run
 
         for token in self.designs:  # an unknown law, a missing file, a bad setting: refused before any run
             # built once: a parameter the law does not take, a claim() that raises or returns no Certificate
@@ -126,9 +127,6 @@ class ValidateSettings:
     def min_search_budget(self) -> int:
         """One CMA-ES generation of each search (wmr_mj.report.search.search_plans): the ladder's box and,
         over the m1 box, the full box at FULL_BOX_FACTOR times the budget."""
-        from wmr_mj.params import uncertainty_ranges
-        from wmr_mj.sim.falsify import cma_population
-
         need = cma_population(1 + len(self.ranges))
         if self.uncertainty == "m1":
             need = max(need, -(-cma_population(len(uncertainty_ranges("full"))) // FULL_BOX_FACTOR))
@@ -137,20 +135,14 @@ class ValidateSettings:
     @property
     def ranges(self) -> dict[str, tuple[float, float]]:
         """The ranged parameters of the uncertainty box other than m1, name -> (lo, hi)."""
-        from wmr_mj.params import uncertainty_ranges
-
         box = uncertainty_ranges(self.uncertainty)
         if self.cart is not None:
-            from wmr_mj.sim.config import cart_file
-
             box = dict(cart_file(RunConfig(cart=self.cart)).uncertainty.get(self.uncertainty, box))
         return {k: v for k, v in box.items() if k != "m1"}
 
     @property
     def base(self):
         """The cart's parameter set (:class:`wmr_mj.params.C80Parameters`; the C80 without a cart)."""
-        from wmr_mj.sim.config import base_for
-
         return base_for(RunConfig(cart=self.cart))
 
     def config(self, design: DesignLike) -> RunConfig:
@@ -159,9 +151,6 @@ class ValidateSettings:
         (:class:`wmr_mj.sim.compare.FileDesign`) keeps its gains and the parts of its own cart, but where these
         settings give a part that is not ideal (validate's --sensing, --actuation, --backlash), as ``run --design
         FILE`` keeps the options given."""
-        from wmr_mj.sim.compare import FileDesign
-        from wmr_mj.sim.designs import on_cart
-
         changes = design.config_changes()
         if not isinstance(design, FileDesign):
             changes = on_cart(changes, self.cart)

@@ -45,7 +45,8 @@ from pathlib import PurePath
 from typing import Any
 
 from wmr_mj.analysis.certificate import VERDICTS
-from wmr_mj.analysis.verdicts import WITHIN_THE_SUPPLY
+from wmr_mj.analysis.verdicts import WITHIN_THE_SUPPLY, format_unmet
+from wmr_mj.hardware import Actuation, Sensing, Transmission
 from wmr_mj.params import COEFFICIENT_MODELS, COEFFICIENT_NAMES
 from wmr_mj.plant.cart_data import identified_from
 from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS
@@ -464,8 +465,6 @@ SENSING_COLUMNS = ("sensing", "verdict", "its E_max rad", "sup|E|/E_max (exact)"
 
 def sensing_rows(summary: Summary) -> list[list[str]]:
     """One row per run of summary.json's ``sensing`` (:mod:`wmr_mj.report.sensing`)."""
-    from wmr_mj.analysis.verdicts import format_unmet
-
     out = []
     for r in (ValidateSummary.of(summary).sensing or {}).get("runs", []):
         plateau = r["settled_E"]
@@ -737,8 +736,6 @@ def _settings_line(summary: Summary) -> str:
 def _cart_words(settings: Mapping[str, Any]) -> str:
     """'; cart: ...' naming the parts of the cart that are not ideal (the settings carry only those); '' for
     today's plant."""
-    from wmr_mj.hardware import Actuation, Sensing, Transmission
-
     parts = [(name, cls) for name, cls in (("sensing", Sensing), ("actuation", Actuation),
                                            ("transmission", Transmission)) if settings.get(name)]
     return "".join(("; cart: " if i == 0 else ", ") + f"{name} {cls.from_spec(settings[name]).label()}"

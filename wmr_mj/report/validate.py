@@ -39,15 +39,25 @@ from __future__ import annotations
 
 import dataclasses
 import os
+import re
+import shutil
 import time
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 from wmr_mj._util.checks import as_pair
-from wmr_mj._util.files import software_versions
+from wmr_mj._util.files import software_versions, write_json_atomic, write_text_atomic
 from wmr_mj._util.progress import Stages
+from wmr_mj.params import with_params
+from wmr_mj.plant.friction import measure_friction_law
+from wmr_mj.plant.identify import identify_plant
+from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS
+from wmr_mj.report.cart_design import cart_design_stage
+from wmr_mj.report.figures import figures_stage
 from wmr_mj.report.results import CertifiedRule, PathSummary, Rung, ValidateSummary
+from wmr_mj.report.search import search_stage
+from wmr_mj.report.sensing import sensing_stage
 from wmr_mj.report.settings import (
     LADDER_GROUPS,
     ValidateSettings,
@@ -56,7 +66,13 @@ from wmr_mj.report.settings import (
     reference_of,
     stage_progress,
 )
-from wmr_mj.sim.designs import CERTIFIED, LADDER, PAPER, Design, DesignLike
+from wmr_mj.report.text import findings, render_html, render_markdown, summary_csv
+from wmr_mj.sim import designs
+from wmr_mj.sim.closed_loop import run_closed_loop, run_parts
+from wmr_mj.sim.compare import FileDesign, is_design_file
+from wmr_mj.sim.designs import CERTIFIED, CORRECTION_RUNG, LADDER, PAPER, Design, DesignLike, TokenDesign
+from wmr_mj.sim.parts import resolve_run
+from wmr_mj.sim.sweep import SweepSpec, SweepSummary, read_runs, run_sweep
 
 __all__ = [
     "ValidateSettings",  # defined in wmr_mj.report.settings, with the defaults; here beside run_validate
@@ -86,8 +102,6 @@ def summarise_rung(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
     Raises:
         ParameterError: no rows.
     """
-    from wmr_mj.sim.sweep import SweepSummary
-
     return SweepSummary.of(rows).rung_dict()
 
 
@@ -118,10 +132,6 @@ def _paper_region(parts: Any) -> dict[str, Any]:
 # --------------------------------------------------------------------------- stages 1-2
 def identify_stage(settings: ValidateSettings, folder: Path, st: Stages) -> dict[str, Any]:
     """Identify the plant at the nominal m1; writes identified.json; its ``to_dict`` and verdict."""
-    from wmr_mj._util.files import write_json_atomic
-    from wmr_mj.params import with_params
-    from wmr_mj.plant.identify import identify_plant
-
     st.start("identify", f"identify the plant (m1 = {settings.nominal_m1:g} kg, {settings.identify_duration:g} s "
                          "excitation)")
     ident = identify_plant(with_params(settings.base, m1=settings.nominal_m1), duration=settings.identify_duration,
@@ -136,10 +146,6 @@ def identify_stage(settings: ValidateSettings, folder: Path, st: Stages) -> dict
 
 def friction_stage(settings: ValidateSettings, st: Stages) -> dict[str, dict[str, Any]]:
     """The steering joint's measured friction law for each of :data:`STEERING_FRICTION_MODELS`."""
-    from wmr_mj.params import with_params
-    from wmr_mj.plant.friction import measure_friction_law
-    from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS
-
     st.start("friction", "the steering joint's friction law (stiction, soft): constant voltages")
     plant = with_params(settings.base, m1=settings.nominal_m1)
     laws = {name: measure_friction_law(plant, steering_friction=name).to_dict() for name in STEERING_FRICTION_MODELS}
@@ -154,9 +160,6 @@ def run_rung(settings: ValidateSettings, k: int, design: DesignLike, folder: Pat
     """Sweep one rung over m1 (resumable in ladder-<k>-<name>/) and summarise it; its certificate and the
     paper's region are the base run's (``settings.config(design)``), resolved once: ``parts``
     (:func:`wmr_mj.sim.parts.resolve_run`), resolved here where None."""
-    from wmr_mj.sim.parts import resolve_run
-    from wmr_mj.sim.sweep import SweepSpec, read_runs, run_sweep
-
     base = settings.config(design)
     parts = resolve_run(base) if parts is None else parts
     spec = SweepSpec(n=settings.n, seed=settings.seed, sampling=settings.sampling,
@@ -191,8 +194,6 @@ def ladder_stage(settings: ValidateSettings, folder: Path, st: Stages) -> list[d
 def correction_stage(settings: ValidateSettings, folder: Path, st: Stages) -> dict[str, Any]:
     """The rung after the ladder: the certified design with the Cartesian correction at C
     (:data:`wmr_mj.sim.designs.CORRECTION_RUNG`; summary.json's ``correction_rung``)."""
-    from wmr_mj.sim.designs import CERTIFIED, CORRECTION_RUNG
-
     rung = run_rung(settings, len(LADDER) + 1, CORRECTION_RUNG, folder, st, CERTIFIED)
     rung.update(changed=["correction"], change="Cartesian correction at C (outer loop on alpha0, "
                                               "controllers/tracking.py)")
@@ -204,11 +205,6 @@ def designs_stage(settings: ValidateSettings, folder: Path, st: Stages, *, first
     as ``wmr-mj compare`` takes it, a design file ``FILE.json`` among them) judged beside the ladder: its rung
     (:func:`run_rung`: the same m1 sweep, its verdicts against its own claim) and its nominal run
     (summary.json's ``designs``)."""
-    from wmr_mj.sim.closed_loop import run_parts
-    from wmr_mj.sim.compare import FileDesign, is_design_file
-    from wmr_mj.sim.designs import TokenDesign
-    from wmr_mj.sim.parts import resolve_run
-
     out = []
     for k, token in enumerate(settings.designs, start=first_index):
         design: DesignLike = FileDesign(token, settings.cart) if is_design_file(token) else TokenDesign(token)
@@ -227,8 +223,6 @@ def designs_stage(settings: ValidateSettings, folder: Path, st: Stages, *, first
 # --------------------------------------------------------------------------- stage 5: nominal runs
 def nominal_stage(settings: ValidateSettings, st: Stages) -> dict[str, Any]:
     """The paper's and the certified design at the nominal m1: {name: RunResult}."""
-    from wmr_mj.sim.closed_loop import run_closed_loop
-
     st.start("nominal", f"nominal runs at m1 = {settings.nominal_m1:g} kg (paper's and certified design)")
     runs = {d.name: run_closed_loop(settings.config(d), progress=False) for d in (PAPER, CERTIFIED)}
     st.done(", ".join(f"{name}: sup|E| = {r.summary.sup_E:.3g} rad, {r.summary.verdict}"
@@ -252,9 +246,6 @@ def _nominal_summary(run) -> dict[str, Any]:
 def write_report(summary: ValidateSummary | Mapping[str, Any], folder: Path) -> None:
     """summary.csv, index.md, index.html and summary.json (last, ``summary.to_dict()``), each written atomically
     (``summary``: the summary, or its JSON read back)."""
-    from wmr_mj._util.files import write_json_atomic, write_text_atomic
-    from wmr_mj.report.text import render_html, render_markdown, summary_csv
-
     summary = ValidateSummary.of(summary)
     write_text_atomic(folder / "summary.csv", summary_csv(summary))
     write_text_atomic(folder / "index.md", render_markdown(summary))
@@ -267,8 +258,6 @@ def write_pointer(folder: str | os.PathLike) -> Path:
     atomically (a temporary link, then ``os.replace``). Where symlinks are unavailable (``os.symlink``
     raises OSError) it is a folder holding a copy of the report instead. Either way
     ``validate-latest/summary.json`` reads the latest report."""
-    import shutil
-
     folder = Path(folder)
     link = folder.parent / "validate-latest"
     tmp = folder.parent / f".validate-latest.{os.getpid()}.tmp"
@@ -289,8 +278,6 @@ def write_pointer(folder: str | os.PathLike) -> Path:
 
 
 def _remove(path: Path) -> None:
-    import shutil
-
     if path.is_symlink() or path.is_file():
         path.unlink()
     elif path.is_dir():
@@ -311,10 +298,6 @@ def _path_summary(settings: ValidateSettings) -> PathSummary:
 
 def _certified_rule(cart: Any = None) -> CertifiedRule:
     """The certified design's rule as designs.py writes it, and the omega_r it gives now on the cart."""
-    import re
-
-    from wmr_mj.sim import designs
-
     doc = designs.__doc__ or ""
     rule = doc.split("``certified``:", 1)[-1].split("The ladder", 1)[0]
     rule = re.sub(r":\w+:`([^`]*)`", r"\1", rule).replace("``", "")
@@ -331,12 +314,6 @@ def run_validate(settings: ValidateSettings, out_dir: str | os.PathLike, *, log:
     Returns the summary, read by attribute (summary.json is its ``to_dict()``). Stage lines go to ``stream`` (default
     stderr) when ``log``; ``tty`` forces or suppresses the live counter.
     """
-    from wmr_mj.report.cart_design import cart_design_stage
-    from wmr_mj.report.figures import figures_stage
-    from wmr_mj.report.search import search_stage
-    from wmr_mj.report.sensing import sensing_stage
-    from wmr_mj.report.text import findings
-
     wall0 = time.perf_counter()
     folder = Path(out_dir)
     folder.mkdir(parents=True, exist_ok=True)
