@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, fields
 from typing import Any, Literal, get_args
 
@@ -52,6 +53,7 @@ __all__ = [
     "COEFFICIENT_MODELS",
     "with_params",
     "parameter_names",
+    "tie_motor_constant",
     "PARAMETER_SOURCES",
     "PAPER_KP",
     "PAPER_KD",
@@ -346,6 +348,37 @@ C80 = C80Parameters()
 
 def parameter_names() -> tuple[str, ...]:
     return tuple(f.name for f in fields(C80Parameters))
+
+
+def tie_motor_constant(drawn: Mapping[str, float],
+                       ranges: Mapping[str, tuple[float, float]]) -> dict[str, float]:
+    """A draw of a box's plant parameters with the motor's one constant tied: k_b = k_i where the box ranges both.
+
+    In SI units the torque constant k_i [N m/A] and the back-EMF constant k_b [V s/rad] are one flux (a cart file
+    must have them equal, :mod:`wmr_mj.carts.cartfile`), so a box that ranges both (an identified cart's does, over
+    one interval) names one axis twice. A run takes k_b = k_i: the point (k_i, k_i) lies inside the box whenever
+    k_b's range holds k_i's, so the run stays inside what its certificate covers (the certificate's hull is taken
+    over the box's corners, which hold that diagonal).
+
+    Args:
+        drawn: parameter name -> drawn value (SI units).
+        ranges: parameter name -> its range (lo, hi) in the box the draw came from.
+
+    Returns:
+        A copy of ``drawn``, with k_b set to k_i where both are drawn.
+
+    Raises:
+        ParameterError: both are drawn and k_b's range does not hold k_i's (no run could have k_b = k_i inside).
+    """
+    tied = dict(drawn)
+    if "k_i" in tied and "k_b" in tied:
+        (i_lo, i_hi), (b_lo, b_hi) = ranges["k_i"], ranges["k_b"]
+        if not (b_lo <= i_lo and i_hi <= b_hi):
+            raise ParameterError(f"the box ranges k_i over [{i_lo:g}, {i_hi:g}] N m/A and k_b over [{b_lo:g}, "
+                                 f"{b_hi:g}] V s/rad; accepted: k_b's range holding k_i's (one flux in SI units: "
+                                 "a run has k_b = k_i)")
+        tied["k_b"] = tied["k_i"]
+    return tied
 
 
 #: One line per field: where its value comes from (the C80 cart file's sources, in the fields' order).

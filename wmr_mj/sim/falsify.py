@@ -102,7 +102,7 @@ import numpy as np
 from wmr_mj._util.checks import positive_range
 from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE, VERDICTS, unmet_assumptions
 from wmr_mj.errors import ParameterError, UnknownNameError
-from wmr_mj.params import parameter_names
+from wmr_mj.params import parameter_names, tie_motor_constant
 from wmr_mj.sim.config import RunConfig, config_from_dict
 from wmr_mj.sim.falsify_objectives import (
     OBJECTIVE_LABELS,
@@ -289,14 +289,16 @@ class FalsifySpec:
     def recorded_values(self, point: Sequence[float]) -> dict[str, float]:
         """Each ranged parameter -> the value its run used (what the search's tables record): as proposed, but a
         hardware axis rounded as the run has it (:func:`wmr_mj.sim.search_space.hardware_values`)."""
-        out = {n: float(v) for n, v in zip(self.names, point)}
+        out = tie_motor_constant({n: float(v) for n, v in zip(self.names, point)}, self.box)
         out.update(hardware_values(self.base, {n: v for n, v in out.items() if hardware_axis(n)}))
         return out
 
     def config(self, point: Sequence[float]) -> RunConfig:
         """The run at ``point`` (values in ``names`` order): m1, the plant overrides and the signals'
-        parameters set (:func:`wmr_mj.sim.search_space.config_for`)."""
-        return config_for(self.base, self.names, point)
+        parameters set (:func:`wmr_mj.sim.search_space.config_for`); k_b as k_i where the box ranges both
+        (:func:`wmr_mj.params.tie_motor_constant`)."""
+        tied = tie_motor_constant({n: float(v) for n, v in zip(self.names, point)}, self.box)
+        return config_for(self.base, self.names, [tied[n] for n in self.names])
 
     def to_dict(self) -> dict[str, Any]:
         """The search's JSON: its base (``RunConfig.to_dict``), the box (name -> [lo, hi]) and its settings."""

@@ -41,7 +41,7 @@ import numpy as np
 
 from wmr_mj._util.checks import positive_range
 from wmr_mj.errors import ParameterError, SchedulerError, UnknownNameError
-from wmr_mj.params import parameter_names
+from wmr_mj.params import parameter_names, tie_motor_constant
 from wmr_mj.sim.batch import run_batch
 from wmr_mj.sim.coerce import coerced
 from wmr_mj.sim.config import RunConfig, config_from_dict
@@ -205,16 +205,18 @@ class SweepSpec:
         base = self.base_for_box()
         hardware = set(self.hardware_names)
         overrides = dict(base.plant_overrides)
-        overrides.update({n: float(v) for n, v in zip(self.names[1:], values[1:]) if n not in hardware})
+        overrides.update(tie_motor_constant({n: float(v) for n, v in zip(self.names[1:], values[1:])
+                                             if n not in hardware}, self.ranges))
         config = base.replace(m1=float(values[0]), plant_overrides=overrides)
         return with_hardware(config, {n: float(v) for n, v in zip(self.names[1:], values[1:]) if n in hardware})
 
     def recorded_values(self, values: Sequence[float]) -> dict[str, float]:
-        """Each ranged axis but m1 -> the value its run used (runs.csv's columns): a plant parameter as drawn,
-        a hardware axis as rounded (:func:`wmr_mj.sim.search_space.hardware_values`)."""
+        """Each ranged axis but m1 -> the value its run used (runs.csv's columns): a plant parameter as drawn
+        (k_b as k_i where both are ranged: :func:`wmr_mj.params.tie_motor_constant`), a hardware axis as rounded
+        (:func:`wmr_mj.sim.search_space.hardware_values`)."""
         from wmr_mj.sim.search_space import hardware_values
 
-        out = {n: float(v) for n, v in zip(self.names[1:], values[1:])}
+        out = tie_motor_constant({n: float(v) for n, v in zip(self.names[1:], values[1:])}, self.ranges)
         out.update(hardware_values(self.base, {n: out[n] for n in self.hardware_names}))
         return out
 
