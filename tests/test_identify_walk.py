@@ -126,11 +126,10 @@ def test_its_runs_on_the_true_cart_stay_within_its_certificate(walk):
 
 
 def test_validate_on_the_identified_cart_names_its_data_first(walk):
-    # validate's own box: m1 (its default). --uncertainty full draws k_i and k_b apart in its runs, which a run
-    # refuses (k_b = k_i: one flux); the design's certificate over the identified box is the test above's
+    # over the identified box (--uncertainty full): its runs take k_b = k_i (one flux; wmr_mj.params.tie_motor_constant)
     out = walk["folder"] / "validate"
     code, printed = _main(["validate", "--cart", str(walk["new"]), "--design", str(walk["design"]),
-                           "--n", "2", "--duration", "10", "--search-budget", "0",
+                           "--uncertainty", "full", "--n", "2", "--duration", "10", "--search-budget", "0",
                            "--identify-duration", "5", "--out", str(out)])
     lines = printed.splitlines()
     assert code == 0
