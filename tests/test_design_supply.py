@@ -50,6 +50,7 @@ def test_a_cap_is_needed():
         score({"p": _cert(0.01, 5.0)}, "E_max-then-voltage")
 
 
+@pytest.mark.slow
 def test_the_12bit_cart_certifies_below_the_full_supply_within_10_percent(tmp_path, capsys):
     """The E_max design of the 12-bit cart needs nearly the whole 24 V supply (23.50 V at budget 120, 23.9997 V at
     budget 600, 2026-11-28); the supply objective, from the same first search, finds one that needs less within
