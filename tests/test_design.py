@@ -113,7 +113,8 @@ def test_nothing_certifies_names_the_binding_assumption(tmp_path, capsys):
     (["--range", "R_a=1.3:1.0"], "the range of R_a is empty or inverted"),
     (["--periods", "0.001,0.0015"], "--periods: 0.0015 s is not a whole number"),
     (["--periods", "0.004", "--duration", "35.002"], "does not divide the run"),
-    (["--objective", "speed"], "--objective 'speed' is not accepted; one of E_max, voltage, margin"),
+    (["--objective", "speed"],
+     "--objective 'speed' is not accepted; one of E_max, voltage, margin, E_max-then-voltage"),
     (["--sensing", "noise=gaussian:0.001"], "Gaussian noise has no bound: no certificate can cover it"),
 ])
 def test_bad_input_is_one_line_exit_2(argv, culprit, tmp_path, capsys):

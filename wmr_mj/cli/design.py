@@ -16,7 +16,7 @@ HELP = "the computed-torque (or sliding-mode) gains, sign width, filter and peri
 def register(sub: argparse._SubParsersAction) -> None:
     from wmr_mj.cli.run import add_hardware_options
     from wmr_mj.params import M1_RANGE
-    from wmr_mj.sim.design_options import DEFAULT_BUDGET, DEFAULT_SEED, METHODS, OBJECTIVES
+    from wmr_mj.sim.design_options import DEFAULT_BUDGET, DEFAULT_SEED, METHODS, OBJECTIVE_WORDS
 
     p = sub.add_parser(
         "design", help=HELP,
@@ -49,8 +49,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="control periods to try, s, each a whole number of 1 ms physics steps dividing the run "
                         "(default 0.001)")
     p.add_argument("--objective", default="E_max",
-                   help=f"what is minimised: one of {', '.join(OBJECTIVES)} (the worst certified E_max, the worst "
-                        "certified voltage, minus the smallest relative margin of the checked assumptions)")
+                   help="what is minimised (default E_max): " + "; ".join(
+                       f"{name}: {words}" for name, words in OBJECTIVE_WORDS.items()))
     p.add_argument("--method", default="cma", choices=METHODS,
                    help="the optimiser: cma (CMA-ES, the default: the better of the two in bench/bench_design.py) "
                         "or de (scipy's differential evolution)")

@@ -24,6 +24,14 @@ one worker, no gradient polish) with that point in its first population: where t
 design is never worse than it. The start is a fixed point of the search, not the preset (now omega_r 30), so a
 change of the preset moves no design.
 
+The objective ``E_max-then-voltage`` (:data:`OBJECTIVES`) weighs the supply: a first search minimises E_max as
+``E_max`` does (the same points, the same best E*), then a second, of the same budget, started at the first's best
+point of each period, minimises the worst certified voltage over the points whose worst E_max is at most
+(1 + :data:`E_MAX_SLACK`) E* (a point above that cap scores between :data:`PENALTY` and every uncertified point,
+graded by how far above it is). The first's best point meets the cap, so the design is never above E* (1 + 0.1)
+nor above the first's voltage; its score is its voltage. A lexicographic rule, not a weighted sum: it needs no
+exchange rate between radians and volts, and the slack is the issue's own (within 10 % of the same E_max).
+
 Usage::
 
     from wmr_mj.sim.design_search import DesignProblem, search_design
@@ -49,7 +57,7 @@ from wmr_mj.errors import ParameterError
 from wmr_mj.hardware import Actuation, Sensing, Transmission
 from wmr_mj.plant.cart_data import identified_from
 from wmr_mj.sim.coerce import coerced
-from wmr_mj.sim.design_options import DEFAULT_BUDGET, DEFAULT_SEED, LAWS, METHODS, OBJECTIVES
+from wmr_mj.sim.design_options import DEFAULT_BUDGET, DEFAULT_SEED, E_MAX_SLACK, LAWS, METHODS, OBJECTIVES
 from wmr_mj.sim.optimisers import CMAES, Chain, DifferentialEvolution, Optimiser, Points, drive
 from wmr_mj.sim.records import Record
 
@@ -352,6 +360,10 @@ class _Scorer:
         self.graded = bool(law.design_graded)
         self.law_defaults = law.__init__.__kwdefaults__ or {}
         self.evaluations = 0
+        #: what this scorer minimises, and the cap on the worst E_max (rad) of the second search of
+        #: 'E_max-then-voltage' (None: the first, which minimises E_max)
+        self.objective = "E_max" if problem.objective == "E_max-then-voltage" else problem.objective
+        self.e_max_cap: float | None = None
 
     def bounds(self, period: float) -> list[tuple[float, float]]:
         """The point's box: (log omega_n, zeta, log10 w) or (log lam, log phi, log k, log eta, log10 w), then
@@ -392,7 +404,7 @@ class _Scorer:
         return out
 
     def __call__(self, x: Any) -> float:
-        return score(self.certificates(self.config(x)), self.problem.objective, graded=self.graded)
+        return score(self.certificates(self.config(x)), self.objective, graded=self.graded, e_max_cap=self.e_max_cap)
 
 
 def _margin(cert: Any) -> float:
@@ -402,12 +414,21 @@ def _margin(cert: Any) -> float:
     return min(margins, default=0.0)
 
 
-def score(certificates: Mapping[str, Any], objective: str, *, graded: bool = False) -> float:
+def score(certificates: Mapping[str, Any], objective: str, *, graded: bool = False,
+          e_max_cap: float | None = None) -> float:
     """The objective over the paths' certificates: the worst one; :data:`PENALTY` plus the unmet assumptions'
     count where any certificate is missing or not certified. ``graded`` (the sliding-mode search, whose default
     start has its layer saturated: a flat plateau of one unmet assumption): plus x/(1 + x) < 1, x the sum of
     log(value/limit) over the unmet checked assumptions with a finite value and limit > 0, so the optimiser sees
-    how far a point is from meeting them (the count still ranks first)."""
+    how far a point is from meeting them (the count still ranks first).
+
+    ``E_max-then-voltage`` (its second search; ``e_max_cap`` the cap on the worst E_max, rad): the worst voltage
+    where the worst E_max is at most the cap; above it, :data:`PENALTY` + (1 - cap/E_max), in (PENALTY, PENALTY + 1):
+    above every point that meets the cap, below every uncertified one, graded by how far above the cap.
+
+    Raises:
+        ParameterError: ``E_max-then-voltage`` without ``e_max_cap`` on certified certificates.
+    """
     unmet, excess = 0, 0.0
     for cert in certificates.values():
         if cert is None:
@@ -421,6 +442,13 @@ def score(certificates: Mapping[str, Any], objective: str, *, graded: bool = Fal
     certs = list(certificates.values())
     if objective == "E_max":
         return max(c.E_max for c in certs)
+    if objective == "E_max-then-voltage":
+        if e_max_cap is None:
+            raise ParameterError("the objective E_max-then-voltage scores a point against a cap on E_max: none given")
+        worst = max(c.E_max for c in certs)
+        if worst > e_max_cap:
+            return PENALTY + (1.0 - e_max_cap / worst)
+        return max(c.voltage_max for c in certs)
     if objective == "voltage":
         return max(c.voltage_max for c in certs)
     return -min(_margin(c) for c in certs)
@@ -471,18 +499,30 @@ def search_design(problem: DesignProblem) -> DesignResult:
     periods = check_periods(problem.periods, problem.base.duration)
     _check_law(problem.base.controller)
     best: tuple[float, Any] | None = None
-    evaluations = 0
+    firsts = []  # each period's scorer and best (score, point) of the first search
     for period in periods:
         scorer = _Scorer(problem, period)
         value, x = _search(scorer, scorer.bounds(period), problem)
-        evaluations += scorer.evaluations
+        firsts.append((scorer, value, x))
         if best is None or value < best[0]:
             best = (value, scorer.config(x))
     assert best is not None
-    return _finish(problem, best[1], best[0], evaluations, periods)
+    cap = None
+    if problem.objective == "E_max-then-voltage" and best[0] < PENALTY:  # the second search: the supply
+        cap = (1.0 + E_MAX_SLACK) * best[0]
+        best = None
+        for (scorer, _, x), period in zip(firsts, periods):
+            scorer.objective, scorer.e_max_cap = problem.objective, cap
+            value, x = _search(scorer, scorer.bounds(period), problem, start=list(x))
+            if best is None or value < best[0]:
+                best = (value, scorer.config(x))
+        assert best is not None
+    evaluations = sum(scorer.evaluations for scorer, _, _ in firsts)
+    return _finish(problem, best[1], best[0], evaluations, periods, e_max_cap=cap)
 
 
-def _optimiser(scorer: _Scorer, bounds: list[tuple[float, float]], problem: DesignProblem) -> Optimiser:
+def _optimiser(scorer: _Scorer, bounds: list[tuple[float, float]], problem: DesignProblem,
+               start: list[float] | None = None) -> Optimiser:
     """The optimiser of ``problem.method`` (:mod:`wmr_mj.sim.optimisers`), minimising the score.
 
     - ``cma``: CMA-ES (``cmaes``, falsify's optimiser: its own seeded generator, bounds kept by resampling),
@@ -490,8 +530,10 @@ def _optimiser(scorer: _Scorer, bounds: list[tuple[float, float]], problem: Desi
       narrowest range; whole generations until ``budget`` points are scored.
     - ``de``: scipy's differential evolution (seeded, one worker, no gradient polish), START_POINT in its
       first population, popsize 10, budget // (10 dimensions) - 1 generations (at least 1), one point at a time.
+
+    ``start``: the point started from in place of START_POINT (E_max-then-voltage's second search: the first's best).
     """
-    x0 = _preset_point(scorer, bounds)
+    x0 = _preset_point(scorer, bounds) if start is None else start
     if problem.method == "de":
         popsize = 10
         maxiter = max(1, problem.budget // (popsize * len(bounds)) - 1)
@@ -503,11 +545,12 @@ def _optimiser(scorer: _Scorer, bounds: list[tuple[float, float]], problem: Desi
                                      seed=problem.seed))
 
 
-def _search(scorer: _Scorer, bounds: list[tuple[float, float]], problem: DesignProblem) -> tuple[float, Any]:
+def _search(scorer: _Scorer, bounds: list[tuple[float, float]], problem: DesignProblem,
+            start: list[float] | None = None) -> tuple[float, Any]:
     """The best (score, point) of one period's search (:func:`_optimiser`, driven by the one loop
     :func:`wmr_mj.sim.optimisers.drive`): differential evolution's own result; CMA-ES's first point of the
     smallest score."""
-    optimiser = _optimiser(scorer, bounds, problem)
+    optimiser = _optimiser(scorer, bounds, problem, start)
     budget = problem.budget if problem.method == "cma" else None
     trace = drive(optimiser, lambda points: [scorer(x) for x in points], budget=budget)
     if isinstance(optimiser, DifferentialEvolution):
@@ -532,11 +575,11 @@ def _resolved(config: Any, paths: Sequence[str]) -> dict[str, Any]:
 
 
 def _finish(problem: DesignProblem, config: Any, found: float, evaluations: int,
-            periods: tuple[float, ...]) -> DesignResult:
+            periods: tuple[float, ...], *, e_max_cap: float | None = None) -> DesignResult:
     resolved = _resolved(config, problem.paths)
     certificates = {path: parts.claim for path, parts in resolved.items()}
     law = type(next(iter(resolved.values())).controller)
-    value = score(certificates, problem.objective, graded=law.design_graded)
+    value = score(certificates, problem.objective, graded=law.design_graded, e_max_cap=e_max_cap)
     if value != found:  # the search's certificate is the run's: a difference is a bug, never rounded away
         raise RuntimeError(f"design: the search scored {found!r} but the run's certificate gives {value!r}")
     settings = {name: getattr(config, name) for name in DESIGN_FIELDS}
