@@ -60,7 +60,7 @@ from wmr_mj.params import M1_RANGE, uncertainty_ranges  # noqa: E402
 from wmr_mj.sim.config import RunConfig  # noqa: E402
 from wmr_mj.sim.designs import CERTIFIED  # noqa: E402
 from wmr_mj.sim.falsify import METHODS, FalsifySpec, covering_design, objective_value, random_worst, search_worst  # noqa: E402
-from wmr_mj.sim.sweep import run_configs  # noqa: E402
+from wmr_mj.sim.many_runs import run_configs  # noqa: E402
 
 THRESHOLDS = {"box": 0.05, "paths": 0.038, "signals": 0.045}  # rad: always(abs(E) <= T), one each space can fail
 

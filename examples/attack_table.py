@@ -35,8 +35,8 @@ from wmr_mj.sim.coerce import coerced
 from wmr_mj.sim.design_search import design_file_settings
 from wmr_mj.sim.falsify import FalsifySpec, check_runnable, falsify
 from wmr_mj.sim.falsify_objectives import binding_term, objective_value, verdict_of
+from wmr_mj.sim.many_runs import run_configs
 from wmr_mj.sim.search_methods import random_worst
-from wmr_mj.sim.sweep import run_configs
 from wmr_mj.sim.tightness import certificate_columns
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))

@@ -11,7 +11,8 @@ from wmr_mj.sim.batch import run_batch
 from wmr_mj.sim.closed_loop import PATH_SAMPLE_S, path_sample_index, run_closed_loop
 from wmr_mj.sim.config import RunConfig
 from wmr_mj.sim.designs import CERTIFIED
-from wmr_mj.sim.sweep import RESULT_COLUMNS, SweepSummary, flat_row
+from wmr_mj.sim.many_runs import RESULT_COLUMNS, flat_row
+from wmr_mj.sim.sweep import SweepSummary
 
 BASE = RunConfig.from_inputs(**CERTIFIED.config_changes()).replace(duration=10.0)
 

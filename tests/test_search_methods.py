@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from wmr_mj.errors import ParameterError
+from wmr_mj.sim import falsify as falsify_module
 from wmr_mj.sim.falsify import (
     FalsifySpec,
     cma_population,
@@ -66,8 +67,6 @@ def test_cma_finds_an_interior_maximum_that_the_vertices_miss(method):
 def test_the_portfolio_is_falsifys_search_routine(monkeypatch):
     """The same search through falsify (a synthetic objective in place of the runs): the worst
     evaluation is the trace's."""
-    from wmr_mj.sim import sweep
-
     class Report:  # what run_configs gives back: the summary as to_dict()
         def __init__(self, v: float) -> None:
             self.v = v
@@ -80,7 +79,7 @@ def test_the_portfolio_is_falsifys_search_routine(monkeypatch):
         unit = (points - [550.0, 0.01]) / [200.0, 0.02]
         return [Report(float(v)) for v in np.exp(-np.sum((unit - [0.4, 0.6]) ** 2, axis=1) / (2 * 0.15**2))]
 
-    monkeypatch.setattr(sweep, "run_configs", fake_run_configs)
+    monkeypatch.setattr(falsify_module, "run_configs", fake_run_configs)  # the name falsify runs
     spec = FalsifySpec(box={"m1": (550.0, 750.0), "mu": (0.01, 0.03)}, objective="sup-E", budget=120, seed=0)
     result = falsify(spec)
     assert spec.method == "portfolio" and len(result.search) == 120

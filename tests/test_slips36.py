@@ -8,13 +8,12 @@ import math
 import pytest
 
 from wmr_mj.sim.config import RunConfig
+from wmr_mj.sim.many_runs import CSV_SIGNIFICANT_DIGITS, csv_number
 from wmr_mj.sim.sweep import (
-    CSV_SIGNIFICANT_DIGITS,
     PRECISE_ROWS,
     SWEEP_KEYS_DEPRECATED,
     SweepSpec,
     SweepSummary,
-    csv_number,
     read_results,
     read_runs,
     run_sweep,

@@ -14,7 +14,7 @@ from wmr_mj.sim.certify import certificate_for
 from wmr_mj.sim.closed_loop import RunConfig
 from wmr_mj.sim.config import build_reference
 from wmr_mj.sim.designs import CERTIFIED
-from wmr_mj.sim.sweep import RESULT_COLUMNS, flat_row
+from wmr_mj.sim.many_runs import RESULT_COLUMNS, flat_row
 
 # the keys `wmr-mj run --json` wrote before the summary was typed (less "log", which the command adds)
 RUN_KEYS = {"E_max", "E_ratio", "Edot_max", "Edot_ratio", "analysis", "certificate", "condition", "control_steps",

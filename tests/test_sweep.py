@@ -11,14 +11,12 @@ import pytest
 
 from wmr_mj import ParameterError, SchedulerError, UnknownNameError
 from wmr_mj.sim.config import RunConfig
+from wmr_mj.sim.many_runs import connect, latin_hypercube, run_configs
 from wmr_mj.sim.sweep import (
     SweepSpec,
-    connect,
     draw_samples,
-    latin_hypercube,
     read_results,
     read_runs,
-    run_configs,
     run_sweep,
 )
 

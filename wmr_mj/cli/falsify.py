@@ -396,7 +396,7 @@ def _table(result) -> str:
     import csv
     import io
 
-    from wmr_mj.sim.sweep import csv_number
+    from wmr_mj.sim.many_runs import csv_number
 
     names = list(result.spec.names)
     buf = io.StringIO()

@@ -52,8 +52,9 @@ from wmr_mj.report.settings import (
 )
 from wmr_mj.sim.designs import CERTIFIED, LADDER, PAPER, Design
 from wmr_mj.sim.falsify import OBJECTIVE_LABELS, FalsifySpec, objective_value, search_worst
+from wmr_mj.sim.many_runs import run_configs
 from wmr_mj.sim.parts import resolve_run
-from wmr_mj.sim.sweep import read_runs, run_configs
+from wmr_mj.sim.sweep import read_runs
 
 __all__ = ["SearchPlan", "search_plans", "run_search", "search_stage"]
 

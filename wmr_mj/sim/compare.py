@@ -559,7 +559,7 @@ def compare(designs: Sequence[Design], suite: Suite, *, scenarios: Sequence[str]
 
     results: list[dict[str, Any]]
     if scheduler is not None:
-        from wmr_mj.sim.sweep import connect
+        from wmr_mj.sim.many_runs import connect
 
         client = connect(scheduler)
         try:

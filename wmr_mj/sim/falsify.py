@@ -40,7 +40,7 @@ Methods (:data:`METHODS`):
   vertices-polish in 6 of 10 seeds, lhs-polish in 5 of 10.
 - ``de``: scipy's differential evolution, a generation per batch (``vectorized=True``).
 
-Each batch of points runs as one batch of simulations (``wmr_mj.sim.sweep.run_configs``:
+Each batch of points runs as one batch of simulations (``wmr_mj.sim.many_runs.run_configs``:
 ``mujoco.batch``, or Dask chunks); the polish asks for one point at a time. A budget below one
 generation (differential evolution's or CMA-ES's population) is refused before any run.
 
@@ -116,6 +116,7 @@ from wmr_mj.sim.falsify_objectives import (
     shares_the_base_certificate,
     verdict_of,
 )
+from wmr_mj.sim.many_runs import connect, flat_row, run_configs
 from wmr_mj.sim.records import BrokenRun, Record, UnmetAssumption
 from wmr_mj.sim.search_methods import (
     METHOD_LABELS,
@@ -141,6 +142,7 @@ from wmr_mj.sim.search_space import (
     config_for,
     hardware_axis,
     hardware_values,
+    parameter_units,
     path_axis,
     signal_axis,
 )
@@ -720,8 +722,6 @@ class FalsifyResult:
             WmrMjError: pandas is not installed (``pip install 'wmr-mj[notebook]'``).
         """
         from wmr_mj.sim import notebook
-        from wmr_mj.sim.sweep import flat_row
-        from wmr_mj.sim.sweep_result import parameter_units
 
         names = self.spec.names
         rows = [{"phase": e.phase, "index": e.index, "generation": e.generation, **e.params,
@@ -765,8 +765,6 @@ def falsify(spec: FalsifySpec, *, chunk: int = 128, nthread: int = 0, scheduler:
     both phases. checkpoint(partial result) is called after every generation (and the
     random batch), so an interrupted search can leave what it evaluated on disk.
     """
-    from wmr_mj.sim.sweep import connect, run_configs
-
     parts = check_runnable(spec.base) if parts is None else parts  # a bad duration or path: one line, here
     check_objective_applies(parts.controller, spec.objective)
     check_objective_defined(parts, spec)  # undefined for every run: refused before any step

@@ -46,7 +46,7 @@ ROW_UNITS: dict[str, str] = {
     "cross_track": "m",
 }
 
-#: a per-run column (runs.csv's name, :data:`wmr_mj.sim.sweep.RESULT_COLUMNS`) -> its name in a sweep's and a
+#: a per-run column (runs.csv's name, :data:`wmr_mj.sim.many_runs.RESULT_COLUMNS`) -> its name in a sweep's and a
 #: search's table: the certificate's bounds and ratios prefixed ``certificate_``, the paper's claim ``paper_``
 #: (runs.csv's bare ``E_max`` is the paper's, easy to plot as the certificate's), units in brackets
 RUN_COLUMNS: dict[str, str] = {
@@ -123,7 +123,7 @@ def rows_frame(rows: Mapping[str, np.ndarray], C_xy: np.ndarray | None = None) -
 
 def runs_frame(rows: Sequence[Mapping[str, Any]], *, parameters: Sequence[str] = (),
                units: Mapping[str, str] | None = None, first: Sequence[str] = ()) -> Any:
-    """Per-run rows (runs.csv's columns, :func:`wmr_mj.sim.sweep.flat_row`) as a DataFrame: one row per run,
+    """Per-run rows (runs.csv's columns, :func:`wmr_mj.sim.many_runs.flat_row`) as a DataFrame: one row per run,
     ``first`` then ``run``, the ranged ``parameters`` (the values each run used, with their ``units``), then
     :data:`RUN_COLUMNS` and any other scalar column (requirements' robustness); nested summaries left out."""
     pandas = require_pandas()

@@ -30,6 +30,7 @@ from collections.abc import Callable, Generator
 import numpy as np
 
 from wmr_mj.errors import ParameterError, UnknownNameError
+from wmr_mj.sim.many_runs import latin_hypercube
 from wmr_mj.sim.optimisers import (
     CMAES,
     DifferentialEvolution,
@@ -41,7 +42,6 @@ from wmr_mj.sim.optimisers import (
     Trace,
     drive,
 )
-from wmr_mj.sim.sweep import latin_hypercube
 
 __all__ = [
     "METHODS",

@@ -45,7 +45,7 @@ from wmr_mj.sim.signals import Signals
 
 __all__ = ["config_for", "signal_axis", "path_axis", "DISTURBANCE_FIELDS", "LOAD_FIELDS", "DEFAULT_HOLD_S",
            "HARDWARE_AXES", "hardware_axis", "hardware_values", "with_hardware", "check_hardware_range",
-           "axis_names_text"]
+           "axis_names_text", "parameter_units"]
 
 #: The fields of a disturbance and of a load change that a search may range.
 DISTURBANCE_FIELDS = ("amplitude", "t1", "t2", "bandwidth", "seed")
@@ -70,6 +70,16 @@ HARDWARE_AXES = {
     "transmission.backlash": "rad at the steering axis, the gear's half-width of play",
 }
 _CART_PREFIXES = ("sensing.", "actuation.", "transmission.")
+
+
+def parameter_units(names: tuple[str, ...]) -> dict[str, str]:
+    """Each ranged parameter -> its unit (m1 in kg, a cart axis as ``HARDWARE_AXES`` says); others none."""
+    units = {"m1": "kg"}
+    for name in names:
+        text = HARDWARE_AXES.get(name)
+        if text:
+            units[name] = text.split(",")[0].split(":")[0].strip()
+    return units
 
 
 def hardware_axis(name: str) -> bool:

@@ -7,7 +7,7 @@ simulation runs on its own compiled model (mass and inertia consistent, as
 bit-identical).
 
 Each chunk of runs is one ``wmr_mj.sim.batch.run_batch`` (all at once on ``mujoco.batch``,
-the law compiled into MuJoCo's control callback).
+the law compiled into MuJoCo's control callback); a run's row is :func:`wmr_mj.sim.many_runs.flat_row`.
 
 Usage::
 
@@ -18,7 +18,7 @@ Usage::
 
 ``run_sweep(spec, out_dir=...)`` writes ``runs.csv`` after every chunk and
 resumes from it; ``scheduler="tcp://host:8786"`` runs the chunks on a Dask
-cluster with the same results. ``run_configs`` runs any list of configs that
+cluster with the same results. ``wmr_mj.sim.many_runs.run_configs`` runs any list of configs that
 differ in plant parameters only (what ``wmr_mj.sim.falsify`` evaluates).
 """
 
@@ -30,44 +30,34 @@ import io
 import json
 import math
 import os
-import socket
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
-from urllib.parse import urlsplit
 
 import numpy as np
 
 from wmr_mj._util.checks import positive_range
-from wmr_mj.errors import ParameterError, SchedulerError, UnknownNameError
+from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import parameter_names, tie_motor_constant
 from wmr_mj.sim.batch import run_batch
 from wmr_mj.sim.coerce import coerced
 from wmr_mj.sim.config import RunConfig, config_from_dict
+from wmr_mj.sim.many_runs import RESULT_COLUMNS, connect, csv_number, flat_row, latin_hypercube, requirement_column
 from wmr_mj.sim.records import BrokenRun, Record, UnmetAssumption
-from wmr_mj.sim.summary import RunSummary
 
 __all__ = [
     "SweepSpec",
     "draw_samples",
-    "latin_hypercube",
     "run_sweep",
     "SAMPLINGS",
-    "RESULT_COLUMNS",
     "read_results",
     "read_runs",
-    "csv_number",
-    "CSV_SIGNIFICANT_DIGITS",
-    "run_configs",
-    "flat_row",
     "max_at",
     "Worst",
     "BrokenRun",
     "SweepSummary",
     "config_from_dict",
-    "connect",
-    "requirement_column",
     "RequirementSweep",
     "Effort",
     "EffortLevel",
@@ -75,42 +65,6 @@ __all__ = [
 ]
 
 SAMPLINGS = ("uniform", "lhs", "grid")
-RESULT_COLUMNS = ("run", "m1", "verdict", "cert_valid", "cert_E_max", "cert_Edot_max", "cert_E_ratio",
-                  "cert_Edot_ratio", "cert_inside", "sup_E", "sup_Edot", "sup_E_settled", "sup_Edot_settled",
-                  "E_max", "Edot_max", "E_ratio", "Edot_ratio", "inside", "saturated_fraction",
-                  # the applied voltage's effort (wmr_mj.sim.summary.VoltageEffort): [V], [V], [V/s]
-                  "peak_voltage", "rms_voltage", "tv_voltage",
-                  "left_steering_range", "final_alpha", "final_alpha_dot", "drift_growing",
-                  # C's path (wmr_mj.analysis.path_error, path_bound): [m], [m], [rad], verdict, [m]
-                  "path_cross_track_max", "path_along_track_final", "path_heading_error_max", "path_verdict",
-                  "path_cross_track_bound")
-#: runs.csv columns taken from a run summary's nested certificate, drift and path (see flat_row)
-_FLAT = {"cert_valid": ("certificate", "certified"), "cert_E_max": ("certificate", "E_max"),
-         "cert_Edot_max": ("certificate", "Edot_max"), "cert_E_ratio": ("certificate", "E_ratio"),
-         "cert_Edot_ratio": ("certificate", "Edot_ratio"), "cert_inside": ("certificate", "inside"),
-         "final_alpha_dot": ("drift", "final_alpha_dot"), "drift_growing": ("drift", "growing"),
-         "path_cross_track_max": ("path_error", "cross_track_max"),
-         "path_along_track_final": ("path_error", "along_track_final"),
-         "path_heading_error_max": ("path_error", "heading_error_max"),
-         "path_verdict": ("path_verdict", "verdict"), "path_cross_track_bound": ("path_verdict", "cross_track_bound")}
-
-
-def requirement_column(index: int) -> str:
-    """runs.csv's column of the robustness of requirement ``index`` (0-based): requirement_1_robustness, ..."""
-    return f"requirement_{index + 1}_robustness"
-
-
-def flat_row(summary: Mapping[str, Any]) -> dict[str, Any]:
-    """A run summary with the runs.csv columns of its certificate, drift, path and requirements added at
-    the top level (cert_valid, cert_E_max, ..., path_cross_track_max, ..., requirement_1_robustness, ...)."""
-    out = dict(summary)
-    for col, (outer, inner) in _FLAT.items():
-        # path_verdict: the summary's is the whole judgement (a mapping); the column is its word
-        if col not in out or isinstance(out[col], Mapping):
-            out[col] = (summary.get(outer) or {}).get(inner)
-    for i, judged in enumerate(summary.get("requirements") or ()):
-        out.setdefault(requirement_column(i), judged.get("robustness"))
-    return out
 
 
 def _count_path_verdicts(rows: Sequence[Mapping[str, Any]]) -> dict[str, int] | None:
@@ -243,21 +197,6 @@ SWEEP_KEYS_DEPRECATED = {"inside": "paper_inside", "outside": "paper_outside", "
                          "Edot_max": "paper_Edot_max"}
 
 
-def latin_hypercube(n: int, d: int, rng: np.random.Generator) -> np.ndarray:
-    """(n, d) points in [0, 1)^d, one in each of the n strata of every axis (scrambled LHS).
-
-    The algorithm of ``scipy.stats.qmc.LatinHypercube(d, rng=parent).random(n)`` (scipy 1.17)
-    with ``rng = parent.spawn(1)[0]``, the child generator scipy draws from: the same
-    numbers (a test compares the two). Written out here because importing scipy.stats
-    costs 0.6-0.8 s, a seventh of a 32-run sweep.
-    """
-    jitter = rng.uniform(size=(n, d))
-    strata = np.tile(np.arange(1, n + 1), (d, 1))
-    for axis in range(d):
-        rng.shuffle(strata[axis, :])
-    return (strata.T - jitter) / n
-
-
 def draw_samples(spec: SweepSpec) -> np.ndarray:
     """(n, d) parameter values: m1 first, then ``spec.ranges`` in order. Seeded."""
     bounds = spec.bounds
@@ -335,44 +274,6 @@ def spec_from_json(text: str) -> SweepSpec:
                      requirements=tuple(obj.get("requirements", ())), m1=obj.get("m1"))
 
 
-def _run_config_chunk(config_dicts: list[dict[str, Any]], nthread: int,
-                      requirements: Sequence[str] = ()) -> list[RunSummary]:
-    """Summaries of configs given as ``to_dict()`` (a Dask task: plain data in, frozen records out)."""
-    return run_batch([config_from_dict(d) for d in config_dicts], nthread=nthread, requirements=requirements)
-
-
-def run_configs(configs: Sequence[RunConfig], *, chunk: int = 128, nthread: int = 0, client: Any = None,
-                progress: Callable[[int, int], None] | None = None,
-                requirements: Sequence[str] = ()) -> list[RunSummary]:
-    """Summaries of ``configs``, in order (``requirements``: STL formulas judged on every run).
-
-    Locally: ``run_batch`` calls of at most ``chunk`` simulations (one batch where they share
-    one, else one by one on ``nthread`` threads). With a Dask ``client`` (see :func:`connect`):
-    one task per chunk, the same numbers. progress(done, total) is called as chunks finish.
-    """
-    if chunk < 1:
-        raise ParameterError(f"chunk = {chunk} must be >= 1")
-    requirements = tuple(requirements)
-    parts = [list(configs[i:i + chunk]) for i in range(0, len(configs), chunk)]
-    reports: list[RunSummary] = []
-    if client is not None:
-        futures = [client.submit(_run_config_chunk, [c.to_dict() for c in part], 1, requirements, pure=False)
-                   for part in parts]
-        for fut in futures:
-            reports.extend(fut.result())
-            if progress is not None:
-                progress(len(reports), len(configs))
-        return reports
-    for part in parts:
-        reports.extend(run_batch(part, nthread=nthread, requirements=requirements))
-        if progress is not None:
-            progress(len(reports), len(configs))
-    return reports
-
-
-#: significant digits of a number in a CSV table (runs.csv, falsify's evaluations.csv): 0.009 where the float
-#: is 0.009000000000000001. Full precision is kept in the JSON (summary.json, :data:`PRECISE_ROWS`).
-CSV_SIGNIFICANT_DIGITS = 12
 #: the sweep folder's file of every runs.csv row at full precision (JSON: floats round-trip exactly), which
 #: a resumed sweep and validate's rungs read (:func:`read_runs`), so that no number they report is rounded
 PRECISE_ROWS = "runs-full-precision.json"
@@ -392,14 +293,9 @@ def _csv_text(rows: list[dict[str, Any]], extra: Sequence[str], tail: Sequence[s
     return buf.getvalue()
 
 
-def csv_number(value: float) -> str:
-    """CSV text of a float: rounded to :data:`CSV_SIGNIFICANT_DIGITS` significant digits, then the shortest
-    text of that float (repr): '0.009' for 0.009000000000000001, 'nan', 'inf'."""
-    return repr(float(f"{float(value):.{CSV_SIGNIFICANT_DIGITS}g}"))
-
-
 def _cell(value: Any) -> Any:
-    """CSV text of a value: floats to :data:`CSV_SIGNIFICANT_DIGITS` digits (:func:`csv_number`), None is empty."""
+    """CSV text of a value: floats to :data:`~wmr_mj.sim.many_runs.CSV_SIGNIFICANT_DIGITS` digits
+    (:func:`~wmr_mj.sim.many_runs.csv_number`), None is empty."""
     if value is None:
         return ""
     if isinstance(value, (bool, np.bool_)):
@@ -428,8 +324,9 @@ def _precise_rows(rows: list[dict[str, Any]], extra: Sequence[str], tail: Sequen
 
 
 def read_results(path: str | os.PathLike) -> list[dict[str, Any]]:
-    """Rows of a sweep's runs.csv, numbers parsed (as the CSV holds them: :data:`CSV_SIGNIFICANT_DIGITS`
-    digits; :func:`read_runs` reads a folder's rows at full precision)."""
+    """Rows of a sweep's runs.csv, numbers parsed (as the CSV holds them:
+    :data:`~wmr_mj.sim.many_runs.CSV_SIGNIFICANT_DIGITS` digits; :func:`read_runs` reads a folder's rows at full
+    precision)."""
     out = []
     with open(path, newline="") as f:
         for row in csv.DictReader(f):
@@ -463,46 +360,6 @@ def read_runs(folder: str | os.PathLike) -> list[dict[str, Any]]:
     return [dict(precise.get(int(r["run"]), r)) for r in rows]
 
 
-def connect(scheduler: str):
-    """A ``distributed.Client`` of the Dask scheduler at ``scheduler`` (SchedulerError if unreachable)."""
-    return _connect(scheduler)
-
-
-def _connect(scheduler: str):
-    try:
-        from distributed import Client
-    except ImportError:
-        raise SchedulerError("--scheduler needs the Dask extra: pip install 'wmr-mj[dask]'") from None
-    if _refused(scheduler):
-        raise SchedulerError(f"cannot reach the Dask scheduler at {scheduler!r} (ConnectionRefusedError); give the "
-                             "address of a running scheduler, e.g. tcp://127.0.0.1:8786")
-    try:
-        return Client(scheduler, timeout="5s", set_as_default=False)
-    except (OSError, TimeoutError, ValueError) as exc:
-        raise SchedulerError(f"cannot reach the Dask scheduler at {scheduler!r} ({type(exc).__name__}); "
-                             "give the address of a running scheduler, e.g. tcp://127.0.0.1:8786") from None
-
-
-def _refused(scheduler: str) -> bool:
-    """True where nothing listens at a ``tcp://HOST:PORT`` address: the host refuses the connection at once,
-    where a ``Client`` would retry until its timeout. False for another scheme, or any other answer (the
-    ``Client`` then says what is wrong)."""
-    address = urlsplit(scheduler)
-    try:
-        port = address.port
-    except ValueError:
-        return False
-    if address.scheme != "tcp" or address.hostname is None or port is None:
-        return False
-    try:
-        with socket.create_connection((address.hostname, port), timeout=5.0):
-            return False
-    except ConnectionRefusedError:
-        return True
-    except OSError:
-        return False
-
-
 def _chunk_progress(progress: Callable[[float, int], None] | None, done: int, size: int,
                     total: int) -> Callable[[int, int], None] | None:
     """A chunk's step progress as fractional runs of the sweep."""
@@ -522,7 +379,7 @@ def run_sweep(spec: SweepSpec, *, out_dir: str | os.PathLike | None = None, chun
     if chunk < 1:
         raise ParameterError(f"chunk = {chunk} must be >= 1")
     # an unreachable scheduler is refused before anything is written (the folder, sweep.json)
-    client = _connect(scheduler) if scheduler is not None else None
+    client = connect(scheduler) if scheduler is not None else None
     try:
         return _run_sweep(spec, out_dir, chunk, nthread, client, progress)
     finally:

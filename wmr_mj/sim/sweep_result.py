@@ -23,20 +23,10 @@ from typing import Any
 
 from wmr_mj.hardware import cart_dict
 from wmr_mj.sim.run_report import add_controller_source
-from wmr_mj.sim.search_space import HARDWARE_AXES
+from wmr_mj.sim.search_space import HARDWARE_AXES, parameter_units
 from wmr_mj.sim.sweep import SweepSpec, SweepSummary, run_sweep, spec_from_json, spec_to_json
 
-__all__ = ["SweepResult", "sweep", "parameter_units"]
-
-
-def parameter_units(names: tuple[str, ...]) -> dict[str, str]:
-    """Each ranged parameter -> its unit (m1 in kg, a cart axis as ``HARDWARE_AXES`` says); others none."""
-    units = {"m1": "kg"}
-    for name in names:
-        text = HARDWARE_AXES.get(name)
-        if text:
-            units[name] = text.split(",")[0].split(":")[0].strip()
-    return units
+__all__ = ["SweepResult", "sweep"]
 
 
 @dataclass(frozen=True)
@@ -45,7 +35,7 @@ class SweepResult:
 
     Attributes:
         spec: the sweep.
-        rows: each run's row, in run order (runs.csv's columns: :func:`wmr_mj.sim.sweep.flat_row`).
+        rows: each run's row, in run order (runs.csv's columns: :func:`wmr_mj.sim.many_runs.flat_row`).
         summary: what the runs add up to.
     """
 
