@@ -9,7 +9,7 @@ Side by side in one process, interleaved repeat by repeat (medians over ``--repe
            ``standard-v1``), open loop, driven by the voltages its closed loop applied (serial runs
            before the timings; the suite's disturbance and payload signals are not replayed: they
            change the forces, not the cost of a step), on ``--nthread`` threads;
-  compare: ``wmr_mj.sim.compare.compare`` then ``wmr_mj.report.compare.write_report``, as the command
+  compare: ``wmr_mj.experiments.compare.compare`` then ``wmr_mj.report.compare.write_report``, as the command
            runs them (every scenario run and judged by the suite's four requirements, the adversary's
            search and random sample at each budget of ``--budgets``, the Markdown, CSV, HTML and figure
            written; the command's imports excluded), on the same threads. Its physics steps
@@ -38,9 +38,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_sweep import OpenLoop, applied_voltages  # noqa: E402
 from mujoco import rollout  # noqa: E402
 
+from wmr_mj.experiments.compare import compare, design_from_token  # noqa: E402
+from wmr_mj.experiments.suite import load_suite  # noqa: E402
 from wmr_mj.report.compare import write_report  # noqa: E402
-from wmr_mj.sim.compare import compare, design_from_token  # noqa: E402
-from wmr_mj.sim.suite import load_suite  # noqa: E402
 
 
 def main() -> None:

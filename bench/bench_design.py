@@ -6,10 +6,10 @@
 Printed:
 
   evaluation: the median wall time (and the quartiles) of one point's score as the search computes it
-              (``wmr_mj.sim.design_search._Scorer``: the law built from the point's gains and
+              (``wmr_mj.searches.design_search._Scorer``: the law built from the point's gains and
               ``wmr_mj.sim.certify.certificate_of`` on the parts ``resolve_run`` gave once), over ``--repeats``
               points drawn uniformly in the law's search space (``_Scorer.bounds``, seeded);
-  design:     for each optimiser (:data:`wmr_mj.sim.design_search.METHODS`) and seed (0 .. ``--seeds`` - 1),
+  design:     for each optimiser (:data:`wmr_mj.searches.design_search.METHODS`) and seed (0 .. ``--seeds`` - 1),
               the median wall time of ``search_design`` (the paper circle, the 1 ms period, ``--budget``
               points) over ``--designs`` repeats, with its certified E_max (the same every repeat: the search
               is seeded): which optimiser finds the smaller certificate at the same budget;
@@ -33,8 +33,7 @@ def main() -> None:
     import numpy as np
 
     from wmr_mj.hardware import Sensing
-    from wmr_mj.sim.config import RunConfig
-    from wmr_mj.sim.design_search import (
+    from wmr_mj.searches.design_search import (
         LAWS,
         METHODS,
         PENALTY,
@@ -43,6 +42,7 @@ def main() -> None:
         law_changes,
         search_design,
     )
+    from wmr_mj.sim.config import RunConfig
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--sensing", default="magnetic-12bit-axis")

@@ -16,7 +16,7 @@ over each of three search spaces (``--spaces``, comma-separated; default all thr
 
 For each space, each budget and each of ``--seeds`` seeds, side by side:
 
-  search: ``wmr_mj.sim.falsify.search_worst`` with ``--method`` (default ``portfolio``: the box's
+  search: ``wmr_mj.searches.falsify.search_worst`` with ``--method`` (default ``portfolio``: the box's
           vertices, then CMA-ES);
   random: the same number of runs as a seeded Latin hypercube (``random_worst``, as falsify does).
 
@@ -57,9 +57,9 @@ import numpy as np  # noqa: E402
 
 from wmr_mj._util.files import write_text_atomic  # noqa: E402
 from wmr_mj.params import M1_RANGE, uncertainty_ranges  # noqa: E402
+from wmr_mj.searches.falsify import METHODS, FalsifySpec, covering_design, objective_value, random_worst, search_worst  # noqa: E402
 from wmr_mj.sim.config import RunConfig  # noqa: E402
 from wmr_mj.sim.designs import CERTIFIED  # noqa: E402
-from wmr_mj.sim.falsify import METHODS, FalsifySpec, covering_design, objective_value, random_worst, search_worst  # noqa: E402
 from wmr_mj.sim.many_runs import run_configs  # noqa: E402
 
 THRESHOLDS = {"box": 0.05, "paths": 0.038, "signals": 0.045}  # rad: always(abs(E) <= T), one each space can fail

@@ -45,10 +45,10 @@ import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 from mujoco import rollout  # noqa: E402
 
+from wmr_mj.experiments.sweep import SweepSpec, run_sweep  # noqa: E402
 from wmr_mj.sim.batch import batch_model, run_batch  # noqa: E402
 from wmr_mj.sim.closed_loop import run_closed_loop
 from wmr_mj.sim.config import RunConfig, plant_parameters
-from wmr_mj.sim.sweep import SweepSpec, run_sweep  # noqa: E402
 
 
 def applied_voltages(configs: list[RunConfig]) -> np.ndarray:
@@ -142,7 +142,7 @@ def main() -> None:
           tempfile.TemporaryDirectory() as tmp):
         sweep_ol = None
         if spec is not None:
-            from wmr_mj.sim.sweep import _run_configs, draw_samples
+            from wmr_mj.experiments.sweep import _run_configs, draw_samples
 
             sweep_configs = _run_configs(spec, draw_samples(spec))
             sweep_ol = OpenLoop(sweep_configs, applied_voltages(sweep_configs), args.nthread)

@@ -31,13 +31,13 @@ from typing import Any
 import numpy as np
 
 import wmr_mj as wm
+from wmr_mj.experiments.tightness import certificate_columns
+from wmr_mj.searches.design_search import design_file_settings
+from wmr_mj.searches.falsify import FalsifySpec, check_runnable, falsify
+from wmr_mj.searches.falsify_objectives import binding_term, objective_value, verdict_of
+from wmr_mj.searches.search_methods import random_worst
 from wmr_mj.sim.coerce import coerced
-from wmr_mj.sim.design_search import design_file_settings
-from wmr_mj.sim.falsify import FalsifySpec, check_runnable, falsify
-from wmr_mj.sim.falsify_objectives import binding_term, objective_value, verdict_of
 from wmr_mj.sim.many_runs import run_configs
-from wmr_mj.sim.search_methods import random_worst
-from wmr_mj.sim.tightness import certificate_columns
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from cart_as_built import CASES  # noqa: E402  (the hardware guide's table of carts, one list)

@@ -3,10 +3,10 @@
 Two axes of the cart, each from the ideal sensor: an encoder on the steering axis of 10-16 bits (rounded, alpha'
 a backward difference over the 1 ms period), and an exact sensor read 0-50 ms late. At each point, for (a) the
 certified design (``--preset certified``) and (b) the design ``wmr-mj design`` finds for that cart
-(:func:`wmr_mj.sim.design_search.search_design`, CMA-ES from the preset's point, seed 0): the certified E_max on
+(:func:`wmr_mj.searches.design_search.search_design`, CMA-ES from the preset's point, seed 0): the certified E_max on
 the paper's circle over the m1 box (550-750 kg; none where the claim does not certify, with what binds), and the
 worst sup|E| that ``falsify`` finds over the m1 box at a small budget (its search and as many random runs;
-:func:`wmr_mj.sim.tightness.cart_tightness`), with the verdicts of its runs.
+:func:`wmr_mj.experiments.tightness.cart_tightness`), with the verdicts of its runs.
 
 Writes the figure (PNG) and its numbers (JSON) beside it.
 
@@ -26,9 +26,9 @@ from pathlib import Path
 from typing import Any
 
 import wmr_mj as wm
-from wmr_mj.sim.design_search import DesignProblem, search_design
+from wmr_mj.experiments.tightness import cart_tightness
+from wmr_mj.searches.design_search import DesignProblem, search_design
 from wmr_mj.sim.parts import resolve_run
-from wmr_mj.sim.tightness import cart_tightness
 
 ROOT = Path(__file__).resolve().parents[1]
 BITS = (10, 11, 12, 13, 14, 15, 16)

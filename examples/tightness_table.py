@@ -6,7 +6,7 @@ worst sup|E| that ``falsify`` finds over the m1 box (550-750 kg) at the given bu
 random runs, both counted; objective sup-E), tightness = worst found / E_max taken, the guide's old tightness
 of the error term alone where one applies (``docs/guides/certificates.md``, "Tightness": 0.076 for a delay,
 0.071 for an encoder's quantised angle), and the verdicts of every run. The carts no claim covers are listed
-below the table with what is unmet. Built on :func:`wmr_mj.sim.tightness.cart_tightness`.
+below the table with what is unmet. Built on :func:`wmr_mj.experiments.tightness.cart_tightness`.
 
 With ``--binding`` it runs nothing: per cart and path, the certificate the run takes and which term of it binds
 (the Coulomb sign's charge, its share of W0 and of E_max, the largest other term; ``docs/guides/certificates.md``,
@@ -27,8 +27,8 @@ import sys
 from pathlib import Path
 
 import wmr_mj as wm
+from wmr_mj.experiments.tightness import CartTightness, cart_tightness
 from wmr_mj.sim.parts import resolve_run
-from wmr_mj.sim.tightness import CartTightness, cart_tightness
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from cart_as_built import CASES  # noqa: E402  (the hardware guide's table of carts, one list)

@@ -22,9 +22,9 @@ from pathlib import Path
 import pytest
 
 from wmr_mj.carts import load_cart
+from wmr_mj.experiments.sweep import SweepSpec
 from wmr_mj.sim.config import RunConfig, coerce
 from wmr_mj.sim.designs import CERTIFIED, CERTIFIED_C80, certified_design
-from wmr_mj.sim.sweep import SweepSpec
 
 DATA = Path(__file__).resolve().parent / "data"
 CART_BOX = (80.0, 120.0)  # the file's [uncertainty.m1.m1] range, kg

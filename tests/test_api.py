@@ -37,7 +37,7 @@ def test_run_sweep_at_the_top_level_is_a_deprecated_alias():
     names what replaces it; ``wm.sweep`` and the module's own ``run_sweep`` do not warn."""
     import warnings
 
-    from wmr_mj.sim.sweep import run_sweep
+    from wmr_mj.experiments.sweep import run_sweep
 
     assert "run_sweep" not in wmr_mj.__all__ and "sweep" in wmr_mj.__all__
     for _ in range(2):  # not cached: the second use warns too

@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import json
 
-from wmr_mj.sim.falsify import _FalsifyRecord
+from wmr_mj.experiments.sweep import SweepSummary
+from wmr_mj.searches.falsify import _FalsifyRecord
 from wmr_mj.sim.records import BrokenRun
-from wmr_mj.sim.sweep import SweepSummary
 
 COMMON = {"params": {"m1": 750.0}, "sup_E": 0.05, "sup_Edot": 0.2, "E_max": 0.04, "ratio": 1.25, "count": 2}
 

@@ -19,10 +19,10 @@ from wmr_mj.hardware import Actuation, Sensing, Transmission
 from wmr_mj.hardware.cart import MAX_ELECTRICAL_TIME_CONSTANT_S, smallest_encoder_ticks
 from wmr_mj.hardware.sensing import SENSING_SPEC_KEYS, measurement_error_bounds
 from wmr_mj.params import C80
+from wmr_mj.searches.search_space import HARDWARE_AXES, with_hardware
 from wmr_mj.sim.certify import certificate_for, measurement_errors_of
 from wmr_mj.sim.config import RunConfig, build_reference, config_from_dict
 from wmr_mj.sim.designs import design_changes
-from wmr_mj.sim.search_space import HARDWARE_AXES, with_hardware
 
 HERE = Path(__file__).resolve().parent.parent
 #: a short run: the lane change reaches its manoeuvre in 6 s

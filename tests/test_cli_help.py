@@ -18,11 +18,11 @@ from wmr_mj.cli.app import COMMANDS, build_parser
 
 #: what only a command's implementation needs: MuJoCo, scipy, the laws and the layers that simulate
 HEAVY_PACKAGES = ("mujoco", "scipy", "controllers")
-HEAVY_LAYERS = ("wmr_mj.sim", "wmr_mj.reference", "wmr_mj.plant", "wmr_mj.analysis", "wmr_mj.report",
-                "wmr_mj.figures", "wmr_mj.logs")
+HEAVY_LAYERS = ("wmr_mj.sim", "wmr_mj.searches", "wmr_mj.experiments", "wmr_mj.reference", "wmr_mj.plant",
+                "wmr_mj.analysis", "wmr_mj.report", "wmr_mj.figures", "wmr_mj.logs")
 #: of those, the modules that hold a command's defaults and import only the standard library at their top (and their
 #: packages): validate's and design's
-DEFAULTS_MODULES = ("wmr_mj.report", "wmr_mj.report.defaults", "wmr_mj.sim", "wmr_mj.sim.design_options")
+DEFAULTS_MODULES = ("wmr_mj.report", "wmr_mj.report.defaults", "wmr_mj.searches", "wmr_mj.searches.design_options")
 
 _PROBE = """
 import contextlib, io, json, sys
@@ -82,9 +82,9 @@ def test_a_help_that_names_the_librarys_names_lists_them(capsys, monkeypatch):
     """The helps computed when shown (the table of run options, compare's --suite) name what the library holds."""
     monkeypatch.setenv("COLUMNS", "10000")  # one line per help: argparse wraps at a hyphen (sliding-mode)
     from controllers.registry import controller_names, tracker_names
+    from wmr_mj.experiments.suite import suite_names
     from wmr_mj.sim.config import PATH_NAMES
     from wmr_mj.sim.designs import PRESET_NAMES
-    from wmr_mj.sim.suite import suite_names
 
     pages = {}
     for command in ("run", "compare"):

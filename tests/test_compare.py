@@ -11,9 +11,9 @@ from helpers import one_error_line
 
 from wmr_mj.cli.app import main
 from wmr_mj.errors import ParameterError, UnknownNameError
+from wmr_mj.experiments.compare import compare, design_from_token
+from wmr_mj.experiments.suite import SUITES_DIR, load_suite, suite_names
 from wmr_mj.sim.closed_loop import run_closed_loop
-from wmr_mj.sim.compare import compare, design_from_token
-from wmr_mj.sim.suite import SUITES_DIR, load_suite, suite_names
 
 REPO = Path(__file__).resolve().parents[1]
 #: standard-v1 as released: any change to the file must come as a new suite version (standard-v2)

@@ -87,8 +87,8 @@ def test_design_beats_or_equals_the_certified_preset_on_the_cart(designed):
 @pytest.mark.parametrize("method", ["cma", "de"])
 def test_same_seed_same_design(method):
     from wmr_mj.hardware import Sensing
+    from wmr_mj.searches.design_search import DesignProblem, search_design
     from wmr_mj.sim.config import RunConfig
-    from wmr_mj.sim.design_search import DesignProblem, search_design
     from wmr_mj.sim.designs import CERTIFIED
 
     problem = DesignProblem(base=RunConfig(**CERTIFIED.config_changes(), sensing=Sensing.from_spec(CART)),
@@ -133,8 +133,8 @@ def test_design_with_preset_is_refused(designed, capsys):
 def test_objectives_score_the_certificate():
     """voltage and margin read the certificate's own numbers; an uncertified point scores above every one."""
     from wmr_mj.hardware import Sensing
+    from wmr_mj.searches.design_search import PENALTY, score
     from wmr_mj.sim.config import RunConfig
-    from wmr_mj.sim.design_search import PENALTY, score
     from wmr_mj.sim.designs import CERTIFIED
     from wmr_mj.sim.parts import resolve_run
 

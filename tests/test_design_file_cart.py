@@ -20,8 +20,8 @@ from helpers import refused_line
 from wmr_mj.carts import CARTS_DIR
 from wmr_mj.cli.app import main
 from wmr_mj.errors import ParameterError
-from wmr_mj.sim.compare import design_file_changes
-from wmr_mj.sim.design_search import design_cart
+from wmr_mj.experiments.compare import design_file_changes
+from wmr_mj.searches.design_search import design_cart
 
 SMALL = ["--budget", "12", "--duration", "10"]
 
@@ -91,8 +91,8 @@ def test_compare_refuses_a_design_found_on_another_cart_without_cart(tmp_path, c
 def test_every_writer_of_a_design_file_records_its_cart(tmp_path):
     """write_design itself records the cart (validate's section (e) writes its design file through it, not
     through the design command): the file then runs on that cart, and a C80 design's file records none."""
+    from wmr_mj.searches.design_search import DesignProblem, search_design, write_design
     from wmr_mj.sim.config import RunConfig
-    from wmr_mj.sim.design_search import DesignProblem, search_design, write_design
     from wmr_mj.sim.designs import CERTIFIED
 
     for cart, expected in (("c80-magmotor", str(CARTS_DIR / "c80-magmotor.toml")), (None, None)):

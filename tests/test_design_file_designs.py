@@ -54,8 +54,8 @@ signals = "none"
 @pytest.fixture(scope="module")
 def design_file(tmp_path_factory) -> Path:
     """A design for the 12-bit axis encoder, found with a small budget (its quality is not what is tested)."""
+    from wmr_mj.searches.design_search import DesignProblem, search_design, write_design
     from wmr_mj.sim.config import RunConfig
-    from wmr_mj.sim.design_search import DesignProblem, search_design, write_design
     from wmr_mj.sim.designs import CERTIFIED
 
     out = tmp_path_factory.mktemp("design") / "design.json"
@@ -98,8 +98,8 @@ def test_compares_row_of_a_design_file_is_run_design_file(design_file, tmp_path,
 
 def test_validate_judges_a_design_file_on_its_own_cart(design_file):
     """``validate --design FILE`` builds the file's law and cart (its gains kept as found), as ``run --design``."""
+    from wmr_mj.experiments.compare import FileDesign, design_file_changes
     from wmr_mj.report.settings import ValidateSettings
-    from wmr_mj.sim.compare import FileDesign, design_file_changes
 
     settings = ValidateSettings(n=1, duration=DURATION, search_budget=0, designs=(str(design_file),))
     config = settings.config(FileDesign(str(design_file)))
@@ -113,7 +113,7 @@ def test_validate_judges_a_design_file_on_its_own_cart(design_file):
 
 
 def test_a_design_file_is_told_by_its_suffix_only():
-    from wmr_mj.sim.compare import is_design_file
+    from wmr_mj.experiments.compare import is_design_file
 
     assert is_design_file("design.json") and is_design_file("logs/d.JSON")
     for token in ("certified", "sliding-mode,k=5", "my_law.py:MyLaw", "pkg.mod:Law", "design"):

@@ -61,7 +61,7 @@ def test_an_unknown_law_is_one_line_exit_2(tmp_path, capsys):
 def test_on_the_ideal_cart_the_sliding_design_is_judged_by_its_sampled_layer(tmp_path, capsys):
     """Since issue 44 the ideal cart computes the sampled layer too and the design is judged by it (the boundary
     layer's phi/lam is never taken alone), and the file names it; run reads the file back to the same bound."""
-    from wmr_mj.sim.compare import design_file_changes
+    from wmr_mj.experiments.compare import design_file_changes
     from wmr_mj.sim.config import RunConfig
     from wmr_mj.sim.parts import resolve_run
 
@@ -77,7 +77,7 @@ def test_compare_and_validate_read_a_sliding_design_file_as_run_does(designed):
     """compare FILE.json and validate --design FILE.json build the design through design_file_changes: the
     sliding-mode law's own parameters (lam, phi, k, eta) must reach it, as they reach run --design FILE (they once
     did not: the law ran with its defaults). The truth: the file's certificate, which run reproduces above."""
-    from wmr_mj.sim.compare import design_file_changes
+    from wmr_mj.experiments.compare import design_file_changes
     from wmr_mj.sim.config import RunConfig
     from wmr_mj.sim.parts import resolve_run
 

@@ -14,8 +14,8 @@ import pytest
 
 from wmr_mj.cli.app import main
 from wmr_mj.errors import ParameterError
-from wmr_mj.sim.design_options import E_MAX_SLACK
-from wmr_mj.sim.design_search import PENALTY, score
+from wmr_mj.searches.design_options import E_MAX_SLACK
+from wmr_mj.searches.design_search import PENALTY, score
 
 #: (E_max rad, voltage V) of five certified points and one uncertified: the best E_max is 0.0100 at the full
 #: 24 V; the cap is 1.1 x 0.0100 = 0.0110; within it the least voltage is 9 V (0.0108); 0.0111 at 5 V is past it

@@ -61,8 +61,8 @@ def test_the_site_builds_strict(tmp_path):
     assert (tmp_path / "site" / "reference" / "api" / "index.html").is_file()
     api = (tmp_path / "site" / "reference" / "api" / "index.html").read_text()
     for name in ("wmr_mj.sim.config.RunConfig", "wmr_mj.sim.closed_loop.run_closed_loop", "wmr_mj.sim.batch.run_batch",
-                 "wmr_mj.sim.sweep.run_sweep", "wmr_mj.sim.certify.certificate_for", "wmr_mj.sim.falsify.falsify",
-                 "wmr_mj.logs.reader.load_log", "wmr_mj.logs.replay", "controllers"):
+                 "wmr_mj.experiments.sweep.run_sweep", "wmr_mj.sim.certify.certificate_for",
+                 "wmr_mj.searches.falsify.falsify", "wmr_mj.logs.reader.load_log", "wmr_mj.logs.replay", "controllers"):
         assert f'id="{name}"' in api, name
 
 

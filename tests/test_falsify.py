@@ -12,9 +12,7 @@ import numpy as np
 import pytest
 
 from wmr_mj.errors import ParameterError, UnknownNameError
-from wmr_mj.sim.closed_loop import run_closed_loop
-from wmr_mj.sim.config import RunConfig
-from wmr_mj.sim.falsify import (
+from wmr_mj.searches.falsify import (
     Evaluation,
     FalsifyResult,
     FalsifySpec,
@@ -27,6 +25,8 @@ from wmr_mj.sim.falsify import (
     search_worst,
     worst_config,
 )
+from wmr_mj.sim.closed_loop import run_closed_loop
+from wmr_mj.sim.config import RunConfig
 
 BOX = np.array([[550.0, 750.0], [0.01, 0.03], [0.6, 1.0]])
 CORNER = np.array([550.0, 0.03, 0.6])  # the synthetic worst case: low, high, low

@@ -8,8 +8,8 @@ import json
 import pytest
 
 from wmr_mj.cli.app import main
+from wmr_mj.experiments.sweep import SWEEP_KEYS_DEPRECATED
 from wmr_mj.sim.summary import PAPER_KEYS_DEPRECATED
-from wmr_mj.sim.sweep import SWEEP_KEYS_DEPRECATED
 
 
 @pytest.fixture(scope="module")

@@ -16,10 +16,10 @@ from wmr_mj.analysis.verdicts import format_unmet, unmet_assumptions
 from wmr_mj.cli.app import main
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.hardware import Sensing
+from wmr_mj.searches.search_space import HARDWARE_AXES, config_for, with_hardware
 from wmr_mj.sim.closed_loop import run_closed_loop
 from wmr_mj.sim.config import RunConfig
 from wmr_mj.sim.designs import design_changes
-from wmr_mj.sim.search_space import HARDWARE_AXES, config_for, with_hardware
 
 #: a short run: the lane change reaches its manoeuvre in 6 s
 SHORT = ["--preset", "certified", "--path", "lane-change", "--duration", "6"]
@@ -149,7 +149,7 @@ def test_sweep_over_the_sensing_delay_records_the_cart_and_the_axis(tmp_path, ca
         assert 0.0 <= delay <= 0.01 and abs(periods - round(periods)) < 1e-9  # whole 1 ms periods
     # a sensed run goes one by one on the engine; the same config alone gives the same bits (the folder's
     # rows at full precision: runs.csv rounds to 12 digits)
-    from wmr_mj.sim.sweep import read_runs
+    from wmr_mj.experiments.sweep import read_runs
 
     row = read_runs(out)[1]
     single = run_closed_loop(RunConfig(**design_changes("certified"), path="lane-change", duration=6.0,

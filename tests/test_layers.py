@@ -14,11 +14,16 @@ rank  modules                                     what
 4     wmr_mj.analysis                             the paper's section 4, the certificate, verdicts
 5     controllers                                 steering laws and path trackers, each with its claim
 6     wmr_mj.figures                              headless figures: the drawing, and each result's ``.plot()``
-7     wmr_mj.sim                                  closed loop, batch, sweep, falsify, designs
-8     wmr_mj.logs                                 MCAP format, writer, reader, replay, video
-9     wmr_mj.report                               validate, text, HTML, the figures it writes
-10    wmr_mj.cli                                  the wmr-mj commands
-11    wmr_mj (its ``__init__``)                   the public API: may import any layer
+7     wmr_mj.sim                                  the run: its config and coercion, parts, closed loop, batch
+                                                  engine, certify, designs, many runs at once
+8     wmr_mj.searches                             what asks for runs to find a point: falsify, design search,
+                                                  their optimisers
+9     wmr_mj.experiments                          what asks for runs and searches for one answer: sweep,
+                                                  compare and its suites, tightness, cart check
+10    wmr_mj.logs                                 MCAP format, writer, reader, replay, video
+11    wmr_mj.report                               validate, text, HTML, the figures it writes
+12    wmr_mj.cli                                  the wmr-mj commands
+13    wmr_mj (its ``__init__``)                   the public API: may import any layer
 ====  ==========================================  =====================================================
 """
 
@@ -37,6 +42,8 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("controllers",),
     ("wmr_mj.figures",),
     ("wmr_mj.sim",),
+    ("wmr_mj.searches",),
+    ("wmr_mj.experiments",),
     ("wmr_mj.logs",),
     ("wmr_mj.report",),
     ("wmr_mj.cli",),
@@ -98,6 +105,8 @@ def test_rank_of_known_modules():
     assert rank("wmr_mj") == len(LAYERS) - 1
     assert rank("controllers.computed_torque") == 5
     assert rank("wmr_mj.figures.results") < rank("wmr_mj.sim.closed_loop")  # a result's plot() imports it
+    # the run below what asks for runs: a search below an experiment, which may run one (compare's adversary)
+    assert rank("wmr_mj.sim.many_runs") < rank("wmr_mj.searches.falsify") < rank("wmr_mj.experiments.compare")
     assert rank("numpy") is None
 
 

@@ -137,7 +137,7 @@ def test_compare_is_loud_and_its_table_says_why(tmp_path, capsys):
 
 
 def test_compare_counts_a_claim_broken_by_the_adversary_beside_the_scenarios():
-    from wmr_mj.sim.compare import _claim_broken
+    from wmr_mj.experiments.compare import _claim_broken
 
     scenario = SimpleNamespace(verdict="certified-outside", scenario="lane/nominal/none",
                                summary={"m1": 650.0, "sup_E": 2.0, "certificate": {"E_max": 1.0, "E_ratio": 2.0}})

@@ -8,10 +8,10 @@ Truth: in SI units the torque and back-EMF constants are one flux (k_i [N m/A] =
 import pytest
 
 from wmr_mj.errors import ParameterError
+from wmr_mj.experiments.sweep import SweepSpec, draw_samples
 from wmr_mj.params import C80, tie_motor_constant
+from wmr_mj.searches.falsify import FalsifySpec
 from wmr_mj.sim.config import RunConfig
-from wmr_mj.sim.falsify import FalsifySpec
-from wmr_mj.sim.sweep import SweepSpec, draw_samples
 
 K = C80.k_i
 BOX = {"k_i": (0.95 * K, 1.05 * K), "k_b": (0.95 * K, 1.05 * K)}

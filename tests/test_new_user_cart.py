@@ -47,8 +47,8 @@ def mine(tmp_path_factory):
 
 
 def test_cart_check_answers_in_its_first_lines(mine):
+    from wmr_mj.searches.design_search import DesignProblem, search_design
     from wmr_mj.sim.config import RunConfig
-    from wmr_mj.sim.design_search import DesignProblem, search_design
     from wmr_mj.sim.designs import CERTIFIED
 
     proc = _cli("cart", "check", "mine.toml", cwd=mine.parent)

@@ -19,8 +19,8 @@ import pytest
 
 import wmr_mj as wm
 from wmr_mj.errors import WmrMjError
+from wmr_mj.experiments.sweep import run_sweep
 from wmr_mj.sim import notebook
-from wmr_mj.sim.sweep import run_sweep
 
 pd = pytest.importorskip("pandas", reason="pandas is not installed: pip install -e '.[notebook]'")
 

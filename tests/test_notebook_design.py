@@ -65,7 +65,7 @@ def test_a_tightness_row_as_a_table_and_a_few_lines(found):
 def test_a_design_round_trips_through_its_json(found):
     """``DesignResult.to_dict`` is the design file's content (what ``design --json`` and ``--out`` write), and
     ``from_dict`` reads it back: the certificates as the file records them, the settings as the run's parts."""
-    from wmr_mj.sim.design_search import DesignResult, design_dict
+    from wmr_mj.searches.design_search import DesignResult, design_dict
 
     _, result = found
     d = result.to_dict()
@@ -78,7 +78,7 @@ def test_a_design_round_trips_through_its_json(found):
 
 
 def test_a_tightness_row_round_trips_through_its_json(found):
-    from wmr_mj.sim.tightness import CartTightness
+    from wmr_mj.experiments.tightness import CartTightness
 
     base, result = found
     row = wm.cart_tightness(base.replace(**result.settings), budget=5)

@@ -1,4 +1,4 @@
-"""The ask/tell optimiser layer (:mod:`wmr_mj.sim.optimisers`): each optimiser driven by the one loop gives what
+"""The ask/tell optimiser layer (:mod:`wmr_mj.searches.optimisers`): each optimiser driven by the one loop gives what
 its library gives when called directly (the same points, in the same order, the same answer, bit for bit), as
 MuJoCo's rollout tests compare against a plain loop; an error of the objective comes back as itself and leaves
 no worker thread behind; the loop's record is every point evaluated, in order."""
@@ -13,7 +13,7 @@ from cmaes import CMA
 from scipy.optimize import differential_evolution, minimize
 
 from wmr_mj.errors import ParameterError
-from wmr_mj.sim.optimisers import CMAES, Chain, DifferentialEvolution, NelderMead, Points, drive
+from wmr_mj.searches.optimisers import CMAES, Chain, DifferentialEvolution, NelderMead, Points, drive
 
 BOX = np.array([[-1.0, 2.0], [0.0, 3.0], [-2.0, 0.5]])
 

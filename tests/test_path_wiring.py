@@ -7,12 +7,12 @@ import functools
 import numpy as np
 import pytest
 
+from wmr_mj.experiments.sweep import SweepSummary
 from wmr_mj.sim.batch import run_batch
 from wmr_mj.sim.closed_loop import PATH_SAMPLE_S, path_sample_index, run_closed_loop
 from wmr_mj.sim.config import RunConfig
 from wmr_mj.sim.designs import CERTIFIED
 from wmr_mj.sim.many_runs import RESULT_COLUMNS, flat_row
-from wmr_mj.sim.sweep import SweepSummary
 
 BASE = RunConfig.from_inputs(**CERTIFIED.config_changes()).replace(duration=10.0)
 

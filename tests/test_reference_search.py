@@ -13,12 +13,12 @@ from scipy import signal
 from wmr_mj.errors import ParameterError
 from wmr_mj.params import C80
 from wmr_mj.reference.bounds import ReferenceBounds, reference_bounds_from
+from wmr_mj.searches.falsify import FalsifySpec, falsify, search_worst, worst_config
+from wmr_mj.searches.search_space import config_for
 from wmr_mj.sim.certify import certificate_for
 from wmr_mj.sim.closed_loop import run_closed_loop
 from wmr_mj.sim.config import RunConfig, build_reference, coerce, estimate_parameters
 from wmr_mj.sim.designs import CERTIFIED
-from wmr_mj.sim.falsify import FalsifySpec, falsify, search_worst, worst_config
-from wmr_mj.sim.search_space import config_for
 
 BASE = RunConfig(**{**CERTIFIED.config_changes(), "duration": 12.0})
 
@@ -57,7 +57,7 @@ def test_reference_bounds_round_trip_through_the_config_json():
     config = BASE.replace(reference_bounds="paper")
     d = config.to_dict()
     assert d["reference_bounds"] == reference_bounds_from("paper").to_dict()
-    from wmr_mj.sim.sweep import config_from_dict
+    from wmr_mj.experiments.sweep import config_from_dict
 
     assert config_from_dict(json.loads(json.dumps(d))) == coerce(config)  # the record is of the coerced config
     assert "reference_bounds" not in BASE.to_dict()  # configs without them keep the keys they had

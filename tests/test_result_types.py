@@ -17,15 +17,15 @@ import pytest
 from matplotlib.figure import Figure
 
 from wmr_mj.analysis.claim_types import Assumption
+from wmr_mj.experiments.cart_check import CartCheck
+from wmr_mj.experiments.compare import CompareResult
+from wmr_mj.experiments.sweep_result import SweepResult
+from wmr_mj.experiments.tightness import CartTightness
 from wmr_mj.plant.cartcheck import COEFFICIENT_UNITS, CoefficientCheck, IdentificationCheck, RandomStepCheck
 from wmr_mj.report.results import ValidateSummary
-from wmr_mj.sim.cart_check import CartCheck
+from wmr_mj.searches.design_search import DesignCertificate, DesignResult
+from wmr_mj.searches.falsify import FalsifyResult
 from wmr_mj.sim.closed_loop import RunResult
-from wmr_mj.sim.compare import CompareResult
-from wmr_mj.sim.design_search import DesignCertificate, DesignResult
-from wmr_mj.sim.falsify import FalsifyResult
-from wmr_mj.sim.sweep_result import SweepResult
-from wmr_mj.sim.tightness import CartTightness
 
 #: each command's one result type
 RESULTS = {"run": RunResult, "sweep": SweepResult, "falsify": FalsifyResult, "compare": CompareResult,

@@ -1,5 +1,5 @@
 """The search methods of falsify on synthetic objectives with known worst cases, through the routine
-``falsify`` itself calls (:func:`wmr_mj.sim.falsify.search_worst`, with FalsifySpec's default method):
+``falsify`` itself calls (:func:`wmr_mj.searches.falsify.search_worst`, with FalsifySpec's default method):
 CMA-ES and the portfolio find an interior maximum the vertices miss, the portfolio keeps a vertex
 worst case exact within 64 runs, starts CMA-ES on the worse side of the vertices' significant main
 effects, spends its last share around the worst point found (from 200 runs ending in coordinate moves,
@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 
 from wmr_mj.errors import ParameterError
-from wmr_mj.sim import falsify as falsify_module
-from wmr_mj.sim.falsify import (
+from wmr_mj.searches import falsify as falsify_module
+from wmr_mj.searches.falsify import (
     FalsifySpec,
     cma_population,
     covering_design,
@@ -164,7 +164,7 @@ def test_from_200_runs_the_global_phase_is_two_independent_cma_runs_from_the_scr
     """6-D at 300: 32 vertices, then 19 generations of 9 split 9 + 10 between two CMA-ES runs, then the local
     phase. The first run is the one-run portfolio's own, to the bit, up to the split; the second is a fresh
     CMA-ES at the vertices' screened start with the first step (0.3 of each range), to the bit."""
-    import wmr_mj.sim.search_methods as search_methods
+    import wmr_mj.searches.search_methods as search_methods
 
     box6 = np.array([[-1.0, 1.0]] * 6)
     peak = np.array([0.6, 0.6, 0.6, -0.6, 0.6, 0.6])
@@ -205,7 +205,7 @@ def test_from_200_runs_the_local_phase_ends_in_coordinate_moves_of_the_worst_poi
     moves in batches of 9 (the last 7): each point is the worst point found before its batch with one or more
     coordinates moved by a normal step of 0.05 of the range, the others equal to the bit. Before them the
     search is the one without the moves, to the bit; below 200 runs there are none."""
-    import wmr_mj.sim.search_methods as search_methods
+    import wmr_mj.searches.search_methods as search_methods
 
     box6 = np.array([[-1.0, 1.0]] * 6)
     peak = np.array([0.3, -0.4, 0.1, 0.25, -0.2, 0.5])
@@ -241,7 +241,7 @@ def test_the_coordinate_moves_climb_a_thin_ridge_that_an_isotropic_step_seldom_s
     x0 = 1 on it; the vertices all lie off it, at 0.3 x0): at a budget of 300 the portfolio comes within 5%
     of the maximum in at least 14 of 20 seeds (measured here: 17; random sampling's median 0.74 of it).
     Without the coordinate moves, the local CMA-ES to the end as below 200 runs: 11 of 20, below that."""
-    import wmr_mj.sim.search_methods as search_methods
+    import wmr_mj.searches.search_methods as search_methods
 
     def ridge(x: np.ndarray) -> np.ndarray:
         return x[:, 0] * np.exp(-(((x[:, 1] - x[:, 2] - 0.1) / 0.01) ** 2)) + 0.3 * x[:, 0]
@@ -301,7 +301,7 @@ def test_falsifys_printout_names_the_portfolios_phases_as_the_search_spends_them
     from types import SimpleNamespace
 
     from wmr_mj.cli.falsify import _portfolio_phases_text
-    from wmr_mj.sim.falsify import Evaluation, portfolio_phases
+    from wmr_mj.searches.falsify import Evaluation, portfolio_phases
 
     names = ("m1", "a", "b", "c", "d", "e")
     bounds = np.array([[550.0, 750.0]] + [[-1.0, 1.0]] * 5)

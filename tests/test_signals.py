@@ -224,7 +224,7 @@ def test_batches_run_signal_configs_one_by_one_bit_identical_to_single_runs():
 
 
 def test_search_space_maps_signal_axes_and_refuses_unknown_ones():
-    from wmr_mj.sim.search_space import config_for
+    from wmr_mj.searches.search_space import config_for
 
     template = Signals(disturbance=Disturbance("pulse", 1.0, t1=0.5, t2=1.0), d_max=12.0,
                        loads=(LoadChange("step", 700.0, t=1.5),))

@@ -160,7 +160,7 @@ def test_the_sampled_layer_certifies_the_12bit_and_20ms_carts(sensing):
 @pytest.mark.parametrize("sensing", ["magnetic-12bit-axis", "delay=0.02"])
 def test_runs_are_certified_inside_or_uncertified(sensing):
     """A small sweep over the m1 box: never certified-outside (4 runs of 10 s each)."""
-    from wmr_mj.sim.sweep import SweepSpec, run_sweep
+    from wmr_mj.experiments.sweep import SweepSpec, run_sweep
 
     spec = Sensing.from_spec(sensing)
     base = RunConfig.from_inputs(**{**BASE, "duration": 10.0, "controller_params": dict(CERTIFYING), "sensing": spec})

@@ -7,9 +7,7 @@ import math
 
 import pytest
 
-from wmr_mj.sim.config import RunConfig
-from wmr_mj.sim.many_runs import CSV_SIGNIFICANT_DIGITS, csv_number
-from wmr_mj.sim.sweep import (
+from wmr_mj.experiments.sweep import (
     PRECISE_ROWS,
     SWEEP_KEYS_DEPRECATED,
     SweepSpec,
@@ -18,6 +16,8 @@ from wmr_mj.sim.sweep import (
     read_runs,
     run_sweep,
 )
+from wmr_mj.sim.config import RunConfig
+from wmr_mj.sim.many_runs import CSV_SIGNIFICANT_DIGITS, csv_number
 
 BASE = RunConfig(model="nonholonomic", duration=10.0)
 
@@ -109,8 +109,8 @@ def test_the_unmet_record_round_trips_its_range():
 def test_falsify_records_the_encoder_bits_each_run_used(tmp_path):
     """A search over sensing.encoder_bits proposes fractional bits; the run has 2**round(bits) ticks, and the
     JSON, the evaluations and evaluations.csv record those whole bits (as sweep's runs.csv does)."""
+    from wmr_mj.searches.falsify import FalsifySpec, falsify, worst_config
     from wmr_mj.sim.designs import CERTIFIED
-    from wmr_mj.sim.falsify import FalsifySpec, falsify, worst_config
 
     base = RunConfig(**CERTIFIED.config_changes(), duration=9.0, sensing="magnetic-12bit-axis")
     spec = FalsifySpec(base=base, box={"sensing.encoder_bits": (10.6, 13.4)}, objective="sup-E", budget=5,
@@ -151,7 +151,7 @@ def test_falsify_refuses_an_objective_undefined_for_every_run_before_any_step(tm
 def test_a_box_that_reaches_the_certificate_is_not_refused_up_front():
     """Where a run's certificate may differ from the base's (a cart axis, its limits), the base's says nothing of
     every run's: no refusal before the runs."""
-    from wmr_mj.sim.falsify import shares_the_base_certificate
+    from wmr_mj.searches.falsify import shares_the_base_certificate
 
     ideal = RunConfig()
     sensed = RunConfig(sensing="magnetic-12bit-axis")
@@ -164,14 +164,14 @@ def test_a_box_that_reaches_the_certificate_is_not_refused_up_front():
 # -- 4: falsify warns of runs its objective leaves blank ------------------------------------------
 
 def _evaluations(phase: str, objectives: list[float | None]):
-    from wmr_mj.sim.falsify import Evaluation
+    from wmr_mj.searches.falsify import Evaluation
 
     return [Evaluation(phase=phase, index=i, generation=0, params={"m1": 600.0 + i}, objective=v,
                        summary={"sup_E": 0.01 * (i + 1), "sup_Edot": 0.1}) for i, v in enumerate(objectives)]
 
 
 def test_falsify_warns_how_many_runs_have_no_certificate_objective():
-    from wmr_mj.sim.falsify import FalsifyResult, FalsifySpec, undefined_objective_warning
+    from wmr_mj.searches.falsify import FalsifyResult, FalsifySpec, undefined_objective_warning
 
     spec = FalsifySpec(box={"m1": (600.0, 700.0)}, budget=16)
     blank = FalsifyResult(spec=spec, search=_evaluations("search", [None] * 11 + [0.5] * 5),
@@ -358,8 +358,8 @@ def test_runs_csv_has_the_effort_columns(swept):
 # -- 11: compare's adversary over the cart's axes; a figure that tells designs apart ----------------
 
 def test_the_adversary_searches_the_carts_axes_where_a_scenario_declares_a_non_ideal_cart():
-    from wmr_mj.sim.compare import adversary_spec, design_from_token
-    from wmr_mj.sim.suite import load_suite
+    from wmr_mj.experiments.compare import adversary_spec, design_from_token
+    from wmr_mj.experiments.suite import load_suite
 
     v2 = load_suite("standard-v2")
     design = design_from_token("certified", v2)
@@ -437,7 +437,7 @@ def test_a_random_sample_without_the_objective_is_no_error():
     """falsify --range sensing.delay=0:0.05: one search run had a certificate and no random run; the command
     said "the objective is undefined for every run" after both phases. The search's worst stands; the random
     sample's is its largest sup|E|, without an objective."""
-    from wmr_mj.sim.falsify import FalsifyResult, FalsifySpec, undefined_objective_warning
+    from wmr_mj.searches.falsify import FalsifyResult, FalsifySpec, undefined_objective_warning
 
     spec = FalsifySpec(box={"m1": (600.0, 700.0)}, budget=16)
     result = FalsifyResult(spec=spec, search=_evaluations("search", [None, 0.4, None]),

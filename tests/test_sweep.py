@@ -10,15 +10,15 @@ import numpy as np
 import pytest
 
 from wmr_mj import ParameterError, SchedulerError, UnknownNameError
-from wmr_mj.sim.config import RunConfig
-from wmr_mj.sim.many_runs import connect, latin_hypercube, run_configs
-from wmr_mj.sim.sweep import (
+from wmr_mj.experiments.sweep import (
     SweepSpec,
     draw_samples,
     read_results,
     read_runs,
     run_sweep,
 )
+from wmr_mj.sim.config import RunConfig
+from wmr_mj.sim.many_runs import connect, latin_hypercube, run_configs
 
 BASE = RunConfig(model="nonholonomic", duration=10.0)
 KEYS = ("sup_E", "sup_Edot", "sup_E_settled", "sup_Edot_settled", "E_max", "Edot_max", "saturated_fraction",

@@ -1,4 +1,4 @@
-"""examples/tightness_table.py and wmr_mj.sim.tightness: the table of covered carts, in quick mode.
+"""examples/tightness_table.py and wmr_mj.experiments.tightness: the table of covered carts, in quick mode.
 
 The E_max columns are checked against the certificate a run computes (``resolve_run(...).claim`` and
 ``run_closed_loop``'s summary), the worst found against a run at its m1 (falsify's runs are reproduced bit for
@@ -19,8 +19,8 @@ from helpers import example_module
 
 import wmr_mj as wm
 from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE
+from wmr_mj.experiments.tightness import certificate_columns
 from wmr_mj.sim.parts import resolve_run
-from wmr_mj.sim.tightness import certificate_columns
 
 ROOT = Path(__file__).resolve().parents[1]
 SCRIPT = ROOT / "examples" / "tightness_table.py"

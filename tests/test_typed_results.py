@@ -13,9 +13,9 @@ import pytest
 import wmr_mj
 from wmr_mj.analysis.verdicts import VERDICTS
 from wmr_mj.errors import ParameterError
-from wmr_mj.sim import search_methods
+from wmr_mj.searches import search_methods
+from wmr_mj.searches.falsify import METHOD_LABELS, METHODS, Evaluation, FalsifyResult, FalsifySpec
 from wmr_mj.sim.config import RunConfig
-from wmr_mj.sim.falsify import METHOD_LABELS, METHODS, Evaluation, FalsifyResult, FalsifySpec
 
 
 def _usage_block(doc: str) -> str:
@@ -42,7 +42,7 @@ def test_the_package_docstring_example_runs():
 
 # -- the falsify history plot's label names the search that runs ------------------------------------
 
-#: the words that name each private search of wmr_mj.sim.search_methods, as a reader knows them
+#: the words that name each private search of wmr_mj.searches.search_methods, as a reader knows them
 _SEARCH_WORDS = {"_search_cma": "CMA-ES", "_search_de": "differential evolution",
                  "_search_vertices_polish": "Nelder-Mead"}
 
@@ -149,12 +149,12 @@ def test_the_removed_record_names_warn_and_still_read_the_commands_json():
     with pytest.warns(DeprecationWarning, match="report"):
         assert _falsify_result().report().to_dict() == d
     with pytest.warns(DeprecationWarning, match="CompareResult"):
-        from wmr_mj.sim.compare import CompareReport  # noqa: F401
+        from wmr_mj.experiments.compare import CompareReport  # noqa: F401
     assert "FalsifyReport" not in wmr_mj.__all__ and "CompareReport" not in wmr_mj.__all__
 
 
 def test_sweep_summary_is_typed_and_round_trips():
-    from wmr_mj.sim.sweep import SweepSummary
+    from wmr_mj.experiments.sweep import SweepSummary
 
     def row(run, m1, verdict, cert, ratio):
         return {"run": run, "m1": m1, "verdict": verdict, "certificate": cert, "cert_E_ratio": ratio,
@@ -183,8 +183,8 @@ def test_sweep_summary_is_typed_and_round_trips():
 def test_sweep_result_round_trips():
     """A sweep's one result carries its spec, its rows and their summary in its JSON (no run needed: the rows
     above, added up as :func:`wmr_mj.sweep` adds them)."""
-    from wmr_mj.sim.sweep import SweepSpec, SweepSummary
-    from wmr_mj.sim.sweep_result import SweepResult
+    from wmr_mj.experiments.sweep import SweepSpec, SweepSummary
+    from wmr_mj.experiments.sweep_result import SweepResult
 
     spec = SweepSpec(n=2, seed=3, ranges={"mu": (0.01, 0.03)}, base=RunConfig(duration=5.0))
     rows = ({"run": 0, "m1": 600.0, "mu": 0.02, "verdict": "certified-inside", "certificate": _CERT_OUT,
@@ -201,8 +201,8 @@ def test_sweep_result_round_trips():
 
 
 def test_compare_result_is_typed_and_round_trips():
-    from wmr_mj.sim.compare import CompareResult, DesignRow, ScenarioRun
-    from wmr_mj.sim.suite import load_suite
+    from wmr_mj.experiments.compare import CompareResult, DesignRow, ScenarioRun
+    from wmr_mj.experiments.suite import load_suite
 
     row = DesignRow(label="certified", controller="computed-torque", tracker=None, runs=2, requirements_passed=3,
                     requirements_total=4, least_normalised=-0.25, least_at="tracking @ circle/nominal",

@@ -48,7 +48,7 @@ def validated(tmp_path_factory):
 
 def _rows(folder: Path, rel: str) -> list[dict[str, str]]:
     if rel.endswith("runs.csv"):  # a sweep's: its cells as text at full precision (runs.csv rounds to 12 digits)
-        from wmr_mj.sim.sweep import read_runs
+        from wmr_mj.experiments.sweep import read_runs
 
         return [{k: "" if v is None else str(v) for k, v in r.items()} for r in read_runs((folder / rel).parent)]
     with open(folder / rel, newline="") as f:

@@ -6,7 +6,7 @@ The truths: the design is the one the recorded ``wmr-mj design`` command writes 
 count and worst ratio is recomputed from the sweeps' runs.csv by a plain loop; a run of ``run --design FILE`` at
 one of the section's m1 draws gives that draw's row to the last bit; both designs ran the same draws; the search
 starts at the certified design's point, so the design's bound is never above the certified design's
-(wmr_mj/sim/design_search.py); the summary reads back from its JSON to the same JSON.
+(wmr_mj/searches/design_search.py); the summary reads back from its JSON to the same JSON.
 """
 
 from __future__ import annotations
@@ -36,7 +36,7 @@ def _cli(*args: str, timeout: float = 300) -> subprocess.CompletedProcess:
 
 
 def _runs(folder: Path, rel: str) -> list[dict]:
-    from wmr_mj.sim.sweep import read_runs
+    from wmr_mj.experiments.sweep import read_runs
 
     return read_runs((folder / rel).parent)
 
@@ -184,7 +184,7 @@ def test_the_recorded_command_searches_the_sections_problem():
     from wmr_mj.cli import design as design_cli
     from wmr_mj.report.cart_design import design_command, design_problem
     from wmr_mj.report.settings import ValidateSettings
-    from wmr_mj.sim.design_search import search_design
+    from wmr_mj.searches.design_search import search_design
 
     settings = ValidateSettings(n=1, duration=12.0, path="lane-change", m1_range=(560.0, 740.0),
                                 actuation="delay=0.002", search_budget=0)

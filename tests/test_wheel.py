@@ -165,7 +165,7 @@ def test_the_installed_package_runs_a_built_in_plug_in_and_the_packaged_suite(in
                 "--path", "lane-change", "--duration", "10", "--no-log", "--json"], cwd=outside, env=env)
     summary = json.loads(out)
     assert summary["controller"] == "sliding-mode" and summary["verdict"].endswith(("inside", "outside"))
-    code = ("from wmr_mj.sim.suite import load_suite; s = load_suite('standard-v1'); "
+    code = ("from wmr_mj.experiments.suite import load_suite; s = load_suite('standard-v1'); "
             "print(s.name, len(s.scenarios), s.source)")
     printed = _run([str(bin_dir / "python"), "-c", code], cwd=outside, env=env)
     assert printed.startswith("standard-v1 30 ") and str(bin_dir.parent) in printed

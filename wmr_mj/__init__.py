@@ -40,24 +40,24 @@ from ._version import __version__ as __version__
 
 if TYPE_CHECKING:
     from wmr_mj.carts import CartFile, load_cart
+    from wmr_mj.experiments.compare import CompareResult, Design, DesignRow, compare, design_from_token
+    from wmr_mj.experiments.suite import load_suite
+    from wmr_mj.experiments.sweep import SweepSpec, SweepSummary
+    from wmr_mj.experiments.sweep_result import SweepResult, sweep
+    from wmr_mj.experiments.tightness import CartTightness, cart_tightness
     from wmr_mj.figures.results import ResultPlot
     from wmr_mj.logs.reader import load_log
     from wmr_mj.logs.writer import LogOptions, RunLogger
     from wmr_mj.report.results import ValidateSummary
+    from wmr_mj.searches.design_search import DesignProblem, DesignResult, search_design, write_design
+    from wmr_mj.searches.falsify import FalsifyResult, FalsifySpec, falsify
     from wmr_mj.sim.certify import certificate_for
     from wmr_mj.sim.closed_loop import RunResult, run_closed_loop
-    from wmr_mj.sim.compare import CompareResult, Design, DesignRow, compare, design_from_token
     from wmr_mj.sim.config import RunConfig, controller_for
-    from wmr_mj.sim.design_search import DesignProblem, DesignResult, search_design, write_design
     from wmr_mj.sim.designs import CERTIFIED, CERTIFIED_C80, PAPER, PRESETS, preset
-    from wmr_mj.sim.falsify import FalsifyResult, FalsifySpec, falsify
     from wmr_mj.sim.log_header import LogHeader
     from wmr_mj.sim.parts import RunParts, resolve_run
     from wmr_mj.sim.signals import Disturbance, LoadChange, Signals
-    from wmr_mj.sim.suite import load_suite
-    from wmr_mj.sim.sweep import SweepSpec, SweepSummary
-    from wmr_mj.sim.sweep_result import SweepResult, sweep
-    from wmr_mj.sim.tightness import CartTightness, cart_tightness
 
 #: name -> the module that defines it, imported on first access
 _LAZY: dict[str, str] = {
@@ -66,13 +66,13 @@ _LAZY: dict[str, str] = {
     "run_closed_loop": "wmr_mj.sim.closed_loop",
     "RunResult": "wmr_mj.sim.closed_loop",
     "certificate_for": "wmr_mj.sim.certify",
-    "SweepSpec": "wmr_mj.sim.sweep",
-    "SweepSummary": "wmr_mj.sim.sweep",
-    "sweep": "wmr_mj.sim.sweep_result",
-    "SweepResult": "wmr_mj.sim.sweep_result",
-    "FalsifySpec": "wmr_mj.sim.falsify",
-    "falsify": "wmr_mj.sim.falsify",
-    "FalsifyResult": "wmr_mj.sim.falsify",
+    "SweepSpec": "wmr_mj.experiments.sweep",
+    "SweepSummary": "wmr_mj.experiments.sweep",
+    "sweep": "wmr_mj.experiments.sweep_result",
+    "SweepResult": "wmr_mj.experiments.sweep_result",
+    "FalsifySpec": "wmr_mj.searches.falsify",
+    "falsify": "wmr_mj.searches.falsify",
+    "FalsifyResult": "wmr_mj.searches.falsify",
     "ValidateSummary": "wmr_mj.report.results",
     "PAPER": "wmr_mj.sim.designs",
     "CERTIFIED": "wmr_mj.sim.designs",
@@ -88,21 +88,21 @@ _LAZY: dict[str, str] = {
     "LogOptions": "wmr_mj.logs.writer",
     "resolve_run": "wmr_mj.sim.parts",
     "RunParts": "wmr_mj.sim.parts",
-    "load_suite": "wmr_mj.sim.suite",
-    "compare": "wmr_mj.sim.compare",
-    "CompareResult": "wmr_mj.sim.compare",
-    "DesignRow": "wmr_mj.sim.compare",
-    "Design": "wmr_mj.sim.compare",
-    "design_from_token": "wmr_mj.sim.compare",
+    "load_suite": "wmr_mj.experiments.suite",
+    "compare": "wmr_mj.experiments.compare",
+    "CompareResult": "wmr_mj.experiments.compare",
+    "DesignRow": "wmr_mj.experiments.compare",
+    "Design": "wmr_mj.experiments.compare",
+    "design_from_token": "wmr_mj.experiments.compare",
     "ResultPlot": "wmr_mj.figures.results",
     "load_cart": "wmr_mj.carts",
     "CartFile": "wmr_mj.carts",
-    "DesignProblem": "wmr_mj.sim.design_search",
-    "DesignResult": "wmr_mj.sim.design_search",
-    "search_design": "wmr_mj.sim.design_search",
-    "write_design": "wmr_mj.sim.design_search",
-    "cart_tightness": "wmr_mj.sim.tightness",
-    "CartTightness": "wmr_mj.sim.tightness",
+    "DesignProblem": "wmr_mj.searches.design_search",
+    "DesignResult": "wmr_mj.searches.design_search",
+    "search_design": "wmr_mj.searches.design_search",
+    "write_design": "wmr_mj.searches.design_search",
+    "cart_tightness": "wmr_mj.experiments.tightness",
+    "CartTightness": "wmr_mj.experiments.tightness",
 }
 
 __all__ = [
@@ -186,10 +186,13 @@ __all__ = [
 
 #: names kept at the top level for one release, each with its module and what to use instead: a warning on use
 _DEPRECATED = {
-    "run_sweep": ("wmr_mj.sim.sweep", "wm.sweep(spec), whose .rows are these rows (or wmr_mj.sim.sweep.run_sweep)"),
+    "run_sweep": ("wmr_mj.experiments.sweep",
+                  "wm.sweep(spec), whose .rows are these rows (or wmr_mj.experiments.sweep.run_sweep)"),
     # one result per command: the search's and the comparison's records are their results' to_dict(runs=False)
-    "FalsifyReport": ("wmr_mj.sim.falsify", "wm.FalsifyResult, read by attribute (to_dict(runs=False) is its JSON)"),
-    "CompareReport": ("wmr_mj.sim.compare", "wm.CompareResult, read by attribute (to_dict(runs=False) is its JSON)"),
+    "FalsifyReport": ("wmr_mj.searches.falsify",
+                      "wm.FalsifyResult, read by attribute (to_dict(runs=False) is its JSON)"),
+    "CompareReport": ("wmr_mj.experiments.compare",
+                      "wm.CompareResult, read by attribute (to_dict(runs=False) is its JSON)"),
 }
 
 

@@ -13,8 +13,8 @@ cart's default sensing, actuation and play: E_max, the voltage bound against the
 unmet. This is a report, not a check: a cart whose design cannot be certified still passes ``cart check``.
 
 Its third line answers whether ``wmr-mj design`` can certify the cart on its default sensing: the design search
-(:func:`wmr_mj.sim.design_search.search_design`, CMA-ES seeded with ``--seed``, design's default budget
-(:data:`wmr_mj.sim.design_search.DEFAULT_BUDGET`) of certificates, the paper circle, the cart's m1 box, a 1 ms
+(:func:`wmr_mj.searches.design_search.search_design`, CMA-ES seeded with ``--seed``, design's default budget
+(:data:`wmr_mj.searches.design_search.DEFAULT_BUDGET`) of certificates, the paper circle, the cart's m1 box, a 1 ms
 period) run on the cart, as ``wmr-mj design --cart FILE --seed S`` runs it: "design certifies it: E_max ... rad
 (K_P ..., K_D ...)" or "no gains in the box certify this cart: ... binds". Also a report: it does not change the
 exit status. It adds about 2 s (2026-11-27, 2 cores under a shared load of 4-5: 603 certificates in 2.0 s, the
@@ -103,8 +103,8 @@ def _print_text(check: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     from wmr_mj.carts import load_cart
     from wmr_mj.cli._common import print_json
+    from wmr_mj.experiments.cart_check import cart_check, default_parts
     from wmr_mj.params import parameters_of_cart
-    from wmr_mj.sim.cart_check import cart_check, default_parts
 
     cart = load_cart(args.cart)
     if args.action == "card":  # a parameter set or default part that cannot be built: one line, before the card

@@ -62,7 +62,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _suite_help() -> str:
-    from wmr_mj.sim.suite import suite_names
+    from wmr_mj.experiments.suite import suite_names
 
     return f"the scenario suite: one of {', '.join(suite_names())} or a suite file (.toml)"
 
@@ -88,9 +88,9 @@ def run(args: argparse.Namespace) -> int:
     from wmr_mj._util.progress import counter_callback, progress_bar
     from wmr_mj.cli._common import CLAIM_BROKEN_EXIT, print_json
     from wmr_mj.errors import ParameterError
+    from wmr_mj.experiments.compare import adversary_spec, compare, design_from_token
+    from wmr_mj.experiments.suite import load_suite
     from wmr_mj.report.compare import markdown, write_report
-    from wmr_mj.sim.compare import adversary_spec, compare, design_from_token
-    from wmr_mj.sim.suite import load_suite
 
     if args.budget < 0:
         raise ParameterError(f"--budget {args.budget} is not accepted: a number of runs >= 0")

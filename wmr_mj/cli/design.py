@@ -1,5 +1,5 @@
 """``wmr-mj design``: the computed-torque (or sliding-mode) gains a given cart can certify
-(:mod:`wmr_mj.sim.design_search`)."""
+(:mod:`wmr_mj.searches.design_search`)."""
 
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ HELP = "the computed-torque (or sliding-mode) gains, sign width, filter and peri
 def register(sub: argparse._SubParsersAction) -> None:
     from wmr_mj.cli.run import add_hardware_options
     from wmr_mj.params import M1_RANGE
-    from wmr_mj.sim.design_options import DEFAULT_BUDGET, DEFAULT_SEED, METHODS, OBJECTIVE_WORDS
+    from wmr_mj.searches.design_options import DEFAULT_BUDGET, DEFAULT_SEED, METHODS, OBJECTIVE_WORDS
 
     p = sub.add_parser(
         "design", help=HELP,
@@ -66,7 +66,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def problem_from_args(args: argparse.Namespace) -> Any:
-    """The :class:`~wmr_mj.sim.design_search.DesignProblem` of the options, every input checked first.
+    """The :class:`~wmr_mj.searches.design_search.DesignProblem` of the options, every input checked first.
 
     Raises:
         ParameterError: an empty box, an unknown objective, a period list that is not accepted, a cart no claim
@@ -76,8 +76,8 @@ def problem_from_args(args: argparse.Namespace) -> Any:
     from wmr_mj.cli.run import hardware_from_args
     from wmr_mj.errors import ParameterError
     from wmr_mj.params import M1_RANGE
+    from wmr_mj.searches.design_search import OBJECTIVES, DesignProblem, check_periods, law_changes, uncovered
     from wmr_mj.sim.config import RunConfig
-    from wmr_mj.sim.design_search import OBJECTIVES, DesignProblem, check_periods, law_changes, uncovered
 
     law = law_changes(args.controller)
     if args.objective not in OBJECTIVES:
@@ -118,7 +118,7 @@ def run(args: argparse.Namespace) -> int:
 
     from wmr_mj.cli._common import print_json
     from wmr_mj.errors import ParameterError
-    from wmr_mj.sim.design_search import search_design, write_design
+    from wmr_mj.searches.design_search import search_design, write_design
 
     if args.check < 0:
         raise ParameterError(f"--check {args.check} is not accepted; a number of runs >= 0")
@@ -143,8 +143,8 @@ def check_design(problem: Any, result: Any, n: int) -> dict[str, Any]:
     the search's seed: its verdict counts."""
     import dataclasses
 
-    from wmr_mj.sim.design_search import DESIGN_FIELDS
-    from wmr_mj.sim.sweep import SweepSpec, SweepSummary, run_sweep
+    from wmr_mj.experiments.sweep import SweepSpec, SweepSummary, run_sweep
+    from wmr_mj.searches.design_search import DESIGN_FIELDS
 
     base = dataclasses.replace(problem.base, path=problem.paths[0], **{k: result.settings[k] for k in DESIGN_FIELDS})
     spec = SweepSpec(n=n, seed=problem.seed, sampling="lhs", m1_range=tuple(base.m1_range),

@@ -10,7 +10,7 @@ from wmr_mj.cli._common import positive_int
 from wmr_mj.cli.options import add_json, add_out, add_seed, add_threads
 
 if TYPE_CHECKING:
-    from wmr_mj.sim.falsify import FalsifyResult
+    from wmr_mj.searches.falsify import FalsifyResult
 
 _AGAINST = ("certificate", "paper")
 _OBJECTIVE_KINDS = ("ratio", "sup-E")
@@ -114,7 +114,7 @@ def _portfolio_phases_text(spec, first, population: int) -> str:
     phases, and (from 200 runs) the coordinate moves that end it."""
     import numpy as np
 
-    from wmr_mj.sim.falsify import (
+    from wmr_mj.searches.falsify import (
         PORTFOLIO_COORDINATE_STEP,
         portfolio_coordinate_runs,
         portfolio_global_runs,
@@ -155,7 +155,7 @@ def _base_and_box(args: argparse.Namespace):
     from wmr_mj.cli.options import command_ranges
     from wmr_mj.cli.run import config_from_args
     from wmr_mj.errors import ParameterError
-    from wmr_mj.sim.search_space import path_axis
+    from wmr_mj.searches.search_space import path_axis
 
     searched = command_ranges(args, "falsify").searched  # the one rule of --range; the plant's go to the box
     if args.path_knots < 0:
@@ -184,7 +184,7 @@ def run(args: argparse.Namespace) -> int:
     from wmr_mj._util.files import check_output_path, write_text_atomic
     from wmr_mj._util.progress import counter_callback, progress_bar
     from wmr_mj.cli._common import print_json
-    from wmr_mj.sim.falsify import (
+    from wmr_mj.searches.falsify import (
         FalsifySpec,
         check_objective_applies,
         check_objective_defined,
@@ -230,7 +230,7 @@ def _write_outputs(result, base, args: argparse.Namespace, out, *, law_settings)
     from wmr_mj.figures.plots import falsify_history, save_figure
     from wmr_mj.hardware import cart_dict
     from wmr_mj.logs.writer import run_logged
-    from wmr_mj.sim.falsify import worst_config
+    from wmr_mj.searches.falsify import worst_config
     from wmr_mj.sim.run_report import add_controller_source
 
     worst, log_path = result.worst, out / "worst.mcap"
@@ -268,7 +268,7 @@ def _write_outputs(result, base, args: argparse.Namespace, out, *, law_settings)
 def _print_text(result, base, summary: dict, args: argparse.Namespace, logged_sup_E: float) -> None:
     """falsify's printout: how the search ran, the worst of the search and of the random sample, the claim,
     the worst run's certificate (E_max, the largest term of delta1) and tightness, its parameters and files."""
-    from wmr_mj.sim.falsify import OBJECTIVE_LABELS, worst_config
+    from wmr_mj.searches.falsify import OBJECTIVE_LABELS, worst_config
 
     spec, worst = result.spec, result.worst
     names, how = ", ".join(spec.names), _how_text(spec, result)
@@ -323,7 +323,7 @@ def _print_cart(base, worst, names) -> None:
     """The cart's line where it is not ideal or is searched: the base's, and the worst run's (its hardware axes
     rounded as the run had them)."""
     from wmr_mj.hardware import cart_line, is_ideal_cart
-    from wmr_mj.sim.search_space import hardware_axis
+    from wmr_mj.searches.search_space import hardware_axis
 
     searched = [n for n in names if hardware_axis(n)]
     if not is_ideal_cart(base) and not searched:

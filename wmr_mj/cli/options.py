@@ -188,7 +188,7 @@ class Ranges:
 
 def range_kind(name: str) -> str:
     """The kind of a --range name (:data:`RANGE_KINDS`): 'cart', 'signal', 'path', else 'plant'."""
-    from wmr_mj.sim.search_space import hardware_axis, path_axis, signal_axis
+    from wmr_mj.searches.search_space import hardware_axis, path_axis, signal_axis
 
     if hardware_axis(name):
         return "cart"
@@ -279,7 +279,7 @@ def box_ranges_from_args(args: argparse.Namespace) -> dict[str, tuple[float, flo
 
 def hardware_ranges_from_args(args: argparse.Namespace) -> dict[str, tuple[float, float]]:
     """The cart's axes among the --range NAME=LO:HI items (``sensing.delay``, ``sensing.encoder_ticks``, ...:
-    :data:`wmr_mj.sim.search_space.HARDWARE_AXES`), in the order given; each is checked where the sweep
+    :data:`wmr_mj.searches.search_space.HARDWARE_AXES`), in the order given; each is checked where the sweep
     or the search is built."""
     return command_ranges(args).cart
 

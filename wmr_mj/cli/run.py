@@ -98,10 +98,11 @@ def config_from_args(args: argparse.Namespace, **extra):
 
 def with_design_file(args: argparse.Namespace) -> argparse.Namespace:
     """``args`` with each option that --design FILE sets and was not given taken from the file, in place (the
-    command reads them from ``args`` after this): its settings (:func:`wmr_mj.sim.design_search.design_file_settings`)
-    as a preset's are, its cart (:func:`~wmr_mj.sim.design_search.design_cart`), and what it was found on
-    (:func:`~wmr_mj.sim.design_search.design_file_box`): its m1 box, reference bounds and path. --omega-r keeps the
-    file's gains out. A --cart other than the design's runs the gains on that cart with the cart's own sensing,
+    command reads them from ``args`` after this): its settings
+    (:func:`wmr_mj.searches.design_search.design_file_settings`) as a preset's are, its cart
+    (:func:`~wmr_mj.searches.design_search.design_cart`), and what it was found on
+    (:func:`~wmr_mj.searches.design_search.design_file_box`): its m1 box, reference bounds and path. --omega-r keeps
+    the file's gains out. A --cart other than the design's runs the gains on that cart with the cart's own sensing,
     actuation and play; it, and an --m1-range beyond the design's box, print one note naming both.
 
     Raises:
@@ -112,7 +113,7 @@ def with_design_file(args: argparse.Namespace) -> argparse.Namespace:
 
     from wmr_mj.errors import ParameterError
     from wmr_mj.params import M1_RANGE
-    from wmr_mj.sim.design_search import (
+    from wmr_mj.searches.design_search import (
         design_cart,
         design_cart_name,
         design_file_box,

@@ -11,7 +11,7 @@ from wmr_mj.cli._common import CLAIM_BROKEN_EXIT, positive_int
 from wmr_mj.cli.options import add_json, add_out, add_seed, add_threads
 
 if TYPE_CHECKING:
-    from wmr_mj.sim.sweep import SweepSummary
+    from wmr_mj.experiments.sweep import SweepSummary
 
 
 #: the command's line in ``wmr-mj --help`` (read without registering the command: wmr_mj/cli/app.py)
@@ -90,9 +90,9 @@ def _spec_from_args(args: argparse.Namespace) -> tuple[Any, Any]:
     from wmr_mj.cli._common import box_ranges_from_args, hardware_ranges_from_args
     from wmr_mj.cli.run import config_from_args, requirements_from_args
     from wmr_mj.errors import ParameterError
+    from wmr_mj.experiments.sweep import SweepSpec
     from wmr_mj.plant.mjcf import TIMESTEP
     from wmr_mj.sim.parts import resolve_run
-    from wmr_mj.sim.sweep import SweepSpec
 
     if args.n < 1:
         raise ParameterError(f"--n {args.n} is not accepted; the number of runs must be >= 1")
@@ -126,7 +126,7 @@ def run(args: argparse.Namespace) -> int:
     from wmr_mj._util.files import check_output_path, write_json_atomic
     from wmr_mj._util.progress import counter_callback, progress_bar
     from wmr_mj.cli._common import print_json
-    from wmr_mj.sim.sweep_result import sweep
+    from wmr_mj.experiments.sweep_result import sweep
 
     out = check_output_path(args.out or f"logs/sweep-{time.strftime('%Y%m%d-%H%M%S')}", kind="dir", option="--out")
     spec, base_parts = _spec_from_args(args)

@@ -71,7 +71,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _sampling_help() -> str:
-    from wmr_mj.sim.sweep import SAMPLINGS
+    from wmr_mj.experiments.sweep import SAMPLINGS
 
     return f"sampling of m1: one of {', '.join(SAMPLINGS)} (default lhs)"
 

@@ -5,11 +5,11 @@ On the 12-bit absolute magnetic encoder on the steering axis (:data:`DESIGN_SENS
 the ams AS5045, its velocity the backward difference), the stage
 
 1. searches the computed-torque gains this cart certifies, as ``wmr-mj design --sensing magnetic-12bit-axis``
-   does (:func:`wmr_mj.sim.design_search.search_design`, CMA-ES, :data:`DESIGN_SEED`, :data:`DESIGN_BUDGET`
+   does (:func:`wmr_mj.searches.design_search.search_design`, CMA-ES, :data:`DESIGN_SEED`, :data:`DESIGN_BUDGET`
    certificates: a few seconds), for the report's box, path and duration; writes the design file into the
    report folder and reads it back as ``wmr-mj run --design FILE`` reads it;
 2. sweeps the certified design and the found design on that cart over the same m1 draws
-   (:func:`wmr_mj.sim.sweep.run_sweep`: min(n, :data:`DESIGN_RUNS`) runs, the report's seed and sampling;
+   (:func:`wmr_mj.experiments.sweep.run_sweep`: min(n, :data:`DESIGN_RUNS`) runs, the report's seed and sampling;
    resumable in cart-design-<name>/), each judged against its own certificate.
 
 For each design it records the gains, the certificate (E_max, the voltage it needs, which certificate:
@@ -36,17 +36,17 @@ from typing import Any
 from wmr_mj._util.checks import as_pair
 from wmr_mj._util.progress import Stages
 from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE
+from wmr_mj.experiments.compare import design_file_changes
+from wmr_mj.experiments.sweep import SweepSpec, SweepSummary, read_runs, run_sweep
 from wmr_mj.hardware import Sensing
 from wmr_mj.params import M1_RANGE
 from wmr_mj.report.settings import ValidateSettings, loud, stage_progress
+from wmr_mj.searches.design_search import DEFAULT_BUDGET, DEFAULT_SEED, DesignProblem, search_design, write_design
 from wmr_mj.sim.certify import certificate_name
 from wmr_mj.sim.coerce import coerce
-from wmr_mj.sim.compare import design_file_changes
-from wmr_mj.sim.design_search import DEFAULT_BUDGET, DEFAULT_SEED, DesignProblem, search_design, write_design
 from wmr_mj.sim.designs import CERTIFIED
 from wmr_mj.sim.parts import resolve_run
 from wmr_mj.sim.records import Record
-from wmr_mj.sim.sweep import SweepSpec, SweepSummary, read_runs, run_sweep
 
 __all__ = ["DESIGN_SENSING", "DESIGN_SEED", "DESIGN_BUDGET", "DESIGN_RUNS", "DesignOnCart", "CartDesign",
            "design_problem", "design_command", "cart_design_stage"]
@@ -142,7 +142,7 @@ class CartDesign(Record):
 
 def design_problem(settings: ValidateSettings, *, sensing: str = DESIGN_SENSING, seed: int = DESIGN_SEED,
                    budget: int = DESIGN_BUDGET) -> Any:
-    """The :class:`~wmr_mj.sim.design_search.DesignProblem` of the section: the certified design's run of these
+    """The :class:`~wmr_mj.searches.design_search.DesignProblem` of the section: the certified design's run of these
     settings (their box, path, duration and cart) on ``sensing``, searched as ``wmr-mj design`` searches
     (the 1 ms period, the E_max objective, CMA-ES)."""
     base = coerce(settings.config(CERTIFIED).replace(sensing=sensing))  # the sensing's spec typed

@@ -20,10 +20,10 @@ from typing import Any
 
 from wmr_mj._util.files import write_json_atomic, write_text_atomic
 from wmr_mj.analysis.verdicts import certified_outside_banner, format_unmet
+from wmr_mj.experiments.compare import CompareResult, DesignRow, runs_json
 from wmr_mj.figures.plots import save_figure
 from wmr_mj.figures.results import figure_compare
 from wmr_mj.hardware import Actuation, Sensing, Transmission, cart_line
-from wmr_mj.sim.compare import CompareResult, DesignRow, runs_json
 
 __all__ = ["table_rows", "markdown", "csv_text", "html_page", "write_report", "COLUMNS", "legend_lines",
            "banner_lines", "cart_text"]
@@ -161,7 +161,7 @@ def markdown(result: CompareResult) -> str:
 
 
 def csv_text(result: CompareResult) -> str:
-    """One CSV line per design with every figure of :class:`~wmr_mj.sim.compare.DesignRow` (full precision)."""
+    """One CSV line per design with every figure of :class:`~wmr_mj.experiments.compare.DesignRow` (full precision)."""
     rows = [r.to_dict() for r in result.rows]
     buf = io.StringIO()
     names = list(dict.fromkeys(k for r in rows for k in r))  # "cart" only where a design's cart is not ideal

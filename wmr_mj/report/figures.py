@@ -26,12 +26,12 @@ from typing import Any
 import numpy as np
 
 from wmr_mj._util.progress import Stages
+from wmr_mj.experiments.sweep import read_runs
 from wmr_mj.figures import plots
 from wmr_mj.report.paper_example import paper_example
 from wmr_mj.report.results import Rung
 from wmr_mj.report.settings import ValidateSettings
 from wmr_mj.sim.config import plant_parameters
-from wmr_mj.sim.sweep import read_runs
 
 __all__ = ["figures_stage", "travelled_paths"]
 

@@ -35,7 +35,7 @@ class Rung(Record):
     """One rung of validate's ladder (a sweep over m1 of one design), or the correction rung, or a design of
     the user's (``validate --design``): summary.json's ``ladder[k]``, ``correction_rung``, ``designs[k]``.
 
-    The counts and worst values are :meth:`wmr_mj.sim.sweep.SweepSummary.rung_dict`'s (sup|E| [rad],
+    The counts and worst values are :meth:`wmr_mj.experiments.sweep.SweepSummary.rung_dict`'s (sup|E| [rad],
     sup|E'| [rad/s], ratios [-], m1 [kg], cross-track [m]); then the design's place and words.
 
     Attributes:

@@ -1,7 +1,7 @@
 """Stage 4 of ``wmr-mj validate``: the worst-case search beside the Monte-Carlo worst and the certificate.
 
 Three searches (:func:`search_plans`), each falsify's default portfolio: the box's vertices, then
-CMA-ES on whole generations (:func:`wmr_mj.sim.falsify.search_worst`, every batch one ``mujoco.batch``;
+CMA-ES on whole generations (:func:`wmr_mj.searches.falsify.search_worst`, every batch one ``mujoco.batch``;
 differential evolution until the portfolio replaced it):
 
 - the paper's design over the m1 box, maximising sup|E|/E_max of the paper's claim (it has
@@ -40,6 +40,7 @@ from wmr_mj._util.checks import as_pair
 from wmr_mj._util.files import write_json_atomic, write_text_atomic
 from wmr_mj._util.progress import Stages
 from wmr_mj.analysis.verdicts import count_verdicts
+from wmr_mj.experiments.sweep import read_runs
 from wmr_mj.logs.writer import run_logged
 from wmr_mj.params import uncertainty_ranges
 from wmr_mj.report.settings import (
@@ -50,11 +51,10 @@ from wmr_mj.report.settings import (
     max_at,
     stage_progress,
 )
+from wmr_mj.searches.falsify import OBJECTIVE_LABELS, FalsifySpec, objective_value, search_worst
 from wmr_mj.sim.designs import CERTIFIED, LADDER, PAPER, Design
-from wmr_mj.sim.falsify import OBJECTIVE_LABELS, FalsifySpec, objective_value, search_worst
 from wmr_mj.sim.many_runs import run_configs
 from wmr_mj.sim.parts import resolve_run
-from wmr_mj.sim.sweep import read_runs
 
 __all__ = ["SearchPlan", "search_plans", "run_search", "search_stage"]
 
@@ -63,7 +63,7 @@ __all__ = ["SearchPlan", "search_plans", "run_search", "search_stage"]
 class SearchPlan:
     """One worst-case search of the report.
 
-    objective: of :data:`wmr_mj.sim.falsify.OBJECTIVES`; mc_rung / mc_column: the ladder rung
+    objective: of :data:`wmr_mj.searches.falsify.OBJECTIVES`; mc_rung / mc_column: the ladder rung
     (1-based) whose Monte-Carlo sweep is compared, and its runs.csv column holding the same
     objective (None: no Monte-Carlo sweep of this box).
     """

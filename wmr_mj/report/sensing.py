@@ -45,7 +45,7 @@ SETTLED_WINDOW_S = 5.0
 
 def voltage_activity(voltage: np.ndarray, control_period: float) -> tuple[float, float]:
     """RMS u [V] and the total variation of u per second [V/s] (sum |u[k+1] - u[k]| / duration), as
-    ``wmr-mj compare`` computes them (:func:`wmr_mj.sim.compare.run_scenario`).
+    ``wmr-mj compare`` computes them (:func:`wmr_mj.experiments.compare.run_scenario`).
 
     Args:
         voltage: the applied voltage at each control step [V], shape (n,).

@@ -17,18 +17,18 @@ from typing import Any
 from wmr_mj._util.checks import as_pair, integer_at_least, positive_number
 from wmr_mj._util.progress import Stages
 from wmr_mj.errors import ParameterError, UnknownNameError
-from wmr_mj.hardware.cart import CART_PARTS, cart_dict
-from wmr_mj.params import UNCERTAINTY_NAMES, uncertainty_ranges
-from wmr_mj.report.defaults import DEFAULT_DURATION, DEFAULT_N, DEFAULT_SEARCH_BUDGET, FULL_BOX_FACTOR
-from wmr_mj.sim.compare import FileDesign, design_token_changes, is_design_file
-from wmr_mj.sim.config import RunConfig, base_for, build_reference, cart_file
-from wmr_mj.sim.designs import DesignLike, design_changes, on_cart
-from wmr_mj.sim.falsify import cma_population
-from wmr_mj.sim.parts import resolve_run
-from wmr_mj.sim.sweep import (
+from wmr_mj.experiments.compare import FileDesign, design_token_changes, is_design_file
+from wmr_mj.experiments.sweep import (
     SAMPLINGS,
     max_at,  # noqa: F401  (re-exported: the report reads runs.csv with it)
 )
+from wmr_mj.hardware.cart import CART_PARTS, cart_dict
+from wmr_mj.params import UNCERTAINTY_NAMES, uncertainty_ranges
+from wmr_mj.report.defaults import DEFAULT_DURATION, DEFAULT_N, DEFAULT_SEARCH_BUDGET, FULL_BOX_FACTOR
+from wmr_mj.searches.falsify import cma_population
+from wmr_mj.sim.config import RunConfig, base_for, build_reference, cart_file
+from wmr_mj.sim.designs import DesignLike, design_changes, on_cart
+from wmr_mj.sim.parts import resolve_run
 
 __all__ = [
     "DEFAULT_N",
@@ -47,7 +47,7 @@ __all__ = [
 #: What a ladder rung may change, in groups of RunConfig fields: each rung changes exactly one.
 LADDER_GROUPS = {"controller": ("controller",), "model source": ("model",),
                  "compensation": ("friction_sign", "friction_width"), "gains": ("kp", "kd")}
-_MIN_POPULATION = 5  # the smallest generation (wmr_mj.sim.falsify.MIN_POPULATION)
+_MIN_POPULATION = 5  # the smallest generation (wmr_mj.searches.falsify.MIN_POPULATION)
 
 # --------------------------------------------------------------------------- settings
 @dataclass(frozen=True, kw_only=True)
@@ -148,7 +148,7 @@ class ValidateSettings:
     def config(self, design: DesignLike) -> RunConfig:
         """The run of ``design`` these settings sweep (m1 at nominal; the sweep draws it), on the cart: the
         certified design's gains derived on it (:func:`wmr_mj.sim.designs.on_cart`). A design file
-        (:class:`wmr_mj.sim.compare.FileDesign`) keeps its gains and the parts of its own cart, but where these
+        (:class:`wmr_mj.experiments.compare.FileDesign`) keeps its gains and the parts of its own cart, but where these
         settings give a part that is not ideal (validate's --sensing, --actuation, --backlash), as ``run --design
         FILE`` keeps the options given."""
         changes = design.config_changes()

@@ -49,6 +49,8 @@ from typing import Any
 from wmr_mj._util.checks import as_pair
 from wmr_mj._util.files import software_versions, write_json_atomic, write_text_atomic
 from wmr_mj._util.progress import Stages
+from wmr_mj.experiments.compare import FileDesign, is_design_file
+from wmr_mj.experiments.sweep import SweepSpec, SweepSummary, read_runs, run_sweep
 from wmr_mj.params import with_params
 from wmr_mj.plant.friction import measure_friction_law
 from wmr_mj.plant.identify import identify_plant
@@ -69,10 +71,8 @@ from wmr_mj.report.settings import (
 from wmr_mj.report.text import findings, render_html, render_markdown, summary_csv
 from wmr_mj.sim import designs
 from wmr_mj.sim.closed_loop import run_closed_loop, run_parts
-from wmr_mj.sim.compare import FileDesign, is_design_file
 from wmr_mj.sim.designs import CERTIFIED, CORRECTION_RUNG, LADDER, PAPER, Design, DesignLike, TokenDesign
 from wmr_mj.sim.parts import resolve_run
-from wmr_mj.sim.sweep import SweepSpec, SweepSummary, read_runs, run_sweep
 
 __all__ = [
     "ValidateSettings",  # defined in wmr_mj.report.settings, with the defaults; here beside run_validate
@@ -93,7 +93,7 @@ __all__ = [
 def summarise_rung(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
     """The numbers of one rung from its runs (rows of runs.csv, ``sweep.read_results``).
 
-    :meth:`wmr_mj.sim.sweep.SweepSummary.rung_dict` of the sweep's one aggregator: verdicts
+    :meth:`wmr_mj.experiments.sweep.SweepSummary.rung_dict` of the sweep's one aggregator: verdicts
     (a count for each of the four), passes, certified_outside, paper_inside (runs inside the
     paper's claim), the worst sup|E| [rad] (and its m1 [kg]), sup|E'| [rad/s], sup|E|/E_max of
     the certificate and of the paper's claim (and their m1), hit_stop (runs that reached the

@@ -80,7 +80,7 @@ def flat_row(summary: Mapping[str, Any]) -> dict[str, Any]:
 
 #: significant digits of a number in a CSV table (runs.csv, falsify's evaluations.csv): 0.009 where the float
 #: is 0.009000000000000001. Full precision is kept in the JSON (summary.json, a sweep's
-#: :data:`wmr_mj.sim.sweep.PRECISE_ROWS`).
+#: :data:`wmr_mj.experiments.sweep.PRECISE_ROWS`).
 CSV_SIGNIFICANT_DIGITS = 12
 
 

@@ -107,8 +107,8 @@ class UnmetAssumption(Record):
 
 @dataclasses.dataclass(frozen=True, kw_only=True)
 class BrokenRun(Record):
-    """The run that breaks the law's claim most: a sweep's (:attr:`wmr_mj.sim.sweep.SweepSummary.claim_broken`)
-    or a search's (:attr:`wmr_mj.sim.falsify.FalsifyResult.claim_broken`), one record for both.
+    """The run that breaks the law's claim most: a sweep's (:attr:`wmr_mj.experiments.sweep.SweepSummary.claim_broken`)
+    or a search's (:attr:`wmr_mj.searches.falsify.FalsifyResult.claim_broken`), one record for both.
 
     Attributes:
         run: a sweep's run index, or its place in its search phase (1-based); None where a sweep's row has none.

@@ -1,6 +1,6 @@
 """The design search's names and defaults, in a module of their own: ``wmr-mj design``'s parser reads them
 without importing the search (and scipy with it), so that ``wmr-mj --help`` stays light (tests/test_cli_help.py).
-:mod:`wmr_mj.sim.design_search` re-exports them."""
+:mod:`wmr_mj.searches.design_search` re-exports them."""
 
 from __future__ import annotations
 

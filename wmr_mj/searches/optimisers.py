@@ -21,7 +21,7 @@ The optimisers:
 - :class:`Chain`: optimisers one after the other, up to a budget.
 - :class:`Steps`: a strategy written as a generator that yields batches and receives their values
   (falsify's portfolio: the vertices, CMA-ES, a local CMA-ES, coordinate moves:
-  :mod:`wmr_mj.sim.search_methods`).
+  :mod:`wmr_mj.searches.search_methods`).
 
 scipy's optimisers call their objective; :class:`DifferentialEvolution` and :class:`NelderMead` run the
 library on a worker thread whose objective hands each call to :meth:`Optimiser.ask` and waits for
@@ -31,7 +31,7 @@ wrapped, not rewritten.
 Usage::
 
     import numpy as np
-    from wmr_mj.sim.optimisers import CMAES, drive
+    from wmr_mj.searches.optimisers import CMAES, drive
     box = np.array([[-1.0, 1.0], [0.0, 2.0]])
     opt = CMAES(mean=box.mean(axis=1), sigma=0.3, bounds=box, seed=0)
     trace = drive(opt, lambda x: np.sum(x**2, axis=1), budget=60)   # minimises

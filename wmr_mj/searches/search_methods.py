@@ -1,5 +1,5 @@
-"""falsify's search methods (:data:`METHODS`), each an ask/tell optimiser of :mod:`wmr_mj.sim.optimisers` that
-:func:`search_worst` drives with the one loop (:func:`wmr_mj.sim.optimisers.drive`), maximising.
+"""falsify's search methods (:data:`METHODS`), each an ask/tell optimiser of :mod:`wmr_mj.searches.optimisers` that
+:func:`search_worst` drives with the one loop (:func:`wmr_mj.searches.optimisers.drive`), maximising.
 
 - ``portfolio`` (the default): the box's vertices, then CMA-ES from the screened start (:func:`screened_start`)
   in one or two independent runs, then a local CMA-ES around the worst point found, from 200 runs ending in
@@ -9,13 +9,13 @@
   Nelder-Mead from the worst point found, restarted from the next-worst;
 - ``de``: scipy's differential evolution, a generation per batch.
 
-How each was chosen, and what each costs: :mod:`wmr_mj.sim.falsify`'s docstring and the benchmarks guide.
+How each was chosen, and what each costs: :mod:`wmr_mj.searches.falsify`'s docstring and the benchmarks guide.
 Every method is seeded: the same seed gives the same points, in the same order.
 
 Usage::
 
     import numpy as np
-    from wmr_mj.sim.search_methods import search_worst
+    from wmr_mj.searches.search_methods import search_worst
     box = np.array([[550.0, 750.0], [0.01, 0.03]])
     trace = search_worst(lambda p: -np.sum((p - box[:, 0]) ** 2, axis=1), box, budget=64, seed=0)
     trace.points[trace.best]   # the worst case found (the largest value)
@@ -30,8 +30,7 @@ from collections.abc import Callable, Generator
 import numpy as np
 
 from wmr_mj.errors import ParameterError, UnknownNameError
-from wmr_mj.sim.many_runs import latin_hypercube
-from wmr_mj.sim.optimisers import (
+from wmr_mj.searches.optimisers import (
     CMAES,
     DifferentialEvolution,
     NelderMead,
@@ -42,6 +41,7 @@ from wmr_mj.sim.optimisers import (
     Trace,
     drive,
 )
+from wmr_mj.sim.many_runs import latin_hypercube
 
 __all__ = [
     "METHODS",

@@ -68,13 +68,13 @@ Objectives (:data:`OBJECTIVES`), read from a run's summary by :func:`objective_v
 
 The box (``FalsifySpec.box``) ranges plant parameters and, where the base config has signals
 (:mod:`wmr_mj.sim.signals`), their parameters: ``disturbance.amplitude``, ``disturbance.t1``,
-``load0.m1``, ... (:mod:`wmr_mj.sim.search_space`). A ranged disturbance amplitude with no
+``load0.m1``, ... (:mod:`wmr_mj.searches.search_space`). A ranged disturbance amplitude with no
 declared ``d_max`` declares the box's largest |amplitude|, one certificate for the whole search.
 Runs with signals do not share a batch: they run one by one, ``nthread`` at a time.
 
 Usage::
 
-    from wmr_mj.sim.falsify import FalsifySpec, falsify
+    from wmr_mj.searches.falsify import FalsifySpec, falsify
     from wmr_mj.params import uncertainty_ranges
     from wmr_mj.sim.closed_loop import RunConfig
     box = uncertainty_ranges("full")  # the certificate covers the declared box: give the base the same ranges
@@ -103,8 +103,7 @@ from wmr_mj._util.checks import positive_range
 from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE, VERDICTS, unmet_assumptions
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import parameter_names, tie_motor_constant
-from wmr_mj.sim.config import RunConfig, config_from_dict
-from wmr_mj.sim.falsify_objectives import (
+from wmr_mj.searches.falsify_objectives import (
     OBJECTIVE_LABELS,
     OBJECTIVES,
     binding_term,
@@ -116,9 +115,7 @@ from wmr_mj.sim.falsify_objectives import (
     shares_the_base_certificate,
     verdict_of,
 )
-from wmr_mj.sim.many_runs import connect, flat_row, run_configs
-from wmr_mj.sim.records import BrokenRun, Record, UnmetAssumption
-from wmr_mj.sim.search_methods import (
+from wmr_mj.searches.search_methods import (
     METHOD_LABELS,
     METHODS,
     MIN_POPULATION,
@@ -137,7 +134,7 @@ from wmr_mj.sim.search_methods import (
     screened_start,
     search_worst,
 )
-from wmr_mj.sim.search_space import (
+from wmr_mj.searches.search_space import (
     check_hardware_range,
     config_for,
     hardware_axis,
@@ -146,6 +143,9 @@ from wmr_mj.sim.search_space import (
     path_axis,
     signal_axis,
 )
+from wmr_mj.sim.config import RunConfig, config_from_dict
+from wmr_mj.sim.many_runs import connect, flat_row, run_configs
+from wmr_mj.sim.records import BrokenRun, Record, UnmetAssumption
 
 __all__ = [
     "OBJECTIVES",
@@ -174,7 +174,7 @@ __all__ = [
     "falsify",
     "check_runnable",
     "worst_config",
-    # re-exported from wmr_mj.sim.falsify_objectives and wmr_mj.sim.search_methods, where they live
+    # re-exported from wmr_mj.searches.falsify_objectives and wmr_mj.searches.search_methods, where they live
     "MIN_POPULATION",
     "PORTFOLIO_COORDINATE_STEP",
     "check_budget",
@@ -290,14 +290,14 @@ class FalsifySpec:
 
     def recorded_values(self, point: Sequence[float]) -> dict[str, float]:
         """Each ranged parameter -> the value its run used (what the search's tables record): as proposed, but a
-        hardware axis rounded as the run has it (:func:`wmr_mj.sim.search_space.hardware_values`)."""
+        hardware axis rounded as the run has it (:func:`wmr_mj.searches.search_space.hardware_values`)."""
         out = tie_motor_constant({n: float(v) for n, v in zip(self.names, point)}, self.box)
         out.update(hardware_values(self.base, {n: v for n, v in out.items() if hardware_axis(n)}))
         return out
 
     def config(self, point: Sequence[float]) -> RunConfig:
         """The run at ``point`` (values in ``names`` order): m1, the plant overrides and the signals'
-        parameters set (:func:`wmr_mj.sim.search_space.config_for`); k_b as k_i where the box ranges both
+        parameters set (:func:`wmr_mj.searches.search_space.config_for`); k_b as k_i where the box ranges both
         (:func:`wmr_mj.params.tie_motor_constant`)."""
         tied = tie_motor_constant({n: float(v) for n, v in zip(self.names, point)}, self.box)
         return config_for(self.base, self.names, [tied[n] for n in self.names])
@@ -374,7 +374,7 @@ class Evaluation:
 @dataclass(frozen=True, kw_only=True)
 class BindingTerm(Record):
     """The largest part of delta1 of a run's certificate, the term that binds its E_max most
-    (:func:`wmr_mj.sim.falsify_objectives.binding_term`).
+    (:func:`wmr_mj.searches.falsify_objectives.binding_term`).
 
     Attributes:
         name: the term's name in the certificate's JSON (``friction_term``, ``gyro_term``, ``K_term``, ...).
@@ -746,7 +746,7 @@ class FalsifyResult:
 
 def __getattr__(name: str) -> Any:
     if name == "FalsifyReport":  # deprecated alias: keep one release (FalsifyResult is falsify's one result)
-        warnings.warn("wmr_mj.sim.falsify.FalsifyReport is deprecated: FalsifyResult is the search's one result "
+        warnings.warn("wmr_mj.searches.falsify.FalsifyReport is deprecated: FalsifyResult is the search's one result "
                       "(read it by attribute; to_dict(runs=False) is falsify --json's object)", DeprecationWarning,
                       stacklevel=2)
         return _FalsifyRecord

@@ -11,7 +11,7 @@ largest term of its delta1 (:func:`binding_term`), which falsify's worst run car
 
 Usage::
 
-    from wmr_mj.sim.falsify_objectives import objective_value
+    from wmr_mj.searches.falsify_objectives import objective_value
     objective_value({"sup_E": 0.05, "certificate": {"E_ratio": 0.4}}, "certificate")   # 0.4
 """
 
@@ -23,9 +23,9 @@ from typing import Any
 
 from controllers import SteeringController
 from wmr_mj.errors import ParameterError, UnknownNameError
+from wmr_mj.searches.search_space import hardware_axis, path_axis, signal_axis
 from wmr_mj.sim.coerce import coerced
 from wmr_mj.sim.config import RunConfig, estimate_of
-from wmr_mj.sim.search_space import hardware_axis, path_axis, signal_axis
 
 __all__ = ["OBJECTIVES", "OBJECTIVE_LABELS", "objective_value", "objective_source", "check_objective_applies",
            "check_objective_defined", "shares_the_base_certificate", "verdict_of", "certificate_E_max", "binding_term"]
@@ -104,8 +104,8 @@ def check_objective_defined(parts: Any, spec: Any) -> None:
     (:func:`shares_the_base_certificate`); ``run`` knows this before it steps, and so does falsify.
 
     Args:
-        parts: ``spec.base`` resolved (:func:`wmr_mj.sim.falsify.check_runnable`).
-        spec: the search (a :class:`wmr_mj.sim.falsify.FalsifySpec`): its objective, base and names.
+        parts: ``spec.base`` resolved (:func:`wmr_mj.searches.falsify.check_runnable`).
+        spec: the search (a :class:`wmr_mj.searches.falsify.FalsifySpec`): its objective, base and names.
 
     Raises:
         ParameterError: one line naming why there is no bound and what to search instead.

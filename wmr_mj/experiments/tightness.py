@@ -9,7 +9,7 @@ Usage::
 
     from wmr_mj.sim.config import RunConfig
     from wmr_mj.sim.designs import CERTIFIED
-    from wmr_mj.sim.tightness import cart_tightness
+    from wmr_mj.experiments.tightness import cart_tightness
     base = RunConfig(**CERTIFIED.config_changes(), sensing="magnetic-12bit-axis", path="lane-change")
     t = cart_tightness(base, budget=64)          # the m1 box by default: 128 runs
     t.E_max, t.worst_sup_E, t.tightness, t.verdicts
@@ -145,7 +145,7 @@ def cart_tightness(base: Any, *, box: Mapping[str, tuple[float, float]] | None =
         base: the run (:class:`wmr_mj.sim.config.RunConfig`): the law, the cart, the path, the duration.
         box: the ranges searched (None: m1 over the certificate's ``base.m1_range``, kg).
         budget: falsify's budget (as many runs again on its random sample).
-        seed: falsify's seed; method: its search (:data:`wmr_mj.sim.falsify.METHODS`).
+        seed: falsify's seed; method: its search (:data:`wmr_mj.searches.falsify.METHODS`).
         nthread: threads of the batch.
 
     Returns:
@@ -155,7 +155,7 @@ def cart_tightness(base: Any, *, box: Mapping[str, tuple[float, float]] | None =
     Raises:
         ParameterError: what falsify refuses (a budget below one population, a bad range or path).
     """
-    from wmr_mj.sim.falsify import FalsifySpec, check_runnable, falsify
+    from wmr_mj.searches.falsify import FalsifySpec, check_runnable, falsify
 
     base = coerced(base)  # a base given directly: its cart's m1 box read here
     if box is None:

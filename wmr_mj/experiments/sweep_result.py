@@ -1,8 +1,8 @@
 """A sweep as one typed result: its spec, every run's row and what they add up to, for a notebook.
 
-:func:`wmr_mj.sim.sweep.run_sweep` returns the runs' rows (runs.csv's columns, a list of mappings), as the
+:func:`wmr_mj.experiments.sweep.run_sweep` returns the runs' rows (runs.csv's columns, a list of mappings), as the
 CLI and validate read them; :func:`sweep` runs the same sweep and keeps the rows beside their
-:class:`~wmr_mj.sim.sweep.SweepSummary`, with a table (:meth:`SweepResult.to_pandas`), a figure
+:class:`~wmr_mj.experiments.sweep.SweepSummary`, with a table (:meth:`SweepResult.to_pandas`), a figure
 (:meth:`SweepResult.plot`) and a few lines for a notebook. It writes nothing that ``run_sweep`` does not.
 
 Usage::
@@ -21,10 +21,10 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from wmr_mj.experiments.sweep import SweepSpec, SweepSummary, run_sweep, spec_from_json, spec_to_json
 from wmr_mj.hardware import cart_dict
+from wmr_mj.searches.search_space import HARDWARE_AXES, parameter_units
 from wmr_mj.sim.run_report import add_controller_source
-from wmr_mj.sim.search_space import HARDWARE_AXES, parameter_units
-from wmr_mj.sim.sweep import SweepSpec, SweepSummary, run_sweep, spec_from_json, spec_to_json
 
 __all__ = ["SweepResult", "sweep"]
 
@@ -120,14 +120,14 @@ class SweepResult:
 
 def sweep(spec: SweepSpec, *, out_dir: str | os.PathLike | None = None, chunk: int = 128, nthread: int = 0,
           scheduler: str | None = None, progress: Callable[[float, int], None] | None = None) -> SweepResult:
-    """:func:`wmr_mj.sim.sweep.run_sweep` (the same runs, the same files with ``out_dir``), typed.
+    """:func:`wmr_mj.experiments.sweep.run_sweep` (the same runs, the same files with ``out_dir``), typed.
 
     Args:
         spec: the sweep.
-        out_dir, chunk, nthread, scheduler, progress: as :func:`~wmr_mj.sim.sweep.run_sweep`.
+        out_dir, chunk, nthread, scheduler, progress: as :func:`~wmr_mj.experiments.sweep.run_sweep`.
 
     Returns:
-        SweepResult: the rows and their :class:`~wmr_mj.sim.sweep.SweepSummary`.
+        SweepResult: the rows and their :class:`~wmr_mj.experiments.sweep.SweepSummary`.
     """
     rows = run_sweep(spec, out_dir=out_dir, chunk=chunk, nthread=nthread, scheduler=scheduler, progress=progress)
     summary = SweepSummary.of(rows, spec.requirements, names=spec.names)

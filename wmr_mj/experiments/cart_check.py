@@ -3,12 +3,12 @@ certify on it, can the design search certify it (:func:`cart_check`; the CLI pri
 
 The checks of the file itself (compile and step with random controls, identify the reduced model) are
 :mod:`wmr_mj.plant.cartcheck`'s; this module, above the run, adds the certified design's certificate on the cart
-(:mod:`wmr_mj.sim.designs`) and the design search's answer (:mod:`wmr_mj.sim.design_search`).
+(:mod:`wmr_mj.sim.designs`) and the design search's answer (:mod:`wmr_mj.searches.design_search`).
 
 Usage::
 
     from wmr_mj.carts import load_cart
-    from wmr_mj.sim.cart_check import cart_check
+    from wmr_mj.experiments.cart_check import cart_check
 
     check = cart_check(load_cart("c80"), seed=0)
     check.passed, check.answer, check.to_dict()["design"]["certified"]
@@ -25,10 +25,7 @@ from wmr_mj.errors import InfeasiblePathError, ParameterError, StiffReferenceErr
 from wmr_mj.hardware import Actuation, Sensing, Transmission
 from wmr_mj.params import parameters_of_cart
 from wmr_mj.plant.cartcheck import COEFFICIENT_UNITS, check_identification, step_with_random_controls
-from wmr_mj.sim import notebook
-from wmr_mj.sim.coerce import default_path
-from wmr_mj.sim.config import RunConfig, build_reference
-from wmr_mj.sim.design_search import (
+from wmr_mj.searches.design_search import (
     DEFAULT_BUDGET,
     DEFAULT_SEED,
     DesignProblem,
@@ -36,6 +33,9 @@ from wmr_mj.sim.design_search import (
     search_design,
     uncovered,
 )
+from wmr_mj.sim import notebook
+from wmr_mj.sim.coerce import default_path
+from wmr_mj.sim.config import RunConfig, build_reference
 from wmr_mj.sim.designs import certified_design
 from wmr_mj.sim.parts import resolve_run
 
@@ -216,7 +216,7 @@ def design_on_cart(cart: Any, *, seed: int | None = None, budget: int | None = N
         certified; where certified: E_max [rad], voltage_max [V], kp [1/s^2], kd [1/s], friction_width [rad/s];
         else binding (the assumption, or why no certificate covers the cart's sensing); budget, seed, evaluations,
         and the ``wmr-mj design`` command that runs the same search. seed, budget: None, design's defaults
-        (:data:`~wmr_mj.sim.design_search.DEFAULT_SEED`, :data:`~wmr_mj.sim.design_search.DEFAULT_BUDGET`).
+        (:data:`~wmr_mj.searches.design_search.DEFAULT_SEED`, :data:`~wmr_mj.searches.design_search.DEFAULT_BUDGET`).
     """
 
     seed = DEFAULT_SEED if seed is None else seed

@@ -12,14 +12,14 @@ the law compiled into MuJoCo's control callback); a run's row is :func:`wmr_mj.s
 Usage::
 
     from wmr_mj.sim.closed_loop import RunConfig
-    from wmr_mj.sim.sweep import SweepSpec, run_sweep
+    from wmr_mj.experiments.sweep import SweepSpec, run_sweep
     spec = SweepSpec(n=64, seed=1, sampling="lhs", base=RunConfig(model="nonholonomic", duration=20.0))
     results = run_sweep(spec)             # per-run rows (a summary's JSON, flat), in run order
 
 ``run_sweep(spec, out_dir=...)`` writes ``runs.csv`` after every chunk and
 resumes from it; ``scheduler="tcp://host:8786"`` runs the chunks on a Dask
 cluster with the same results. ``wmr_mj.sim.many_runs.run_configs`` runs any list of configs that
-differ in plant parameters only (what ``wmr_mj.sim.falsify`` evaluates).
+differ in plant parameters only (what ``wmr_mj.searches.falsify`` evaluates).
 """
 
 from __future__ import annotations
@@ -107,7 +107,7 @@ class SweepSpec:
         if self.m1 is not None and (isinstance(self.m1, bool) or not isinstance(self.m1, (int, float))
                                     or not (math.isfinite(self.m1) and self.m1 > 0)):
             raise ParameterError(f"m1 = {self.m1!r} is not accepted; a fixed m1 is a finite number of kg > 0")
-        from wmr_mj.sim.search_space import HARDWARE_AXES, check_hardware_range, hardware_axis
+        from wmr_mj.searches.search_space import HARDWARE_AXES, check_hardware_range, hardware_axis
 
         names = set(parameter_names()) - {"m1"}
         for name, (lo, hi) in self.ranges.items():
@@ -141,9 +141,9 @@ class SweepSpec:
 
     @property
     def hardware_names(self) -> tuple[str, ...]:
-        """The ranged axes of the cart (:data:`wmr_mj.sim.search_space.HARDWARE_AXES`), in order: drawn per run,
+        """The ranged axes of the cart (:data:`wmr_mj.searches.search_space.HARDWARE_AXES`), in order: drawn per run,
         never part of the certificate's plant box (each run's claim covers its own cart)."""
-        from wmr_mj.sim.search_space import hardware_axis
+        from wmr_mj.searches.search_space import hardware_axis
 
         return tuple(n for n in self.ranges if hardware_axis(n))
 
@@ -154,7 +154,7 @@ class SweepSpec:
     def config_at(self, values: Sequence[float]) -> RunConfig:
         """The run of one draw (``values`` in :attr:`names` order: m1 first): m1 and the plant parameters set,
         the cart's axes set in its parts (rounded to what a run can have)."""
-        from wmr_mj.sim.search_space import with_hardware
+        from wmr_mj.searches.search_space import with_hardware
 
         base = self.base_for_box()
         hardware = set(self.hardware_names)
@@ -167,8 +167,8 @@ class SweepSpec:
     def recorded_values(self, values: Sequence[float]) -> dict[str, float]:
         """Each ranged axis but m1 -> the value its run used (runs.csv's columns): a plant parameter as drawn
         (k_b as k_i where both are ranged: :func:`wmr_mj.params.tie_motor_constant`), a hardware axis as rounded
-        (:func:`wmr_mj.sim.search_space.hardware_values`)."""
-        from wmr_mj.sim.search_space import hardware_values
+        (:func:`wmr_mj.searches.search_space.hardware_values`)."""
+        from wmr_mj.searches.search_space import hardware_values
 
         out = tie_motor_constant({n: float(v) for n, v in zip(self.names[1:], values[1:])}, self.ranges)
         out.update(hardware_values(self.base, {n: out[n] for n in self.hardware_names}))

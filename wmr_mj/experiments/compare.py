@@ -14,8 +14,8 @@ Every design declares the suite's uncertainty box, so a claim covers the plants 
 
 Usage::
 
-    from wmr_mj.sim.compare import compare, design_from_token
-    from wmr_mj.sim.suite import load_suite
+    from wmr_mj.experiments.compare import compare, design_from_token
+    from wmr_mj.experiments.suite import load_suite
     suite = load_suite("standard-v1")
     designs = [design_from_token(t, suite) for t in ("paper", "certified", "sliding-mode")]
     result = compare(designs, suite, scenarios=["circle/*"], budget=32, seed=0)
@@ -39,6 +39,7 @@ import numpy as np
 
 from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE, count_unmet, unmet_assumptions
 from wmr_mj.errors import ParameterError
+from wmr_mj.experiments.suite import Scenario, Suite, load_suite, versions
 from wmr_mj.hardware import cart_dict
 from wmr_mj.params import uncertainty_ranges
 from wmr_mj.plant.mjcf import TIMESTEP
@@ -50,7 +51,6 @@ from wmr_mj.sim.config import (
     controller_source,
 )
 from wmr_mj.sim.records import Record, plain
-from wmr_mj.sim.suite import Scenario, Suite, load_suite, versions
 
 __all__ = ["Design", "design_from_token", "is_design_file", "design_file_changes", "design_token_changes",
            "FileDesign", "ScenarioRun", "DesignRow", "CompareResult", "compare",
@@ -120,7 +120,7 @@ def design_file_changes(path: str, *, cart: Any = None) -> dict[str, Any]:
             found on another cart where ``cart`` is None (one line naming the file).
     """
     from wmr_mj.hardware import Actuation, Sensing, Transmission
-    from wmr_mj.sim.design_search import design_file_settings, read_design
+    from wmr_mj.searches.design_search import design_file_settings, read_design
     from wmr_mj.sim.spec import LawChoice, law_fields
 
     try:
@@ -284,7 +284,7 @@ def adversary_cart_box(base: RunConfig, scenarios: Sequence[Any]) -> dict[str, t
 
     Args:
         base: the adversary's base run (the design's cart).
-        scenarios: the compared scenarios (:meth:`wmr_mj.sim.suite.Suite.select`).
+        scenarios: the compared scenarios (:meth:`wmr_mj.experiments.suite.Suite.select`).
     """
     box: dict[str, tuple[float, float]] = {}
     for axis, (part, key) in ADVERSARY_CART_AXES.items():
@@ -302,7 +302,7 @@ def adversary_spec(design: Design, suite: Suite, *, budget: int, seed: int, meth
     bounds and a disturbance pulse (start, amplitude within +-d_max), against the suite's requirement; and the
     cart's axes where a compared scenario (``scenarios``) declares a non-ideal cart (:func:`adversary_cart_box`)."""
     from wmr_mj.reference.knots import KnotSpace
-    from wmr_mj.sim.falsify import FalsifySpec
+    from wmr_mj.searches.falsify import FalsifySpec
 
     adv = suite.adversary
     width = adv.pulse_width
@@ -511,8 +511,8 @@ class _CompareRecord(Record):
 
 def __getattr__(name: str) -> Any:
     if name == "CompareReport":  # deprecated alias: keep one release (CompareResult is compare's one result)
-        warnings.warn("wmr_mj.sim.compare.CompareReport is deprecated: CompareResult is the comparison's one result "
-                      "(read it by attribute; to_dict(runs=False) is compare.json's object)", DeprecationWarning,
+        warnings.warn("wmr_mj.experiments.compare.CompareReport is deprecated: CompareResult is the comparison's one "
+                      "result (read it by attribute; to_dict(runs=False) is compare.json's object)", DeprecationWarning,
                       stacklevel=2)
         return _CompareRecord
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
@@ -525,7 +525,7 @@ def compare(designs: Sequence[Design], suite: Suite, *, scenarios: Sequence[str]
 
     Args:
         designs: from :func:`design_from_token`.
-        suite: the suite (:func:`wmr_mj.sim.suite.load_suite`).
+        suite: the suite (:func:`wmr_mj.experiments.suite.load_suite`).
         scenarios: shell-style patterns of scenario ids (none: all).
         budget: the adversary's simulations per design (and as many for its random sample); 0: no adversary.
         seed: the adversary's seed, the same for every design.
@@ -594,7 +594,7 @@ def compare(designs: Sequence[Design], suite: Suite, *, scenarios: Sequence[str]
         mine = [r for r in runs if r.design == d.label]
         adversary = claim = None
         if specs:
-            from wmr_mj.sim.falsify import check_runnable, falsify
+            from wmr_mj.searches.falsify import check_runnable, falsify
 
             parts = check_runnable(specs[i].base)  # the adversary's base run, resolved once: its claim is the row's
             claim = parts.claim
@@ -660,7 +660,7 @@ def _row(design: Design, runs: Sequence[ScenarioRun], adversary: Any, cert: Any)
 
 def _claim_broken(runs: Sequence[ScenarioRun], adversary: Any) -> dict[str, Any] | None:
     """DesignRow.claim_broken: of the certified-outside scenario runs and the adversary's
-    (:attr:`~wmr_mj.sim.falsify.FalsifyResult.claim_broken`), the one of the largest sup|E|/E_max
+    (:attr:`~wmr_mj.searches.falsify.FalsifyResult.claim_broken`), the one of the largest sup|E|/E_max
     (scenarios first among equals)."""
     found: list[dict[str, Any]] = []
     for r in runs:

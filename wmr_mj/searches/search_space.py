@@ -23,7 +23,7 @@ so a search over plants, signals, paths and the cart at once is a box over these
 --range disturbance.amplitude=-1.5:1.5 --path-knots 3``). The config of a point carries its signals with every
 parameter, so its ``to_dict()["signals"]`` is the ``--signals`` that reproduces the run::
 
-    from wmr_mj.sim.search_space import config_for
+    from wmr_mj.searches.search_space import config_for
     from wmr_mj.sim.signals import Signals, Disturbance
     template = Signals(disturbance=Disturbance("pulse", 1.0, t1=10.0, t2=11.0), d_max=1.0)
     cfg = config_for(base.replace(signals=template), ["m1", "disturbance.t1"], [700.0, 12.5])

@@ -34,7 +34,7 @@ exchange rate between radians and volts, and the slack is the issue's own (withi
 
 Usage::
 
-    from wmr_mj.sim.design_search import DesignProblem, search_design
+    from wmr_mj.searches.design_search import DesignProblem, search_design
     result = search_design(DesignProblem(base=config, paths=("paper-circle",), periods=(0.001,)))
     result.settings            # {'controller': 'computed-torque', 'kp': ..., 'kd': ..., ...}
     write_design(result, "design.json"); design_file_settings("design.json")
@@ -56,9 +56,9 @@ from wmr_mj.analysis.claim_types import Assumption
 from wmr_mj.errors import ParameterError
 from wmr_mj.hardware import Actuation, Sensing, Transmission
 from wmr_mj.plant.cart_data import identified_from
+from wmr_mj.searches.design_options import DEFAULT_BUDGET, DEFAULT_SEED, E_MAX_SLACK, LAWS, METHODS, OBJECTIVES
+from wmr_mj.searches.optimisers import CMAES, Chain, DifferentialEvolution, Optimiser, Points, drive
 from wmr_mj.sim.coerce import coerced
-from wmr_mj.sim.design_options import DEFAULT_BUDGET, DEFAULT_SEED, E_MAX_SLACK, LAWS, METHODS, OBJECTIVES
-from wmr_mj.sim.optimisers import CMAES, Chain, DifferentialEvolution, Optimiser, Points, drive
 from wmr_mj.sim.records import Record
 
 __all__ = ["DesignProblem", "DesignResult", "OBJECTIVES", "METHODS", "LAWS", "DEFAULT_SEED", "DEFAULT_BUDGET",
@@ -523,7 +523,7 @@ def search_design(problem: DesignProblem) -> DesignResult:
 
 def _optimiser(scorer: _Scorer, bounds: list[tuple[float, float]], problem: DesignProblem,
                start: list[float] | None = None) -> Optimiser:
-    """The optimiser of ``problem.method`` (:mod:`wmr_mj.sim.optimisers`), minimising the score.
+    """The optimiser of ``problem.method`` (:mod:`wmr_mj.searches.optimisers`), minimising the score.
 
     - ``cma``: CMA-ES (``cmaes``, falsify's optimiser: its own seeded generator, bounds kept by resampling),
       started at :data:`START_POINT`, which is scored first, or at the box's centre, with a step of 0.3 of the
@@ -548,7 +548,7 @@ def _optimiser(scorer: _Scorer, bounds: list[tuple[float, float]], problem: Desi
 def _search(scorer: _Scorer, bounds: list[tuple[float, float]], problem: DesignProblem,
             start: list[float] | None = None) -> tuple[float, Any]:
     """The best (score, point) of one period's search (:func:`_optimiser`, driven by the one loop
-    :func:`wmr_mj.sim.optimisers.drive`): differential evolution's own result; CMA-ES's first point of the
+    :func:`wmr_mj.searches.optimisers.drive`): differential evolution's own result; CMA-ES's first point of the
     smallest score."""
     optimiser = _optimiser(scorer, bounds, problem, start)
     budget = problem.budget if problem.method == "cma" else None

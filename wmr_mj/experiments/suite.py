@@ -9,7 +9,7 @@ suite's name and version with the wmr-mj and MuJoCo versions (:func:`versions`).
 
 Usage::
 
-    from wmr_mj.sim.suite import load_suite
+    from wmr_mj.experiments.suite import load_suite
     suite = load_suite("standard-v1")
     [s.id for s in suite.scenarios][:2]      # ['circle/nominal/none', 'circle/nominal/pulse']
     config = suite.scenarios[0].config(base)  # the RunConfig of that scenario for a design's base config
