@@ -46,6 +46,7 @@ from typing import Any, Protocol
 
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import PAPER_KD, PAPER_KP
+from wmr_mj.reference.route import path_name
 
 __all__ = [
     "Design",
@@ -187,8 +188,9 @@ def _certified_on(text: str, cart_path: str, path: str | None) -> Design:
     if w is None:
         raise ParameterError(f"cart file {cart_path!r}: the certified design's rule finds no omega_r in "
                              f"{OMEGA_R_GRID[0]:g}-{OMEGA_R_GRID[-1]:g} rad/s whose certificate is valid with "
-                             f"E_max <= {ERROR_SPEC:g} rad on this cart and path {_path_of(record, path)}; give the "
-                             "gains with --kp/--kd or --omega-r, or another --path")
+                             f"E_max <= {ERROR_SPEC:g} rad on this cart and path "
+                             f"{path_name(_path_of(record, path))}; give the gains with --kp/--kd or --omega-r, or "
+                             "another --path")
     return dataclasses.replace(CERTIFIED, kp=w * w / 4.0, kd=w)
 
 
