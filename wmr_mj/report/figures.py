@@ -25,13 +25,14 @@ from typing import Any
 import numpy as np
 
 from wmr_mj._util.progress import Stages
+from wmr_mj.analysis.verdicts import paper_region_name
 from wmr_mj.report.results import Rung
 from wmr_mj.report.settings import ValidateSettings
 
 __all__ = ["figures_stage", "travelled_paths"]
 
 
-def _rung_figure(rung: Rung, folder: Path):
+def _rung_figure(rung: Rung, folder: Path, claim: str):
     from wmr_mj.figures import plots
     from wmr_mj.sim.sweep import read_runs
 
@@ -40,7 +41,7 @@ def _rung_figure(rung: Rung, folder: Path):
     regions = [plots.Region(f"certificate: |E| <= {cert['E_max']:.3g} rad, |E'| <= {cert['Edot_max']:.3g} rad/s",
                             [tuple(v) for v in cert["vertices"]], gid=plots.CERTIFICATE_GID)] if cert["valid"] else []
     if paper["vertices"]:
-        regions.append(plots.Region(f"paper's claim: |E| <= {paper['E_max']:.3g} rad, |E'| <= "
+        regions.append(plots.Region(f"{claim.removeprefix('the ')}: |E| <= {paper['E_max']:.3g} rad, |E'| <= "
                                     f"{paper['Edot_max']:.3g} rad/s", [tuple(v) for v in paper["vertices"]],
                                     color=plots.PAPER_CLAIM_COLOR, filled=False, gid=plots.REGION_GID))
     note = None if cert["valid"] else "no certificate:\n" + _wrap(cert["reason"] or ", ".join(cert["unmet"]), 48)
@@ -55,7 +56,7 @@ def _wrap(text: str, width: int) -> str:
     return "\n".join(textwrap.wrap(text, width))
 
 
-def _history_figures(nominal: Mapping[str, Any]) -> dict[str, Any]:
+def _history_figures(nominal: Mapping[str, Any], claim: str) -> dict[str, Any]:
     from wmr_mj.figures import plots
     from wmr_mj.sim.config import plant_parameters
 
@@ -65,7 +66,7 @@ def _history_figures(nominal: Mapping[str, Any]) -> dict[str, Any]:
         if s.certificate is not None and s.certificate.certified:
             bounds, whose = (s.certificate.E_max, s.certificate.Edot_max), "certificate"
         else:
-            bounds, whose = (s.E_max, s.Edot_max), "paper's claim"
+            bounds, whose = (s.E_max, s.Edot_max), claim.removeprefix("the ")
         figs[f"history_{name}"] = plots.figure_time_history(
             run.rows, s, voltage_limit=plant_parameters(run.config).voltage_limit, bounds=bounds, bound_name=whose,
             title=f"{name} design on the MuJoCo plant, m1 = {s.m1:g} kg: {s.verdict}")
@@ -110,12 +111,14 @@ def figures_stage(settings: ValidateSettings, folder: Path, st: Stages, rungs: S
     from wmr_mj.report.paper_example import paper_example
 
     st.start("figures", "figures (PNG + SVG)")
+    claim = paper_region_name(settings.cart is None)  # the region (4.21)-(4.23): the paper's claim on its C80 only
     figs: dict[str, Any] = {"ladder": plots.figure_ladder(
         [f"{r.index}. {r.label}" for r in rungs], [r.verdicts for r in rungs],
-        [r.paper_inside for r in rungs], title=f"Verdicts per rung, {settings.n} runs over m1 each")}
+        [r.paper_inside for r in rungs], title=f"Verdicts per rung, {settings.n} runs over m1 each",
+        claim=claim.removeprefix("the "))}
     for rung in rungs:
-        figs[f"rung_{rung.index}_{rung.name}"] = _rung_figure(rung, folder)
-    figs.update(_history_figures(nominal))
+        figs[f"rung_{rung.index}_{rung.name}"] = _rung_figure(rung, folder, claim)
+    figs.update(_history_figures(nominal, claim))
     if searches:
         figs["search_history"] = _search_figure(searches, rungs)
     example = paper_example(duration=settings.duration, mujoco=False)
