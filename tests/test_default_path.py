@@ -116,3 +116,12 @@ def test_a_run_on_the_cart_names_the_derived_path_once(cart_file):
     named = _cli("run", "--cart", cart_file.name, "--path", "lane-change", "--no-log", "--duration", "2",
                  cwd=cart_file.parent)
     assert "default path:" not in named.stderr  # a path given: nothing to name
+
+
+def test_validate_names_a_derived_path_by_its_route_name(cart_file):
+    from wmr_mj.report.text import _path_words
+
+    path = default_path(load_cart(cart_file))
+    assert _path_words({"path": path}) == f"the path route '{LOOP_NAME}'"  # not its canonical JSON
+    assert _path_words({"path": "paper-circle"}) == "the paper circle"
+    assert _path_words({"path": "lane-change"}) == "the path lane-change"

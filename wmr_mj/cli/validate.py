@@ -115,10 +115,14 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     m1_range = _design_file_options(args)  # a design file: its cart, m1 box, path and sensing, unless given
     if args.path is None:  # the cart's own path (the paper circle on the C80)
-        from wmr_mj.sim.coerce import cart_file_of_record, default_path
+        from wmr_mj.sim.coerce import cart_file_of_record, default_path, default_path_note
         from wmr_mj.sim.config import RunConfig
 
-        args.path = default_path(cart_file_of_record(RunConfig.from_inputs(cart=getattr(args, "cart", None)).cart))
+        cart = cart_file_of_record(RunConfig.from_inputs(cart=getattr(args, "cart", None)).cart)
+        args.path = default_path(cart)
+        note = default_path_note(cart)  # a path derived from the cart's stops, named
+        if note is not None:
+            print(f"wmr-mj: note: {note}", file=sys.stderr)
     settings = ValidateSettings(n=args.n, seed=args.seed, sampling=args.sampling, duration=args.duration,
                                 identify_duration=args.identify_duration, search_budget=args.search_budget,
                                 nthread=args.nthread, uncertainty=args.uncertainty, path=args.path,

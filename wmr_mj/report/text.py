@@ -47,6 +47,7 @@ from wmr_mj.analysis.certificate import VERDICTS
 from wmr_mj.analysis.verdicts import WITHIN_THE_SUPPLY, paper_region_name
 from wmr_mj.params import COEFFICIENT_MODELS, COEFFICIENT_NAMES
 from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS
+from wmr_mj.reference.route import path_name
 from wmr_mj.report.results import Rung, ValidateSummary
 
 #: a summary as run_validate returns it, or its JSON read back (summary.json); each public function takes either
@@ -728,7 +729,7 @@ def answer_blocks(summary: Summary, *, brief: bool = False, with_banner: bool = 
 def _path_words(settings: Mapping[str, Any]) -> str:
     """The runs' path of C in words: 'the paper circle' (also for reports written before --path)."""
     path = settings.get("path", "paper-circle")
-    return "the paper circle" if path == "paper-circle" else f"the path {path}"
+    return "the paper circle" if path == "paper-circle" else f"the path {path_name(path)}"
 
 
 def _settings_line(summary: Summary) -> str:
