@@ -88,7 +88,7 @@ class CartCheck:
                 "identification": None if ident is None else ident.to_dict(),
                 "identification_error": self.identification_error,
                 "certified_design": dict(self.certified_design), "design": dict(self.design),
-                "path_note": self.path_note}
+                **({} if self.path_note is None else {"path_note": self.path_note})}  # only where the path is derived
 
 
 def cart_check(cart: Any, *, seed: int = 0, duration: float = 20.0, path: str | None = None) -> CartCheck:
