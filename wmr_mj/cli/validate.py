@@ -88,12 +88,19 @@ def _design_file_options(args: argparse.Namespace) -> tuple[float, float] | None
     files = [t.strip() for t in args.design or () if is_design_file(t) and "," not in t]
     if not files:
         return None
-    from wmr_mj.cli.run import with_design_file
+    from wmr_mj.cli.run import hardware_from_args, with_design_file
+    from wmr_mj.errors import ParameterError, WmrMjError
 
     read = argparse.Namespace(preset=None, design=files[0], cart=args.cart, omega_r=None, path=args.path,
                               m1_range=M1_RANGE, sensing=args.sensing, actuation=args.actuation,
                               backlash=args.backlash)
     with_design_file(read)
+    taken = {name: None if getattr(args, name) is not None else getattr(read, name)
+             for name in ("sensing", "actuation", "backlash")}  # the parts the file gives
+    try:  # refused naming the file, as a design token's parts are
+        hardware_from_args(argparse.Namespace(**taken))
+    except (WmrMjError, ValueError, TypeError) as exc:
+        raise ParameterError(f"design {files[0]!r}: its sensing, actuation or play is not accepted: {exc}") from None
     args.cart, args.path = read.cart, read.path
     args.sensing, args.actuation, args.backlash = read.sensing, read.actuation, read.backlash
     return None if read.m1_range is M1_RANGE else (float(read.m1_range[0]), float(read.m1_range[1]))
