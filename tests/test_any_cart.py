@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -148,9 +149,15 @@ def test_certified_is_the_rule_on_the_cart_and_the_c80s_gains_a_named_value():
     assert on_cart.kp == on_cart.kd ** 2 / 4.0  # the rule's gains: K_P = omega_r^2/4, K_D = omega_r
 
 
-def test_validate_on_the_cart_asks_of_its_box_and_path(folder):
-    proc = _cli("validate", "--cart", "anycart.toml", "--n", "2", "--duration", "10", "--identify-duration", "10",
+@pytest.fixture(scope="module")
+def validate(folder) -> subprocess.CompletedProcess:
+    """validate on the cart, small (2 runs, 10 s, a 5-run search), once for the tests of its output and its report."""
+    return _cli("validate", "--cart", "anycart.toml", "--n", "2", "--duration", "10", "--identify-duration", "10",
                 "--search-budget", "5", "--seed", "3", "--out", "report", cwd=folder)
+
+
+def test_validate_on_the_cart_asks_of_its_box_and_path(folder, validate):
+    proc = validate
     assert proc.returncode == 0, proc.stderr
     first = proc.stdout.splitlines()[0]
     assert first.startswith("Question: does the paper's robustness region hold for the cart anycart 1.0.0 under m1 in "
@@ -159,3 +166,50 @@ def test_validate_on_the_cart_asks_of_its_box_and_path(folder):
         assert word not in proc.stdout, word
     rule = certified_design(str(folder / "anycart.toml"))  # the rung's gains are the rule's on this cart
     assert f"K_P = {rule.kp:g}, K_D = {rule.kd:g}" in proc.stdout.splitlines()[3]
+
+
+def test_validate_report_has_no_c80_box_path_or_claim(folder, validate):
+    """The report (index.md, index.html, the figures' SVG text) names the region (4.21)-(4.23) as this cart's, never as
+    the paper's claim, which the paper makes for its C80 only; no C80 box, path or nominal mass (650 kg)."""
+    assert validate.returncode == 0, validate.stderr
+    report = folder / "report"
+    texts = {name: (report / name).read_text(encoding="utf-8") for name in ("index.md", "index.html")}
+    texts.update({str(svg.relative_to(report)): "\n".join(re.findall(r"<text[^>]*>([^<]*)", svg.read_text("utf-8")))
+                  for svg in sorted((report / "figures").glob("*.svg"))
+                  if not svg.stem.startswith("fig")})  # the figures' words (their text elements); Figs. 4-7 are the
+    # paper's, labelled so
+    assert len(texts) > 2  # the ladder's and the rungs' figures are there to be read
+    for name, text in texts.items():
+        text = text.replace("&#x27;", "'")
+        for word in (*C80_WORDS, "650 kg"):
+            assert word not in text, (name, word)
+    assert "inside the (4.21)-(4.23) region on this cart" in texts["index.md"]  # named, not left out
+
+
+def test_sweep_region_plot_labels_the_region_as_this_carts():
+    """sweep's region plot (region.png): on the cart the region (4.21)-(4.23) is this cart's; on the C80 the
+    paper's claim (the label is chosen, so a plot that always said one of them fails here)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from wmr_mj.cli.sweep import region_figure
+    from wmr_mj.experiments.sweep_result import sweep
+
+    labels = {}
+    for name, cart in (("cart", str(DATA / "anycart.toml")), ("C80", None)):
+        path = "paper-circle" if cart is None else str(DATA / "anycart-loop.toml")
+        result = sweep(SweepSpec(n=2, seed=0, base=RunConfig.from_inputs(cart=cart, path=path, duration=10.0)))
+        fig = region_figure(result)
+        labels[name] = fig.axes[0].get_legend_handles_labels()[1]
+    assert "(4.21)-(4.23) region on this cart" in labels["cart"]
+    assert not any("paper" in label for label in labels["cart"])
+    assert "paper's claim" in labels["C80"]
+
+
+def test_robustness_certificate_on_the_cart_names_the_region_as_this_carts(folder):
+    proc = _cli("robustness", "--certificate", "--cart", "anycart.toml", cwd=folder)
+    assert proc.returncode == 0, proc.stderr
+    assert "the (4.21)-(4.23) region on this cart" in proc.stdout
+    _no_c80(proc)
+    c80 = _cli("robustness", "--certificate", cwd=folder)
+    assert "the paper's claim" in c80.stdout  # the C80 keeps the paper's words

@@ -65,7 +65,8 @@ def test_controllers_first_then_wmr_mj_in_a_fresh_interpreter(first):
 
 
 def test_importing_wmr_mj_loads_no_simulation():
-    code = "import sys, wmr_mj; print(sorted(m for m in sys.modules if m.startswith(('wmr_mj.sim', 'wmr_mj.logs'))))"
+    layers = ("wmr_mj.sim", "wmr_mj.searches", "wmr_mj.experiments", "wmr_mj.logs")
+    code = f"import sys, wmr_mj; print(sorted(m for m in sys.modules if m.startswith({layers!r})))"
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.strip() == "[]"

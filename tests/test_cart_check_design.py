@@ -58,9 +58,11 @@ def test_cart_check_says_no_gains_certify_a_cart_on_a_3_v_supply(tmp_path, capsy
 
 
 def test_cart_check_answers_where_the_cart_cannot_follow_the_paper_circle(tmp_path, capsys):
-    """Stops at 0.5 rad: the paper circle needs 0.66 rad, so design refuses the cart in one line; cart check still
-    answers (no certified design, no gains, the path's reason), not a refusal. (A 1 V supply, this test's cart
-    before, is now refused as absurd: it cannot break the steering's 1.52 V of friction, tests/test_absurd_carts.py.)"""
+    """Stops at 0.5 rad: the paper circle needs 0.66 rad, so design refuses the cart on it in one line; cart check
+    still answers (no certified design, no gains, the path's reason), not a refusal. (A 1 V supply, this test's cart
+    before, is now refused as absurd: it cannot break the steering's 1.52 V of friction, tests/test_absurd_carts.py.)
+    The circle is asked for with --path: the cart's own default is a path its stops steer
+    (tests/test_default_path.py)."""
     import re
 
     from helpers import refused_line
@@ -70,10 +72,11 @@ def test_cart_check_answers_where_the_cart_cannot_follow_the_paper_circle(tmp_pa
     text, n = re.subn(r"(\[supply\.steering_range\]\nvalue = )[^\n]+", lambda m: m.group(1) + "0.5", text)
     assert n == 1
     mine.write_text(text, encoding="utf-8")
-    refusal = refused_line(capsys, ["design", "--cart", str(mine), "--out", str(tmp_path / "d.json")])
+    refusal = refused_line(capsys, ["design", "--cart", str(mine), "--path", "paper-circle",
+                                    "--out", str(tmp_path / "d.json")])
     reason = refusal.removeprefix("wmr-mj: error: ")
     assert reason.startswith("path infeasible at s = ") and "0.5 rad" in reason
-    assert main(["cart", "check", str(mine)]) == 0  # the cart itself passes its checks
+    assert main(["cart", "check", str(mine), "--path", "paper-circle"]) == 0  # the cart itself passes its checks
     lines = capsys.readouterr().out.splitlines()
     assert ": passes: " in lines[0]
     assert lines[1] == f"certified design: none on this cart ({reason})"

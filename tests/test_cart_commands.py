@@ -85,9 +85,11 @@ def test_a_cart_with_another_m1_box_changes_the_certificate_box(tmp_path):
 
 def test_a_carts_stops_refuse_a_path_that_needs_more_steering(tmp_path, capsys):
     """The paper circle needs asin(l1/R) = 0.659 rad; a cart with 0.6 rad stops refuses it in one line (exit 2),
-    the C80's 0.9 rad stops take it."""
+    the C80's 0.9 rad stops take it. (Asked for with --path: the cart's own default is a path its stops steer,
+    tests/test_default_path.py.)"""
     stops = _cart(tmp_path, ('[supply.steering_range]\nvalue = 0.9', '[supply.steering_range]\nvalue = 0.6'))
-    line = refused_line(capsys, ["run", "--cart", str(stops), "--duration", "10", "--no-log"])
+    line = refused_line(capsys, ["run", "--cart", str(stops), "--path", "paper-circle", "--duration", "10",
+                                 "--no-log"])
     assert line.startswith("wmr-mj: error: path infeasible") and "max_angle = 0.6 rad" in line
     assert main(["run", "--duration", "10", "--no-log", "--json"]) == 0
 

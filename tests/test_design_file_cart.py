@@ -4,7 +4,8 @@ Without it ``run --design FILE`` with no ``--cart`` ran a design found on anothe
 cart's gains: its certificate was then silently another cart's. The independent truth is the certificate the
 design file states (the search's, on the cart): ``run --design FILE`` alone must give it, to the bit. Where the
 cart file is no longer where it was with the same text, the run is refused in one line; compare and validate run
-every design on one cart and refuse a design found on another where no ``--cart`` is named. Budgets and durations
+every design on one cart: without ``--cart`` the CLI brings the design's (tests/test_design_travels.py), and the
+library's design_file_changes refuses a design found on another where it is given none. Budgets and durations
 are small (a few seconds each); the numbers compared are the same computation's, so they are compared exactly.
 """
 

@@ -228,6 +228,17 @@ def _num(x: Any, spec: str = ".5g") -> str:
 
 #: What every output says of the paper's region for a law outside the paper's family.
 PAPER_CLAIM_NOT_APPLICABLE = "not applicable (its region is for the paper's computed-torque law, not this one)"
+#: What outputs call the region (4.21)-(4.23) of the paper's analysis on a cart that is not the paper's C80: the
+#: paper claims it for its C80 only (:func:`paper_region_name`).
+PAPER_REGION_ON_CART = "the (4.21)-(4.23) region on this cart"
+
+
+def paper_region_name(on_c80: bool) -> str:
+    """The name of the region (4.21)-(4.23) in an output: "the paper's claim" on the paper's C80 (``on_c80``: the
+    run's cart record is None), else :data:`PAPER_REGION_ON_CART`, the paper's analysis on a cart it never claimed."""
+    return "the paper's claim" if on_c80 else PAPER_REGION_ON_CART
+
+
 def certified_outside_banner(where: str = "") -> str:
     """The one banner of a broken claim, as ``run`` prints it above its verdict and ``falsify``, ``sweep``
     and ``compare`` print it above the run that broke it.

@@ -66,12 +66,15 @@ def _design_line(d: dict[str, Any], wall: float) -> str:
 
 def _certified_line(c: dict[str, Any]) -> str:
     """The second line: the certified design's certificate on the cart."""
+    from wmr_mj.reference.route import path_name
+
     if c["omega_r"] is None:
         return f"certified design: none on this cart ({c['reason']})"
     head = (f"certified design on this cart: omega_r = {c['omega_r']:g} rad/s (K_P = {c['kp']:g}, K_D = {c['kd']:g}, "
             "the rule of wmr_mj/sim/designs.py run on the cart): ")
     numbers = (f"E_max = {c['E_max']:.4g} rad, |E'| <= {c['Edot_max']:.4g} rad/s, |u| <= {c['voltage_max']:.4g} V "
-               f"of the {c['voltage_limit']:g} V supply, on the cart's default sensing, path {c['path']}")
+               f"of the {c['voltage_limit']:g} V supply, on the cart's default sensing, path "
+               f"{path_name(c['path'])}")
     if c["certified"]:
         return head + f"CERTIFIED, all {len(c['met'])} assumptions met; " + numbers
     return head + f"NOT certified: {', '.join(c['unmet']) or 'no valid bound'} not met; " + numbers
@@ -83,6 +86,8 @@ def _print_text(check: Any) -> None:
 
     parts, steps, ident = check.defaults, check.steps, check.identification
     print(check.answer)
+    if check.path_note is not None:
+        print(check.path_note)
     print(_certified_line(check.certified_design))
     print(_design_line(check.design, check.design_wall_s))
     print(f"defaults: sensing {parts['sensing']}; actuation {parts['actuation']}; play {parts['backlash']}")

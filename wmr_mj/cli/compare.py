@@ -8,8 +8,9 @@ own parameters (``sliding-mode,k=5``). A law's name means what ``wmr-mj run --co
 law with its own defaults (``computed-torque`` and ``pd`` with the paper's model and gains, so
 ``computed-torque`` is the ``paper`` preset; ``sliding-mode`` and ``adaptive-computed-torque`` on the
 non-holonomic model); ``certified`` names the certified design. A DESIGN ending in ``.json`` is a design file
-(``wmr-mj design --out FILE.json``): its law, gains, period and cart, as ``wmr-mj run --design FILE`` reads
-them (a bad file: one line, exit status 2). Example::
+(``wmr-mj design --out FILE.json``): its law, gains, period, cart and m1 box, as ``wmr-mj run --design FILE``
+reads them (a bad file: one line, exit status 2); without ``--cart`` every design runs on the design's cart, and a
+``--cart`` other than the design's prints one note naming both. Example::
 
     wmr-mj compare paper certified certified,correction=true sliding-mode adaptive-computed-torque \\
         sliding-mode,tracker=pure-pursuit --scenarios 'circle/*' --budget 32
@@ -23,6 +24,7 @@ option the cart of every other run. An option overrides a design's own ``,sensin
 from __future__ import annotations
 
 import argparse
+from typing import Any
 
 from wmr_mj.cli.options import add_argument_with_help_of, add_json, add_out, add_seed, add_threads
 
@@ -80,6 +82,44 @@ def _cart_options(args: argparse.Namespace) -> dict:
     return out
 
 
+def design_files_found_on(args: argparse.Namespace) -> dict[str, dict[str, Any]]:
+    """What each design file among ``args.designs`` was found on, read as ``run --design FILE`` reads it
+    (:func:`wmr_mj.cli.run.with_design_file`): token -> {"m1_range": its m1 box (lo, hi) kg, "path": its path},
+    returned as :func:`wmr_mj.experiments.compare.design_from_token` takes them; and the cart, which becomes
+    ``args.cart`` where --cart is not given (compare runs every design on one cart). A --cart other than a design's
+    prints one note naming both, and that design then takes the cart's own m1 box.
+
+    Raises:
+        ParameterError: design files found on different carts and no --cart (one line naming them).
+    """
+    from wmr_mj.cli.run import with_design_file
+    from wmr_mj.errors import ParameterError
+    from wmr_mj.experiments.compare import is_design_file
+    from wmr_mj.params import M1_RANGE
+    from wmr_mj.sim.config import RunConfig
+
+    found: dict[str, dict[str, Any]] = {}
+    carts: dict[str, Any] = {}
+    for token in args.designs:
+        if not is_design_file(token) or "," in token:  # a file with settings is refused where it is read
+            continue
+        read = argparse.Namespace(preset=None, design=token.strip(), cart=args.cart, omega_r=None, path=None,
+                                  m1_range=M1_RANGE, sensing=None, actuation=None, backlash=None)
+        with_design_file(read)
+        carts[token] = read.cart
+        found[token] = {"path": read.path, "m1_range": None if read.m1_range is M1_RANGE
+                        else (float(read.m1_range[0]), float(read.m1_range[1]))}
+    if args.cart is None and carts:
+        records = {token: RunConfig.from_inputs(cart=cart).cart for token, cart in carts.items()}
+        texts = {None if r is None else r["text"] for r in records.values()}
+        if len(texts) > 1:
+            raise ParameterError("the design files were found on different carts ("
+                                 + ", ".join(f"{t}: {'C80' if r is None else r['name']}" for t, r in records.items())
+                                 + "); give --cart FILE to compare them on one cart")
+        args.cart = next(iter(carts.values()))
+    return found
+
+
 def run(args: argparse.Namespace) -> int:
     import time
     from pathlib import Path
@@ -96,8 +136,9 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError(f"--budget {args.budget} is not accepted: a number of runs >= 0")
     suite = load_suite(args.suite)
     chosen = suite.select(args.scenarios or [])  # an unknown scenario: one line, before any run
+    found_on = design_files_found_on(args)  # a design file's cart (where --cart is not given), m1 box and path
     cart = _cart_options(args)
-    designs = [design_from_token(t, suite, cart=cart) for t in args.designs]
+    designs = [design_from_token(t, suite, cart=cart, **found_on.get(t, {})) for t in args.designs]
     labels = [d.label for d in designs]
     if len(set(labels)) != len(labels):
         twice = sorted({x for x in labels if labels.count(x) > 1})

@@ -129,6 +129,9 @@ def run(args: argparse.Namespace) -> int:
     write_design(result, args.out)
     out = result.to_dict()  # the design file's content (design_dict), then what the command adds
     out.update(file=str(args.out), wall_s=wall, run=run_line(args))
+    note = _path_note(args, problem)
+    if note is not None:  # the default path derived from the cart's stops, named
+        out["path_note"] = note
     if result.certified and args.check > 0:
         out["check"] = check_design(problem, result, args.check)
     if args.json:
@@ -153,11 +156,22 @@ def check_design(problem: Any, result: Any, n: int) -> dict[str, Any]:
     return {"n": runs.n, "verdicts": dict(runs.verdicts), "path": base.path}
 
 
+def _path_note(args: argparse.Namespace, problem: Any) -> str | None:
+    """The line naming the default path derived from the cart's stops where no --path is given
+    (:func:`wmr_mj.sim.coerce.default_path_note`); None otherwise."""
+    from wmr_mj.sim.coerce import cart_file_of_record, default_path_note
+
+    return None if args.path else default_path_note(cart_file_of_record(problem.base.cart))
+
+
 def _print(result: Any, args: argparse.Namespace, out: dict[str, Any], wall: float) -> None:
+    from wmr_mj.reference.route import path_name
     from wmr_mj.sim.certify import certificate_name
 
     s = result.settings
-    paths = ", ".join(result.paths)
+    paths = ", ".join(path_name(p) for p in result.paths)
+    if "path_note" in out:
+        print(out["path_note"])
     if not result.certified:
         print(f"no gains in the box certify this cart: {result.binding} binds (the best point found, over "
               f"{paths}; {result.evaluations} certificates in {wall:.1f} s)")
@@ -175,11 +189,11 @@ def _print(result: Any, args: argparse.Namespace, out: dict[str, Any], wall: flo
           f"{wall:.1f} s): {law}, period {s['control_period'] * 1e3:g} ms"
           + (f", tau_f {tau * 1e3:.4g} ms" if tau is not None else ""))
     for path, cert in result.certificates.items():
-        print(f"  {path}: certified, E_max {cert.E_max:.6g} rad, voltage {cert.voltage_max:.4g} V "
+        print(f"  {path_name(path)}: certified, E_max {cert.E_max:.6g} rad, voltage {cert.voltage_max:.4g} V "
               f"({certificate_name(cert)}; {len(cert.assumptions)} assumptions met)")
     if "check" in out:
         c = out["check"]
-        print(f"check: {c['n']} runs over the box on {c['path']}: "
+        print(f"check: {c['n']} runs over the box on {path_name(c['path'])}: "
               + ", ".join(f"{v} {n}" for v, n in c["verdicts"].items()))
     if result.cart is not None:  # a cart identified from recordings: the data the design rests on
         from wmr_mj.plant.cart_data import identified_from_line

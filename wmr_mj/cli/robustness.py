@@ -375,7 +375,7 @@ def _small_gain_table(cert, config, paper) -> str:
     """The text report of section 4's certificate: its inputs, gammas, deltas and terms, and every assumption."""
     import dataclasses
 
-    from wmr_mj.analysis.verdicts import format_delta1_parts, format_measurement_cause
+    from wmr_mj.analysis.verdicts import format_delta1_parts, format_measurement_cause, paper_region_name
 
     inp = cert.inputs  # the run's record (controller, model, box rule) by key; section 4's inputs typed
     law = inp.law
@@ -411,7 +411,7 @@ def _small_gain_table(cert, config, paper) -> str:
         ("||E'|| max [rad/s]", fmt(cert.Edot_max)),
         ("alpha_max [rad]", fmt(cert.alpha_max)),
         ("voltage needed [V]", fmt(cert.voltage_max)),
-        ("the paper's claim", f"E_max {fmt(paper.E_max)} rad, Edot_max {fmt(paper.Edot_max)} rad/s, "
+        (paper_region_name(config.cart is None), f"E_max {fmt(paper.E_max)} rad, Edot_max {fmt(paper.Edot_max)} rad/s, "
                               f"(4.23) {fmt(paper.condition)} (wmr_mj.analysis.robustness, as the paper bounds it)"),
     ]
     cause = cert.terms.measurement_cause

@@ -165,6 +165,17 @@ def with_design_file(args: argparse.Namespace) -> argparse.Namespace:
     return args
 
 
+def default_path_note_of(args: argparse.Namespace, config: Any) -> str | None:
+    """The line naming the config's path where it is the default derived from the cart's stops (no --path given,
+    none from a design; :func:`wmr_mj.sim.coerce.default_path_note`); None otherwise."""
+    from wmr_mj.sim.coerce import cart_file_of_record, default_path, default_path_note
+
+    if getattr(args, "path", None) is not None:
+        return None
+    cart = cart_file_of_record(config.cart)
+    return default_path_note(cart) if config.path == default_path(cart) else None
+
+
 def _box_name(ranges: dict[str, tuple[float, float]], cart: Any) -> str | None:
     """The name of the cart's uncertainty box (--uncertainty NAME) whose ranges besides m1 are ``ranges`` (a design
     file's box_ranges); None where no box of the cart is that."""
@@ -451,9 +462,9 @@ def run(args: argparse.Namespace) -> int:
     if path is not None:
         factory = functools.partial(RunLogger, path, options=LogOptions(log_every=args.log_every, background=True))
     parts = resolve_run(config)  # the run's law, reference and claim, built once
-    note = no_estimate_note(parts)
-    if note:
-        print(f"wmr-mj: note: {note}", file=sys.stderr)
+    for note in (default_path_note_of(args, config), no_estimate_note(parts)):
+        if note:
+            print(f"wmr-mj: note: {note}", file=sys.stderr)
     with terminate_as_interrupt():
         result = run_parts(parts, logger_factory=factory, progress=args.progress)
     law_note = _law_note(result, config)

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -137,7 +136,7 @@ def run(args: argparse.Namespace) -> int:
     wall = time.perf_counter() - t0
     runs = result.summary  # the one aggregator of sweep and validate
     summary = result.report(wall_s=wall, folder=out)
-    plot_path = _plot(result.rows, runs, out / "region")
+    plot_path = _plot(result, out / "region")
     summary["plot"] = str(plot_path)
     if args.log:
         _log_runs(spec, result.rows, out / "mcap")
@@ -232,19 +231,33 @@ def claim_lines(runs: SweepSummary) -> list[str]:
     return lines
 
 
-def _plot(results: Sequence[Mapping[str, Any]], runs: SweepSummary, stem: Path) -> Path:
-    """Fig.-7-style plot ``<stem>.png``: the bounds a run is judged by (sup|E| <= E_max and
-    sup|E'| <= E'_max, the sweep's inside/outside) and every run's (sup|E|, sup|E'|)."""
+def _plot(result: Any, stem: Path) -> Path:
+    """:func:`region_figure` of the sweep's ``result`` written as ``<stem>.png``."""
+    from wmr_mj.figures.plots import save_figure
+
+    (path,) = save_figure(region_figure(result), stem, formats=("png",))
+    return path
+
+
+def region_figure(result: Any):
+    """Fig.-7-style plot of a sweep's ``result`` (:class:`wmr_mj.experiments.sweep_result.SweepResult`): the bounds a
+    run is judged by (sup|E| <= E_max and sup|E'| <= E'_max, the sweep's inside/outside) and every run's (sup|E|,
+    sup|E'|). The region (4.21)-(4.23) is labelled the paper's claim on the paper's C80 only
+    (:func:`wmr_mj.analysis.verdicts.paper_region_name`)."""
     import math
 
     from matplotlib.patches import Rectangle
 
-    from wmr_mj.figures.plots import new_figure, save_figure
+    from wmr_mj.analysis.verdicts import paper_region_name
+    from wmr_mj.figures.plots import new_figure
+    from wmr_mj.sim.coerce import coerced
 
+    results, runs = result.rows, result.summary
+    claim = paper_region_name(coerced(result.spec.base).cart is None)
     fig, ax = new_figure(5.0, 4.0)
     for (E_max, Ed_max), colour, label in (
             ((runs.certificate_E_max, runs.certificate_Edot_max), "C2", "certificate's bounds"),
-            ((runs.paper_E_max, runs.paper_Edot_max), "C0", "paper's claim")):
+            ((runs.paper_E_max, runs.paper_Edot_max), "C0", claim.removeprefix("the "))):
         if E_max is not None and Ed_max is not None and math.isfinite(E_max) and math.isfinite(Ed_max):
             ax.add_patch(Rectangle((0, 0), E_max, Ed_max, alpha=0.15, color=colour, label=label))
     sc = ax.scatter([r["sup_E"] for r in results], [r["sup_Edot"] for r in results], c=[r["m1"] for r in results],
@@ -253,5 +266,4 @@ def _plot(results: Sequence[Mapping[str, Any]], runs: SweepSummary, stem: Path) 
     ax.set_xlabel("sup |E| [rad]")
     ax.set_ylabel("sup |E'| [rad/s]")
     ax.legend(loc="best")  # the runs sit anywhere; keep the legend off them
-    (path,) = save_figure(fig, stem, formats=("png",))
-    return path
+    return fig

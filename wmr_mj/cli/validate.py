@@ -59,8 +59,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="a design of your own, judged beside the ladder (its rung and its nominal run): a preset, "
                         "a law's name, FILE.py:Class or module:Class, with ,key=value settings as for wmr-mj "
                         "compare, e.g. 'sliding-mode' or 'my_law.py:MyLaw,k=2', or a design file FILE.json "
-                        "(wmr-mj design --out: its gains and cart; validate's --sensing, --actuation, --backlash "
-                        "replace a part) (repeatable)")
+                        "(wmr-mj design --out: its gains; the first design file's cart, m1 box, path and sensing are "
+                        "every run's where --cart, --path, --sensing, --actuation, --backlash are not given, and a "
+                        "--cart other than the design's prints one note) (repeatable)")
     add_threads(p, help="simulation threads (default 0: all CPUs)")
     add_out(p, help="report folder (default logs/validate-<timestamp>/; an existing folder resumes its sweeps)")
     add_json(p, help="print the summary object (summary.json) on stdout")
@@ -74,6 +75,35 @@ def _sampling_help() -> str:
     from wmr_mj.experiments.sweep import SAMPLINGS
 
     return f"sampling of m1: one of {', '.join(SAMPLINGS)} (default lhs)"
+
+
+def _design_file_options(args: argparse.Namespace) -> tuple[float, float] | None:
+    """The first design file among --design, read as ``run --design FILE`` reads it
+    (:func:`wmr_mj.cli.run.with_design_file`): its cart, path, sensing, actuation and play fill --cart, --path,
+    --sensing, --actuation, --backlash where not given (in ``args``), and its m1 box is returned (None: no design
+    file, or a --cart other than the design's, which prints one note naming both and runs on that cart's box)."""
+    from wmr_mj.experiments.compare import is_design_file
+    from wmr_mj.params import M1_RANGE
+
+    files = [t.strip() for t in args.design or () if is_design_file(t) and "," not in t]
+    if not files:
+        return None
+    from wmr_mj.cli.run import hardware_from_args, with_design_file
+    from wmr_mj.errors import ParameterError, WmrMjError
+
+    read = argparse.Namespace(preset=None, design=files[0], cart=args.cart, omega_r=None, path=args.path,
+                              m1_range=M1_RANGE, sensing=args.sensing, actuation=args.actuation,
+                              backlash=args.backlash)
+    with_design_file(read)
+    taken = {name: None if getattr(args, name) is not None else getattr(read, name)
+             for name in ("sensing", "actuation", "backlash")}  # the parts the file gives
+    try:  # refused naming the file, as a design token's parts are
+        hardware_from_args(argparse.Namespace(**taken))
+    except (WmrMjError, ValueError, TypeError) as exc:
+        raise ParameterError(f"design {files[0]!r}: its sensing, actuation or play is not accepted: {exc}") from None
+    args.cart, args.path = read.cart, read.path
+    args.sensing, args.actuation, args.backlash = read.sensing, read.actuation, read.backlash
+    return None if read.m1_range is M1_RANGE else (float(read.m1_range[0]), float(read.m1_range[1]))
 
 
 def run(args: argparse.Namespace) -> int:
@@ -90,15 +120,21 @@ def run(args: argparse.Namespace) -> int:
     from wmr_mj.report.validate import ValidateSettings, run_validate, write_pointer
 
     t0 = time.perf_counter()
+    m1_range = _design_file_options(args)  # a design file: its cart, m1 box, path and sensing, unless given
     if args.path is None:  # the cart's own path (the paper circle on the C80)
-        from wmr_mj.sim.coerce import cart_file_of_record, default_path
+        from wmr_mj.sim.coerce import cart_file_of_record, default_path, default_path_note
         from wmr_mj.sim.config import RunConfig
 
-        args.path = default_path(cart_file_of_record(RunConfig.from_inputs(cart=getattr(args, "cart", None)).cart))
+        cart = cart_file_of_record(RunConfig.from_inputs(cart=getattr(args, "cart", None)).cart)
+        args.path = default_path(cart)
+        note = default_path_note(cart)  # a path derived from the cart's stops, named
+        if note is not None:
+            print(f"wmr-mj: note: {note}", file=sys.stderr)
     settings = ValidateSettings(n=args.n, seed=args.seed, sampling=args.sampling, duration=args.duration,
                                 identify_duration=args.identify_duration, search_budget=args.search_budget,
                                 nthread=args.nthread, uncertainty=args.uncertainty, path=args.path,
                                 designs=tuple(args.design or ()), cart=getattr(args, "cart", None),
+                                m1_range=m1_range,  # type: ignore[arg-type]  # None: the cart's box, as the field
                                 **hardware_from_args(args))
     out = check_output_path(args.out or default_folder("validate"), kind="dir", option="--out")
     summary = run_validate(settings, out)

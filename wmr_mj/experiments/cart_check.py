@@ -25,6 +25,7 @@ from wmr_mj.errors import InfeasiblePathError, ParameterError, StiffReferenceErr
 from wmr_mj.hardware import Actuation, Sensing, Transmission
 from wmr_mj.params import parameters_of_cart
 from wmr_mj.plant.cartcheck import COEFFICIENT_UNITS, check_identification, step_with_random_controls
+from wmr_mj.reference.route import path_name
 from wmr_mj.searches.design_search import (
     DEFAULT_BUDGET,
     DEFAULT_SEED,
@@ -34,7 +35,7 @@ from wmr_mj.searches.design_search import (
     uncovered,
 )
 from wmr_mj.sim import notebook
-from wmr_mj.sim.coerce import default_path
+from wmr_mj.sim.coerce import default_path, default_path_note
 from wmr_mj.sim.config import RunConfig, build_reference
 from wmr_mj.sim.designs import certified_design
 from wmr_mj.sim.parts import resolve_run
@@ -56,6 +57,8 @@ class CartCheck:
         certified_design: the certified design's certificate on the cart (:func:`certified_on_cart`).
         design: whether the design search certifies the cart (:func:`design_on_cart`).
         design_wall_s: the design search's wall time [s] (not in the JSON).
+        path_note: the line naming the default path derived from the cart's stops where it answers on it
+            (:func:`wmr_mj.sim.coerce.default_path_note`); None otherwise.
     """
 
     cart: Any
@@ -66,6 +69,7 @@ class CartCheck:
     certified_design: Mapping[str, Any]
     design: Mapping[str, Any]
     design_wall_s: float = 0.0
+    path_note: str | None = None
 
     @property
     def passed(self) -> bool:
@@ -84,7 +88,8 @@ class CartCheck:
                 "path": str(cart.path), "defaults": dict(self.defaults), "steps": self.steps.to_dict(),
                 "identification": None if ident is None else ident.to_dict(),
                 "identification_error": self.identification_error,
-                "certified_design": dict(self.certified_design), "design": dict(self.design)}
+                "certified_design": dict(self.certified_design), "design": dict(self.design),
+                **({} if self.path_note is None else {"path_note": self.path_note})}  # only where the path is derived
 
     # -- in a notebook (wmr_mj.sim.notebook): one row per coefficient, the coefficients' figure, a few lines
     def to_pandas(self) -> Any:
@@ -126,7 +131,7 @@ def cart_check(cart: Any, *, seed: int = 0, duration: float = 20.0, path: str | 
     """Check ``cart`` (a :class:`wmr_mj.carts.CartFile`): its default parts, the certified design's certificate
     on it, the design search, 1 s of random controls, and the identification over a ``duration`` s excitation,
     each seeded with ``seed``. ``path``: the path the certified design and the design search answer for (None: the
-    cart's own, ``[paths] default`` in its file, else paper-circle; named in the answer).
+    cart's own, :func:`wmr_mj.sim.coerce.default_path`; named in the answer).
 
     Raises:
         ParameterError: a default part that cannot be built, or a reference that cannot be built in bounded time
@@ -151,8 +156,9 @@ def cart_check(cart: Any, *, seed: int = 0, duration: float = 20.0, path: str | 
         ident = check_identification(params, duration=duration, seed=seed)
     except ParameterError as exc:  # too few sliding samples: the cart's answer, not the user's input
         ident_error = str(exc)
+    note = default_path_note(cart) if path == default_path(cart) else None
     return CartCheck(cart=cart, defaults=parts, steps=steps, identification=ident, identification_error=ident_error,
-                     certified_design=certified, design=design, design_wall_s=design_wall)
+                     certified_design=certified, design=design, design_wall_s=design_wall, path_note=note)
 
 
 def default_parts(cart: Any) -> dict[str, str]:
@@ -233,7 +239,8 @@ def design_on_cart(cart: Any, *, seed: int | None = None, budget: int | None = N
     try:
         result = search_design(DesignProblem(base=base, seed=seed, budget=budget, paths=(path,)))
     except InfeasiblePathError as exc:  # the cart cannot follow the path: no gains certify it
-        return {**out, "certified": False, "evaluations": 0, "binding": f"the path {path}'s feasibility ({exc})"}
+        return {**out, "certified": False, "evaluations": 0,
+                "binding": f"the path {path_name(path)}'s feasibility ({exc})"}
     out.update(certified=result.certified, evaluations=result.evaluations)
     if not result.certified:
         return {**out, "binding": result.binding}

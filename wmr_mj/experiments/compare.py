@@ -65,7 +65,8 @@ class Design:
     config: RunConfig
 
 
-def design_from_token(token: str, suite: Suite, *, cart: Mapping[str, Any] | None = None) -> Design:
+def design_from_token(token: str, suite: Suite, *, cart: Mapping[str, Any] | None = None,
+                      m1_range: tuple[float, float] | None = None, path: str | None = None) -> Design:
     """A design from ``NAME[,key=value...]`` (:func:`wmr_mj.sim.designs.design_changes`) or a design file
     ``FILE.json`` (:func:`design_file_changes`), declaring the suite's uncertainty box and running the suite's
     duration.
@@ -77,6 +78,10 @@ def design_from_token(token: str, suite: Suite, *, cart: Mapping[str, Any] | Non
             each overrides the token's own setting of it): its runs and its adversary's run on that cart,
             but for a scenario that names its own; and ``cart`` (``compare --cart``): the cart file, whose box
             the design declares and on which the certified design's gains are derived.
+        m1_range: the m1 box [kg] the design declares (a design file's own, ``wmr-mj compare``); None: the box of
+            the suite's uncertainty on the cart.
+        path: the design's own path (a design file's, ``wmr-mj compare``; each scenario runs its own); None: the
+            cart's own (:func:`wmr_mj.sim.coerce.default_path`, the paper circle on the C80).
 
     Raises:
         UnknownNameError, ParameterError: an unknown preset or law, a bad setting (one line each).
@@ -87,8 +92,10 @@ def design_from_token(token: str, suite: Suite, *, cart: Mapping[str, Any] | Non
         from wmr_mj.sim.config import cart_file
 
         box = dict(cart_file(RunConfig(cart=on)).uncertainty.get(suite.adversary.uncertainty, box))
-    m1_range = box.pop("m1")
+    suite_m1 = box.pop("m1")
+    m1_range = suite_m1 if m1_range is None else (float(m1_range[0]), float(m1_range[1]))
     changes = {**design_token_changes(token, cart=on), **(cart or {})}
+    changes.setdefault("path", path)  # None: the cart's own
     config = RunConfig.from_inputs(**changes, m1_range=m1_range, box_ranges=box, duration=suite.duration)
     from wmr_mj.sim.parts import resolve_run
 

@@ -691,9 +691,9 @@ def figure_verdict_plane(sup_E: Sequence[float], sup_Edot: Sequence[float], verd
 
 
 def figure_ladder(labels: Sequence[str], counts: Sequence[Mapping[str, int]], paper_inside: Sequence[int | None], *,
-                  title: str | None = None) -> Figure:
+                  title: str | None = None, claim: str = "paper's claim") -> Figure:
     """Verdict counts per rung as stacked horizontal bars (first rung on top), each with its
-    count, and the runs inside the paper's claim beside each bar."""
+    count, and the runs inside the paper's claim (``claim``: its name, the paper's on the C80 only) beside each bar."""
     fig, ax = new_figure(7.0, 0.55 * len(labels) + 1.6)
     y = np.arange(len(labels))[::-1]
     n = [sum(c.values()) for c in counts]
@@ -711,7 +711,7 @@ def figure_ladder(labels: Sequence[str], counts: Sequence[Mapping[str, int]], pa
     for yi, k, total in zip(y, paper_inside, n):
         if k is None:  # a law outside the paper's family: its region says nothing of the rung
             continue
-        ax.text(1.01 * max(n), yi, f"paper's claim: {k}/{total} inside", va="center", fontsize=7, color="#a04000")
+        ax.text(1.01 * max(n), yi, f"{claim}: {k}/{total} inside", va="center", fontsize=7, color="#a04000")
     ax.set_yticks(y, labels)
     ax.set_xlim(0.0, 1.45 * max(n))
     ax.set_xlabel("runs")

@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from wmr_mj.analysis.verdicts import paper_region_name
 from wmr_mj.figures import plots
 
 __all__ = ["ResultPlot", "plot_run", "plot_sweep", "plot_falsify", "plot_compare", "plot_validate", "figure_compare",
@@ -187,8 +188,9 @@ def figure_compare(result: Any) -> Any:
 def plot_validate(summary: Any) -> ResultPlot:
     """The validation (``ValidateSummary``): the verdicts of each rung of the ladder (and the user's designs)."""
     rungs = summary.rungs
+    claim = paper_region_name(not summary.settings.get("cart"))  # the paper's claim on its C80 only
     return _plot(plots.figure_ladder([f"{r.index}. {r.label}" for r in rungs], [r.verdicts for r in rungs],
-                                     [r.paper_inside for r in rungs]))
+                                     [r.paper_inside for r in rungs], claim=claim.removeprefix("the ")))
 
 
 def _bound(cert: Any, name: str) -> float:

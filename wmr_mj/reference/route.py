@@ -67,11 +67,11 @@ import numpy as np
 from wmr_mj._util.resources import DATA_DIR
 from wmr_mj.errors import InfeasiblePathError, ParameterError, UnknownNameError
 from wmr_mj.params import C80Parameters
-from wmr_mj.reference.paths import Path, Reference, Segment, SegmentKind, _s5_int, make_reference
+from wmr_mj.reference.paths import Path, Reference, Segment, SegmentKind, _s5_int, make_reference, paper_circle
 
 __all__ = ["Route", "ROUTES_DIR", "route_names", "load_route", "parse_route", "route_from_path",
            "is_route_spec", "route_reference", "RouteProgress", "route_progress",
-           "route_length", "route_of", "route_spec_of"]
+           "route_length", "route_of", "route_spec_of", "turns_loop", "path_name"]
 
 #: Routes shipped with the package, selectable by name (the file's stem).
 ROUTES_DIR = DATA_DIR / "routes"
@@ -430,6 +430,34 @@ def route_from_path(path: Path, *, name: str = "path", closed: bool = False) -> 
                         "path": [{f.name: getattr(s, f.name) for f in fields(Segment)} for s in path.segments]})
 
 
+#: the straight before and after each half-turn of :func:`turns_loop` [m]: the paper circle's lead-in
+TURNS_LOOP_STRAIGHT_M = 0.4
+
+
+def turns_loop(params: C80Parameters, radius: float, *, name: str) -> Route:
+    """A closed route of two half-turns of ``radius`` m (left), each entered and left through the paper circle's
+    steering ramp (:func:`~wmr_mj.reference.paths.paper_circle`'s entry, matched to params.l1, so the steering
+    rises from 0 to asin(l1/R) and back along a septic smoothstep), joined by straights of 2 x
+    :data:`TURNS_LOOP_STRAIGHT_M`. It starts mid-way along a straight with the steering at 0, as the plant does;
+    the two halves are the same segments, the second turned by pi, so the loop closes exactly.
+
+    Raises:
+        ParameterError: a radius at or below the wheelbase, or ramps that alone turn C by pi or more (one line).
+    """
+    entry = paper_circle(params, radius=radius).segments[1]  # line, ramp, arc: the ramp into the circle
+    ramp_in = entry
+    ramp_out = Segment("ramp", entry.length, entry.end_curvature, 0.0, wheelbase=entry.wheelbase)
+    turn = math.pi - ramp_in.heading_change - ramp_out.heading_change
+    if turn <= 0.0:
+        raise ParameterError(f"a loop of {radius:.4g} m half-turns: its steering ramps alone turn C by "
+                             f"{math.pi - turn:.4g} rad >= pi")
+    straight = Segment("line", TURNS_LOOP_STRAIGHT_M, 0.0, 0.0)
+    arc = Segment("arc", radius * turn, entry.end_curvature, entry.end_curvature)
+    half = (straight, ramp_in, arc, ramp_out, straight)
+    return parse_route({"route": {"name": name, "closed": True},
+                        "path": [{f.name: getattr(s, f.name) for f in fields(Segment)} for s in half + half]})
+
+
 def load_route(spec: str | os.PathLike) -> Route:
     """A route from a packaged name (:func:`route_names`), canonical JSON text, or a .toml/.json file."""
     text_spec = os.fspath(spec)
@@ -561,6 +589,17 @@ def route_progress(spec: str, reference: Any, duration: float) -> RouteProgress 
     the duration)."""
     length_m = route_length(spec)
     return None if length_m is None else RouteProgress.along(length_m, reference, duration)
+
+
+def path_name(spec: str) -> str:
+    """The path ``spec`` as outputs print it: a route given as canonical JSON by its name (``route 'NAME'``), any
+    other path (a name, a route file) as given."""
+    if not isinstance(spec, str) or not spec.lstrip().startswith("{"):
+        return str(spec)
+    try:
+        return f"route {load_route(spec).name!r}"
+    except ParameterError:
+        return "a route given as JSON"
 
 
 def route_length(spec: str) -> float | None:

@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from wmr_mj._util.progress import Stages
+from wmr_mj.analysis.verdicts import paper_region_name
 from wmr_mj.experiments.sweep import read_runs
 from wmr_mj.figures import plots
 from wmr_mj.report.paper_example import paper_example
@@ -36,13 +37,13 @@ from wmr_mj.sim.config import plant_parameters
 __all__ = ["figures_stage", "travelled_paths"]
 
 
-def _rung_figure(rung: Rung, folder: Path):
+def _rung_figure(rung: Rung, folder: Path, claim: str):
     rows = read_runs((folder / rung.runs_csv).parent)
     cert, paper = rung.certificate, rung.paper_region
     regions = [plots.Region(f"certificate: |E| <= {cert['E_max']:.3g} rad, |E'| <= {cert['Edot_max']:.3g} rad/s",
                             [tuple(v) for v in cert["vertices"]], gid=plots.CERTIFICATE_GID)] if cert["valid"] else []
     if paper["vertices"]:
-        regions.append(plots.Region(f"paper's claim: |E| <= {paper['E_max']:.3g} rad, |E'| <= "
+        regions.append(plots.Region(f"{claim.removeprefix('the ')}: |E| <= {paper['E_max']:.3g} rad, |E'| <= "
                                     f"{paper['Edot_max']:.3g} rad/s", [tuple(v) for v in paper["vertices"]],
                                     color=plots.PAPER_CLAIM_COLOR, filled=False, gid=plots.REGION_GID))
     note = None if cert["valid"] else "no certificate:\n" + _wrap(cert["reason"] or ", ".join(cert["unmet"]), 48)
@@ -55,14 +56,14 @@ def _wrap(text: str, width: int) -> str:
     return "\n".join(textwrap.wrap(text, width))
 
 
-def _history_figures(nominal: Mapping[str, Any]) -> dict[str, Any]:
+def _history_figures(nominal: Mapping[str, Any], claim: str) -> dict[str, Any]:
     figs = {}
     for name, run in nominal.items():
         s = run.summary
         if s.certificate is not None and s.certificate.certified:
             bounds, whose = (s.certificate.E_max, s.certificate.Edot_max), "certificate"
         else:
-            bounds, whose = (s.E_max, s.Edot_max), "paper's claim"
+            bounds, whose = (s.E_max, s.Edot_max), claim.removeprefix("the ")
         figs[f"history_{name}"] = plots.figure_time_history(
             run.rows, s, voltage_limit=plant_parameters(run.config).voltage_limit, bounds=bounds, bound_name=whose,
             title=f"{name} design on the MuJoCo plant, m1 = {s.m1:g} kg: {s.verdict}")
@@ -102,12 +103,14 @@ def figures_stage(settings: ValidateSettings, folder: Path, st: Stages, rungs: S
                   ) -> tuple[dict[str, list[str]], dict[str, Any]]:
     """Write every figure (PNG + SVG) into figures/: ({stem: [relative paths]}, Fig. 7's numbers)."""
     st.start("figures", "figures (PNG + SVG)")
+    claim = paper_region_name(settings.cart is None)  # the region (4.21)-(4.23): the paper's claim on its C80 only
     figs: dict[str, Any] = {"ladder": plots.figure_ladder(
         [f"{r.index}. {r.label}" for r in rungs], [r.verdicts for r in rungs],
-        [r.paper_inside for r in rungs], title=f"Verdicts per rung, {settings.n} runs over m1 each")}
+        [r.paper_inside for r in rungs], title=f"Verdicts per rung, {settings.n} runs over m1 each",
+        claim=claim.removeprefix("the "))}
     for rung in rungs:
-        figs[f"rung_{rung.index}_{rung.name}"] = _rung_figure(rung, folder)
-    figs.update(_history_figures(nominal))
+        figs[f"rung_{rung.index}_{rung.name}"] = _rung_figure(rung, folder, claim)
+    figs.update(_history_figures(nominal, claim))
     if searches:
         figs["search_history"] = _search_figure(searches, rungs)
     example = paper_example(duration=settings.duration, mujoco=False)

@@ -39,7 +39,7 @@ import numpy as np
 from wmr_mj._util.checks import as_pair
 from wmr_mj._util.files import write_json_atomic, write_text_atomic
 from wmr_mj._util.progress import Stages
-from wmr_mj.analysis.verdicts import count_verdicts
+from wmr_mj.analysis.verdicts import count_verdicts, paper_region_name
 from wmr_mj.experiments.sweep import read_runs
 from wmr_mj.logs.writer import run_logged
 from wmr_mj.params import uncertainty_ranges
@@ -86,7 +86,8 @@ def search_plans(settings: ValidateSettings) -> tuple[SearchPlan, ...]:
         return ()
     box = settings.uncertainty  # the box the ladder sampled: the Monte-Carlo worst to compare with
     return (
-        SearchPlan(key="paper", title=f"the paper's design against the paper's claim, {box} box", design=PAPER,
+        SearchPlan(key="paper", title=f"the paper's design against {paper_region_name(settings.cart is None)}, "
+                                      f"{box} box", design=PAPER,
                    box=box, objective="paper", budget=b, mc_rung=1, mc_column="E_ratio"),
         SearchPlan(key="certified", title=f"the certified design against its certificate, {box} box",
                    design=CERTIFIED, box=box, objective="certificate", budget=b, mc_rung=len(LADDER),

@@ -118,7 +118,7 @@ class ValidateSettings:
         for token in self.designs:  # an unknown law, a missing file, a bad setting: refused before any run
             # built once: a parameter the law does not take, a claim() that raises or returns no Certificate
             changes = design_token_changes(token, cart=self.cart) if is_design_file(token) else design_changes(token)
-            resolve_run(RunConfig.from_inputs(**changes, cart=self.cart))
+            resolve_run(RunConfig.from_inputs(**{"path": self.path, **changes}, cart=self.cart))  # the runs' path
         if 0 < self.search_budget < self.min_search_budget:
             raise ParameterError(f"search_budget = {self.search_budget} is below one generation of CMA-ES (the "
                                  f"searches' portfolio); give 0 (no search) or an integer >= {self.min_search_budget}")

@@ -45,11 +45,12 @@ from pathlib import PurePath
 from typing import Any
 
 from wmr_mj.analysis.certificate import VERDICTS
-from wmr_mj.analysis.verdicts import WITHIN_THE_SUPPLY, format_unmet
+from wmr_mj.analysis.verdicts import WITHIN_THE_SUPPLY, format_unmet, paper_region_name
 from wmr_mj.hardware import Actuation, Sensing, Transmission
 from wmr_mj.params import COEFFICIENT_MODELS, COEFFICIENT_NAMES
 from wmr_mj.plant.cart_data import identified_from
 from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS
+from wmr_mj.reference.route import path_name
 from wmr_mj.report.results import Rung, ValidateSummary
 
 #: a summary as run_validate returns it, or its JSON read back (summary.json); each public function takes either
@@ -210,11 +211,24 @@ def verdict_lines(summary: Summary) -> list[str]:
 
 
 # --------------------------------------------------------------------------- (a) the paper's design
+def _claim(summary: ValidateSummary) -> str:
+    """The region (4.21)-(4.23)'s name in the report: the paper's claim on the C80 only
+    (:func:`wmr_mj.analysis.verdicts.paper_region_name`)."""
+    return paper_region_name(not summary.settings.get("cart"))
+
+
+def _claim_4_21(summary: ValidateSummary) -> str:
+    """:func:`_claim` with its equations named once."""
+    claim = _claim(summary)
+    return claim if "(4.21)-(4.23)" in claim else f"{claim} (4.21)-(4.23)"
+
+
 def paper_design_lines(summary: Summary) -> list[str]:
     rung = ValidateSummary.of(summary).ladder[0]
     n, pr, cert = rung.n, rung.paper_region, rung.certificate
     lines = [f"Design: {rung.design}, {n} runs over m1 {rung.m1_min:.0f}-{rung.m1_max:.0f} kg.",
-             f"Against the paper's claim (|E| <= {_fmt(pr['E_max'])} rad, |E'| <= {_fmt(pr['Edot_max'])} rad/s, "
+             f"Against {_claim(ValidateSummary.of(summary))} (|E| <= {_fmt(pr['E_max'])} rad, |E'| <= "
+             f"{_fmt(pr['Edot_max'])} rad/s, "
              f"(4.23) = {_fmt(pr['condition'], '.4g')}): {rung.paper_inside}/{n} runs inside; worst sup|E|/E_max "
              f"= {_fmt(rung.worst_paper_ratio)} (m1 = {_fmt(rung.worst_paper_ratio_m1, '.0f')} kg), worst "
              f"sup|E| = {_fmt(rung.worst_sup_E)} rad."]
@@ -385,7 +399,8 @@ def _search_bound_sentence(s: Mapping[str, Any], summary: ValidateSummary) -> st
     if s["objective"] == "paper":
         where = (f"is exceeded {worst_ratio:.3g} times over at its worst" if worst_ratio > 1.0 else
                  f"holds at its worst, at {worst_ratio:.3g} of its bound")
-        text = (f"The paper's claim {where}; the design has "
+        claim = _claim(summary)
+        text = (f"{claim[0].upper()}{claim[1:]} {where}; the design has "
                 f"{'a certificate' if cert.get('certified') else 'no certificate'} to compare with.")
         rung = summary.ladder[(s.get("mc") or {}).get("rung", 1) - 1]
         if rung.hit_stop and cert.get("alpha0_max") is not None and cert.get("steering_range") is not None:
@@ -566,7 +581,7 @@ def sensing_finding(section: Mapping[str, Any]) -> str:
 
 
 # --------------------------------------------------------------------------- (g) findings
-def _rung_finding(before: Rung, r: Rung) -> str:
+def _rung_finding(before: Rung, r: Rung, claim: str) -> str:
     def step(key: str, fmt: str = "d") -> str:
         a, b = getattr(before, key), getattr(r, key)
         return f"{_fmt(a, fmt) if fmt != 'd' else a} -> {_fmt(b, fmt) if fmt != 'd' else b}"
@@ -574,7 +589,7 @@ def _rung_finding(before: Rung, r: Rung) -> str:
     cb, ca = before.certificate, r.certificate
     cert = ("certificate: " + ("none" if not cb.get("certified") else f"E_max {_fmt(cb['E_max'])} rad") + " -> "
             + ("none" if not ca.get("certified") else f"E_max {_fmt(ca['E_max'], '.4g')} rad, all assumptions met"))
-    paper = "" if r.paper_inside is None else f", inside the paper's claim {step('paper_inside')}"
+    paper = "" if r.paper_inside is None else f", inside {claim} {step('paper_inside')}"
     return (f"Rung {r.index} ({r.change}): certified-inside {step('passes')}{paper}, "
             f"at the stop {step('hit_stop')}, |E| growing {step('growing')} of {r.n}; "
             f"worst sup|E| {step('worst_sup_E', '.3g')} rad; {cert}.")
@@ -618,7 +633,7 @@ def _paper_view_finding(summary: ValidateSummary) -> list[str]:
     return [f"Paper's view (Fig. 7): the same law on the reduced paper model as the plant ({red}) stays "
             f"{'inside' if inside else 'OUTSIDE'} the region of the paper's (5.1) example (E_max = {ex['E_max']:.3g} "
             f"rad, E'_max = {ex['Edot_max']:.3g} rad/s, (4.23) = {ex['condition']:.4f}; the paper reports 0.2613); "
-            "the MuJoCo plant is the rung-1 design at m1 = 650 kg."]
+            f"the MuJoCo plant is the rung-1 design at m1 = {summary.settings['nominal_m1']:g} kg."]
 
 
 def _search_findings(summary: ValidateSummary) -> list[str]:
@@ -646,11 +661,11 @@ def findings(summary: Summary) -> list[str]:
     summary = ValidateSummary.of(summary)
     ladder = summary.ladder
     first, last = ladder[0], ladder[-1]
-    out = [f"The paper's design keeps {first.paper_inside}/{first.n} runs inside the paper's claim and has no "
+    out = [f"The paper's design keeps {first.paper_inside}/{first.n} runs inside {_claim(summary)} and has no "
            f"valid certificate ({', '.join(first.certificate['unmet']) or 'none unmet'}), so none of its runs is "
            f"a pass." if not first.certificate.get("certified") else
            f"The paper's design: {first.passes}/{first.n} certified-inside."]
-    out += [_rung_finding(a, b) for a, b in zip(ladder, ladder[1:])]
+    out += [_rung_finding(a, b, _claim(summary)) for a, b in zip(ladder, ladder[1:])]
     out.append(f"The certified design ({last.design}): {last.passes}/{last.n} runs certified-inside, worst "
                f"sup|E| = {_fmt(last.worst_sup_E, '.4g')} rad against E_max = "
                f"{_fmt(last.certificate.get('E_max'), '.4g')} rad.")
@@ -699,9 +714,9 @@ def answer_blocks(summary: Summary, *, brief: bool = False, with_banner: bool = 
         ("h2", "(b) The ladder: from the paper's design to the certified one, one change per rung"),
         ("table", LADDER_COLUMNS, ladder_rows(summary)),
         ("p", "cert-in = certified-inside, the only pass; CERT-OUT = certified-outside (a bug or a modelling gap); "
-              "uncert-* = an assumption of the certificate fails: never a pass. paper in: inside the paper's claim "
-              "(4.21)-(4.23); sup|E|/E_max: of the certificate; stop: reached the steering stop; growing: |E| still "
-              "growing at the end."),
+              "uncert-* = an assumption of the certificate fails: never a pass. paper in: inside "
+              f"{_claim_4_21(ValidateSummary.of(summary))}; sup|E|/E_max: of the certificate; stop: reached the "
+              "steering stop; growing: |E| still growing at the end."),
         ("h2", "(c) The certified design"),
         ("ul", certified_lines(summary, brief=brief)),
         ("h3", "Its certificate, every assumption"),
@@ -719,7 +734,7 @@ def answer_blocks(summary: Summary, *, brief: bool = False, with_banner: bool = 
 def _path_words(settings: Mapping[str, Any]) -> str:
     """The runs' path of C in words: 'the paper circle' (also for reports written before --path)."""
     path = settings.get("path", "paper-circle")
-    return "the paper circle" if path == "paper-circle" else f"the path {path}"
+    return "the paper circle" if path == "paper-circle" else f"the path {path_name(path)}"
 
 
 def _settings_line(summary: Summary) -> str:
@@ -749,8 +764,8 @@ def fig4_caption(summary: Summary) -> str:
 
 FIGURE_GROUPS = (
     ("The ladder", [("verdict counts per rung", "ladder")]),
-    ("Every run of each rung by verdict, with the certificate's region and the paper's claim", None),
-    ("Nominal runs (m1 = 650 kg)", [("the paper's design: E, E', voltage", "history_paper"),
+    ("Every run of each rung by verdict, with the certificate's region and {claim}", None),
+    ("Nominal runs (m1 = {nominal_m1:g} kg)", [("the paper's design: E, E', voltage", "history_paper"),
                                     ("the certified design: E, E', voltage", "history_certified")]),
     ("Worst-case search", [("each run's objective, the running worst, the Monte-Carlo worst", "search_history")]),
     ("The paper's figures", [("Fig. 4 desired path and the paths C travelled", "fig4_trajectory"),
@@ -769,7 +784,8 @@ def _figure_blocks(summary: ValidateSummary) -> list[Block]:
             items = [(f"rung {r.index}: {r.label}", f"rung_{r.index}_{r.name}") for r in summary.ladder]
         items = [(c, s) for c, s in items if s in figs]
         if items:
-            out += [("h3", heading), ("figures", items)]
+            words = {"claim": _claim(summary), "nominal_m1": summary.settings["nominal_m1"]}
+            out += [("h3", heading.format(**words)), ("figures", items)]
     return out
 
 

@@ -55,6 +55,7 @@ from wmr_mj.params import with_params
 from wmr_mj.plant.friction import measure_friction_law
 from wmr_mj.plant.identify import identify_plant
 from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS
+from wmr_mj.reference.route import path_name
 from wmr_mj.report.cart_design import cart_design_stage
 from wmr_mj.report.figures import figures_stage
 from wmr_mj.report.results import CertifiedRule, PathSummary, Rung, ValidateSummary
@@ -296,12 +297,22 @@ def _path_summary(settings: ValidateSettings) -> PathSummary:
     return PathSummary(name=settings.path, circle_radius=radius)
 
 
-def _certified_rule(cart: Any = None) -> CertifiedRule:
-    """The certified design's rule as designs.py writes it, and the omega_r it gives now on the cart."""
+def _certified_rule(settings: ValidateSettings) -> CertifiedRule:
+    """The certified design's rule as designs.py writes it (its C80 box, path and wheelbase replaced by the cart's
+    where the report is of another cart), and the omega_r it gives now on the cart."""
+    cart = settings.cart
     doc = designs.__doc__ or ""
-    rule = doc.split("``certified``:", 1)[-1].split("The ladder", 1)[0]
-    rule = re.sub(r":\w+:`([^`]*)`", r"\1", rule).replace("``", "")
-    return CertifiedRule(text=" ".join(rule.split()), error_spec=designs.ERROR_SPEC,
+    rule = " ".join(re.sub(r":\w+:`([^`]*)`", r"\1", doc.split("``certified``:", 1)[-1].split("The ladder", 1)[0])
+                    .replace("``", "").split())
+    if cart is not None:  # the rule run on this cart: its box, path and wheelbase, not the C80's
+        l1 = settings.base.l1
+        lo, hi = settings.m1_range
+        for c80, own in ((designs.RULE_C80_BOX, f"{lo:g}-{hi:g} kg, {path_name(settings.path)}"),
+                         (designs.RULE_C80_OFFSET, f"about {designs.ERROR_SPEC * l1 * 100:.2g} cm of lateral offset of "
+                                                   f"C at this cart's {l1:g} m wheelbase")):
+            assert c80 in rule, c80  # designs.py's docstring holds the C80's words the rule is written with
+            rule = rule.replace(c80, own)
+    return CertifiedRule(text=rule, error_spec=designs.ERROR_SPEC,
                          omega_r_grid_step=designs.OMEGA_R_GRID[1] - designs.OMEGA_R_GRID[0],
                          omega_r_rule=designs.certified_omega_r(cart=cart),
                          omega_r_design=designs.certified_design(cart).kd)
@@ -333,7 +344,7 @@ def run_validate(settings: ValidateSettings, out_dir: str | os.PathLike, *, log:
     st.start("report", "summary.json, summary.csv, index.md, index.html")
     summary = ValidateSummary(
         folder=str(folder), created=time.strftime("%Y-%m-%d %H:%M:%S %z"), settings=settings.to_dict(),
-        seed=settings.seed, ladder=tuple(rungs), certified_rule=_certified_rule(settings.cart),
+        seed=settings.seed, ladder=tuple(rungs), certified_rule=_certified_rule(settings),
         searches=tuple(searches),
         nominal={name: _nominal_summary(run) for name, run in nominal.items()}, friction=friction,
         identification=identification, paper_example=fig7, figures=figures,

@@ -17,9 +17,9 @@ an analytic bound, never a simulation):
    vanishes at rest, so under stiction the friction mismatch stays F_max
    (:func:`wmr_mj.analysis.certificate.friction_term`), and it does not chatter on a 1 ms loop;
 3. gains: critical damping (3.6), K_P = omega_r^2/4, K_D = omega_r, with omega_r the
-   smallest value on a grid of 5 rad/s whose certificate over the paper's m1 box
-   (550-750 kg, the paper circle) is valid (every assumption met) and bounds the steering
-   error by :data:`ERROR_SPEC` = 0.05 rad (about 3 cm of lateral offset of C at the
+   smallest value on a grid of 5 rad/s whose certificate over the cart's m1 box and path
+   (the C80's: 550-750 kg, the paper circle) is valid (every assumption met) and bounds the steering
+   error by :data:`ERROR_SPEC` = 0.05 rad (about 3 cm of lateral offset of C at the C80's
    0.612 m wheelbase). The smallest such gain leaves the most room to what the plant
    model leaves out (sampling, unmodelled motor dynamics, sensor noise).
 
@@ -46,6 +46,7 @@ from typing import Any, Protocol
 
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import PAPER_KD, PAPER_KP
+from wmr_mj.reference.route import path_name
 
 __all__ = [
     "Design",
@@ -66,6 +67,9 @@ __all__ = [
 
 #: The certified design's tracking specification: |E| <= 0.05 rad, set before any run.
 ERROR_SPEC = 0.05
+#: The words of the rule (the module docstring) that are the C80's: a report of another cart writes its own there.
+RULE_C80_BOX = "the C80's: 550-750 kg, the paper circle"
+RULE_C80_OFFSET = "about 3 cm of lateral offset of C at the C80's 0.612 m wheelbase"
 #: The grid of omega_r (rad/s) the rule searches, smallest first.
 OMEGA_R_GRID = tuple(float(w) for w in range(5, 105, 5))
 SMOOTHING_WIDTH = 0.01  # rad/s, the certified design's sign smoothing w
@@ -187,8 +191,9 @@ def _certified_on(text: str, cart_path: str, path: str | None) -> Design:
     if w is None:
         raise ParameterError(f"cart file {cart_path!r}: the certified design's rule finds no omega_r in "
                              f"{OMEGA_R_GRID[0]:g}-{OMEGA_R_GRID[-1]:g} rad/s whose certificate is valid with "
-                             f"E_max <= {ERROR_SPEC:g} rad on this cart and path {_path_of(record, path)}; give the "
-                             "gains with --kp/--kd or --omega-r, or another --path")
+                             f"E_max <= {ERROR_SPEC:g} rad on this cart and path "
+                             f"{path_name(_path_of(record, path))}; give the gains with --kp/--kd or --omega-r, or "
+                             "another --path")
     return dataclasses.replace(CERTIFIED, kp=w * w / 4.0, kd=w)
 
 
