@@ -160,9 +160,9 @@ def test_validate_on_the_cart_asks_of_its_box_and_path(folder, validate):
     proc = validate
     assert proc.returncode == 0, proc.stderr
     first = proc.stdout.splitlines()[0]
-    assert first.startswith("Question: does the paper's robustness region hold for the cart anycart 1.0.0 under m1 in "
-                            "80-120 kg?") and "on the path anycart-loop.toml" in first
-    for word in ("550", "750", "paper-circle", "paper circle", "C80"):
+    assert first.startswith("Question: does the (4.21)-(4.23) region, computed for this cart, hold for the cart "
+                            "anycart 1.0.0 under m1 in 80-120 kg?") and "on the path anycart-loop.toml" in first
+    for word in ("550", "750", "paper-circle", "paper circle", "C80", "paper's region", "paper's E_max"):
         assert word not in proc.stdout, word
     rule = certified_design(str(folder / "anycart.toml"))  # the rung's gains are the rule's on this cart
     assert f"K_P = {rule.kp:g}, K_D = {rule.kd:g}" in proc.stdout.splitlines()[3]
@@ -181,7 +181,7 @@ def test_validate_report_has_no_c80_box_path_or_claim(folder, validate):
     assert len(texts) > 2  # the ladder's and the rungs' figures are there to be read
     for name, text in texts.items():
         text = text.replace("&#x27;", "'")
-        for word in (*C80_WORDS, "650 kg"):
+        for word in (*C80_WORDS, "650 kg", "C80", "paper's region", "paper's robustness region", "paper's E_max"):
             assert word not in text, (name, word)
     assert "inside the (4.21)-(4.23) region on this cart" in texts["index.md"]  # named, not left out
 
@@ -213,3 +213,25 @@ def test_robustness_certificate_on_the_cart_names_the_region_as_this_carts(folde
     _no_c80(proc)
     c80 = _cli("robustness", "--certificate", cwd=folder)
     assert "the paper's claim" in c80.stdout  # the C80 keeps the paper's words
+
+
+def test_validate_searches_the_carts_own_boxes_not_the_c80s(tmp_path):
+    """validate's worst-case searches range the cart's own boxes: a cart whose full box differs from the C80's (here
+    its mu range, 0.02-0.03 against the C80's 0.0129-0.0215) is searched over its own, as its ladder samples it."""
+    from wmr_mj.report.search import _search_spec, search_plans
+    from wmr_mj.report.settings import ValidateSettings
+
+    text = (DATA / "anycart.toml").read_text(encoding="utf-8")
+    start = text.index("[uncertainty.full.mu]")
+    end = text.index("[uncertainty.full.ground_friction]")
+    mine = text[:start] + text[start:end].replace("range = [0.0129, 0.0215]", "range = [0.02, 0.03]") + text[end:]
+    assert mine != text
+    cart = tmp_path / "mycart.toml"
+    cart.write_text(mine, encoding="utf-8")
+    (tmp_path / "anycart-loop.toml").write_text((DATA / "anycart-loop.toml").read_text(encoding="utf-8"))
+    settings = ValidateSettings(cart=str(cart), path=str(tmp_path / "anycart-loop.toml"), search_budget=8, n=2,
+                                duration=10.0)
+    plans = {plan.key: plan for plan in search_plans(settings)}
+    full = _search_spec(plans["certified-full"], settings)  # over the m1 box, the full box gets its own search
+    assert full.box["mu"] == (0.02, 0.03) and full.box["m1"] == (80.0, 120.0)
+    assert settings.box_ranges("full")["mu"] == (0.02, 0.03)

@@ -70,8 +70,8 @@ def test_validate_on_the_users_cart_answers_first(mine):
                 "--search-budget", "5", "--seed", "3", "--out", "report", cwd=mine.parent)
     assert proc.returncode == 0, proc.stderr
     lines = proc.stdout.splitlines()
-    assert lines[0].startswith(f"Question: does the paper's robustness region hold for the cart mine "
-                               f"{load_cart(mine).version} under m1 in 500-700 kg?")
+    assert lines[0].startswith("Question: does the (4.21)-(4.23) region, computed for this cart, hold for the cart "
+                               f"mine {load_cart(mine).version} under m1 in 500-700 kg?")
     assert lines[1].startswith("The paper's design")
     claim = resolve_run(RunConfig(**certified_design(str(mine)).config_changes(), cart=str(mine),
                                   duration=10.0)).claim

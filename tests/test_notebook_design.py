@@ -120,6 +120,6 @@ def test_validates_history_figure_draws_the_supply_of_its_cart(twenty_volt_run):
     """validate --cart's history figures likewise (they drew the C80's 24 V on every cart)."""
     from wmr_mj.report.figures import _history_figures
 
-    fig = _history_figures({"certified": twenty_volt_run})["history_certified"]
+    fig = _history_figures({"certified": twenty_volt_run}, "the (4.21)-(4.23) region on this cart")["history_certified"]
     levels = set().union(*(_levels(ax) for ax in fig.axes))
     assert {20.0, -20.0} <= levels and 24.0 not in levels

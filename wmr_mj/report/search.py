@@ -42,7 +42,6 @@ from wmr_mj._util.progress import Stages
 from wmr_mj.analysis.verdicts import count_verdicts, paper_region_name
 from wmr_mj.experiments.sweep import read_runs
 from wmr_mj.logs.writer import run_logged
-from wmr_mj.params import uncertainty_ranges
 from wmr_mj.report.settings import (
     FULL_BOX_FACTOR,
     ValidateSettings,
@@ -97,8 +96,14 @@ def search_plans(settings: ValidateSettings) -> tuple[SearchPlan, ...]:
          if box == "m1" else ())  # over the full box the search above already covers it
 
 
+def _objective_label(plan: SearchPlan, settings: ValidateSettings) -> str:
+    """The search's objective in words; the paper's region named as this cart's on another cart than the C80."""
+    label = OBJECTIVE_LABELS[plan.objective]
+    return label.replace("the paper's region", paper_region_name(settings.cart is None)) if settings.cart else label
+
+
 def _search_spec(plan: SearchPlan, settings: ValidateSettings):
-    extra = {k: v for k, v in uncertainty_ranges(plan.box).items() if k != "m1"}
+    extra = settings.box_ranges(plan.box)  # the cart's own box of that name (the C80's without a cart)
     base = settings.config(plan.design).replace(box_ranges=extra)
     return FalsifySpec(base=base, box={"m1": as_pair(settings.m1_range), **extra}, objective=plan.objective,
                        budget=plan.budget, seed=settings.seed)  # falsify's default method: the portfolio
@@ -178,12 +183,12 @@ def _read_back(saved: Path, fingerprint: str) -> dict[str, Any] | None:
 
 
 def _result(plan: SearchPlan, spec, runs: Sequence[Mapping[str, Any]], worst: Mapping[str, Any] | None,
-            reproduced: bool, certificate: Any, out: Path, folder: Path) -> dict[str, Any]:
+            reproduced: bool, certificate: Any, out: Path, folder: Path, objective_label: str) -> dict[str, Any]:
     return {
         "key": plan.key, "title": plan.title, "fingerprint": _fingerprint(spec), "design": plan.design.name,
         "design_text": plan.design.describe(), "box_name": plan.box,
         "box": {k: list(v) for k, v in spec.box.items()}, "names": list(spec.names), "objective": plan.objective,
-        "objective_label": OBJECTIVE_LABELS[plan.objective], "budget": spec.budget,
+        "objective_label": objective_label, "budget": spec.budget,
         "method": spec.method, "population": spec.population_size,
         "generations": 1 + max(r["generation"] for r in runs),
         "evaluations": len(runs), "seed": spec.seed, "worst": None if worst is None else dict(worst),
@@ -215,11 +220,11 @@ def run_search(plan: SearchPlan, settings: ValidateSettings, folder: Path, st: S
     if worst:
         logged = run_logged(spec.config([worst["params"][n] for n in spec.names]), str(out / "worst.mcap"))
     result = _result(plan, spec, runs, worst, bool(worst and logged is not None and logged.sup_E == worst["sup_E"]),
-                     resolve_run(spec.base).claim, out, folder)
+                     resolve_run(spec.base).claim, out, folder, _objective_label(plan, settings))
     _compare(result, plan, rungs, folder)
     write_text_atomic(out / "evaluations.csv", _evaluations_csv(spec.names, runs))
     write_json_atomic(out / "search.json", result)
-    st.done(f"worst {_num(worst and worst['objective'])} ({OBJECTIVE_LABELS[plan.objective]})"
+    st.done(f"worst {_num(worst and worst['objective'])} ({_objective_label(plan, settings)})"
             + loud(result["verdicts"]["certified-outside"], f"search {plan.key}"))
     return result
 

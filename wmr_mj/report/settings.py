@@ -129,15 +129,20 @@ class ValidateSettings:
         over the m1 box, the full box at FULL_BOX_FACTOR times the budget."""
         need = cma_population(1 + len(self.ranges))
         if self.uncertainty == "m1":
-            need = max(need, -(-cma_population(len(uncertainty_ranges("full"))) // FULL_BOX_FACTOR))
+            need = max(need, -(-cma_population(1 + len(self.box_ranges("full"))) // FULL_BOX_FACTOR))
         return need
 
     @property
     def ranges(self) -> dict[str, tuple[float, float]]:
         """The ranged parameters of the uncertainty box other than m1, name -> (lo, hi)."""
-        box = uncertainty_ranges(self.uncertainty)
+        return self.box_ranges(self.uncertainty)
+
+    def box_ranges(self, name: str) -> dict[str, tuple[float, float]]:
+        """The ranged parameters of uncertainty box ``name`` ('m1', 'full') other than m1: the cart's own box of
+        that name where the cart file declares one, else the C80's (:func:`wmr_mj.params.uncertainty_ranges`)."""
+        box = uncertainty_ranges(name)
         if self.cart is not None:
-            box = dict(cart_file(RunConfig(cart=self.cart)).uncertainty.get(self.uncertainty, box))
+            box = dict(cart_file(RunConfig(cart=self.cart)).uncertainty.get(name, box))
         return {k: v for k, v in box.items() if k != "m1"}
 
     @property

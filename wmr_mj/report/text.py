@@ -146,13 +146,15 @@ def _paper_verdict(summary: ValidateSummary) -> str:
     n, inside, pr = rung.n, 0 if rung.paper_inside is None else rung.paper_inside, rung.paper_region
     answer = "Yes" if inside == n else "No"
     ratio = rung.worst_paper_ratio
-    parts = [f"{n - inside}/{n} runs leave the paper's region" if inside < n else f"{n}/{n} runs stay inside it"]
+    on_c80 = not summary.settings.get("cart")  # the paper's region on its C80; on another cart, computed for it
+    region, e_max = ("the paper's region", "the paper's E_max") if on_c80 else (_claim(summary), "its E_max")
+    parts = [f"{n - inside}/{n} runs leave {region}" if inside < n else f"{n}/{n} runs stay inside it"]
     cross = rung.worst_path_cross_track
     if cross is not None:
         parts.append(f"C leaves {_path_text(summary)} by up to {_fmt(cross, '.3g')} m")
     parts.append(f"{rung.hit_stop}/{n} runs reach the steering stop")
-    parts.append(f"worst sup|E| = {_fmt(rung.worst_sup_E, '.3g')} rad, {_fmt(ratio, '.3g')} times the paper's "
-                 f"E_max = {_fmt(pr['E_max'], '.3g')} rad")
+    parts.append(f"worst sup|E| = {_fmt(rung.worst_sup_E, '.3g')} rad, {_fmt(ratio, '.3g')} times {e_max} = "
+                 f"{_fmt(pr['E_max'], '.3g')} rad")
     return f"The paper's design ({rung.design}): {answer}. " + "; ".join(parts) + "."
 
 
@@ -202,12 +204,19 @@ def verdict_lines(summary: Summary) -> list[str]:
     if data:
         files = " and ".join(PurePath(name).name for name, _sha256 in data)
         vehicle += f" (identified from {files}; the answer assumes the real cart inside its identified box)"
-    question = (f"Question: does the paper's robustness region hold for {vehicle} under m1 in {lo:g}-{hi:g} kg? "
+    region = "the paper's robustness region" if not cart else "the (4.21)-(4.23) region, computed for this cart,"
+    question = (f"Question: does {region} hold for {vehicle} under m1 in {lo:g}-{hi:g} kg? "
                 f"({summary.ladder[0].n} MuJoCo runs per design on {_path_words(s)}, {s['duration']:g} s each)")
     report = (f"Report: {summary.folder}/index.html (also index.md, summary.json); the details follow: (a) the "
               "paper's design, (b) the ladder between the designs, (c) the certified design, (d) the friction law, "
               "(e) the certified design on realistic sensing.")
     return [question, _paper_verdict(summary), _why_verdict(summary), _certified_verdict(summary), report]
+
+
+def _vehicle(summary: ValidateSummary) -> str:
+    """The report's title's vehicle: the MuJoCo C80, or the cart validate was given (its name and version)."""
+    cart = summary.settings.get("cart")
+    return "the MuJoCo C80" if not cart else f"the MuJoCo cart {cart['name']} {cart['version']}"
 
 
 # --------------------------------------------------------------------------- (a) the paper's design
@@ -813,7 +822,7 @@ def document(summary: Summary) -> list[Block]:
         ("answer", verdict_lines(summary)),
         *banner(summary),
         *lead,
-        ("h1", "wmr-mj validate: does the paper's steering controller keep its promise on the MuJoCo C80?"),
+        ("h1", f"wmr-mj validate: does the paper's steering controller keep its promise on {_vehicle(summary)}?"),
         ("p", f"{summary.created} - {_settings_line(summary)}."),
         *answer_blocks(summary, with_banner=False),
         ("h2", f"(f) Identification (m1 = {ident['m1']:g} kg, {ident['duration']:g} s excitation)"),
