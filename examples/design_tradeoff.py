@@ -2,7 +2,7 @@
 
 Two axes of the cart, each from the ideal sensor: an encoder on the steering axis of 10-16 bits (rounded, alpha'
 a backward difference over the 1 ms period), and an exact sensor read 0-50 ms late. At each point, for (a) the
-certified design (``--preset certified``) and (b) the design ``wmr-mj design`` finds for that cart
+certified design (``--preset certified``) and (b) the design ``wmr-mj design --objective E_max`` finds for that cart
 (:func:`wmr_mj.sim.design_search.search_design`, CMA-ES from the preset's point, seed 0): the certified E_max on
 the paper's circle over the m1 box (550-750 kg; none where the claim does not certify, with what binds), and the
 worst sup|E| that ``falsify`` finds over the m1 box at a small budget (its search and as many random runs;
@@ -62,7 +62,8 @@ def point(axis: str, value: float, *, duration: float, design_budget: int, falsi
     base = wm.RunConfig(**wm.CERTIFIED.config_changes(), duration=duration, path="paper-circle")
     config = base.replace(sensing=sensing_of(axis, value))
     t0 = time.perf_counter()
-    found = search_design(DesignProblem(base=config, budget=design_budget))
+    # the E_max design (the objective the figure was measured with, 2026-11-27; the default weighs the supply since)
+    found = search_design(DesignProblem(base=config, budget=design_budget, objective="E_max"))
     design_s = time.perf_counter() - t0
     design = _claimed(config.replace(**found.settings), falsify_budget) if found.certified else {
         "certified": False, "E_max": None, "binding": found.binding, "worst_sup_E": None, "verdicts": {}}

@@ -12,10 +12,10 @@ from types import SimpleNamespace
 
 import pytest
 
-from wmr_mj.cli.app import main
+from wmr_mj.cli.app import build_parser, main
 from wmr_mj.errors import ParameterError
-from wmr_mj.sim.design_options import E_MAX_SLACK
-from wmr_mj.sim.design_search import PENALTY, score
+from wmr_mj.sim.design_options import DEFAULT_OBJECTIVE, E_MAX_SLACK
+from wmr_mj.sim.design_search import PENALTY, DesignProblem, DesignResult, score
 
 #: (E_max rad, voltage V) of five certified points and one uncertified: the best E_max is 0.0100 at the full
 #: 24 V; the cap is 1.1 x 0.0100 = 0.0110; within it the least voltage is 9 V (0.0108); 0.0111 at 5 V is past it
@@ -43,6 +43,25 @@ def test_the_worst_path_counts_for_both_e_max_and_voltage():
     both = {"a": _cert(0.0109, 6.0), "b": _cert(0.0105, 8.0)}
     assert score(both, "E_max-then-voltage", e_max_cap=cap) == 8.0
     assert score({**both, "c": _cert(0.0112, 1.0)}, "E_max-then-voltage", e_max_cap=cap) > PENALTY
+
+
+def test_the_default_weighs_the_supply_and_picks_the_lower_voltage_on_a_known_table():
+    """Where no objective is given (DesignProblem, ``wmr-mj design``; validate's section (e) and ``cart check`` build
+    a DesignProblem without one) the search weighs the supply: on TABLE the default picks 9 V at 0.0108 rad, within
+    10 % of the best E_max, where E_max alone takes the full 24 V for 0.0100 rad. A design file written before the
+    objective was recorded still reads as an E_max design."""
+    assert DEFAULT_OBJECTIVE == "E_max-then-voltage"
+    assert DesignProblem(base=None).objective == DEFAULT_OBJECTIVE
+    assert build_parser(("design",)).parse_args(["design"]).objective == DEFAULT_OBJECTIVE
+    assert [f.default for f in DesignResult.__dataclass_fields__.values() if f.name == "objective"] == ["E_max"]
+    cap = (1.0 + E_MAX_SLACK) * min(e for e, _ in TABLE)
+
+    def pick(objective: str) -> tuple[float, float]:
+        scores = [score({"p": _cert(e, v)}, objective, e_max_cap=cap) for e, v in TABLE]
+        return TABLE[scores.index(min(scores))]
+
+    assert pick(DesignProblem(base=None).objective) == (0.0108, 9.0)
+    assert pick("E_max") == (0.0100, 24.0)
 
 
 def test_a_cap_is_needed():

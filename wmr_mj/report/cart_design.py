@@ -42,7 +42,14 @@ from wmr_mj.report.settings import ValidateSettings, loud, stage_progress
 from wmr_mj.sim.certify import certificate_name
 from wmr_mj.sim.coerce import coerce
 from wmr_mj.sim.compare import design_file_changes
-from wmr_mj.sim.design_search import DEFAULT_BUDGET, DEFAULT_SEED, DesignProblem, search_design, write_design
+from wmr_mj.sim.design_search import (
+    DEFAULT_BUDGET,
+    DEFAULT_OBJECTIVE,
+    DEFAULT_SEED,
+    DesignProblem,
+    search_design,
+    write_design,
+)
 from wmr_mj.sim.designs import CERTIFIED
 from wmr_mj.sim.parts import resolve_run
 from wmr_mj.sim.records import Record
@@ -144,7 +151,7 @@ def design_problem(settings: ValidateSettings, *, sensing: str = DESIGN_SENSING,
                    budget: int = DESIGN_BUDGET) -> Any:
     """The :class:`~wmr_mj.sim.design_search.DesignProblem` of the section: the certified design's run of these
     settings (their box, path, duration and cart) on ``sensing``, searched as ``wmr-mj design`` searches
-    (the 1 ms period, the E_max objective, CMA-ES)."""
+    (the 1 ms period, the default objective: E_max, then the supply within 10 % of it; CMA-ES)."""
     base = coerce(settings.config(CERTIFIED).replace(sensing=sensing))  # the sensing's spec typed
     return DesignProblem(base=base, paths=(settings.path,), seed=seed, budget=budget)
 
@@ -172,6 +179,8 @@ def design_command(settings: ValidateSettings, problem: Any) -> str:
         words += ["--seed", str(problem.seed)]
     if problem.budget != DESIGN_BUDGET:
         words += ["--budget", str(problem.budget)]
+    if problem.objective != DEFAULT_OBJECTIVE:
+        words += ["--objective", problem.objective]
     return " ".join(words)
 
 
