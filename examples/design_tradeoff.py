@@ -2,7 +2,7 @@
 
 Two axes of the cart, each from the ideal sensor: an encoder on the steering axis of 10-16 bits (rounded, alpha'
 a backward difference over the 1 ms period), and an exact sensor read 0-50 ms late. At each point, for (a) the
-certified design (``--preset certified``) and (b) the design ``wmr-mj design --objective E_max`` finds for that cart
+certified design (``--preset certified``) and (b) the design ``wmr-mj design`` finds for that cart
 (:func:`wmr_mj.sim.design_search.search_design`, CMA-ES from the preset's point, seed 0): the certified E_max on
 the paper's circle over the m1 box (550-750 kg; none where the claim does not certify, with what binds), and the
 worst sup|E| that ``falsify`` finds over the m1 box at a small budget (its search and as many random runs;

@@ -14,11 +14,11 @@ unmet. This is a report, not a check: a cart whose design cannot be certified st
 
 Its third line answers whether ``wmr-mj design`` can certify the cart on its default sensing: the design search
 (:func:`wmr_mj.sim.design_search.search_design`, CMA-ES seeded with ``--seed``, design's default budget
-(:data:`wmr_mj.sim.design_search.DEFAULT_BUDGET`) of certificates, its default objective, the paper circle, the
-cart's m1 box, a 1 ms period) run on the cart, as ``wmr-mj design --cart FILE --seed S`` runs it: "design
-certifies it: E_max ... rad (K_P ..., K_D ...)" or "no gains in the box certify this cart: ... binds". Also a
-report: it does not change the exit status. It adds about 4 s (2026-11-28, 2 cores, shared: two searches, 1206
-certificates in 4.0 s, the whole ``cart check c80`` in 5.3 s wall).
+(:data:`wmr_mj.sim.design_search.DEFAULT_BUDGET`) of certificates, the paper circle, the cart's m1 box, a 1 ms
+period) run on the cart, as ``wmr-mj design --cart FILE --seed S`` runs it: "design certifies it: E_max ... rad
+(K_P ..., K_D ...)" or "no gains in the box certify this cart: ... binds". Also a report: it does not change the
+exit status. It adds about 2 s (2026-11-27, 2 cores under a shared load of 4-5: 603 certificates in 2.0 s, the
+whole ``cart check c80`` in 5.3 s wall).
 """
 
 from __future__ import annotations

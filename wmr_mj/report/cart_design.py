@@ -42,14 +42,7 @@ from wmr_mj.report.settings import ValidateSettings, loud, stage_progress
 from wmr_mj.sim.certify import certificate_name
 from wmr_mj.sim.coerce import coerce
 from wmr_mj.sim.compare import design_file_changes
-from wmr_mj.sim.design_search import (
-    DEFAULT_BUDGET,
-    DEFAULT_OBJECTIVE,
-    DEFAULT_SEED,
-    DesignProblem,
-    search_design,
-    write_design,
-)
+from wmr_mj.sim.design_search import DEFAULT_BUDGET, DEFAULT_SEED, DesignProblem, search_design, write_design
 from wmr_mj.sim.designs import CERTIFIED
 from wmr_mj.sim.parts import resolve_run
 from wmr_mj.sim.records import Record
@@ -179,8 +172,6 @@ def design_command(settings: ValidateSettings, problem: Any) -> str:
         words += ["--seed", str(problem.seed)]
     if problem.budget != DESIGN_BUDGET:
         words += ["--budget", str(problem.budget)]
-    if problem.objective != DEFAULT_OBJECTIVE:
-        words += ["--objective", problem.objective]
     return " ".join(words)
 
 
