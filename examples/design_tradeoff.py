@@ -62,7 +62,8 @@ def point(axis: str, value: float, *, duration: float, design_budget: int, falsi
     base = wm.RunConfig(**wm.CERTIFIED.config_changes(), duration=duration, path="paper-circle")
     config = base.replace(sensing=sensing_of(axis, value))
     t0 = time.perf_counter()
-    found = search_design(DesignProblem(base=config, budget=design_budget))
+    # the E_max design (the objective the figure was measured with, 2026-11-27; the default weighs the supply since)
+    found = search_design(DesignProblem(base=config, budget=design_budget, objective="E_max"))
     design_s = time.perf_counter() - t0
     design = _claimed(config.replace(**found.settings), falsify_budget) if found.certified else {
         "certified": False, "E_max": None, "binding": found.binding, "worst_sup_E": None, "verdicts": {}}

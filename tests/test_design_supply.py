@@ -12,7 +12,8 @@ from types import SimpleNamespace
 
 import pytest
 
-from wmr_mj.cli.app import main
+import wmr_mj as wm
+from wmr_mj.cli.app import build_parser, main
 from wmr_mj.errors import ParameterError
 from wmr_mj.searches.design_options import E_MAX_SLACK
 from wmr_mj.searches.design_search import PENALTY, score
@@ -43,6 +44,25 @@ def test_the_worst_path_counts_for_both_e_max_and_voltage():
     both = {"a": _cert(0.0109, 6.0), "b": _cert(0.0105, 8.0)}
     assert score(both, "E_max-then-voltage", e_max_cap=cap) == 8.0
     assert score({**both, "c": _cert(0.0112, 1.0)}, "E_max-then-voltage", e_max_cap=cap) > PENALTY
+
+
+def test_the_default_weighs_the_supply_and_picks_the_lower_voltage_on_a_known_table():
+    """Where no objective is given (DesignProblem, ``wmr-mj design``; validate's section (e) and ``cart check`` build
+    a DesignProblem without one) the search weighs the supply: on TABLE the default picks 9 V at 0.0108 rad, within
+    10 % of the best E_max, where E_max alone takes the full 24 V for 0.0100 rad. A design file written before the
+    objective was recorded still reads as an E_max design."""
+    default = "E_max-then-voltage"  # wmr_mj.searches.design_options.DEFAULT_OBJECTIVE
+    assert wm.DesignProblem(base=None).objective == default
+    assert build_parser(("design",)).parse_args(["design"]).objective == default
+    assert [f.default for f in wm.DesignResult.__dataclass_fields__.values() if f.name == "objective"] == ["E_max"]
+    cap = (1.0 + E_MAX_SLACK) * min(e for e, _ in TABLE)
+
+    def pick(objective: str) -> tuple[float, float]:
+        scores = [score({"p": _cert(e, v)}, objective, e_max_cap=cap) for e, v in TABLE]
+        return TABLE[scores.index(min(scores))]
+
+    assert pick(wm.DesignProblem(base=None).objective) == (0.0108, 9.0)
+    assert pick("E_max") == (0.0100, 24.0)
 
 
 def test_a_cap_is_needed():

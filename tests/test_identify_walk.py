@@ -75,8 +75,8 @@ def walk(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
                                        "--data", f"{eight}:m1=100", "--out", str(new), "--json"])
     # design over the identified box (--uncertainty full: the intervals identify wrote) on the measured sensing
     # (the new cart's default); a small budget: a certified design, not the best one
-    design_code, printed = _main(["design", "--cart", str(new), "--uncertainty", "full", "--budget", "12",
-                                  "--out", str(design)])
+    design_code, printed = _main(["design", "--cart", str(new), "--uncertainty", "full", "--objective", "E_max",
+                                  "--budget", "12", "--out", str(design)])
     # the design's gains on the TRUE cart with its real sensor, m1 over the box: measured sup|E| of each run
     sweep_code, swept = _json(["sweep", "--design", str(design), "--cart", str(TRUTH), "--sensing", SENSING,
                                "--n", str(SWEEP_RUNS), "--out", str(folder / "sweep"), "--json"])

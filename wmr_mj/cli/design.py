@@ -16,7 +16,7 @@ HELP = "the computed-torque (or sliding-mode) gains, sign width, filter and peri
 def register(sub: argparse._SubParsersAction) -> None:
     from wmr_mj.cli.run import add_hardware_options
     from wmr_mj.params import M1_RANGE
-    from wmr_mj.searches.design_options import DEFAULT_BUDGET, DEFAULT_SEED, METHODS, OBJECTIVE_WORDS
+    from wmr_mj.searches.design_options import DEFAULT_BUDGET, DEFAULT_OBJECTIVE, DEFAULT_SEED, METHODS, OBJECTIVE_WORDS
 
     p = sub.add_parser(
         "design", help=HELP,
@@ -48,9 +48,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--periods", default="0.001", metavar="T1,T2,...",
                    help="control periods to try, s, each a whole number of 1 ms physics steps dividing the run "
                         "(default 0.001)")
-    p.add_argument("--objective", default="E_max",
-                   help="what is minimised (default E_max): " + "; ".join(
-                       f"{name}: {words}" for name, words in OBJECTIVE_WORDS.items()))
+    p.add_argument("--objective", default=DEFAULT_OBJECTIVE,
+                   help=f"what is minimised (default {DEFAULT_OBJECTIVE}): " + "; ".join(
+                       f"{name}: {words}" for name, words in OBJECTIVE_WORDS.items()).replace("%", "%%"))
     p.add_argument("--method", default="cma", choices=METHODS,
                    help="the optimiser: cma (CMA-ES, the default: the better of the two in bench/bench_design.py) "
                         "or de (scipy's differential evolution)")

@@ -144,7 +144,7 @@ def design_problem(settings: ValidateSettings, *, sensing: str = DESIGN_SENSING,
                    budget: int = DESIGN_BUDGET) -> Any:
     """The :class:`~wmr_mj.searches.design_search.DesignProblem` of the section: the certified design's run of these
     settings (their box, path, duration and cart) on ``sensing``, searched as ``wmr-mj design`` searches
-    (the 1 ms period, the E_max objective, CMA-ES)."""
+    (the 1 ms period, the default objective: E_max, then the supply within 10 % of it; CMA-ES)."""
     base = coerce(settings.config(CERTIFIED).replace(sensing=sensing))  # the sensing's spec typed
     return DesignProblem(base=base, paths=(settings.path,), seed=seed, budget=budget)
 

@@ -537,6 +537,12 @@ def cart_design_rows(summary: Summary) -> list[list[str]]:
     return out
 
 
+#: what the design of the supply-weighing objective is, in section (e)'s words (a report of the E_max objective, or
+#: one written before the search recorded it, keeps the E_max words)
+_SUPPLY_WORDS = ("that certify on this cart with the least supply among those whose certificate over the box is "
+                 "within 10 % of the smallest found")
+
+
 def cart_design_blocks(summary: Summary) -> list[Block]:
     """The design ``wmr-mj design`` finds for the 12-bit axis encoder beside the certified design on it, in
     section (e), where the report has it (reports written before it have no ``cart_design``)."""
@@ -552,8 +558,10 @@ def cart_design_blocks(summary: Summary) -> list[Block]:
                    f"{sec.duration:g} s"),
             ("table", CART_DESIGN_COLUMNS, cart_design_rows(summary)),
             ("p", f"The design is what '{sec.command}' finds ({search['method']}, seed {search['seed']}, "
-                  f"{search['evaluations']} certificates): the gains, sign width and period whose certificate on "
-                  f"this cart is the smallest over the box; it is written to {sec.design_file} ('wmr-mj run "
+                  f"{search['evaluations']} certificates): the gains, sign width and period "
+                  + (_SUPPLY_WORDS if search.get("objective") == "E_max-then-voltage" else
+                     "whose certificate on this cart is the smallest over the box")
+                  + f"; it is written to {sec.design_file} ('wmr-mj run "
                   f"--design {summary.folder}/{sec.design_file}') and swept as that file reads back. Both designs "
                   "run the same m1 draws on the same cart; each run is judged against its own design's "
                   "certificate, and sup|E|/E_max is of that certificate. TV u: the voltage's total variation per "

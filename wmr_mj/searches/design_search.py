@@ -56,14 +56,22 @@ from wmr_mj.analysis.claim_types import Assumption
 from wmr_mj.errors import ParameterError
 from wmr_mj.hardware import Actuation, Sensing, Transmission
 from wmr_mj.plant.cart_data import identified_from
-from wmr_mj.searches.design_options import DEFAULT_BUDGET, DEFAULT_SEED, E_MAX_SLACK, LAWS, METHODS, OBJECTIVES
+from wmr_mj.searches.design_options import (
+    DEFAULT_BUDGET,
+    DEFAULT_OBJECTIVE,
+    DEFAULT_SEED,
+    E_MAX_SLACK,
+    LAWS,
+    METHODS,
+    OBJECTIVES,
+)
 from wmr_mj.searches.optimisers import CMAES, Chain, DifferentialEvolution, Optimiser, Points, drive
 from wmr_mj.sim.coerce import coerced
 from wmr_mj.sim.records import Record
 
 __all__ = ["DesignProblem", "DesignResult", "OBJECTIVES", "METHODS", "LAWS", "DEFAULT_SEED", "DEFAULT_BUDGET",
-           "DESIGN_FIELDS", "law_changes", "uncovered", "search_design", "evaluate_design", "write_design",
-           "read_design", "design_file_settings", "design_cart", "check_periods"]
+           "DEFAULT_OBJECTIVE", "DESIGN_FIELDS", "law_changes", "uncovered", "search_design", "evaluate_design",
+           "write_design", "read_design", "design_file_settings", "design_cart", "check_periods"]
 
 #: the RunConfig settings a design file sets (``run --design FILE``), as a preset does
 DESIGN_FIELDS = ("controller", "controller_params", "model", "kp", "kd", "friction_sign", "friction_width",
@@ -82,7 +90,7 @@ class DesignProblem:
             box_ranges, box), the duration; the law's fields are the search's.
         paths: the paths every certificate must hold on (the worst counts).
         periods: the control periods tried, s (each a whole number of physics steps).
-        objective: one of :data:`OBJECTIVES`.
+        objective: one of :data:`OBJECTIVES` (default :data:`DEFAULT_OBJECTIVE`, the supply weighed).
         method: one of :data:`METHODS`.
         seed: the optimiser's seed (same seed, same design).
         budget: points scored per period, about (each point's certificate on every path): CMA-ES's generations
@@ -97,7 +105,7 @@ class DesignProblem:
     base: Any
     paths: tuple[str, ...] = ("paper-circle",)
     periods: tuple[float, ...] = (0.001,)
-    objective: str = "E_max"
+    objective: str = DEFAULT_OBJECTIVE
     method: str = "cma"
     seed: int = DEFAULT_SEED
     budget: int = DEFAULT_BUDGET
