@@ -235,3 +235,23 @@ def test_validate_searches_the_carts_own_boxes_not_the_c80s(tmp_path):
     full = _search_spec(plans["certified-full"], settings)  # over the m1 box, the full box gets its own search
     assert full.box["mu"] == (0.02, 0.03) and full.box["m1"] == (80.0, 120.0)
     assert settings.box_ranges("full")["mu"] == (0.02, 0.03)
+
+
+def test_the_python_api_takes_the_carts_path_and_its_run_plot_names_the_region_as_this_carts():
+    """``RunConfig.from_inputs(cart=...)`` with no path runs the cart's own ([paths] default), as the commands do;
+    a run's figure names the paper's region (4.21)-(4.23) as this cart's there, and as the paper's claim on the C80
+    (the label is chosen: a figure that always said one of them fails here)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import wmr_mj as wm
+
+    def legend(result) -> str:
+        axes = [ax for ax in result.plot().axes if ax.get_legend()]
+        return "\n".join(t.get_text() for ax in axes for t in ax.get_legend().get_texts())
+
+    mine = wm.run_closed_loop(wm.RunConfig.from_inputs(cart=str(DATA / "anycart.toml"), duration=10.0), progress=False)
+    assert mine.config.path.endswith("anycart-loop.toml")  # the cart's declared default, not the paper circle
+    assert "(4.21)-(4.23) region on this cart" in legend(mine) and "paper's claim" not in legend(mine)
+    c80 = wm.run_closed_loop(wm.RunConfig.from_inputs(duration=15.0), progress=False)
+    assert c80.config.path == "paper-circle" and "paper's claim" in legend(c80)

@@ -126,9 +126,15 @@ class RunConfig:
         and checked. ``RunConfig(...)`` keeps such input as given (nothing read) until ``resolve_run`` coerces it;
         the commands, the config builders of compare and the reports, and ``config_from_dict`` call this.
 
+        A config on a cart that names no path takes the cart's own (its ``[paths] default``, else one it can steer:
+        :func:`wmr_mj.sim.coerce.default_path`), as the commands do; ``RunConfig(cart=...)`` keeps the field's
+        default, the paper circle, as plain data.
+
         Raises:
             ParameterError, UnknownNameError: what cannot be coerced or is refused, in one line.
         """
+        if user_input.get("cart") is not None:
+            user_input.setdefault("path", None)  # None: the cart's own path, resolved by coerce
         return coerce(cls(**user_input))
 
     # the name of earlier versions, documented in the api reference: one release, with a warning (issue 41)
