@@ -255,3 +255,15 @@ def test_the_python_api_takes_the_carts_path_and_its_run_plot_names_the_region_a
     assert "(4.21)-(4.23) region on this cart" in legend(mine) and "paper's claim" not in legend(mine)
     c80 = wm.run_closed_loop(wm.RunConfig.from_inputs(duration=15.0), progress=False)
     assert c80.config.path == "paper-circle" and "paper's claim" in legend(c80)
+
+
+def test_the_paper_objective_is_named_as_this_carts_off_the_c80_and_the_others_stay():
+    """falsify's and validate's objective label: sup|E|/E_max of the paper's region on the C80, of the (4.21)-(4.23)
+    region on this cart elsewhere; the other objectives do not name the paper and read the same on any cart."""
+    from wmr_mj.searches.falsify import OBJECTIVE_LABELS, OBJECTIVES, objective_label
+
+    assert objective_label("paper") == "sup|E|/E_max of the paper's region"
+    assert objective_label("paper", on_c80=False) == "sup|E|/E_max of the (4.21)-(4.23) region on this cart"
+    for name in OBJECTIVES:
+        if name != "paper":
+            assert objective_label(name, on_c80=False) == objective_label(name) == OBJECTIVE_LABELS[name]

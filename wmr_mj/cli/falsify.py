@@ -268,13 +268,13 @@ def _write_outputs(result, base, args: argparse.Namespace, out, *, law_settings)
 def _print_text(result, base, summary: dict, args: argparse.Namespace, logged_sup_E: float) -> None:
     """falsify's printout: how the search ran, the worst of the search and of the random sample, the claim,
     the worst run's certificate (E_max, the largest term of delta1) and tightness, its parameters and files."""
-    from wmr_mj.searches.falsify import OBJECTIVE_LABELS, worst_config
+    from wmr_mj.searches.falsify import worst_config
 
     spec, worst = result.spec, result.worst
     names, how = ", ".join(spec.names), _how_text(spec, result)
     print(f"worst-case search over {len(spec.names)} parameter(s) ({names}; box {args.uncertainty}): {how}, "
           f"seed {spec.seed}")
-    print(f"objective: {OBJECTIVE_LABELS[spec.objective]}  [{result.objective_source}]")
+    print(f"objective: {result.objective_label}  [{result.objective_source}]")
     fmt = lambda x: "n/a" if x is None else f"{x:.6g}"  # noqa: E731
     print(f"search : worst objective {fmt(worst.objective)} in {len(result.search)} runs "
           f"(sup|E| = {worst.sup_E:.6g} rad, sup|E'| = {worst.sup_Edot:.6g} rad/s, {worst.verdict})")

@@ -50,7 +50,7 @@ from wmr_mj.report.settings import (
     max_at,
     stage_progress,
 )
-from wmr_mj.searches.falsify import OBJECTIVE_LABELS, FalsifySpec, objective_value, search_worst
+from wmr_mj.searches.falsify import FalsifySpec, objective_label, objective_value, search_worst
 from wmr_mj.sim.designs import CERTIFIED, LADDER, PAPER, Design
 from wmr_mj.sim.many_runs import run_configs
 from wmr_mj.sim.parts import resolve_run
@@ -94,12 +94,6 @@ def search_plans(settings: ValidateSettings) -> tuple[SearchPlan, ...]:
     ) + ((SearchPlan(key="certified-full", title="the certified design over the full uncertainty box",
                      design=CERTIFIED, box="full", objective="sup-E", budget=FULL_BOX_FACTOR * b),)
          if box == "m1" else ())  # over the full box the search above already covers it
-
-
-def _objective_label(plan: SearchPlan, settings: ValidateSettings) -> str:
-    """The search's objective in words; the paper's region named as this cart's on another cart than the C80."""
-    label = OBJECTIVE_LABELS[plan.objective]
-    return label.replace("the paper's region", paper_region_name(settings.cart is None)) if settings.cart else label
 
 
 def _search_spec(plan: SearchPlan, settings: ValidateSettings):
@@ -183,12 +177,12 @@ def _read_back(saved: Path, fingerprint: str) -> dict[str, Any] | None:
 
 
 def _result(plan: SearchPlan, spec, runs: Sequence[Mapping[str, Any]], worst: Mapping[str, Any] | None,
-            reproduced: bool, certificate: Any, out: Path, folder: Path, objective_label: str) -> dict[str, Any]:
+            reproduced: bool, certificate: Any, out: Path, folder: Path, label: str) -> dict[str, Any]:
     return {
         "key": plan.key, "title": plan.title, "fingerprint": _fingerprint(spec), "design": plan.design.name,
         "design_text": plan.design.describe(), "box_name": plan.box,
         "box": {k: list(v) for k, v in spec.box.items()}, "names": list(spec.names), "objective": plan.objective,
-        "objective_label": objective_label, "budget": spec.budget,
+        "objective_label": label, "budget": spec.budget,
         "method": spec.method, "population": spec.population_size,
         "generations": 1 + max(r["generation"] for r in runs),
         "evaluations": len(runs), "seed": spec.seed, "worst": None if worst is None else dict(worst),
@@ -214,17 +208,18 @@ def run_search(plan: SearchPlan, settings: ValidateSettings, folder: Path, st: S
         st.done(f"read back from search-{plan.key}/search.json")
         return result
     runs = _evaluate_search(spec, nthread=settings.nthread, progress=stage_progress(st))
+    label = objective_label(plan.objective, on_c80=settings.cart is None)  # the paper's region: this cart's
     worst = _worst_of(runs)
     out.mkdir(parents=True, exist_ok=True)
     logged = None
     if worst:
         logged = run_logged(spec.config([worst["params"][n] for n in spec.names]), str(out / "worst.mcap"))
     result = _result(plan, spec, runs, worst, bool(worst and logged is not None and logged.sup_E == worst["sup_E"]),
-                     resolve_run(spec.base).claim, out, folder, _objective_label(plan, settings))
+                     resolve_run(spec.base).claim, out, folder, label)
     _compare(result, plan, rungs, folder)
     write_text_atomic(out / "evaluations.csv", _evaluations_csv(spec.names, runs))
     write_json_atomic(out / "search.json", result)
-    st.done(f"worst {_num(worst and worst['objective'])} ({_objective_label(plan, settings)})"
+    st.done(f"worst {_num(worst and worst['objective'])} ({label})"
             + loud(result["verdicts"]["certified-outside"], f"search {plan.key}"))
     return result
 

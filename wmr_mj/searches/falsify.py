@@ -110,6 +110,7 @@ from wmr_mj.searches.falsify_objectives import (
     certificate_E_max,
     check_objective_applies,
     check_objective_defined,
+    objective_label,
     objective_source,
     objective_value,
     shares_the_base_certificate,
@@ -153,6 +154,7 @@ __all__ = [
     "METHOD_LABELS",
     "covering_design",
     "OBJECTIVE_LABELS",
+    "objective_label",
     "FalsifySpec",
     "FalsifyResult",
     "WorstRun",
@@ -591,8 +593,9 @@ class FalsifyResult:
 
     @property
     def objective_label(self) -> str:
-        """The objective in words (:data:`OBJECTIVE_LABELS`: ``sup|E|/E_max of the certificate``)."""
-        return OBJECTIVE_LABELS[self.spec.objective]
+        """The objective in words (:func:`objective_label`: ``sup|E|/E_max of the certificate``; the paper's region
+        named as this cart's on another cart than the C80)."""
+        return objective_label(self.spec.objective, on_c80=getattr(self.spec.base, "cart", None) is None)
 
     @property
     def tightness(self) -> Tightness | None:
@@ -621,7 +624,7 @@ class FalsifyResult:
                     f"{factor:.3g} times the worst case found (sup|E| >= {w.sup_E:.4g} rad found, <= {bound} rad "
                     "certified)")
         if self.spec.objective != "certificate":
-            text += f" (the worst run by {OBJECTIVE_LABELS[self.spec.objective]})"
+            text += f" (the worst run by {self.objective_label})"
         return Tightness(ratio=x, factor=factor, found_sup_E=w.sup_E, E_max=e_max, text=text)
 
     @property

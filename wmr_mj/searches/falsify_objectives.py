@@ -22,17 +22,28 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from controllers import SteeringController
+from wmr_mj.analysis.verdicts import PAPER_REGION_ON_CART
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.searches.search_space import hardware_axis, path_axis, signal_axis
 from wmr_mj.sim.coerce import coerced
 from wmr_mj.sim.config import RunConfig, estimate_of
 
-__all__ = ["OBJECTIVES", "OBJECTIVE_LABELS", "objective_value", "objective_source", "check_objective_applies",
-           "check_objective_defined", "shares_the_base_certificate", "verdict_of", "certificate_E_max", "binding_term"]
+__all__ = ["OBJECTIVES", "OBJECTIVE_LABELS", "objective_label", "objective_value", "objective_source",
+           "check_objective_applies", "check_objective_defined", "shares_the_base_certificate", "verdict_of",
+           "certificate_E_max", "binding_term"]
 
 OBJECTIVES = ("certificate", "paper", "sup-E", "requirement")
 OBJECTIVE_LABELS = {"certificate": "sup|E|/E_max of the certificate", "paper": "sup|E|/E_max of the paper's region",
                     "sup-E": "sup|E| [rad]", "requirement": "-robustness of the requirement (> 0: falsified)"}
+
+
+def objective_label(objective: str, *, on_c80: bool = True) -> str:
+    """The objective in words (:data:`OBJECTIVE_LABELS`); on another cart than the paper's C80 (``on_c80`` False:
+    the run's cart record is not None) the paper's region is named as this cart's
+    (:data:`wmr_mj.analysis.verdicts.PAPER_REGION_ON_CART`)."""
+    if objective == "paper" and not on_c80:
+        return f"sup|E|/E_max of {PAPER_REGION_ON_CART}"
+    return OBJECTIVE_LABELS[objective]
 
 
 def _ratio(sup: float, bound: Any) -> float | None:
