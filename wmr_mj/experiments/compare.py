@@ -37,6 +37,7 @@ from typing import Any
 
 import numpy as np
 
+from wmr_mj._util.deprecation import deprecated_names
 from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE, count_unmet, unmet_assumptions
 from wmr_mj.errors import ParameterError
 from wmr_mj.experiments.suite import Scenario, Suite, load_suite, versions
@@ -516,13 +517,10 @@ class _CompareRecord(Record):
     steps: int
 
 
-def __getattr__(name: str) -> Any:
-    if name == "CompareReport":  # deprecated alias: keep one release (CompareResult is compare's one result)
-        warnings.warn("wmr_mj.experiments.compare.CompareReport is deprecated: CompareResult is the comparison's one "
-                      "result (read it by attribute; to_dict(runs=False) is compare.json's object)", DeprecationWarning,
-                      stacklevel=2)
-        return _CompareRecord
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+# deprecated alias: keep one release (CompareResult is compare's one result)
+__getattr__ = deprecated_names(__name__, {"CompareReport": (
+    _CompareRecord, "CompareResult is the comparison's one result (read it by attribute; to_dict(runs=False) is "
+    "compare.json's object)")})
 
 
 def compare(designs: Sequence[Design], suite: Suite, *, scenarios: Sequence[str] = (), budget: int = 32,

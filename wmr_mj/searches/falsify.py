@@ -100,6 +100,7 @@ from typing import Any
 import numpy as np
 
 from wmr_mj._util.checks import positive_range
+from wmr_mj._util.deprecation import deprecated_names
 from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE, VERDICTS, unmet_assumptions
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import parameter_names, tie_motor_constant
@@ -747,13 +748,10 @@ class FalsifyResult:
 
 
 
-def __getattr__(name: str) -> Any:
-    if name == "FalsifyReport":  # deprecated alias: keep one release (FalsifyResult is falsify's one result)
-        warnings.warn("wmr_mj.searches.falsify.FalsifyReport is deprecated: FalsifyResult is the search's one result "
-                      "(read it by attribute; to_dict(runs=False) is falsify --json's object)", DeprecationWarning,
-                      stacklevel=2)
-        return _FalsifyRecord
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+# deprecated alias: keep one release (FalsifyResult is falsify's one result)
+__getattr__ = deprecated_names(__name__, {"FalsifyReport": (
+    _FalsifyRecord, "FalsifyResult is the search's one result (read it by attribute; to_dict(runs=False) is "
+    "falsify --json's object)")})
 
 
 def falsify(spec: FalsifySpec, *, chunk: int = 128, nthread: int = 0, scheduler: str | None = None,
