@@ -199,7 +199,7 @@ def verdict_lines(summary: Summary) -> list[str]:
     s = summary.settings
     lo, hi = s["m1_range"]
     cart = s.get("cart")  # validate --cart: the cart's name (settings without it: the C80)
-    vehicle = "the C80" if not cart else f"the cart {cart['name']} {cart['version']}"
+    vehicle = _vehicle(summary)
     data = identified_from(str(cart.get("text", ""))) if cart else ()  # a cart identify --data wrote
     if data:
         files = " and ".join(PurePath(name).name for name, _sha256 in data)
@@ -214,9 +214,9 @@ def verdict_lines(summary: Summary) -> list[str]:
 
 
 def _vehicle(summary: ValidateSummary) -> str:
-    """The report's title's vehicle: the MuJoCo C80, or the cart validate was given (its name and version)."""
+    """The report's vehicle: the C80, or the cart validate was given (its name and version)."""
     cart = summary.settings.get("cart")
-    return "the MuJoCo C80" if not cart else f"the MuJoCo cart {cart['name']} {cart['version']}"
+    return "the C80" if not cart else f"the cart {cart['name']} {cart['version']}"
 
 
 # --------------------------------------------------------------------------- (a) the paper's design
@@ -830,7 +830,8 @@ def document(summary: Summary) -> list[Block]:
         ("answer", verdict_lines(summary)),
         *banner(summary),
         *lead,
-        ("h1", f"wmr-mj validate: does the paper's steering controller keep its promise on {_vehicle(summary)}?"),
+        ("h1", "wmr-mj validate: does the paper's steering controller keep its promise on the MuJoCo "
+               f"{_vehicle(summary).removeprefix('the ')}?"),
         ("p", f"{summary.created} - {_settings_line(summary)}."),
         *answer_blocks(summary, with_banner=False),
         ("h2", f"(f) Identification (m1 = {ident['m1']:g} kg, {ident['duration']:g} s excitation)"),
