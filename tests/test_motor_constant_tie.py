@@ -45,3 +45,19 @@ def test_a_falsify_point_over_both_constants_is_tied_too():
     config = spec.config([600.0, 1.02 * K, 0.96 * K])
     assert config.plant_overrides["k_b"] == config.plant_overrides["k_i"] == 1.02 * K
     assert spec.recorded_values([600.0, 1.02 * K, 0.96 * K])["k_b"] == 1.02 * K
+
+
+def test_sweep_refuses_a_k_b_range_that_does_not_hold_k_i_s_in_one_line(tmp_path, capsys):
+    from wmr_mj.cli.app import main
+
+    code = main(["sweep", "--n", "2", "--duration", "15", "--range", f"k_i={0.9 * K}:{1.1 * K}",
+                 "--range", f"k_b={0.95 * K}:{1.05 * K}", "--out", str(tmp_path / "sweep")])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1 and "k_b's range holding k_i's" in err
+    assert "Traceback" not in err and not (tmp_path / "sweep").exists()  # refused before any work is written
+
+
+def test_a_falsify_box_whose_k_b_range_does_not_hold_k_i_s_is_refused_at_its_spec():
+    with pytest.raises(ParameterError, match=r"k_b's range holding k_i's"):
+        FalsifySpec(base=RunConfig.from_inputs(duration=10.0), budget=8,
+                    box={"m1": (550.0, 750.0), "k_i": (0.9 * K, 1.1 * K), "k_b": (0.95 * K, 1.05 * K)})

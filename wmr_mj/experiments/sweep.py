@@ -117,6 +117,8 @@ class SweepSpec:
             if name not in names:
                 raise UnknownNameError("axis name", name, [*sorted(names), *HARDWARE_AXES])
             positive_range(name, lo, hi)
+        # k_i and k_b both ranged: each run takes k_b = k_i, so k_b's range must hold k_i's (refused before any run)
+        tie_motor_constant({name: lo for name, (lo, _hi) in self.ranges.items()}, self.ranges)
         if self.sampling == "grid":
             d = self.grid_dimensions
             if d == 0:

@@ -259,7 +259,7 @@ class FalsifySpec:
             # the certificate declares one bound for the whole search: the largest amplitude of the box
             declared = dataclasses.replace(signals, d_max=max(abs(float(amplitude[0])), abs(float(amplitude[1]))))
             object.__setattr__(self, "base", self.base.replace(signals=declared))
-        config_for(self.base, self.names, [lo for lo, _ in self.box.values()])  # a bad axis fails before any run
+        self.config([lo for lo, _ in self.box.values()])  # a bad axis, or k_b's range not holding k_i's, fails here
         if isinstance(self.seed, bool) or not isinstance(self.seed, int):
             raise ParameterError(f"seed = {self.seed!r} is not accepted; give an integer")
         check_budget(self.budget, self.population_size if self.population_size is not None else MIN_POPULATION,
