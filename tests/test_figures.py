@@ -136,11 +136,11 @@ def _legend_labels(fig):
 
 
 def test_verdict_plane_draws_each_region_exactly_and_counts_each_verdict():
-    from wmr_mj.figures.plots import CERTIFICATE_GID, Region, figure_verdict_plane
+    from wmr_mj.figures.plots import CERTIFICATE_GID, DrawnRegion, figure_verdict_plane
 
     cert = [(0.0, 0.0), (0.04, 0.0), (0.046, 0.34), (0.0, 0.33)]
     paper = [(0.0, 0.0), (0.005, 0.0), (0.005, 0.04), (0.0, 0.04)]
-    regions = [Region("certificate", cert, gid=CERTIFICATE_GID), Region("paper's claim", paper, filled=False,
+    regions = [DrawnRegion("certificate", cert, gid=CERTIFICATE_GID), DrawnRegion("paper's claim", paper, filled=False,
                                                                         gid=REGION_GID)]
     E, Ed = [0.02, 0.03, 0.05, 0.01], [0.1, 0.1, 0.2, 0.01]
     verdicts = ["certified-inside", "certified-inside", "certified-outside", "uncertified-inside"]
@@ -155,9 +155,9 @@ def test_verdict_plane_draws_each_region_exactly_and_counts_each_verdict():
 
 
 def test_verdict_plane_splits_into_region_scale_and_full_range_when_runs_leave_it():
-    from wmr_mj.figures.plots import Region, figure_verdict_plane
+    from wmr_mj.figures.plots import DrawnRegion, figure_verdict_plane
 
-    region = Region("r", [(0.0, 0.0), (0.1, 0.0), (0.1, 0.1), (0.0, 0.1)])
+    region = DrawnRegion("r", [(0.0, 0.0), (0.1, 0.0), (0.1, 0.1), (0.0, 0.1)])
     E = [0.05, 1.5, 0.6]  # two beyond 3x the region
     fig = figure_verdict_plane(E, [0.05, 2.0, 2.3], ["uncertified-outside"] * 3, [region], note="no certificate")
     panels = [ax for ax in fig.axes if ax.patches]

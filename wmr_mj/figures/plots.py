@@ -26,7 +26,7 @@ stem.svg atomically.
 
 The validation's figures (``wmr-mj validate``)::
 
-    figure_verdict_plane(sup_E, sup_Edot, verdicts, [Region("certificate", cert.vertices,
+    figure_verdict_plane(sup_E, sup_Edot, verdicts, [DrawnRegion("certificate", cert.vertices,
                          gid=CERTIFICATE_GID)])      # every run of a sweep, by verdict, with regions
     figure_ladder(labels, counts, paper_inside)      # verdict counts per rung, stacked bars
     figure_search_history([SearchHistory(title, ylabel, values, mc_worst=..., bound=1.0)])
@@ -99,7 +99,7 @@ __all__ = [
     "CERTIFICATE_GID",
     "VERDICT_COLORS",
     "PAPER_CLAIM_COLOR",
-    "Region",
+    "DrawnRegion",
     "plot_region_polygon",
     "plot_verdict_points",
     "figure_verdict_plane",
@@ -577,8 +577,9 @@ def figure_time_history(rows: Mapping[str, np.ndarray], summary: Any, *,
 
 # --------------------------------------------------------------------------- the validation's figures
 @dataclass(frozen=True)
-class Region:
-    """A region of the (||E||, ||E'||) plane to draw: its polygon and how.
+class DrawnRegion:
+    """A region of the (||E||, ||E'||) plane as drawn (a patch): its polygon and how; the claim's region itself is
+    a :class:`wmr_mj.analysis.regions.Region`.
 
     vertices: the polygon (e.g. ``Certificate.vertices``, ``RobustnessResult.vertices``);
     empty when the region does not exist. filled: a filled patch (else a dashed outline).
@@ -597,7 +598,7 @@ class Region:
         return (float(v[:, 0].max()), float(v[:, 1].max())) if v.size else (0.0, 0.0)
 
 
-def plot_region_polygon(ax, region: Region):
+def plot_region_polygon(ax, region: DrawnRegion):
     """Draw ``region`` (its vertices exactly); the Polygon, or None when the region is empty."""
     if not len(region.vertices):
         return None
@@ -634,7 +635,7 @@ def plot_verdict_points(ax, sup_E: Sequence[float], sup_Edot: Sequence[float], v
     return out
 
 
-def _plane_panel(ax, E, Ed, verdicts, regions: Sequence[Region], note: str | None) -> None:
+def _plane_panel(ax, E, Ed, verdicts, regions: Sequence[DrawnRegion], note: str | None) -> None:
     for region in regions:
         plot_region_polygon(ax, region)
     plot_verdict_points(ax, E, Ed, verdicts)
@@ -646,7 +647,7 @@ def _plane_panel(ax, E, Ed, verdicts, regions: Sequence[Region], note: str | Non
 
 
 def figure_verdict_plane(sup_E: Sequence[float], sup_Edot: Sequence[float], verdicts: Sequence[str],
-                         regions: Sequence[Region] = (), *, title: str | None = None, note: str | None = None,
+                         regions: Sequence[DrawnRegion] = (), *, title: str | None = None, note: str | None = None,
                          zoom_factor: float = _ZOOM_FACTOR) -> Figure:
     """Every run of a sweep at (sup|E|, sup|E'|) by verdict, with ``regions`` (e.g. the
     certificate's, filled, and the paper's claim, dashed); ``note`` in a box (e.g. why there

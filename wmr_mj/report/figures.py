@@ -40,10 +40,10 @@ __all__ = ["figures_stage", "travelled_paths"]
 def _rung_figure(rung: Rung, folder: Path, claim: str):
     rows = read_runs((folder / rung.runs_csv).parent)
     cert, paper = rung.certificate, rung.paper_region
-    regions = [plots.Region(f"certificate: |E| <= {cert['E_max']:.3g} rad, |E'| <= {cert['Edot_max']:.3g} rad/s",
+    regions = [plots.DrawnRegion(f"certificate: |E| <= {cert['E_max']:.3g} rad, |E'| <= {cert['Edot_max']:.3g} rad/s",
                             [tuple(v) for v in cert["vertices"]], gid=plots.CERTIFICATE_GID)] if cert["valid"] else []
     if paper["vertices"]:
-        regions.append(plots.Region(f"{claim.removeprefix('the ')}: |E| <= {paper['E_max']:.3g} rad, |E'| <= "
+        regions.append(plots.DrawnRegion(f"{claim.removeprefix('the ')}: |E| <= {paper['E_max']:.3g} rad, |E'| <= "
                                     f"{paper['Edot_max']:.3g} rad/s", [tuple(v) for v in paper["vertices"]],
                                     color=plots.PAPER_CLAIM_COLOR, filled=False, gid=plots.REGION_GID))
     note = None if cert["valid"] else "no certificate:\n" + _wrap(cert["reason"] or ", ".join(cert["unmet"]), 48)
