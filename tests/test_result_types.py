@@ -1,31 +1,46 @@
-"""One result type per command (issue 41 item 5): each is a frozen dataclass with ``to_dict``, ``.plot()``,
-``.to_pandas()`` and ``_repr_html_``, and the three this file builds by hand (a design, a cart's tightness, a
-cart check) draw and tabulate the numbers they hold.
+"""One result type per command (issue 41 item 5): each is a frozen dataclass with ``to_dict``/``from_dict``,
+``.plot()``, ``.to_pandas()`` and ``_repr_html_``; every one reads its own JSON back to the bit, and the three this
+file builds by hand (a design, a cart's tightness, a cart check) draw and tabulate the numbers they hold.
 
-The independent truth is the numbers each result is built from here (no run, no search: the fields are given),
-read back from the figure's artists and the table's cells to the bit.
+The independent truth is the numbers each result is built from here (the fields are given; a run's are those the
+run measured), read back from the JSON, the figure's artists and the table's cells to the bit.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import html
+import json
+import math
+import struct
+from collections.abc import Mapping
+from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
 from matplotlib.figure import Figure
 
-from wmr_mj.analysis.claim_types import Assumption
-from wmr_mj.experiments.cart_check import CartCheck
-from wmr_mj.experiments.compare import CompareResult
+from wmr_mj._util.files import json_safe
+from wmr_mj.analysis.claim_types import LAW_CLAIM, Assumption
+from wmr_mj.analysis.requirements import parse_requirement
+from wmr_mj.experiments.cart_check import CartCheck, NamedCart
+from wmr_mj.experiments.compare import CompareResult, DesignRow, ScenarioRun
+from wmr_mj.experiments.suite import load_suite
+from wmr_mj.experiments.sweep import SweepSpec, SweepSummary
 from wmr_mj.experiments.sweep_result import SweepResult
 from wmr_mj.experiments.tightness import CartTightness
+from wmr_mj.hardware import Actuation, Sensing, Transmission
+from wmr_mj.params import COEFFICIENT_NAMES, Coefficients
 from wmr_mj.plant.cartcheck import COEFFICIENT_UNITS, CoefficientCheck, IdentificationCheck, RandomStepCheck
+from wmr_mj.plant.identify import IdentificationResult
 from wmr_mj.report.results import ValidateSummary
 from wmr_mj.searches.design_search import DesignCertificate, DesignResult
-from wmr_mj.searches.falsify import FalsifyResult
-from wmr_mj.sim.closed_loop import RunResult
+from wmr_mj.searches.falsify import Evaluation, FalsifyResult, FalsifySpec
+from wmr_mj.sim.closed_loop import RunResult, run_parts
+from wmr_mj.sim.coerce import coerced
+from wmr_mj.sim.config import RunConfig
+from wmr_mj.sim.parts import resolve_run
 
 #: each command's one result type
 RESULTS = {"run": RunResult, "sweep": SweepResult, "falsify": FalsifyResult, "compare": CompareResult,
@@ -33,18 +48,12 @@ RESULTS = {"run": RunResult, "sweep": SweepResult, "falsify": FalsifyResult, "co
            "cart check": CartCheck}
 
 
-#: the results whose JSON cannot be read back: a run's JSON has no rows (the log holds them), a cart check's names
-#: its cart file and the identification's summary, not the identification
-NOT_READ_BACK = {"run", "cart check"}
-
-
 @pytest.mark.parametrize("command", list(RESULTS))
 def test_each_commands_result_is_frozen_and_has_the_notebooks_methods(command):
     kind = RESULTS[command]
     assert dataclasses.is_dataclass(kind) and kind.__dataclass_params__.frozen  # type: ignore[attr-defined]
-    for method in ("to_dict", "plot", "to_pandas", "_repr_html_"):
+    for method in ("to_dict", "from_dict", "plot", "to_pandas", "_repr_html_"):
         assert callable(getattr(kind, method, None)), f"{kind.__name__} has no {method}"
-    assert callable(getattr(kind, "from_dict", None)) == (command not in NOT_READ_BACK)
 
 
 def test_a_run_result_refuses_to_change(certified_run_10s):
@@ -125,6 +134,19 @@ def test_a_tightness_rows_json_table_and_html(tightness):
 
 
 # -- a cart check: the model's coefficients against the plant's ---------------------------------------------------
+def _identification(rows: tuple[CoefficientCheck, ...]) -> IdentificationResult:
+    """An identification whose coefficients are the rows' (identified, implied, paper), NaN where no row."""
+    by_name = {r.name: r for r in rows}
+
+    def model(key: str) -> Coefficients:
+        return Coefficients(**{n: getattr(by_name[n], key) if n in by_name else math.nan for n in COEFFICIENT_NAMES})
+
+    return IdentificationResult(identified=model("identified"),
+                                predicted={"nonholonomic": model("implied"), "paper": model("paper")},
+                                diagnostics={"samples": 9001, "residual_rms_V": 0.0123, "mujoco_warnings": 0},
+                                duration=20.0, seed=3)
+
+
 def _coefficient(name: str, identified: float, implied: float, allowed: float) -> CoefficientCheck:
     return CoefficientCheck(name=name, identified=identified, implied=implied, paper=implied, allowed=allowed)
 
@@ -133,7 +155,7 @@ def _coefficient(name: str, identified: float, implied: float, allowed: float) -
 def cart_check() -> CartCheck:
     """P within its allowance (0.4 of it), F outside (1.5 times it): the check fails on F."""
     rows = (_coefficient("P", 10.4, 10.0, 1.0), _coefficient("F", 2.3, 2.0, 0.2))
-    ident = IdentificationCheck(result=SimpleNamespace(diagnostics={"mujoco_warnings": 0}), rows=rows)
+    ident = IdentificationCheck(result=_identification(rows), rows=rows)
     steps = RandomStepCheck(duration=1.0, steps=1000, seed=0, warnings={}, finite=True)
     cart = SimpleNamespace(name="mine", version="1", path="mine.toml")
     return CartCheck(cart=cart, defaults={"sensing": "exact"}, steps=steps, identification=ident,
@@ -178,3 +200,171 @@ def test_a_cart_check_without_an_identification_says_why():
     assert any("too few sliding samples" in t.get_text() for t in plot.axes[0].texts)
     text = html.unescape(check._repr_html_())
     assert "no omega_r" in text and "supply binds" in text
+
+
+# -- every result reads its own JSON back, to the bit ---------------------------------------------------------------
+def _bit_equal(a, b, where="") -> None:
+    """``a`` and ``b`` hold the same JSON values: the same keys (the commands write them sorted), floats to the bit
+    (NaN and -0.0 told apart), bools as bools."""
+    if isinstance(a, (bool, np.bool_)) or isinstance(b, (bool, np.bool_)):  # a NumPy bool is written as a bool
+        both = isinstance(a, (bool, np.bool_)) and isinstance(b, (bool, np.bool_))
+        assert both and a == b, f"{where}: {a!r} != {b!r}"
+    elif isinstance(a, float) or isinstance(b, float):
+        assert isinstance(a, float) and isinstance(b, float), f"{where}: {a!r} != {b!r}"
+        assert struct.pack("<d", a) == struct.pack("<d", b), f"{where}: {a!r} != {b!r}"
+    elif isinstance(a, Mapping):
+        assert isinstance(b, Mapping) and sorted(a) == sorted(b), f"{where}: keys {sorted(a)} != {sorted(b)}"
+        for key in a:
+            _bit_equal(a[key], b[key], f"{where}.{key}")
+    elif isinstance(a, (list, tuple)):
+        assert isinstance(b, (list, tuple)) and len(a) == len(b), f"{where}: {a!r} != {b!r}"
+        for i, (x, y) in enumerate(zip(a, b)):
+            _bit_equal(x, y, f"{where}[{i}]")
+    else:
+        assert type(a) is type(b) and a == b, f"{where}: {a!r} != {b!r}"
+
+
+_CERT = {"E_max": 0.05, "E_ratio": 1.5, "certified": True,
+         "assumptions": [{"name": "reachable angle", "met": True, "value": 0.5, "limit": 1.57}]}
+
+
+@pytest.fixture()
+def sweep_result() -> SweepResult:
+    spec = SweepSpec(n=2, seed=3, ranges={"mu": (0.01, 0.03)}, base=RunConfig.from_inputs(duration=5.0))
+    rows = ({"run": 0, "m1": 600.0, "mu": 0.02, "verdict": "certified-outside", "certificate": _CERT,
+             "cert_E_ratio": 1.5, "cert_E_max": 0.05, "sup_E": 0.075, "sup_Edot": 0.1, "inside": None,
+             "left_steering_range": False, "saturated_fraction": 0.0, "steps": 10, "batch_law": "compiled"},)
+    return SweepResult(spec=spec, rows=rows, summary=SweepSummary.of(rows, names=spec.names))
+
+
+@pytest.fixture()
+def falsify_result() -> FalsifyResult:
+    spec = FalsifySpec(base=RunConfig.from_inputs(), box={"m1": (550.0, 750.0)}, budget=12)
+    summary = {"sup_E": 0.075, "sup_Edot": 0.2, "verdict": "certified-outside", "certificate": _CERT}
+    return FalsifyResult(spec=spec, search=[Evaluation(phase="search", index=0, generation=0, params={"m1": 0.1 + 700},
+                                                       objective=1.5, summary=summary)],
+                         random=[Evaluation(phase="random", index=0, generation=0, params={"m1": 650.0},
+                                            objective=0.25, summary={**summary, "sup_E": 0.0125})],
+                         objective_source="certificate of the run", log="worst.mcap")
+
+
+@pytest.fixture()
+def compare_result() -> CompareResult:
+    row = DesignRow(label="certified", controller="computed-torque", tracker=None, runs=1, requirements_passed=1,
+                    requirements_total=2, least_normalised=-0.25, least_at="tracking @ circle/nominal",
+                    certified_inside=0, certified_outside=1, uncertified=0, no_claim=0, failed=0, claim_E_max=0.05,
+                    adversary_worst=0.5, adversary_falsified=True, adversary_runs_to_falsify=3,
+                    adversary_where={"m1": 700.0}, adversary_worst_sup_E=0.04, random_worst=0.25,
+                    random_runs_to_falsify=None, tightness=0.1 + 0.7, rms_voltage=3.0, tv_voltage=9.0,
+                    cross_track_max=0.02, cpu_us_per_step=4.0, law="compiled")
+    suite = load_suite("standard-v1")
+    run = ScenarioRun(design="certified", scenario="circle/nominal", summary={"sup_E": 0.075, "verdict": "x"},
+                      requirements={"tracking": {"robustness": -0.01, "satisfied": False}}, rms_voltage=3.0,
+                      tv_voltage=9.0, cpu_us_per_step=4.0, law="compiled")
+    return CompareResult(suite=suite, scenarios=suite.select(["circle/*"]), rows=(row,), runs=(run,), budget=4,
+                         seed=0, versions={"wmr-mj": "x"}, wall_s=2.0, steps=10)
+
+
+@pytest.fixture()
+def design_file(design) -> DesignResult:
+    """The design above with every setting a design file writes: a 12-bit encoder, the 2 ms period."""
+    settings = {"controller": "computed-torque", "controller_params": {}, "model": "nonholonomic", "kp": 530.0,
+                "kd": 46.0, "friction_sign": "measured", "friction_width": 0.01, "control_period": 0.002,
+                "sensing": Sensing.from_spec("encoder_ticks=4096"), "actuation": Actuation(),
+                "transmission": Transmission(backlash=0.001)}
+    return dataclasses.replace(design, settings=settings, evaluations=40, objective="E_max", seed=2,
+                               periods=(0.001, 0.002), box={"m1_range": [550.0, 750.0], "duration": 35.0})
+
+
+@pytest.fixture()
+def validate_summary() -> ValidateSummary:
+    return ValidateSummary.from_dict(json.loads((Path(__file__).parent / "data" / "validate_summary.json").read_text()))
+
+
+@pytest.fixture(scope="module")
+def sensed_run() -> tuple[RunResult, dict]:
+    """A run on a 4096-tick encoder with a differenced velocity at 2 ms, a 2 ms actuation delay and play, judged by
+    two requirements: its JSON has the cart's parts, the measurement errors and the requirements."""
+    config = RunConfig.from_inputs(duration=9.0, path="lane-change", control_period=0.002,
+                                   sensing="encoder_ticks=4096,velocity=difference", actuation="delay=0.002",
+                                   transmission="backlash=0.001")
+    parts = resolve_run(config)
+    requirements = [parse_requirement("always[0,9](abs(E) <= 0.5)", period=0.002),
+                    parse_requirement("cross-track", period=0.002)]
+    return run_parts(parts, progress=False), {"measurement": parts.measurement, "requirements": requirements}
+
+
+#: each result, by the fixture that builds it, and what its to_dict takes (a run's: the log, the measurement errors)
+ROUND_TRIPS = {"run": "certified_run_10s", "run on a sensed cart": "sensed_run", "sweep": "sweep_result",
+               "falsify": "falsify_result", "compare": "compare_result", "validate": "validate_summary",
+               "design": "design_file", "cart tightness": "tightness", "cart check": "cart_check"}
+
+
+def test_every_commands_result_is_in_the_round_trip():
+    assert {k for k in ROUND_TRIPS if k in RESULTS} == set(RESULTS)
+
+
+@pytest.mark.parametrize("case", list(ROUND_TRIPS))
+def test_each_result_reads_its_own_json_back_to_the_bit(case, request):
+    """``X.from_dict(x.to_dict())`` writes the same JSON again (floats to the bit), directly and through a JSON
+    file; a result whose JSON holds all of it reads back equal, a run and a cart check restore what their JSON
+    holds (each from_dict's docstring names what it does not)."""
+    made = request.getfixturevalue(ROUND_TRIPS[case])
+    result, arguments = made if isinstance(made, tuple) else (made, {})
+    kind = type(result)
+    if kind is RunResult:
+        arguments = {**arguments, "log": "run.mcap"}
+    rewrite = {k: v for k, v in arguments.items() if k != "requirements"}  # judged once, then in the summary
+    d = result.to_dict(**arguments)
+    back = kind.from_dict(d)
+    _bit_equal(back.to_dict(**rewrite), d)
+    text = json.dumps(json_safe(d), sort_keys=True, allow_nan=False)  # as a command writes its JSON file
+    again = kind.from_dict(json.loads(text))
+    assert json.dumps(json_safe(again.to_dict(**rewrite)), sort_keys=True, allow_nan=False) == text
+    if kind is RunResult:
+        _a_runs_restored_fields_match(result, back, d)
+    elif kind is CartCheck:
+        _a_cart_checks_restored_fields_match(result, back)
+    else:
+        assert back == result
+
+
+def _a_runs_restored_fields_match(result: RunResult, back: RunResult, d: dict) -> None:
+    s, b = result.summary, back.summary
+    for field in dataclasses.fields(s):  # every number and name of the summary, to the bit
+        value = getattr(s, field.name)
+        if field.name != "requirements" and (value is None or isinstance(value, (str, bool, int, float))):
+            _bit_equal(getattr(b, field.name), value, field.name)
+    assert b.paper_region == s.paper_region and b.drift == s.drift and b.path_error == s.path_error
+    assert b.path_bound == s.path_bound and b.path_verdict == s.path_verdict and b.effort == s.effort
+    assert b.route == s.route and b.batch == s.batch
+    # the requirements the summary had, or those to_dict judged (read back as the summary's)
+    assert [r.to_dict() for r in b.requirements or ()] == d.get("requirements", [])
+    cert, cert_back = s.certificate.certificate, b.certificate.certificate
+    assert (cert_back.region, cert_back.valid) == (cert.region, cert.valid)
+
+    def finite(x: float) -> float:  # a value the JSON writes null (not finite) reads back NaN
+        return x if math.isfinite(x) else math.nan
+
+    _bit_equal([dataclasses.astuple(a) for a in cert_back.assumptions],
+               [dataclasses.astuple(dataclasses.replace(a, value=finite(a.value), limit=finite(a.limit)))
+                for a in cert.assumptions])
+    _bit_equal([cert_back.alpha_max, cert_back.voltage_max, cert_back.iterations],
+               [cert.alpha_max, cert.voltage_max, cert.iterations])
+    if cert.terms is not None:  # section 4's terms, but delta1's parts (not in the JSON)
+        assert cert_back.terms == dataclasses.replace(cert.terms, delta1_parts=())
+    assert back.claims[LAW_CLAIM] is b.certificate and back.status == result.status and back.rows == {}
+    typed = coerced(result.config)
+    for name in ("controller", "model", "m1", "kp", "kd", "path", "duration", "signals", "sensing", "actuation",
+                 "transmission", "controller_plugin"):
+        assert getattr(back.config, name) == getattr(typed, name), name
+
+
+def _a_cart_checks_restored_fields_match(check: CartCheck, back: CartCheck) -> None:
+    cart = check.cart
+    assert back.cart == NamedCart(name=cart.name, version=cart.version, path=str(cart.path))
+    assert back.steps == check.steps and back.identification.rows == check.identification.rows
+    r, rb = check.identification.result, back.identification.result
+    assert (rb.identified, rb.predicted, rb.duration, rb.seed) == (r.identified, r.predicted, r.duration, r.seed)
+    assert (back.defaults, back.certified_design, back.design) == (check.defaults, check.certified_design, check.design)
+    assert (back.passed, back.answer, back.design_wall_s) == (check.passed, check.answer, 0.0)

@@ -23,7 +23,7 @@ from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from typing import Any, Literal, Protocol, get_args
 
-from wmr_mj.analysis.regions import Region, SmallGainRegion, check_region
+from wmr_mj.analysis.regions import BoxRegion, Region, SmallGainRegion, check_region
 from wmr_mj.analysis.robustness import damping_regime
 from wmr_mj.errors import ParameterError
 
@@ -55,6 +55,16 @@ def finite_or_none(x: float) -> float | None:
     return x if math.isfinite(x) else None
 
 
+def _inf_if_none(x: float | None) -> float:
+    """A bound as :func:`finite_or_none` wrote it: null (not finite) is inf."""
+    return math.inf if x is None else x
+
+
+def _nan_if_none(x: float | None) -> float:
+    """A value as :func:`finite_or_none` wrote it: null (not finite) is NaN."""
+    return math.nan if x is None else x
+
+
 @dataclass(frozen=True)
 class Assumption:
     """One assumption of the certificate: ``met`` when ``value`` is within ``limit``.
@@ -76,6 +86,12 @@ class Assumption:
         return {"name": self.name, "equation": self.equation, "met": bool(self.met),
                 "value": finite_or_none(self.value), "limit": finite_or_none(self.limit),
                 "note": self.note, "kind": self.kind}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> Assumption:
+        """The assumption of its JSON ``d`` (:meth:`to_dict`); a value or limit that is null (not finite) is NaN."""
+        return cls(name=d["name"], equation=d["equation"], met=d["met"], value=_nan_if_none(d["value"]),
+                   limit=_nan_if_none(d["limit"]), note=d.get("note", ""), kind=d.get("kind", "checked"))
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -110,6 +126,16 @@ class MeasurementCause:
                 "binding": list(self.binding),
                 "E_max_without": {name: finite_or_none(E) for name, E in self.E_max_without},
                 "E_max_exact": None if self.E_max_exact is None else finite_or_none(self.E_max_exact)}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> MeasurementCause:
+        """The cause of its JSON ``d`` (:meth:`to_dict`; ``binding`` is derived). A null error or E_max is inf (the
+        writer's null of inf); E_max_exact null is None where E_max_without is empty (a fixed point), else inf."""
+        without = tuple((name, _inf_if_none(E)) for name, E in d["E_max_without"].items())
+        exact = d["E_max_exact"]
+        return cls(e_a=_inf_if_none(d["e_a"]), e_v=_inf_if_none(d["e_v"]), tau=_inf_if_none(d["tau"]),
+                   E_max_without=without,
+                   E_max_exact=(None if not without else math.inf) if exact is None else exact)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -160,10 +186,25 @@ class SmallGainTerms:
         out["friction_sign"] = self.friction_sign
         return out
 
+    @classmethod
+    def from_json_items(cls, d: Mapping[str, Any], *, measurement_cause: MeasurementCause | None = None
+                        ) -> SmallGainTerms:
+        """The terms of a certificate's JSON ``d`` (what :meth:`json_items` wrote there; a null term is inf).
+
+        ``delta1_parts`` is not in that JSON and is () here; ``measurement_cause`` is the run JSON's
+        ``measurement_errors`` (:meth:`MeasurementCause.from_dict`), given by the caller that has it."""
+        terms: dict[str, Any] = {name: _inf_if_none(d[name]) for name in _TERM_KEYS}
+        return cls(**terms, disturbance_term=_inf_if_none(d.get("disturbance_term", 0.0)),
+                   measurement_term=_inf_if_none(d.get("measurement_term", 0.0)), friction_sign=d["friction_sign"],
+                   measurement_cause=measurement_cause)
+
 
 #: What the term properties of a claim without section 4's terms read (a law's box claim, the sampled-data
 #: certificate): placeholders, no claim of the law's; its JSON writes none of them (:meth:`Certificate.to_dict`).
 _NO_TERMS = SmallGainTerms(friction_term=math.nan, gyro_term=math.nan, friction_sign="none")
+
+#: Section 4's region's numbers in the JSON beside its corner (E_max, Edot_max).
+_REGION_KEYS = ("gamma1", "gamma2", "delta1", "delta2", "delta3")
 
 #: The terms' keys in the JSON, in order (disturbance_term, measurement_term and friction_sign follow).
 _TERM_KEYS = ("friction_term", "gyro_term", "K_term", "P_term", "C_V_term", "gyro_Edot_term", "dead_band", "kp", "kd",
@@ -356,7 +397,7 @@ class Certificate:
             out["condition"] = finite_or_none(self.condition)
         out.update(valid=bool(self.valid), certified=self.certified, reason=self.reason,
                    assumptions=[a.to_dict() for a in self.assumptions], unmet=list(self.unmet))
-        for name in ("gamma1", "gamma2", "delta1", "delta2", "delta3") if small_gain else ():
+        for name in _REGION_KEYS if small_gain else ():
             out[name] = finite_or_none(getattr(self, name))
         out.update(alpha_max=finite_or_none(self.alpha_max), voltage_max=finite_or_none(self.voltage_max))
         if self.terms is not None:  # section 4's terms; a claim without them writes none
@@ -370,6 +411,38 @@ class Certificate:
         if self.claimant:
             out["claimant"] = self.claimant
         return out
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any], *, measurement_cause: MeasurementCause | None = None) -> Certificate:
+        """The claim of its JSON ``d`` (what :meth:`to_dict` wrote), such that ``to_dict()`` writes ``d`` again.
+
+        The region is rebuilt from its numbers (section 4's from gamma1 ... delta3 and its corner; a box from
+        E_max, Edot_max); a null number (not finite) is inf. Not in the JSON, so not restored: the terms'
+        ``delta1_parts`` (()), their ``measurement_cause`` (``measurement_cause``: the run JSON's
+        ``measurement_errors``, given by the caller), ``analysis`` (''); the ``inputs`` are the law's inputs as
+        a mapping (not the typed record they were).
+
+        Raises:
+            ParameterError: a region kind this module does not know (a plug-in's own region): one line.
+        """
+        E_max, Edot_max = _inf_if_none(d["E_max"]), _inf_if_none(d["Edot_max"])
+        kind = d.get("region", SmallGainRegion.kind)
+        region: Region
+        if kind == SmallGainRegion.kind:
+            region = SmallGainRegion(**{name: _inf_if_none(d[name]) for name in _REGION_KEYS},
+                                     E_max=E_max, Edot_max=Edot_max)
+        elif kind == BoxRegion.kind:
+            region = BoxRegion(E_max=E_max, Edot_max=Edot_max)
+        else:
+            raise ParameterError(f"region {kind!r} is not read back: a certificate's JSON is read for the regions "
+                                 f"{SmallGainRegion.kind!r} and {BoxRegion.kind!r}")
+        terms = (SmallGainTerms.from_json_items(d, measurement_cause=measurement_cause)
+                 if "friction_term" in d else None)
+        assumptions = tuple(Assumption.from_dict(a) for a in d["assumptions"])
+        return cls(region=region, valid=d["valid"], assumptions=assumptions,
+                   alpha_max=_inf_if_none(d["alpha_max"]), voltage_max=_inf_if_none(d["voltage_max"]), terms=terms,
+                   reason=d["reason"], iterations=d["iterations"], inputs=ClaimInputs(law=dict(d["inputs"])),
+                   claimant=d.get("claimant", ""))
 
 
 #: The claim type (section 4's certificate and a law's own claim alike).
@@ -491,6 +564,15 @@ class CertificateJudgement:
         out.update(inside=self.inside, E_ratio=self.E_ratio, Edot_ratio=self.Edot_ratio,
                    region_ratio=self.region_ratio, verdict=self.verdict, sup_E=self.sup_E, sup_Edot=self.sup_Edot)
         return out
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any], *, measurement_cause: MeasurementCause | None = None
+                  ) -> CertificateJudgement:
+        """The judgement of its JSON ``d`` (:meth:`to_dict`): the certificate as :meth:`Certificate.from_dict`
+        restores it (``measurement_cause`` goes to its terms), and the run's numbers as written."""
+        return cls(certificate=Certificate.from_dict(d, measurement_cause=measurement_cause), inside=d["inside"],
+                   E_ratio=d["E_ratio"], Edot_ratio=d["Edot_ratio"], region_ratio=d["region_ratio"],
+                   verdict=d["verdict"], sup_E=d["sup_E"], sup_Edot=d["sup_Edot"])
 
 
 def judge(cert: Certificate, sup_E: float, sup_Edot: float) -> CertificateJudgement:

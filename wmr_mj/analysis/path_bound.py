@@ -148,6 +148,13 @@ class PathBound:
         d["radius_range"] = None if self.radius_range is None else list(self.radius_range)
         return d
 
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> PathBound:
+        """The bound of its JSON ``d`` (what :meth:`to_dict` wrote: the lists as tuples again)."""
+        radius_range = d.get("radius_range")
+        return cls(**{**d, "assumptions": tuple(d["assumptions"]),
+                      "radius_range": None if radius_range is None else tuple(radius_range)})
+
 
 #: How a path bound without a bound on |E| says so.
 _NO_E_BOUND = "there is no bound on the steering error |E|"
@@ -335,6 +342,11 @@ class PathVerdict:
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> PathVerdict:
+        """The verdict of its JSON ``d`` (what :meth:`to_dict` wrote)."""
+        return cls(**d)
 
 
 def path_verdict(errors: Any, bound: PathBound) -> PathVerdict:

@@ -41,6 +41,7 @@ from __future__ import annotations
 import ctypes
 import math
 import os
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from functools import cache
 from typing import Any
@@ -126,6 +127,11 @@ class PathErrors:
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict: the fields under their names (units as in the field docs)."""
         return asdict(self)
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> PathErrors:
+        """The errors of their JSON ``d`` (what :meth:`to_dict` wrote)."""
+        return cls(**d)
 
 
 def _as_reference_arrays(reference: Any) -> tuple[np.ndarray, ...]:

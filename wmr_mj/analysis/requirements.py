@@ -372,6 +372,17 @@ class RequirementResult:
             d["note"] = self.note
         return d
 
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> RequirementResult:
+        """The result of its JSON ``d`` (what :meth:`to_dict` wrote): ``requirement`` is written only where it is
+        not the formula, and a formula that is None (a preset with no finite bound) is written as the requirement."""
+        if "requirement" not in d:
+            return cls(requirement=d["formula"], formula=d["formula"], robustness=d["robustness"],
+                       satisfied=d["satisfied"], note=d.get("note", ""))
+        formula = None if d["formula"] == d["requirement"] else d["formula"]
+        return cls(requirement=d["requirement"], formula=formula, robustness=d["robustness"],
+                   satisfied=d["satisfied"], note=d.get("note", ""))
+
 
 def parse_requirement(text: str, *, period: float, signals: Sequence[str] = SIGNALS) -> Requirement:
     """Check ``text`` (a preset or a formula over ``signals``) before any run: it parses, names

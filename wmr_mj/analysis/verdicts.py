@@ -112,6 +112,11 @@ class Drift:
                 "E_last_window": self.E_last_window, "E_prev_window": self.E_prev_window,
                 "window_s": self.window_s, "tolerance": self.tolerance}
 
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> Drift:
+        """The drift of its JSON ``d`` (what :meth:`to_dict` wrote)."""
+        return cls(**d)
+
 
 @dataclass(frozen=True)
 class PaperRegion:
@@ -132,6 +137,18 @@ class PaperRegion:
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready, the run summary's paper_region keys (inf stays inf; the writers make it null)."""
         return {"E_max": self.E_max, "Edot_max": self.Edot_max, "condition": self.condition, "inside": self.inside}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> PaperRegion:
+        """The region of its JSON ``d`` (what :meth:`to_dict` wrote; a null bound, as a JSON file writes inf, is
+        inf again)."""
+        return cls(E_max=_inf_if_none(d["E_max"]), Edot_max=_inf_if_none(d["Edot_max"]),
+                   condition=_inf_if_none(d["condition"]), inside=d["inside"])
+
+
+def _inf_if_none(x: float | None) -> float:
+    """A bound as JSON wrote it: null (inf, as the writers make it) is inf."""
+    return math.inf if x is None else x
 
 
 @dataclass(frozen=True)

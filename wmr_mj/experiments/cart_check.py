@@ -24,7 +24,13 @@ from typing import Any
 from wmr_mj.errors import InfeasiblePathError, ParameterError, StiffReferenceError, WmrMjError
 from wmr_mj.hardware import Actuation, Sensing, Transmission
 from wmr_mj.params import parameters_of_cart
-from wmr_mj.plant.cartcheck import COEFFICIENT_UNITS, check_identification, step_with_random_controls
+from wmr_mj.plant.cartcheck import (
+    COEFFICIENT_UNITS,
+    IdentificationCheck,
+    RandomStepCheck,
+    check_identification,
+    step_with_random_controls,
+)
 from wmr_mj.reference.route import path_name
 from wmr_mj.searches.design_search import (
     DEFAULT_BUDGET,
@@ -40,7 +46,21 @@ from wmr_mj.sim.config import RunConfig, build_reference
 from wmr_mj.sim.designs import certified_design
 from wmr_mj.sim.parts import resolve_run
 
-__all__ = ["CartCheck", "cart_check", "default_parts", "certified_on_cart", "design_on_cart"]
+__all__ = ["CartCheck", "NamedCart", "cart_check", "default_parts", "certified_on_cart", "design_on_cart"]
+
+
+@dataclass(frozen=True, kw_only=True)
+class NamedCart:
+    """A cart file as a cart check's JSON names it (:meth:`CartCheck.from_dict`): the file is named, not read.
+
+    Attributes:
+        name, version: the file's name and version.
+        path: the file checked, as the JSON wrote it.
+    """
+
+    name: str
+    version: str
+    path: str
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -90,6 +110,23 @@ class CartCheck:
                 "identification_error": self.identification_error,
                 "certified_design": dict(self.certified_design), "design": dict(self.design),
                 **({} if self.path_note is None else {"path_note": self.path_note})}  # only where the path is derived
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> CartCheck:
+        """The check of its JSON ``d`` (what :meth:`to_dict` wrote, ``wmr-mj cart check --json``), such that
+        ``to_dict()`` writes ``d`` again (``answer`` and ``passed`` are derived).
+
+        Not in the JSON, so not restored: the cart file itself (a :class:`NamedCart`: its name, version and path;
+        the file is not read), the identification's other diagnostics and m1
+        (:meth:`wmr_mj.plant.cartcheck.IdentificationCheck.from_dict`), and the design search's wall time
+        (``design_wall_s``: 0).
+        """
+        ident = d["identification"]
+        return cls(cart=NamedCart(name=d["cart"], version=d["version"], path=d["path"]), defaults=dict(d["defaults"]),
+                   steps=RandomStepCheck.from_dict(d["steps"]),
+                   identification=None if ident is None else IdentificationCheck.from_dict(ident),
+                   identification_error=d["identification_error"], certified_design=dict(d["certified_design"]),
+                   design=dict(d["design"]), path_note=d.get("path_note"))
 
     # -- in a notebook (wmr_mj.sim.notebook): one row per coefficient, the coefficients' figure, a few lines
     def to_pandas(self) -> Any:

@@ -36,7 +36,7 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from wmr_mj.params import COEFFICIENT_NAMES, C80Parameters
+from wmr_mj.params import COEFFICIENT_NAMES, C80Parameters, Coefficients
 from wmr_mj.plant.identify import IdentificationResult, identify_plant
 from wmr_mj.plant.mjcf import compile_model
 
@@ -86,6 +86,12 @@ class RandomStepCheck:
     def to_dict(self) -> dict[str, Any]:
         return {"duration": self.duration, "steps": self.steps, "seed": self.seed, "warnings": dict(self.warnings),
                 "finite": self.finite, "passed": self.passed}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> RandomStepCheck:
+        """The check of its JSON ``d`` (what :meth:`to_dict` wrote; ``passed`` is derived)."""
+        return cls(duration=d["duration"], steps=d["steps"], seed=d["seed"],
+                   warnings=MappingProxyType(dict(d["warnings"])), finite=d["finite"])
 
 
 def step_with_random_controls(params: C80Parameters, *, duration: float = 1.0, seed: int = 0) -> RandomStepCheck:
@@ -145,6 +151,12 @@ class CoefficientCheck:
         return {"identified": self.identified, "implied": self.implied, "paper": self.paper, "allowed": self.allowed,
                 "unit": COEFFICIENT_UNITS[self.name], "passed": self.passed}
 
+    @classmethod
+    def from_dict(cls, name: str, d: Mapping[str, Any]) -> CoefficientCheck:
+        """The coefficient ``name``'s check of its JSON ``d`` (what :meth:`to_dict` wrote; ``unit`` and ``passed``
+        are derived)."""
+        return cls(name=name, identified=d["identified"], implied=d["implied"], paper=d["paper"], allowed=d["allowed"])
+
 
 @dataclass(frozen=True)
 class IdentificationCheck:
@@ -166,6 +178,29 @@ class IdentificationCheck:
         return {"duration": self.result.duration, "seed": self.result.seed, "samples": diag["samples"],
                 "residual_rms_V": diag["residual_rms_V"], "mujoco_warnings": self.warnings,
                 "coefficients": {row.name: row.to_dict() for row in self.rows}, "passed": self.passed}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> IdentificationCheck:
+        """The check of its JSON ``d`` (what :meth:`to_dict` wrote), such that ``to_dict()`` writes ``d`` again.
+
+        The identification (``result``) is rebuilt from what the JSON holds: the identified coefficients, the
+        non-holonomic model's (``implied``) and the paper's as its predictions, its duration and seed, and the
+        diagnostics samples, residual_rms_V and mujoco_warnings. Not in the JSON, so not restored: its other
+        diagnostics (the standard errors, ...) and its m1 (the identification's default).
+        """
+        coefficients = d["coefficients"]
+        rows = tuple(CoefficientCheck.from_dict(name, c) for name, c in coefficients.items())
+
+        def model(key: str) -> Coefficients:  # a coefficient the JSON does not hold is NaN
+            return Coefficients(**{name: coefficients[name][key] if name in coefficients else math.nan
+                                   for name in COEFFICIENT_NAMES})
+
+        result = IdentificationResult(
+            identified=model("identified"), predicted={"nonholonomic": model("implied"), "paper": model("paper")},
+            diagnostics={"samples": d["samples"], "residual_rms_V": d["residual_rms_V"],
+                         "mujoco_warnings": d["mujoco_warnings"]},
+            duration=d["duration"], seed=d["seed"])
+        return cls(result=result, rows=rows)
 
 
 def check_identification(params: C80Parameters, *, duration: float = 20.0, seed: int = 0) -> IdentificationCheck:

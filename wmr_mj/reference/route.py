@@ -58,6 +58,7 @@ import math
 import os
 import re
 import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass, fields
 from pathlib import Path as FilePath
 from typing import Any, Literal, overload
@@ -581,6 +582,11 @@ class RouteProgress:
     def to_dict(self) -> dict[str, Any]:
         """The summary keys route_length_m, route_driven_m, route_finished."""
         return {"route_length_m": self.length_m, "route_driven_m": self.driven_m, "route_finished": self.finished}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> RouteProgress:
+        """The progress of its summary keys ``d`` (what :meth:`to_dict` wrote; route_finished is derived)."""
+        return cls(length_m=d["route_length_m"], driven_m=d["route_driven_m"])
 
 
 def route_progress(spec: str, reference: Any, duration: float) -> RouteProgress | None:

@@ -59,7 +59,7 @@ from wmr_mj.sim.engine import (
 from wmr_mj.sim.log_header import LogHeader
 from wmr_mj.sim.measured_errors import measured_errors_assumption
 from wmr_mj.sim.parts import RunLabels, RunParts, control_substeps, resolve_run, run_reference
-from wmr_mj.sim.run_report import run_report
+from wmr_mj.sim.run_report import config_of_report, run_report, summary_of_report
 from wmr_mj.sim.summary import RunSummary, voltage_effort
 
 __all__ = ["RunResult", "RunMeasures", "run_closed_loop", "report", "run_on_reduced_model", "ROW_FIELDS", "judge_path",
@@ -101,6 +101,30 @@ class RunResult:
         period = (self.config.control_period or TIMESTEP) if period is None else period
         judged = judge_requirements(self, requirements, period=period) if requirements else []
         return run_report(self, measurement=measurement, log=log, judged=judged)
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any], *, config: RunConfig | None = None) -> RunResult:
+        """The run of its JSON ``d`` (what :meth:`to_dict` wrote), such that ``to_dict()`` with the same arguments
+        writes ``d`` again: the summary with every number as written (:func:`~wmr_mj.sim.run_report.summary_of_report`),
+        the status, and the law's claim judged (``claims``, under :data:`~wmr_mj.analysis.claim_types.LAW_CLAIM`).
+
+        Not in the JSON, so not restored: the rows, C's xy, the reference and the path verdict's samples (the run's
+        MCAP log holds them: :mod:`wmr_mj.logs.reader`); the run's other claims (a sampled-data certificate beside
+        the law's); which law ran (``law``: 'compiled'), ``law_note`` and ``cpu_s`` (None); what :meth:`to_dict`
+        takes as arguments (``log``, ``measurement``); and for a claim without section 4's terms, the measurement
+        errors it assumed (pass the run's ``measurement`` to :meth:`to_dict` again). The requirements :meth:`to_dict`
+        judged are read back as the summary's (``to_dict()`` writes the same rows, without judging them again).
+
+        Args:
+            d: the run's JSON (``wmr-mj run --json``).
+            config: the run's config, where the caller has it; None: what the JSON records of it
+                (:func:`~wmr_mj.sim.run_report.config_of_report`: the law, model, m1, gains, path, duration,
+                signals and the cart's parts; the other fields their defaults).
+        """
+        summary = summary_of_report(d)
+        claims = {} if summary.certificate is None else {LAW_CLAIM: summary.certificate}
+        return cls(config=config_of_report(d) if config is None else config, rows={}, summary=summary,
+                   status=d["status"], claims=claims)
 
     # -- in a notebook (wmr_mj.sim.notebook): the rows as a table, the figure, the verdict in a few lines
     def to_pandas(self) -> Any:

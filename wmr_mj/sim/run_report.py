@@ -16,17 +16,21 @@ Usage::
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any
+from collections.abc import Mapping, Sequence
+from typing import Any
 
+from controllers.registry import PluginSource
 from wmr_mj.analysis.claim_types import MeasurementCause
-from wmr_mj.hardware import cart_dict
+from wmr_mj.hardware import CART_PARTS, Actuation, Sensing, Transmission, cart_dict
 from wmr_mj.sim.coerce import controller_source
+from wmr_mj.sim.run_config import RunConfig
+from wmr_mj.sim.signals import Signals
+from wmr_mj.sim.summary import RunSummary
 
-if TYPE_CHECKING:
-    from wmr_mj.sim.summary import RunSummary
+__all__ = ["run_report", "measurement_cause", "add_controller_source", "summary_of_report", "config_of_report"]
 
-__all__ = ["run_report", "measurement_cause", "add_controller_source"]
+#: Each cart part's type, by its key in a run's JSON (:func:`wmr_mj.hardware.cart_dict`).
+_PART_TYPES: Mapping[str, Any] = {"sensing": Sensing, "actuation": Actuation, "transmission": Transmission}
 
 
 def measurement_cause(s: RunSummary, measurement: Any = None) -> MeasurementCause | None:
@@ -88,3 +92,34 @@ def run_report(result: Any, *, measurement: Any = None, log: str | None = None,
     add_controller_source(report, config)
     report.update(cart_dict(config))  # the parts that are not ideal: an ideal run's JSON keeps its keys
     return report
+
+
+def summary_of_report(report: Mapping[str, Any]) -> RunSummary:
+    """The run's summary of its JSON ``report`` (:func:`run_report`): :meth:`RunSummary.from_dict`, with the
+    measurement errors its section-4 certificate assumed (``measurement_errors``) given back to its terms (a
+    claim without those terms, the sampled-data certificate, took them from the run's measurement errors, which
+    the JSON does not hold whole: they are not restored there)."""
+    certificate = report.get("certificate")
+    errors = report.get("measurement_errors")
+    with_terms = certificate is not None and "friction_term" in certificate
+    cause = MeasurementCause.from_dict(errors) if errors is not None and with_terms else None
+    return RunSummary.from_dict(report, measurement_cause=cause)
+
+
+def config_of_report(report: Mapping[str, Any]) -> RunConfig:
+    """What a run's JSON ``report`` (:func:`run_report`) records of its config, as a RunConfig (plain data:
+    nothing read, nothing imported): the law (a plug-in's spec, parameters and source record), model, m1, K_P,
+    K_D, path, duration, signals and the cart's parts that are not ideal. Every other field (the cart, the
+    control period, the box, the plant's overrides, ...) is not in the JSON and takes its default; a setting the
+    law does not read (null in the JSON) too."""
+    source = report.get("controller_source")
+    plugin = None if source is None else PluginSource(**source)
+    fields: dict[str, Any] = {"controller": report["controller"] if plugin is None else plugin.spec,
+                              "controller_params": {} if plugin is None else dict(plugin.params),
+                              "controller_plugin": plugin, "model": report["model"], "m1": report["m1"],
+                              "path": report["path"], "duration": report["duration"]}
+    fields.update({k: report[k] for k in ("kp", "kd") if report[k] is not None})
+    if report.get("signals") is not None:
+        fields["signals"] = Signals.from_dict(report["signals"])
+    fields.update({name: _PART_TYPES[name].from_spec(report.get(name)) for name in CART_PARTS})  # absent: ideal
+    return RunConfig(**fields)

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from wmr_mj.analysis.certificate import Assumption, CertificateJudgement
+from wmr_mj.analysis.claim_types import MeasurementCause
 from wmr_mj.analysis.path_bound import PathBound, PathVerdict
 from wmr_mj.analysis.path_error import PathErrors
 from wmr_mj.analysis.requirements import RequirementResult
@@ -61,6 +62,11 @@ class VoltageEffort:
         """The summary keys peak_voltage, rms_voltage, tv_voltage."""
         return {"peak_voltage": self.peak_voltage, "rms_voltage": self.rms_voltage, "tv_voltage": self.tv_voltage}
 
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> VoltageEffort:
+        """The effort of its summary keys ``d`` (what :meth:`to_dict` wrote)."""
+        return cls(peak_voltage=d["peak_voltage"], rms_voltage=d["rms_voltage"], tv_voltage=d["tv_voltage"])
+
 
 def voltage_effort(voltage: Any, control_period: float) -> VoltageEffort:
     """The effort of the applied voltage ``voltage`` [V] at each control step (a contiguous 1-D array: the
@@ -97,6 +103,12 @@ class BatchFigures:
         """The summary keys final_alpha_after_step, batch_wall_s, batch_steps_per_s, batch_cpu_s, batch_law."""
         return {"final_alpha_after_step": self.final_alpha_after_step, "batch_wall_s": self.wall_s,
                 "batch_steps_per_s": self.steps_per_s, "batch_cpu_s": self.cpu_s, "batch_law": self.law}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> BatchFigures:
+        """The figures of their summary keys ``d`` (what :meth:`to_dict` wrote)."""
+        return cls(final_alpha_after_step=d["final_alpha_after_step"], wall_s=d["batch_wall_s"],
+                   steps_per_s=d["batch_steps_per_s"], cpu_s=d["batch_cpu_s"], law=d["batch_law"])
 
 
 @dataclass(frozen=True)
@@ -334,6 +346,56 @@ class RunSummary:
         if self.effort is not None:
             out.update(self.effort.to_dict())
         return out
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any], *, measurement_cause: MeasurementCause | None = None) -> RunSummary:
+        """The summary of its JSON ``d`` (what :meth:`to_dict` wrote, or a run's JSON, whose further keys are not
+        read), such that ``to_dict()`` writes the same keys and values again.
+
+        Every number the JSON holds is restored as written. Not in the JSON, so not restored: for a law outside
+        the paper's family (``paper_claim_applies`` false), the paper's region (NaN, not inside), ``stable``
+        (False), ``analysis`` (None), and the settings the law does not read (``model`` None, ``kp``/``kd`` NaN);
+        for a law of the paper's family, ``law_settings`` (None: all of them);
+        a certificate's terms' ``delta1_parts`` and ``measurement_cause`` (``measurement_cause``: the run JSON's
+        ``measurement_errors``, which :meth:`wmr_mj.sim.closed_loop.RunResult.from_dict` passes), its
+        ``analysis`` and its typed inputs (:meth:`wmr_mj.analysis.claim_types.Certificate.from_dict`).
+        """
+        paper_law = d.get("paper_claim_applies", True) is not False
+        certificate = d.get("certificate")
+        drift = d.get("drift")
+
+        def number(key: str) -> float:  # a setting the law does not read is null in the JSON
+            return math.nan if d[key] is None else d[key]
+
+        region = (PaperRegion.from_dict({k: d[k] for k in ("E_max", "Edot_max", "condition", "inside")}) if paper_law
+                  else PaperRegion(E_max=math.nan, Edot_max=math.nan, condition=math.nan, inside=False))
+        requirements = d.get("requirements")
+        law_settings = d.get("law_settings")
+
+        def record(kind: Any, key: str) -> Any:
+            value = d.get(key)
+            return None if value is None else kind.from_dict(value)
+
+        return cls(
+            status=d["status"], controller=d["controller"], model=d["model"], m1=d["m1"], kp=number("kp"),
+            kd=number("kd"), path=d["path"], duration=d["duration"], steps=d["steps"], control_steps=d["control_steps"],
+            wall_s=d["wall_s"], realtime_factor=d["realtime_factor"], sup_E=d["sup_E"], sup_Edot=d["sup_Edot"],
+            settle_s=d["settle_s"], sup_E_settled=d["sup_E_settled"], sup_Edot_settled=d["sup_Edot_settled"],
+            stable=bool(d["stable"]), saturated_fraction=d["saturated_fraction"],
+            left_steering_range_at_s=d["left_steering_range_at_s"], final_alpha=d["final_alpha"], paper_region=region,
+            certificate=(None if certificate is None
+                         else CertificateJudgement.from_dict(certificate, measurement_cause=measurement_cause)),
+            drift=Drift.from_dict(drift) if drift else None,
+            mujoco_warnings=d.get("mujoco_warnings"), analysis=d.get("analysis"),
+            controller_config=d.get("controller_config"),
+            batch=BatchFigures.from_dict(d) if "batch_law" in d else None,
+            path_error=record(PathErrors, "path_error"), path_bound=record(PathBound, "path_bound"),
+            path_verdict=record(PathVerdict, "path_verdict"), correction=d.get("correction"),
+            requirements=None if requirements is None else tuple(RequirementResult.from_dict(r) for r in requirements),
+            route=RouteProgress.from_dict(d) if "route_length_m" in d else None,
+            failure=d.get("failure"), claimed=d.get("verdict") != NO_CLAIM, paper_law=paper_law,
+            law_settings=None if law_settings is None else frozenset(law_settings),
+            effort=VoltageEffort.from_dict(d) if "peak_voltage" in d else None)
 
 
 def shown_config(config: Mapping[str, Any], summary: Mapping[str, Any] | None) -> dict[str, Any]:
