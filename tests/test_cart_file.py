@@ -14,7 +14,7 @@ import pytest
 from helpers import refused_line
 
 from wmr_mj.carts import CARTS_DIR, SCHEMA_PATH, cart_names, load_cart, load_schema
-from wmr_mj.carts.schema import SUPPORTED_KEYWORDS, resolve, schema_table
+from wmr_mj.carts.schema import SUPPORTED_KEYWORDS, resolve_ref, schema_table
 from wmr_mj.cli.app import main
 from wmr_mj.errors import ParameterError
 from wmr_mj.params import (
@@ -147,7 +147,7 @@ def test_schema_names_every_parameter_once_with_its_unit():
     assert sorted(names) == sorted(parameter_names())
     for section, params in C80_CART.sections.items():
         for name in params:
-            entry = resolve(schema["properties"][section]["properties"][name], schema)
+            entry = resolve_ref(schema["properties"][section]["properties"][name], schema)
             assert entry["properties"]["unit"]["const"] == C80_CART.units[name]
 
 

@@ -53,7 +53,7 @@ __all__ = [
     "evaluate",
     "evaluate_run",
     "preset_formula",
-    "number",
+    "stl_number",
 ]
 
 #: Signals a requirement may name (a run's rows: wmr_mj.sim.closed_loop.ROW_FIELDS), t in s; cross_track
@@ -71,7 +71,7 @@ PRESETS = {
 }
 
 
-def number(x: float) -> str:
+def stl_number(x: float) -> str:
     """A float as rtamt's grammar reads it (no exponent), shortest digits that round-trip."""
     return np.format_float_positional(float(x), unique=True, trim="-")
 
@@ -81,10 +81,10 @@ def preset_formula(name: str, E_max: float | None, Edot_max: float | None) -> st
     if name not in PRESETS:
         raise UnknownNameError("requirement preset", name, PRESETS)
     if name == "cross-track":  # E_max carries the cross-track bound [m]; the window is evaluate()'s
-        return None if E_max is None or not math.isfinite(E_max) else f"always(abs(cross_track) <= {number(E_max)})"
+        return None if E_max is None or not math.isfinite(E_max) else f"always(abs(cross_track) <= {stl_number(E_max)})"
     if E_max is None or Edot_max is None or not (math.isfinite(E_max) and math.isfinite(Edot_max)):
         return None
-    return f"always((abs(E) <= {number(E_max)}) and (abs(E_dot) <= {number(Edot_max)}))"
+    return f"always((abs(E) <= {stl_number(E_max)}) and (abs(E_dot) <= {stl_number(Edot_max)}))"
 
 
 # -- rtamt with windowed operators in O(n log w) ---------------------------------------------
@@ -418,7 +418,8 @@ def evaluate(requirement: Requirement, signals: Mapping[str, Any], *, period: fl
             n = len(next(iter(signals.values()))) if signals else 0
             start = math.ceil(float(window[0]) / period - 1e-9)
             if start < n - 1:
-                formula = formula.replace("always(", f"always[{number(start * period)},{number((n - 1) * period)}](", 1)
+                window_s = f"{stl_number(start * period)},{stl_number((n - 1) * period)}"
+                formula = formula.replace("always(", f"always[{window_s}](", 1)
     missing = [s for s in requirement.signals if s not in signals and requirement.names(s)]
     if missing:
         raise UnknownNameError("signal", missing[0], tuple(signals))

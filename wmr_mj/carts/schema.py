@@ -27,7 +27,7 @@ from typing import Any
 
 from wmr_mj.errors import ParameterError
 
-__all__ = ["SCHEMA_PATH", "SUPPORTED_KEYWORDS", "load_schema", "check_against_schema", "resolve", "schema_table"]
+__all__ = ["SCHEMA_PATH", "SUPPORTED_KEYWORDS", "load_schema", "check_against_schema", "resolve_ref", "schema_table"]
 
 #: The cart file's JSON Schema (draft 2020-12), shipped beside the carts.
 SCHEMA_PATH = Path(__file__).resolve().parent / "cart.schema.json"
@@ -50,7 +50,7 @@ def load_schema() -> Mapping[str, Any]:
     return json.loads(SCHEMA_PATH.read_text(encoding="utf-8"))
 
 
-def resolve(schema: Mapping[str, Any], root: Mapping[str, Any]) -> dict[str, Any]:
+def resolve_ref(schema: Mapping[str, Any], root: Mapping[str, Any]) -> dict[str, Any]:
     """``schema`` with its local ``$ref`` ('#/$defs/NAME') replaced by the definition; the referring schema's
     own keywords (a description) win over the definition's."""
     if "$ref" not in schema:
@@ -59,7 +59,7 @@ def resolve(schema: Mapping[str, Any], root: Mapping[str, Any]) -> dict[str, Any
     prefix = "#/$defs/"
     if not ref.startswith(prefix) or ref[len(prefix):] not in root.get("$defs", {}):
         raise ParameterError(f"cart schema: $ref {ref!r} is not a local definition ('#/$defs/NAME')")
-    base = resolve(root["$defs"][ref[len(prefix):]], root)
+    base = resolve_ref(root["$defs"][ref[len(prefix):]], root)
     return {**base, **{k: v for k, v in schema.items() if k != "$ref"}}
 
 
@@ -111,7 +111,7 @@ def _check_object(value: dict, schema: Mapping[str, Any], root: Mapping[str, Any
     properties = schema.get("properties", {})
     for key in schema.get("required", ()):
         if key not in value:
-            sub = resolve(properties.get(key, {}), root)
+            sub = resolve_ref(properties.get(key, {}), root)
             what = f" ({sub['description']})" if "description" in sub else ""
             raise ParameterError(f"{_where((*path, key))} is missing{what}; required in {_section(path)}: "
                                  + ", ".join(schema["required"]))
@@ -178,7 +178,7 @@ def check_against_schema(value: Any, schema: Mapping[str, Any], *, root: Mapping
             before an unknown one.
     """
     root = schema if root is None else root
-    schema = resolve(schema, root)
+    schema = resolve_ref(schema, root)
     _check_type(value, schema, path, unit)
     if isinstance(value, dict):
         _check_object(value, schema, root, path)
@@ -212,7 +212,7 @@ def schema_table(schema: Mapping[str, Any] | None = None) -> str:
                         f"{section_schema['description']} |")
             continue
         for name, sub in section_schema["properties"].items():
-            entry = resolve(sub, root)
+            entry = resolve_ref(sub, root)
             props = entry.get("properties", {})
             unit = props.get("unit", {}).get("const", "")
             if "value" in props:

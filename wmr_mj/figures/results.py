@@ -60,7 +60,7 @@ def _plot(fig: Any) -> ResultPlot:
     return ResultPlot(figure=fig, axes=tuple(fig.axes))
 
 
-def run_bounds(summary: Any, *, on_c80: bool = True) -> tuple[float | None, float | None, str]:
+def drawn_error_bounds(summary: Any, *, on_c80: bool = True) -> tuple[float | None, float | None, str]:
     """(E_max [rad], E'_max [rad/s], whose): the certificate's where it bounds E (said "uncertified" where an
     assumption is not met), else the paper's region where the run has one (named the paper's claim on the C80,
     ``on_c80``, else the (4.21)-(4.23) region on this cart: :func:`wmr_mj.analysis.verdicts.paper_region_name`),
@@ -82,7 +82,7 @@ def plot_run(result: Any, *, supply: float, title: str | None = None) -> ResultP
         title: the figure's title; default the law, m1 and the verdict.
     """
     s = result.summary
-    E_max, Edot_max, whose = run_bounds(s, on_c80=getattr(result.config, "cart", None) is None)
+    E_max, Edot_max, whose = drawn_error_bounds(s, on_c80=getattr(result.config, "cart", None) is None)
     with plots.rc_context(plots.STYLE):
         fig = plots.Figure(figsize=(10.0, 5.6))
         grid = fig.add_gridspec(3, 2, width_ratios=(1.5, 1.0))

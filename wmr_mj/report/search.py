@@ -51,7 +51,7 @@ from wmr_mj.report.settings import (
     stage_progress,
 )
 from wmr_mj.searches.falsify import FalsifySpec, objective_label, objective_value, search_worst
-from wmr_mj.sim.designs import CERTIFIED, LADDER, PAPER, Design
+from wmr_mj.sim.designs import CERTIFIED, LADDER, PAPER, DesignPreset
 from wmr_mj.sim.many_runs import run_configs
 from wmr_mj.sim.parts import resolve_run
 
@@ -69,7 +69,7 @@ class SearchPlan:
 
     key: str
     title: str
-    design: Design
+    design: DesignPreset
     box: str  # uncertainty box of wmr_mj.params: 'm1' or 'full'
     objective: str
     budget: int

@@ -72,7 +72,7 @@ from wmr_mj.report.settings import (
 from wmr_mj.report.text import findings, render_html, render_markdown, summary_csv
 from wmr_mj.sim import designs
 from wmr_mj.sim.closed_loop import run_closed_loop, run_parts
-from wmr_mj.sim.designs import CERTIFIED, CORRECTION_RUNG, LADDER, PAPER, Design, DesignLike, TokenDesign
+from wmr_mj.sim.designs import CERTIFIED, CORRECTION_RUNG, LADDER, PAPER, DesignLike, DesignPreset, TokenDesign
 from wmr_mj.sim.parts import resolve_run
 
 __all__ = [
@@ -157,7 +157,7 @@ def friction_stage(settings: ValidateSettings, st: Stages) -> dict[str, dict[str
 
 # --------------------------------------------------------------------------- stage 3: the ladder
 def run_rung(settings: ValidateSettings, k: int, design: DesignLike, folder: Path, st: Stages,
-             before: Design | None, *, parts: Any = None) -> dict[str, Any]:
+             before: DesignPreset | None, *, parts: Any = None) -> dict[str, Any]:
     """Sweep one rung over m1 (resumable in ladder-<k>-<name>/) and summarise it; its certificate and the
     paper's region are the base run's (``settings.config(design)``), resolved once: ``parts``
     (:func:`wmr_mj.sim.parts.resolve_run`), resolved here where None."""
@@ -170,7 +170,7 @@ def run_rung(settings: ValidateSettings, k: int, design: DesignLike, folder: Pat
                             f"{settings.m1_range[0]:g}-{settings.m1_range[1]:g} kg ({settings.sampling})")
     run_sweep(spec, out_dir=sweep_dir, nthread=settings.nthread, progress=stage_progress(st))
     rung = summarise_rung(read_runs(sweep_dir))  # full precision: runs.csv is rounded
-    if isinstance(design, Design) and (base.kp, base.kd) != (design.kp, design.kd):
+    if isinstance(design, DesignPreset) and (base.kp, base.kd) != (design.kp, design.kd):
         design = dataclasses.replace(design, kp=base.kp, kd=base.kd)  # the gains it ran: the rule's on the cart
     rung.update(index=k, name=design.name, label=design.label, design=design.describe(),
                 config=design.config_changes(), changed=[] if before is None else ladder_changes(before, design),

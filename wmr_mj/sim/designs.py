@@ -49,7 +49,7 @@ from wmr_mj.params import PAPER_KD, PAPER_KP
 from wmr_mj.reference.route import path_name
 
 __all__ = [
-    "Design",
+    "DesignPreset",
     "PAPER",
     "CERTIFIED",
     "PRESETS",
@@ -76,8 +76,9 @@ SMOOTHING_WIDTH = 0.01  # rad/s, the certified design's sign smoothing w
 
 
 @dataclass(frozen=True, kw_only=True)
-class Design:
-    """A controller configuration: what a preset or a ladder rung sets."""
+class DesignPreset:
+    """A controller configuration: what a preset or a ladder rung sets (a design to compare, a label and a whole
+    RunConfig, is :class:`wmr_mj.experiments.compare.Design`)."""
 
     name: str
     label: str
@@ -97,7 +98,7 @@ class Design:
             out["correction"] = True
         return out
 
-    def on(self, cart: Any = None, *, path: str | None = None) -> Design:
+    def on(self, cart: Any = None, *, path: str | None = None) -> DesignPreset:
         """This design on ``cart`` (anything ``RunConfig(cart=...)`` takes; None: the C80): the certified design's
         gain rule run on the cart (and ``path``; None: the cart's own default path) for :data:`CERTIFIED`, as
         ``--preset certified --cart`` runs it; any other design as it is (its gains are the cart's as given)."""
@@ -115,36 +116,36 @@ class Design:
             ", Cartesian correction" if self.correction else "")
 
 
-PAPER = Design(name="paper", label="the paper's design")
+PAPER = DesignPreset(name="paper", label="the paper's design")
 #: the certified design: the gain rule (:func:`certified_omega_r`) on a cart -- ``CERTIFIED.on(cart)`` runs it on
 #: ``cart`` (``--preset certified --cart``); as a value, CERTIFIED is the rule's answer on the C80
 #: (:data:`CERTIFIED_C80`, omega_r = 30 rad/s: K_P = 225, K_D = 30, the rule on the sampled-data certificate,
 #: issue 44), never another cart's; a test keeps it equal to :func:`certified_omega_r`
-CERTIFIED = Design(name="certified", label="certified design", model="nonholonomic", kp=225.0, kd=30.0,
+CERTIFIED = DesignPreset(name="certified", label="certified design", model="nonholonomic", kp=225.0, kd=30.0,
                    friction_sign="measured", friction_width=SMOOTHING_WIDTH)
 #: the certified design's gains on the C80 (the rule on the C80 and the paper circle), by its C80 name
 CERTIFIED_C80 = CERTIFIED
-PRESETS: dict[str, Design] = {"paper": PAPER, "certified": CERTIFIED}
+PRESETS: dict[str, DesignPreset] = {"paper": PAPER, "certified": CERTIFIED}
 PRESET_NAMES = tuple(PRESETS)
 
-LADDER: tuple[Design, ...] = (
+LADDER: tuple[DesignPreset, ...] = (
     PAPER,
-    Design(name="model", label="+ non-holonomic model", model="nonholonomic"),
-    Design(name="compensation", label="+ smoothed compensation", model="nonholonomic",
+    DesignPreset(name="model", label="+ non-holonomic model", model="nonholonomic"),
+    DesignPreset(name="compensation", label="+ smoothed compensation", model="nonholonomic",
            friction_width=SMOOTHING_WIDTH),
-    Design(name="gains", label=f"+ gains omega_r = {CERTIFIED.kd:g} (= certified)", model=CERTIFIED.model,
+    DesignPreset(name="gains", label=f"+ gains omega_r = {CERTIFIED.kd:g} (= certified)", model=CERTIFIED.model,
            kp=CERTIFIED.kp, kd=CERTIFIED.kd, friction_sign=CERTIFIED.friction_sign,
            friction_width=CERTIFIED.friction_width),
 )
 
 #: validate's rung after the ladder: the certified design with the Cartesian correction at C
 #: (not in LADDER, whose last rung is the certified design)
-CORRECTION_RUNG = Design(name="correction", label="+ Cartesian correction", model=CERTIFIED.model, kp=CERTIFIED.kp,
-                         kd=CERTIFIED.kd, friction_sign=CERTIFIED.friction_sign,
-                         friction_width=CERTIFIED.friction_width, correction=True)
+CORRECTION_RUNG = DesignPreset(name="correction", label="+ Cartesian correction", model=CERTIFIED.model,
+                               kp=CERTIFIED.kp, kd=CERTIFIED.kd, friction_sign=CERTIFIED.friction_sign,
+                               friction_width=CERTIFIED.friction_width, correction=True)
 
 
-def preset(name: str, *, cart: Any = None, path: str | None = None) -> Design:
+def preset(name: str, *, cart: Any = None, path: str | None = None) -> DesignPreset:
     """The design called ``name``; unknown names raise UnknownNameError listing the valid ones.
 
     cart: the cart the design is for (anything ``RunConfig(cart=...)`` takes; None: the C80). The paper's
@@ -169,7 +170,7 @@ def _cart_record(cart: Any) -> dict[str, Any] | None:
     return RunConfig.from_inputs(cart=cart).cart
 
 
-def certified_design(cart: Any = None, *, path: str | None = None) -> Design:
+def certified_design(cart: Any = None, *, path: str | None = None) -> DesignPreset:
     """The certified design on ``cart`` (None, or the C80's numbers: the C80, :data:`CERTIFIED_C80`): the rule run
     on the cart and on ``path`` (None: the cart's own default path, :func:`wmr_mj.sim.coerce.default_path`).
 
@@ -185,7 +186,7 @@ def certified_design(cart: Any = None, *, path: str | None = None) -> Design:
 
 
 @functools.lru_cache(maxsize=8)
-def _certified_on(text: str, cart_path: str, path: str | None) -> Design:
+def _certified_on(text: str, cart_path: str, path: str | None) -> DesignPreset:
     record = {"text": text, "path": cart_path}
     w = certified_omega_r(cart=record, path=path)
     if w is None:
@@ -206,9 +207,10 @@ def _path_of(cart: Any, path: str | None) -> str:
 
 
 def on_cart(changes: dict[str, Any], cart: Any) -> dict[str, Any]:
-    """A design's RunConfig fields (``Design.config_changes``) on ``cart``: where they carry the certified design's
-    gains (:data:`CERTIFIED`'s K_P and K_D: the certified preset, the ladder's gains rung, the correction rung), the
-    gains the rule gives on the cart (:func:`certified_design`); the rest as given. None: the C80, unchanged."""
+    """A design's RunConfig fields (``DesignPreset.config_changes``) on ``cart``: where they carry the certified
+    design's gains (:data:`CERTIFIED`'s K_P and K_D: the certified preset, the ladder's gains rung, the correction
+    rung), the gains the rule gives on the cart (:func:`certified_design`); the rest as given. None: the C80,
+    unchanged."""
     if cart is None or (changes.get("kp"), changes.get("kd")) != (CERTIFIED.kp, CERTIFIED.kd):
         return changes
     derived = certified_design(cart)
@@ -238,7 +240,7 @@ def certified_omega_r(*, error_spec: float = ERROR_SPEC, grid: tuple[float, ...]
 
 
 class DesignLike(Protocol):
-    """What a rung of validate's ladder needs of a design: :class:`Design`, or a token's
+    """What a rung of validate's ladder needs of a design: :class:`DesignPreset`, or a token's
     (:class:`TokenDesign`)."""
 
     @property
@@ -298,7 +300,7 @@ def design_changes(token: str) -> dict[str, Any]:
 
 @dataclass(frozen=True)
 class TokenDesign:
-    """A design named by a token (:func:`design_changes`), shaped as :class:`Design` for validate's ladder
+    """A design named by a token (:func:`design_changes`), shaped as :class:`DesignPreset` for validate's ladder
     (``validate --design``)."""
 
     token: str
