@@ -16,7 +16,7 @@ from helpers import one_error_line
 from wmr_mj.cli.app import main
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.hardware import Actuation, Sensing, Transmission
-from wmr_mj.hardware.cart import MAX_ELECTRICAL_TIME_CONSTANT_S, smallest_encoder_ticks
+from wmr_mj.hardware.assembly import MAX_ELECTRICAL_TIME_CONSTANT_S, smallest_encoder_ticks
 from wmr_mj.hardware.sensing import SENSING_SPEC_KEYS, measurement_error_bounds
 from wmr_mj.params import C80
 from wmr_mj.searches.search_space import HARDWARE_AXES, with_hardware
@@ -350,3 +350,17 @@ def test_the_run_names_the_motor_side_reason_for_an_exact_motor_angle(capsys):
     out = capsys.readouterr().out
     assert "the play's stop is soft" in out and "encoder on the steering axis" not in out
 
+
+
+def test_the_modules_old_name_warns_and_hands_the_same_objects():
+    """``wmr_mj.hardware.cart`` (beside the cart files' ``wmr_mj.carts``) is ``wmr_mj.hardware.assembly`` now; the old
+    name is kept one release, each name warning and the very object of the new module."""
+    import wmr_mj.hardware.cart as old
+    from wmr_mj.hardware import assembly
+
+    for name in assembly.__all__:
+        with pytest.warns(DeprecationWarning, match=rf"hardware\.cart\.{name} is deprecated: use "
+                                                    rf"wmr_mj\.hardware\.assembly\.{name}"):
+            assert getattr(old, name) is getattr(assembly, name)
+    with pytest.raises(AttributeError):
+        old.no_such_name  # noqa: B018

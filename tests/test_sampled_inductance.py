@@ -155,7 +155,7 @@ def test_the_carts_inductance_is_the_default_and_an_actuation_overrides_it():
 
 def test_the_cart_files_limit_is_the_actuations():
     from wmr_mj.carts.cartfile import MAX_ELECTRICAL_TIME_CONSTANT_S as in_cart_file
-    from wmr_mj.hardware.cart import MAX_ELECTRICAL_TIME_CONSTANT_S
+    from wmr_mj.hardware.assembly import MAX_ELECTRICAL_TIME_CONSTANT_S
 
     assert in_cart_file == MAX_ELECTRICAL_TIME_CONSTANT_S
 

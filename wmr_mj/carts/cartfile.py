@@ -58,7 +58,7 @@ PARAMETER_SECTIONS: tuple[str, ...] = tuple(
 #: How far k_b may differ from k_i, relative: a rounding, not a second constant (see _check_rules).
 MOTOR_CONSTANT_RTOL = 1e-9
 #: The largest armature electrical time constant L_a / R_a accepted in a cart file's motor.L_a, s: the limit of
-#: --actuation inductance=, :data:`wmr_mj.hardware.cart.MAX_ELECTRICAL_TIME_CONSTANT_S` (its source there; the
+#: --actuation inductance=, :data:`wmr_mj.hardware.assembly.MAX_ELECTRICAL_TIME_CONSTANT_S` (its source there; the
 #: carts sit below the hardware layer, so it is written twice and a test holds the two equal).
 MAX_ELECTRICAL_TIME_CONSTANT_S = 0.1
 #: The keys of the [defaults] section: the default sensing, actuation and play of a run on the cart.

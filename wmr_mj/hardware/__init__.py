@@ -17,14 +17,14 @@ derived) and its ``label()``; the model, the engine and the claims read them the
 
 Modules: :mod:`.spec` (the one parser, the whole-periods check), :mod:`.coverage`, :mod:`.sensing`,
 :mod:`.estimators` (the velocity estimates and the delay as discrete linear systems), :mod:`.actuation`,
-:mod:`.transmission`, :mod:`.presets` (named hardware with sources), :mod:`.cart` (the three parts in one line
-and one mapping).
+:mod:`.transmission`, :mod:`.presets` (named hardware with sources), :mod:`.assembly` (the three parts together:
+one line, one mapping, the checks against the plant; the cart *file* is :mod:`wmr_mj.carts`'s).
 """
 
 from __future__ import annotations
 
 from wmr_mj.hardware.actuation import Actuation
-from wmr_mj.hardware.cart import CART_PARTS, cart_dict, cart_line, check_cart, is_ideal_cart
+from wmr_mj.hardware.assembly import CART_PARTS, cart_dict, cart_line, check_cart, is_ideal_cart
 from wmr_mj.hardware.coverage import Coverage
 from wmr_mj.hardware.presets import (
     SENSING_PRESET_SOURCES,

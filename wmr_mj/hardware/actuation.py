@@ -38,7 +38,7 @@ class Actuation:
     Raises:
         ParameterError: a negative delay or inductance, a current limit that is not > 0. The limits that need the
             plant and the run (L_a/R_a <= 0.1 s, a delay shorter than the run) are
-            :func:`wmr_mj.hardware.cart.check_cart`'s.
+            :func:`wmr_mj.hardware.assembly.check_cart`'s.
     """
 
     delay: float = 0.0  # s, from the law's output to the motor's terminals

@@ -149,7 +149,7 @@ class Sensing:
         ParameterError: zero, negative or more than 2**48 ticks, a negative delay or noise magnitude, a filter
             time constant that is missing (``velocity='filtered'``), not > 0, or given for another velocity
             estimate, a negative seed. The limits that need the plant and the run (a delay against the duration,
-            a reading against the steering stops) are :func:`wmr_mj.hardware.cart.check_cart`'s.
+            a reading against the steering stops) are :func:`wmr_mj.hardware.assembly.check_cart`'s.
         UnknownNameError: an unknown side, rounding, velocity estimate or noise kind.
     """
 

@@ -38,7 +38,7 @@ class Transmission:
 
     Raises:
         ParameterError: a negative or non-finite backlash. Play as wide as the steering stops or wider is refused
-            where the plant is known (:func:`wmr_mj.hardware.cart.check_cart`).
+            where the plant is known (:func:`wmr_mj.hardware.assembly.check_cart`).
     """
 
     backlash: float = 0.0  # rad at the steering axis: the half-width b of the play (the gap is 2 b)

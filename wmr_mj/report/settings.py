@@ -22,7 +22,7 @@ from wmr_mj.experiments.sweep import (
     SAMPLINGS,
     max_at,  # noqa: F401  (re-exported: the report reads runs.csv with it)
 )
-from wmr_mj.hardware.cart import CART_PARTS, cart_dict
+from wmr_mj.hardware.assembly import CART_PARTS, cart_dict
 from wmr_mj.params import UNCERTAINTY_NAMES, uncertainty_ranges
 from wmr_mj.report.defaults import DEFAULT_DURATION, DEFAULT_N, DEFAULT_SEARCH_BUDGET, FULL_BOX_FACTOR
 from wmr_mj.searches.falsify import cma_population

@@ -37,7 +37,7 @@ from wmr_mj.carts import CartFile, cart_of, cart_of_text
 from wmr_mj.carts.cartfile import MOTOR_CONSTANT_RTOL
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.hardware import Actuation, Sensing, Transmission, check_cart, is_ideal_cart
-from wmr_mj.hardware.cart import CART_PARTS, cart_dict
+from wmr_mj.hardware.assembly import CART_PARTS, cart_dict
 from wmr_mj.params import (
     C80,
     C80_CART,
@@ -376,11 +376,11 @@ def coerced(config: Any) -> Any:
 
 
 def _check_parts(config: Any, base: C80Parameters, plant: C80Parameters) -> None:
-    """The cart's parts against their grids and the plant (``hardware.cart.check_cart``), and k_b = k_i after the
+    """The cart's parts against their grids and the plant (``hardware.assembly.check_cart``), and k_b = k_i after the
     overrides of ``base``."""
     config.sensing.delay_steps(TIMESTEP if config.control_period is None else config.control_period)
     config.actuation.delay_steps(TIMESTEP)
-    if not is_ideal_cart(config):  # the limits that need the plant and the duration (hardware.cart.check_cart)
+    if not is_ideal_cart(config):  # the limits that need the plant and the duration (hardware.assembly.check_cart)
         check_cart(config, plant)
     overrides = config.plant_overrides
     if "k_i" in overrides or "k_b" in overrides:

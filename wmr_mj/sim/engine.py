@@ -55,7 +55,7 @@ import mujoco
 import numpy as np
 
 from wmr_mj.errors import ParameterError, UnknownNameError, WmrMjError
-from wmr_mj.hardware.cart import CART_PARTS
+from wmr_mj.hardware.assembly import CART_PARTS
 from wmr_mj.hardware.sensing import P_GEAR_RATIO, SensingChain
 from wmr_mj.params import C80Parameters
 from wmr_mj.sim import compiled_law

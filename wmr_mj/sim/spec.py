@@ -168,7 +168,7 @@ def no_estimate_note(parts: Any) -> str | None:
             resolved here first.
     """
     from controllers.registry import is_builtin
-    from wmr_mj.hardware.cart import is_ideal_cart
+    from wmr_mj.hardware.assembly import is_ideal_cart
     from wmr_mj.sim.certify import claim_on_estimate
     from wmr_mj.sim.config import RunConfig
     from wmr_mj.sim.designs import CERTIFIED
