@@ -59,7 +59,10 @@ if TYPE_CHECKING:
     from wmr_mj.sim.parts import RunParts, resolve_run
     from wmr_mj.sim.signals import Disturbance, LoadChange, Signals
 
-#: name -> the module that defines it, imported on first access
+#: name -> the module that defines it, imported on first access (PEP 562, :func:`__getattr__`). Deliberately lazy,
+#: not an oversight of "imports at module top": ``import wmr_mj`` runs first for every ``wmr-mj`` command, so an
+#: eager import here would load MuJoCo, scipy and the laws before ``wmr-mj --help`` answers (tests/test_cli_help.py),
+#: and ``controllers`` imports ``wmr_mj.params``, so importing ``wmr_mj.sim`` from here would be circular
 _LAZY: dict[str, str] = {
     "RunConfig": "wmr_mj.sim.config",
     "controller_for": "wmr_mj.sim.config",
@@ -197,6 +200,8 @@ _DEPRECATED = {
 
 
 def __getattr__(name: str) -> Any:
+    """A public name of :data:`_LAZY`, its module imported on this first access (lazy on purpose: see
+    :data:`_LAZY`); a name of :data:`_DEPRECATED`, with a warning at every use."""
     if name in _DEPRECATED:  # not cached: every use warns
         where, instead = _DEPRECATED[name]
         warnings.warn(f"wmr_mj.{name} is deprecated and leaves the top level in the next release; use {instead}",

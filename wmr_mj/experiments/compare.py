@@ -38,20 +38,34 @@ from typing import Any
 import numpy as np
 
 from wmr_mj._util.deprecation import deprecated_names
+from wmr_mj.analysis.requirements import parse_requirement
 from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE, count_unmet, unmet_assumptions
 from wmr_mj.errors import ParameterError
 from wmr_mj.experiments.suite import Scenario, Suite, load_suite, versions
-from wmr_mj.hardware import cart_dict
+from wmr_mj.hardware import Actuation, Sensing, Transmission, cart_dict
 from wmr_mj.params import uncertainty_ranges
 from wmr_mj.plant.mjcf import TIMESTEP
+from wmr_mj.reference.knots import KnotSpace
+from wmr_mj.searches.design_search import design_file_settings, read_design
+from wmr_mj.searches.falsify import FalsifySpec, check_runnable, falsify
+from wmr_mj.sim import notebook
+from wmr_mj.sim.batch import thread_count
+from wmr_mj.sim.closed_loop import judge_requirements, run_closed_loop
 from wmr_mj.sim.config import (
     RunConfig,
+    cart_file,
     coerce,
     config_from_dict,
+    controller_for,
     controller_name,
     controller_source,
+    estimate_parameters,
 )
+from wmr_mj.sim.designs import design_changes, on_cart
+from wmr_mj.sim.many_runs import connect
+from wmr_mj.sim.parts import resolve_run
 from wmr_mj.sim.records import Record, plain
+from wmr_mj.sim.spec import LawChoice, law_fields
 
 __all__ = ["Design", "design_from_token", "is_design_file", "design_file_changes", "design_token_changes",
            "FileDesign", "ScenarioRun", "DesignRow", "CompareResult", "compare",
@@ -90,15 +104,12 @@ def design_from_token(token: str, suite: Suite, *, cart: Mapping[str, Any] | Non
     box = uncertainty_ranges(suite.adversary.uncertainty)
     on = (cart or {}).get("cart")  # a cart file (compare --cart): its box, the certified gains derived on it
     if on is not None:
-        from wmr_mj.sim.config import cart_file
-
         box = dict(cart_file(RunConfig(cart=on)).uncertainty.get(suite.adversary.uncertainty, box))
     suite_m1 = box.pop("m1")
     m1_range = suite_m1 if m1_range is None else (float(m1_range[0]), float(m1_range[1]))
     changes = {**design_token_changes(token, cart=on), **(cart or {})}
     changes.setdefault("path", path)  # None: the cart's own
     config = RunConfig.from_inputs(**changes, m1_range=m1_range, box_ranges=box, duration=suite.duration)
-    from wmr_mj.sim.parts import resolve_run
 
     resolve_run(config)  # built once: a parameter the law does not take, a claim() that raises, before any run
     return Design(label=str(token), config=config)
@@ -127,10 +138,6 @@ def design_file_changes(path: str, *, cart: Any = None) -> dict[str, Any]:
         ParameterError: a file that cannot be read or is not a design file, a setting a run refuses, a design
             found on another cart where ``cart`` is None (one line naming the file).
     """
-    from wmr_mj.hardware import Actuation, Sensing, Transmission
-    from wmr_mj.searches.design_search import design_file_settings, read_design
-    from wmr_mj.sim.spec import LawChoice, law_fields
-
     try:
         data = read_design(path)
     except ParameterError as exc:  # read_design names the run option; here the file is a design's name
@@ -164,8 +171,6 @@ def design_token_changes(token: str, *, cart: Any = None) -> dict[str, Any]:
     Raises:
         UnknownNameError, ParameterError: an unknown preset or law, a bad setting, a bad design file (one line).
     """
-    from wmr_mj.sim.designs import design_changes, on_cart
-
     if is_design_file(token):
         if "," in str(token):
             raise ParameterError(f"design {token!r}: a design file takes no ,key=value settings (the file is the "
@@ -196,8 +201,6 @@ class FileDesign:
         return design_file_changes(self.path, cart=self.cart)
 
     def describe(self) -> str:
-        from wmr_mj.sim.config import controller_for, estimate_parameters
-
         return (f"{controller_for(RunConfig(**self.config_changes()), estimate_parameters()).label()} "
                 f"(the design file {self.path})")
 
@@ -234,9 +237,6 @@ def run_scenario(config: RunConfig, requirements: Mapping[str, str], *, parsed: 
     ``parsed``: the requirements already parsed (rtamt imports on the calling thread: two threads importing
     it at once deadlock); ``monitor``: a lock around rtamt's monitor (pure Python, process-wide logging).
     """
-    from wmr_mj.analysis.requirements import parse_requirement
-    from wmr_mj.sim.closed_loop import judge_requirements, run_closed_loop
-
     period = TIMESTEP if config.control_period is None else config.control_period
     if parsed is None:
         parsed = [parse_requirement(text, period=period) for text in requirements.values()]
@@ -309,9 +309,6 @@ def adversary_spec(design: Design, suite: Suite, *, budget: int, seed: int, meth
     """The FalsifySpec of the suite's adversary for ``design``: its plant box, C's knot path within the declared
     bounds and a disturbance pulse (start, amplitude within +-d_max), against the suite's requirement; and the
     cart's axes where a compared scenario (``scenarios``) declares a non-ideal cart (:func:`adversary_cart_box`)."""
-    from wmr_mj.reference.knots import KnotSpace
-    from wmr_mj.searches.falsify import FalsifySpec
-
     adv = suite.adversary
     width = adv.pulse_width
     t1 = adv.pulse_t1[0]
@@ -469,20 +466,16 @@ class CompareResult:
         Raises:
             WmrMjError: pandas is not installed (``pip install 'wmr-mj[notebook]'``).
         """
-        from wmr_mj.sim import notebook
-
         return notebook.compare_frame(self.runs, self.rows)
 
     def plot(self, **options: Any) -> Any:
         """The comparison's figure (compare.png: the requirement checks held, effort against C's path), as a
         :class:`wmr_mj.figures.results.ResultPlot`."""
-        from wmr_mj.figures.results import plot_compare
+        from wmr_mj.figures.results import plot_compare  # matplotlib loads only when a figure is asked for
 
         return plot_compare(self, **options)
 
     def _repr_html_(self) -> str:
-        from wmr_mj.sim import notebook
-
         return notebook.compare_html(self.rows, self.claims_broken)
 
 
@@ -543,9 +536,6 @@ def compare(designs: Sequence[Design], suite: Suite, *, scenarios: Sequence[str]
     Raises:
         ParameterError: no design, a budget below one generation (before any run), a design that cannot run.
     """
-    from wmr_mj.analysis.requirements import parse_requirement
-    from wmr_mj.sim.batch import thread_count
-
     if not designs:
         raise ParameterError("compare needs at least one design")
     chosen = suite.select(scenarios)
@@ -564,8 +554,6 @@ def compare(designs: Sequence[Design], suite: Suite, *, scenarios: Sequence[str]
 
     results: list[dict[str, Any]]
     if scheduler is not None:
-        from wmr_mj.sim.many_runs import connect
-
         client = connect(scheduler)
         try:
             futures = [client.submit(_scenario_task, cfg.to_dict(), dict(suite.requirements), pure=False)
@@ -599,8 +587,6 @@ def compare(designs: Sequence[Design], suite: Suite, *, scenarios: Sequence[str]
         mine = [r for r in runs if r.design == d.label]
         adversary = claim = None
         if specs:
-            from wmr_mj.searches.falsify import check_runnable, falsify
-
             parts = check_runnable(specs[i].base)  # the adversary's base run, resolved once: its claim is the row's
             claim = parts.claim
             adversary = falsify(specs[i], nthread=nthread, scheduler=scheduler,

@@ -26,7 +26,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from wmr_mj._version import __version__
 from wmr_mj.errors import ParameterError, UnknownNameError
+from wmr_mj.hardware import Actuation, Sensing, Transmission
 from wmr_mj.params import parameter_names
 from wmr_mj.sim.coerce import coerce
 from wmr_mj.sim.config import RunConfig
@@ -148,8 +150,6 @@ def versions() -> dict[str, str]:
     """The versions results name beside the suite's: wmr-mj's and MuJoCo's."""
     import mujoco
 
-    from wmr_mj._version import __version__
-
     return {"wmr_mj": __version__, "mujoco": mujoco.__version__}
 
 
@@ -193,8 +193,6 @@ def _hardware(name: str, spec: Mapping[str, Any], where: str) -> dict[str, Any]:
         UnknownNameError: an unknown key of the table (or of a spec).
         ParameterError: a bad value (the part's message, prefixed with the table).
     """
-    from wmr_mj.hardware import Actuation, Sensing, Transmission
-
     for key in spec:
         if key not in _HARDWARE_KEYS:
             raise UnknownNameError(f"{where}: [hardware.{name}] key", str(key), _HARDWARE_KEYS)

@@ -38,8 +38,18 @@ from typing import Any
 import numpy as np
 
 from wmr_mj._util.checks import positive_range
+from wmr_mj._util.files import write_json_atomic, write_text_atomic
+from wmr_mj.analysis.path_bound import PATH_VERDICTS
+from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE, PASS, count_unmet, count_verdicts, unmet_assumptions
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import parameter_names, tie_motor_constant
+from wmr_mj.searches.search_space import (
+    HARDWARE_AXES,
+    check_hardware_range,
+    hardware_axis,
+    hardware_values,
+    with_hardware,
+)
 from wmr_mj.sim.batch import run_batch
 from wmr_mj.sim.coerce import coerced
 from wmr_mj.sim.config import RunConfig, config_from_dict
@@ -69,8 +79,6 @@ SAMPLINGS = ("uniform", "lhs", "grid")
 
 def _count_path_verdicts(rows: Sequence[Mapping[str, Any]]) -> dict[str, int] | None:
     """The count of each path verdict in ``rows`` (zeros included); None when no row has one."""
-    from wmr_mj.analysis.path_bound import PATH_VERDICTS
-
     seen = [str(r["path_verdict"]) for r in rows if r.get("path_verdict")]
     if not seen:
         return None
@@ -107,7 +115,6 @@ class SweepSpec:
         if self.m1 is not None and (isinstance(self.m1, bool) or not isinstance(self.m1, (int, float))
                                     or not (math.isfinite(self.m1) and self.m1 > 0)):
             raise ParameterError(f"m1 = {self.m1!r} is not accepted; a fixed m1 is a finite number of kg > 0")
-        from wmr_mj.searches.search_space import HARDWARE_AXES, check_hardware_range, hardware_axis
 
         names = set(parameter_names()) - {"m1"}
         for name, (lo, hi) in self.ranges.items():
@@ -145,8 +152,6 @@ class SweepSpec:
     def hardware_names(self) -> tuple[str, ...]:
         """The ranged axes of the cart (:data:`wmr_mj.searches.search_space.HARDWARE_AXES`), in order: drawn per run,
         never part of the certificate's plant box (each run's claim covers its own cart)."""
-        from wmr_mj.searches.search_space import hardware_axis
-
         return tuple(n for n in self.ranges if hardware_axis(n))
 
     def base_for_box(self) -> RunConfig:
@@ -156,8 +161,6 @@ class SweepSpec:
     def config_at(self, values: Sequence[float]) -> RunConfig:
         """The run of one draw (``values`` in :attr:`names` order: m1 first): m1 and the plant parameters set,
         the cart's axes set in its parts (rounded to what a run can have)."""
-        from wmr_mj.searches.search_space import with_hardware
-
         base = self.base_for_box()
         hardware = set(self.hardware_names)
         overrides = dict(base.plant_overrides)
@@ -170,8 +173,6 @@ class SweepSpec:
         """Each ranged axis but m1 -> the value its run used (runs.csv's columns): a plant parameter as drawn
         (k_b as k_i where both are ranged: :func:`wmr_mj.params.tie_motor_constant`), a hardware axis as rounded
         (:func:`wmr_mj.searches.search_space.hardware_values`)."""
-        from wmr_mj.searches.search_space import hardware_values
-
         out = tie_motor_constant({n: float(v) for n, v in zip(self.names[1:], values[1:])}, self.ranges)
         out.update(hardware_values(self.base, {n: out[n] for n in self.hardware_names}))
         return out
@@ -392,8 +393,6 @@ def run_sweep(spec: SweepSpec, *, out_dir: str | os.PathLike | None = None, chun
 def _run_sweep(spec: SweepSpec, out_dir: str | os.PathLike | None, chunk: int, nthread: int, client: Any,
                progress: Callable[[float, int], None] | None) -> list[dict[str, Any]]:
     """:func:`run_sweep` once its inputs are checked: locally, or on ``client`` (a Dask client) where given."""
-    from wmr_mj._util.files import write_json_atomic, write_text_atomic
-
     done: dict[int, dict[str, Any]] = {}
     out = Path(out_dir) if out_dir is not None else None
     extra = list(spec.names[1:])
@@ -511,8 +510,6 @@ class RequirementSweep(Record):
 
 def _claim_broken(rows: Sequence[Mapping[str, Any]], names: Sequence[str]) -> BrokenRun | None:
     """SweepSummary.claim_broken of ``rows``: the certified-outside run of the largest cert_E_ratio."""
-    from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE
-
     broken = [r for r in rows if r.get("verdict") == CERTIFIED_OUTSIDE]
     if not broken:
         return None
@@ -531,8 +528,6 @@ def _claim_broken(rows: Sequence[Mapping[str, Any]], names: Sequence[str]) -> Br
 def _unmet_over(rows: Sequence[Mapping[str, Any]]) -> tuple[UnmetAssumption, ...]:
     """SweepSummary.unmet of ``rows``: each unmet assumption once, its first run's value and limit, and
     the number of runs that do not meet it."""
-    from wmr_mj.analysis.verdicts import count_unmet, unmet_assumptions
-
     certificates = (r.get("certificate") for r in rows)
     counted = count_unmet(unmet_assumptions(c if isinstance(c, Mapping) else None) for c in certificates)
     return tuple(UnmetAssumption.from_dict(a) for a in counted)
@@ -703,8 +698,6 @@ class SweepSummary(Record):
         Raises:
             ParameterError: no rows.
         """
-        from wmr_mj.analysis.verdicts import count_verdicts
-
         if not rows:
             raise ParameterError("no runs to summarise")
         first = rows[0]
@@ -743,8 +736,6 @@ class SweepSummary(Record):
     @property
     def passes(self) -> int:
         """Runs ``certified-inside``, the only pass."""
-        from wmr_mj.analysis.verdicts import PASS
-
         return self.verdicts[PASS]
 
     @property

@@ -24,6 +24,7 @@ from typing import Any
 from wmr_mj.experiments.sweep import SweepSpec, SweepSummary, run_sweep, spec_from_json, spec_to_json
 from wmr_mj.hardware import cart_dict
 from wmr_mj.searches.search_space import HARDWARE_AXES, parameter_units
+from wmr_mj.sim import notebook
 from wmr_mj.sim.run_report import add_controller_source
 
 __all__ = ["SweepResult", "sweep"]
@@ -90,23 +91,18 @@ class SweepResult:
         Raises:
             WmrMjError: pandas is not installed (``pip install 'wmr-mj[notebook]'``).
         """
-        from wmr_mj.sim import notebook
-
         return notebook.runs_frame(self.rows, parameters=self.spec.names, units=parameter_units(self.spec.names))
 
     def plot(self, **options: Any) -> Any:
         """sup|E| of every run against each ranged parameter, one panel each, with the certificate's E_max
         (:class:`wmr_mj.figures.results.ResultPlot`); each panel's x label is the parameter's column in
         :meth:`to_pandas` (with its unit)."""
-        from wmr_mj.figures.results import plot_sweep
-        from wmr_mj.sim import notebook
+        from wmr_mj.figures.results import plot_sweep  # matplotlib loads only when a figure is asked for
 
         units = parameter_units(self.spec.names)
         return plot_sweep(self, xlabels=[notebook.run_column(n, units) for n in self.spec.names], **options)
 
     def _repr_html_(self) -> str:
-        from wmr_mj.sim import notebook
-
         s = self.summary
         lines = [f"{s.n} runs over {', '.join(self.spec.names)}: {notebook.verdict_counts_text(s.verdicts)}",
                  f"worst sup|E| {notebook.number(s.sup_E.value, 'rad')}; certificate's E_max "

@@ -23,7 +23,11 @@ from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from typing import Any
 
+from wmr_mj.searches.falsify import FalsifySpec, check_runnable, falsify
+from wmr_mj.sim import notebook
+from wmr_mj.sim.certify import certificate_name
 from wmr_mj.sim.coerce import coerced
+from wmr_mj.sim.notebook import html_lines, number, verdict_counts_text
 from wmr_mj.sim.records import Record
 
 __all__ = ["CartTightness", "cart_tightness", "certificate_columns"]
@@ -87,8 +91,6 @@ class CartTightness(Record):
         Raises:
             WmrMjError: pandas is not installed (``pip install 'wmr-mj[notebook]'``).
         """
-        from wmr_mj.sim import notebook
-
         return notebook.records_frame([{
             "path": self.path, "certificate": self.certificate, "certified": self.certified,
             "E_max [rad]": self.E_max, "E_max_section4 [rad]": self.E_max_section4,
@@ -103,8 +105,6 @@ class CartTightness(Record):
         return plot_tightness([self])
 
     def _repr_html_(self) -> str:
-        from wmr_mj.sim.notebook import html_lines, number, verdict_counts_text
-
         where = ", ".join(f"{k} = {v:.6g}" for k, v in self.worst_params.items())
         return html_lines("tightness", number(self.tightness), [
             f"{self.path}: E_max {number(self.E_max, 'rad')} ({self.certificate or 'no certificate'}; section 4 "
@@ -123,7 +123,6 @@ def certificate_columns(cert: Any) -> dict[str, Any]:
     """
     if cert is None:
         return {"certificate": "", "certified": False, "E_max": None, "E_max_section4": None, "E_max_sampled": None}
-    from wmr_mj.sim.certify import certificate_name
 
     e_max = float(cert.E_max) if cert.valid and math.isfinite(cert.E_max) else None
     both = cert.inputs.get("certificates")
@@ -155,8 +154,6 @@ def cart_tightness(base: Any, *, box: Mapping[str, tuple[float, float]] | None =
     Raises:
         ParameterError: what falsify refuses (a budget below one population, a bad range or path).
     """
-    from wmr_mj.searches.falsify import FalsifySpec, check_runnable, falsify
-
     base = coerced(base)  # a base given directly: its cart's m1 box read here
     if box is None:
         box = {"m1": (float(base.m1_range[0]), float(base.m1_range[1]))}

@@ -52,10 +52,13 @@ from typing import Any
 
 import numpy as np
 
+from wmr_mj._util.files import write_json_atomic
 from wmr_mj.analysis.claim_types import Assumption
+from wmr_mj.carts import cart_names, cart_path
 from wmr_mj.errors import ParameterError
 from wmr_mj.hardware import Actuation, Sensing, Transmission
 from wmr_mj.plant.cart_data import identified_from
+from wmr_mj.plant.mjcf import TIMESTEP
 from wmr_mj.searches.design_options import (
     DEFAULT_BUDGET,
     DEFAULT_OBJECTIVE,
@@ -66,7 +69,13 @@ from wmr_mj.searches.design_options import (
     OBJECTIVES,
 )
 from wmr_mj.searches.optimisers import CMAES, Chain, DifferentialEvolution, Optimiser, Points, drive
+from wmr_mj.sim import notebook
+from wmr_mj.sim.certify import certificate_name, certificate_of, measurement_errors_of
 from wmr_mj.sim.coerce import coerced
+from wmr_mj.sim.config import base_for, controller_and_settings
+from wmr_mj.sim.designs import CERTIFIED
+from wmr_mj.sim.notebook import number
+from wmr_mj.sim.parts import resolve_run
 from wmr_mj.sim.records import Record
 
 __all__ = ["DesignProblem", "DesignResult", "OBJECTIVES", "METHODS", "LAWS", "DEFAULT_SEED", "DEFAULT_BUDGET",
@@ -163,8 +172,6 @@ class DesignCertificate(Record):
     @classmethod
     def of(cls, cert: Any) -> DesignCertificate:
         """The record of a live certificate (a record is itself)."""
-        from wmr_mj.sim.certify import certificate_name
-
         if isinstance(cert, DesignCertificate):
             return cert
         return cls(certified=cert.certified, E_max=cert.E_max if cert.valid else None,
@@ -265,9 +272,6 @@ class DesignResult:
         Raises:
             WmrMjError: pandas is not installed (``pip install 'wmr-mj[notebook]'``).
         """
-        from wmr_mj.sim import notebook
-        from wmr_mj.sim.certify import certificate_name
-
         rows = []
         for path, cert in self.certificates.items():
             valid = cert is not None and cert.valid
@@ -287,8 +291,6 @@ class DesignResult:
         return plot_design(self)
 
     def _repr_html_(self) -> str:
-        from wmr_mj.sim import notebook
-
         return notebook.html_lines("design", "certified" if self.certified else "nothing certifies",
                                    design_lines(self))
 
@@ -300,8 +302,6 @@ def law_changes(law: str) -> dict[str, Any]:
     Raises:
         ParameterError: a law not in :data:`LAWS` (one line listing them).
     """
-    from wmr_mj.sim.designs import CERTIFIED
-
     _check_law(law)
     return CERTIFIED.config_changes() if law == "computed-torque" else {"controller": law, "model": "nonholonomic"}
 
@@ -315,9 +315,6 @@ def uncovered(base: Any) -> str:
     """Why no certificate can cover ``base``'s cart (its sensing, actuation and play on its parameter set), so that
     no design can certify it (e.g. "Gaussian noise has no bound"); '' where its errors are covered. What ``wmr-mj
     design`` refuses before any search and ``cart check`` reports as binding."""
-    from wmr_mj.sim.certify import measurement_errors_of
-    from wmr_mj.sim.config import base_for
-
     measurement = measurement_errors_of(base, base_for(base))
     return "" if measurement.covered else str(measurement.why_not)
 
@@ -328,8 +325,6 @@ def check_periods(periods: Sequence[float], duration: float) -> tuple[float, ...
     Raises:
         ParameterError: an empty list or a period that is not accepted (one line naming it).
     """
-    from wmr_mj.plant.mjcf import TIMESTEP
-
     out = []
     for p in periods:
         p = float(p)
@@ -355,8 +350,6 @@ class _Scorer:
     """The certificate of a point on each path, on the parts ``resolve_run`` gives (resolved once per path)."""
 
     def __init__(self, problem: DesignProblem, period: float):
-        from wmr_mj.sim.parts import resolve_run
-
         self.problem = problem
         self.template = dataclasses.replace(problem.base, control_period=period)
         self.parts = {path: resolve_run(dataclasses.replace(self.template, path=path)) for path in problem.paths}
@@ -399,9 +392,6 @@ class _Scorer:
         return dataclasses.replace(self.template, kp=kp, kd=kd, friction_width=10.0 ** float(x[2]), sensing=sensing)
 
     def certificates(self, config: Any) -> dict[str, Any]:
-        from wmr_mj.sim.certify import certificate_of
-        from wmr_mj.sim.config import controller_and_settings
-
         out = {}
         for path, parts in self.parts.items():
             c = dataclasses.replace(config, path=path)
@@ -577,8 +567,6 @@ def evaluate_design(config: Any, paths: Sequence[str]) -> dict[str, Any]:
 
 def _resolved(config: Any, paths: Sequence[str]) -> dict[str, Any]:
     """Each path's :class:`~wmr_mj.sim.parts.RunParts` of ``config``, as ``wmr-mj run`` resolves it."""
-    from wmr_mj.sim.parts import resolve_run
-
     return {path: resolve_run(dataclasses.replace(config, path=path)) for path in paths}
 
 
@@ -603,9 +591,6 @@ def _finish(problem: DesignProblem, config: Any, found: float, evaluations: int,
 
 def design_lines(result: DesignResult) -> list[str]:
     """The design in a few lines: the law's parameters, then each path's certificate (or what binds)."""
-    from wmr_mj.sim.certify import certificate_name
-    from wmr_mj.sim.notebook import number
-
     s = result.settings
     if result.law_parameters:  # the law's own parameters (controller_params), not the run's gains
         law = s["controller"].replace("-", " ") + " " + ", ".join(
@@ -664,8 +649,6 @@ def _cart_entry(record: Mapping[str, Any]) -> dict[str, Any]:
 
 def write_design(result: DesignResult, path: str | os.PathLike) -> None:
     """Write the design file (JSON; floats at full precision, so ``run --design`` reads the same numbers)."""
-    from wmr_mj._util.files import write_json_atomic
-
     write_json_atomic(path, design_dict(result))
 
 
@@ -748,8 +731,6 @@ def design_cart(path: str | os.PathLike, given: Any = None, *, data: Mapping[str
             line naming it and what is accepted.
     """
     from pathlib import Path
-
-    from wmr_mj.carts import cart_names, cart_path
 
     recorded = (read_design(path) if data is None else data).get("cart")
     if given is not None or not isinstance(recorded, Mapping):

@@ -101,9 +101,11 @@ import numpy as np
 
 from wmr_mj._util.checks import positive_range
 from wmr_mj._util.deprecation import deprecated_names
+from wmr_mj.analysis.requirements import parse_requirement
 from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE, VERDICTS, unmet_assumptions
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import parameter_names, tie_motor_constant
+from wmr_mj.plant.mjcf import TIMESTEP
 from wmr_mj.searches.falsify_objectives import (
     OBJECTIVE_LABELS,
     OBJECTIVES,
@@ -145,8 +147,10 @@ from wmr_mj.searches.search_space import (
     path_axis,
     signal_axis,
 )
+from wmr_mj.sim import notebook
 from wmr_mj.sim.config import RunConfig, config_from_dict
 from wmr_mj.sim.many_runs import connect, flat_row, run_configs
+from wmr_mj.sim.parts import resolve_run
 from wmr_mj.sim.records import BrokenRun, Record, UnmetAssumption
 
 __all__ = [
@@ -267,9 +271,6 @@ class FalsifySpec:
 
     @property
     def parsed_requirement(self):
-        from wmr_mj.analysis.requirements import parse_requirement
-        from wmr_mj.plant.mjcf import TIMESTEP
-
         period = TIMESTEP if self.base.control_period is None else self.base.control_period
         return parse_requirement(self.requirement, period=period)
 
@@ -725,8 +726,6 @@ class FalsifyResult:
         Raises:
             WmrMjError: pandas is not installed (``pip install 'wmr-mj[notebook]'``).
         """
-        from wmr_mj.sim import notebook
-
         names = self.spec.names
         rows = [{"phase": e.phase, "index": e.index, "generation": e.generation, **e.params,
                  "objective": e.objective, **{k: v for k, v in flat_row(e.summary).items() if k not in e.params}}
@@ -737,13 +736,11 @@ class FalsifyResult:
     def plot(self, **options: Any) -> Any:
         """The search beside random: each run's objective and the running worst of each
         (a :class:`wmr_mj.figures.results.ResultPlot`)."""
-        from wmr_mj.figures.results import plot_falsify
+        from wmr_mj.figures.results import plot_falsify  # matplotlib loads only when a figure is asked for
 
         return plot_falsify(self, **options)
 
     def _repr_html_(self) -> str:
-        from wmr_mj.sim import notebook
-
         return notebook.falsify_html(self)
 
 
@@ -835,8 +832,6 @@ def check_runnable(base: RunConfig) -> Any:
     Returns:
         RunParts: ``base`` resolved (:func:`wmr_mj.sim.parts.resolve_run`), for :func:`falsify`'s ``parts``.
     """
-    from wmr_mj.sim.parts import resolve_run
-
     return resolve_run(base)
 
 

@@ -39,8 +39,11 @@ from typing import Any
 
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import parameter_names
+from wmr_mj.plant.mjcf import TIMESTEP
+from wmr_mj.reference.knots import knot_path
+from wmr_mj.reference.route import route_from_path
 from wmr_mj.sim.coerce import coerced
-from wmr_mj.sim.config import RunConfig
+from wmr_mj.sim.config import RunConfig, base_for, estimate_parameters
 from wmr_mj.sim.signals import Signals
 
 __all__ = ["config_for", "signal_axis", "path_axis", "DISTURBANCE_FIELDS", "LOAD_FIELDS", "DEFAULT_HOLD_S",
@@ -100,8 +103,6 @@ def hardware_values(base: RunConfig, values: Mapping[str, float]) -> dict[str, f
         UnknownNameError: a name that is not in :data:`HARDWARE_AXES`.
         ParameterError: a negative number of bits.
     """
-    from wmr_mj.plant.mjcf import TIMESTEP
-
     out: dict[str, float] = {}
     for name, value in values.items():
         if name not in HARDWARE_AXES:
@@ -247,10 +248,6 @@ def config_for(base: RunConfig, names: Sequence[str], x: Sequence[float]) -> Run
 
 def _knot_route(base: RunConfig, values: dict[str, float]) -> str:
     """The canonical route text of the knot path at ``values`` (path.k<i>, path.hold)."""
-    from wmr_mj.reference.knots import knot_path
-    from wmr_mj.reference.route import route_from_path
-    from wmr_mj.sim.config import base_for, estimate_parameters
-
     if base.reference_bounds is None:
         raise ParameterError("searching C's path (path.k<i>, path.hold) needs declared reference bounds, for which "
                              "the certificate holds and within which every searched path stays: give "

@@ -43,10 +43,12 @@ import mujoco
 import numpy as np
 
 from wmr_mj._util.memory import require_memory
+from wmr_mj.analysis.requirements import parse_requirement
 from wmr_mj.analysis.verdicts import drift, drift_window_steps
 from wmr_mj.errors import ParameterError
 from wmr_mj.params import C80, M1_NOMINAL, C80Parameters
 from wmr_mj.plant.mjcf import TIMESTEP
+from wmr_mj.reference.route import RouteProgress
 from wmr_mj.sim import compiled_law
 from wmr_mj.sim.closed_loop import (
     PathJudgement,
@@ -59,7 +61,7 @@ from wmr_mj.sim.closed_loop import (
 )
 from wmr_mj.sim.coerce import coerced
 from wmr_mj.sim.config import RunConfig, has_tracker
-from wmr_mj.sim.engine import LAW_BACKENDS, batch_law_backend, batch_model, held_mujoco_warnings
+from wmr_mj.sim.engine import LAW_BACKENDS, _heading, batch_law_backend, batch_model, held_mujoco_warnings
 from wmr_mj.sim.parts import RunLabels, RunParts, plant_and_claim, resolve_run
 from wmr_mj.sim.summary import BatchFigures, RunSummary, voltage_effort
 
@@ -266,8 +268,6 @@ def _path_stats(loop: _Loop, stats: _BatchStats, idx: np.ndarray, k0: int, rows:
                 quat: np.ndarray | None = None, heading: np.ndarray | None = None) -> None:
     """Keep C's xy and the heading (or the chassis quaternion's yaw) of control steps k0 .. k0+rows-1
     that are path samples; (rows, g, ...) buffers."""
-    from wmr_mj.sim.engine import _heading
-
     lo, hi = np.searchsorted(loop.path_at, [k0, k0 + rows])
     if lo == hi:
         return
@@ -494,7 +494,6 @@ def _summaries(configs: Sequence[RunConfig], plants: Sequence[C80Parameters], st
     # C's projections are NumPy work that releases the GIL: judged on the batch's threads, each run alone
     with concurrent.futures.ThreadPoolExecutor(max(1, min(run.threads, nsim))) as pool:
         paths = list(pool.map(path_of, range(nsim)))
-    from wmr_mj.reference.route import RouteProgress
 
     progress = (None if parts.route_length_m is None  # one path: one progress
                 else RouteProgress.along(parts.route_length_m, reference, n * substeps * TIMESTEP))
@@ -548,8 +547,6 @@ def _run_one_by_one(configs: Sequence[RunConfig], *, base: C80Parameters, progre
     does not keep the state after its last step. ``batch.wall_s`` is the wall time of them
     all, ``batch.cpu_s`` the sum of the threads' CPU time.
     """
-    from wmr_mj.analysis.requirements import parse_requirement
-
     def period_of(config: RunConfig) -> float:
         return TIMESTEP if config.control_period is None else config.control_period
 

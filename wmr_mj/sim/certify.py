@@ -46,6 +46,8 @@ from wmr_mj.plant.mjcf import TIMESTEP
 from wmr_mj.sim.builders import BoxSpec, run_bounds
 from wmr_mj.sim.coerce import coerced
 from wmr_mj.sim.config import (
+    base_for,
+    controller_and_settings,
     controller_for,
     estimate_parameters,
     plant_parameters,
@@ -195,8 +197,6 @@ def certificate_for(config: Any, reference: Any, *, params: C80Parameters = C80,
         The controller's claim (``SteeringController.claim``: the section-4 certificate for the
         computed-torque and PD laws) with the run's inputs recorded; None where the law states none.
     """
-    from wmr_mj.sim.config import base_for
-
     config = coerced(config)  # a config given directly: its references read here
     params = base_for(config, params)  # the config's cart, where it names one
     estimate_params = estimate_parameters(params)
@@ -214,8 +214,6 @@ def claim_on_estimate(parts: Any, model: str) -> Certificate | None:
     Raises:
         WmrMjError: what the law on that estimate cannot build or claim.
     """
-    from wmr_mj.sim.config import controller_and_settings
-
     config = parts.config.replace(model=model)
     controller, _ = controller_and_settings(config, parts.estimate)
     return certificate_of(config, parts.reference, base=parts.base, estimate=parts.estimate, plant=parts.plant,

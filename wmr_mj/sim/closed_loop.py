@@ -38,16 +38,34 @@ from wmr_mj._util.memory import require_run_memory
 from wmr_mj._util.progress import progress_bar
 from wmr_mj.analysis.claim import with_measured
 from wmr_mj.analysis.claim_types import LAW_CLAIM, Assumption, CertificateJudgement, judge
-from wmr_mj.analysis.path_bound import PathBound, PathVerdict
-from wmr_mj.analysis.path_error import PathErrors, PathErrorSeries
-from wmr_mj.analysis.verdicts import Drift
+from wmr_mj.analysis.path_bound import (
+    PathBound,
+    PathVerdict,
+    guaranteed_E_max,
+    path_bound,
+    path_verdict,
+    without_guarantee,
+)
+from wmr_mj.analysis.path_error import (
+    PathErrors,
+    PathErrorSeries,
+    PathProjector,
+    path_error_series,
+    summarize_series,
+    wrap_angle,
+)
+from wmr_mj.analysis.requirements import evaluate_run
+from wmr_mj.analysis.verdicts import Drift, drift, drift_window_steps, judge_run, paper_region
 from wmr_mj.errors import ParameterError, WmrMjError
 from wmr_mj.params import C80, C80Parameters
 from wmr_mj.plant.mjcf import TIMESTEP, scene_xml
+from wmr_mj.plant.reduced import smooth_sign
 from wmr_mj.reference.route import RouteProgress
+from wmr_mj.sim import notebook
 from wmr_mj.sim.config import (
     RunConfig,
     estimate_parameters,
+    plant_parameters,
 )
 from wmr_mj.sim.engine import (
     ROW_FIELDS,
@@ -135,22 +153,17 @@ class RunResult:
         Raises:
             WmrMjError: pandas is not installed (``pip install 'wmr-mj[notebook]'``).
         """
-        from wmr_mj.sim import notebook
-
         return notebook.rows_frame(self.rows, self.C_xy)
 
     def plot(self, **options: Any) -> Any:
         """E and E' between the certificate's bounds, the voltage between the supply limits, and C's path
         (a :class:`wmr_mj.figures.results.ResultPlot`: ``.figure``, ``.axes``)."""
-        from wmr_mj.figures.results import plot_run
-        from wmr_mj.sim.config import plant_parameters
+        from wmr_mj.figures.results import plot_run  # matplotlib loads only when a figure is asked for
 
         # the supply of the plant the run simulated: its cart's, with its --param overrides
         return plot_run(self, supply=float(plant_parameters(self.config).voltage_limit), **options)
 
     def _repr_html_(self) -> str:
-        from wmr_mj.sim import notebook
-
         return notebook.run_html(self.summary)
 
 
@@ -186,8 +199,6 @@ def judge_requirements(result: RunResult, requirements: Sequence[Any], *, period
     rows (:func:`requirement_rows`), the presets against its summary; ``monitor``: a lock held around rtamt's
     monitor (pure Python, process-wide logging: one run at a time where runs share threads)."""
     import contextlib
-
-    from wmr_mj.analysis.requirements import evaluate_run
 
     with monitor if monitor is not None else contextlib.nullcontext():
         rows = requirement_rows(result, requirements, base=base)
@@ -240,7 +251,6 @@ def report(labels: RunLabels, measured: RunMeasures, *, analysis, params: C80Par
     m = measured
     sup_E, sup_Edot = float(m.sup_E), float(m.sup_Edot)
     steps, wall_s = m.steps, m.wall_s
-    from wmr_mj.analysis.verdicts import judge_run, paper_region
 
     judged = None
     if certificate is not None:
@@ -310,16 +320,12 @@ class _PathRows:
     log's writer calls it, on its own thread when it has one, so the run does not wait for it."""
 
     def __init__(self, reference, period: float) -> None:
-        from wmr_mj.analysis.path_error import PathProjector
-
         self.projector = PathProjector(reference)
         self.rt, self.rs = np.asarray(reference.t, float), np.asarray(reference.s, float)
         self.s_prev = float(self.rs[0])
         self.period = period
 
     def __call__(self, block: Mapping[str, np.ndarray], every: int) -> dict[str, np.ndarray]:
-        from wmr_mj.analysis.path_error import wrap_angle
-
         every = max(1, int(every))
         t = np.asarray(block["t"], float)
         n = t.size
@@ -358,9 +364,6 @@ def judge_path(reference, t: np.ndarray, C_xy: np.ndarray, heading: np.ndarray, 
     is finite (a diverged run): nothing to project. ``corrected``: the run had the Cartesian
     correction (position feedback at C); the bound and verdict say that no bound is proven for it.
     """
-    from wmr_mj.analysis.path_bound import guaranteed_E_max, path_bound, path_verdict, without_guarantee
-    from wmr_mj.analysis.path_error import path_error_series, summarize_series
-
     tt, X, h = np.asarray(t, float), np.asarray(C_xy, float), np.asarray(heading, float)
     ok = np.isfinite(tt) & np.isfinite(X).all(axis=1) & np.isfinite(h)
     if not ok.any():
@@ -392,8 +395,6 @@ def _drift_of(E: np.ndarray, final_alpha_dot: float, period: float) -> Drift:
 
     final_alpha_dot: alpha' of the last control step, as alpha0' - E' (the batch keeps E', not alpha').
     """
-    from wmr_mj.analysis.verdicts import drift, drift_window_steps
-
     k = len(E)
     w = drift_window_steps(k, period)
     h = k - w + w // 2  # the last window's halves: [k - w, h) and [h, k)
@@ -593,8 +594,6 @@ def run_on_reduced_model(
     reference's grid.
     """
     from scipy.integrate import solve_ivp
-
-    from wmr_mj.plant.reduced import smooth_sign
 
     T = float(reference.duration if duration is None else duration)
     law = controller.voltage_scalar

@@ -73,7 +73,9 @@ from typing import Any
 import mujoco
 import numpy as np
 
+from controllers import ComputedTorque, PDController
 from wmr_mj.errors import ParameterError
+from wmr_mj.hardware.sensing import _VELOCITY_CODES, N_PARAMETERS, S_RING
 
 __all__ = ["LAW_FIELDS", "USERDATA_FIELDS", "SENSING_USERDATA_FIELDS", "SENSING_STATE_ADR", "sensing_numeric",
             "unavailable_reason", "install", "supports", "law_vector", "attach",
@@ -120,8 +122,6 @@ def _library() -> tuple[ctypes.CDLL | None, str | None]:
 def _sensing_layout() -> int:
     """The sensing layout's sizes as the C file encodes them (wmr_mj_sensing_layout), and the number of velocity
     codes it knows (a library built before velocity=none would difference where the chain gives NaN)."""
-    from wmr_mj.hardware.sensing import _VELOCITY_CODES, N_PARAMETERS, S_RING
-
     return 100000 * len(_VELOCITY_CODES) + 1000 * len(SENSE_FIELDS) + 10 * N_PARAMETERS + S_RING
 
 
@@ -170,8 +170,6 @@ def supports(controller: Any) -> bool:
 
     A subclass may change the law, so it keeps the NumPy path.
     """
-    from controllers import ComputedTorque, PDController
-
     return type(controller) in (ComputedTorque, PDController)
 
 
@@ -286,7 +284,6 @@ def law_vector(controller: Any, *, voltage_limit: float, substeps: int, nstep: i
                      qpos_adr=qpos_adr, dof_adr=dof_adr, actuator=actuator, chassis=chassis, function=slot,
                      nparam=len(p))
         return np.concatenate([np.array([float(fixed[name]) for name in LAW_FIELDS]), p])
-    from controllers import ComputedTorque
 
     values: dict[str, Any] = {"C_V": 0.0, "F": 0.0, "K": 0.0, "gyro_V": 0.0, "friction_width": 0.0,
                               "friction_sign": "measured"}

@@ -44,9 +44,14 @@ import functools
 from dataclasses import dataclass
 from typing import Any, Protocol
 
+from controllers import CONTROLLER_NAMES, gains_from_omega_r
+from controllers.registry import parse_params
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import PAPER_KD, PAPER_KP
 from wmr_mj.reference.route import path_name
+from wmr_mj.sim.certify import certificate_for
+from wmr_mj.sim.coerce import cart_file_of_record, default_path
+from wmr_mj.sim.config import RunConfig, base_for, build_reference, controller_for, estimate_parameters
 
 __all__ = [
     "DesignPreset",
@@ -165,8 +170,6 @@ def preset(name: str, *, cart: Any = None, path: str | None = None) -> DesignPre
 
 def _cart_record(cart: Any) -> dict[str, Any] | None:
     """The cart's record as RunConfig keeps it (None: the C80)."""
-    from wmr_mj.sim.config import RunConfig
-
     return RunConfig.from_inputs(cart=cart).cart
 
 
@@ -200,9 +203,6 @@ def _certified_on(text: str, cart_path: str, path: str | None) -> DesignPreset:
 
 def _path_of(cart: Any, path: str | None) -> str:
     """The path the rule runs on: ``path``, else the cart's own default."""
-    from wmr_mj.sim.coerce import cart_file_of_record, default_path
-    from wmr_mj.sim.config import RunConfig
-
     return path if path is not None else default_path(cart_file_of_record(RunConfig.from_inputs(cart=cart).cart))
 
 
@@ -225,9 +225,6 @@ def certified_omega_r(*, error_spec: float = ERROR_SPEC, grid: tuple[float, ...]
 
     cart: the cart (anything ``RunConfig(cart=...)`` takes; None: the C80): its parameter set, its m1 box, its
     stops and supply."""
-    from wmr_mj.sim.certify import certificate_for
-    from wmr_mj.sim.config import RunConfig, base_for, build_reference
-
     on_cart = RunConfig.from_inputs(cart=cart)
     reference, _ = build_reference(_path_of(cart, path), base_for(on_cart), dt=1e-3, duration=35.0)
     for w in grid:
@@ -271,9 +268,6 @@ def design_changes(token: str) -> dict[str, Any]:
         UnknownNameError: an unknown preset or law (from RunConfig, naming the valid ones).
         ParameterError: an empty name, a setting the design does not take.
     """
-    from controllers import CONTROLLER_NAMES, gains_from_omega_r
-    from controllers.registry import parse_params
-
     name, _, rest = str(token).partition(",")
     name = name.strip()
     if not name:
@@ -319,6 +313,4 @@ class TokenDesign:
         return design_changes(self.token)
 
     def describe(self) -> str:
-        from wmr_mj.sim.config import RunConfig, controller_for, estimate_parameters
-
         return controller_for(RunConfig(**self.config_changes()), estimate_parameters()).label()

@@ -58,6 +58,7 @@ from wmr_mj.errors import ParameterError, UnknownNameError, WmrMjError
 from wmr_mj.hardware.assembly import CART_PARTS
 from wmr_mj.hardware.sensing import P_GEAR_RATIO, SensingChain
 from wmr_mj.params import C80Parameters
+from wmr_mj.plant.mjcf import scene_spec, steering_joint_addresses
 from wmr_mj.sim import compiled_law
 
 __all__ = ["run_engine", "Schedule", "EngineRun", "batch_model", "batch_law_backend", "LAW_BACKENDS", "LAW_PATHS",
@@ -116,9 +117,7 @@ def batch_model(params: C80Parameters, *, law: tuple[Any, ...] | None = None,
     compiled law (:func:`wmr_mj.sim.compiled_law.attach`: two numerics and userdata, no physics; a
     third numeric with the disturbance torque).
     """
-    from wmr_mj.plant import mjcf as plant
-
-    spec = plant.scene_spec(params, **plant_options)
+    spec = scene_spec(params, **plant_options)
     for texture in list(spec.textures):
         if texture.type == mujoco.mjtTexture.mjTEXTURE_SKYBOX:
             spec.delete(texture)
@@ -219,8 +218,6 @@ class _Plant:
     """Indices and constants the engine reads, from a compiled model."""
 
     def __init__(self, m: mujoco.MjModel) -> None:
-        from wmr_mj.plant.mjcf import steering_joint_addresses
-
         steering = steering_joint_addresses(m)
         self.qpos, self.dof = steering.axle_qpos, steering.axle_dof  # alpha, alpha'
         # the motor side (the axle's joint itself where the gear has no play): the motor's torque acts on its

@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from wmr_mj.analysis.verdicts import format_unmet
 from wmr_mj.errors import WmrMjError
 
 __all__ = ["NOTEBOOK_INSTALL", "require_pandas", "ROW_UNITS", "row_column", "RUN_COLUMNS", "run_column", "rows_frame",
@@ -181,8 +182,6 @@ def compare_frame(runs: Sequence[Any], rows: Sequence[Any]) -> Any:
     """A comparison's runs (``ScenarioRun``) as one row per design and scenario, plain columns: the run's
     verdict and errors, the certificate's bound, each requirement's robustness, whether it held and its
     robustness over its threshold, effort and C's path, then the design's adversary (``DesignRow``)."""
-    from wmr_mj.analysis.verdicts import format_unmet
-
     by_label = {r.label: r for r in rows}
     records = []
     for run in runs:

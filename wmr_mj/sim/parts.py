@@ -31,6 +31,7 @@ from wmr_mj.hardware import Actuation, Sensing, Transmission
 from wmr_mj.params import C80, C80Parameters, with_params
 from wmr_mj.plant.mjcf import TIMESTEP
 from wmr_mj.reference.named import build_reference
+from wmr_mj.sim import certify
 from wmr_mj.sim.builders import (
     BoxSpec,
     LawSpec,
@@ -47,6 +48,7 @@ from wmr_mj.sim.coerce import (
     law_name,
     plant_parameters,
 )
+from wmr_mj.sim.engine import load_fields, plant_options
 from wmr_mj.sim.run_config import RunConfig
 
 __all__ = ["RunParts", "RunLabels", "resolve_run", "run_reference", "plant_and_claim", "control_substeps",
@@ -189,9 +191,6 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
     Raises:
         WmrMjError: what the config cannot build (a plug-in, a path too short, a period that does not fit).
     """
-    from wmr_mj.sim.certify import law_certificate, measurement_errors
-    from wmr_mj.sim.engine import plant_options
-
     typed = coerce_with_classes(config, base=base)  # the one read of the config's files and plug-ins
     config, classes, base, plant, record = typed.config, typed.classes, typed.base, typed.plant, typed.record
     # the typed config read once, here in the sim layer, into what each part is built from
@@ -217,9 +216,9 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
     bounds = reference.bounds() if config.reference_bounds is None else config.reference_bounds
     paper_estimate = estimate_of(controller)  # None: not the paper's law, whose region then says nothing of it
     analysis = analysis_of(box, bounds, estimate, kp=law.kp, kd=law.kd, estimate=paper_estimate)
-    measurement = measurement_errors(config.sensing, config.actuation, config.transmission, plant,
+    measurement = certify.measurement_errors(config.sensing, config.actuation, config.transmission, plant,
                                      period=claim_period)  # once: the claim and the run's parts share it
-    law_claim = law_certificate(reference, controller=controller, tracker=tracker, box=box, base=base,
+    law_claim = certify.law_certificate(reference, controller=controller, tracker=tracker, box=box, base=base,
                                 estimate=estimate, plant=plant, period=claim_period, signals=config.signals,
                                 declared_bounds=config.reference_bounds, sensing=config.sensing,
                                 actuation=config.actuation, transmission=config.transmission,
@@ -252,11 +251,9 @@ def plant_and_claim(config: RunConfig, shared: RunParts, *, base: C80Parameters 
     """A batch's further run: its own plant, and the claim of ``shared``'s law (the batch's parts, which it shares
     but for the plant: law, tracker, reference, belief) on that plant -- a plant outside the box fails its
     assumption. ``base``: the batch's base parameter set, as :func:`wmr_mj.sim.batch.run_batch` is given it."""
-    from wmr_mj.sim.certify import certificate_of
-
     config = coerced(config)
     plant = plant_parameters(config, base)
-    claim = certificate_of(config, shared.reference, base=base, estimate=shared.estimate, plant=plant,
+    claim = certify.certificate_of(config, shared.reference, base=base, estimate=shared.estimate, plant=plant,
                            controller=shared.controller, tracker=shared.tracker)
     return plant, claim
 
@@ -276,7 +273,6 @@ def signal_inputs(signals: Any, plant: C80Parameters, options: dict[str, Any], *
     """
     if signals is None:
         return None, ()
-    from wmr_mj.sim.engine import load_fields
 
     disturbance = None
     if signals.disturbance is not None:

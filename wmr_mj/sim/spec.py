@@ -18,7 +18,17 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+from controllers import gains_from_omega_r
+from controllers.computed_torque import CONTROLLER_NAMES
+from controllers.registry import is_builtin
 from wmr_mj.errors import ParameterError
+from wmr_mj.hardware.assembly import is_ideal_cart
+from wmr_mj.params import C80
+from wmr_mj.plant.identify import identify_plant
+from wmr_mj.sim.certify import claim_on_estimate
+from wmr_mj.sim.config import RunConfig, base_for, controller_and_settings, declared_parameters, estimate_parameters
+from wmr_mj.sim.designs import CERTIFIED, preset
+from wmr_mj.sim.parts import resolve_run
 
 __all__ = ["LawChoice", "law_fields", "no_estimate_note", "LAW_OPTIONS"]
 
@@ -74,9 +84,6 @@ def law_fields(choice: LawChoice) -> dict[str, Any]:
         ParameterError, UnknownNameError: an unknown preset, both omega_r and kp/kd, a bad friction width, a
             law option the law neither declares nor reads (:func:`_route_law_options`).
     """
-    from controllers import gains_from_omega_r
-    from wmr_mj.sim.designs import preset
-
     design = preset("paper" if choice.preset is None else choice.preset, cart=choice.cart, path=choice.path)
     if choice.omega_r is not None and (choice.kp is not None or choice.kd is not None):
         raise ParameterError("give either --omega-r or --kp/--kd, not both")
@@ -95,9 +102,6 @@ def law_fields(choice: LawChoice) -> dict[str, Any]:
         raise ParameterError(f"--friction-width {friction_width} must be finite and >= 0 (rad/s)")
     identified = choice.identified
     if model == "identified" and identified is None:
-        from wmr_mj.plant.identify import identify_plant
-        from wmr_mj.sim.config import RunConfig, base_for
-
         identified = identify_plant(base_for(RunConfig(cart=choice.cart)), duration=30.0, seed=0).to_dict()
     settings: dict[str, Any] = {"model": model, "kp": kp, "kd": kd, "friction_sign": friction_sign,
                                 "friction_width": friction_width}
@@ -117,10 +121,6 @@ def _route_law_options(choice: LawChoice, controller: str, params: dict, setting
         ParameterError: an option the law neither declares nor reads (one line naming what it takes), or
             one given both as an option and as --controller-param.
     """
-    from controllers.computed_torque import CONTROLLER_NAMES
-    from wmr_mj.params import C80
-    from wmr_mj.sim.config import RunConfig, controller_and_settings, declared_parameters, estimate_parameters
-
     given = choice.given()
     if not given or controller == "computed-torque":
         return params
@@ -167,13 +167,6 @@ def no_estimate_note(parts: Any) -> str | None:
             again; the law on the other estimate is built once, and its claim computed once. A RunConfig is
             resolved here first.
     """
-    from controllers.registry import is_builtin
-    from wmr_mj.hardware.assembly import is_ideal_cart
-    from wmr_mj.sim.certify import claim_on_estimate
-    from wmr_mj.sim.config import RunConfig
-    from wmr_mj.sim.designs import CERTIFIED
-    from wmr_mj.sim.parts import resolve_run
-
     if isinstance(parts, RunConfig):
         parts = resolve_run(parts)
     config = parts.config
