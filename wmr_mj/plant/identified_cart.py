@@ -5,6 +5,9 @@ source ``identified from FILE (SHA-256 ...), 95 % interval [lo, hi]``; the 'full
 intervals as its ranges (m1's range stays the start's, widened to hold every recording's m1); ``defaults.sensing``
 carries the measured encoder, delay and noise (the start's velocity estimate kept: a recording of the angle
 does not say how the board differences it; 'exact' becomes 'difference', what a board with an encoder does).
+The measured delay is the voltage-to-angle one, sensing and actuation together: ``defaults.sensing`` runs all of it
+(the start's actuation delay, if any, set to 0) and ``[defaults.delay_split]`` is 'unknown', so that every
+certificate on the file covers each split of it (:mod:`wmr_mj.analysis.delay_split`).
 The file is checked as any cart file is (:func:`wmr_mj.carts.load_cart_text`) before it is returned.
 
 Usage::
@@ -23,6 +26,7 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from wmr_mj.carts import PARAMETER_SECTIONS, CartFile, load_cart_text
+from wmr_mj.hardware.actuation import Actuation
 from wmr_mj.hardware.sensing import Sensing
 from wmr_mj.params import parameters_of_cart
 from wmr_mj.plant.output_error import IDENTIFIED_PARAMETERS, SteeringFit
@@ -53,6 +57,11 @@ def _spec_text(sensing: Sensing) -> str:
         if value is None or value == "none" or (key == "delay" and value == 0.0) or (key == "seed" and value == 0):
             continue
         pairs.append(f"{key}={value!r}" if isinstance(value, float) else f"{key}={value}")
+    return ",".join(pairs) if pairs else "ideal"
+
+
+def _actuation_text(actuation: Actuation) -> str:
+    pairs = [f"{key}={value!r}" for key, value in actuation.to_dict().items() if value not in (None, 0.0)]
     return ",".join(pairs) if pairs else "ideal"
 
 
@@ -143,10 +152,24 @@ def identified_cart_text(start: CartFile, fit: SteeringFit, recordings: Sequence
         "value": _spec_text(sensing),
         "source": (f"measured from {made_of}: encoder {encoder}; delay {fit.delay_steps} control periods of "
                    f"{fit.period:g} s, 95 % interval [{fit.delay.lo:g}, {fit.delay.hi:g}] s (the voltage-to-angle "
-                   "delay: sensing and actuation delays are not separable when the voltage is recorded as applied, "
-                   f"so all of it is counted as sensing); noise {fit.noise_rad:.3g} rad standard deviation beyond "
+                   "delay, sensing and actuation together: run as sensing, its split unknown, [defaults.delay_split]"
+                   f"); noise {fit.noise_rad:.3g} rad standard deviation beyond "
                    "the quantisation (written as uniform of the same variance); the velocity estimate is the "
                    "start's (not in the recording)"),
+    }
+    actuation = Actuation.from_spec(start.defaults["actuation"])
+    if actuation.delay:  # the measured delay holds the start's actuation delay: not counted twice
+        entry = document["defaults"]["actuation"]
+        entry["value"] = _actuation_text(dataclasses.replace(actuation, delay=0.0))
+        entry["source"] += (f"; its delay ({actuation.delay:g} s) set to 0: the measured voltage-to-angle delay in "
+                            "defaults.sensing holds it")
+    document["defaults"]["delay_split"] = {
+        "value": "unknown",
+        "source": (f"measured from {made_of}: the voltage the controller applied and the angle its encoder read fix "
+                   f"only the sum of the sensing and actuation delays, {fit.delay_steps} control periods of "
+                   f"{fit.period:g} s (a pure delay commutes with the plant); each lies in [0, {fit.delay.hi:g}] s. "
+                   "A run simulates all of it as sensing (defaults.sensing); every certificate covers each split "
+                   "of the sum in whole control periods, the worst claimed"),
     }
     version = _bump_minor(document["version"])
     document["version"] = version

@@ -126,8 +126,11 @@ class SteeringFit:
         coefficients: 'P', 'C_V', 'F', 'K', 'gyro' at the first recording's m1 -> :class:`Interval` (K = 0 and
             gyro = P/l1 fixed from the cart's structure).
         physical: the cart-file parameters of :data:`IDENTIFIED_PARAMETERS` -> :class:`Interval`.
-        delay_steps: the delay between the applied voltage and the angle read, control periods.
-        delay: its :class:`Interval`, s.
+        delay_steps: the delay between the applied voltage and the angle read, control periods: the sensing and
+            the actuation delays together (a pure delay commutes with the plant: from the voltage the controller
+            applied and the angle it read, only their sum is identifiable).
+        delay: its :class:`Interval`, s. :attr:`sensing_delay` and :attr:`actuation_delay`: what the recordings
+            allow of each.
         period: the control period, s (the recordings' median step).
         encoder_ticks: ticks per revolution of the steering axis read from the angle's quantisation, or None
             where the angle is not on one grid (noise above the quantisation, or no encoder).
@@ -156,12 +159,27 @@ class SteeringFit:
     draws: np.ndarray = field(repr=False)
     jacobian_half_width: dict[str, float] = field(default_factory=dict)
 
+    @property
+    def sensing_delay(self) -> Interval:
+        """The sensing delay, s: the whole delay as the cart file runs it (its value), anywhere in [0, the sum's
+        upper end] as far as the recordings say (they fix only the sum)."""
+        return Interval(self.delay.value, 0.0, self.delay.hi)
+
+    @property
+    def actuation_delay(self) -> Interval:
+        """The actuation delay, s: 0 as the cart file runs it, anywhere in [0, the sum's upper end] as far as the
+        recordings say."""
+        return Interval(0.0, 0.0, self.delay.hi)
+
     def to_dict(self) -> dict[str, object]:
         return {
             "coefficients": {k: v.to_dict() for k, v in self.coefficients.items()},
             "physical": {k: v.to_dict() for k, v in self.physical.items()},
             "delay_steps": self.delay_steps,
-            "sensing_delay_s": self.delay.to_dict(),
+            "delay_s": self.delay.to_dict(),
+            "sensing_delay_s": self.sensing_delay.to_dict(),
+            "actuation_delay_s": self.actuation_delay.to_dict(),
+            "delay_split": "unknown",
             "period_s": self.period,
             "encoder_ticks": self.encoder_ticks,
             "noise_rad": self.noise_rad,

@@ -76,8 +76,12 @@ class IdentifyReport:
         out += [{"name": k, "value": iv.value, "lo": iv.lo, "hi": iv.hi, "unit": UNITS[k],
                  "how": IDENTIFIED_PARAMETERS[k]} for k, iv in self.fit.physical.items()]
         d = self.fit.delay
-        out.append({"name": "sensing_delay", "value": d.value, "lo": d.lo, "hi": d.hi, "unit": "s",
-                    "how": "identified: voltage to angle, whole control periods"})
+        out.append({"name": "delay", "value": d.value, "lo": d.lo, "hi": d.hi, "unit": "s",
+                    "how": "identified: voltage to angle (sensing and actuation together), whole control periods"})
+        for name, iv in (("sensing_delay", self.fit.sensing_delay), ("actuation_delay", self.fit.actuation_delay)):
+            out.append({"name": name, "value": iv.value, "lo": iv.lo, "hi": iv.hi, "unit": "s",
+                        "how": "not identifiable alone (only the sum is): run as all sensing, certified over every "
+                               "split"})
         return out
 
     def to_pandas(self) -> Any:

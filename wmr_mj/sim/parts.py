@@ -189,7 +189,7 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
     Raises:
         WmrMjError: what the config cannot build (a plug-in, a path too short, a period that does not fit).
     """
-    from wmr_mj.sim.certify import law_certificate, measurement_errors
+    from wmr_mj.sim.certify import delay_split_of, law_certificate, measurement_errors
     from wmr_mj.sim.engine import plant_options
 
     typed = coerce_with_classes(config, base=base)  # the one read of the config's files and plug-ins
@@ -224,7 +224,7 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
                                 declared_bounds=config.reference_bounds, sensing=config.sensing,
                                 actuation=config.actuation, transmission=config.transmission,
                                 steering_friction=config.steering_friction, measurement=measurement,
-                                sampled_data=True)
+                                sampled_data=True, delay_split=delay_split_of(config.cart))
     claims = claim_set(**{LAW_CLAIM: law_claim})
     disturbance, loads = signal_inputs(config.signals, plant, options, n=n, period=period,
                                        m1_inertia=config.m1_inertia)
