@@ -3,7 +3,8 @@
 Independent truth: each split's certificate computed alone, by a run on a cart file without
 ``[defaults.delay_split]`` whose sensing and actuation delays are that split (``SampledCart.of`` from the run's own
 parts, not the split loop's ``dataclasses.replace``); the worst over the splits must be at least each of them and
-equal one. A certificate assembled by hand (one split uncertified) checks the rule that no split may fail.
+equal one. A certificate assembled by hand (one split uncertified) checks the rule that no split may fail. The
+actuation delay read from an actuator-side signal (u_applied_V) against the shift the recordings were built with.
 """
 
 from __future__ import annotations
@@ -11,6 +12,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from wmr_mj.analysis.claim import ClaimContext
@@ -29,6 +31,8 @@ from wmr_mj.carts import load_cart, load_cart_text
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import C80
 from wmr_mj.plant.cart_data import delay_split_unknown
+from wmr_mj.plant.output_error import actuation_delay_of
+from wmr_mj.plant.recordings import Recording
 from wmr_mj.reference.bounds import ReferenceBounds
 from wmr_mj.sim.certify import delay_split_of
 from wmr_mj.sim.parts import resolve_run
@@ -150,3 +154,34 @@ def test_a_claim_context_refuses_an_unknown_split_word():
     with pytest.raises(UnknownNameError):
         ClaimContext(plant=box, reference=ref, limits=PlantLimits(steering_range=0.9, voltage_limit=24.0),
                      control_period=T, initial_error=(0.0, 0.0), estimate=C80, delay_split="maybe")
+
+
+# -- an actuator-side signal separates them (u_applied_V) --------------------------------------------------------
+def _recording(d_a: int, *, seconds: float = 4.0, seed: int = 0, applied: bool = True) -> Recording:
+    """A voltage of 1 kHz steps and its copy d_a periods later (what a driver logging its output would record)."""
+    rng = np.random.default_rng(seed)
+    n = int(seconds / T)
+    u = np.repeat(rng.uniform(-5.0, 5.0, n // 20 + 1), 20)[:n] + rng.normal(0.0, 0.5, n)
+    late = np.concatenate([np.zeros(d_a), u[:n - d_a]])
+    t = np.arange(n) * T
+    return Recording(name=f"rec{seed}.csv", sha256="", t=t, voltage=u, alpha=np.zeros(n),
+                     applied=late if applied else None)
+
+
+def test_the_applied_voltage_gives_the_actuation_delay_exactly():
+    # independent truth: the shift the recordings were built with
+    assert actuation_delay_of([_recording(2), _recording(2, seed=1)], steps=1000, max_delay=50, total=5) == (2, 2, 2)
+    assert actuation_delay_of([_recording(0)], steps=1000, max_delay=50, total=5) == (0, 0, 0)
+    assert actuation_delay_of([_recording(2, applied=False)], steps=1000, max_delay=50, total=5) is None
+
+
+def test_an_applied_voltage_that_does_not_fit_is_one_line():
+    with pytest.raises(ParameterError, match="u_applied_V is recorded in rec0.csv but not in the others"):
+        actuation_delay_of([_recording(2), _recording(2, seed=1, applied=False)], steps=1000, max_delay=50, total=5)
+    with pytest.raises(ParameterError, match="beyond the 1 from u_V to the angle"):
+        actuation_delay_of([_recording(2)], steps=1000, max_delay=50, total=1)
+    other = _recording(2)
+    wrong = Recording(name="wrong.csv", sha256="", t=other.t, voltage=other.voltage, alpha=other.alpha,
+                      applied=_recording(2, seed=7).voltage)  # another recording's voltage
+    with pytest.raises(ParameterError, match="u_applied_V does not follow u_V at any delay of 0-50 control periods"):
+        actuation_delay_of([wrong], steps=1000, max_delay=50, total=5)

@@ -16,6 +16,7 @@ import json
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 
 from wmr_mj.analysis.delay_split import DELAY_SPLIT_COVERED
@@ -38,16 +39,23 @@ SWEEP_RUNS = 3
 pytestmark = pytest.mark.slow
 
 
-def _record_csv(path: str, seed: int, duration: float, out: Path) -> Path:
-    """The true cart as its board logs it: the voltage the law applied (before the motor's 2 ms) and the angle read."""
+def _record_csv(path: str, seed: int, duration: float, out: Path) -> tuple[Path, Path]:
+    """The true cart as its board logs it: the voltage the law applied (before the motor's 2 ms) and the angle read;
+    and the same with the voltage at the motor as its driver would log it (``u_applied_V``: the law's voltage 2
+    periods later, MuJoCo's actuator delay of the run, 0 V before the first)."""
     cfg = RunConfig.from_inputs(cart=str(TRUTH), sensing=SENSING, actuation=ACTUATION, path=path, duration=duration,
                                 controller=f"{LAW}:DitheredPD", controller_params={"seed": seed})
     rows = run_closed_loop(cfg, progress=False).rows
-    with open(out, "w", encoding="utf-8") as f:
+    d_a = round(ACTUATION_S / PERIOD_S)
+    applied = np.concatenate([np.zeros(d_a), rows["voltage"][:-d_a]])
+    with_applied = out.with_name(out.stem + "-applied.csv")
+    with open(out, "w", encoding="utf-8") as f, open(with_applied, "w", encoding="utf-8") as g:
         f.write("t_s,u_V,alpha_rad\n")
-        for t, u, a in zip(rows["t"], rows["voltage"], rows["alpha_measured"]):
+        g.write("t_s,u_V,alpha_rad,u_applied_V\n")
+        for t, u, a, v in zip(rows["t"], rows["voltage"], rows["alpha_measured"], applied):
             f.write(f"{float(t)!r},{float(u)!r},{float(a)!r}\n")
-    return out
+            g.write(f"{float(t)!r},{float(u)!r},{float(a)!r},{float(v)!r}\n")
+    return out, with_applied
 
 
 def _main(argv: list[str]) -> tuple[int, str]:
@@ -61,18 +69,22 @@ def _main(argv: list[str]) -> tuple[int, str]:
 def walk(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     """Recordings of the 3 + 2 ms cart -> identify -> design over the identified box -> runs on the true cart."""
     folder = tmp_path_factory.mktemp("split")
-    lane = _record_csv("lane-change", 0, 20.0, folder / "lane.csv")
-    eight = _record_csv("figure-eight", 1, 20.0, folder / "eight.csv")
+    lane, lane_applied = _record_csv("lane-change", 0, 20.0, folder / "lane.csv")
+    eight, eight_applied = _record_csv("figure-eight", 1, 20.0, folder / "eight.csv")
     new, design = folder / "new.toml", folder / "design.json"
     code, printed = _main(["identify", "--cart", str(START), "--data", f"{lane}:m1=100", "--data", f"{eight}:m1=100",
                            "--out", str(new), "--json"])
     identified = (code, json.loads(printed))
+    separated = folder / "separated.toml"
+    code, printed = _main(["identify", "--cart", str(START), "--data", f"{lane_applied}:m1=100",
+                           "--data", f"{eight_applied}:m1=100", "--out", str(separated), "--json"])
+    identified_apart = (code, json.loads(printed))
     designed = _main(["design", "--cart", str(new), "--uncertainty", "full", "--objective", "E_max", "--budget", "12",
                       "--out", str(design)])
     code, printed = _main(["sweep", "--design", str(design), "--cart", str(TRUTH), "--sensing", SENSING,
                            "--actuation", ACTUATION, "--n", str(SWEEP_RUNS), "--out", str(folder / "sweep"), "--json"])
     return {"new": new, "design": design, "identify": identified, "design_run": designed,
-            "sweep": (code, json.loads(printed))}
+            "sweep": (code, json.loads(printed)), "separated": separated, "identify_apart": identified_apart}
 
 
 def test_the_sum_is_found_to_one_period_and_each_interval_holds_its_truth(walk):
@@ -114,3 +126,18 @@ def test_the_true_cart_with_its_true_split_stays_within_the_certificate(walk):
     assert code == 0 and swept["n"] == SWEEP_RUNS and swept["hit_steering_stop"] == 0
     assert swept["sensing"]["delay"] == SENSING_S and swept["actuation"]["delay"] == ACTUATION_S
     assert 0 < swept["worst_sup_E"] <= design["E_max"], (swept["worst_sup_E"], design["E_max"])
+
+
+def test_the_voltage_at_the_motor_separates_them(walk):
+    """With u_applied_V each delay is measured: 2 periods from u_V to the motor, the other 3 from the motor to the
+    angle; the cart file runs the true split and says it is known (no split to cover)."""
+    code, obj = walk["identify_apart"]
+    assert code == 0 and obj["delay_split"] == "known"
+    for key, truth in (("sensing_delay_s", SENSING_S), ("actuation_delay_s", ACTUATION_S)):
+        lo, hi = obj[key]["interval"]
+        assert abs(obj[key]["value"] - truth) <= PERIOD_S + 1e-12 and lo - 1e-12 <= truth <= hi + 1e-12, (key, obj[key])
+    assert obj["actuation_delay_s"]["interval"] == [ACTUATION_S, ACTUATION_S]  # the driver's log: exact
+    cart = load_cart(walk["separated"])
+    assert cart.defaults["delay_split"] == "known"
+    sensing, actuation = Sensing.from_spec(cart.defaults["sensing"]), Actuation.from_spec(cart.defaults["actuation"])
+    assert (sensing.delay, actuation.delay) == (obj["sensing_delay_s"]["value"], obj["actuation_delay_s"]["value"])
