@@ -30,7 +30,7 @@ __all__ = ["DELAY_SPLIT_COVERED", "DELAY_SPLITS", "delay_splits", "worst_over_sp
 
 #: The assumption a certificate over every split adds: every split of the total certified.
 DELAY_SPLIT_COVERED = "delay split covered"
-#: How a cart file says how its delay divides (``[defaults.delay_split]``, ``docs/guides/carts.md``): 'known' (the
+#: How a cart file says how its delay divides (``[defaults.delay_split]``, ``docs/reference/cart.md``): 'known' (the
 #: sensing and actuation delays as written, the default where the file has none), 'unknown' (only their sum).
 DELAY_SPLITS = ("known", "unknown")
 
