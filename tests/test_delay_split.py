@@ -28,6 +28,7 @@ from wmr_mj.analysis.plant_box import PlantBox, PlantLimits
 from wmr_mj.analysis.regions import BoxRegion
 from wmr_mj.analysis.robustness import ParameterBox
 from wmr_mj.carts import load_cart, load_cart_text
+from wmr_mj.cli.app import main
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import C80
 from wmr_mj.plant.cart_data import delay_split_unknown
@@ -185,3 +186,14 @@ def test_an_applied_voltage_that_does_not_fit_is_one_line():
                       applied=_recording(2, seed=7).voltage)  # another recording's voltage
     with pytest.raises(ParameterError, match="u_applied_V does not follow u_V at any delay of 0-50 control periods"):
         actuation_delay_of([wrong], steps=1000, max_delay=50, total=5)
+
+
+def test_a_run_says_which_delay_it_was_certified_for(tmp_path, capsys):
+    cart = _unknown_split_cart(tmp_path)
+    argv = ["run", "--cart", str(cart), "--model", "nonholonomic", "--kp", str(GAINS["kp"]), "--kd", str(GAINS["kd"]),
+            "--friction-width", str(GAINS["friction_width"]), "--sensing", "encoder_ticks=4096,velocity=difference,"
+            "delay=0.003", "--actuation", "delay=0.002", "--path", "paper-circle", "--duration", "8",
+            "--out", str(tmp_path / "run.mcap"), "--no-progress"]
+    assert main(argv) == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("certificate:"))
+    assert "the sampled-data certificate (delay 5 ms, any split sensing/actuation; section 4's" in line
