@@ -81,7 +81,8 @@ def with_sampled_data(own: Certificate, own_name: str, context: ClaimContext,
     own = covers_measurement(own, context.measurement)
     try:
         cart = sampled_cart(context)
-        if context.delay_split == "unknown":  # only the sum is measured: every split, the worst claimed
+        total = cart.sensing_delay + cart.actuation_delay
+        if context.delay_split == "unknown" and total:  # only the sum is measured: every split, the worst claimed
             cert = over_delay_splits(cart, context, sampled)
         else:
             cert = sampled(cart)

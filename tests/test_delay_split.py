@@ -197,3 +197,21 @@ def test_a_run_says_which_delay_it_was_certified_for(tmp_path, capsys):
     assert main(argv) == 0
     line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("certificate:"))
     assert "the sampled-data certificate (delay 5 ms, any split sensing/actuation; section 4's" in line
+
+
+def test_a_plug_in_claim_that_does_not_cover_the_splits_is_not_certified(tmp_path):
+    """examples/observer_law.py computes its claim on the split the run simulates: on a cart whose split is unknown
+    the assumption is added unmet (as an uncovered sensing is), and on a cart whose split is known nothing is."""
+    law = str(Path(__file__).resolve().parent.parent / "examples" / "observer_law.py") + ":ObserverLaw"
+
+    def claim(cart: Path):
+        cfg = RunConfig.from_inputs(cart=str(cart), controller=law, control_period=T, path="paper-circle",
+                                    sensing="encoder_bits=13,velocity=none,delay=0.003")
+        return resolve_run(cfg).claim
+
+    unknown, known = claim(_unknown_split_cart(tmp_path)), claim(TRUTH)
+    added = next(a for a in unknown.assumptions if a.name == DELAY_SPLIT_COVERED)
+    assert not added.met and not unknown.certified and "does not state that it covers every split" in added.note
+    assert added.equation.endswith("delay 3 ms, any split sensing/actuation")
+    assert DELAY_SPLIT_COVERED not in {a.name for a in known.assumptions}
+    assert [a for a in unknown.assumptions if a.name != DELAY_SPLIT_COVERED] == list(known.assumptions)

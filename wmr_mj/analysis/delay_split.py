@@ -26,7 +26,7 @@ from wmr_mj.analysis.regions import BoxRegion
 from wmr_mj.errors import ParameterError
 
 __all__ = ["DELAY_SPLIT_COVERED", "DELAY_SPLITS", "delay_splits", "worst_over_splits", "split_label",
-           "covered_split"]
+           "covered_split", "covers_delay_split"]
 
 #: The assumption a certificate over every split adds: every split of the total certified.
 DELAY_SPLIT_COVERED = "delay split covered"
@@ -61,6 +61,25 @@ def covered_split(assumptions: Iterable[Assumption]) -> str | None:
         if a.name == DELAY_SPLIT_COVERED and a.met:
             return a.equation.split(": ", 1)[1]
     return None
+
+
+def _split_assumption(total_periods: int, control_period: float, *, met: bool, value: float, limit: float,
+                      note: str) -> Assumption:
+    return Assumption(DELAY_SPLIT_COVERED,
+                      f"every split d_s + d_a = {total_periods} control periods certified: "
+                      f"{split_label(total_periods, control_period)}", met, value, limit, note, kind="checked")
+
+
+def covers_delay_split(cert: Certificate, *, total_periods: int, control_period: float) -> Certificate:
+    """``cert`` on a cart whose delay split is unknown: unchanged where the delay is 0 or the claim states
+    :data:`DELAY_SPLIT_COVERED` itself; else with it unmet (a plug-in's claim computed on the split the run
+    simulates covers that split only), as :func:`wmr_mj.analysis.claim.covers_measurement` does for sensing."""
+    if total_periods == 0 or any(a.name == DELAY_SPLIT_COVERED for a in cert.assumptions):
+        return cert
+    note = (f"{cert.claimant or 'the claim'} does not state that it covers every split of the delay (only its sum "
+            "is known); a claim computed on each split, or on the sum as one delay, states it")
+    return dataclasses.replace(cert, assumptions=(*cert.assumptions, _split_assumption(
+        total_periods, control_period, met=False, value=0.0, limit=float(total_periods + 1), note=note)))
 
 
 def _severity(cert: Certificate) -> tuple[bool, bool, float]:
@@ -103,13 +122,11 @@ def worst_over_splits(certificates: Mapping[Split, Certificate], *, control_peri
                      + ("" if certificates[(d_s, d_a)].certified else " (not certified: "
                         + ", ".join(certificates[(d_s, d_a)].unmet or ("no bound",)) + ")")
                      for d_s, d_a in splits)
-    covered = Assumption(
-        DELAY_SPLIT_COVERED,
-        f"every split d_s + d_a = {total} control periods certified: {label}",
-        not failed, float(len(splits) - len(failed)), float(len(splits)),
-        f"sensing+actuation periods: {each}; the worst {worst_split[0]}+{worst_split[1]} is claimed"
+    covered = _split_assumption(
+        total, control_period, met=not failed, value=float(len(splits) - len(failed)), limit=float(len(splits)),
+        note=f"sensing+actuation periods: {each}; the worst {worst_split[0]}+{worst_split[1]} is claimed"
         + ("" if simulated is None else f"; the run simulates {simulated[0]}+{simulated[1]}")
-        + "; the recordings fix only the sum", kind="checked")
+        + "; only their sum is known")
     region = worst.region
     if valid and all(isinstance(certificates[s].region, BoxRegion) for s in splits):  # the box of the boxes
         region = BoxRegion(E_max=max(certificates[s].E_max for s in splits),

@@ -34,6 +34,7 @@ from wmr_mj.analysis.certificate import (
     replace_inputs,
 )
 from wmr_mj.analysis.claim import ClaimContext, covers_measurement
+from wmr_mj.analysis.delay_split import covers_delay_split
 from wmr_mj.analysis.measurement import MeasurementErrors
 from wmr_mj.analysis.plant_box import F_OVER_P_NOT_MONOTONE, box_corners
 from wmr_mj.analysis.plant_box import hull as _hull
@@ -351,6 +352,9 @@ def law_certificate(reference: Any, *, controller: Any, tracker: Any, box: BoxSp
         raise ParameterError(f"controller {controller.name!r}: claim() returned {type(cert).__name__}, not a "
                              "Certificate (see wmr_mj.analysis.claim.box_claim) or None")
     cert = covers_measurement(cert, measurement)
+    if delay_split == "unknown" and sampled_data:  # the cart's own delay, known as its sum: every split, or unmet
+        total = round((sensing.delay + actuation.delay) / period)
+        cert = covers_delay_split(cert, total_periods=total, control_period=period)
     inputs = dict(cert.inputs)
     inputs.update(model=box.model, controller=controller.name, box_rule=box.box,
                   m1_range=list(box.m1_range), box_ranges={k: list(v) for k, v in ranges.items()},
