@@ -24,10 +24,11 @@ from collections.abc import Callable
 
 from wmr_mj.analysis.claim import SAMPLED_DATA_NAME, ClaimContext, best_certificate, covers_measurement
 from wmr_mj.analysis.claim_types import Certificate
+from wmr_mj.analysis.delay_split import delay_splits, worst_over_splits
 from wmr_mj.analysis.sampled_certificate import SampledCart
 from wmr_mj.errors import ParameterError
 
-__all__ = ["MAX_SAMPLED_DELAY_PERIODS", "sampled_cart", "with_sampled_data", "named"]
+__all__ = ["MAX_SAMPLED_DELAY_PERIODS", "sampled_cart", "with_sampled_data", "over_delay_splits", "named"]
 
 #: the longest delay, in control periods (sensing plus actuation), for which the sampled-data certificate is computed:
 #: its loop carries one state per period of delay, so a delay of seconds at a 1 ms period would cost minutes; far
@@ -66,7 +67,8 @@ def with_sampled_data(own: Certificate, own_name: str, context: ClaimContext,
     """The law's claim: ``own`` (named ``own_name``) alone where the run asks for no sampled-data analysis (a
     what-if measurement the cart's parts do not describe), else ``sampled(cart)`` with ``own`` beside it
     (:func:`wmr_mj.analysis.claim.best_certificate`; ``own`` with the assumption 'sampling bounded' unmet and
-    the reason where the cart cannot be evaluated).
+    the reason where the cart cannot be evaluated; over every split of the delay where the context's ``delay_split`` is
+    'unknown': :func:`over_delay_splits`).
 
     Args:
         own: the law's continuous claim. own_name: its name ('section-4', 'boundary-layer').
@@ -78,7 +80,24 @@ def with_sampled_data(own: Certificate, own_name: str, context: ClaimContext,
         return own
     own = covers_measurement(own, context.measurement)
     try:
-        cert = named(sampled(sampled_cart(context)), SAMPLED_DATA_NAME)
+        cart = sampled_cart(context)
+        total = cart.sensing_delay + cart.actuation_delay
+        if context.delay_split == "unknown" and total:  # only the sum is measured: every split, the worst claimed
+            cert = over_delay_splits(cart, context, sampled)
+        else:
+            cert = sampled(cart)
     except ParameterError as exc:  # e.g. an actuation delay that is not a whole number of control periods
         return best_certificate(own, own_name, str(exc))
-    return best_certificate(own, own_name, cert)
+    return best_certificate(own, own_name, named(cert, SAMPLED_DATA_NAME))
+
+
+def over_delay_splits(cart: SampledCart, context: ClaimContext,
+                      sampled: Callable[[SampledCart], Certificate]) -> Certificate:
+    """``sampled`` on every split (d_s, d_a) of the cart's whole delay d_s + d_a, the worst claimed
+    (:func:`wmr_mj.analysis.delay_split.worst_over_splits`): each split is the cart with its sensing delay d_s and
+    its actuation delay d_a, all else as it is; the run simulates the cart's own split."""
+    total = cart.sensing_delay + cart.actuation_delay
+    certificates = {(d_s, d_a): sampled(dataclasses.replace(cart, sensing_delay=d_s, actuation_delay=d_a))
+                    for d_s, d_a in delay_splits(total)}
+    return worst_over_splits(certificates, control_period=context.control_period,
+                             simulated=(cart.sensing_delay, cart.actuation_delay))

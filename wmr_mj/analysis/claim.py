@@ -41,10 +41,11 @@ from dataclasses import dataclass, field
 from typing import Any, NamedTuple
 
 from wmr_mj.analysis.claim_types import Assumption, Certificate, ClaimInputs
+from wmr_mj.analysis.delay_split import DELAY_SPLITS
 from wmr_mj.analysis.measurement import MEASUREMENT_COVERED, MeasurementErrors, coverage_assumption_fields
 from wmr_mj.analysis.plant_box import PlantBox, PlantLimits
 from wmr_mj.analysis.regions import BoxRegion
-from wmr_mj.errors import ParameterError
+from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.hardware.sensing import Sensing
 from wmr_mj.params import C80Parameters
 from wmr_mj.reference.bounds import ReferenceBounds
@@ -89,6 +90,9 @@ class ClaimContext:
         gear_ratio: i2 of the run's plant (a motor-side encoder's step at the axis is 2 pi / (N i2)); None:
             the estimate's.
         play: the gear's play b [rad at the axis] (0 without play; never covered today: see ``measurement``).
+        delay_split: how the sensing delay and ``actuation_delay`` divide: 'known' (as given), or 'unknown' (a
+            cart identified from controller-side recordings: only their sum is measured), and then a sampled-data
+            certificate covers every split of the whole periods (:mod:`wmr_mj.analysis.delay_split`).
         sampled_data: whether ``measurement`` is the cart's own, derived from its parts (``sensing``,
             ``actuation_delay``, ``play``): a law with a sampled-data analysis then computes it beside its
             continuous claim and is judged by it (:func:`best_certificate`), on the ideal cart too (exact
@@ -110,6 +114,7 @@ class ClaimContext:
     actuation_delay: float = 0.0
     gear_ratio: float | None = None
     play: float = 0.0
+    delay_split: str = "known"
     sampled_data: bool = False
 
     @property
@@ -125,6 +130,8 @@ class ClaimContext:
             raise ParameterError(f"sensing must be a wmr_mj.hardware.Sensing, got {type(self.sensing).__name__}")
         if self.gear_ratio is None:
             object.__setattr__(self, "gear_ratio", float(self.estimate.i2))
+        if self.delay_split not in DELAY_SPLITS:
+            raise UnknownNameError("delay split", str(self.delay_split), DELAY_SPLITS)
 
 
 class RunAssumptions(NamedTuple):

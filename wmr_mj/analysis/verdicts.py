@@ -327,7 +327,7 @@ def count_unmet(per_run: Iterable[Iterable[Mapping[str, Any]]]) -> list[dict[str
 def _which_certificate(cert: dict) -> str:
     """Which analysis gave the run's certificate: section 4's condition (4.23), or, where a cart that is not
     ideal gave the sampled-data certificate the smaller bound (:func:`wmr_mj.sim.certify.certificate_of`), its
-    name beside what section 4 gave."""
+    name beside what section 4 gave (and, on a cart whose delay split is unknown, that every split was covered)."""
     inputs = cert.get("inputs") or {}
     if inputs.get("certificate") != "sampled-data":
         return f"(4.23) = {_num(cert.get('condition'), '.4f')}"
@@ -337,7 +337,9 @@ def _which_certificate(cert: dict) -> str:
     section4 = (f"|E| <= {_num(other.get('E_max'))} rad" if other.get("E_max") is not None
                 else f"none: {other.get('reason') or 'no finite bound'}")
     label = "the boundary layer's" if name == "boundary-layer" else "section 4's"
-    return f"the sampled-data certificate ({label}: {section4})"
+    split = inputs.get("delay_split")  # a delay known as its sum: every split certified (analysis/delay_split.py)
+    over = f"{split['label']}; " if isinstance(split, dict) and split.get("label") else ""
+    return f"the sampled-data certificate ({over}{label}: {section4})"
 
 
 _NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")

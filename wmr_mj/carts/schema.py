@@ -37,7 +37,7 @@ SUPPORTED_KEYWORDS = frozenset({
     "$schema", "$id", "$defs", "$ref", "title", "description",  # identification, references and annotations
     "type", "properties", "required", "additionalProperties",  # objects
     "items", "minItems", "maxItems",  # arrays
-    "const", "minLength", "pattern",  # strings and constants
+    "const", "enum", "minLength", "pattern",  # strings and constants
     "minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum",  # numbers
 })
 
@@ -144,6 +144,9 @@ def _check_scalar(value: Any, schema: Mapping[str, Any], path: tuple[str | int, 
     if "const" in schema and value != schema["const"]:
         why = " (every value is in SI units)" if path and path[-1] == "unit" else ""
         raise ParameterError(f"{where} = {value!r} is not accepted; accepted: {schema['const']!r} only{why}")
+    if "enum" in schema and value not in schema["enum"]:
+        raise ParameterError(f"{where} = {value!r} is not accepted; accepted: "
+                             + " or ".join(repr(v) for v in schema["enum"]))
     if isinstance(value, str):
         if len(value) < schema.get("minLength", 0):
             raise ParameterError(f"{where} = {value!r} is empty; accepted: a non-empty string")
@@ -191,6 +194,8 @@ def check_against_schema(value: Any, schema: Mapping[str, Any], *, root: Mapping
 def _accepted_value(value_schema: Mapping[str, Any]) -> str:
     if value_schema.get("type") == "number":
         return _accepted_number(value_schema, "")
+    if "enum" in value_schema:
+        return " or ".join(f"`{v!r}`" for v in value_schema["enum"])
     return "a non-empty string" if value_schema.get("minLength") else "a string"
 
 

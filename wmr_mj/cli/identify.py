@@ -107,6 +107,16 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+#: what --json says of the two delays: the recordings (the voltage the controller applied, the angle it read) fix
+#: only their sum; with the voltage at the motor (u_applied_V) the actuation delay is measured, the rest is sensing
+_SPLIT_NOTES = {
+    "unknown": ("the recordings fix only the sum (delay_s): each lies in [0, the sum's upper end]; the cart file runs "
+                "all of it as sensing ([defaults.delay_split] 'unknown') and its certificates cover every split"),
+    "known": ("measured apart: the actuation delay from u_V to u_applied_V (the voltage at the motor), the sensing "
+              "delay the rest of delay_s"),
+}
+
+
 def _split_data(item: str) -> tuple[str, float | None]:
     """'FILE[:m1=KG]' -> (FILE, KG or None)."""
     from wmr_mj.errors import ParameterError
@@ -192,10 +202,10 @@ def run_data(args: argparse.Namespace) -> int:
         "fixed_from_structure": {"K": "0: absent from the plant (non-holonomic model)",
                                  "gyro": "P / l1: moves with C_V at constant speed, not separable"},
         "physical": {k: v.to_dict() for k, v in fit.physical.items()},
-        "sensing_delay_s": fit.delay.to_dict(),
-        "actuation_delay_s": {"value": 0.0, "interval": [0.0, 0.0], "note": (
-            "not separable from the sensing delay when the voltage is recorded as applied: the whole "
-            "voltage-to-angle delay is in sensing_delay_s")},
+        "delay_s": {**fit.delay.to_dict(), "note": "the voltage-to-angle delay: sensing and actuation together"},
+        "sensing_delay_s": {**fit.sensing_delay.to_dict(), "note": _SPLIT_NOTES[fit.delay_split]},
+        "actuation_delay_s": {**fit.actuation_delay.to_dict(), "note": _SPLIT_NOTES[fit.delay_split]},
+        "delay_split": fit.delay_split,
         "encoder_ticks": fit.encoder_ticks,
         "noise_rad": fit.noise_rad,
         "residual_rms_rad": fit.residual_rms_rad,
@@ -249,7 +259,12 @@ def _print_fit(fit, recordings, holdout, nrmse, out) -> None:
         fixed = "  (fixed: K = 0)" if name == "K" else ("  (fixed: P / l1)" if name == "gyro" else "")
         print(f"{name:16s} {iv.value:12.5g} [{iv.lo:11.5g}, {iv.hi:11.5g}]  {units[name]}{fixed}")
     print(f"delay: {fit.delay_steps} control periods = {fit.delay.value * 1e3:g} ms, 95 % interval "
-          f"[{fit.delay.lo * 1e3:g}, {fit.delay.hi * 1e3:g}] ms (voltage to angle: sensing and actuation together)")
+          f"[{fit.delay.lo * 1e3:g}, {fit.delay.hi * 1e3:g}] ms (voltage to angle: sensing and actuation together); "
+          + (f"the split is not identifiable: sensing and actuation each in [0, {fit.delay.hi * 1e3:g}] ms, run as "
+             "sensing, certified over every split" if fit.actuation_steps is None else
+             f"of it actuation {fit.actuation_delay.value * 1e3:g} ms [{fit.actuation_delay.lo * 1e3:g}, "
+             f"{fit.actuation_delay.hi * 1e3:g}] (u_V to u_applied_V), sensing {fit.sensing_delay.value * 1e3:g} ms "
+             f"[{fit.sensing_delay.lo * 1e3:g}, {fit.sensing_delay.hi * 1e3:g}]"))
     enc = ("not readable (the angle is not on one grid)" if fit.encoder_ticks is None
            else f"{fit.encoder_ticks} ticks/rev")
     print(f"encoder: {enc}; noise beyond the quantisation: {fit.noise_rad:.3g} rad")

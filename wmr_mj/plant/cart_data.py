@@ -19,7 +19,7 @@ from collections.abc import Mapping
 
 from wmr_mj.carts import PARAMETER_SECTIONS
 
-__all__ = ["identified_from", "identified_from_line"]
+__all__ = ["identified_from", "identified_from_line", "delay_split_unknown"]
 
 #: 'FILE (SHA-256 HEX)' in a source, after the 'identified from ' or the ' and ' that joins it to the one before
 _NAMED_FILE = re.compile(r"(?:identified from | and )(.+?) \(SHA-256 ([0-9a-f]{64})\)")
@@ -50,5 +50,18 @@ def identified_from_line(text: str, cart: str) -> str | None:
     if not named:
         return None
     files = " and ".join(f"{name} (SHA-256 {sha[:12]}...)" for name, sha in named)
+    split = ("; they cover the measured delay in any split between sensing and actuation (the data fix only its sum)"
+             if delay_split_unknown(text) else "")
     return (f"the cart {cart} is identified from {files}: its certificates hold for the real cart if the real cart "
-            "lies inside the identified box, which those data support at 95 % per parameter")
+            f"lies inside the identified box, which those data support at 95 % per parameter{split}")
+
+
+def delay_split_unknown(text: str) -> bool:
+    """Whether a cart file's text says that only the sum of its sensing and actuation delays is known
+    (``[defaults.delay_split]`` 'unknown': written by ``identify --data``)."""
+    try:
+        document = tomllib.loads(text)
+    except tomllib.TOMLDecodeError:
+        return False
+    entry = document.get("defaults", {}).get("delay_split")
+    return isinstance(entry, Mapping) and entry.get("value") == "unknown"

@@ -5,6 +5,9 @@ source ``identified from FILE (SHA-256 ...), 95 % interval [lo, hi]``; the 'full
 intervals as its ranges (m1's range stays the start's, widened to hold every recording's m1); ``defaults.sensing``
 carries the measured encoder, delay and noise (the start's velocity estimate kept: a recording of the angle
 does not say how the board differences it; 'exact' becomes 'difference', what a board with an encoder does).
+The measured delay is the voltage-to-angle one, sensing and actuation together: ``defaults.sensing`` runs all of it
+(the start's actuation delay, if any, set to 0) and ``[defaults.delay_split]`` is 'unknown', so that every
+certificate on the file covers each split of it (:mod:`wmr_mj.analysis.delay_split`).
 The file is checked as any cart file is (:func:`wmr_mj.carts.load_cart_text`) before it is returned.
 
 Usage::
@@ -23,6 +26,7 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from wmr_mj.carts import PARAMETER_SECTIONS, CartFile, load_cart_text
+from wmr_mj.hardware.actuation import Actuation
 from wmr_mj.hardware.sensing import Sensing
 from wmr_mj.params import parameters_of_cart
 from wmr_mj.plant.output_error import IDENTIFIED_PARAMETERS, SteeringFit
@@ -37,13 +41,14 @@ def provenance(recordings: Sequence[Recording]) -> str:
 
 
 def sensing_of_fit(start: CartFile, fit: SteeringFit) -> Sensing:
-    """The start's default sensing with the measured encoder (on the axis, rounding), delay and noise."""
+    """The start's default sensing with the measured encoder (on the axis, rounding), delay and noise (the delay: the
+    whole voltage-to-angle delay, or that less the actuation delay where ``u_applied_V`` measured it)."""
     base = Sensing.from_spec(start.defaults["sensing"])
     velocity = "difference" if base.velocity == "exact" else base.velocity
     noise = fit.noise_rad * math.sqrt(3.0)  # uniform on [-B, B) has the standard deviation B/sqrt(3)
     return dataclasses.replace(
         base, encoder_ticks=fit.encoder_ticks, encoder_side="axis", encoder_rounding="round", velocity=velocity,
-        filter_tau=base.filter_tau if velocity == "filtered" else None, delay=fit.delay_steps * fit.period,
+        filter_tau=base.filter_tau if velocity == "filtered" else None, delay=fit.sensing_steps * fit.period,
         noise_kind="uniform" if noise > 0 else "none", noise=noise)
 
 
@@ -53,6 +58,41 @@ def _spec_text(sensing: Sensing) -> str:
         if value is None or value == "none" or (key == "delay" and value == 0.0) or (key == "seed" and value == 0):
             continue
         pairs.append(f"{key}={value!r}" if isinstance(value, float) else f"{key}={value}")
+    return ",".join(pairs) if pairs else "ideal"
+
+
+def _write_actuation(document: dict[str, Any], start: CartFile, fit: SteeringFit, made_of: str) -> None:
+    """defaults.actuation (the start's, its delay the measured one or 0) and [defaults.delay_split]."""
+    actuation = Actuation.from_spec(start.defaults["actuation"])
+    delay = (fit.actuation_steps or 0) * fit.period
+    entry = document["defaults"]["actuation"]
+    if actuation.delay != delay:  # measured, or held by the measured voltage-to-angle delay: not counted twice
+        entry["value"] = _actuation_text(dataclasses.replace(actuation, delay=delay))
+        entry["source"] = (f"delay {delay:g} s " + (
+            "(the measured voltage-to-angle delay in defaults.sensing holds the start's)" if fit.actuation_steps is None
+            else f"measured from u_applied_V in {made_of}") + f"; the rest the start's: {entry['source']}")
+    if fit.actuation_steps is None:
+        document["defaults"]["delay_split"] = {
+            "value": "unknown",
+            "source": (f"measured from {made_of}: the voltage the controller applied and the angle its encoder read "
+                       f"fix only the sum of the sensing and actuation delays, {fit.delay_steps} control periods of "
+                       f"{fit.period:g} s (a pure delay commutes with the plant); each lies in [0, {fit.delay.hi:g}] "
+                       "s. A run simulates all of it as sensing (defaults.sensing); every certificate covers each "
+                       "split of the sum in whole control periods, the worst claimed"),
+        }
+    else:
+        a = fit.actuation_delay
+        document["defaults"]["delay_split"] = {
+            "value": "known",
+            "source": (f"measured from {made_of}: the voltage at the motor (u_applied_V) follows the voltage the "
+                       f"controller applied by {fit.actuation_steps} control periods, 95 % interval [{a.lo:g}, "
+                       f"{a.hi:g}] s (the actuation delay, defaults.actuation); the rest of the {fit.delay_steps} "
+                       "periods from the voltage to the angle is the sensing delay (defaults.sensing)"),
+        }
+
+
+def _actuation_text(actuation: Actuation) -> str:
+    pairs = [f"{key}={value!r}" for key, value in actuation.to_dict().items() if value not in (None, 0.0)]
     return ",".join(pairs) if pairs else "ideal"
 
 
@@ -139,15 +179,22 @@ def identified_cart_text(start: CartFile, fit: SteeringFit, recordings: Sequence
                else f"{fit.encoder_ticks} ticks per revolution read from the angle's quantisation ("
                     + ("every reading a whole number of ticks)" if fit.noise_rad == 0.0
                        else "the readings concentrate on its grid through the noise)"))
+    total = (f"{fit.delay_steps} control periods of {fit.period:g} s, 95 % interval [{fit.delay.lo:g}, "
+             f"{fit.delay.hi:g}] s")
+    if fit.actuation_steps is None:
+        delay = (f"delay {total} (the voltage-to-angle delay, sensing and actuation together: run as sensing, its "
+                 "split unknown, [defaults.delay_split])")
+    else:
+        s_iv = fit.sensing_delay
+        delay = (f"delay {fit.sensing_steps} control periods, 95 % interval [{s_iv.lo:g}, {s_iv.hi:g}] s: the "
+                 f"voltage-to-angle delay ({total}) less the actuation delay (defaults.actuation)")
     document["defaults"]["sensing"] = {
         "value": _spec_text(sensing),
-        "source": (f"measured from {made_of}: encoder {encoder}; delay {fit.delay_steps} control periods of "
-                   f"{fit.period:g} s, 95 % interval [{fit.delay.lo:g}, {fit.delay.hi:g}] s (the voltage-to-angle "
-                   "delay: sensing and actuation delays are not separable when the voltage is recorded as applied, "
-                   f"so all of it is counted as sensing); noise {fit.noise_rad:.3g} rad standard deviation beyond "
-                   "the quantisation (written as uniform of the same variance); the velocity estimate is the "
-                   "start's (not in the recording)"),
+        "source": (f"measured from {made_of}: encoder {encoder}; {delay}; noise {fit.noise_rad:.3g} rad standard "
+                   "deviation beyond the quantisation (written as uniform of the same variance); the velocity "
+                   "estimate is the start's (not in the recording)"),
     }
+    _write_actuation(document, start, fit, made_of)
     version = _bump_minor(document["version"])
     document["version"] = version
     document["changelog"] = [f"{version} ({date}): identified by {command} from {made_of}: "

@@ -92,6 +92,10 @@ IDENTIFIED_PARAMETERS: dict[str, str] = {
     "k_b": "C_V = k_b i2: equal to k_i (one flux in SI units)",
     "mu": "F = (R_a/k_i) (l3 l4/(l1 i2)) mu Q: the steering's Coulomb coefficient",
 }
+#: A recorded applied voltage (``u_applied_V``) must follow u_V delayed by whole control periods: its RMS residual
+#: at the best delay at most this fraction of its own RMS variation (an ADC's noise and the driver's rounding are
+#: far below it; a wrong column, or a voltage in other units, is far above).
+APPLIED_MATCH_MAX = 0.1
 _COEFFICIENTS = ("P", "C_V", "F")
 
 
@@ -126,8 +130,11 @@ class SteeringFit:
         coefficients: 'P', 'C_V', 'F', 'K', 'gyro' at the first recording's m1 -> :class:`Interval` (K = 0 and
             gyro = P/l1 fixed from the cart's structure).
         physical: the cart-file parameters of :data:`IDENTIFIED_PARAMETERS` -> :class:`Interval`.
-        delay_steps: the delay between the applied voltage and the angle read, control periods.
-        delay: its :class:`Interval`, s.
+        delay_steps: the delay between the applied voltage and the angle read, control periods: the sensing and
+            the actuation delays together (a pure delay commutes with the plant: from the voltage the controller
+            applied and the angle it read, only their sum is identifiable).
+        delay: its :class:`Interval`, s. :attr:`sensing_delay` and :attr:`actuation_delay`: what the recordings
+            allow of each.
         period: the control period, s (the recordings' median step).
         encoder_ticks: ticks per revolution of the steering axis read from the angle's quantisation, or None
             where the angle is not on one grid (noise above the quantisation, or no encoder).
@@ -155,13 +162,48 @@ class SteeringFit:
     m1: tuple[float, ...]
     draws: np.ndarray = field(repr=False)
     jacobian_half_width: dict[str, float] = field(default_factory=dict)
+    actuation_steps: int | None = None
+    actuation: Interval | None = None
+
+    @property
+    def delay_split(self) -> str:
+        """'known' where an actuator-side signal (``u_applied_V``) gave the actuation delay; 'unknown' where the
+        recordings fix only the sum."""
+        return "unknown" if self.actuation_steps is None else "known"
+
+    @property
+    def sensing_steps(self) -> int:
+        """The sensing delay as the cart file runs it, control periods: the sum less the actuation delay where it
+        was measured, else the whole sum (the recorded convention)."""
+        return self.delay_steps - (self.actuation_steps or 0)
+
+    @property
+    def sensing_delay(self) -> Interval:
+        """The sensing delay, s. Without an actuator-side signal: the whole delay as the cart file runs it (its
+        value), anywhere in [0, the sum's upper end] as far as the recordings say (they fix only the sum). With
+        one: the sum less the actuation delay, its interval the sum's less the actuation delay's."""
+        if self.actuation is None:
+            return Interval(self.delay.value, 0.0, self.delay.hi)
+        T, a = self.period, self.actuation
+        lo = max(0, round(self.delay.lo / T) - round(a.hi / T))
+        hi = max(0, round(self.delay.hi / T) - round(a.lo / T))
+        return Interval(self.sensing_steps * T, lo * T, hi * T)
+
+    @property
+    def actuation_delay(self) -> Interval:
+        """The actuation delay, s: measured from ``u_applied_V`` where recorded; else 0 as the cart file runs it,
+        anywhere in [0, the sum's upper end] as far as the recordings say."""
+        return self.actuation if self.actuation is not None else Interval(0.0, 0.0, self.delay.hi)
 
     def to_dict(self) -> dict[str, object]:
         return {
             "coefficients": {k: v.to_dict() for k, v in self.coefficients.items()},
             "physical": {k: v.to_dict() for k, v in self.physical.items()},
             "delay_steps": self.delay_steps,
-            "sensing_delay_s": self.delay.to_dict(),
+            "delay_s": self.delay.to_dict(),
+            "sensing_delay_s": self.sensing_delay.to_dict(),
+            "actuation_delay_s": self.actuation_delay.to_dict(),
+            "delay_split": self.delay_split,
             "period_s": self.period,
             "encoder_ticks": self.encoder_ticks,
             "noise_rad": self.noise_rad,
@@ -507,13 +549,71 @@ def fit_recordings(recordings: Sequence[Recording], params: C80Parameters, *, se
     if coefficients["P"].relative_half_width > POORLY_DETERMINED:
         delay_interval = Interval(delay * period, 0.0, max_delay * period)
     ticks = encoder_ticks_of([rec.alpha for rec in recordings], gear_ratio=params.i2)
+    applied = actuation_delay_of(recordings, steps=steps, max_delay=max_delay, total=delay)
     return SteeringFit(
         coefficients=coefficients, physical=physical, delay_steps=delay,
         delay=delay_interval, period=period, encoder_ticks=ticks,
         noise_rad=noise_of([rec.alpha for rec in recordings], r, ticks),
         residual_rms_rad=float(np.sqrt(np.mean(r * r))), segments=int(r.shape[1]),
         segment_steps=steps, m1=tuple(float(rec.m1) if rec.m1 is not None else params.m1 for rec in recordings),
-        draws=boot, jacobian_half_width=_jacobian_half_width(r, J))
+        draws=boot, jacobian_half_width=_jacobian_half_width(r, J),
+        actuation_steps=None if applied is None else applied[0],
+        actuation=None if applied is None else Interval(*(k * period for k in applied)))
+
+
+def actuation_delay_of(recordings: Sequence[Recording], *, steps: int, max_delay: int,
+                       total: int) -> tuple[int, int, int] | None:
+    """The actuation delay from an actuator-side signal: the whole periods d_a by which ``u_applied_V`` follows
+    ``u_V`` (u_applied[k] = u[k - d_a]), least squares over every recording; its interval the range of each
+    segment's own best (segments of ``steps`` rows in which one delay is best; a constant voltage says nothing).
+
+    Returns:
+        (d_a, lo, hi) in control periods, or None where no recording has ``u_applied_V``.
+
+    Raises:
+        ParameterError: ``u_applied_V`` in some recordings only, one that follows ``u_V`` at no delay up to
+            ``max_delay`` (its residual above :data:`APPLIED_MATCH_MAX` of its RMS variation), or an actuation delay
+            beyond the voltage-to-angle delay ``total`` (the angle would answer before the motor).
+    """
+    have = [rec.applied is not None for rec in recordings]
+    if not any(have):
+        return None
+    if not all(have):
+        named = ", ".join(r.name for r in recordings if r.applied is not None)
+        raise ParameterError(f"u_applied_V is recorded in {named} but not in the others; accepted: in every "
+                             "recording or in none")
+    costs, counts, spread = np.zeros(max_delay + 1), 0, 0.0
+    bests: list[int] = []
+    for rec in recordings:
+        u, a = rec.voltage, rec.applied
+        assert a is not None
+        n = (u.size - max_delay) // steps * steps  # whole segments after max_delay rows of history
+        if n <= 0:
+            continue
+        target = a[max_delay:max_delay + n]
+        sq = np.stack([(target - u[max_delay - d:max_delay - d + n]) ** 2 for d in range(max_delay + 1)])
+        costs += sq.sum(axis=1)
+        counts += n
+        spread += float(np.sum((target - target.mean()) ** 2))
+        per_segment = sq.reshape(max_delay + 1, -1, steps).sum(axis=2)  # (delays, segments)
+        ordered = np.sort(per_segment, axis=0)
+        informative = ordered[1] > ordered[0] * (1.0 + 1e-9) + 1e-300  # one delay strictly best
+        bests += np.argmin(per_segment, axis=0)[informative].tolist()
+    if counts == 0:
+        raise ParameterError(f"u_applied_V: the recordings are shorter than the {max_delay} periods searched")
+    best = int(np.argmin(costs))
+    residual, variation = math.sqrt(costs[best] / counts), math.sqrt(spread / counts)
+    if not residual <= APPLIED_MATCH_MAX * variation:
+        raise ParameterError(f"u_applied_V does not follow u_V at any delay of 0-{max_delay} control periods (at the "
+                             f"best, {best} periods, a residual of {residual:.3g} V rms against {variation:.3g} V of "
+                             f"its own variation; accepted: at most {APPLIED_MATCH_MAX:g} of it): not the voltage the "
+                             "driver applied from this u_V")
+    if best > total:
+        raise ParameterError(f"u_applied_V follows u_V by {best} control periods, beyond the {total} from u_V to the "
+                             "angle: the angle would answer before the motor is driven; accepted: an actuator-side "
+                             "signal of this recording (check the columns)")
+    bests.append(best)
+    return best, min(bests), max(bests)
 
 
 def _jacobian_half_width(r: np.ndarray, J: np.ndarray) -> dict[str, float]:

@@ -39,6 +39,8 @@ COLUMNS: Mapping[str, str] = {
     "u_V": "armature voltage applied to the steering motor, V",
     "alpha_rad": "steering angle as the encoder read it, rad",
     "speed_m_per_s": "forward speed of A, m/s (optional: the cart's V_A where absent)",
+    "u_applied_V": ("the voltage at the motor's terminals as the driver applied it, after the bus, V (optional: with "
+                    "it the actuation delay, from u_V to it, is identified apart from the sensing delay)"),
 }
 REQUIRED_COLUMNS: tuple[str, ...] = ("t_s", "u_V", "alpha_rad")
 #: A column named with another unit of a known quantity: the header disagrees with the units read.
@@ -67,6 +69,8 @@ class Recording:
         alpha: steering angle as read, rad, (N,).
         speed: forward speed of A, m/s, (N,), or None where not recorded.
         m1: chassis mass during the recording, kg, or None: the cart's.
+        applied: the voltage at the motor's terminals, V, (N,), or None where not recorded (an actuator-side
+            signal: the delay from ``voltage`` to it is the actuation delay).
     """
 
     name: str
@@ -76,6 +80,7 @@ class Recording:
     alpha: np.ndarray
     speed: np.ndarray | None = None
     m1: float | None = None
+    applied: np.ndarray | None = None
 
     @property
     def samples(self) -> int:
@@ -93,7 +98,7 @@ class Recording:
         return float(self.t[-1] - self.t[0]) if self.t.size else 0.0
 
     def with_m1(self, m1: float) -> Recording:
-        return Recording(self.name, self.sha256, self.t, self.voltage, self.alpha, self.speed, m1)
+        return Recording(self.name, self.sha256, self.t, self.voltage, self.alpha, self.speed, m1, self.applied)
 
 
 def file_sha256(path: str | Path) -> str:
@@ -178,7 +183,7 @@ def read_csv(path: str | Path, *, m1: float | None = None, columns: Mapping[str,
                                      "a number") from None
     col = {key: data[:, j].copy() for j, key in enumerate(keys)}
     return Recording(name=str(path), sha256=file_sha256(path), t=col["t_s"], voltage=col["u_V"],
-                     alpha=col["alpha_rad"], speed=col.get("speed_m_per_s"), m1=m1)
+                     alpha=col["alpha_rad"], speed=col.get("speed_m_per_s"), m1=m1, applied=col.get("u_applied_V"))
 
 
 def check_recording(rec: Recording, *, voltage_limit: float, steering_range: float,
@@ -200,6 +205,8 @@ def check_recording(rec: Recording, *, voltage_limit: float, steering_range: flo
     arrays = {"t_s": rec.t, "u_V": rec.voltage, "alpha_rad": rec.alpha}
     if rec.speed is not None:
         arrays["speed_m_per_s"] = rec.speed
+    if rec.applied is not None:
+        arrays["u_applied_V"] = rec.applied
     for key, values in arrays.items():
         bad = np.flatnonzero(~np.isfinite(values))
         if bad.size:

@@ -76,8 +76,14 @@ class IdentifyReport:
         out += [{"name": k, "value": iv.value, "lo": iv.lo, "hi": iv.hi, "unit": UNITS[k],
                  "how": IDENTIFIED_PARAMETERS[k]} for k, iv in self.fit.physical.items()]
         d = self.fit.delay
-        out.append({"name": "sensing_delay", "value": d.value, "lo": d.lo, "hi": d.hi, "unit": "s",
-                    "how": "identified: voltage to angle, whole control periods"})
+        out.append({"name": "delay", "value": d.value, "lo": d.lo, "hi": d.hi, "unit": "s",
+                    "how": "identified: voltage to angle (sensing and actuation together), whole control periods"})
+        split = ("not identifiable alone (only the sum is): run as all sensing, certified over every split"
+               if self.fit.actuation_steps is None else
+               "identified: the actuation delay from u_V to u_applied_V (the voltage at the motor), the sensing "
+               "delay the rest")
+        for name, iv in (("sensing_delay", self.fit.sensing_delay), ("actuation_delay", self.fit.actuation_delay)):
+            out.append({"name": name, "value": iv.value, "lo": iv.lo, "hi": iv.hi, "unit": "s", "how": split})
         return out
 
     def to_pandas(self) -> Any:

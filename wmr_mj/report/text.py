@@ -48,7 +48,7 @@ from wmr_mj.analysis.certificate import VERDICTS
 from wmr_mj.analysis.verdicts import WITHIN_THE_SUPPLY, format_unmet, paper_region_name
 from wmr_mj.hardware import Actuation, Sensing, Transmission
 from wmr_mj.params import COEFFICIENT_MODELS, COEFFICIENT_NAMES
-from wmr_mj.plant.cart_data import identified_from
+from wmr_mj.plant.cart_data import delay_split_unknown, identified_from
 from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS
 from wmr_mj.reference.route import path_name
 from wmr_mj.report.results import Rung, ValidateSummary
@@ -200,10 +200,12 @@ def verdict_lines(summary: Summary) -> list[str]:
     lo, hi = s["m1_range"]
     cart = s.get("cart")  # validate --cart: the cart's name (settings without it: the C80)
     vehicle = _vehicle(summary)
-    data = identified_from(str(cart.get("text", ""))) if cart else ()  # a cart identify --data wrote
+    text = str(cart.get("text", "")) if cart else ""
+    data = identified_from(text) if cart else ()  # a cart identify --data wrote
     if data:
         files = " and ".join(PurePath(name).name for name, _sha256 in data)
-        vehicle += f" (identified from {files}; the answer assumes the real cart inside its identified box)"
+        split = ", its delay in any split between sensing and actuation" if delay_split_unknown(text) else ""
+        vehicle += f" (identified from {files}; the answer assumes the real cart inside its identified box{split})"
     region = "the paper's robustness region" if not cart else "the (4.21)-(4.23) region, computed for this cart,"
     question = (f"Question: does {region} hold for {vehicle} under m1 in {lo:g}-{hi:g} kg? "
                 f"({summary.ladder[0].n} MuJoCo runs per design on {_path_words(s)}, {s['duration']:g} s each)")

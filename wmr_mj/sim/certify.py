@@ -34,6 +34,7 @@ from wmr_mj.analysis.certificate import (
     replace_inputs,
 )
 from wmr_mj.analysis.claim import ClaimContext, covers_measurement
+from wmr_mj.analysis.delay_split import covers_delay_split
 from wmr_mj.analysis.measurement import MeasurementErrors
 from wmr_mj.analysis.plant_box import F_OVER_P_NOT_MONOTONE, box_corners
 from wmr_mj.analysis.plant_box import hull as _hull
@@ -44,7 +45,7 @@ from wmr_mj.hardware import Actuation, Sensing, Transmission
 from wmr_mj.params import C80, COEFFICIENT_NAMES, C80Parameters
 from wmr_mj.plant.mjcf import TIMESTEP
 from wmr_mj.sim.builders import BoxSpec, run_bounds
-from wmr_mj.sim.coerce import coerced
+from wmr_mj.sim.coerce import cart_file_of_record, coerced
 from wmr_mj.sim.config import (
     base_for,
     controller_and_settings,
@@ -56,7 +57,8 @@ from wmr_mj.sim.config import (
 
 __all__ = ["certificate_for", "certificate_of", "law_certificate", "measurement_errors", "outside_of",
            "claim_on_estimate", "identified_spread",
-           "box_spans", "outside_the_box", "reference_within", "certificate_name", "MAX_SAMPLED_DELAY_PERIODS"]
+           "box_spans", "outside_the_box", "reference_within", "certificate_name", "delay_split_of",
+           "MAX_SAMPLED_DELAY_PERIODS"]
 
 
 def identified_spread(identified: Any) -> dict[str, tuple[float, float]]:
@@ -284,14 +286,16 @@ def certificate_of(config: Any, reference: Any, *, base: C80Parameters, estimate
                            signals=getattr(config, "signals", None), declared_bounds=config.reference_bounds,
                            sensing=config.sensing, actuation=config.actuation, transmission=config.transmission,
                            steering_friction=getattr(config, "steering_friction", None), measurement=measurement,
-                           sampled_data=derived, k_band=k_band, gyro_band=gyro_band)
+                           sampled_data=derived, k_band=k_band, gyro_band=gyro_band,
+                           delay_split=delay_split_of(config.cart))
 
 
 def law_certificate(reference: Any, *, controller: Any, tracker: Any, box: BoxSpec, base: C80Parameters,
                     estimate: C80Parameters, plant: C80Parameters, period: float, signals: Any,
                     declared_bounds: Any, sensing: Sensing, actuation: Actuation, transmission: Transmission,
                     steering_friction: str | None, measurement: MeasurementErrors, sampled_data: bool,
-                    k_band: float = PLANT_K_BAND, gyro_band: tuple[float, float] = GYRO_BAND) -> Certificate | None:
+                    k_band: float = PLANT_K_BAND, gyro_band: tuple[float, float] = GYRO_BAND,
+                    delay_split: str = "known") -> Certificate | None:
     """The law's claim (``controller.claim``) on the run's typed parts, with the run's inputs recorded: what
     :func:`certificate_for` computes, from what :func:`wmr_mj.sim.parts.resolve_run` resolved once.
 
@@ -306,6 +310,8 @@ def law_certificate(reference: Any, *, controller: Any, tracker: Any, box: BoxSp
             (:func:`measurement_errors`); sampled_data: they are the cart's own, derived from those parts.
         steering_friction: the plant's steering friction law, as the inputs record it.
         k_band [V], gyro_band: the plant K and gyro bands (:data:`PLANT_K_BAND`, :data:`GYRO_BAND`).
+        delay_split: how the sensing and actuation delays divide (:func:`delay_split_of` the run's cart): 'unknown'
+            makes a sampled-data certificate cover every split of their sum.
     """
     k_band = finite_number("k_band", k_band, minimum=0.0)
     gyro_band = interval("gyro_band", gyro_band, positive=True)
@@ -331,7 +337,8 @@ def law_certificate(reference: Any, *, controller: Any, tracker: Any, box: BoxSp
                            limits=PlantLimits(steering_range=plant.steering_range, voltage_limit=plant.voltage_limit),
                            control_period=period, initial_error=initial, stated=stated, estimate=estimate,
                            measurement=measurement, sensing=sensing, actuation_delay=actuation.delay,
-                           gear_ratio=plant.i2, play=transmission.backlash, sampled_data=sampled_data)
+                           gear_ratio=plant.i2, play=transmission.backlash, delay_split=delay_split,
+                           sampled_data=sampled_data)
     try:
         cert = controller.claim(context)
     except Exception as exc:  # noqa: BLE001  (any error of a law's own claim: one line naming the law, before any step)
@@ -343,6 +350,9 @@ def law_certificate(reference: Any, *, controller: Any, tracker: Any, box: BoxSp
         raise ParameterError(f"controller {controller.name!r}: claim() returned {type(cert).__name__}, not a "
                              "Certificate (see wmr_mj.analysis.claim.box_claim) or None")
     cert = covers_measurement(cert, measurement)
+    if delay_split == "unknown" and sampled_data:  # the cart's own delay, known as its sum: every split, or unmet
+        total = round((sensing.delay + actuation.delay) / period)
+        cert = covers_delay_split(cert, total_periods=total, control_period=period)
     inputs = dict(cert.inputs)
     inputs.update(model=box.model, controller=controller.name, box_rule=box.box,
                   m1_range=list(box.m1_range), box_ranges={k: list(v) for k, v in ranges.items()},
@@ -350,6 +360,14 @@ def law_certificate(reference: Any, *, controller: Any, tracker: Any, box: BoxSp
     if signals is not None:
         inputs.update(signals=signals.to_dict(), d_max=signals.declared_d_max)
     return replace_inputs(cert, inputs)
+
+
+def delay_split_of(cart: Mapping[str, str] | None) -> str:
+    """How the run's cart divides its delay (its ``[defaults.delay_split]``): 'unknown' for a cart identified from
+    recordings at the controller, which fix only the sum of the sensing and actuation delays; 'known' for any other
+    cart and the C80. ``cart``: a typed config's cart record (``RunConfig.cart``; None: the C80)."""
+    found = cart_file_of_record(cart)
+    return "known" if found is None else str(found.defaults.get("delay_split", "known"))
 
 
 def certificate_name(cert: Certificate) -> str:

@@ -223,7 +223,7 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
                                 declared_bounds=config.reference_bounds, sensing=config.sensing,
                                 actuation=config.actuation, transmission=config.transmission,
                                 steering_friction=config.steering_friction, measurement=measurement,
-                                sampled_data=True)
+                                sampled_data=True, delay_split=certify.delay_split_of(config.cart))
     claims = claim_set(**{LAW_CLAIM: law_claim})
     disturbance, loads = signal_inputs(config.signals, plant, options, n=n, period=period,
                                        m1_inertia=config.m1_inertia)
