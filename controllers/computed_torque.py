@@ -37,6 +37,7 @@ from controllers.base import SteeringController
 from controllers.sampled_claim import with_sampled_data
 from wmr_mj.analysis.certificate import Certificate, Compensation, Estimate, Gains, certify
 from wmr_mj.analysis.claim import ClaimContext
+from wmr_mj.analysis.robustness import gains_from_omega_r
 from wmr_mj.analysis.sampled_certificate import sampled_certificate
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import C80, COEFFICIENT_NAMES, PAPER_KD, PAPER_KP, C80Parameters
@@ -78,12 +79,6 @@ def _check_gain(name: str, value: float) -> float:
     if not math.isfinite(value) or value <= 0:
         raise ParameterError(f"gain {name} = {value!r} is not accepted; gains must be finite and > 0")
     return value
-
-
-def gains_from_omega_r(omega_r: float) -> tuple[float, float]:
-    """(K_P, K_D) = (omega_r^2 / 4, omega_r), critical damping (3.6)."""
-    omega_r = _check_gain("omega_r", omega_r)
-    return omega_r**2 / 4.0, omega_r
 
 
 def _read_identified(identified: str | Path | Mapping) -> Mapping:
