@@ -74,6 +74,7 @@ from wmr_mj.analysis.measurement import (
 from wmr_mj.analysis.sliding_sampled import sliding_sampled_certificate
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.plant.reduced import SteeringModel, smooth_sign
+from wmr_mj.reference.bounds import sin_cos3
 
 __all__ = ["SlidingMode", "Uncertainty", "MeasuredLayer", "SAMPLING_FRACTION", "SLIDING_FRICTION_SIGNS",
            "MEASURED_STEP", "BOUNDARY_LAYER"]
@@ -99,10 +100,6 @@ def _positive(name: str, value: Any, *, allow_zero: bool = False) -> float:
         raise ParameterError(f"sliding-mode {name} = {value!r} is not accepted: a finite number "
                              f"{'>= 0' if allow_zero else '> 0'}")
     return v
-
-
-def _S(a: float) -> float:
-    return math.sin(a) / math.cos(a) ** 3
 
 
 @dataclass(frozen=True)
@@ -255,7 +252,7 @@ class SlidingMode(SteeringController):
         C_term = max(abs(c - m.C_V) for c in box.C_V) * rate
         phi_f = friction_term(self.friction_sign, F=box.F, F_hat=self._F)
         if a_max < 0.5 * math.pi:
-            K_term = max(abs(kk - m.K) for kk in box.K) * _S(a_max)
+            K_term = max(abs(kk - m.K) for kk in box.K) * sin_cos3(a_max)
             c2 = math.cos(a_max) ** 2
             gam = [g * v for g in plant.gyro for v in plant.V_A]
             G_term = max(abs(g - self._gyro_V) for g in gam) * rate / c2
@@ -276,7 +273,7 @@ class SlidingMode(SteeringController):
             return math.inf
         rate = ref.alpha_dot_max + 2.0 * self.phi
         return (m.P * (ref.alpha_ddot_max + 2.0 * self.lam * self.phi) + abs(m.C_V) * rate + self._F
-                + abs(m.K) * _S(a_max) + abs(self._gyro_V) * rate / math.cos(a_max) ** 2 + self.k)
+                + abs(m.K) * sin_cos3(a_max) + abs(self._gyro_V) * rate / math.cos(a_max) ** 2 + self.k)
 
     def measured_layer(self, context: ClaimContext) -> MeasuredLayer:
         """The layer |s| <= Phi [rad/s] when the law reads alpha + e_a, alpha' + e_v and acts tau late
@@ -337,7 +334,7 @@ class SlidingMode(SteeringController):
         new_layer = self.phi + e_v + lam * e_a
         rate_m = rate + e_v
         voltage = (m.P * (ref.alpha_ddot_max + lam * (2.0 * layer + e_v)) + abs(m.C_V) * rate_m + self._F
-                   + abs(m.K) * _S(A_m) + abs(self._gyro_V) * rate_m / c2_m + k)
+                   + abs(m.K) * sin_cos3(A_m) + abs(self._gyro_V) * rate_m / c2_m + k)
         return MeasuredLayer(layer=new_layer, D=D, e_alpha=e_a, e_alpha_dot=e_v, rho=rho, alpha_m=A_m,
                              voltage_max=voltage, uncertainty=unc, reason="")
 

@@ -34,7 +34,7 @@ import numpy as np
 from wmr_mj.analysis.certificate import Assumption
 from wmr_mj.analysis.path_error import PathProjector, wrap_angle
 from wmr_mj.errors import ParameterError
-from wmr_mj.reference.bounds import ReferenceBounds
+from wmr_mj.reference.bounds import ReferenceBounds, sin_cos3
 
 if TYPE_CHECKING:
     from controllers.base import BuildContext
@@ -187,7 +187,7 @@ def corrected_bounds(bounds: ReferenceBounds, gains: CorrectionGains = DEFAULT_G
         raise ParameterError(f"max|alpha0| + delta_max = {a:.4g} rad reaches pi/2")
     return ReferenceBounds(alpha_max=a, alpha_dot_max=bounds.alpha_dot_max + gains.rate_max,
                            alpha_ddot_max=bounds.alpha_ddot_max + gains.acc_max,
-                           sin_cos3_max=max(bounds.sin_cos3_max, math.sin(a) / math.cos(a) ** 3))
+                           sin_cos3_max=max(bounds.sin_cos3_max, sin_cos3(a)))
 
 
 def correction_assumptions(gains: CorrectionGains = DEFAULT_GAINS) -> tuple[Assumption, ...]:

@@ -28,15 +28,24 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 from wmr_mj.errors import ParameterError
 
-__all__ = ["ReferenceBounds", "PAPER_BOUNDS", "angle_of_sin_cos3", "sin_cos3", "reference_bounds_from"]
+__all__ = ["ReferenceBounds", "PAPER_BOUNDS", "angle_of_sin_cos3", "sin_cos3", "sin_cos3_of_samples",
+           "reference_bounds_from"]
 
 
 def sin_cos3(angle: float) -> float:
     """S(a) = sin(a)/cos^3(a) of an angle |a| < pi/2 [rad] (the stiffness's shape in (2.13), the paper's (5.1)
     quantity) [-]; its one scalar definition: the certificates (small_gain, sampled_certificate) call it."""
     return math.sin(angle) / math.cos(angle) ** 3
+
+
+def sin_cos3_of_samples(angles: np.ndarray) -> np.ndarray:
+    """S(a) of each of ``angles`` [rad], shape kept: :func:`sin_cos3` on NumPy's sin and cos (a path's
+    samples; NumPy's and libm's sin may differ in the last bit, so the scalar stays libm's)."""
+    return np.sin(angles) / np.cos(angles) ** 3
 
 
 def angle_of_sin_cos3(value: float) -> float:

@@ -93,7 +93,7 @@ from wmr_mj._util.checks import positive_real as _positive
 from wmr_mj._util.checks import real as _number
 from wmr_mj.errors import InfeasiblePathError, ParameterError, StiffReferenceError
 from wmr_mj.params import C80, C80Parameters
-from wmr_mj.reference.bounds import PAPER_BOUNDS, ReferenceBounds
+from wmr_mj.reference.bounds import PAPER_BOUNDS, ReferenceBounds, sin_cos3_of_samples
 
 __all__ = [
     "Segment",
@@ -792,7 +792,7 @@ class Reference:
         return ReferenceBounds(
             alpha_ddot_max=float(np.max(np.abs(self.alpha0_ddot))),
             alpha_dot_max=float(np.max(np.abs(self.alpha0_dot))),
-            sin_cos3_max=float(np.max(np.abs(np.sin(a) / np.cos(a) ** 3))),
+            sin_cos3_max=float(np.max(np.abs(sin_cos3_of_samples(a)))),
             alpha_max=float(np.max(np.abs(a))),
         )
 
