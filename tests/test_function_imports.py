@@ -15,7 +15,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGES = ("wmr_mj/logs", "wmr_mj/report", "wmr_mj/analysis", "wmr_mj/plant", "wmr_mj/figures", "wmr_mj/_util",
-            "controllers")
+            "controllers", "wmr_mj/cli")
 PROJECT = ("wmr_mj", "controllers")
 
 
