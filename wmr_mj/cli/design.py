@@ -14,7 +14,7 @@ from wmr_mj.cli._common import print_json
 from wmr_mj.cli.ranges import box_ranges_from_args
 from wmr_mj.cli.run import hardware_from_args
 from wmr_mj.errors import ParameterError
-from wmr_mj.experiments.sweep import SweepSpec, SweepSummary, run_sweep
+from wmr_mj.experiments.sweep import sweep_over_box
 from wmr_mj.params import M1_RANGE
 from wmr_mj.plant.cart_data import identified_from_line
 from wmr_mj.reference.route import path_name
@@ -99,9 +99,7 @@ def check_design(problem: Any, result: Any, n: int) -> dict[str, Any]:
     """A sweep of ``n`` runs over the box (m1 and the --range parameters) at the design, on the first path, with
     the search's seed: its verdict counts."""
     base = dataclasses.replace(problem.base, path=problem.paths[0], **{k: result.settings[k] for k in DESIGN_FIELDS})
-    spec = SweepSpec(n=n, seed=problem.seed, sampling="lhs", m1_range=tuple(base.m1_range),
-                     ranges={k: tuple(v) for k, v in base.box_ranges.items()}, base=base)
-    runs = SweepSummary.of(run_sweep(spec), spec.requirements, names=spec.names)
+    runs = sweep_over_box(base, n, seed=problem.seed)
     return {"n": runs.n, "verdicts": dict(runs.verdicts), "path": base.path}
 
 
@@ -140,7 +138,6 @@ def _print(result: Any, args: argparse.Namespace, out: dict[str, Any], wall: flo
         print(f"check: {c['n']} runs over the box on {path_name(c['path'])}: "
               + ", ".join(f"{v} {n}" for v, n in c["verdicts"].items()))
     if result.cart is not None:  # a cart identified from recordings: the data the design rests on
-
         rests_on = identified_from_line(str(result.cart.get("text", "")), str(result.cart.get("path", "")))
         if rests_on is not None:
             print(rests_on)

@@ -10,8 +10,6 @@ import sys
 import time
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
 from wmr_mj._util.files import check_output_path, write_json_atomic, write_text_atomic
 from wmr_mj._util.progress import counter_callback, progress_bar
 from wmr_mj.analysis.verdicts import certified_outside_banner, format_unmet
@@ -36,7 +34,7 @@ from wmr_mj.searches.falsify import (
     portfolio_global_runs,
     portfolio_local_phase,
     portfolio_phases,
-    screened_start,
+    portfolio_start,
     undefined_objective_warning,
     worst_config,
 )
@@ -93,11 +91,7 @@ def command_line(config: Any, replay: Replay, *, command: str = "wmr-mj run") ->
 def _portfolio_phases_text(spec, first, population: int) -> str:
     """What the portfolio did after its vertices: where CMA-ES started (the screening), its global and local
     phases, and (from 200 runs) the coordinate moves that end it."""
-    lo, hi = spec.bounds[:, 0], spec.bounds[:, 1]
-    corners = np.array([e.point or [e.params[n] for n in spec.names] for e in first])  # as searched, unrounded
-    corners = np.where(hi > lo, (corners - lo) / np.where(hi > lo, hi - lo, 1.0), 0.0)
-    values = np.array([np.nan if e.objective is None else e.objective for e in first])
-    start = screened_start(corners, values)
+    start = portfolio_start(spec, first)
     moved = [f"{'up' if u > 0.5 else 'down'} in {n}" for n, u in zip(spec.names, start) if u != 0.5]
     _, global_runs, local_runs = portfolio_phases(len(spec.names), spec.budget, population)
     where = "the box's centre" + (f" moved {', '.join(moved)} (the vertices' main effects)" if moved else "")
@@ -140,7 +134,6 @@ def _base_and_box(args: argparse.Namespace):
 def run(args: argparse.Namespace) -> int:
     objective = _objective(args)
     if args.design is not None:  # the design's box before falsify's own default (the full box)
-
         with_design_file(args)
     args.uncertainty = args.uncertainty or "full"
     base, box = _base_and_box(args)

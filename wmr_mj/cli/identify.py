@@ -13,6 +13,7 @@ import argparse
 import datetime
 import sys
 from pathlib import Path
+from typing import Any
 
 from wmr_mj._util.files import check_output_path, write_json_atomic
 from wmr_mj.carts import load_cart, load_cart_text
@@ -97,21 +98,10 @@ def _read_recording(item: str, columns: dict[str, str], params, topics: dict[str
 
 def run_data(args: argparse.Namespace) -> int:
     """``identify --data``: recordings -> NEW.toml, intervals, the hold-out's check."""
-    if not args.out:
-        raise ParameterError("identify --data needs --out NEW.toml: the identified cart file")
-    if args.sysid:  # asked for: the extra must be there before any work (one line naming it, exit 2)
-
-        import_sysid()
-    out = check_output_path(args.out, kind="file", option="--out")
-    if args.report:
-        check_output_path(args.report, kind="dir", option="--report")
+    out = _checked_data_outputs(args)
     start = load_cart(args.cart or "c80")
     params = parameters_of_cart(start)
-    columns = parse_columns(args.columns)
-
-    topics = parse_topics(args.topics) if args.topics else None
-    recordings = [_read_recording(item, columns, params, topics) for item in args.data]
-    holdout = _read_recording(args.holdout, columns, params, topics) if args.holdout else None
+    recordings, holdout = _recordings_of(args, params)
     fit = fit_recordings(recordings, params, seed=args.seed)
     date = datetime.datetime.now(datetime.UTC).date().isoformat()
     command = "wmr-mj identify " + " ".join(sys.argv[2:]) if len(sys.argv) > 2 else "wmr-mj identify"
@@ -126,7 +116,50 @@ def run_data(args: argparse.Namespace) -> int:
     failed = nrmse is not None and not nrmse <= HOLDOUT_NRMSE_MAX
     if rollouts is not None and holdout is not None:
         failed = failed or not rollouts[holdout.name] <= HOLDOUT_NRMSE_MAX
-    obj = {
+    if args.json:
+        print_json(_data_json(fit, recordings, holdout, nrmse, failed, out=out, report_files=report_files,
+                              rollouts=rollouts))
+    else:
+        _print_fit(fit, recordings, holdout, nrmse, out)
+        for name, value in (rollouts or {}).items():
+            print(f"MuJoCo rollouts of {out}'s MJCF (mujoco.sysid) on {name}: normalised RMS error {value:.3g}")
+        for path in report_files:
+            print(f"wrote {path}")
+    if failed and holdout is not None:
+        worst = max(v for v in (nrmse, (rollouts or {}).get(holdout.name)) if v is not None)
+        print(f"hold-out {holdout.name}: the identified model does not predict it: normalised RMS error {worst:.3g} "
+              f"above {HOLDOUT_NRMSE_MAX:g}", file=sys.stderr)
+        return 1
+    return 0
+
+
+def _checked_data_outputs(args: argparse.Namespace) -> Path:
+    """``identify --data``'s --out (the cart file to write), checked with --report's folder and the sysid extra
+    before any work (one line each, exit status 2)."""
+    if not args.out:
+        raise ParameterError("identify --data needs --out NEW.toml: the identified cart file")
+    if args.sysid:  # asked for: the extra must be there before any work (one line naming it, exit 2)
+        import_sysid()
+    out = check_output_path(args.out, kind="file", option="--out")
+    if args.report:
+        check_output_path(args.report, kind="dir", option="--report")
+    return out
+
+
+def _recordings_of(args: argparse.Namespace, params) -> tuple[list, Any]:
+    """The --data recordings and the --holdout one (None where not given), each read and checked."""
+    columns = parse_columns(args.columns)
+    topics = parse_topics(args.topics) if args.topics else None
+    recordings = [_read_recording(item, columns, params, topics) for item in args.data]
+    holdout = _read_recording(args.holdout, columns, params, topics) if args.holdout else None
+    return recordings, holdout
+
+
+def _data_json(fit, recordings, holdout, nrmse, failed: bool, *, out, report_files: list[str],
+               rollouts: dict[str, float] | None) -> dict[str, Any]:
+    """``identify --data --json``: the fit's intervals, the delay, the encoder and the noise, the recordings it rests
+    on, the hold-out's check and the files written."""
+    return {
         "coefficients": {k: v.to_dict() for k, v in fit.coefficients.items()},
         "fixed_from_structure": {"K": "0: absent from the plant (non-holonomic model)",
                                  "gyro": "P / l1: moves with C_V at constant speed, not separable"},
@@ -148,20 +181,6 @@ def run_data(args: argparse.Namespace) -> int:
         "report": report_files,
         **({} if rollouts is None else {"mjcf_rollouts": {"nrmse": rollouts, "nrmse_max": HOLDOUT_NRMSE_MAX}}),
     }
-    if args.json:
-        print_json(obj)
-    else:
-        _print_fit(fit, recordings, holdout, nrmse, out)
-        for name, value in (rollouts or {}).items():
-            print(f"MuJoCo rollouts of {out}'s MJCF (mujoco.sysid) on {name}: normalised RMS error {value:.3g}")
-        for path in report_files:
-            print(f"wrote {path}")
-    if failed and holdout is not None:
-        worst = max(v for v in (nrmse, (rollouts or {}).get(holdout.name)) if v is not None)
-        print(f"hold-out {holdout.name}: the identified model does not predict it: normalised RMS error {worst:.3g} "
-              f"above {HOLDOUT_NRMSE_MAX:g}", file=sys.stderr)
-        return 1
-    return 0
 
 
 def _mjcf_rollouts(text, holdout, recordings, fit) -> dict[str, float]:

@@ -167,7 +167,6 @@ def box_ranges_from_args(args: argparse.Namespace) -> dict[str, tuple[float, flo
     box = getattr(args, "uncertainty", None) or "m1"
     ranges = {k: v for k, v in uncertainty_ranges(box).items() if k != "m1"}
     if getattr(args, "cart", None) is not None:  # the cart's own box (--cart)
-
         boxes = load_cart(args.cart).uncertainty
         if box in boxes:
             ranges = {k: v for k, v in boxes[box].items() if k != "m1"}

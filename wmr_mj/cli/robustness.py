@@ -45,7 +45,7 @@ from wmr_mj.params import (
     parameters_of_cart,
     uncertainty_ranges,
 )
-from wmr_mj.sim.certify import certificate_of, measurement_errors_of
+from wmr_mj.sim.certify import section_4_beside
 from wmr_mj.sim.parts import resolve_run
 
 
@@ -100,7 +100,6 @@ def _box(args: argparse.Namespace):
     ranges = command_ranges(args, "robustness").plant  # m1's range is --m1-range (the one rule of --range)
     params, name, default_m1 = C80, "C80", M1_RANGE
     if args.cart is not None:  # --cart: its parameter set and its m1 box
-
         cart = load_cart(args.cart)
         params, name, default_m1 = parameters_of_cart(cart), cart.name, cart.uncertainty["m1"]["m1"]
     m1_range = tuple(args.m1_range) if args.m1_range is not None else default_m1
@@ -164,7 +163,6 @@ def _box_ranges(args: argparse.Namespace) -> tuple[tuple[float, float], dict[str
     ranges = uncertainty_ranges(args.uncertainty) if getattr(args, "uncertainty", None) else {}
     default_m1 = M1_RANGE
     if getattr(args, "cart", None) is not None:  # --cart: its boxes
-
         boxes = load_cart(args.cart).uncertainty
         default_m1 = boxes["m1"]["m1"]
         ranges = dict(boxes.get(args.uncertainty, ranges)) if getattr(args, "uncertainty", None) else {}
@@ -308,19 +306,6 @@ def certificate_breakdown(cert) -> dict:
     return out
 
 
-def _section_4_beside(parts, cert):
-    """Section 4's certificate of the run where the one taken is the sampled-data certificate and section 4's is
-    recorded beside it (issue 44: the paper's analysis, a second opinion): the law's continuous claim alone, as
-    :func:`wmr_mj.sim.certify.certificate_of` gives it for the cart's own measurement as a what-if; else None."""
-    if "section-4" not in (cert.inputs.get("certificates") or {}):
-        return None
-    config = parts.config
-    alone = certificate_of(config, parts.reference, base=parts.base, estimate=parts.estimate, plant=parts.plant,
-                           controller=parts.controller, tracker=parts.tracker,
-                           measurement=measurement_errors_of(config, parts.plant))
-    return alone if alone is not None and isinstance(alone.region, SmallGainRegion) else None
-
-
 def run_certificate(args: argparse.Namespace) -> int:
     """``wmr-mj robustness --certificate [run options]``."""
     given = [opt for opt, name in _OUTER_OPTIONS if getattr(args, name) is not None]
@@ -341,7 +326,7 @@ def run_certificate(args: argparse.Namespace) -> int:
         raise ParameterError(f"controller {parts.controller_name!r} states no claim: there is no certificate to "
                              "print; judge its runs by requirements (wmr-mj run --require ...)")
     paper = parts.analysis
-    second = _section_4_beside(parts, cert)
+    second = section_4_beside(parts, cert)
     if as_json:
         out = cert.to_dict()
         if parts.paper_law:  # the paper's region says nothing of a law outside its family (run: not applicable)

@@ -291,7 +291,6 @@ def format_report(s: RunSummary, *, measurement: Any = None, cart: str | None = 
         f"voltage saturated {100 * s.saturated_fraction:.1f}% of the time",
     ]
     if s.mujoco_warnings:  # counted over the run and said once here (MuJoCo's console printing is held)
-
         said = next((a.note for a in (cert.assumptions if cert is not None else ())
                      if a.name == MUJOCO_WITHOUT_WARNINGS), "")
         lines.append(f"MuJoCo warned {s.mujoco_warnings} time(s) during the run; the run is not certified "

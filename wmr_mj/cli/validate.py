@@ -51,7 +51,6 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     m1_range = _design_file_options(args)  # a design file: its cart, m1 box, path and sensing, unless given
     if args.path is None:  # the cart's own path (the paper circle on the C80)
-
         cart = cart_file_of_record(RunConfig.from_inputs(cart=getattr(args, "cart", None)).cart)
         args.path = default_path(cart)
         note = default_path_note(cart)  # a path derived from the cart's stops, named
