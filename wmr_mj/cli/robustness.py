@@ -159,7 +159,7 @@ _OUTER_OPTIONS = (("--kp", "kp"), ("--kd", "kd"), ("--omega-r", "omega_r"), ("--
 
 def _box_ranges(args: argparse.Namespace) -> tuple[tuple[float, float], dict[str, tuple[float, float]]]:
     """(m1_range, other ranges) from --uncertainty, --m1-range and --range (read by the one rule of every
-    command, :func:`wmr_mj.cli.options.parse_ranges`: m1's range is --m1-range)."""
+    command, :func:`wmr_mj.cli.ranges.parse_ranges`: m1's range is --m1-range)."""
     ranges = uncertainty_ranges(args.uncertainty) if getattr(args, "uncertainty", None) else {}
     default_m1 = M1_RANGE
     if getattr(args, "cart", None) is not None:  # --cart: its boxes

@@ -290,6 +290,14 @@ def format_report(s: RunSummary, *, measurement: Any = None, cart: str | None = 
         f"{num(cert_Edot_max):>12s} {ratio(cert_Edot_ratio):>8s}" + paper(s.Edot_max, s.Edot_ratio),
         f"voltage saturated {100 * s.saturated_fraction:.1f}% of the time",
     ]
+    return "\n".join(lines + _after_the_table(s))
+
+
+def _after_the_table(s: RunSummary) -> list[str]:
+    """The lines of a run's report below its table: MuJoCo's warnings, C's path and its verdict, a route not
+    finished, the steering's stop, a run that did not complete (none where nothing of these happened)."""
+    lines = []
+    cert = s.certificate
     if s.mujoco_warnings:  # counted over the run and said once here (MuJoCo's console printing is held)
         said = next((a.note for a in (cert.assumptions if cert is not None else ())
                      if a.name == MUJOCO_WITHOUT_WARNINGS), "")
@@ -309,7 +317,7 @@ def format_report(s: RunSummary, *, measurement: Any = None, cart: str | None = 
         lines.append(f"the steering reached its stop (+-range) at t = {s.left_steering_range_at_s:.3f} s")
     if s.status != "completed":
         lines.append(f"run {s.status}: report covers the simulated part only")
-    return "\n".join(lines)
+    return lines
 
 
 def _law_note(result: Any, config: Any) -> str | None:

@@ -4,7 +4,7 @@ that field is written back as the option.
 The table (:func:`run_options`) drives both ways:
 
 * argparse: :func:`add_options` adds a group of rows (``wmr-mj run``'s options, the cart's, the signals', the
-  requirement) to a command's parser (``wmr_mj.cli.run.add_run_options`` and friends);
+  requirement) to a command's parser (``wmr_mj.cli.parsers.run.add_run_options`` and friends);
 * the reproduce line: :func:`wmr_mj.cli.falsify.command_line` writes a RunConfig back as the ``wmr-mj run`` line
   that builds it,
   each row writing its own field (``wmr-mj falsify``'s reproduce line), so a field read by one row's parser is

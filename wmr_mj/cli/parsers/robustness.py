@@ -43,6 +43,26 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         default=None,
         help="critical damping (3.6): K_P = omega_r^2/4, K_D = omega_r (not with --kp/--kd)",
     )
+    _add_box_options(p)
+    _add_reading_options(p)
+    p.add_argument("--alpha-ddot", type=_nonneg_float, default=None, help="||alpha0''|| [rad/s^2] (default 0.4)")
+    p.add_argument("--alpha-dot", type=_nonneg_float, default=None, help="||alpha0'|| [rad/s] (default 0.23)")
+    p.add_argument("--sin-cos3", type=_nonneg_float, default=None, help="||sin/cos^3|| (default 1.24)")
+    add_json(p, help="print one JSON object")
+    p.add_argument(
+        "--certificate",
+        nargs=argparse.REMAINDER,
+        default=None,
+        metavar="RUN-OPTIONS",
+        help="print the certificate for a controller as `wmr-mj run` would run it; every option after "
+        "--certificate is one of run's (--model, --controller, --kp/--kd/--omega-r, --friction-sign, "
+        "--friction-width, --control-period, --m1, --box, --m1-range, --param) or --range NAME=LO:HI, "
+        "--uncertainty m1|full, --json (see: wmr-mj robustness --certificate --help)",
+    )
+
+
+def _add_box_options(p: argparse.ArgumentParser) -> None:
+    """The box of the analysis: the paper's, or derived from a cart over ranges, by a reduced model."""
     p.add_argument(
         "--box",
         choices=("paper", "derived"),
@@ -80,6 +100,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         metavar="NAME=VALUE",
         help="fixed estimate of P, C_V, F or K (repeatable); others are anywhere in the box (4.2)",
     )
+
+
+def _add_reading_options(p: argparse.ArgumentParser) -> None:
+    """The estimate, the reading of (4.19)-(4.20) and the operator gains."""
     p.add_argument(
         "--reading",
         choices=("corrected", "printed", "printed-literal"),
@@ -91,20 +115,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         choices=("exact", "paper"),
         default=None,
         help="operator gains: exact integrals (default) or the paper's (4.16) 1/K_P, 4/(e K_D)",
-    )
-    p.add_argument("--alpha-ddot", type=_nonneg_float, default=None, help="||alpha0''|| [rad/s^2] (default 0.4)")
-    p.add_argument("--alpha-dot", type=_nonneg_float, default=None, help="||alpha0'|| [rad/s] (default 0.23)")
-    p.add_argument("--sin-cos3", type=_nonneg_float, default=None, help="||sin/cos^3|| (default 1.24)")
-    add_json(p, help="print one JSON object")
-    p.add_argument(
-        "--certificate",
-        nargs=argparse.REMAINDER,
-        default=None,
-        metavar="RUN-OPTIONS",
-        help="print the certificate for a controller as `wmr-mj run` would run it; every option after "
-        "--certificate is one of run's (--model, --controller, --kp/--kd/--omega-r, --friction-sign, "
-        "--friction-width, --control-period, --m1, --box, --m1-range, --param) or --range NAME=LO:HI, "
-        "--uncertainty m1|full, --json (see: wmr-mj robustness --certificate --help)",
     )
 
 
