@@ -158,7 +158,7 @@ def _if(condition: Callable[[Any, Replay], bool], words: Callable[[Any, Replay],
 def run_options() -> tuple[RunOption, ...]:
     """The run options, in the order the reproduce line writes them (and the help lists them): the law and the
     run's length, then the plant and its analysis box, then the outer loop, the signals and the cart."""
-    return _law_rows() + _plant_and_outer_rows()
+    return _law_rows() + _plant_rows() + _outer_signal_and_cart_rows()
 
 
 def _law_rows() -> tuple[RunOption, ...]:
@@ -206,7 +206,7 @@ def _law_rows() -> tuple[RunOption, ...]:
     )
 
 
-def _plant_and_outer_rows() -> tuple[RunOption, ...]:
+def _plant_rows() -> tuple[RunOption, ...]:
     R = RunOption
     return (
         R(flag="--steering-friction", group="run", sets="steering_friction", settings=dict(default="stiction"),
@@ -229,6 +229,12 @@ def _plant_and_outer_rows() -> tuple[RunOption, ...]:
         R(flag="--uncertainty", group="run", sets="box_ranges", settings=dict(default=None), help=_uncertainty_help,
           write=_write_uncertainty),
         R(flag="--range", group="command", sets="box_ranges", write=_write_ranges),
+    )
+
+
+def _outer_signal_and_cart_rows() -> tuple[RunOption, ...]:
+    R = RunOption
+    return (
         R(flag="--correction", group="run", sets="correction", settings=dict(action="store_true"),
           help="Cartesian correction: an outer loop at C (Stanley-like, from C's cross-track and heading errors) "
                "corrects alpha0 within declared rate and acceleration limits, which the certificate then assumes "
