@@ -4,12 +4,9 @@ from __future__ import annotations
 
 import argparse
 import functools
-import math
 import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
-
-from matplotlib.patches import Rectangle
 
 from wmr_mj._util.files import check_output_path, write_json_atomic
 from wmr_mj._util.progress import counter_callback, progress_bar
@@ -17,7 +14,6 @@ from wmr_mj.analysis.verdicts import (
     PAPER_CLAIM_NOT_APPLICABLE,
     certified_outside_banner,
     format_unmet,
-    paper_region_name,
 )
 from wmr_mj.cli._common import CLAIM_BROKEN_EXIT, print_json
 from wmr_mj.cli.ranges import box_ranges_from_args, hardware_ranges_from_args
@@ -25,7 +21,8 @@ from wmr_mj.cli.run import config_from_args, requirements_from_args
 from wmr_mj.errors import ParameterError
 from wmr_mj.experiments.sweep import SweepSpec
 from wmr_mj.experiments.sweep_result import sweep
-from wmr_mj.figures.plots import new_figure, save_figure
+from wmr_mj.figures.plots import save_figure
+from wmr_mj.figures.results import figure_sweep_region
 from wmr_mj.hardware import cart_line, is_ideal_cart
 from wmr_mj.logs.writer import RunLogger
 from wmr_mj.params import M1_RANGE
@@ -191,22 +188,6 @@ def _plot(result: Any, stem: Path) -> Path:
 
 
 def region_figure(result: Any):
-    """Fig.-7-style plot of a sweep's ``result`` (:class:`wmr_mj.experiments.sweep_result.SweepResult`): the bounds a
-    run is judged by (sup|E| <= E_max and sup|E'| <= E'_max, the sweep's inside/outside) and every run's (sup|E|,
-    sup|E'|). The region (4.21)-(4.23) is labelled the paper's claim on the paper's C80 only
-    (:func:`wmr_mj.analysis.verdicts.paper_region_name`)."""
-    results, runs = result.rows, result.summary
-    claim = paper_region_name(coerced(result.spec.base).cart is None)
-    fig, ax = new_figure(5.0, 4.0)
-    for (E_max, Ed_max), colour, label in (
-            ((runs.certificate_E_max, runs.certificate_Edot_max), "C2", "certificate's bounds"),
-            ((runs.paper_E_max, runs.paper_Edot_max), "C0", claim.removeprefix("the "))):
-        if E_max is not None and Ed_max is not None and math.isfinite(E_max) and math.isfinite(Ed_max):
-            ax.add_patch(Rectangle((0, 0), E_max, Ed_max, alpha=0.15, color=colour, label=label))
-    sc = ax.scatter([r["sup_E"] for r in results], [r["sup_Edot"] for r in results], c=[r["m1"] for r in results],
-                    s=12, label="runs")
-    fig.colorbar(sc, ax=ax, label="m1 [kg]")
-    ax.set_xlabel("sup |E| [rad]")
-    ax.set_ylabel("sup |E'| [rad/s]")
-    ax.legend(loc="best")  # the runs sit anywhere; keep the legend off them
-    return fig
+    """Fig.-7-style plot of a sweep's ``result`` (:class:`wmr_mj.experiments.sweep_result.SweepResult`):
+    :func:`wmr_mj.figures.results.figure_sweep_region`, its region named as the paper's claim on the C80 only."""
+    return figure_sweep_region(result, on_c80=coerced(result.spec.base).cart is None)
