@@ -8,6 +8,7 @@ shown, name what the library holds. Timed by bench/bench_cli_help.py, not here.
 
 from __future__ import annotations
 
+import importlib
 import json
 import subprocess
 import sys
@@ -74,8 +75,21 @@ def test_main_builds_only_the_command_given(capsys):
         build_parser(()).parse_args(["--help"])
     listing = capsys.readouterr().out
     for command in COMMANDS:  # every command, with its one line
-        module = __import__(f"wmr_mj.cli.{command}", fromlist=["HELP"])
+        module = importlib.import_module(f"wmr_mj.cli.parsers.{command}")
         assert f"    {command} " in listing and " ".join(module.HELP.split()[:3]) in " ".join(listing.split())
+
+
+def test_each_command_is_a_parser_and_an_implementation_run_by_name():
+    """``main`` runs ``wmr_mj.cli.<name>.run`` for the command given (wmr_mj/cli/app.py): every command has its parser
+    module (HELP, register) and its implementation module (run), and the dispatch finds the latter by name."""
+    from wmr_mj.cli.app import PARSERS, _implementation
+
+    assert tuple(PARSERS) == COMMANDS
+    for command in COMMANDS:
+        implementation = importlib.import_module(f"wmr_mj.cli.{command}")
+        assert PARSERS[command] is importlib.import_module(f"wmr_mj.cli.parsers.{command}")
+        assert PARSERS[command].HELP and callable(PARSERS[command].register)
+        assert _implementation(command) is implementation.run
 
 
 def test_a_help_that_names_the_librarys_names_lists_them(capsys, monkeypatch):

@@ -52,7 +52,8 @@ def test_design_file_round_trip_is_the_same_config(designed):
     """run --design FILE builds the RunConfig the design's settings give, field by field."""
     import argparse
 
-    from wmr_mj.cli.run import add_run_options, config_from_args
+    from wmr_mj.cli.parsers.run import add_run_options
+    from wmr_mj.cli.run import config_from_args
     from wmr_mj.hardware import Sensing
     from wmr_mj.sim.config import RunConfig
 

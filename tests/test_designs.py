@@ -51,7 +51,8 @@ def test_unknown_preset_lists_the_valid_ones():
 
 
 def _config(argv):
-    from wmr_mj.cli.run import add_run_options, config_from_args
+    from wmr_mj.cli.parsers.run import add_run_options
+    from wmr_mj.cli.run import config_from_args
 
     p = argparse.ArgumentParser()
     add_run_options(p)

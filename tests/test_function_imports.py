@@ -17,10 +17,11 @@ ROOT = Path(__file__).resolve().parents[1]
 PACKAGES = ("wmr_mj/logs", "wmr_mj/report", "wmr_mj/analysis", "wmr_mj/plant", "wmr_mj/figures", "wmr_mj/_util",
             "controllers")
 #: the run, what asks for runs, and the layers below them; and wmr_mj's own top-level modules (files)
-PACKAGES += ("wmr_mj/sim", "wmr_mj/searches", "wmr_mj/experiments", "wmr_mj/reference", "wmr_mj/hardware",
-             "wmr_mj/carts", "wmr_mj/__init__.py", "wmr_mj/errors.py", "wmr_mj/params.py", "wmr_mj/_version.py")
+PACKAGES += ("wmr_mj/cli", "wmr_mj/sim", "wmr_mj/searches", "wmr_mj/experiments", "wmr_mj/reference",
+             "wmr_mj/hardware", "wmr_mj/carts", "wmr_mj/__init__.py", "wmr_mj/errors.py", "wmr_mj/params.py",
+             "wmr_mj/_version.py")
 #: the packages not swept yet
-NOT_YET = ("wmr_mj/cli",)
+NOT_YET: tuple[str, ...] = ()
 PROJECT = ("wmr_mj", "controllers")
 
 

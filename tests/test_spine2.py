@@ -136,7 +136,7 @@ def test_every_run_option_is_in_the_table_and_the_table_is_the_parser():
     `wmr-mj run` that sets a RunConfig field is a row."""
     import argparse
 
-    from wmr_mj.cli.run import add_require_option, add_run_options, add_signal_options
+    from wmr_mj.cli.parsers.run import add_require_option, add_run_options, add_signal_options
     from wmr_mj.cli.run_options import run_options
 
     p = argparse.ArgumentParser()
@@ -193,7 +193,7 @@ def test_every_command_refuses_the_same_range_names_with_the_same_line(command, 
 def test_every_command_reads_a_plant_range_the_same_way(command):
     """A plant parameter (R_a) replaces the range the --uncertainty box gives it, and adds one it has not (l3),
     in every command, by the one parser; the kinds a command does not vary are refused by name."""
-    from wmr_mj.cli.options import RANGE_ACCEPTS, RANGE_KINDS, parse_ranges
+    from wmr_mj.cli.ranges import RANGE_ACCEPTS, RANGE_KINDS, parse_ranges
 
     key = command.split()[0]
     items = ["R_a=1.0:1.4", "l3=0.14:0.15"]

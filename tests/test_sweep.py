@@ -130,7 +130,7 @@ def test_cli_sweep_json_and_files(tmp_path):
 def test_uncertainty_box_and_ranges_from_the_command_line():
     import argparse
 
-    from wmr_mj.cli._common import box_ranges_from_args
+    from wmr_mj.cli.ranges import box_ranges_from_args
     from wmr_mj.params import uncertainty_ranges
 
     full = uncertainty_ranges("full")

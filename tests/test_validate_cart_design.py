@@ -182,6 +182,7 @@ def test_the_recorded_command_searches_the_sections_problem():
     import shlex
 
     from wmr_mj.cli import design as design_cli
+    from wmr_mj.cli.parsers import design as design_parser
     from wmr_mj.report.cart_design import design_command, design_problem
     from wmr_mj.report.settings import ValidateSettings
     from wmr_mj.searches.design_search import search_design
@@ -194,7 +195,7 @@ def test_the_recorded_command_searches_the_sections_problem():
                    "--budget 12"):
         assert option in command, option
     parser = argparse.ArgumentParser()
-    design_cli.register(parser.add_subparsers())
+    design_parser.register(parser.add_subparsers())
     args = parser.parse_args(shlex.split(command)[1:])
     again = design_cli.problem_from_args(args)
     ours, theirs = search_design(problem), search_design(again)

@@ -1,21 +1,24 @@
-"""Argument helpers shared by the subcommands (the shared options and --range: :mod:`wmr_mj.cli.options`, whose
-argparse types and range readers are also importable from here)."""
+"""Helpers shared by the commands, light enough for their parsers (:mod:`wmr_mj.cli.parsers`): the exit status of
+a broken claim, ``NAME=VALUE`` options, ``--param m1=``, one JSON object on stdout, a default output folder (the
+shared options: :mod:`wmr_mj.cli.options`, whose argparse types are also importable from here; --range:
+:mod:`wmr_mj.cli.ranges`)."""
 
 from __future__ import annotations
 
 import json
 import math
 import sys
+import time
 from typing import Any
 
+from wmr_mj._util.files import json_safe
 from wmr_mj.cli.options import (  # noqa: F401  (importable from here, as before)
-    box_ranges_from_args,
-    hardware_ranges_from_args,
     int_at_least,
-    parse_range,
     positive_float,
     positive_int,
 )
+from wmr_mj.errors import ParameterError
+from wmr_mj.params import M1_NOMINAL
 
 #: Exit status of ``run``, ``sweep``, ``compare`` and ``falsify`` when a run breaks its law's claim (a
 #: ``certified-outside`` run), and of ``falsify`` when it falsifies its ``--require``: a CI job can gate on
@@ -26,8 +29,6 @@ CLAIM_BROKEN_EXIT = 3
 def parse_assignments(items: list[str] | None, *, option: str = "--param",
                       example: str = "mu=0.02") -> dict[str, Any]:
     """``NAME=VALUE`` pairs (``--param l3=0.15``) into a dict; bad syntax raises ParameterError."""
-    from wmr_mj.errors import ParameterError
-
     out: dict[str, float] = {}
     for item in items or []:
         name, sep, value = item.partition("=")
@@ -47,9 +48,6 @@ def m1_of_param(args: Any) -> Any:
     Raises:
         ParameterError: two different masses, or a malformed --param (one line).
     """
-    from wmr_mj.errors import ParameterError
-    from wmr_mj.params import M1_NOMINAL
-
     items = getattr(args, "param", None)
     if not items or not hasattr(args, "m1"):
         return args
@@ -73,7 +71,10 @@ def m1_of_param(args: Any) -> Any:
 
 def print_json(obj: Any) -> None:
     """One JSON object on stdout; non-finite numbers become null."""
-    from wmr_mj._util.files import json_safe
-
     json.dump(json_safe(obj), sys.stdout, indent=2, sort_keys=True, allow_nan=False, default=float)
     sys.stdout.write("\n")
+
+
+def default_folder(prefix: str) -> str:
+    """``logs/<prefix>-<local time>``: a command's output folder where --out is not given."""
+    return f"logs/{prefix}-{time.strftime('%Y%m%d-%H%M%S')}"

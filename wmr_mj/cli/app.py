@@ -1,12 +1,18 @@
 """The ``wmr-mj`` command line.
 
-Each subcommand lives in ``wmr_mj.cli.<name>`` and provides ``HELP`` (its line in
-``wmr-mj --help``) and ``register(subparsers)``, which adds its parser and sets
-``func(args) -> int``. A command line registers only its own command (the others are
-listed by name and ``HELP``), and a command module imports its implementation (the
-simulation, MuJoCo, scipy) inside ``func``, a help that names what a heavy module
-holds being computed for ``--help`` alone (``wmr_mj.cli.options.add_argument_with_help_of``):
-so ``wmr-mj --help`` and a bad option answer without importing the simulation
+Each command has two modules:
+
+* its parser, ``wmr_mj.cli.parsers.<name>``: ``HELP`` (its line in ``wmr-mj --help``) and ``register(subparsers)``,
+  which adds its parser and options; argparse and the light modules of the CLI only (the options,
+  :mod:`wmr_mj.cli.options`; the table of run options, :mod:`wmr_mj.cli.run_options`; the parameter set), a help
+  that names what a heavy module holds being computed for ``--help`` alone
+  (:func:`wmr_mj.cli.options.add_argument_with_help_of`, :func:`~wmr_mj.cli.options.names_in`);
+* its implementation, ``wmr_mj.cli.<name>``: ``run(args) -> int``, with every import at its top (the
+  simulation, MuJoCo, scipy).
+
+A command line registers only its own command (the others are listed by name and ``HELP``), and :func:`main`
+imports the implementation of the command given, by name, once its options are parsed: the one place where the
+CLI defers an import. So ``wmr-mj --help`` and a bad option answer without importing the simulation
 (``bench/bench_cli_help.py``; tests/test_cli_help.py checks what building a parser imports).
 
 Bad input raises a :class:`wmr_mj.errors.WmrMjError`; it is printed here as one
@@ -17,40 +23,47 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 from collections.abc import Collection, Sequence
 
 from wmr_mj.cli._common import m1_of_param
+from wmr_mj.cli.options import OneLineParser
+from wmr_mj.cli.parsers import (
+    cart,
+    compare,
+    design,
+    excite,
+    falsify,
+    figures,
+    identify,
+    model,
+    replay,
+    robustness,
+    run,
+    sweep,
+    validate,
+)
+from wmr_mj.cli.run_options import DEFAULT_DURATION
 from wmr_mj.errors import WmrMjError
 
-COMMANDS = ("identify", "robustness", "run", "replay", "sweep", "falsify", "compare", "validate", "figures", "model",
-            "cart", "design", "excite")
-
-
-class _OneLineParser(argparse.ArgumentParser):
-    """Argument errors as one line (no usage dump), exit status 2."""
-
-    def error(self, message: str) -> None:  # type: ignore[override]
-        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+#: each command's parser module (:mod:`wmr_mj.cli.parsers`), in the order ``wmr-mj --help`` lists them
+PARSERS = {"identify": identify, "robustness": robustness, "run": run, "replay": replay, "sweep": sweep,
+           "falsify": falsify, "compare": compare, "validate": validate, "figures": figures, "model": model,
+           "cart": cart, "design": design, "excite": excite}
+COMMANDS = tuple(PARSERS)
 
 
 def build_parser(commands: Collection[str] = COMMANDS) -> argparse.ArgumentParser:
     """The ``wmr-mj`` parser: the commands named in ``commands`` (default: all) with all their options; the
     others by name and one-line help alone (as ``wmr-mj --help`` lists them), not registered, so a command line
     builds only its own command's options."""
-    parser = _OneLineParser(
+    parser = OneLineParser(
         prog="wmr-mj",
         description="MuJoCo validation testbed for computed-torque steering control of the C80 cart.",
     )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
-    for name in COMMANDS:
-        try:
-            # a command's module by name: light at import (argparse-level), its implementation imported by its func
-            module = importlib.import_module(f"wmr_mj.cli.{name}")
-        except ModuleNotFoundError as exc:
-            if exc.name != f"wmr_mj.cli.{name}":
-                raise
-            continue  # command not built yet
+    for name, module in PARSERS.items():
         if name in commands:
             module.register(sub)
         else:
@@ -66,16 +79,21 @@ def _commands_of(argv: Sequence[str]) -> tuple[str, ...]:
 def _mujoco_importable() -> str | None:
     """None when MuJoCo imports; else one line naming the cause (a MUJOCO_GL backend that is not installed
     makes ``import mujoco`` fail inside PyOpenGL, before any command runs)."""
-    import os
-
     try:
-        import mujoco  # noqa: F401
+        import mujoco  # noqa: F401  (the check itself: whether MuJoCo imports here, before any command runs)
     except Exception as exc:  # noqa: BLE001  (any failure here ends in one line, not a traceback)
         gl = os.environ.get("MUJOCO_GL")
         hint = (f"MUJOCO_GL={gl!r} names a GL backend that cannot be loaded here; unset it or use egl, glfw or "
                 "osmesa with its library installed" if gl else "reinstall it: pip install mujoco")
         return f"MuJoCo cannot be imported ({type(exc).__name__}: {exc}); {hint}"
     return None
+
+
+def _implementation(command: str):
+    """The ``run(args) -> int`` of ``command``: its implementation module ``wmr_mj.cli.<command>``."""
+    # imported by name, here and only here, once the command line is parsed: an implementation imports the
+    # simulation (MuJoCo, scipy, the laws), which --help and a bad option must not wait for (tests/test_cli_help.py)
+    return importlib.import_module(f"wmr_mj.cli.{command}").run
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -87,7 +105,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser(_commands_of(argv)).parse_args(argv)
     try:
         m1_of_param(args)  # --param m1=KG is --m1 KG wherever --m1 is an option
-        return int(args.func(args) or 0)
+        return int(_implementation(args.command)(args) or 0)
     except WmrMjError as exc:
         print(f"wmr-mj: error: {_with_where_duration_came_from(str(exc), args)}", file=sys.stderr)
         return 2
@@ -95,21 +113,17 @@ def main(argv: Sequence[str] | None = None) -> int:
         print("wmr-mj: interrupted", file=sys.stderr)
         return 130
     except BrokenPipeError:  # output piped into `head` and friends
-        import os
-
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
 
 
-if __name__ == "__main__":
-    sys.exit(main())
-
-
 def _with_where_duration_came_from(message: str, args: argparse.Namespace) -> str:
     """``message``, and where a refused duration came from when the user gave none: the default --duration."""
-    from wmr_mj.cli.run_options import DEFAULT_DURATION
-
     if "duration = " in message and getattr(args, "duration", None) is DEFAULT_DURATION:
         return (f"{message} (the duration is --duration's default, {DEFAULT_DURATION:g} s, as none was given; "
                 "give --duration)")
     return message
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -26,33 +26,14 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from wmr_mj.cli._common import positive_float
-
-#: the command's line in ``wmr-mj --help`` (read without registering the command: wmr_mj/cli/app.py)
-HELP = "check a cart file (TOML): schema, compile and step, identification"
-
-
-def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("cart", help=HELP)
-    p.add_argument("action", choices=("check", "card"),
-                   help="check: read the file against its schema, compile and step the generated model for 1 s "
-                        "with random controls (no MuJoCo warning), identify P, C_V, F, K, gyro from a simulated "
-                        "excitation and compare them with what the file implies, and report the certified design's "
-                        "certificate on the cart; exit 1 if a check fails. card: write the cart's model card "
-                        "(Markdown, as models/README.md is the C80's; about a minute of measurements)")
-    p.add_argument("cart", metavar="FILE|NAME", help="a cart file (.toml, see wmr_mj/carts/c80.toml) or a shipped "
-                                                     "cart's name (c80)")
-    p.add_argument("--duration", type=positive_float, default=20.0,
-                   help="length of the identification's excitation, s (default 20)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the random controls and the excitation (default 0)")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--path", metavar="NAME|FILE", default=None,
-                   help="check: the path the certified design and the design search answer for (a path name, a "
-                        "packaged route or a route file; default: the cart's own, [paths] default in its file, "
-                        "else paper-circle)")
-    p.add_argument("--out", metavar="PATH", default=None,
-                   help="card: the Markdown file to write (default: logs/<cart file's stem>-card.md)")
-    p.set_defaults(func=run)
+from wmr_mj._util.files import check_output_path, write_text_atomic
+from wmr_mj.carts import load_cart
+from wmr_mj.cli._common import print_json
+from wmr_mj.experiments.cart_check import cart_check, default_parts
+from wmr_mj.params import parameters_of_cart
+from wmr_mj.plant.cartcheck import COEFFICIENT_UNITS
+from wmr_mj.plant.modelcard import render_model_card
+from wmr_mj.reference.route import path_name
 
 
 def _design_line(d: dict[str, Any], wall: float) -> str:
@@ -66,8 +47,6 @@ def _design_line(d: dict[str, Any], wall: float) -> str:
 
 def _certified_line(c: dict[str, Any]) -> str:
     """The second line: the certified design's certificate on the cart."""
-    from wmr_mj.reference.route import path_name
-
     if c["omega_r"] is None:
         return f"certified design: none on this cart ({c['reason']})"
     head = (f"certified design on this cart: omega_r = {c['omega_r']:g} rad/s (K_P = {c['kp']:g}, K_D = {c['kd']:g}, "
@@ -82,8 +61,6 @@ def _certified_line(c: dict[str, Any]) -> str:
 
 def _print_text(check: Any) -> None:
     """``cart check``'s report as text (``--json`` prints ``check.to_dict()``)."""
-    from wmr_mj.plant.cartcheck import COEFFICIENT_UNITS
-
     parts, steps, ident = check.defaults, check.steps, check.identification
     print(check.answer)
     if check.path_note is not None:
@@ -106,11 +83,6 @@ def _print_text(check: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from wmr_mj.carts import load_cart
-    from wmr_mj.cli._common import print_json
-    from wmr_mj.experiments.cart_check import cart_check, default_parts
-    from wmr_mj.params import parameters_of_cart
-
     cart = load_cart(args.cart)
     if args.action == "card":  # a parameter set or default part that cannot be built: one line, before the card
         parameters_of_cart(cart)
@@ -126,9 +98,6 @@ def run(args: argparse.Namespace) -> int:
 
 def _write_card(cart: Any, out: str | None) -> int:
     """Write the cart's model card (:func:`wmr_mj.plant.modelcard.render_model_card`) to ``out``."""
-    from wmr_mj._util.files import check_output_path, write_text_atomic
-    from wmr_mj.plant.modelcard import render_model_card
-
     path = check_output_path(out or f"logs/{cart.path.stem}-card.md", kind="file", option="--out")
     print(f"wrote {write_text_atomic(path, render_model_card(cart=cart))}")
     return 0

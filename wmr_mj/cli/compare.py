@@ -1,79 +1,28 @@
-"""``wmr-mj compare DESIGN...``: every design on every scenario of a versioned suite, then the same adversary.
-
-Each DESIGN is a preset (``paper``, ``certified``), a built-in law (``sliding-mode``,
-``adaptive-computed-torque``, ``computed-torque``, ``pd``), or a law of one's own (``FILE.py:Class``,
-``module:Class``), with ``,key=value`` settings: ``tracker=NAME`` (``stanley-at-C``, ``pure-pursuit``,
-FILE.py:Class), ``correction=true``, ``model=...``, ``kp=...``, ``kd=...``, ``omega_r=...``, or the law's
-own parameters (``sliding-mode,k=5``). A law's name means what ``wmr-mj run --controller NAME`` means: the
-law with its own defaults (``computed-torque`` and ``pd`` with the paper's model and gains, so
-``computed-torque`` is the ``paper`` preset; ``sliding-mode`` and ``adaptive-computed-torque`` on the
-non-holonomic model); ``certified`` names the certified design. A DESIGN ending in ``.json`` is a design file
-(``wmr-mj design --out FILE.json``): its law, gains, period, cart and m1 box, as ``wmr-mj run --design FILE``
-reads them (a bad file: one line, exit status 2); without ``--cart`` every design runs on the design's cart, and a
-``--cart`` other than the design's prints one note naming both. Example::
-
-    wmr-mj compare paper certified certified,correction=true sliding-mode adaptive-computed-torque \\
-        sliding-mode,tracker=pure-pursuit --scenarios 'circle/*' --budget 32
-
-The cart (``--sensing``, ``--actuation``, ``--backlash``, as for ``wmr-mj run``) applies to every design: to
-each scenario's run and to the adversary's. A scenario that names its own sensing, actuation or backlash
-(the suite's hardware scenarios) runs with its own: the suite's scenario is the condition compared, the
-option the cart of every other run. An option overrides a design's own ``,sensing=PRESET`` setting.
-"""
+"""``wmr-mj compare DESIGN...``: every design on every scenario of a versioned suite, then the same adversary (what
+a DESIGN may be, and how the cart options apply: the command's help page, :mod:`wmr_mj.cli.parsers.compare`)."""
 
 from __future__ import annotations
 
 import argparse
+import time
+from pathlib import Path
 from typing import Any
 
-from wmr_mj.cli.options import add_argument_with_help_of, add_json, add_out, add_seed, add_threads
-
-#: the command's line in ``wmr-mj --help`` (read without registering the command: wmr_mj/cli/app.py)
-HELP = ("every design on every scenario of a versioned suite, then the same adversary: one table (Markdown, "
-        "CSV, HTML) and a figure")
-
-
-def register(sub: argparse._SubParsersAction) -> None:
-    from wmr_mj.cli._common import CLAIM_BROKEN_EXIT
-
-    p = sub.add_parser("compare", help=HELP,
-                       description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter,
-                       epilog=f"exit status: 0; {CLAIM_BROKEN_EXIT} when a run of a design (a scenario's or the "
-                              "adversary's) is certified-outside: it breaks that design's claim (a banner above "
-                              "the table names the run); 2 bad input")
-    p.add_argument("designs", nargs="+", metavar="DESIGN", help="a preset, a law's name, FILE.py:Class or "
-                                                               "module:Class, with ,key=value settings; or a "
-                                                               "design file FILE.json (wmr-mj design --out)")
-    add_argument_with_help_of(p, "--suite", _suite_help, default="standard-v1")
-    p.add_argument("--scenarios", action="append", metavar="PATTERN",
-                   help="only the scenarios whose id matches (shell pattern, e.g. 'circle/*'; repeatable)")
-    p.add_argument("--budget", type=int, default=32,
-                   help="the adversary's simulations per design, and as many random ones (default 32; 0: none)")
-    add_seed(p, help="the adversary's seed, the same for every design (default 0)")
-    p.add_argument("--method", default=None, help="the adversary's search method (default: falsify's)")
-    add_threads(p, help="threads (default 0: every core)")
-    p.add_argument("--scheduler", metavar="ADDRESS", help="run on a Dask cluster (e.g. tcp://127.0.0.1:8786)")
-    add_out(p, help="output folder (default logs/compare-<time>)")
-    add_json(p, help="print one JSON object")
-    p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
-                   help="progress bar (default: only on a terminal)")
-    from wmr_mj.cli.run import add_hardware_options
-
-    add_hardware_options(p)  # every design's cart: its scenarios (but one that names its own) and its adversary
-    p.set_defaults(func=run)
-
-
-def _suite_help() -> str:
-    from wmr_mj.experiments.suite import suite_names
-
-    return f"the scenario suite: one of {', '.join(suite_names())} or a suite file (.toml)"
+from wmr_mj._util.files import check_output_path
+from wmr_mj._util.progress import counter_callback, progress_bar
+from wmr_mj.cli._common import CLAIM_BROKEN_EXIT, print_json
+from wmr_mj.cli.run import hardware_from_args, with_design_file
+from wmr_mj.errors import ParameterError
+from wmr_mj.experiments.compare import adversary_spec, compare, design_from_token, is_design_file
+from wmr_mj.experiments.suite import load_suite
+from wmr_mj.params import M1_RANGE
+from wmr_mj.report.compare import markdown, write_report
+from wmr_mj.sim.config import RunConfig
 
 
 def _cart_options(args: argparse.Namespace) -> dict:
     """The parts of the cart that --sensing, --actuation, --backlash give (each overrides a design's own
     ``,sensing=...`` setting; a part not given stays the design's)."""
-    from wmr_mj.cli.run import hardware_from_args
-
     parts = hardware_from_args(args)
     given = {"sensing": args.sensing, "actuation": args.actuation, "transmission": args.backlash}
     out = {name: part for name, part in parts.items() if given[name] is not None}
@@ -92,12 +41,6 @@ def design_files_found_on(args: argparse.Namespace) -> dict[str, dict[str, Any]]
     Raises:
         ParameterError: design files found on different carts and no --cart (one line naming them).
     """
-    from wmr_mj.cli.run import with_design_file
-    from wmr_mj.errors import ParameterError
-    from wmr_mj.experiments.compare import is_design_file
-    from wmr_mj.params import M1_RANGE
-    from wmr_mj.sim.config import RunConfig
-
     found: dict[str, dict[str, Any]] = {}
     carts: dict[str, Any] = {}
     for token in args.designs:
@@ -121,17 +64,6 @@ def design_files_found_on(args: argparse.Namespace) -> dict[str, dict[str, Any]]
 
 
 def run(args: argparse.Namespace) -> int:
-    import time
-    from pathlib import Path
-
-    from wmr_mj._util.files import check_output_path
-    from wmr_mj._util.progress import counter_callback, progress_bar
-    from wmr_mj.cli._common import CLAIM_BROKEN_EXIT, print_json
-    from wmr_mj.errors import ParameterError
-    from wmr_mj.experiments.compare import adversary_spec, compare, design_from_token
-    from wmr_mj.experiments.suite import load_suite
-    from wmr_mj.report.compare import markdown, write_report
-
     if args.budget < 0:
         raise ParameterError(f"--budget {args.budget} is not accepted: a number of runs >= 0")
     suite = load_suite(args.suite)

@@ -4,65 +4,34 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import math
+import shlex
+import time
 from typing import Any
 
-from wmr_mj.cli.options import add_json, positive_float, positive_int
-
-#: the command's line in ``wmr-mj --help`` (read without registering the command: wmr_mj/cli/app.py)
-HELP = "the computed-torque (or sliding-mode) gains, sign width, filter and period a given cart certifies"
-
-
-def register(sub: argparse._SubParsersAction) -> None:
-    from wmr_mj.cli.run import add_hardware_options
-    from wmr_mj.params import M1_RANGE
-    from wmr_mj.searches.design_options import DEFAULT_BUDGET, DEFAULT_OBJECTIVE, DEFAULT_SEED, METHODS, OBJECTIVE_WORDS
-
-    p = sub.add_parser(
-        "design", help=HELP,
-        description="A seeded search (CMA-ES or scipy's differential evolution) over omega_n and zeta "
-                    "(K_P = omega_n^2, K_D = 2 zeta omega_n; with --controller sliding-mode: lam, phi, k and eta), the "
-                    "Coulomb sign's smoothing width, the velocity filter's tau_f "
-                    "(where --sensing has velocity=filtered) and the control period (--periods), minimising the "
-                    "certificate a run computes (the worst over --path) subject to every one of its assumptions "
-                    "over the plant box, on the cart (--cart FILE|NAME: its parameters, box, supply and stops; its "
-                    "default sensing, actuation and play unless given). Writes a design file that `wmr-mj run --design "
-                    "FILE` (and sweep, falsify, robustness --certificate; compare FILE.json, validate --design "
-                    "FILE.json) read back as the same design, on the cart it was found on.",
-        epilog="exit status: 0 a certified design found; 1 none certifies (the binding assumption is named); "
-               "2 bad input")
-    add_hardware_options(p)
-    p.add_argument("--controller", default="computed-torque", metavar="LAW",
-                   help="the law searched: computed-torque (default: omega_n, zeta) or sliding-mode (lam, phi, k, eta "
-                        "on the non-holonomic model); both with the sign's width, tau_f and the period")
-    p.add_argument("--path", action="append", metavar="NAME|FILE",
-                   help="a path every certificate must hold on (repeatable; default: the cart's own, [paths] default "
-                        "in its file, else paper-circle)")
-    p.add_argument("--uncertainty", default=None, help="the plant box: m1 (default) or full (wmr_mj/params.py)")
-    p.add_argument("--m1-range", nargs=2, type=float, metavar=("LO", "HI"), default=M1_RANGE,
-                   help="m1 range of the box, kg (default: the cart's m1 box, 550 750 on the C80)")
-    p.add_argument("--range", action="append", metavar="NAME=LO:HI", help="another ranged parameter of the box")
-    p.add_argument("--reference-bounds", metavar="paper|KEY=VALUE,...", default=None,
-                   help="declared reference bounds the certificates cover (default: each path's own)")
-    p.add_argument("--duration", type=positive_float, default=35.0, help="the run's length, s (default 35, run's)")
-    p.add_argument("--periods", default="0.001", metavar="T1,T2,...",
-                   help="control periods to try, s, each a whole number of 1 ms physics steps dividing the run "
-                        "(default 0.001)")
-    p.add_argument("--objective", default=DEFAULT_OBJECTIVE,
-                   help=f"what is minimised (default {DEFAULT_OBJECTIVE}): " + "; ".join(
-                       f"{name}: {words}" for name, words in OBJECTIVE_WORDS.items()).replace("%", "%%"))
-    p.add_argument("--method", default="cma", choices=METHODS,
-                   help="the optimiser: cma (CMA-ES, the default: the better of the two in bench/bench_design.py) "
-                        "or de (scipy's differential evolution)")
-    p.add_argument("--seed", type=int, default=DEFAULT_SEED,
-                   help=f"the optimiser's seed (same seed, same design; default {DEFAULT_SEED})")
-    p.add_argument("--budget", type=positive_int, default=DEFAULT_BUDGET,
-                   help=f"certificate evaluations per period and path, about (default {DEFAULT_BUDGET})")
-    p.add_argument("--check", type=int, default=0, metavar="N",
-                   help="then sweep N runs over the box at the design and count the verdicts (default 0: none)")
-    p.add_argument("--out", default="design.json", metavar="FILE", help="the design file (default design.json)")
-    add_json(p)
-    p.set_defaults(func=run)
+from wmr_mj.analysis.delay_split import covered_split
+from wmr_mj.cli._common import print_json
+from wmr_mj.cli.ranges import box_ranges_from_args
+from wmr_mj.cli.run import hardware_from_args
+from wmr_mj.errors import ParameterError
+from wmr_mj.experiments.sweep import sweep_over_box
+from wmr_mj.params import M1_RANGE
+from wmr_mj.plant.cart_data import identified_from_line
+from wmr_mj.reference.route import path_name
+from wmr_mj.searches.design_search import (
+    DESIGN_FIELDS,
+    OBJECTIVES,
+    DesignProblem,
+    check_periods,
+    law_changes,
+    search_design,
+    uncovered,
+    write_design,
+)
+from wmr_mj.sim.certify import certificate_name
+from wmr_mj.sim.coerce import cart_file_of_record, default_path, default_path_note
+from wmr_mj.sim.config import RunConfig
 
 
 def problem_from_args(args: argparse.Namespace) -> Any:
@@ -72,13 +41,6 @@ def problem_from_args(args: argparse.Namespace) -> Any:
         ParameterError: an empty box, an unknown objective, a period list that is not accepted, a cart no claim
             covers (one line naming the culprit).
     """
-    from wmr_mj.cli._common import box_ranges_from_args
-    from wmr_mj.cli.run import hardware_from_args
-    from wmr_mj.errors import ParameterError
-    from wmr_mj.params import M1_RANGE
-    from wmr_mj.searches.design_search import OBJECTIVES, DesignProblem, check_periods, law_changes, uncovered
-    from wmr_mj.sim.config import RunConfig
-
     law = law_changes(args.controller)
     if args.objective not in OBJECTIVES:
         raise ParameterError(f"--objective {args.objective!r} is not accepted; one of {', '.join(OBJECTIVES)}")
@@ -105,7 +67,6 @@ def problem_from_args(args: argparse.Namespace) -> Any:
     if why_not:
         raise ParameterError(f"{why_not}: no certificate can cover it (--sensing, --actuation, --backlash); a "
                              "bounded error is accepted")
-    from wmr_mj.sim.coerce import cart_file_of_record, default_path
 
     paths = tuple(args.path or (default_path(cart_file_of_record(base.cart)),))  # none given: the cart's own
     return DesignProblem(base=base, paths=paths, periods=periods,
@@ -114,12 +75,6 @@ def problem_from_args(args: argparse.Namespace) -> Any:
 
 
 def run(args: argparse.Namespace) -> int:
-    import time
-
-    from wmr_mj.cli._common import print_json
-    from wmr_mj.errors import ParameterError
-    from wmr_mj.searches.design_search import search_design, write_design
-
     if args.check < 0:
         raise ParameterError(f"--check {args.check} is not accepted; a number of runs >= 0")
     problem = problem_from_args(args)
@@ -144,31 +99,18 @@ def run(args: argparse.Namespace) -> int:
 def check_design(problem: Any, result: Any, n: int) -> dict[str, Any]:
     """A sweep of ``n`` runs over the box (m1 and the --range parameters) at the design, on the first path, with
     the search's seed: its verdict counts."""
-    import dataclasses
-
-    from wmr_mj.experiments.sweep import SweepSpec, SweepSummary, run_sweep
-    from wmr_mj.searches.design_search import DESIGN_FIELDS
-
     base = dataclasses.replace(problem.base, path=problem.paths[0], **{k: result.settings[k] for k in DESIGN_FIELDS})
-    spec = SweepSpec(n=n, seed=problem.seed, sampling="lhs", m1_range=tuple(base.m1_range),
-                     ranges={k: tuple(v) for k, v in base.box_ranges.items()}, base=base)
-    runs = SweepSummary.of(run_sweep(spec), spec.requirements, names=spec.names)
+    runs = sweep_over_box(base, n, seed=problem.seed)
     return {"n": runs.n, "verdicts": dict(runs.verdicts), "path": base.path}
 
 
 def _path_note(args: argparse.Namespace, problem: Any) -> str | None:
     """The line naming the default path derived from the cart's stops where no --path is given
     (:func:`wmr_mj.sim.coerce.default_path_note`); None otherwise."""
-    from wmr_mj.sim.coerce import cart_file_of_record, default_path_note
-
     return None if args.path else default_path_note(cart_file_of_record(problem.base.cart))
 
 
 def _print(result: Any, args: argparse.Namespace, out: dict[str, Any], wall: float) -> None:
-    from wmr_mj.analysis.delay_split import covered_split
-    from wmr_mj.reference.route import path_name
-    from wmr_mj.sim.certify import certificate_name
-
     s = result.settings
     paths = ", ".join(path_name(p) for p in result.paths)
     if "path_note" in out:
@@ -199,8 +141,6 @@ def _print(result: Any, args: argparse.Namespace, out: dict[str, Any], wall: flo
         print(f"check: {c['n']} runs over the box on {path_name(c['path'])}: "
               + ", ".join(f"{v} {n}" for v, n in c["verdicts"].items()))
     if result.cart is not None:  # a cart identified from recordings: the data the design rests on
-        from wmr_mj.plant.cart_data import identified_from_line
-
         rests_on = identified_from_line(str(result.cart.get("text", "")), str(result.cart.get("path", "")))
         if rests_on is not None:
             print(rests_on)
@@ -210,10 +150,6 @@ def _print(result: Any, args: argparse.Namespace, out: dict[str, Any], wall: flo
 def run_line(args: argparse.Namespace) -> str:
     """The ``wmr-mj run`` line of the design on its first path: the file, and the box and run options the
     design was certified for where they are not run's defaults (the file holds the law and the cart only)."""
-    import shlex
-
-    from wmr_mj.params import M1_RANGE
-
     words = ["wmr-mj", "run", "--design", shlex.quote(str(args.out))]
     if getattr(args, "cart", None) is not None:
         words += ["--cart", shlex.quote(str(args.cart))]

@@ -3,33 +3,17 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
-from wmr_mj.cli._common import positive_float
-from wmr_mj.cli.options import add_seed
-
-#: the command's line in ``wmr-mj --help`` (read without registering the command: wmr_mj/cli/app.py)
-HELP = "write an excitation plan (target angle + voltage dither) for identify --data"
-
-
-def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("excite", help=HELP)
-    p.add_argument("--cart", default="c80", help="the cart file (or a shipped cart's name), default c80")
-    p.add_argument("--duration", type=positive_float, default=60.0, help="plan length, s (default 60)")
-    p.add_argument("--out", required=True, metavar="PLAN.csv", help="the plan: t_s,alpha0_rad,u_dither_V")
-    add_seed(p, help="seed of the multisines (default 0)")
-    p.set_defaults(func=run)
+from wmr_mj._util.files import check_output_path
+from wmr_mj.carts import load_cart
+from wmr_mj.hardware.sensing import Sensing
+from wmr_mj.params import parameters_of_cart
+from wmr_mj.plant.excite import excitation_plan, plan_csv, preview
+from wmr_mj.plant.output_error import POORLY_DETERMINED
 
 
 def run(args: argparse.Namespace) -> int:
-    from pathlib import Path
-
-    from wmr_mj._util.files import check_output_path
-    from wmr_mj.carts import load_cart
-    from wmr_mj.hardware.sensing import Sensing
-    from wmr_mj.params import parameters_of_cart
-    from wmr_mj.plant.excite import excitation_plan, plan_csv, preview
-    from wmr_mj.plant.output_error import POORLY_DETERMINED
-
     out = check_output_path(args.out, kind="file", option="--out")
     cart = load_cart(args.cart)
     params = parameters_of_cart(cart)

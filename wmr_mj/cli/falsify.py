@@ -3,11 +3,46 @@
 from __future__ import annotations
 
 import argparse
+import csv
+import io
 import json
-from typing import TYPE_CHECKING
+import sys
+import time
+from typing import TYPE_CHECKING, Any
 
-from wmr_mj.cli._common import positive_int
-from wmr_mj.cli.options import add_json, add_out, add_seed, add_threads
+from wmr_mj._util.files import check_output_path, write_json_atomic, write_text_atomic
+from wmr_mj._util.progress import counter_callback, progress_bar
+from wmr_mj.analysis.verdicts import certified_outside_banner, format_unmet
+from wmr_mj.cli._common import CLAIM_BROKEN_EXIT, print_json
+from wmr_mj.cli.ranges import box_ranges_from_args, command_ranges
+from wmr_mj.cli.run import config_from_args, with_design_file
+from wmr_mj.cli.run_options import Replay, run_options
+from wmr_mj.cli.sweep import fixed_m1_from_args
+from wmr_mj.errors import ParameterError, UnknownNameError
+from wmr_mj.figures.plots import falsify_history, save_figure
+from wmr_mj.hardware import cart_dict, cart_line, is_ideal_cart
+from wmr_mj.logs.writer import run_logged
+from wmr_mj.reference.knots import KnotSpace
+from wmr_mj.searches.falsify import (
+    PORTFOLIO_COORDINATE_STEP,
+    FalsifySpec,
+    check_objective_applies,
+    check_objective_defined,
+    check_runnable,
+    falsify,
+    portfolio_coordinate_runs,
+    portfolio_global_runs,
+    portfolio_local_phase,
+    portfolio_phases,
+    portfolio_start,
+    undefined_objective_warning,
+    worst_config,
+)
+from wmr_mj.searches.search_space import hardware_axis, path_axis
+from wmr_mj.sim.coerce import coerced
+from wmr_mj.sim.config import base_for, controller_and_settings, estimate_parameters
+from wmr_mj.sim.many_runs import csv_number
+from wmr_mj.sim.run_report import add_controller_source
 
 if TYPE_CHECKING:
     from wmr_mj.searches.falsify import FalsifyResult
@@ -16,70 +51,7 @@ _AGAINST = ("certificate", "paper")
 _OBJECTIVE_KINDS = ("ratio", "sup-E")
 
 
-#: the command's line in ``wmr-mj --help`` (read without registering the command: wmr_mj/cli/app.py)
-HELP = ("worst-case search over the uncertainty box (its vertices, then CMA-ES; or a local polish, or "
-        "differential evolution) on mujoco.batch, beside the same budget spent at random")
-
-
-def register(sub: argparse._SubParsersAction) -> None:
-    from wmr_mj.cli._common import CLAIM_BROKEN_EXIT
-    from wmr_mj.cli.run import add_run_options, add_signal_options
-
-    p = sub.add_parser("falsify", help=HELP,
-                       epilog=f"exit status: 0 nothing falsified; {CLAIM_BROKEN_EXIT} falsified: a run of the search "
-                              "or of the random sample is certified-outside (it breaks the law's claim), or the "
-                              "--require is falsified; 1 the serial re-run of the worst run did not reproduce it; "
-                              "2 bad input")
-    from wmr_mj.cli.sweep import add_fixed_m1_option
-
-    add_run_options(p)
-    add_fixed_m1_option(p)
-    p.add_argument("--range", action="append", metavar="NAME=LO:HI",
-                   help="add a plant parameter to the box or replace its range (repeatable); with --disturbance "
-                        "or --load, also their parameters: disturbance.amplitude, disturbance.t1, ..., load0.m1, "
-                        "load0.t, ..., d_max (a ranged amplitude without --d-max declares the box's largest); "
-                        "and the cart's axes, searched but not in the certificate's box (each run's claim covers its "
-                        "own cart): sensing.delay (whole control periods), sensing.encoder_ticks (whole ticks), "
-                        "sensing.encoder_bits (2**round(bits) ticks), sensing.noise, "
-                        "sensing.velocity_noise, sensing.filter_tau, actuation.delay (whole 1 ms steps), "
-                        "actuation.inductance, actuation.current_limit, transmission.backlash")
-    p.add_argument("--path-knots", type=int, default=0, metavar="N",
-                   help="search C's path too: N curvature knots (path.k1..path.kN, each within +-kappa_max of the "
-                        "declared reference bounds) and the hold time at each (path.hold, 0-3 s), every path "
-                        "feasible for those bounds (wmr_mj/reference/knots.py); declares --reference-bounds paper "
-                        "unless given (default 0: the --path given)")
-    p.add_argument("--against", default="certificate",
-                   help="the region of the ratio sup|E|/E_max: certificate (default) or paper (the paper's region)")
-    p.add_argument("--objective", default="ratio", help="what is maximised: ratio (default, see --against) or sup-E")
-    p.add_argument("--method", default="portfolio",
-                   help="search: portfolio (default: the box's 2^d vertices where they fit half the budget, else a "
-                        "fractional-factorial covering of at most an eighth of it, then CMA-ES from the box's centre "
-                        "moved to the worse side of significant main effects, a generation per batch, then a local "
-                        "CMA-ES around the worst found), cma (CMA-ES alone), vertices-polish (the vertices, then "
-                        "scipy's Nelder-Mead from the worst), lhs-polish (a Latin hypercube of half the budget, then "
-                        "the same polish) or de (differential evolution)")
-    p.add_argument("--require", metavar="STL",
-                   help="falsify an STL requirement (e.g. 'always(abs(E) <= 0.05)', signals as for wmr-mj run "
-                        "--require): maximise minus its robustness (> 0: falsified); runs one by one, the batch "
-                        "keeps no per-step signals")
-    p.add_argument("--budget", type=positive_int, default=256,
-                   help="simulations of the search (default 256); the random sample gets as many")
-    p.add_argument("--population", type=int, default=None,
-                   help="members per generation: CMA-ES's (default 4 + 3 ln d) or differential evolution's "
-                        "(default: 10 per parameter, at most budget/8, at least 5)")
-    add_seed(p, help="seed of the search and of the random sample (default 0)")
-    p.add_argument("--chunk", type=positive_int, default=128, help="simulations per batch (default 128)")
-    add_threads(p, help="threads of the batch (default 0: all cores)")
-    p.add_argument("--scheduler", metavar="ADDRESS", help="run the batches on a Dask cluster (e.g. tcp://127.0.0.1:8786)")
-    add_out(p, help="output folder (default logs/falsify-<time>)")
-    add_json(p, help="print one JSON object")
-    add_signal_options(p)
-    p.set_defaults(func=run)
-
-
 def _objective(args: argparse.Namespace) -> str:
-    from wmr_mj.errors import UnknownNameError
-
     if args.objective not in _OBJECTIVE_KINDS:
         raise UnknownNameError("objective", args.objective, _OBJECTIVE_KINDS)
     if args.against not in _AGAINST:
@@ -93,15 +65,11 @@ def reproduce_command(config, params: dict[str, float], args: argparse.Namespace
                       signals_file: str | None = None, path_file: str | None = None,
                       law_settings: frozenset[str] | None = None) -> str:
     """A ``wmr-mj run`` line that repeats the worst run ``config``, written by the table of run options
-    (:func:`wmr_mj.cli.run_options.command_line`: each option writes back the field it sets, parameters at full
+    (:func:`command_line`: each option writes back the field it sets, parameters at full
     precision; its signals, when it has some, from ``signals_file``, and its searched path from ``path_file``,
     where they were written exactly). ``params``: the worst run's searched values (already in ``config``)."""
-    from wmr_mj.cli.run_options import Replay, command_line
-
     read = law_settings  # only the settings the law reads: the resolved run's (RunParts.law_settings)
     if read is None:
-        from wmr_mj.sim.config import controller_and_settings, estimate_parameters
-
         read = controller_and_settings(config, estimate_parameters())[1]
     require = getattr(args, "require", None) or ()
     return command_line(config, Replay(preset=args.preset, law_settings=frozenset(read), path_file=path_file,
@@ -109,25 +77,21 @@ def reproduce_command(config, params: dict[str, float], args: argparse.Namespace
                                        require=(require,) if isinstance(require, str) else tuple(require)))
 
 
+def command_line(config: Any, replay: Replay, *, command: str = "wmr-mj run") -> str:
+    """The ``wmr-mj run`` line that builds ``config`` again: each row of the table writes its own field.
+
+    Args:
+        config: the run's RunConfig (a direct one is coerced first: its defaults resolved, as the run resolves them).
+        replay: what the config does not record (:class:`Replay`).
+    """
+    config = coerced(config)
+    return " ".join([command, *(w for row in run_options() for w in row.write(config, replay))])
+
+
 def _portfolio_phases_text(spec, first, population: int) -> str:
     """What the portfolio did after its vertices: where CMA-ES started (the screening), its global and local
     phases, and (from 200 runs) the coordinate moves that end it."""
-    import numpy as np
-
-    from wmr_mj.searches.falsify import (
-        PORTFOLIO_COORDINATE_STEP,
-        portfolio_coordinate_runs,
-        portfolio_global_runs,
-        portfolio_local_phase,
-        portfolio_phases,
-        screened_start,
-    )
-
-    lo, hi = spec.bounds[:, 0], spec.bounds[:, 1]
-    corners = np.array([e.point or [e.params[n] for n in spec.names] for e in first])  # as searched, unrounded
-    corners = np.where(hi > lo, (corners - lo) / np.where(hi > lo, hi - lo, 1.0), 0.0)
-    values = np.array([np.nan if e.objective is None else e.objective for e in first])
-    start = screened_start(corners, values)
+    start = portfolio_start(spec, first)
     moved = [f"{'up' if u > 0.5 else 'down'} in {n}" for n, u in zip(spec.names, start) if u != 0.5]
     _, global_runs, local_runs = portfolio_phases(len(spec.names), spec.budget, population)
     where = "the box's centre" + (f" moved {', '.join(moved)} (the vertices' main effects)" if moved else "")
@@ -151,26 +115,16 @@ def _base_and_box(args: argparse.Namespace):
     Raises:
         ParameterError: a bad --path-knots or range (one line).
     """
-    from wmr_mj.cli._common import box_ranges_from_args
-    from wmr_mj.cli.options import command_ranges
-    from wmr_mj.cli.run import config_from_args
-    from wmr_mj.errors import ParameterError
-    from wmr_mj.searches.search_space import path_axis
-
     searched = command_ranges(args, "falsify").searched  # the one rule of --range; the plant's go to the box
     if args.path_knots < 0:
         raise ParameterError(f"--path-knots {args.path_knots} is not accepted: a number of knots >= 0")
     if (args.path_knots or any(path_axis(n) for n in searched)) and args.reference_bounds is None:
         args.reference_bounds = "paper"  # every searched path within the bounds its certificate declares
-    from wmr_mj.cli.sweep import fixed_m1_from_args
 
     fixed_m1 = fixed_m1_from_args(args)  # --m1 or a zero-width --m1-range: m1 not searched
     base = config_from_args(args) if fixed_m1 is None else config_from_args(args, m1=fixed_m1)
     if args.path_knots:
-        from wmr_mj.reference.knots import KnotSpace
-
         space = KnotSpace(args.path_knots, hold_range=(0.0, 3.0))
-        from wmr_mj.sim.config import base_for
 
         searched = {**space.ranges(base.reference_bounds, base_for(base)), **searched}  # the cart's l1 and stops
     box = {**({"m1": tuple(args.m1_range)} if fixed_m1 is None else {}), **box_ranges_from_args(args), **searched}
@@ -178,25 +132,8 @@ def _base_and_box(args: argparse.Namespace):
 
 
 def run(args: argparse.Namespace) -> int:
-    import sys
-    import time
-
-    from wmr_mj._util.files import check_output_path, write_text_atomic
-    from wmr_mj._util.progress import counter_callback, progress_bar
-    from wmr_mj.cli._common import print_json
-    from wmr_mj.searches.falsify import (
-        FalsifySpec,
-        check_objective_applies,
-        check_objective_defined,
-        check_runnable,
-        falsify,
-        undefined_objective_warning,
-    )
-
     objective = _objective(args)
     if args.design is not None:  # the design's box before falsify's own default (the full box)
-        from wmr_mj.cli.run import with_design_file
-
         with_design_file(args)
     args.uncertainty = args.uncertainty or "full"
     base, box = _base_and_box(args)
@@ -226,13 +163,6 @@ def _write_outputs(result, base, args: argparse.Namespace, out, *, law_settings)
     """Re-run the worst run serially with its MCAP log, write the search's files (falsify.json, evaluations.csv,
     the history plot, the worst run's signals and searched path where it has them): (the JSON, the re-run's
     sup|E| [rad]). ``base``: the command's base run (its controller, cart, path and reference bounds)."""
-    from wmr_mj._util.files import write_json_atomic, write_text_atomic
-    from wmr_mj.figures.plots import falsify_history, save_figure
-    from wmr_mj.hardware import cart_dict
-    from wmr_mj.logs.writer import run_logged
-    from wmr_mj.searches.falsify import worst_config
-    from wmr_mj.sim.run_report import add_controller_source
-
     worst, log_path = result.worst, out / "worst.mcap"
     config = worst_config(result)
     logged = run_logged(config, str(log_path))
@@ -268,8 +198,6 @@ def _write_outputs(result, base, args: argparse.Namespace, out, *, law_settings)
 def _print_text(result, base, summary: dict, args: argparse.Namespace, logged_sup_E: float) -> None:
     """falsify's printout: how the search ran, the worst of the search and of the random sample, the claim,
     the worst run's certificate (E_max, the largest term of delta1) and tightness, its parameters and files."""
-    from wmr_mj.searches.falsify import worst_config
-
     spec, worst = result.spec, result.worst
     names, how = ", ".join(spec.names), _how_text(spec, result)
     print(f"worst-case search over {len(spec.names)} parameter(s) ({names}; box {args.uncertainty}): {how}, "
@@ -322,9 +250,6 @@ def certificate_line(result: FalsifyResult) -> str | None:
 def _print_cart(base, worst, names) -> None:
     """The cart's line where it is not ideal or is searched: the base's, and the worst run's (its hardware axes
     rounded as the run had them)."""
-    from wmr_mj.hardware import cart_line, is_ideal_cart
-    from wmr_mj.searches.search_space import hardware_axis
-
     searched = [n for n in names if hardware_axis(n)]
     if not is_ideal_cart(base) and not searched:
         print(cart_line(base))
@@ -364,8 +289,6 @@ def exit_status(summary: dict) -> int:
     """falsify's exit status from its JSON: 1 when the serial re-run did not reproduce the worst run (its
     numbers cannot be trusted), else CLAIM_BROKEN_EXIT when it falsified (a claim broken or the
     requirement falsified), else 0."""
-    from wmr_mj.cli._common import CLAIM_BROKEN_EXIT
-
     if not summary["reproduced"]:
         return 1
     return CLAIM_BROKEN_EXIT if summary["falsified"] else 0
@@ -374,8 +297,6 @@ def exit_status(summary: dict) -> int:
 def claim_lines(result: FalsifyResult) -> list[str]:
     """Beside the verdict: the banner and the run that broke the claim (where one did), and the worst
     run's unmet assumptions (name, value vs limit)."""
-    from wmr_mj.analysis.verdicts import certified_outside_banner, format_unmet
-
     lines = []
     broken = result.claim_broken
     if broken is not None:
@@ -393,11 +314,6 @@ def claim_lines(result: FalsifyResult) -> list[str]:
 def _table(result) -> str:
     """evaluations.csv: every run of both phases, each parameter as its run used it (a hardware axis rounded as
     the run had it), numbers to 12 significant digits (falsify.json keeps every bit)."""
-    import csv
-    import io
-
-    from wmr_mj.sim.many_runs import csv_number
-
     names = list(result.spec.names)
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")

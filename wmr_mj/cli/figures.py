@@ -1,42 +1,17 @@
-"""``wmr-mj figures``: the paper's Figs. 4-7 regenerated headless as PNG and SVG.
-
-Fig. 4 desired trajectory (paths of A and C), Fig. 5 alpha0(t), Fig. 6
-alpha0'(t) and alpha0''(t), Fig. 7 the region (4.21)-(4.23) of the (5.1) example
-with the error trajectories of the paper's view (reduced paper model as the
-plant) and of the MuJoCo plant. See :mod:`wmr_mj.figures.plots`.
-"""
+"""``wmr-mj figures``: the paper's Figs. 4-7 regenerated headless as PNG and SVG (which figures: the command's help
+page, :mod:`wmr_mj.cli.parsers.figures`; the drawing: :mod:`wmr_mj.figures.plots`)."""
 
 from __future__ import annotations
 
 import argparse
 
-from wmr_mj.cli._common import positive_float
-from wmr_mj.cli.options import add_out
-
-#: the command's line in ``wmr-mj --help`` (read without registering the command: wmr_mj/cli/app.py)
-HELP = "regenerate the paper's Figs. 4-7 (PNG and SVG, headless)"
-
-
-def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("figures", help=HELP,
-                       description=__doc__.split("\n\n")[1] if __doc__ else None)
-    add_out(p, help="output folder (default logs/figures-<timestamp>/)")
-    p.add_argument("--duration", type=positive_float, default=35.0,
-                   help="length of the paper circle run, s (default 35; >= ~10 s reaches the circle)")
-    p.set_defaults(func=run)
-
-
-def default_folder(prefix: str) -> str:
-    import time
-
-    return f"logs/{prefix}-{time.strftime('%Y%m%d-%H%M%S')}"
+from wmr_mj._util.files import check_output_path
+from wmr_mj.cli._common import default_folder
+from wmr_mj.figures.plots import paper_figures, write_figures
+from wmr_mj.report.paper_example import paper_example
 
 
 def run(args: argparse.Namespace) -> int:
-    from wmr_mj._util.files import check_output_path
-    from wmr_mj.figures.plots import paper_figures, write_figures
-    from wmr_mj.report.paper_example import paper_example
-
     out = check_output_path(args.out or default_folder("figures"), kind="dir", option="--out")
     example = paper_example(duration=args.duration)
     paths = write_figures(paper_figures(example), out)

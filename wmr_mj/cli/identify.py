@@ -10,64 +10,31 @@ With ``--data FILE[:m1=KG]`` (repeatable): output-error identification from the 
 from __future__ import annotations
 
 import argparse
+import datetime
+import sys
+from pathlib import Path
+from typing import Any
 
-from wmr_mj.cli._common import parse_assignments, positive_float
-from wmr_mj.cli.options import add_json, add_out, add_seed
-from wmr_mj.params import M1_NOMINAL
-
-#: the command's line in ``wmr-mj --help`` (read without registering the command: wmr_mj/cli/app.py)
-HELP = ("fit the steering model: the simulated plant excited (P, C_V, F, K, gyro by least squares), or a cart's "
-        "recordings (--data) into a cart file with intervals")
-
-
-def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("identify", help=HELP)
-    p.add_argument("--m1", type=positive_float, default=M1_NOMINAL,
-                   help="chassis mass of the plant, kg (default: the cart's, 650 on the C80)")
-    p.add_argument("--duration", type=positive_float, default=60.0, help="excitation length, s (default 60)")
-    add_seed(p, help="seed of the excitation signal (default 0)")
-    p.add_argument("--param", action="append", metavar="NAME=VALUE", help="override a plant parameter (repeatable)")
-    add_out(p, metavar="PATH", help="also write the result as JSON (used by --model identified); with --data: the "
-            "identified cart file NEW.toml")
-    p.add_argument("--data", action="append", metavar="FILE[:m1=KG]",
-                   help="a recording of the cart (CSV with the header t_s,u_V,alpha_rad[,speed_m_per_s], or a "
-                        "wmr-mj run's MCAP log); :m1= gives the chassis mass during it (default: the cart's); "
-                        "repeatable. Identifies P, C_V, F (as front_axle_mass, k_i = k_b, mu), the delay, the "
-                        "encoder and the noise, and writes --out NEW.toml")
-    p.add_argument("--holdout", metavar="FILE[:m1=KG]",
-                   help="a recording the fit never sees: the identified model must predict it (normalised RMS error "
-                        "at most 0.1, else exit 1)")
-    p.add_argument("--report", metavar="DIR",
-                   help="with --data: write identify.html and identify.png (recorded against simulated angle on the "
-                        "hold-out, or the first recording; residuals; the table of intervals) into DIR")
-    p.add_argument("--topics", metavar="u=/T,alpha=/T[,speed=/T]",
-                   help="with --data BAG.mcap: a ROS 2 bag's topics of the voltage, the angle and the speed (a topic "
-                        "with .field or .field[i]; default field data), read through mcap-ros2-support")
-    p.add_argument("--columns", metavar="KEY=NAME,...",
-                   help="CSV column names of another header: t_s=...,u_V=...,alpha_rad=...,speed_m_per_s=...")
-    p.add_argument("--sysid", action="store_true",
-                   help="with --data: also roll out the identified cart file's MJCF with mujoco.sysid on each segment "
-                        "of the hold-out (else of each recording) against the recorded angle and report its normalised "
-                        "RMS error (the hold-out's limit applies); needs the sysid extra: pip install 'wmr-mj[sysid]'")
-    add_json(p, help="print one JSON object")
-    from wmr_mj.cli.run_options import add_option
-
-    add_option(p, "--cart")
-    p.set_defaults(func=run)
+from wmr_mj._util.files import check_output_path, write_json_atomic
+from wmr_mj.carts import load_cart, load_cart_text
+from wmr_mj.cli._common import parse_assignments, print_json
+from wmr_mj.cli.ranges import cart_parameters
+from wmr_mj.errors import ParameterError
+from wmr_mj.logs.recordings import parse_topics, read_ros2_bag, read_run_log
+from wmr_mj.params import COEFFICIENT_MODELS, COEFFICIENT_NAMES, M1_NOMINAL, parameters_of_cart, with_params
+from wmr_mj.plant.identified_cart import identified_cart_text
+from wmr_mj.plant.identify import identify_plant
+from wmr_mj.plant.mjcf_rollouts import import_sysid, mjcf_rollout_nrmse
+from wmr_mj.plant.output_error import HOLDOUT_NRMSE_MAX, POORLY_DETERMINED, fit_recordings, holdout_error
+from wmr_mj.plant.recordings import check_recording, parse_columns, read_csv
+from wmr_mj.report.identify import IdentifyReport
+from wmr_mj.sim.config import check_motor_constant
 
 
 def run(args: argparse.Namespace) -> int:
-    from wmr_mj._util.files import check_output_path, write_json_atomic
-    from wmr_mj.cli._common import print_json
-    from wmr_mj.cli.options import cart_parameters
-    from wmr_mj.params import COEFFICIENT_MODELS, COEFFICIENT_NAMES, with_params
-    from wmr_mj.plant.identify import identify_plant
-
     if args.data:
         return run_data(args)
     if args.holdout or args.columns or args.report or args.topics or args.sysid:
-        from wmr_mj.errors import ParameterError
-
         raise ParameterError("--holdout, --columns, --topics, --report and --sysid need --data (recordings of the cart "
                              "to identify from)")
     if args.out:  # before the identification, which takes a while
@@ -77,8 +44,6 @@ def run(args: argparse.Namespace) -> int:
     overrides = parse_assignments(args.param)
     params = with_params(base, m1=m1, **overrides)
     if "k_i" in overrides or "k_b" in overrides:
-        from wmr_mj.sim.config import check_motor_constant
-
         check_motor_constant(params.k_i, params.k_b)
     result = identify_plant(params, duration=args.duration, seed=args.seed)
     obj = result.to_dict()
@@ -119,8 +84,6 @@ _SPLIT_NOTES = {
 
 def _split_data(item: str) -> tuple[str, float | None]:
     """'FILE[:m1=KG]' -> (FILE, KG or None)."""
-    from wmr_mj.errors import ParameterError
-
     path, sep, rest = item.rpartition(":m1=")
     if not sep:
         return item, None
@@ -132,16 +95,10 @@ def _split_data(item: str) -> tuple[str, float | None]:
 
 
 def _read_recording(item: str, columns: dict[str, str], params, topics: dict[str, str] | None = None):
-    from wmr_mj.plant.recordings import check_recording, read_csv
-
     path, m1 = _split_data(item)
     if topics:
-        from wmr_mj.logs.recordings import read_ros2_bag
-
         rec = read_ros2_bag(path, topics, m1=m1)
     elif path.endswith(".mcap"):
-        from wmr_mj.logs.recordings import read_run_log
-
         rec = read_run_log(path, m1=m1)
     else:
         rec = read_csv(path, m1=m1, columns=columns)
@@ -151,36 +108,10 @@ def _read_recording(item: str, columns: dict[str, str], params, topics: dict[str
 
 def run_data(args: argparse.Namespace) -> int:
     """``identify --data``: recordings -> NEW.toml, intervals, the hold-out's check."""
-    import datetime
-    import sys
-    from pathlib import Path
-
-    from wmr_mj._util.files import check_output_path
-    from wmr_mj.carts import load_cart
-    from wmr_mj.cli._common import print_json
-    from wmr_mj.errors import ParameterError
-    from wmr_mj.params import parameters_of_cart
-    from wmr_mj.plant.identified_cart import identified_cart_text
-    from wmr_mj.plant.output_error import HOLDOUT_NRMSE_MAX, fit_recordings, holdout_error
-    from wmr_mj.plant.recordings import parse_columns
-
-    if not args.out:
-        raise ParameterError("identify --data needs --out NEW.toml: the identified cart file")
-    if args.sysid:  # asked for: the extra must be there before any work (one line naming it, exit 2)
-        from wmr_mj.plant.mjcf_rollouts import import_sysid
-
-        import_sysid()
-    out = check_output_path(args.out, kind="file", option="--out")
-    if args.report:
-        check_output_path(args.report, kind="dir", option="--report")
+    out = _checked_data_outputs(args)
     start = load_cart(args.cart or "c80")
     params = parameters_of_cart(start)
-    columns = parse_columns(args.columns)
-    from wmr_mj.logs.recordings import parse_topics
-
-    topics = parse_topics(args.topics) if args.topics else None
-    recordings = [_read_recording(item, columns, params, topics) for item in args.data]
-    holdout = _read_recording(args.holdout, columns, params, topics) if args.holdout else None
+    recordings, holdout = _recordings_of(args, params)
     fit = fit_recordings(recordings, params, seed=args.seed)
     date = datetime.datetime.now(datetime.UTC).date().isoformat()
     command = "wmr-mj identify " + " ".join(sys.argv[2:]) if len(sys.argv) > 2 else "wmr-mj identify"
@@ -189,15 +120,56 @@ def run_data(args: argparse.Namespace) -> int:
     nrmse = holdout_error(fit, holdout, params) if holdout is not None else None
     report_files: list[str] = []
     if args.report:
-        from wmr_mj.report.identify import IdentifyReport
-
         report = IdentifyReport.of(fit, recordings, params, holdout=holdout)
         report_files = [str(p) for p in report.write(args.report)]
     rollouts = _mjcf_rollouts(text, holdout, recordings, fit) if args.sysid else None
     failed = nrmse is not None and not nrmse <= HOLDOUT_NRMSE_MAX
     if rollouts is not None and holdout is not None:
         failed = failed or not rollouts[holdout.name] <= HOLDOUT_NRMSE_MAX
-    obj = {
+    if args.json:
+        print_json(_data_json(fit, recordings, holdout, nrmse, failed, out=out, report_files=report_files,
+                              rollouts=rollouts))
+    else:
+        _print_fit(fit, recordings, holdout, nrmse, out)
+        for name, value in (rollouts or {}).items():
+            print(f"MuJoCo rollouts of {out}'s MJCF (mujoco.sysid) on {name}: normalised RMS error {value:.3g}")
+        for path in report_files:
+            print(f"wrote {path}")
+    if failed and holdout is not None:
+        worst = max(v for v in (nrmse, (rollouts or {}).get(holdout.name)) if v is not None)
+        print(f"hold-out {holdout.name}: the identified model does not predict it: normalised RMS error {worst:.3g} "
+              f"above {HOLDOUT_NRMSE_MAX:g}", file=sys.stderr)
+        return 1
+    return 0
+
+
+def _checked_data_outputs(args: argparse.Namespace) -> Path:
+    """``identify --data``'s --out (the cart file to write), checked with --report's folder and the sysid extra
+    before any work (one line each, exit status 2)."""
+    if not args.out:
+        raise ParameterError("identify --data needs --out NEW.toml: the identified cart file")
+    if args.sysid:  # asked for: the extra must be there before any work (one line naming it, exit 2)
+        import_sysid()
+    out = check_output_path(args.out, kind="file", option="--out")
+    if args.report:
+        check_output_path(args.report, kind="dir", option="--report")
+    return out
+
+
+def _recordings_of(args: argparse.Namespace, params) -> tuple[list, Any]:
+    """The --data recordings and the --holdout one (None where not given), each read and checked."""
+    columns = parse_columns(args.columns)
+    topics = parse_topics(args.topics) if args.topics else None
+    recordings = [_read_recording(item, columns, params, topics) for item in args.data]
+    holdout = _read_recording(args.holdout, columns, params, topics) if args.holdout else None
+    return recordings, holdout
+
+
+def _data_json(fit, recordings, holdout, nrmse, failed: bool, *, out, report_files: list[str],
+               rollouts: dict[str, float] | None) -> dict[str, Any]:
+    """``identify --data --json``: the fit's intervals, the delay, the encoder and the noise, the recordings it rests
+    on, the hold-out's check and the files written."""
+    return {
         "coefficients": {k: v.to_dict() for k, v in fit.coefficients.items()},
         "fixed_from_structure": {"K": "0: absent from the plant (non-holonomic model)",
                                  "gyro": "P / l1: moves with C_V at constant speed, not separable"},
@@ -219,29 +191,11 @@ def run_data(args: argparse.Namespace) -> int:
         "report": report_files,
         **({} if rollouts is None else {"mjcf_rollouts": {"nrmse": rollouts, "nrmse_max": HOLDOUT_NRMSE_MAX}}),
     }
-    if args.json:
-        print_json(obj)
-    else:
-        _print_fit(fit, recordings, holdout, nrmse, out)
-        for name, value in (rollouts or {}).items():
-            print(f"MuJoCo rollouts of {out}'s MJCF (mujoco.sysid) on {name}: normalised RMS error {value:.3g}")
-        for path in report_files:
-            print(f"wrote {path}")
-    if failed and holdout is not None:
-        worst = max(v for v in (nrmse, (rollouts or {}).get(holdout.name)) if v is not None)
-        print(f"hold-out {holdout.name}: the identified model does not predict it: normalised RMS error {worst:.3g} "
-              f"above {HOLDOUT_NRMSE_MAX:g}", file=sys.stderr)
-        return 1
-    return 0
 
 
 def _mjcf_rollouts(text, holdout, recordings, fit) -> dict[str, float]:
     """File -> the normalised RMS error of the identified cart file's MJCF rolled out by mujoco.sysid on the
     hold-out (else on each recording), at its m1 (wmr_mj.plant.mjcf_rollouts)."""
-    from wmr_mj.carts import load_cart_text
-    from wmr_mj.params import parameters_of_cart
-    from wmr_mj.plant.mjcf_rollouts import mjcf_rollout_nrmse
-
     identified = parameters_of_cart(load_cart_text(text, path="<identified cart>"))
     targets = [(holdout, holdout.m1)] if holdout is not None else list(zip(recordings, fit.m1))
     return {rec.name: mjcf_rollout_nrmse(identified, [rec], delay_steps=fit.delay_steps, m1=m1)
@@ -268,7 +222,6 @@ def _print_fit(fit, recordings, holdout, nrmse, out) -> None:
     enc = ("not readable (the angle is not on one grid)" if fit.encoder_ticks is None
            else f"{fit.encoder_ticks} ticks/rev")
     print(f"encoder: {enc}; noise beyond the quantisation: {fit.noise_rad:.3g} rad")
-    from wmr_mj.plant.output_error import POORLY_DETERMINED
 
     wide = [n for n, iv in fit.physical.items() if iv.relative_half_width > POORLY_DETERMINED]
     if wide:

@@ -6,45 +6,34 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from wmr_mj.cli.options import add_json
-
-#: the command's line in ``wmr-mj --help`` (read without registering the command: wmr_mj/cli/app.py)
-HELP = "write/check the MJCF files generated from the C80 parameter set"
-
-
-def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("model", help=HELP)
-    p.add_argument("action", choices=("write", "check", "params", "slip", "friction", "card", "image"),
-                   help="write: regenerate models/*.xml; check: exit 1 if they differ from the parameter set; "
-                        "params: print the parameter set with sources and the derived coefficients; "
-                        "slip: measure the wheels' side slip on the 1 m circle; friction: measure the steering "
-                        "joint's friction law (break-away, creep, sliding) for each friction model; "
-                        "card: write models/README.md; image: render models/c80.png (the scene at its home "
-                        "keyframe, offscreen: EGL or OSMesa)")
-    p.add_argument("--param", action="append", metavar="NAME=VALUE", help="override a parameter (repeatable)")
-    add_json(p, help="with 'params', 'slip' or 'friction': print one JSON object")
-    from wmr_mj.cli.run_options import add_option
-
-    add_option(p, "--cart")  # params, slip, friction on the cart (its card: wmr-mj cart card FILE)
-    p.set_defaults(func=run)
+from wmr_mj._util.files import write_text_atomic
+from wmr_mj._util.resources import MODELS_IN_CHECKOUT
+from wmr_mj.carts import load_cart
+from wmr_mj.cli._common import parse_assignments, print_json
+from wmr_mj.cli.ranges import cart_parameters
+from wmr_mj.errors import ParameterError
+from wmr_mj.params import COEFFICIENT_NAMES, PARAMETER_SOURCES, with_params
+from wmr_mj.plant.friction import measure_friction_law
+from wmr_mj.plant.image import write_model_image
+from wmr_mj.plant.mjcf import (
+    MODELS_DIR,
+    STEERING_FRICTION_MODELS,
+    measure_side_slip,
+    robot_xml,
+    scene_file_xml,
+    write_model_files,
+)
+from wmr_mj.plant.modelcard import render_model_card
+from wmr_mj.sim.config import check_motor_constant
 
 
 def run(args: argparse.Namespace) -> int:
-    from wmr_mj.cli._common import parse_assignments
-    from wmr_mj.cli.options import cart_parameters
-    from wmr_mj.params import with_params
-    from wmr_mj.plant.mjcf import write_model_files
-
     if getattr(args, "cart", None) is not None and args.action in ("write", "check", "card", "image"):
-        from wmr_mj.errors import ParameterError
-
         raise ParameterError(f"model {args.action} is for the C80's files in models/; it takes no --cart (a cart's "
                              "model card: wmr-mj cart card FILE); accepted with --cart: params, slip, friction")
     overrides = parse_assignments(args.param)
     params = with_params(cart_parameters(args), **overrides)
     if "k_i" in overrides or "k_b" in overrides:
-        from wmr_mj.sim.config import check_motor_constant
-
         check_motor_constant(params.k_i, params.k_b)
     if args.action == "write":
         for path in write_model_files(params):
@@ -57,9 +46,6 @@ def run(args: argparse.Namespace) -> int:
 
 def _check(args: argparse.Namespace, params: Any) -> int:
     """model check: are models/c80.xml and scene.xml those of the parameter set?"""
-    from wmr_mj._util.resources import MODELS_IN_CHECKOUT
-    from wmr_mj.plant.mjcf import MODELS_DIR, robot_xml, scene_file_xml
-
     stale = [name for name, text in (("c80.xml", robot_xml(params)), ("scene.xml", scene_file_xml(params)))
              if not (MODELS_DIR / name).is_file() or (MODELS_DIR / name).read_text() != text]
     where = f"{MODELS_DIR} ({'checkout' if MODELS_IN_CHECKOUT else 'copy installed with the package'})"
@@ -72,10 +58,6 @@ def _check(args: argparse.Namespace, params: Any) -> int:
 
 def _card(args: argparse.Namespace, params: Any) -> int:
     """model card: models/README.md."""
-    from wmr_mj._util.files import write_text_atomic
-    from wmr_mj.plant.mjcf import MODELS_DIR
-    from wmr_mj.plant.modelcard import render_model_card
-
     path = write_text_atomic(MODELS_DIR / "README.md", render_model_card(params))
     print(f"wrote {path}")
     return 0
@@ -83,12 +65,7 @@ def _card(args: argparse.Namespace, params: Any) -> int:
 
 def _image(args: argparse.Namespace, params: Any) -> int:
     """model image: the C80's picture in models/."""
-    from wmr_mj.plant.image import write_model_image
-    from wmr_mj.plant.mjcf import MODELS_DIR
-
     if args.param:
-        from wmr_mj.errors import ParameterError
-
         raise ParameterError("model image renders the C80 parameter set of models/; it takes no --param")
     print(f"wrote {write_model_image(MODELS_DIR)}")
     return 0
@@ -96,10 +73,6 @@ def _image(args: argparse.Namespace, params: Any) -> int:
 
 def _friction(args: argparse.Namespace, params: Any) -> int:
     """model friction: each steering friction law measured on the plant."""
-    from wmr_mj.cli._common import print_json
-    from wmr_mj.plant.friction import measure_friction_law
-    from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS
-
     laws = {name: measure_friction_law(params, steering_friction=name) for name in STEERING_FRICTION_MODELS}
     if args.json:
         print_json({name: law.to_dict() for name, law in laws.items()})
@@ -123,9 +96,6 @@ def _friction(args: argparse.Namespace, params: Any) -> int:
 
 def _slip(args: argparse.Namespace, params: Any) -> int:
     """model slip: the side slip on the 1 m circle."""
-    from wmr_mj.cli._common import print_json
-    from wmr_mj.plant.mjcf import measure_side_slip
-
     slip = measure_side_slip(params)
     if args.json:
         print_json(slip)
@@ -138,9 +108,6 @@ def _slip(args: argparse.Namespace, params: Any) -> int:
 
 def _params(args: argparse.Namespace, params: Any) -> int:
     """model params: the parameter set with its sources, and the reduced model's coefficients."""
-    from wmr_mj.cli._common import print_json
-    from wmr_mj.params import COEFFICIENT_NAMES, PARAMETER_SOURCES
-
     paper, nonholonomic = params.coefficients("paper"), params.coefficients("nonholonomic")
     if args.json:
         print_json({"parameters": params.to_dict(), "paper": paper.to_dict(), "nonholonomic": nonholonomic.to_dict(),
@@ -148,8 +115,6 @@ def _params(args: argparse.Namespace, params: Any) -> int:
         return 0
     sources = PARAMETER_SOURCES
     if getattr(args, "cart", None) is not None:
-        from wmr_mj.carts import load_cart
-
         sources = dict(load_cart(args.cart).sources)
     for name, value in params.to_dict().items():
         print(f"{name:22s} {value:12.6g}  {sources[name]}")

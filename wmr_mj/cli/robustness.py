@@ -14,117 +14,43 @@ run on the plant actually simulated (:mod:`wmr_mj.analysis.certificate`), every 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import math
 
-from wmr_mj.cli._common import parse_assignments, positive_float
-from wmr_mj.cli.options import add_json
-from wmr_mj.params import COEFFICIENT_MODELS, M1_NOMINAL, M1_RANGE, PAPER_KD, PAPER_KP
-
-
-def _nonneg_float(text: str) -> float:
-    """argparse type: a finite number >= 0."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number; a finite number >= 0 is accepted") from None
-    if not math.isfinite(value) or value < 0:
-        raise argparse.ArgumentTypeError(f"{text!r} is not accepted; a finite number >= 0 is required")
-    return value
-
-
-#: the command's line in ``wmr-mj --help`` (read without registering the command: wmr_mj/cli/app.py)
-HELP = "robustness condition (4.23) and error bounds of the computed-torque controller"
-
-
-def register(subparsers: argparse._SubParsersAction) -> None:
-    p = subparsers.add_parser(
-        "robustness",
-        help=HELP,
-        description=(
-            "Evaluate the robustness analysis of section 4: operator gains gamma1, gamma2 (4.14), "
-            "delta1 (4.18), the coefficients of ||E|| and ||E'|| in (4.19), condition (4.23) and the "
-            "bounds on ||E||, ||E'||. Default: the paper's (5.1) example."
-        ),
-    )
-    p.add_argument("--kp", type=positive_float, default=None, help="K_P [1/s^2] (default 6)")
-    p.add_argument("--kd", type=positive_float, default=None, help="K_D [1/s] (default 9)")
-    p.add_argument(
-        "--omega-r",
-        type=positive_float,
-        default=None,
-        help="critical damping (3.6): K_P = omega_r^2/4, K_D = omega_r (not with --kp/--kd)",
-    )
-    p.add_argument(
-        "--box",
-        choices=("paper", "derived"),
-        default=None,
-        help="uncertainty box: the paper's (5.1) intervals (default), or derived from the C80 parameter set",
-    )
-    p.add_argument(
-        "--m1-range",
-        nargs=2,
-        type=positive_float,
-        metavar=("LO", "HI"),
-        default=None,
-        help="chassis mass range [kg] for --box derived (default 550 750)",
-    )
-    p.add_argument(
-        "--range",
-        action="append",
-        default=None,
-        metavar="NAME=LO:HI",
-        help="extra C80 parameter range for --box derived (repeatable), e.g. mu=0.015:0.02",
-    )
-    p.add_argument("--cart", default=None, metavar="FILE|NAME",
-                   help="for --box derived: the cart whose parameter set and m1 box span it (a cart file or a "
-                        "shipped cart's name; default the C80)")
-    p.add_argument(
-        "--model",
-        choices=COEFFICIENT_MODELS,
-        default=None,
-        help="reduced model whose coefficients span --box derived (default paper)",
-    )
-    p.add_argument(
-        "--estimate",
-        action="append",
-        default=None,
-        metavar="NAME=VALUE",
-        help="fixed estimate of P, C_V, F or K (repeatable); others are anywhere in the box (4.2)",
-    )
-    p.add_argument(
-        "--reading",
-        choices=("corrected", "printed", "printed-literal"),
-        default=None,
-        help="reading of (4.19)-(4.20): corrected from (4.10) (default), printed labels, or (4.20) verbatim",
-    )
-    p.add_argument(
-        "--gammas",
-        choices=("exact", "paper"),
-        default=None,
-        help="operator gains: exact integrals (default) or the paper's (4.16) 1/K_P, 4/(e K_D)",
-    )
-    p.add_argument("--alpha-ddot", type=_nonneg_float, default=None, help="||alpha0''|| [rad/s^2] (default 0.4)")
-    p.add_argument("--alpha-dot", type=_nonneg_float, default=None, help="||alpha0'|| [rad/s] (default 0.23)")
-    p.add_argument("--sin-cos3", type=_nonneg_float, default=None, help="||sin/cos^3|| (default 1.24)")
-    add_json(p, help="print one JSON object")
-    p.add_argument(
-        "--certificate",
-        nargs=argparse.REMAINDER,
-        default=None,
-        metavar="RUN-OPTIONS",
-        help="print the certificate for a controller as `wmr-mj run` would run it; every option after "
-        "--certificate is one of run's (--model, --controller, --kp/--kd/--omega-r, --friction-sign, "
-        "--friction-width, --control-period, --m1, --box, --m1-range, --param) or --range NAME=LO:HI, "
-        "--uncertainty m1|full, --json (see: wmr-mj robustness --certificate --help)",
-    )
-    p.set_defaults(func=run)
+from wmr_mj._util.checks import as_pair
+from wmr_mj.analysis.claim_types import finite_or_none
+from wmr_mj.analysis.regions import BoxRegion, SmallGainRegion
+from wmr_mj.analysis.robustness import (
+    PAPER_CONDITION,
+    ParameterBox,
+    ReferenceBounds,
+    analyse,
+    exact_gammas,
+    gains_from_omega_r,
+    paper_gammas,
+)
+from wmr_mj.analysis.verdicts import format_delta1_parts, format_measurement_cause, paper_region_name
+from wmr_mj.carts import load_cart
+from wmr_mj.cli._common import parse_assignments, print_json
+from wmr_mj.cli.parsers.robustness import certificate_parser
+from wmr_mj.cli.ranges import command_ranges
+from wmr_mj.cli.run import config_from_args
+from wmr_mj.errors import ParameterError
+from wmr_mj.hardware import cart_line, is_ideal_cart
+from wmr_mj.params import (
+    C80,
+    M1_RANGE,
+    PAPER_KD,
+    PAPER_KP,
+    parameters_of_cart,
+    uncertainty_ranges,
+)
+from wmr_mj.sim.certify import section_4_beside
+from wmr_mj.sim.parts import resolve_run
 
 
 def run(args: argparse.Namespace) -> int:
     """``wmr-mj robustness``: the paper's region (4.17)-(4.23) for a box, gains and reference bounds."""
-    from wmr_mj.analysis.robustness import ReferenceBounds, analyse
-    from wmr_mj.cli._common import print_json
-
     if args.certificate is not None:
         return run_certificate(args)
     _fill_defaults(args)
@@ -155,9 +81,6 @@ def _fill_defaults(args: argparse.Namespace) -> None:
 
 def _gains(args: argparse.Namespace) -> tuple[float, float]:
     """(K_P [1/s^2], K_D [1/s]) from --omega-r, or --kp/--kd (default the paper's)."""
-    from wmr_mj.analysis.robustness import gains_from_omega_r
-    from wmr_mj.errors import ParameterError
-
     if args.omega_r is not None:
         if args.kp is not None or args.kd is not None:
             raise ParameterError("--omega-r sets both gains by (3.6); it cannot be combined with --kp/--kd")
@@ -167,24 +90,16 @@ def _gains(args: argparse.Namespace) -> tuple[float, float]:
 
 def _box(args: argparse.Namespace):
     """(the ParameterBox, its label): the paper's (5.1) intervals, or derived from C80 over the ranges."""
-    from wmr_mj.analysis.robustness import ParameterBox
-    from wmr_mj.errors import ParameterError
-
     if args.box == "paper":
         used = [opt for opt, v in (("--m1-range", args.m1_range), ("--range", args.range), ("--model", args.model),
                                    ("--cart", args.cart)) if v]
         if used:
             raise ParameterError(f"{', '.join(used)} only apply to --box derived (got --box paper)")
         return ParameterBox.paper(), "paper (5.1)"
-    from wmr_mj.cli.options import command_ranges
-    from wmr_mj.params import C80
 
     ranges = command_ranges(args, "robustness").plant  # m1's range is --m1-range (the one rule of --range)
     params, name, default_m1 = C80, "C80", M1_RANGE
     if args.cart is not None:  # --cart: its parameter set and its m1 box
-        from wmr_mj.carts import load_cart
-        from wmr_mj.params import parameters_of_cart
-
         cart = load_cart(args.cart)
         params, name, default_m1 = parameters_of_cart(cart), cart.name, cart.uncertainty["m1"]["m1"]
     m1_range = tuple(args.m1_range) if args.m1_range is not None else default_m1
@@ -197,8 +112,6 @@ def _box(args: argparse.Namespace):
 def _analysis_table(args: argparse.Namespace, result, gains: tuple[float, float], box_and_label,
                     estimate, paper_example: bool) -> str:
     """The text report of :func:`wmr_mj.analysis.robustness.analyse`'s result, gammas beside the paper's."""
-    from wmr_mj.analysis.robustness import PAPER_CONDITION, exact_gammas, paper_gammas
-
     kp, kd = gains
     box, box_label = box_and_label
     g1e, g2e = exact_gammas(kp, kd)
@@ -244,50 +157,12 @@ _OUTER_OPTIONS = (("--kp", "kp"), ("--kd", "kd"), ("--omega-r", "omega_r"), ("--
                   ("--alpha-dot", "alpha_dot"), ("--sin-cos3", "sin_cos3"), ("--cart", "cart"))
 
 
-def certificate_parser() -> argparse.ArgumentParser:
-    """The options read after ``--certificate``: those of ``wmr-mj run`` plus the box's ranges."""
-    from wmr_mj.cli.app import _OneLineParser
-    from wmr_mj.cli.run import add_run_options
-    from wmr_mj.params import UNCERTAINTY_NAMES
-
-    p = _OneLineParser(
-        prog="wmr-mj robustness --certificate",
-        description="The certificate (wmr_mj.analysis.certificate) for the controller `wmr-mj run` would run with "
-        "these options, on the plant it would simulate: region, terms and every assumption with its number.",
-    )
-    add_run_options(p)
-    taken = set(p._option_string_actions)
-    if "--m1" not in taken:
-        p.add_argument("--m1", type=positive_float, default=M1_NOMINAL,
-                       help="plant chassis mass, kg (default 650); the certificate's box includes it")
-    if "--range" not in taken:
-        p.add_argument("--range", action="append", metavar="NAME=LO:HI",
-                       help="another ranged plant parameter of the box (repeatable), e.g. R_a=1.0:1.3")
-    if "--d-max" not in taken:
-        p.add_argument("--d-max", type=float, default=None, metavar="NM",
-                       help="a steering disturbance torque bound, N m: its term R_a d_max/(k_i i2)/P enters delta1 "
-                       "(wmr-mj run --disturbance)")
-    if "--uncertainty" not in taken:
-        p.add_argument("--uncertainty", choices=UNCERTAINTY_NAMES, default=None,
-                       help="a named uncertainty box of wmr_mj.params: m1 (the paper's 550-750 kg) or full "
-                       "(m1, mu, ground_friction, R_a, V_A); --m1-range and --range override its entries")
-    if "--json" not in taken:
-        add_json(p, help="print one JSON object")
-    return p
-
-
 def _box_ranges(args: argparse.Namespace) -> tuple[tuple[float, float], dict[str, tuple[float, float]]]:
     """(m1_range, other ranges) from --uncertainty, --m1-range and --range (read by the one rule of every
-    command, :func:`wmr_mj.cli.options.parse_ranges`: m1's range is --m1-range)."""
-    from wmr_mj._util.checks import as_pair
-    from wmr_mj.cli.options import command_ranges
-    from wmr_mj.params import M1_RANGE, uncertainty_ranges
-
+    command, :func:`wmr_mj.cli.ranges.parse_ranges`: m1's range is --m1-range)."""
     ranges = uncertainty_ranges(args.uncertainty) if getattr(args, "uncertainty", None) else {}
     default_m1 = M1_RANGE
     if getattr(args, "cart", None) is not None:  # --cart: its boxes
-        from wmr_mj.carts import load_cart
-
         boxes = load_cart(args.cart).uncertainty
         default_m1 = boxes["m1"]["m1"]
         ranges = dict(boxes.get(args.uncertainty, ranges)) if getattr(args, "uncertainty", None) else {}
@@ -362,8 +237,6 @@ def _assumption_lines(cert, fmt) -> list[str]:
 
 def _certificate_table(cert, config, paper) -> str:
     """The text report of ``cert``, chosen by its region's type: section 4's table, or a law's box claim's."""
-    from wmr_mj.analysis.regions import BoxRegion, SmallGainRegion
-
     if isinstance(cert.region, BoxRegion):
         return _claim_table(cert)
     if not isinstance(cert.region, SmallGainRegion):
@@ -373,10 +246,6 @@ def _certificate_table(cert, config, paper) -> str:
 
 def _small_gain_table(cert, config, paper) -> str:
     """The text report of section 4's certificate: its inputs, gammas, deltas and terms, and every assumption."""
-    import dataclasses
-
-    from wmr_mj.analysis.verdicts import format_delta1_parts, format_measurement_cause, paper_region_name
-
     inp = cert.inputs  # the run's record (controller, model, box rule) by key; section 4's inputs typed
     law = inp.law
     box, ref = law.plant.box, law.reference
@@ -428,8 +297,6 @@ def certificate_breakdown(cert) -> dict:
     """The JSON keys section 4's certificate adds beside :meth:`Certificate.to_dict`: ``delta1_parts``
     ({term: rad/s^2}, adding up to delta1) and, with measurement errors, ``measurement_errors``
     (:meth:`~wmr_mj.analysis.claim_types.MeasurementCause.to_dict`); {} for a claim without section 4's terms."""
-    from wmr_mj.analysis.claim_types import finite_or_none
-
     terms = cert.terms
     if terms is None:
         return {}
@@ -439,36 +306,14 @@ def certificate_breakdown(cert) -> dict:
     return out
 
 
-def _section_4_beside(parts, cert):
-    """Section 4's certificate of the run where the one taken is the sampled-data certificate and section 4's is
-    recorded beside it (issue 44: the paper's analysis, a second opinion): the law's continuous claim alone, as
-    :func:`wmr_mj.sim.certify.certificate_of` gives it for the cart's own measurement as a what-if; else None."""
-    from wmr_mj.analysis.regions import SmallGainRegion
-    from wmr_mj.sim.certify import certificate_of, measurement_errors_of
-
-    if "section-4" not in (cert.inputs.get("certificates") or {}):
-        return None
-    config = parts.config
-    alone = certificate_of(config, parts.reference, base=parts.base, estimate=parts.estimate, plant=parts.plant,
-                           controller=parts.controller, tracker=parts.tracker,
-                           measurement=measurement_errors_of(config, parts.plant))
-    return alone if alone is not None and isinstance(alone.region, SmallGainRegion) else None
-
-
 def run_certificate(args: argparse.Namespace) -> int:
     """``wmr-mj robustness --certificate [run options]``."""
-    from wmr_mj.cli._common import print_json
-    from wmr_mj.errors import ParameterError
-
     given = [opt for opt, name in _OUTER_OPTIONS if getattr(args, name) is not None]
     if given:
         raise ParameterError(f"{', '.join(given)} before --certificate: with --certificate give the controller "
                              "as `wmr-mj run` takes it, after --certificate (e.g. --certificate --kp 100 --kd 20)")
     inner = certificate_parser().parse_args(args.certificate)
     as_json = bool(args.json or inner.json)
-
-    from wmr_mj.cli.run import config_from_args
-    from wmr_mj.sim.parts import resolve_run
 
     m1_range, ranges = _box_ranges(inner)
     inner.m1_range = m1_range
@@ -481,7 +326,7 @@ def run_certificate(args: argparse.Namespace) -> int:
         raise ParameterError(f"controller {parts.controller_name!r} states no claim: there is no certificate to "
                              "print; judge its runs by requirements (wmr-mj run --require ...)")
     paper = parts.analysis
-    second = _section_4_beside(parts, cert)
+    second = section_4_beside(parts, cert)
     if as_json:
         out = cert.to_dict()
         if parts.paper_law:  # the paper's region says nothing of a law outside its family (run: not applicable)
@@ -499,7 +344,6 @@ def run_certificate(args: argparse.Namespace) -> int:
         print("Second opinion, not taken (the continuous law: the zero-order hold is not bounded there; "
               "docs/guides/certificates.md, 'Sampling bounded on every cart'):")
         print(_certificate_table(second, config, paper))
-    from wmr_mj.hardware import cart_line, is_ideal_cart
 
     if not is_ideal_cart(config):
         print(cart_line(config))

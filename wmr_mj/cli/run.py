@@ -3,36 +3,43 @@
 from __future__ import annotations
 
 import argparse
+import functools
+import json
+import sys
+import time
 from typing import TYPE_CHECKING, Any
 
-from wmr_mj.cli._common import box_ranges_from_args, parse_assignments, positive_float, positive_int
-from wmr_mj.cli.options import add_json, add_out
-from wmr_mj.params import M1_NOMINAL
+from controllers.registry import parse_params
+from wmr_mj._util.files import check_output_path
+from wmr_mj._util.memory import require_run_memory
+from wmr_mj.analysis.requirements import parse_requirement
+from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE, format_measurement_cause, format_verdict
+from wmr_mj.carts import load_cart
+from wmr_mj.cli._common import CLAIM_BROKEN_EXIT, parse_assignments, print_json
+from wmr_mj.cli.ranges import box_ranges_from_args
+from wmr_mj.errors import ParameterError
+from wmr_mj.hardware import Actuation, Sensing, Transmission, cart_line, is_ideal_cart
+from wmr_mj.logs.writer import LogOptions, RunLogger, terminate_as_interrupt
+from wmr_mj.params import M1_NOMINAL, M1_RANGE, uncertainty_ranges
+from wmr_mj.plant.mjcf import TIMESTEP
+from wmr_mj.searches.design_search import (
+    design_cart,
+    design_cart_name,
+    design_file_box,
+    design_file_settings,
+    read_design,
+)
+from wmr_mj.sim.closed_loop import MUJOCO_WITHOUT_WARNINGS, run_parts
+from wmr_mj.sim.coerce import cart_file_of_record, default_path, default_path_note
+from wmr_mj.sim.config import RunConfig, plugin_source
+from wmr_mj.sim.engine import law_path
+from wmr_mj.sim.parts import resolve_run
+from wmr_mj.sim.run_report import measurement_cause
+from wmr_mj.sim.signals import signals_from
+from wmr_mj.sim.spec import LawChoice, law_fields, no_estimate_note
 
 if TYPE_CHECKING:
     from wmr_mj.sim.summary import RunSummary
-
-
-def add_run_options(p: argparse.ArgumentParser) -> None:
-    """Options shared by ``run``, ``sweep``, ``falsify`` and ``robustness --certificate`` (the closed-loop
-    configuration): the 'run' rows of the table of run options (:func:`wmr_mj.cli.run_options.run_options`,
-    which also writes a config back as its ``wmr-mj run`` line), then the cart's (:func:`add_hardware_options`)."""
-    from wmr_mj.cli.run_options import add_options
-
-    add_options(p, "run")
-    add_hardware_options(p)
-
-
-def add_hardware_options(p: argparse.ArgumentParser) -> None:
-    """--sensing, --actuation, --backlash: the cart as it is built (wmr_mj.hardware), RunConfig's sensing,
-    actuation and transmission (``run``, ``sweep``, ``falsify``, ``robustness --certificate``, ``compare``,
-    ``validate``): the 'cart' rows of the table of run options. Each is parsed by its part: bad values raise
-    one line (exit status 2)."""
-    from wmr_mj.cli.run_options import add_options
-
-    g = p.add_argument_group("the cart as it is built (wmr_mj/hardware; default ideal: the exact alpha and alpha', "
-                             "no delay, no inductance, no play); shown in every summary and JSON where not ideal")
-    add_options(g, "cart")
 
 
 def hardware_from_args(args: argparse.Namespace) -> dict[str, Any]:
@@ -43,8 +50,6 @@ def hardware_from_args(args: argparse.Namespace) -> dict[str, Any]:
         ParameterError, UnknownNameError: a malformed spec, an unknown key or preset, a value out of range (a
             delay on the control period's grid is checked where RunConfig is built).
     """
-    from wmr_mj.hardware import Actuation, Sensing, Transmission
-
     # an option not given stays None: the cart's default (RunConfig.cart; ideal on the C80)
     given: dict[str, tuple[Any, str]] = {"sensing": (Sensing, "sensing"), "actuation": (Actuation, "actuation"),
                                          "transmission": (Transmission, "backlash")}
@@ -55,17 +60,11 @@ def hardware_from_args(args: argparse.Namespace) -> dict[str, Any]:
 def config_from_args(args: argparse.Namespace, **extra):
     """A RunConfig from the shared options (raises WmrMjError on bad input): the law's options merged with the
     preset by :func:`wmr_mj.sim.spec.law_fields`, the rest parsed here."""
-    from controllers.registry import parse_params
-    from wmr_mj.errors import ParameterError
-    from wmr_mj.sim.config import RunConfig
-    from wmr_mj.sim.spec import LawChoice, law_fields
-
     if getattr(args, "design", None) is not None:
         with_design_file(args)
     tracker = getattr(args, "tracker", None)
     if bool(getattr(args, "correction", False)) and tracker not in (None, "stanley-at-C"):
         raise ParameterError(f"--correction is the tracker stanley-at-C; give it or --tracker {tracker}, not both")
-    from wmr_mj.params import M1_RANGE
 
     # --cart: the cart's parameter set, boxes and defaults; --m1 and --m1-range not given (their defaults, the
     # very objects): the cart's m1 and m1 box
@@ -109,18 +108,6 @@ def with_design_file(args: argparse.Namespace) -> argparse.Namespace:
         ParameterError: --design with --preset, a file that is not a design file, a design found on a cart
             file that is no longer there (and no --cart given).
     """
-    import sys
-
-    from wmr_mj.errors import ParameterError
-    from wmr_mj.params import M1_RANGE
-    from wmr_mj.searches.design_search import (
-        design_cart,
-        design_cart_name,
-        design_file_box,
-        design_file_settings,
-        read_design,
-    )
-
     if args.preset is not None:
         raise ParameterError("give --design FILE or --preset, not both (a design file is a preset of its own)")
     if getattr(args, "design_applied", None) == args.design:
@@ -168,8 +155,6 @@ def with_design_file(args: argparse.Namespace) -> argparse.Namespace:
 def default_path_note_of(args: argparse.Namespace, config: Any) -> str | None:
     """The line naming the config's path where it is the default derived from the cart's stops (no --path given,
     none from a design; :func:`wmr_mj.sim.coerce.default_path_note`); None otherwise."""
-    from wmr_mj.sim.coerce import cart_file_of_record, default_path, default_path_note
-
     if getattr(args, "path", None) is not None:
         return None
     cart = cart_file_of_record(config.cart)
@@ -179,11 +164,7 @@ def default_path_note_of(args: argparse.Namespace, config: Any) -> str | None:
 def _box_name(ranges: dict[str, tuple[float, float]], cart: Any) -> str | None:
     """The name of the cart's uncertainty box (--uncertainty NAME) whose ranges besides m1 are ``ranges`` (a design
     file's box_ranges); None where no box of the cart is that."""
-    from wmr_mj.params import uncertainty_ranges
-
     if cart is not None:
-        from wmr_mj.carts import load_cart
-
         boxes = {name: dict(box) for name, box in load_cart(cart).uncertainty.items()}
     else:
         boxes = {name: uncertainty_ranges(name) for name in ("m1", "full")}
@@ -196,69 +177,14 @@ def _box_name(ranges: dict[str, tuple[float, float]], cart: Any) -> str | None:
 def _same_cart(given: Any, recorded: Any) -> bool:
     """Whether the cart ``given`` (--cart) is the one a design file records (None: the C80): the same text, or
     both the C80's numbers."""
-    from wmr_mj.sim.config import RunConfig
-
     record = RunConfig.from_inputs(cart=given).cart
     if record is None or not isinstance(recorded, dict):
         return record is None and not isinstance(recorded, dict)
     return record["text"] == recorded.get("text")
 
 
-#: the command's line in ``wmr-mj --help`` (read without registering the command: wmr_mj/cli/app.py)
-HELP = "simulate the circle headless with a controller and report the errors"
-
-
-def register(sub: argparse._SubParsersAction) -> None:
-    from wmr_mj.cli._common import CLAIM_BROKEN_EXIT
-
-    p = sub.add_parser(
-        "run", help=HELP,
-        epilog=f"exit status: 0; {CLAIM_BROKEN_EXIT} when the run is certified-outside: it breaks the law's claim "
-               "(the banner above the verdict); 1 the law failed mid-run; 2 bad input; 130 interrupted",
-        description="One closed-loop run on the MuJoCo plant, reported against the regions. The run is a "
-                    "batch of one: the steering law runs compiled in MuJoCo's control callback and "
-                    "mujoco.batch steps a simulated second per call, recording every control step as "
-                    "arrays (the rows and the MCAP log, flushed every simulated second). Where the "
-                    "compiled law cannot run (no C compiler at install, WMR_MJ_COMPILED_LAW=0) the same "
-                    "engine evaluates the Python law, with the same numbers, and says so on stderr.")
-    add_run_options(p)
-    p.add_argument("--m1", type=positive_float, default=M1_NOMINAL,
-                   help="plant chassis mass, kg (default: the cart's, 650 on the C80)")
-    p.add_argument("--range", action="append", metavar="NAME=LO:HI",
-                   help="another ranged plant parameter of the analysis box (repeatable; it adds the parameter to "
-                        "the --uncertainty box or replaces its range, e.g. R_a=1.0:1.3); a run draws nothing")
-    add_out(p, metavar="PATH", help="MCAP log path (default logs/run-<time>-<model>-m<m1>.mcap)")
-    p.add_argument("--no-log", action="store_true", help="do not write an MCAP log")
-    p.add_argument("--log-every", type=positive_int, default=1, help="log signals every k-th control step (default 1)")
-    p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
-                   help="progress bar (default: only on a terminal)")
-    add_require_option(p)
-    add_json(p)
-    add_signal_options(p)
-    p.set_defaults(func=run)
-
-
-def add_signal_options(p: argparse.ArgumentParser) -> None:
-    """--signals, --disturbance, --load, --d-max (``run``, ``sweep``, ``falsify``; see signals_from_args): the
-    'signals' rows of the table of run options."""
-    from wmr_mj.cli.run_options import add_options
-
-    g = p.add_argument_group("signals on the plant during the run (wmr_mj/sim/signals.py); reported under "
-                             "'signals' in --json, which --signals takes back to reproduce the run to the bit")
-    add_options(g, "signals")
-
-
-def add_require_option(p: argparse.ArgumentParser) -> None:
-    """--require STL (repeatable; ``run``, ``sweep``): the 'require' row of the table of run options."""
-    from wmr_mj.cli.run_options import add_options
-
-    add_options(p, "require")
-
-
 def requirements_from_args(args: argparse.Namespace, period: float) -> list:
     """The --require requirements, each checked (syntax, signal names, time bounds) before any run."""
-    from wmr_mj.analysis.requirements import parse_requirement
-
     return [parse_requirement(text, period=period) for text in getattr(args, "require", None) or []]
 
 
@@ -278,8 +204,6 @@ def format_requirements(results: list[dict]) -> list[str]:
 
 def _key_values(option: str, text: str) -> dict:
     """'k=v,k=v' -> {k: v}, numbers as numbers (seed an integer), kind as text."""
-    from wmr_mj.errors import ParameterError
-
     out: dict = {}
     for item in text.split(","):
         key, sep, value = item.partition("=")
@@ -298,9 +222,6 @@ def _key_values(option: str, text: str) -> dict:
 
 def signals_from_args(args: argparse.Namespace):
     """The run's Signals from --signals, --disturbance, --load, --d-max (None without any)."""
-    from wmr_mj.errors import ParameterError
-    from wmr_mj.sim.signals import signals_from
-
     data: dict = {}
     if getattr(args, "signals", None):
         s = signals_from(args.signals)
@@ -320,8 +241,6 @@ def signals_from_args(args: argparse.Namespace):
 
 def default_log_path(config) -> str:
     """logs/run-<time>-<model>-m<m1>.mcap for a RunConfig or the run command's arguments."""
-    import time
-
     stamp = time.strftime("%Y%m%d-%H%M%S")
     return f"logs/run-{stamp}-{config.model}-m{config.m1:g}.mcap"
 
@@ -330,9 +249,6 @@ def format_report(s: RunSummary, *, measurement: Any = None, cart: str | None = 
     """Human-readable run report of the summary ``s`` (``measurement``: as :func:`measurement_cause` takes it).
     ``cart``: the name of the cart the run is on where it is not the paper's C80 (None: the C80): the paper's claim,
     which the paper makes for its C80 only, is then not printed (its numbers stay in --json, as the paper's)."""
-    from wmr_mj.analysis.verdicts import format_measurement_cause, format_verdict
-    from wmr_mj.sim.run_report import measurement_cause
-
     def ratio(x):
         return "n/a" if x is None else f"{x:.3f}"
 
@@ -374,9 +290,15 @@ def format_report(s: RunSummary, *, measurement: Any = None, cart: str | None = 
         f"{num(cert_Edot_max):>12s} {ratio(cert_Edot_ratio):>8s}" + paper(s.Edot_max, s.Edot_ratio),
         f"voltage saturated {100 * s.saturated_fraction:.1f}% of the time",
     ]
-    if s.mujoco_warnings:  # counted over the run and said once here (MuJoCo's console printing is held)
-        from wmr_mj.sim.closed_loop import MUJOCO_WITHOUT_WARNINGS
+    return "\n".join(lines + _after_the_table(s))
 
+
+def _after_the_table(s: RunSummary) -> list[str]:
+    """The lines of a run's report below its table: MuJoCo's warnings, C's path and its verdict, a route not
+    finished, the steering's stop, a run that did not complete (none where nothing of these happened)."""
+    lines = []
+    cert = s.certificate
+    if s.mujoco_warnings:  # counted over the run and said once here (MuJoCo's console printing is held)
         said = next((a.note for a in (cert.assumptions if cert is not None else ())
                      if a.name == MUJOCO_WITHOUT_WARNINGS), "")
         lines.append(f"MuJoCo warned {s.mujoco_warnings} time(s) during the run; the run is not certified "
@@ -395,14 +317,11 @@ def format_report(s: RunSummary, *, measurement: Any = None, cart: str | None = 
         lines.append(f"the steering reached its stop (+-range) at t = {s.left_steering_range_at_s:.3f} s")
     if s.status != "completed":
         lines.append(f"run {s.status}: report covers the simulated part only")
-    return "\n".join(lines)
+    return lines
 
 
 def _law_note(result: Any, config: Any) -> str | None:
     """The stderr line on which law ran: the Python law's fallback, or a plug-in's compiled or Python path."""
-    from wmr_mj.sim.config import plugin_source
-    from wmr_mj.sim.engine import law_path
-
     plugin = plugin_source(config) is not None
     if result.law_note:
         if not plugin:
@@ -416,10 +335,6 @@ def _law_note(result: Any, config: Any) -> str | None:
 
 def _print_text(result: Any, parts: Any, report: dict[str, Any], path: str | None) -> None:
     """The run's report as text (``--json`` prints ``report`` instead)."""
-    import json
-
-    from wmr_mj.hardware import cart_line, is_ideal_cart
-
     config = result.config
     record = parts.config.cart  # None: the C80
     print(format_report(result.summary, measurement=parts.measurement,
@@ -436,19 +351,6 @@ def _print_text(result: Any, parts: Any, report: dict[str, Any], path: str | Non
 
 
 def run(args: argparse.Namespace) -> int:
-    import functools
-    import sys
-
-    from wmr_mj._util.files import check_output_path
-    from wmr_mj._util.memory import require_run_memory
-    from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE
-    from wmr_mj.cli._common import CLAIM_BROKEN_EXIT, print_json
-    from wmr_mj.logs.writer import LogOptions, RunLogger, terminate_as_interrupt
-    from wmr_mj.plant.mjcf import TIMESTEP
-    from wmr_mj.sim.closed_loop import run_parts
-    from wmr_mj.sim.parts import resolve_run
-    from wmr_mj.sim.spec import no_estimate_note
-
     # refuse what cannot work before anything runs (an identification for --model identified)
     require_run_memory(duration_s=args.duration, control_period_s=args.control_period or TIMESTEP)
     path = None

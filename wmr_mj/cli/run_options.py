@@ -4,14 +4,16 @@ that field is written back as the option.
 The table (:func:`run_options`) drives both ways:
 
 * argparse: :func:`add_options` adds a group of rows (``wmr-mj run``'s options, the cart's, the signals', the
-  requirement) to a command's parser (``wmr_mj.cli.run.add_run_options`` and friends);
-* the reproduce line: :func:`command_line` writes a RunConfig back as the ``wmr-mj run`` line that builds it,
+  requirement) to a command's parser (``wmr_mj.cli.parsers.run.add_run_options`` and friends);
+* the reproduce line: :func:`wmr_mj.cli.falsify.command_line` writes a RunConfig back as the ``wmr-mj run`` line
+  that builds it,
   each row writing its own field (``wmr-mj falsify``'s reproduce line), so a field read by one row's parser is
   written by the same row, and a test parses the line back into an equal config (``tests/test_spine2.py``).
 
 Usage::
 
-    from wmr_mj.cli.run_options import Replay, command_line
+    from wmr_mj.cli.falsify import command_line
+    from wmr_mj.cli.run_options import Replay
     command_line(config, Replay(preset="certified", law_settings=parts.law_settings))
 """
 
@@ -25,9 +27,11 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from wmr_mj.cli.options import add_argument_with_help_of, positive_float
+from wmr_mj.cli.options import add_argument_with_help_of, names_in, positive_float
+from wmr_mj.hardware.spec import spec_string
+from wmr_mj.params import M1_RANGE, UNCERTAINTY_NAMES, uncertainty_ranges
 
-__all__ = ["RunOption", "Replay", "run_options", "add_options", "add_option", "command_line", "GROUPS"]
+__all__ = ["RunOption", "Replay", "run_options", "add_options", "add_option", "GROUPS"]
 
 #: --duration's default, s: the very object argparse keeps where --duration is not given (a message about the
 #: duration then says that it is the default: wmr_mj.cli.app)
@@ -111,8 +115,6 @@ def _each(flag: str, pairs: Callable[[Any], Mapping[str, Any]], text: Callable[[
 def _uncertainty_box(config: Any) -> tuple[str, dict[str, tuple[float, float]]]:
     """The --uncertainty box and the --range items that give ``config.box_ranges`` back: the named box whose
     ranges (besides m1, which is --m1-range) all stay in it, with the fewest items to add or replace."""
-    from wmr_mj.params import UNCERTAINTY_NAMES, uncertainty_ranges
-
     best: tuple[str, dict[str, tuple[float, float]]] | None = None
     ranges = {k: tuple(v) for k, v in config.box_ranges.items()}
     for name in UNCERTAINTY_NAMES:
@@ -139,8 +141,6 @@ def _write_part(option: str, part: str) -> Callable[[Any, Replay], list[str]]:
     """The writer of --sensing or --actuation: every field of the part, at full precision, where not ideal."""
 
     def write(config: Any, replay: Replay) -> list[str]:
-        from wmr_mj.hardware.spec import spec_string
-
         value = getattr(config, part)
         if value.is_ideal:
             return []
@@ -158,7 +158,7 @@ def _if(condition: Callable[[Any, Replay], bool], words: Callable[[Any, Replay],
 def run_options() -> tuple[RunOption, ...]:
     """The run options, in the order the reproduce line writes them (and the help lists them): the law and the
     run's length, then the plant and its analysis box, then the outer loop, the signals and the cart."""
-    return _law_rows() + _plant_and_outer_rows()
+    return _law_rows() + _plant_rows() + _outer_signal_and_cart_rows()
 
 
 def _law_rows() -> tuple[RunOption, ...]:
@@ -206,9 +206,7 @@ def _law_rows() -> tuple[RunOption, ...]:
     )
 
 
-def _plant_and_outer_rows() -> tuple[RunOption, ...]:
-    from wmr_mj.params import M1_RANGE
-
+def _plant_rows() -> tuple[RunOption, ...]:
     R = RunOption
     return (
         R(flag="--steering-friction", group="run", sets="steering_friction", settings=dict(default="stiction"),
@@ -231,6 +229,12 @@ def _plant_and_outer_rows() -> tuple[RunOption, ...]:
         R(flag="--uncertainty", group="run", sets="box_ranges", settings=dict(default=None), help=_uncertainty_help,
           write=_write_uncertainty),
         R(flag="--range", group="command", sets="box_ranges", write=_write_ranges),
+    )
+
+
+def _outer_signal_and_cart_rows() -> tuple[RunOption, ...]:
+    R = RunOption
+    return (
         R(flag="--correction", group="run", sets="correction", settings=dict(action="store_true"),
           help="Cartesian correction: an outer loop at C (Stanley-like, from C's cross-track and heading errors) "
                "corrects alpha0 within declared rate and acceleration limits, which the certificate then assumes "
@@ -305,80 +309,53 @@ def _add_row(p: argparse.ArgumentParser | Any, row: RunOption) -> None:
         p.add_argument(row.flag, help=row.help, **row.settings)
 
 
-def command_line(config: Any, replay: Replay, *, command: str = "wmr-mj run") -> str:
-    """The ``wmr-mj run`` line that builds ``config`` again: each row of the table writes its own field.
-
-    Args:
-        config: the run's RunConfig (a direct one is coerced first: its defaults resolved, as the run resolves them).
-        replay: what the config does not record (:class:`Replay`).
-    """
-    from wmr_mj.sim.coerce import coerced  # the coercer: this module's table is read by --help, which stays light
-
-    config = coerced(config)
-    return " ".join([command, *(w for row in run_options() for w in row.write(config, replay))])
-
-
 def _preset_help() -> str:
-    from wmr_mj.sim.designs import PRESET_NAMES
-
-    return (f"controller design: one of {', '.join(PRESET_NAMES)} (default paper: paper model, K_P = 6, K_D = 9, "
-            "exact sign; certified: see wmr_mj/sim/designs.py); explicit options override it. With --controller and "
-            "no --preset, the law's estimate is its own default model (as RunConfig(controller=NAME) and wmr-mj "
-            "compare NAME: non-holonomic for sliding-mode)")
+    return (f"controller design: one of {names_in('wmr_mj.sim.designs', 'PRESET_NAMES')} (default paper: paper "
+            "model, K_P = 6, K_D = 9, exact sign; certified: see wmr_mj/sim/designs.py); explicit options override "
+            "it. With --controller and no --preset, the law's estimate is its own default model (as "
+            "RunConfig(controller=NAME) and wmr-mj compare NAME: non-holonomic for sliding-mode)")
 
 
 def _controller_help() -> str:
-    from controllers.registry import controller_names
-
-    return (f"the steering law: one of {', '.join(controller_names())}, a class in a file of your own "
-            "(FILE.py:Class), or of an importable module (module:Class) (default: the preset's; see "
+    return (f"the steering law: one of {names_in('controllers.registry', 'controller_names')}, a class in a file of "
+            "your own (FILE.py:Class), or of an importable module (module:Class) (default: the preset's; see "
             "controllers/base.py)")
 
 
 def _tracker_help() -> str:
-    from controllers.registry import tracker_names
-
-    return (f"a path tracker, the outer loop on C that writes alpha0: one of {', '.join(tracker_names())}, "
+    return ("a path tracker, the outer loop on C that writes alpha0: one of "
+            f"{names_in('controllers.registry', 'tracker_names')}, "
             "FILE.py:Class or module:Class (default: none, the path's own alpha0; see controllers/tracking.py)")
 
 
 def _model_help() -> str:
-    from controllers.computed_torque import MODEL_SOURCES
-
-    return f"model source of the estimate: one of {', '.join(MODEL_SOURCES)} (default: the preset's)"
+    return (f"model source of the estimate: one of {names_in('controllers.computed_torque', 'MODEL_SOURCES')} "
+            "(default: the preset's)")
 
 
 def _friction_sign_help() -> str:
-    from controllers.computed_torque import FRICTION_SIGNS
-
-    return f"Coulomb compensation sign: one of {', '.join(FRICTION_SIGNS)} (default: the preset's)"
+    return (f"Coulomb compensation sign: one of {names_in('controllers.computed_torque', 'FRICTION_SIGNS')} "
+            "(default: the preset's)")
 
 
 def _path_help() -> str:
-    from wmr_mj.sim.config import PATH_NAMES
-
-    return (f"reference path of point C: one of {', '.join(PATH_NAMES)}, a packaged route (agv-loop), or a route "
-            "file (.toml/.json: segments or waypoints; see wmr_mj/reference/route.py); default: the --design file's "
-            "path, else the cart's own ([paths] default in its file), else paper-circle")
+    return (f"reference path of point C: one of {names_in('wmr_mj.sim.config', 'PATH_NAMES')}, a packaged route "
+            "(agv-loop), or a route file (.toml/.json: segments or waypoints; see wmr_mj/reference/route.py); "
+            "default: the --design file's path, else the cart's own ([paths] default in its file), else "
+            "paper-circle")
 
 
 def _steering_friction_help() -> str:
-    from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS
-
-    return (f"plant's steering friction law: one of {', '.join(STEERING_FRICTION_MODELS)} (default stiction: holds "
-            "below break-away; soft: MuJoCo's default frictionloss, creeps at mrad/s)")
+    return (f"plant's steering friction law: one of {names_in('wmr_mj.plant.mjcf', 'STEERING_FRICTION_MODELS')} "
+            "(default stiction: holds below break-away; soft: MuJoCo's default frictionloss, creeps at mrad/s)")
 
 
 def _tyre_contact_help() -> str:
-    from wmr_mj.plant.mjcf import TYRE_CONTACT_MODELS
-
-    return (f"plant's tyre-floor contacts: one of {', '.join(TYRE_CONTACT_MODELS)} (default stiff; soft: MuJoCo's "
-            "default solref, see models/README.md)")
+    return (f"plant's tyre-floor contacts: one of {names_in('wmr_mj.plant.mjcf', 'TYRE_CONTACT_MODELS')} (default "
+            "stiff; soft: MuJoCo's default solref, see models/README.md)")
 
 
 def _uncertainty_help() -> str:
-    from wmr_mj.params import UNCERTAINTY_NAMES
-
     return (f"uncertainty box: one of {', '.join(UNCERTAINTY_NAMES)} (m1: the paper's 550-750 kg, the default of run "
             "and sweep; full: also steering and tyre friction, R_a and V_A, the default of falsify; sources in "
             "wmr_mj/params.py). A run draws nothing: the box is what its analysis covers; m1's range is --m1-range")
@@ -392,27 +369,23 @@ def _reference_bounds_help() -> str:
 
 
 def _sensing_help() -> str:
-    from wmr_mj.hardware import SENSING_SPEC_KEYS, sensing_preset_names
-
     return ("the steering sensor between the plant and the law: a preset "
-            f"({', '.join(sensing_preset_names())}), KEY=VALUE pairs ({', '.join(SENSING_SPEC_KEYS)}, preset; e.g. "
+            f"({names_in('wmr_mj.hardware', 'sensing_preset_names')}), KEY=VALUE pairs "
+            f"({names_in('wmr_mj.hardware', 'SENSING_SPEC_KEYS')}, preset; e.g. "
             "encoder_ticks=4096,velocity=difference,delay=0.005,noise=uniform:0.0005,seed=3; the delay a whole number "
             "of control periods) or a .json/.toml file of the same")
 
 
 def _cart_help() -> str:
-    from wmr_mj.carts import cart_names
-
-    return (f"the cart: a cart file (.toml, see wmr_mj/carts/c80.toml and docs/reference/cart.md) or a shipped cart "
-            f"({', '.join(cart_names())}); it gives the parameter set, the m1 box, the supply and stops, the default "
-            "sensing, actuation and play, and the certified preset's gains (its rule run on the cart) "
-            "(default: c80)")
+    return ("the cart: a cart file (.toml, see wmr_mj/carts/c80.toml and docs/reference/cart.md) or a shipped cart "
+            f"({names_in('wmr_mj.carts', 'cart_names')}); it gives the parameter set, the m1 box, the supply and "
+            "stops, the default sensing, actuation and play, and the certified preset's gains (its rule run on the "
+            "cart) (default: c80)")
 
 
 def _require_help() -> str:
-    from wmr_mj.analysis.requirements import PRESETS, SIGNALS
-
     return ("a requirement in Signal Temporal Logic, monitored by rtamt on the run's signals "
-            f"({', '.join(SIGNALS)}; time bounds in s), e.g. 'always[8,35](abs(E) <= 0.05)', or a preset: "
-            f"{', '.join(PRESETS)} (the certificate's or the paper's |E|, |E'| bounds for the whole run); "
-            "repeatable. Its robustness (> 0: held with that margin) is reported")
+            f"({names_in('wmr_mj.analysis.requirements', 'SIGNALS')}; time bounds in s), e.g. "
+            "'always[8,35](abs(E) <= 0.05)', or a preset: "
+            f"{names_in('wmr_mj.analysis.requirements', 'PRESETS')} (the certificate's or the paper's |E|, |E'| "
+            "bounds for the whole run); repeatable. Its robustness (> 0: held with that margin) is reported")

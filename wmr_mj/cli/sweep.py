@@ -3,59 +3,38 @@
 from __future__ import annotations
 
 import argparse
+import functools
+import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from wmr_mj.cli._common import CLAIM_BROKEN_EXIT, positive_int
-from wmr_mj.cli.options import add_json, add_out, add_seed, add_threads
+from wmr_mj._util.files import check_output_path, write_json_atomic
+from wmr_mj._util.progress import counter_callback, progress_bar
+from wmr_mj.analysis.verdicts import (
+    PAPER_CLAIM_NOT_APPLICABLE,
+    certified_outside_banner,
+    format_unmet,
+)
+from wmr_mj.cli._common import CLAIM_BROKEN_EXIT, print_json
+from wmr_mj.cli.ranges import box_ranges_from_args, hardware_ranges_from_args
+from wmr_mj.cli.run import config_from_args, requirements_from_args
+from wmr_mj.errors import ParameterError
+from wmr_mj.experiments.sweep import SweepSpec
+from wmr_mj.experiments.sweep_result import sweep
+from wmr_mj.figures.plots import save_figure
+from wmr_mj.figures.results import figure_sweep_region
+from wmr_mj.hardware import cart_line, is_ideal_cart
+from wmr_mj.logs.writer import RunLogger
+from wmr_mj.params import M1_RANGE
+from wmr_mj.plant.mjcf import TIMESTEP
+from wmr_mj.sim.closed_loop import run_closed_loop
+from wmr_mj.sim.coerce import coerced
+from wmr_mj.sim.config import estimate_of
+from wmr_mj.sim.engine import law_path
+from wmr_mj.sim.parts import resolve_run
 
 if TYPE_CHECKING:
     from wmr_mj.experiments.sweep import SweepSummary
-
-
-#: the command's line in ``wmr-mj --help`` (read without registering the command: wmr_mj/cli/app.py)
-HELP = "Monte-Carlo over m1 (and --uncertainty/--range) on mujoco.batch: per-run verdicts, table and plot"
-
-
-def register(sub: argparse._SubParsersAction) -> None:
-    from wmr_mj.cli.run import add_require_option, add_run_options, add_signal_options
-
-    p = sub.add_parser("sweep",
-                       help=HELP,
-                       epilog=f"exit status: 0; {CLAIM_BROKEN_EXIT} when a run is certified-outside: it breaks the "
-                              "law's claim (a banner names the run; summary.json's claim_broken); 2 bad input")
-    add_run_options(p)
-    add_fixed_m1_option(p)
-    p.add_argument("--n", type=int, default=200, help="number of runs (default 200)")
-    add_seed(p, help="seed of the draw (default 0)")
-    p.add_argument("--sampling", default="lhs", help="uniform, lhs (Latin hypercube, default) or grid")
-    p.add_argument("--range", action="append", metavar="NAME=LO:HI",
-                   help="draw another plant parameter over a range too (repeatable); the box includes it. Or a "
-                        "hardware axis of the cart, drawn per run but not in the certificate's box (each run's claim "
-                        "covers its own cart): sensing.delay (rounded to whole control periods), "
-                        "sensing.encoder_ticks (rounded to whole ticks), sensing.encoder_bits (2**round(bits) "
-                        "ticks), sensing.noise, sensing.velocity_noise, sensing.filter_tau, "
-                        "actuation.delay (whole 1 ms steps), actuation.inductance, actuation.current_limit, "
-                        "transmission.backlash; runs.csv records the value each run used")
-    add_out(p, help="output folder (default logs/sweep-<time>); rerun to resume")
-    p.add_argument("--chunk", type=positive_int, default=128, help="simulations per batch (default 128)")
-    add_threads(p, help="threads of the batch (default 0: all cores)")
-    p.add_argument("--scheduler", metavar="ADDRESS", help="run the chunks on a Dask cluster (e.g. tcp://127.0.0.1:8786)")
-    p.add_argument("--log", action="store_true",
-                   help="also write an MCAP log per run (re-run one by one; bit-identical)")
-    add_json(p, help="print one summary JSON object")
-    add_require_option(p)
-    add_signal_options(p)
-    p.set_defaults(func=run)
-
-
-def add_fixed_m1_option(p: argparse.ArgumentParser) -> None:
-    """sweep's and falsify's --m1: a fixed m1, so that the other axes are swept or searched alone."""
-    from wmr_mj.cli._common import positive_float
-
-    p.add_argument("--m1", type=positive_float, default=None, metavar="KG",
-                   help="fix every run's m1 at KG (the other ranges swept alone; the certificate's box stays "
-                        "--m1-range); a zero-width --m1-range KG KG is the same, the box then the default 550-750 kg")
 
 
 def fixed_m1_from_args(args: argparse.Namespace) -> float | None:
@@ -66,9 +45,6 @@ def fixed_m1_from_args(args: argparse.Namespace) -> float | None:
     Raises:
         ParameterError: a zero-width range outside the default box, or one that differs from --m1.
     """
-    from wmr_mj.errors import ParameterError
-    from wmr_mj.params import M1_RANGE
-
     fixed = getattr(args, "m1", None)
     lo, hi = (float(v) for v in args.m1_range)
     if lo != hi:
@@ -86,13 +62,6 @@ def fixed_m1_from_args(args: argparse.Namespace) -> float | None:
 def _spec_from_args(args: argparse.Namespace) -> tuple[Any, Any]:
     """The sweep of the options, and its base's resolved parts (what the runs would raise, a law's claim() that
     raises, is one line here, before any output)."""
-    from wmr_mj.cli._common import box_ranges_from_args, hardware_ranges_from_args
-    from wmr_mj.cli.run import config_from_args, requirements_from_args
-    from wmr_mj.errors import ParameterError
-    from wmr_mj.experiments.sweep import SweepSpec
-    from wmr_mj.plant.mjcf import TIMESTEP
-    from wmr_mj.sim.parts import resolve_run
-
     if args.n < 1:
         raise ParameterError(f"--n {args.n} is not accepted; the number of runs must be >= 1")
     fixed_m1 = fixed_m1_from_args(args)  # --m1 or a zero-width --m1-range: m1 not drawn
@@ -108,11 +77,6 @@ def _spec_from_args(args: argparse.Namespace) -> tuple[Any, Any]:
 
 def _log_runs(spec: Any, rows: Any, logs_dir: Path) -> None:
     """--log: each run again with its MCAP log, ``run-NNNNN.mcap`` in ``logs_dir``."""
-    import functools
-
-    from wmr_mj.logs.writer import RunLogger
-    from wmr_mj.sim.closed_loop import run_closed_loop
-
     for r in rows:
         cfg = spec.config_at([r[k] for k in spec.names])
         run_closed_loop(cfg, logger_factory=functools.partial(RunLogger, logs_dir / f"run-{r['run']:05d}.mcap"),
@@ -120,13 +84,6 @@ def _log_runs(spec: Any, rows: Any, logs_dir: Path) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    import time
-
-    from wmr_mj._util.files import check_output_path, write_json_atomic
-    from wmr_mj._util.progress import counter_callback, progress_bar
-    from wmr_mj.cli._common import print_json
-    from wmr_mj.experiments.sweep_result import sweep
-
     out = check_output_path(args.out or f"logs/sweep-{time.strftime('%Y%m%d-%H%M%S')}", kind="dir", option="--out")
     spec, base_parts = _spec_from_args(args)
     t0 = time.perf_counter()
@@ -153,11 +110,6 @@ def run(args: argparse.Namespace) -> int:
 
 def _print_text(spec: Any, runs: SweepSummary, law: Any, summary: dict[str, Any], wall: float) -> None:
     """The sweep's report as text (``--json`` prints ``summary`` instead)."""
-    from wmr_mj.analysis.verdicts import PAPER_CLAIM_NOT_APPLICABLE
-    from wmr_mj.hardware import cart_line, is_ideal_cart
-    from wmr_mj.sim.config import estimate_of
-    from wmr_mj.sim.engine import law_path
-
     fmt = lambda x: "n/a" if x is None else f"{x:.3f}"  # noqa: E731
     base = spec.base
     m1_text = (f"m1 fixed at {spec.m1:g} kg" if spec.m1 is not None
@@ -216,8 +168,6 @@ def effort_lines(runs: SweepSummary) -> list[str]:
 def claim_lines(runs: SweepSummary) -> list[str]:
     """Beside the verdicts: the banner and the run that broke the claim (where one did), and the claim's
     unmet assumptions (name, value vs limit, in how many runs)."""
-    from wmr_mj.analysis.verdicts import certified_outside_banner, format_unmet
-
     lines = []
     b = runs.claim_broken
     if b is not None:
@@ -233,37 +183,11 @@ def claim_lines(runs: SweepSummary) -> list[str]:
 
 def _plot(result: Any, stem: Path) -> Path:
     """:func:`region_figure` of the sweep's ``result`` written as ``<stem>.png``."""
-    from wmr_mj.figures.plots import save_figure
-
     (path,) = save_figure(region_figure(result), stem, formats=("png",))
     return path
 
 
 def region_figure(result: Any):
-    """Fig.-7-style plot of a sweep's ``result`` (:class:`wmr_mj.experiments.sweep_result.SweepResult`): the bounds a
-    run is judged by (sup|E| <= E_max and sup|E'| <= E'_max, the sweep's inside/outside) and every run's (sup|E|,
-    sup|E'|). The region (4.21)-(4.23) is labelled the paper's claim on the paper's C80 only
-    (:func:`wmr_mj.analysis.verdicts.paper_region_name`)."""
-    import math
-
-    from matplotlib.patches import Rectangle
-
-    from wmr_mj.analysis.verdicts import paper_region_name
-    from wmr_mj.figures.plots import new_figure
-    from wmr_mj.sim.coerce import coerced
-
-    results, runs = result.rows, result.summary
-    claim = paper_region_name(coerced(result.spec.base).cart is None)
-    fig, ax = new_figure(5.0, 4.0)
-    for (E_max, Ed_max), colour, label in (
-            ((runs.certificate_E_max, runs.certificate_Edot_max), "C2", "certificate's bounds"),
-            ((runs.paper_E_max, runs.paper_Edot_max), "C0", claim.removeprefix("the "))):
-        if E_max is not None and Ed_max is not None and math.isfinite(E_max) and math.isfinite(Ed_max):
-            ax.add_patch(Rectangle((0, 0), E_max, Ed_max, alpha=0.15, color=colour, label=label))
-    sc = ax.scatter([r["sup_E"] for r in results], [r["sup_Edot"] for r in results], c=[r["m1"] for r in results],
-                    s=12, label="runs")
-    fig.colorbar(sc, ax=ax, label="m1 [kg]")
-    ax.set_xlabel("sup |E| [rad]")
-    ax.set_ylabel("sup |E'| [rad/s]")
-    ax.legend(loc="best")  # the runs sit anywhere; keep the legend off them
-    return fig
+    """Fig.-7-style plot of a sweep's ``result`` (:class:`wmr_mj.experiments.sweep_result.SweepResult`):
+    :func:`wmr_mj.figures.results.figure_sweep_region`, its region named as the paper's claim on the C80 only."""
+    return figure_sweep_region(result, on_c80=coerced(result.spec.base).cart is None)

@@ -4,6 +4,8 @@
 - :func:`plot_run`: E and E' between the bounds the run is judged by, the voltage between the supply limits
   (:func:`wmr_mj.figures.plots.plot_time_history`), and C's path beside its reference.
 - :func:`plot_sweep`: sup|E| of every run against each ranged parameter, with the certificate's E_max.
+- :func:`figure_sweep_region`: a sweep's runs in the (sup|E|, sup|E'|) plane with the bounds they are judged by
+  (``wmr-mj sweep``'s region.png).
 - :func:`plot_falsify`: the search beside random (:func:`wmr_mj.figures.plots.falsify_history`).
 - :func:`plot_compare`: compare's figure (:func:`figure_compare`, compare.png).
 - :func:`plot_validate`: the ladder's verdicts (:func:`wmr_mj.figures.plots.figure_ladder`).
@@ -26,12 +28,13 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from matplotlib.patches import Rectangle
 
 from wmr_mj.analysis.verdicts import paper_region_name
 from wmr_mj.figures import plots
 
 __all__ = ["ResultPlot", "plot_run", "plot_sweep", "plot_falsify", "plot_compare", "plot_validate", "figure_compare",
-           "plot_design", "plot_tightness", "plot_cart_check"]
+           "plot_design", "plot_tightness", "plot_cart_check", "figure_sweep_region"]
 
 #: a certified bar's colour and an uncertified one's (the verdicts' colours)
 _CERTIFIED_COLOUR, _UNCERTIFIED_COLOUR = plots.VERDICT_COLORS["certified-inside"], "0.6"
@@ -150,6 +153,28 @@ def plot_sweep(result: Any, *, xlabels: Sequence[str] | None = None) -> ResultPl
     axes[-1].legend(loc="best", fontsize=6.5)
     fig.suptitle(f"sweep of {result.summary.n} runs", fontsize=10)
     return ResultPlot(figure=fig, axes=axes)
+
+
+def figure_sweep_region(result: Any, *, on_c80: bool) -> Any:
+    """Fig.-7-style plot of a sweep's ``result`` (``SweepResult``, read by attribute: ``rows``, ``summary``): the
+    bounds a run is judged by (sup|E| <= E_max and sup|E'| <= E'_max, the sweep's inside/outside) and every run's
+    (sup|E|, sup|E'|), coloured by m1. The region (4.21)-(4.23) is labelled the paper's claim on the paper's C80
+    only (``on_c80``: the sweep's base runs on no cart file; :func:`wmr_mj.analysis.verdicts.paper_region_name`)."""
+    results, runs = result.rows, result.summary
+    claim = paper_region_name(on_c80)
+    fig, ax = plots.new_figure(5.0, 4.0)
+    for (E_max, Ed_max), colour, label in (
+            ((runs.certificate_E_max, runs.certificate_Edot_max), "C2", "certificate's bounds"),
+            ((runs.paper_E_max, runs.paper_Edot_max), "C0", claim.removeprefix("the "))):
+        if E_max is not None and Ed_max is not None and math.isfinite(E_max) and math.isfinite(Ed_max):
+            ax.add_patch(Rectangle((0, 0), E_max, Ed_max, alpha=0.15, color=colour, label=label))
+    sc = ax.scatter([r["sup_E"] for r in results], [r["sup_Edot"] for r in results], c=[r["m1"] for r in results],
+                    s=12, label="runs")
+    fig.colorbar(sc, ax=ax, label="m1 [kg]")
+    ax.set_xlabel("sup |E| [rad]")
+    ax.set_ylabel("sup |E'| [rad/s]")
+    ax.legend(loc="best")  # the runs sit anywhere; keep the legend off them
+    return fig
 
 
 def plot_falsify(result: Any) -> ResultPlot:

@@ -181,6 +181,7 @@ __all__ = [
     "falsify",
     "check_runnable",
     "worst_config",
+    "portfolio_start",
     # re-exported from wmr_mj.searches.falsify_objectives and wmr_mj.searches.search_methods, where they live
     "MIN_POPULATION",
     "PORTFOLIO_COORDINATE_STEP",
@@ -843,3 +844,14 @@ def worst_config(result: FalsifyResult) -> RunConfig:
     """The worst run's config, rebuilt from its reported parameters."""
     w = result.worst
     return result.spec.config(w.point or [w.params[n] for n in result.spec.names])
+
+
+def portfolio_start(spec: FalsifySpec, first: Sequence[Evaluation]) -> np.ndarray:
+    """Where the portfolio's CMA-ES started (d,) in the unit box: :func:`screened_start` of its vertices ``first``
+    (the runs of generation 0), each at its point as searched (unrounded) scaled to [0, 1] per range (a range of
+    zero width at 0), their objectives the values (a run without one left out)."""
+    lo, hi = spec.bounds[:, 0], spec.bounds[:, 1]
+    corners = np.array([e.point or [e.params[n] for n in spec.names] for e in first])  # as searched, unrounded
+    corners = np.where(hi > lo, (corners - lo) / np.where(hi > lo, hi - lo, 1.0), 0.0)
+    values = np.array([np.nan if e.objective is None else e.objective for e in first])
+    return screened_start(corners, values)

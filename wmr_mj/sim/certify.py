@@ -38,6 +38,7 @@ from wmr_mj.analysis.delay_split import covers_delay_split
 from wmr_mj.analysis.measurement import MeasurementErrors
 from wmr_mj.analysis.plant_box import F_OVER_P_NOT_MONOTONE, box_corners
 from wmr_mj.analysis.plant_box import hull as _hull
+from wmr_mj.analysis.regions import SmallGainRegion
 from wmr_mj.analysis.robustness import ParameterBox
 from wmr_mj.analysis.verdicts import OUTSIDE_THE_BOX
 from wmr_mj.errors import ParameterError
@@ -58,7 +59,7 @@ from wmr_mj.sim.config import (
 __all__ = ["certificate_for", "certificate_of", "law_certificate", "measurement_errors", "outside_of",
            "claim_on_estimate", "identified_spread",
            "box_spans", "outside_the_box", "reference_within", "certificate_name", "delay_split_of",
-           "MAX_SAMPLED_DELAY_PERIODS"]
+           "MAX_SAMPLED_DELAY_PERIODS", "section_4_beside"]
 
 
 def identified_spread(identified: Any) -> dict[str, tuple[float, float]]:
@@ -497,3 +498,19 @@ def _signal_assumptions(signals: Any, m1: float, m1_box: tuple[float, float]) ->
     return tuple(out)
 
 
+def section_4_beside(parts: Any, cert: Certificate) -> Certificate | None:
+    """Section 4's certificate of a run whose claim taken, ``cert``, is the sampled-data certificate and records
+    section 4's beside it (issue 44: the paper's analysis, a second opinion): the law's continuous claim alone, as
+    :func:`certificate_of` gives it for the cart's own measurement as a what-if; else None.
+
+    Args:
+        parts: the run's resolved parts (:class:`wmr_mj.sim.parts.RunParts`): its config, reference, parameter
+            sets, law and tracker.
+    """
+    if "section-4" not in (cert.inputs.get("certificates") or {}):
+        return None
+    config = parts.config
+    alone = certificate_of(config, parts.reference, base=parts.base, estimate=parts.estimate, plant=parts.plant,
+                           controller=parts.controller, tracker=parts.tracker,
+                           measurement=measurement_errors_of(config, parts.plant))
+    return alone if alone is not None and isinstance(alone.region, SmallGainRegion) else None
