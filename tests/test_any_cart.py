@@ -267,3 +267,67 @@ def test_the_paper_objective_is_named_as_this_carts_off_the_c80_and_the_others_s
     for name in OBJECTIVES:
         if name != "paper":
             assert objective_label(name, on_c80=False) == objective_label(name) == OBJECTIVE_LABELS[name]
+
+
+def _undeclared_cart(tmp_path: Path) -> Path:
+    """The new user's cart without its [paths] section: the paper's 1 m circle needs 1.12 rad of its +-0.7 rad stops,
+    so its own path is the one derived from its stops (wmr_mj.sim.coerce.default_path)."""
+    text = (DATA / "anycart.toml").read_text(encoding="utf-8")
+    cut = re.sub(r"\[paths\]\ndefault = [^\n]+\nsource = [^\n]+\n", "", text)
+    assert cut != text
+    path = tmp_path / "anycart-undeclared.toml"
+    path.write_text(cut, encoding="utf-8")
+    return path
+
+
+@pytest.mark.parametrize("declared", [True, False], ids=["declared-path", "derived-path"])
+def test_a_config_built_directly_on_a_cart_runs_on_the_carts_path(tmp_path, declared):
+    """``RunConfig(cart=...)`` built directly (not ``from_inputs``) is data (its path None: the cart's own) and runs
+    on the cart's path through ``run_closed_loop`` and a sweep, as the commands do. Before: the field's default, the
+    paper circle, which this cart's stops cannot steer (run refused, the sweep's runs on the circle).
+    The truth: the cart file's ``[paths] default``, else the loop derived from its stops (its note names it)."""
+    from wmr_mj.experiments.sweep import run_sweep
+    from wmr_mj.sim.closed_loop import run_closed_loop
+    from wmr_mj.sim.coerce import default_path, default_path_note
+
+    cart_path = DATA / "anycart.toml" if declared else _undeclared_cart(tmp_path)
+    cart = load_cart(cart_path)
+    own = cart.default_path if declared else default_path(cart)
+    if declared:
+        assert own.endswith("anycart-loop.toml")
+    else:
+        assert cart.default_path is None and "loop-of-" in default_path_note(cart)  # derived from the stops
+        assert '"name":"loop-of-' in own and "paper" not in own
+    config = RunConfig(cart=str(cart_path), duration=15.0)
+    result = run_closed_loop(config, progress=False)
+    assert result.config.path == own and result.summary.path == own
+    rows = run_sweep(SweepSpec(n=1, base=config))
+    assert len(rows) == 1 and rows[0]["path"] == own and rows[0]["status"] == "completed", rows[0]
+    assert coerce(config).path == own and config.to_dict()["path"] == own
+    assert config.path is None  # plain data: nothing read at construction
+
+
+def test_a_config_built_directly_without_a_cart_keeps_the_paper_circle():
+    """No cart (the C80): the paper circle, as before, in the record and in a sweep's fingerprint."""
+    assert RunConfig().path is None and RunConfig().to_dict()["path"] == "paper-circle"
+    assert coerce(RunConfig(cart="c80-magmotor")).path == "paper-circle"  # a shipped cart steers it
+
+
+def test_every_python_api_that_takes_a_path_defaults_to_the_carts_own():
+    """The design search, validate's settings and cart check's answers, given a cart and no path, take the cart's
+    own ([paths] default), as their commands do; without a cart, the paper circle as before. Before: each held
+    the paper circle as a plain default, which this cart cannot steer."""
+    from wmr_mj.experiments.cart_check import certified_on_cart
+    from wmr_mj.report.settings import ValidateSettings
+    from wmr_mj.searches.design_search import DesignProblem, search_design
+
+    cart = load_cart(DATA / "anycart.toml")
+    own = cart.default_path
+    assert ValidateSettings(cart=str(DATA / "anycart.toml")).path == own
+    assert ValidateSettings().path == "paper-circle"
+    answer = certified_on_cart(cart)
+    assert answer["path"] == own and answer["omega_r"] is not None, answer
+    base = RunConfig(**CERTIFIED.on(str(DATA / "anycart.toml")).config_changes(), cart=str(DATA / "anycart.toml"),
+                     duration=15.0)
+    found = search_design(DesignProblem(base=base, budget=4))
+    assert found.paths == (own,) and tuple(found.certificates) == (own,)
