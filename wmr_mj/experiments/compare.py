@@ -81,8 +81,9 @@ def design_from_token(token: str, suite: Suite, *, cart: Mapping[str, Any] | Non
             the design declares and on which the certified design's gains are derived.
         m1_range: the m1 box [kg] the design declares (a design file's own, ``wmr-mj compare``); None: the box of
             the suite's uncertainty on the cart.
-        path: the design's own path (a design file's, ``wmr-mj compare``; each scenario runs its own); None: the
-            cart's own (:func:`wmr_mj.sim.coerce.default_path`, the paper circle on the C80).
+        path: the design's own path (a design file's, ``wmr-mj compare``): a scenario (or the adversary) that
+            names no path runs on it, one that names its own runs that; None: the cart's own
+            (:func:`wmr_mj.sim.coerce.default_path`, the paper circle on the C80).
 
     Raises:
         UnknownNameError, ParameterError: an unknown preset or law, a bad setting (one line each).
@@ -317,7 +318,8 @@ def adversary_spec(design: Design, suite: Suite, *, budget: int, seed: int, meth
     t1 = adv.pulse_t1[0]
     signals = {"disturbance": {"kind": "pulse", "amplitude": adv.pulse_amplitude[1], "t1": t1, "t2": t1 + width},
                "d_max": suite.d_max}
-    base = coerce(design.config.replace(path=adv.path, signals=signals, reference_bounds=suite.reference_bounds))
+    path = design.config.path if adv.path is None else adv.path  # none named: the design's own
+    base = coerce(design.config.replace(path=path, signals=signals, reference_bounds=suite.reference_bounds))
     box: dict[str, tuple[float, float]] = {"m1": (float(base.m1_range[0]), float(base.m1_range[1])),
                                            **{k: (float(v[0]), float(v[1])) for k, v in base.box_ranges.items()}}
     if adv.path_knots:
