@@ -299,10 +299,11 @@ def _undeclared_cart(tmp_path: Path) -> Path:
 @pytest.mark.parametrize("declared", [True, False], ids=["declared-path", "derived-path"])
 def test_a_config_built_directly_on_a_cart_runs_on_the_carts_path(tmp_path, declared):
     """``RunConfig(cart=...)`` built directly (not ``from_inputs``) is data (its path None: the cart's own) and runs
-    on the cart's path through ``run_closed_loop`` and a sweep, as the commands do. Before: the field's default, the
-    paper circle, which this cart's stops cannot steer (run refused, the sweep's runs on the circle).
+    on the cart's path through ``run_closed_loop``, a sweep and falsify, as the commands do. Before: the field's
+    default, the paper circle, which this cart's stops cannot steer (run refused, the sweep's runs on the circle).
     The truth: the cart file's ``[paths] default``, else the loop derived from its stops (its note names it)."""
     from wmr_mj.experiments.sweep import run_sweep
+    from wmr_mj.searches.falsify import FalsifySpec, falsify
     from wmr_mj.sim.closed_loop import run_closed_loop
     from wmr_mj.sim.coerce import default_path, default_path_note
 
@@ -319,6 +320,9 @@ def test_a_config_built_directly_on_a_cart_runs_on_the_carts_path(tmp_path, decl
     assert result.config.path == own and result.summary.path == own
     rows = run_sweep(SweepSpec(n=1, base=config))
     assert len(rows) == 1 and rows[0]["path"] == own and rows[0]["status"] == "completed", rows[0]
+    found = falsify(FalsifySpec(base=config, box={"m1": CART_BOX}, budget=8, seed=0, method="lhs-polish",
+                                objective="sup-E"))
+    assert {e.summary["path"] for e in (*found.search, *found.random)} == {own}
     assert coerce(config).path == own and config.to_dict()["path"] == own
     assert config.path is None  # plain data: nothing read at construction
 
