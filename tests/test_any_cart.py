@@ -151,6 +151,18 @@ def test_a_c80_design_on_this_cart_runs_on_its_sensing_box_and_path_and_says_so(
     assert summary["sensing"]["delay"] == 0.01 and summary["sensing"]["encoder_ticks"] == 4096
 
 
+def test_compare_on_a_scenario_the_cart_cannot_steer_names_the_scenario_and_what_changes_it(folder):
+    """compare has no --path: a packaged scenario's path this cart cannot steer (the paper circle) is refused in one
+    line naming the scenario, the path, the stops and the options that change it. Before: "--path changes it"."""
+    proc = _cli("compare", "certified", "--cart", "anycart.toml", "--scenarios", "circle/nominal/none", "--budget",
+                "0", "--out", "cmp-circle", cwd=folder)
+    assert proc.returncode == 2, proc.stderr
+    line = proc.stderr.strip().splitlines()[-1]
+    assert line.startswith("wmr-mj: error: scenario 'circle/nominal/none': path infeasible"), line
+    assert "on path 'paper-circle'" in line and "+-0.7 rad" in line and "--scenarios" in line
+    assert "--path" not in line and "Traceback" not in proc.stderr
+
+
 def test_a_sweep_spec_on_a_cart_takes_the_carts_box():
     spec = SweepSpec(n=2, base=RunConfig(cart=str(DATA / "anycart.toml")))
     assert spec.m1_range == CART_BOX

@@ -39,11 +39,12 @@ import numpy as np
 
 from wmr_mj._util.deprecation import deprecated_names
 from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE, count_unmet, unmet_assumptions
-from wmr_mj.errors import ParameterError
+from wmr_mj.errors import InfeasiblePathError, ParameterError
 from wmr_mj.experiments.suite import Scenario, Suite, load_suite, versions
 from wmr_mj.hardware import cart_dict
 from wmr_mj.params import uncertainty_ranges
 from wmr_mj.plant.mjcf import TIMESTEP
+from wmr_mj.reference.named import PATH_OPTION_HINT
 from wmr_mj.sim.config import (
     RunConfig,
     coerce,
@@ -270,6 +271,17 @@ def _slim(summary: Mapping[str, Any]) -> dict[str, Any]:
     pe = summary.get("path_error") or {}
     out["cross_track_max"] = pe.get("cross_track_max")
     return out
+
+
+#: what changes a scenario's path that a cart cannot steer: compare has no --path (the suite names the paths)
+SCENARIO_PATH_HINT = ("the suite names the scenario's path, not an option: --scenarios leaves the scenario out, and a "
+                      "scenario of a suite of your own that names no path runs each design on its own (its cart's "
+                      "[paths] default, a design file's path)")
+
+
+def _scenario_refused(scenario: Scenario, exc: InfeasiblePathError) -> InfeasiblePathError:
+    """``exc`` (a scenario's path the cart cannot steer) as one line naming the scenario and what changes it."""
+    return type(exc)(f"scenario {scenario.id!r}: {str(exc).replace(PATH_OPTION_HINT, SCENARIO_PATH_HINT)}")
 
 
 def _scenario_task(config_dict: Mapping[str, Any], requirements: Mapping[str, str]) -> dict[str, Any]:
@@ -573,8 +585,11 @@ def compare(designs: Sequence[Design], suite: Suite, *, scenarios: Sequence[str]
             futures = [client.submit(_scenario_task, cfg.to_dict(), dict(suite.requirements), pure=False)
                        for _, _, cfg in jobs]
             results = []
-            for fut in futures:
-                results.append(fut.result())
+            for fut, (_, scenario, _) in zip(futures, jobs):
+                try:
+                    results.append(fut.result())
+                except InfeasiblePathError as exc:
+                    raise _scenario_refused(scenario, exc) from None
                 tick()
         finally:
             client.close()
@@ -583,14 +598,18 @@ def compare(designs: Sequence[Design], suite: Suite, *, scenarios: Sequence[str]
         parsed = {p: [parse_requirement(t, period=p) for t in suite.requirements.values()] for p in periods}
         monitor = threading.Lock()
 
-        def one(cfg: RunConfig) -> dict[str, Any]:
+        def one(job: tuple[Design, Scenario, RunConfig]) -> dict[str, Any]:
+            _, scenario, cfg = job
             p = TIMESTEP if cfg.control_period is None else cfg.control_period
-            out = run_scenario(cfg, suite.requirements, parsed=parsed[p], monitor=monitor)
+            try:
+                out = run_scenario(cfg, suite.requirements, parsed=parsed[p], monitor=monitor)
+            except InfeasiblePathError as exc:
+                raise _scenario_refused(scenario, exc) from None
             tick()
             return out
 
         with concurrent.futures.ThreadPoolExecutor(thread_count(nthread, len(jobs))) as pool:
-            results = list(pool.map(one, [cfg for _, _, cfg in jobs]))
+            results = list(pool.map(one, jobs))
     runs = tuple(ScenarioRun(design=d.label, scenario=s.id, summary=r["summary"], requirements=r["requirements"],
                              rms_voltage=r["rms_voltage"], tv_voltage=r["tv_voltage"],
                              cpu_us_per_step=r["cpu_us_per_step"], law=r["law"])
