@@ -135,6 +135,34 @@ def test_a_cart_beyond_the_designs_says_so_in_one_note_and_runs_on_its_own_sensi
     assert len(notes) == 1 and "60 130" in notes[0] and "80-120 kg" in notes[0]
 
 
+def test_a_c80_design_on_this_cart_runs_on_its_sensing_box_and_path_and_says_so(folder):
+    """The issue's ``run --design <a C80 design> --cart mycart.toml``: one note naming both carts, and the run on the
+    cart's own 10 ms delay, m1 and path. Before: silent and without the delay, then (the design's path kept) refused
+    with the paper circle's infeasibility, a path the user never named."""
+    made = _cli("design", "--budget", "4", "--duration", "15", "--out", "c80-design.json", cwd=folder)
+    assert made.returncode in (0, 1), made.stderr  # 1: not certified in 4 evaluations; the file is written
+    proc = _cli("run", "--design", "c80-design.json", "--cart", "anycart.toml", "--no-log", "--duration", "15",
+                "--json", cwd=folder)
+    assert proc.returncode == 0, proc.stderr
+    notes = [line for line in proc.stderr.splitlines() if "not the cart the design" in line]
+    assert len(notes) == 1 and "(C80)" in notes[0] and "--cart anycart.toml" in notes[0] and "path" in notes[0]
+    summary = json.loads(proc.stdout)
+    assert summary["m1"] == 100.0 and summary["path"].endswith("anycart-loop.toml")
+    assert summary["sensing"]["delay"] == 0.01 and summary["sensing"]["encoder_ticks"] == 4096
+
+
+def test_compare_on_a_scenario_the_cart_cannot_steer_names_the_scenario_and_what_changes_it(folder):
+    """compare has no --path: a packaged scenario's path this cart cannot steer (the paper circle) is refused in one
+    line naming the scenario, the path, the stops and the options that change it. Before: "--path changes it"."""
+    proc = _cli("compare", "certified", "--cart", "anycart.toml", "--scenarios", "circle/nominal/none", "--budget",
+                "0", "--out", "cmp-circle", cwd=folder)
+    assert proc.returncode == 2, proc.stderr
+    line = proc.stderr.strip().splitlines()[-1]
+    assert line.startswith("wmr-mj: error: scenario 'circle/nominal/none': path infeasible"), line
+    assert "on path 'paper-circle'" in line and "+-0.7 rad" in line and "--scenarios" in line
+    assert "--path" not in line and "Traceback" not in proc.stderr
+
+
 def test_a_sweep_spec_on_a_cart_takes_the_carts_box():
     spec = SweepSpec(n=2, base=RunConfig(cart=str(DATA / "anycart.toml")))
     assert spec.m1_range == CART_BOX
@@ -267,3 +295,71 @@ def test_the_paper_objective_is_named_as_this_carts_off_the_c80_and_the_others_s
     for name in OBJECTIVES:
         if name != "paper":
             assert objective_label(name, on_c80=False) == objective_label(name) == OBJECTIVE_LABELS[name]
+
+
+def _undeclared_cart(tmp_path: Path) -> Path:
+    """The new user's cart without its [paths] section: the paper's 1 m circle needs 1.12 rad of its +-0.7 rad stops,
+    so its own path is the one derived from its stops (wmr_mj.sim.coerce.default_path)."""
+    text = (DATA / "anycart.toml").read_text(encoding="utf-8")
+    cut = re.sub(r"\[paths\]\ndefault = [^\n]+\nsource = [^\n]+\n", "", text)
+    assert cut != text
+    path = tmp_path / "anycart-undeclared.toml"
+    path.write_text(cut, encoding="utf-8")
+    return path
+
+
+@pytest.mark.parametrize("declared", [True, False], ids=["declared-path", "derived-path"])
+def test_a_config_built_directly_on_a_cart_runs_on_the_carts_path(tmp_path, declared):
+    """``RunConfig(cart=...)`` built directly (not ``from_inputs``) is data (its path None: the cart's own) and runs
+    on the cart's path through ``run_closed_loop``, a sweep and falsify, as the commands do. Before: the field's
+    default, the paper circle, which this cart's stops cannot steer (run refused, the sweep's runs on the circle).
+    The truth: the cart file's ``[paths] default``, else the loop derived from its stops (its note names it)."""
+    from wmr_mj.experiments.sweep import run_sweep
+    from wmr_mj.searches.falsify import FalsifySpec, falsify
+    from wmr_mj.sim.closed_loop import run_closed_loop
+    from wmr_mj.sim.coerce import default_path, default_path_note
+
+    cart_path = DATA / "anycart.toml" if declared else _undeclared_cart(tmp_path)
+    cart = load_cart(cart_path)
+    own = cart.default_path if declared else default_path(cart)
+    if declared:
+        assert own.endswith("anycart-loop.toml")
+    else:
+        assert cart.default_path is None and "loop-of-" in default_path_note(cart)  # derived from the stops
+        assert '"name":"loop-of-' in own and "paper" not in own
+    config = RunConfig(cart=str(cart_path), duration=15.0)
+    result = run_closed_loop(config, progress=False)
+    assert result.config.path == own and result.summary.path == own
+    rows = run_sweep(SweepSpec(n=1, base=config))
+    assert len(rows) == 1 and rows[0]["path"] == own and rows[0]["status"] == "completed", rows[0]
+    found = falsify(FalsifySpec(base=config, box={"m1": CART_BOX}, budget=8, seed=0, method="lhs-polish",
+                                objective="sup-E"))
+    assert {e.summary["path"] for e in (*found.search, *found.random)} == {own}
+    assert coerce(config).path == own and config.to_dict()["path"] == own
+    assert config.path is None  # plain data: nothing read at construction
+
+
+def test_a_config_built_directly_without_a_cart_keeps_the_paper_circle():
+    """No cart (the C80): the paper circle, as before, in the record and in a sweep's fingerprint."""
+    assert RunConfig().path is None and RunConfig().to_dict()["path"] == "paper-circle"
+    assert coerce(RunConfig(cart="c80-magmotor")).path == "paper-circle"  # a shipped cart steers it
+
+
+def test_every_python_api_that_takes_a_path_defaults_to_the_carts_own():
+    """The design search, validate's settings and cart check's answers, given a cart and no path, take the cart's
+    own ([paths] default), as their commands do; without a cart, the paper circle as before. Before: each held
+    the paper circle as a plain default, which this cart cannot steer."""
+    from wmr_mj.experiments.cart_check import certified_on_cart
+    from wmr_mj.report.settings import ValidateSettings
+    from wmr_mj.searches.design_search import DesignProblem, search_design
+
+    cart = load_cart(DATA / "anycart.toml")
+    own = cart.default_path
+    assert ValidateSettings(cart=str(DATA / "anycart.toml")).path == own
+    assert ValidateSettings().path == "paper-circle"
+    answer = certified_on_cart(cart)
+    assert answer["path"] == own and answer["omega_r"] is not None, answer
+    base = RunConfig(**CERTIFIED.on(str(DATA / "anycart.toml")).config_changes(), cart=str(DATA / "anycart.toml"),
+                     duration=15.0)
+    found = search_design(DesignProblem(base=base, budget=4))
+    assert found.paths == (own,) and tuple(found.certificates) == (own,)

@@ -105,3 +105,58 @@ def test_validate_design_file_runs_on_the_designs_cart_box_and_path(folder):
     assert "the cart anycart 1.0.0 under m1 in 80-120 kg" in first and "anycart-loop.toml" in first
     for word in ("550", "750", "paper-circle", "paper circle"):
         assert word not in proc.stdout, word
+
+
+#: a suite of the user's whose first scenario and adversary name no path: each runs the design's own
+_OWN_PATH_SUITE = """
+[suite]
+name = "own-path"
+version = 1
+duration = 15.0
+
+[plants.nominal]
+
+[signals.none]
+
+[requirements]
+settled-error = "always[10,15](abs(E) <= 0.05)"
+
+[adversary]
+requirement = "settled-error"
+uncertainty = "m1"
+hold_range = [0.0, 3.0]
+disturbance = { kind = "pulse", t1 = [5.0, 10.0], amplitude = [-1.0, 1.0], width = 1.0 }
+
+[[scenario]]
+id = "own/nominal/none"
+plant = "nominal"
+signals = "none"
+
+[[scenario]]
+id = "lane/nominal/none"
+path = "lane-change"
+plant = "nominal"
+signals = "none"
+"""
+
+
+def test_compare_runs_a_scenario_that_names_no_path_on_the_design_files_path(folder):
+    """A scenario (and the adversary) that names no path runs the design file's own (anycart-loop.toml, the path the
+    design was found on); one that names its path runs that. Before: every scenario had to name one (the suite
+    refused a scenario without ``path``), so the design file's path was never used by compare."""
+    from wmr_mj.experiments.compare import adversary_spec
+
+    (folder / "own-path.toml").write_text(_OWN_PATH_SUITE, encoding="utf-8")
+    suite = load_suite(str(folder / "own-path.toml"))
+    args = _compare_args(folder, "d.json")
+    found = design_files_found_on(args)
+    design = design_from_token(args.designs[0], suite, cart={"cart": args.cart}, **found[args.designs[0]])
+    own, lane = suite.scenarios
+    assert own.path is None and Path(own.config(design.config).path).name == "anycart-loop.toml"
+    assert lane.config(design.config).path == "lane-change"
+    assert Path(adversary_spec(design, suite, budget=16, seed=0).base.path).name == "anycart-loop.toml"
+    proc = _cli("compare", "d.json", "--suite", "own-path.toml", "--scenarios", "own/*", "--budget", "0", "--json",
+                "--out", "cmp-own", cwd=folder)
+    assert proc.returncode == 0, proc.stderr
+    rows = [json.loads(line) for line in (folder / "cmp-own" / "runs.jsonl").read_text().splitlines()]
+    assert len(rows) == 1 and Path(rows[0]["summary"]["path"]).name == "anycart-loop.toml", rows

@@ -51,6 +51,22 @@ def test_sweep_param_m1_fixes_every_run_as_sweep_m1_does(tmp_path, capsys):
     assert by_param["verdicts"] == by_option["verdicts"]
 
 
+def test_falsify_param_m1_fixes_the_mass_as_falsify_m1_does(tmp_path, capsys):
+    """falsify's --m1 fixes every run's m1 (the other axes searched alone): --param m1= the same search, to the bit."""
+    common = ["falsify", "--range", "R_a=1.0:1.3", "--budget", "8", "--duration", "10", "--objective", "sup-E",
+              "--json"]
+    by_param = _json_of(capsys, [*common, "--param", "m1=700", "--out", str(tmp_path / "a")])
+    by_option = _json_of(capsys, [*common, "--m1", "700", "--out", str(tmp_path / "b")])
+    assert "m1" not in by_param["worst"]["params"]  # not searched: fixed
+    assert by_param["worst"] == by_option["worst"]
+
+
+def test_identify_param_m1_is_identify_m1(capsys):
+    common = ["identify", "--duration", "5", "--json"]
+    by_param = _json_of(capsys, [*common, "--param", "m1=700"])
+    assert by_param == _json_of(capsys, [*common, "--m1", "700"]) and by_param["m1"] == 700.0
+
+
 def test_a_run_config_takes_an_override_of_m1_as_its_m1():
     config = RunConfig(plant_overrides={"m1": 700.0, "mu": 0.02})
     assert config.m1 == 700.0 and dict(config.plant_overrides) == {"mu": 0.02}

@@ -187,7 +187,7 @@ def test_the_carts_inductance_reaches_the_dcmotor_and_an_actuation_overrides_it(
 def test_a_cart_file_with_inductance_is_certified_on_the_12bit_encoder(tmp_path):
     """motor.L_a = R_a x 1 ms in the cart file, no --actuation: the measurement carries L_a/R_a = 1 ms, section 4
     leaves it uncovered, and the sampled-data certificate holds it: certified, E_max as with --actuation inductance=
-    (the same number, 0.1107 rad at m1 = 750 kg, docs/guides/certificates.md)."""
+    (the same number, 0.05062 rad at m1 = 750 kg, docs/guides/certificates.md)."""
     import wmr_mj as wm
     from wmr_mj.sim.config import RunConfig
     from wmr_mj.sim.parts import resolve_run

@@ -148,7 +148,7 @@ Usage::
     from wmr_mj.sim.certify import certificate_for          # the certificate of a configured run
     from wmr_mj.sim.config import RunConfig, build_reference
     cfg = RunConfig(model="nonholonomic", kp=100.0, kd=20.0, friction_width=0.01)
-    cert = certificate_for(cfg, build_reference(cfg.path, C80, dt=1e-3, duration=35.0)[0])
+    cert = certificate_for(cfg, build_reference("paper-circle", C80, dt=1e-3, duration=35.0)[0])
 """
 
 from __future__ import annotations

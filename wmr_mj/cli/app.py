@@ -44,7 +44,6 @@ from wmr_mj.cli.parsers import (
     sweep,
     validate,
 )
-from wmr_mj.cli.run_options import DEFAULT_DURATION
 from wmr_mj.errors import WmrMjError
 
 #: each command's parser module (:mod:`wmr_mj.cli.parsers`), in the order ``wmr-mj --help`` lists them
@@ -107,7 +106,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         m1_of_param(args)  # --param m1=KG is --m1 KG wherever --m1 is an option
         return int(_implementation(args.command)(args) or 0)
     except WmrMjError as exc:
-        print(f"wmr-mj: error: {_with_where_duration_came_from(str(exc), args)}", file=sys.stderr)
+        print(f"wmr-mj: error: {_with_where_duration_came_from(str(exc), args, argv)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("wmr-mj: interrupted", file=sys.stderr)
@@ -117,12 +116,21 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 0
 
 
-def _with_where_duration_came_from(message: str, args: argparse.Namespace) -> str:
-    """``message``, and where a refused duration came from when the user gave none: the default --duration."""
-    if "duration = " in message and getattr(args, "duration", None) is DEFAULT_DURATION:
-        return (f"{message} (the duration is --duration's default, {DEFAULT_DURATION:g} s, as none was given; "
-                "give --duration)")
-    return message
+def _with_where_duration_came_from(message: str, args: argparse.Namespace, argv: Sequence[str]) -> str:
+    """``message``, and where a refused duration came from when the user gave none: the command's default
+    --duration (run's, design's, validate's, ...), or, for ``cart check`` (whose --duration is the identification's
+    excitation), the length of its runs on the cart's path."""
+    if "duration = " not in message or any(a == "--duration" or a.startswith("--duration=") for a in argv):
+        return message
+    if getattr(args, "command", None) == "cart":
+        return (f"{message} (the duration of cart check's runs on the path, run's default, as no --duration of a run "
+                "is given here; cart check's --duration is the identification's excitation: give --path, or declare "
+                "[paths] default in the cart file, for a path the cart drives within it)")
+    duration = getattr(args, "duration", None)
+    if not isinstance(duration, (int, float)):
+        return message
+    return (f"{message} (the duration is --duration's default, {duration:g} s, as none was given; "
+            "give --duration)")
 
 
 if __name__ == "__main__":

@@ -122,10 +122,11 @@ def with_design_file(args: argparse.Namespace) -> argparse.Namespace:
         if given is not None and not _same_cart(given, data.get("cart")):
             notes.append(f"--cart {given} is not the cart the design {args.design} was found on "
                          f"({design_cart_name(args.design, data)}): its gains run on {given} with that cart's own "
-                         "sensing, actuation, play and m1 box")
+                         "sensing, actuation, play, m1 box and path")
             for name in ("sensing", "actuation", "backlash"):
                 settings.pop(name)
             found_on.pop("m1_range", None)
+            found_on.pop("path", None)  # the design's path may be one the given cart cannot steer
     if args.omega_r is not None:
         settings.pop("kp"), settings.pop("kd")
     for name, value in settings.items():

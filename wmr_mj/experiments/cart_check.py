@@ -232,12 +232,14 @@ def _answer(cart: Any, steps: Any, ident: Any, ident_error: str | None) -> str:
             "P, C_V, F, K, gyro are those the file implies")
 
 
-def certified_on_cart(cart: Any, path: str = "paper-circle") -> dict[str, Any]:
-    """The certified design on ``cart`` (a checked CartFile) and its certificate on ``path`` with the cart's
-    default sensing, actuation and play: omega_r [rad/s], kp, kd, certified, E_max [rad], Edot_max [rad/s],
+def certified_on_cart(cart: Any, path: str | None = None) -> dict[str, Any]:
+    """The certified design on ``cart`` (a checked CartFile) and its certificate on ``path`` (None: the cart's own,
+    :func:`wmr_mj.sim.coerce.default_path`) with the cart's default sensing, actuation and play: omega_r [rad/s],
+    kp, kd, certified, E_max [rad], Edot_max [rad/s],
     voltage_max [V], voltage_limit [V], met, unmet (assumption names); or omega_r None and 'reason' where the rule
     finds no omega_r on its grid."""
 
+    path = default_path(cart) if path is None else path
     try:  # a paper circle the cart's supply or stops cannot follow: the cart's answer, not the user's input
         design = certified_design(cart, path=path)
         claim = resolve_run(RunConfig(**design.config_changes(), cart=cart, path=path)).claim
@@ -251,9 +253,10 @@ def certified_on_cart(cart: Any, path: str = "paper-circle") -> dict[str, Any]:
 
 
 def design_on_cart(cart: Any, *, seed: int | None = None, budget: int | None = None,
-                   path: str = "paper-circle") -> dict[str, Any]:
+                   path: str | None = None) -> dict[str, Any]:
     """Can ``wmr-mj design`` certify ``cart`` (a checked CartFile) on its default sensing, actuation and play? The
-    design search on ``path`` over the cart's m1 box, computed-torque law, 1 ms period, E_max minimised.
+    design search on ``path`` (None: the cart's own, :func:`wmr_mj.sim.coerce.default_path`) over the cart's m1
+    box, computed-torque law, 1 ms period, E_max minimised.
 
     Returns:
         certified; where certified: E_max [rad], voltage_max [V], kp [1/s^2], kd [1/s], friction_width [rad/s];
@@ -264,6 +267,7 @@ def design_on_cart(cart: Any, *, seed: int | None = None, budget: int | None = N
 
     seed = DEFAULT_SEED if seed is None else seed
     budget = DEFAULT_BUDGET if budget is None else budget
+    path = default_path(cart) if path is None else path
     command = (f"wmr-mj design --cart {cart.path} --seed {seed}"
                + ("" if budget == DEFAULT_BUDGET else f" --budget {budget}")
                + ("" if path == default_path(cart) else f" --path {path}"))

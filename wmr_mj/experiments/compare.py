@@ -40,12 +40,13 @@ import numpy as np
 from wmr_mj._util.deprecation import deprecated_names
 from wmr_mj.analysis.requirements import parse_requirement
 from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE, count_unmet, unmet_assumptions
-from wmr_mj.errors import ParameterError
+from wmr_mj.errors import InfeasiblePathError, ParameterError
 from wmr_mj.experiments.suite import Scenario, Suite, load_suite, versions
 from wmr_mj.hardware import Actuation, Sensing, Transmission, cart_dict
 from wmr_mj.params import uncertainty_ranges
 from wmr_mj.plant.mjcf import TIMESTEP
 from wmr_mj.reference.knots import KnotSpace
+from wmr_mj.reference.named import PATH_OPTION_HINT
 from wmr_mj.searches.design_search import design_file_settings, read_design
 from wmr_mj.searches.falsify import FalsifySpec, check_runnable, falsify
 from wmr_mj.sim import notebook
@@ -95,8 +96,9 @@ def design_from_token(token: str, suite: Suite, *, cart: Mapping[str, Any] | Non
             the design declares and on which the certified design's gains are derived.
         m1_range: the m1 box [kg] the design declares (a design file's own, ``wmr-mj compare``); None: the box of
             the suite's uncertainty on the cart.
-        path: the design's own path (a design file's, ``wmr-mj compare``; each scenario runs its own); None: the
-            cart's own (:func:`wmr_mj.sim.coerce.default_path`, the paper circle on the C80).
+        path: the design's own path (a design file's, ``wmr-mj compare``): a scenario (or the adversary) that
+            names no path runs on it, one that names its own runs that; None: the cart's own
+            (:func:`wmr_mj.sim.coerce.default_path`, the paper circle on the C80).
 
     Raises:
         UnknownNameError, ParameterError: an unknown preset or law, a bad setting (one line each).
@@ -271,6 +273,17 @@ def _slim(summary: Mapping[str, Any]) -> dict[str, Any]:
     return out
 
 
+#: what changes a scenario's path that a cart cannot steer: compare has no --path (the suite names the paths)
+SCENARIO_PATH_HINT = ("the suite names the scenario's path, not an option: --scenarios leaves the scenario out, and a "
+                      "scenario of a suite of your own that names no path runs each design on its own (its cart's "
+                      "[paths] default, a design file's path)")
+
+
+def _scenario_refused(scenario: Scenario, exc: InfeasiblePathError) -> InfeasiblePathError:
+    """``exc`` (a scenario's path the cart cannot steer) as one line naming the scenario and what changes it."""
+    return type(exc)(f"scenario {scenario.id!r}: {str(exc).replace(PATH_OPTION_HINT, SCENARIO_PATH_HINT)}")
+
+
 def _scenario_task(config_dict: Mapping[str, Any], requirements: Mapping[str, str]) -> dict[str, Any]:
     """A Dask task: plain data in, plain data out."""
     return run_scenario(config_from_dict(config_dict), requirements)
@@ -314,7 +327,8 @@ def adversary_spec(design: Design, suite: Suite, *, budget: int, seed: int, meth
     t1 = adv.pulse_t1[0]
     signals = {"disturbance": {"kind": "pulse", "amplitude": adv.pulse_amplitude[1], "t1": t1, "t2": t1 + width},
                "d_max": suite.d_max}
-    base = coerce(design.config.replace(path=adv.path, signals=signals, reference_bounds=suite.reference_bounds))
+    path = design.config.path if adv.path is None else adv.path  # none named: the design's own
+    base = coerce(design.config.replace(path=path, signals=signals, reference_bounds=suite.reference_bounds))
     box: dict[str, tuple[float, float]] = {"m1": (float(base.m1_range[0]), float(base.m1_range[1])),
                                            **{k: (float(v[0]), float(v[1])) for k, v in base.box_ranges.items()}}
     if adv.path_knots:
@@ -559,8 +573,11 @@ def compare(designs: Sequence[Design], suite: Suite, *, scenarios: Sequence[str]
             futures = [client.submit(_scenario_task, cfg.to_dict(), dict(suite.requirements), pure=False)
                        for _, _, cfg in jobs]
             results = []
-            for fut in futures:
-                results.append(fut.result())
+            for fut, (_, scenario, _) in zip(futures, jobs):
+                try:
+                    results.append(fut.result())
+                except InfeasiblePathError as exc:
+                    raise _scenario_refused(scenario, exc) from None
                 tick()
         finally:
             client.close()
@@ -569,14 +586,18 @@ def compare(designs: Sequence[Design], suite: Suite, *, scenarios: Sequence[str]
         parsed = {p: [parse_requirement(t, period=p) for t in suite.requirements.values()] for p in periods}
         monitor = threading.Lock()
 
-        def one(cfg: RunConfig) -> dict[str, Any]:
+        def one(job: tuple[Design, Scenario, RunConfig]) -> dict[str, Any]:
+            _, scenario, cfg = job
             p = TIMESTEP if cfg.control_period is None else cfg.control_period
-            out = run_scenario(cfg, suite.requirements, parsed=parsed[p], monitor=monitor)
+            try:
+                out = run_scenario(cfg, suite.requirements, parsed=parsed[p], monitor=monitor)
+            except InfeasiblePathError as exc:
+                raise _scenario_refused(scenario, exc) from None
             tick()
             return out
 
         with concurrent.futures.ThreadPoolExecutor(thread_count(nthread, len(jobs))) as pool:
-            results = list(pool.map(one, [cfg for _, _, cfg in jobs]))
+            results = list(pool.map(one, jobs))
     runs = tuple(ScenarioRun(design=d.label, scenario=s.id, summary=r["summary"], requirements=r["requirements"],
                              rms_voltage=r["rms_voltage"], tv_voltage=r["tv_voltage"],
                              cpu_us_per_step=r["cpu_us_per_step"], law=r["law"])

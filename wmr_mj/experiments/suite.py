@@ -40,11 +40,12 @@ SUITES_DIR = Path(__file__).resolve().parents[1] / "data" / "suites"
 
 @dataclass(frozen=True)
 class Scenario:
-    """One scenario: its stable ``id``, C's ``path``, the plant's parameters (``plant``: name and overrides,
-    m1 among them where set) and the run's ``signals`` (JSON form, None: none)."""
+    """One scenario: its stable ``id``, C's ``path`` (None where the suite names none: the design's own, a design
+    file's path or its cart's), the plant's parameters (``plant``: name and overrides, m1 among them where set) and
+    the run's ``signals`` (JSON form, None: none)."""
 
     id: str
-    path: str
+    path: str | None
     plant: str
     plant_params: Mapping[str, float]
     signals_name: str
@@ -59,11 +60,12 @@ class Scenario:
     transmission: Any = None  # wmr_mj.hardware.Transmission
 
     def config(self, base: RunConfig) -> RunConfig:
-        """``base`` (a design: its controller, tracker, gains, model) on this scenario; on the scenario's
+        """``base`` (a design: its controller, tracker, gains, model) on this scenario: on the scenario's path where it
+        names one, else the design's own (``base.path``: a design file's, else its cart's); on the scenario's
         hardware where it names one (its sensing, actuation and transmission replace the design's)."""
         params = dict(self.plant_params)
         m1 = params.pop("m1", None)
-        changes: dict[str, Any] = {"path": self.path, "duration": self.duration,
+        changes: dict[str, Any] = {"path": base.path if self.path is None else self.path, "duration": self.duration,
                                    "plant_overrides": {**base.plant_overrides, **params},
                                    "signals": None if self.signals is None else dict(self.signals),
                                    "reference_bounds": self.reference_bounds}
@@ -77,10 +79,11 @@ class Scenario:
 @dataclass(frozen=True)
 class Adversary:
     """The box ``compare`` falsifies every controller over: the plant's uncertainty box, C's path (knots and
-    hold within the declared bounds) and a disturbance pulse (start and amplitude), against one requirement."""
+    hold within the declared bounds; ``path`` the base path, None where the suite names none: the design's own)
+    and a disturbance pulse (start and amplitude), against one requirement."""
 
     requirement: str
-    path: str
+    path: str | None
     uncertainty: str
     path_knots: int
     hold_range: tuple[float, float]
@@ -237,14 +240,16 @@ def _build(data: Mapping[str, Any], where: str, source: str, sha256: str) -> Sui
             if s["hardware"] not in hardware:
                 raise UnknownNameError(f"{where}: scenario {sid!r} hardware", s["hardware"], tuple(hardware))
             built = {"hardware": str(s["hardware"]), **hardware[s["hardware"]]}
-        scenarios.append(Scenario(id=sid, path=str(s["path"]), plant=str(s["plant"]), plant_params=plants[s["plant"]],
+        path = None if s.get("path") is None else str(s["path"])  # none: the design's own
+        scenarios.append(Scenario(id=sid, path=path, plant=str(s["plant"]), plant_params=plants[s["plant"]],
                                   signals_name=str(s["signals"]), signals=signal_sets[s["signals"]],
                                   duration=duration, reference_bounds=bounds, **built))
     adv = data["adversary"]
     if adv["requirement"] not in requirements:
         raise UnknownNameError(f"{where}: [adversary] requirement", adv["requirement"], tuple(requirements))
     pulse = adv["disturbance"]
-    adversary = Adversary(requirement=str(adv["requirement"]), path=str(adv["path"]),
+    adv_path = None if adv.get("path") is None else str(adv["path"])  # none: the design's own
+    adversary = Adversary(requirement=str(adv["requirement"]), path=adv_path,
                           uncertainty=str(adv["uncertainty"]), path_knots=int(adv.get("path_knots", 0)),
                           hold_range=(float(adv["hold_range"][0]), float(adv["hold_range"][1])),
                           pulse_t1=(float(pulse["t1"][0]), float(pulse["t1"][1])),

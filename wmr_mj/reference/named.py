@@ -23,7 +23,7 @@ from wmr_mj.reference import paths as ref
 from wmr_mj.reference.route import is_route_spec, route_names, route_of, route_reference
 
 __all__ = ["PATH_NAMES", "build_reference", "REFERENCE_CACHE_SIZE", "path_label", "LANE_CHANGE_LEAD_IN_M",
-           "LANE_CHANGE_OFFSET_M", "LANE_CHANGE_LENGTH_M"]
+           "LANE_CHANGE_OFFSET_M", "LANE_CHANGE_LENGTH_M", "PATH_OPTION_HINT"]
 
 #: the paths of C a run names (the others are routes)
 PATH_NAMES = ("paper-circle", "lane-change", "figure-eight")
@@ -56,6 +56,11 @@ def build_reference(path: str, params: C80Parameters, *, dt: float, duration: fl
 #: references kept by :func:`build_reference`
 REFERENCE_CACHE_SIZE = 16
 
+#: what an infeasible path's message says changes it, where the path is the user's (a command's --path); a caller
+#: whose path is another's (compare's scenario, the suite's) replaces it with its own option
+PATH_OPTION_HINT = ("--path changes it (a path this cart steers: e.g. a route of larger radius, or the cart file's "
+                    "[paths] default)")
+
 
 @functools.lru_cache(maxsize=REFERENCE_CACHE_SIZE)
 def _cached_reference(path: str, file_key: tuple | None, params: C80Parameters, dt: float, duration: float):
@@ -65,8 +70,7 @@ def _cached_reference(path: str, file_key: tuple | None, params: C80Parameters, 
         raise
     except InfeasiblePathError as exc:  # the path, the stops and the option that changes it, named
         raise InfeasiblePathError(f"{exc} -- on path {path_label(path)}, with the cart's steering stops at "
-                                  f"+-{params.steering_range:g} rad; --path changes it (a path this cart steers: "
-                                  "e.g. a route of larger radius, or the cart file's [paths] default)") from None
+                                  f"+-{params.steering_range:g} rad; {PATH_OPTION_HINT}") from None
 
 
 def path_label(path: str) -> str:

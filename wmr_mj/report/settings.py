@@ -72,7 +72,9 @@ class ValidateSettings:
     m1_range: tuple[float, float] = None  # type: ignore[assignment]
     nominal_m1: float = None  # type: ignore[assignment]
     uncertainty: str = "m1"
-    path: str = "paper-circle"
+    # C's path of every run; None: the cart's own (wmr_mj.sim.coerce.default_path; the paper circle on the C80),
+    # resolved when checked, as validate takes it
+    path: str = None  # type: ignore[assignment]
     designs: tuple[str, ...] = ()  # designs of the user's, each judged beside the ladder (validate --design)
     # the cart every run of the report runs on (wmr_mj.hardware parts or their specs, as RunConfig takes them;
     # validate --sensing/--actuation/--backlash); None: ideal (to_dict then has none of these keys)
@@ -91,6 +93,8 @@ class ValidateSettings:
             object.__setattr__(self, "m1_range", on_cart.m1_range)
         if self.nominal_m1 is None:
             object.__setattr__(self, "nominal_m1", on_cart.m1)
+        if self.path is None:
+            object.__setattr__(self, "path", on_cart.path)
 
         integer_at_least("n", self.n, 1, "the number of runs per rung must be an integer >= 1")
         integer_at_least("seed", self.seed, 0, "an integer >= 0 is required")

@@ -97,7 +97,9 @@ class DesignProblem:
     Attributes:
         base: the run's configuration: the cart (sensing, actuation, transmission), the plant box (m1_range,
             box_ranges, box), the duration; the law's fields are the search's.
-        paths: the paths every certificate must hold on (the worst counts).
+        paths: the paths every certificate must hold on (the worst counts); empty: the base's own path (its
+            ``path``, else its cart's: :func:`wmr_mj.sim.coerce.default_path`, the paper circle on the C80), as
+            ``wmr-mj design`` takes it.
         periods: the control periods tried, s (each a whole number of physics steps).
         objective: one of :data:`OBJECTIVES` (default :data:`DEFAULT_OBJECTIVE`, the supply weighed).
         method: one of :data:`METHODS`.
@@ -112,7 +114,7 @@ class DesignProblem:
     """
 
     base: Any
-    paths: tuple[str, ...] = ("paper-circle",)
+    paths: tuple[str, ...] = ()
     periods: tuple[float, ...] = (0.001,)
     objective: str = DEFAULT_OBJECTIVE
     method: str = "cma"
@@ -493,7 +495,8 @@ def search_design(problem: DesignProblem) -> DesignResult:
         raise ParameterError(f"--objective {problem.objective!r} is not accepted; one of {', '.join(OBJECTIVES)}")
     if problem.method not in METHODS:
         raise ParameterError(f"--method {problem.method!r} is not accepted; one of {', '.join(METHODS)}")
-    problem = dataclasses.replace(problem, base=coerced(problem.base))  # a base given directly: typed once, here
+    base = coerced(problem.base)  # a base given directly: typed once, here (its path the cart's where it names none)
+    problem = dataclasses.replace(problem, base=base, paths=problem.paths or (base.path,))
     periods = check_periods(problem.periods, problem.base.duration)
     _check_law(problem.base.controller)
     best: tuple[float, Any] | None = None

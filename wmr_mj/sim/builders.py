@@ -14,7 +14,7 @@ Usage::
     from wmr_mj.sim.builders import LawSpec, build_reference, controller_for, estimate_parameters, law_and_settings
     controller = controller_for(config, estimate_parameters())
     controller, settings = law_and_settings(LawSpec.of(config), estimate_parameters())   # a typed config's law
-    reference, settle_s = build_reference(config.path, estimate_parameters(), dt=1e-3, duration=35.0)
+    reference, settle_s = build_reference("paper-circle", estimate_parameters(), dt=1e-3, duration=35.0)
 """
 
 from __future__ import annotations

@@ -7,7 +7,7 @@ Usage::
     from wmr_mj.sim.config import RunConfig, build_reference
     from wmr_mj import C80
     cfg = RunConfig(model="nonholonomic", kp=100.0, kd=20.0, friction_width=0.01)
-    cert = certificate_for(cfg, build_reference(cfg.path, C80, dt=1e-3, duration=35.0)[0])
+    cert = certificate_for(cfg, build_reference("paper-circle", C80, dt=1e-3, duration=35.0)[0])
     print(cert.E_max, cert.valid)
 """
 

@@ -8,10 +8,10 @@ that hold them.
 
 Usage::
 
-    from wmr_mj.sim.config import RunConfig, build_reference, controller_for, estimate_parameters
+    from wmr_mj.sim.config import RunConfig, build_reference, coerce, controller_for, estimate_parameters
     config = RunConfig(model="nonholonomic", kp=100.0, kd=20.0, m1=700.0)
     controller = controller_for(config, estimate_parameters())
-    reference, settle_s = build_reference(config.path, estimate_parameters(), dt=1e-3, duration=35.0)
+    reference, settle_s = build_reference(coerce(config).path, estimate_parameters(), dt=1e-3, duration=35.0)
 """
 
 from __future__ import annotations

@@ -62,9 +62,10 @@ class RunConfig:
     friction_width: float = 0.0  # rad/s, tanh smoothing of the Coulomb sign (0: exact sign)
     # C's path: one of PATH_NAMES, a packaged route name (wmr_mj.reference.route.route_names()), a
     # .toml/.json route file, or canonical route JSON; a Path or Route object is stored as its canonical JSON
-    # None: the cart's own (its file's [paths] default), else the paper circle (resolved where the config is
-    # coerced; the commands give None where --path is not given)
-    path: str = "paper-circle"
+    # None: the cart's own (wmr_mj.sim.coerce.default_path: its file's [paths] default, else the paper circle where
+    # its stops steer it, else a loop derived from them; the paper circle without a cart), resolved where the config
+    # is coerced, so that RunConfig(cart=...), a sweep's or a search's base on it, and the commands agree
+    path: str = None  # type: ignore[assignment]
     plant_overrides: Mapping[str, float] = field(default_factory=dict)  # other plant parameters
     m1_inertia: str = "payload"
     identified: Any = None  # path or mapping from `wmr-mj identify` for model='identified'
@@ -126,15 +127,13 @@ class RunConfig:
         and checked. ``RunConfig(...)`` keeps such input as given (nothing read) until ``resolve_run`` coerces it;
         the commands, the config builders of compare and the reports, and ``config_from_dict`` call this.
 
-        A config on a cart that names no path takes the cart's own (its ``[paths] default``, else one it can steer:
-        :func:`wmr_mj.sim.coerce.default_path`), as the commands do; ``RunConfig(cart=...)`` keeps the field's
-        default, the paper circle, as plain data.
+        A config that names no path (``path`` None) takes the cart's own (its ``[paths] default``, else one it can
+        steer: :func:`wmr_mj.sim.coerce.default_path`; the paper circle without a cart), here as wherever the
+        config is coerced: ``RunConfig(cart=...)`` keeps None as plain data until then.
 
         Raises:
             ParameterError, UnknownNameError: what cannot be coerced or is refused, in one line.
         """
-        if user_input.get("cart") is not None:
-            user_input.setdefault("path", None)  # None: the cart's own path, resolved by coerce
         return coerce(cls(**user_input))
 
     # the name of earlier versions, documented in the api reference: one release, with a warning (issue 41)

@@ -1,0 +1,63 @@
+"""A refused duration says where it came from (issue 42, "the duration message names where the duration came
+from"): the command's default --duration where none was given, the option where one was, and, for ``cart check``
+(whose --duration is the identification's excitation), its runs on the path with the options that change it.
+
+The truth is the command line itself: a slow cart (the C80's file at V_A = 0.01 m/s, whose paper circle's lead-in
+and entry alone take 46 s) refuses the 35 s runs every command defaults to. Before: each said "duration = 35.0 s is
+not accepted" (run excepted) although the user gave no duration.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+from helpers import refused_line
+
+from wmr_mj.carts import CARTS_DIR
+from wmr_mj.cli.app import main
+
+DEFAULT_SAID = "(the duration is --duration's default, 35 s, as none was given; give --duration)"
+
+
+@pytest.fixture(scope="module")
+def slow(tmp_path_factory) -> Path:
+    text = (CARTS_DIR / "c80.toml").read_text(encoding="utf-8").replace('name = "C80"', 'name = "slow"', 1)
+    text, n = re.subn(r"(\[operation\.V_A\]\nvalue = )[^\n]+", r"\g<1>0.01", text)
+    text, m = re.subn(r"(\[uncertainty\.full\.V_A\]\nrange = )[^\n]+", r"\g<1>[0.008, 0.012]", text)
+    assert n == m == 1
+    path = tmp_path_factory.mktemp("slow") / "slow.toml"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def _error_line(capsys, argv: list[str]) -> str:
+    """The error line of a refused command that may have printed progress before it (exit status 2)."""
+    assert main(argv) == 2
+    lines = [line for line in capsys.readouterr().err.splitlines() if line.startswith("wmr-mj: error: ")]
+    assert len(lines) == 1
+    return lines[0]
+
+
+@pytest.mark.parametrize("argv", [["run", "--no-log"], ["design", "--budget", "4"]], ids=["run", "design"])
+def test_a_default_duration_refused_says_it_is_the_default(slow, capsys, argv):
+    line = refused_line(capsys, [*argv, "--cart", str(slow)])
+    assert "duration = 35.0 s is not accepted: the lead-in and entry alone take 46.089 s" in line
+    assert line.endswith(DEFAULT_SAID)
+
+
+def test_validates_default_duration_refused_says_it_is_the_default(slow, capsys):
+    line = _error_line(capsys, ["validate", "--cart", str(slow), "--n", "1", "--search-budget", "0"])
+    assert "duration = 35.0 s is not accepted" in line and line.endswith(DEFAULT_SAID)
+
+
+def test_a_given_duration_refused_is_the_users(slow, capsys):
+    line = refused_line(capsys, ["run", "--no-log", "--cart", str(slow), "--duration", "20"])
+    assert "duration = 20.0 s is not accepted" in line and "default" not in line
+
+
+def test_cart_checks_runs_refused_name_the_runs_and_the_options_that_change_them(slow, capsys):
+    line = refused_line(capsys, ["cart", "check", str(slow)])
+    assert "duration = 35.0 s is not accepted" in line and "cart check's runs on the path" in line
+    assert "--path" in line and "[paths] default" in line and "--duration's default" not in line
