@@ -26,9 +26,9 @@ import pytest
 from wmr_mj.carts import load_cart
 from wmr_mj.errors import InfeasiblePathError
 from wmr_mj.params import parameters_of_cart
-from wmr_mj.reference.route import load_route
+from wmr_mj.reference.route import DEFAULT_PATH_STOP_FRACTION, load_route
 from wmr_mj.sim.builders import build_reference
-from wmr_mj.sim.coerce import DEFAULT_PATH_STOP_FRACTION, default_path, default_path_note
+from wmr_mj.sim.coerce import default_path, default_path_note
 from wmr_mj.sim.config import RunConfig, coerce
 
 DATA = Path(__file__).resolve().parent / "data"
@@ -125,3 +125,20 @@ def test_validate_names_a_derived_path_by_its_route_name(cart_file):
     assert _path_words({"path": path}) == f"the path route '{LOOP_NAME}'"  # not its canonical JSON
     assert _path_words({"path": "paper-circle"}) == "the paper circle"
     assert _path_words({"path": "lane-change"}) == "the path lane-change"
+
+
+def test_a_config_built_directly_reads_its_path_none_as_the_default_of_its_parameters(cart_file):
+    """RunConfig's path is None (the cart's own) until it is coerced; Python code that builds a reference from
+    ``config.path`` directly (``build_reference(config.path, C80, ...)``, as before the field became None) gets
+    the default path of the parameters it passes: the paper circle on the C80, the derived loop on this cart."""
+    config = RunConfig()
+    assert config.path is None
+    c80_default, _ = build_reference(config.path, parameters_of_cart(load_cart("c80")), dt=1e-3, duration=20.0)
+    c80_circle, _ = build_reference("paper-circle", parameters_of_cart(load_cart("c80")), dt=1e-3, duration=20.0)
+    assert np.array_equal(c80_default.alpha0, c80_circle.alpha0)
+    params = parameters_of_cart(load_cart(str(cart_file)))
+    loop, _ = build_reference(None, params, dt=1e-3, duration=20.0)
+    coerced_path = coerce(RunConfig(cart=str(cart_file))).path  # what a run on the cart resolves
+    assert coerced_path == default_path(load_cart(str(cart_file))) != "paper-circle"
+    assert np.array_equal(loop.alpha0, build_reference(coerced_path, params, dt=1e-3, duration=20.0)[0].alpha0)
+    assert float(np.max(np.abs(loop.alpha0))) == pytest.approx(STEADY_RAD, abs=1e-9)  # as above: asin(l1/R)

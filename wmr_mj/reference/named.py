@@ -20,7 +20,7 @@ import numpy as np
 from wmr_mj.errors import InfeasiblePathError, StiffReferenceError, UnknownNameError, WmrMjError
 from wmr_mj.params import C80Parameters
 from wmr_mj.reference import paths as ref
-from wmr_mj.reference.route import is_route_spec, route_names, route_of, route_reference
+from wmr_mj.reference.route import default_path_of, is_route_spec, route_names, route_of, route_reference
 
 __all__ = ["PATH_NAMES", "build_reference", "REFERENCE_CACHE_SIZE", "path_label", "LANE_CHANGE_LEAD_IN_M",
            "LANE_CHANGE_OFFSET_M", "LANE_CHANGE_LENGTH_M", "PATH_OPTION_HINT"]
@@ -33,7 +33,7 @@ PATH_NAMES = ("paper-circle", "lane-change", "figure-eight")
 LANE_CHANGE_LEAD_IN_M, LANE_CHANGE_OFFSET_M, LANE_CHANGE_LENGTH_M = 0.5, 0.5, 4.0
 
 
-def build_reference(path: str, params: C80Parameters, *, dt: float, duration: float):
+def build_reference(path: str | None, params: C80Parameters, *, dt: float, duration: float):
     """(reference, settle_s) for a path of C on a grid of step dt: a named path (PATH_NAMES) or
     a route (a packaged route name, a route file, canonical route JSON; a closed route is
     repeated lap after lap to fill the duration).
@@ -45,7 +45,12 @@ def build_reference(path: str, params: C80Parameters, *, dt: float, duration: fl
     runs that share a path, as a comparison's scenarios on one path or a sweep's chunks do, build it
     once (it costs about a quarter of a 35 s run's physics). A route file is keyed by its
     modification time and size as well as its name, so an edited file is read again.
+
+    ``path`` None is the default path of a cart of ``params`` (:func:`wmr_mj.reference.route.default_path_of`:
+    the paper circle on the C80), what a ``RunConfig`` whose path is None runs on where its cart declares none.
     """
+    if path is None:
+        path = default_path_of(params)[0]
     file_key = None
     if path not in PATH_NAMES and not path.lstrip().startswith("{") and os.path.isfile(path):
         st = os.stat(path)

@@ -72,7 +72,8 @@ from wmr_mj.reference.paths import Path, Reference, Segment, SegmentKind, _s5_in
 
 __all__ = ["Route", "ROUTES_DIR", "route_names", "load_route", "parse_route", "route_from_path",
            "is_route_spec", "route_reference", "RouteProgress", "route_progress",
-           "route_length", "route_of", "route_spec_of", "turns_loop", "path_name"]
+           "route_length", "route_of", "route_spec_of", "turns_loop", "path_name", "default_path_of",
+           "DEFAULT_PATH_STOP_FRACTION", "PAPER_CIRCLE_RADIUS_M"]
 
 #: Routes shipped with the package, selectable by name (the file's stem).
 ROUTES_DIR = DATA_DIR / "routes"
@@ -457,6 +458,38 @@ def turns_loop(params: C80Parameters, radius: float, *, name: str) -> Route:
     half = (straight, ramp_in, arc, ramp_out, straight)
     return parse_route({"route": {"name": name, "closed": True},
                         "path": [{f.name: getattr(s, f.name) for f in fields(Segment)} for s in half + half]})
+
+
+#: the steady steering angle of a cart's default path where its file declares none, as a fraction of its stops
+DEFAULT_PATH_STOP_FRACTION = 0.85
+#: the radius of the paper's circle [m] (section 5; the named path paper-circle)
+PAPER_CIRCLE_RADIUS_M = 1.0
+
+
+@functools.lru_cache(maxsize=8)
+def default_path_of(params: C80Parameters) -> tuple[str, str | None]:
+    """(the path a cart of ``params`` takes where it names none and declares none, the line naming it or None).
+
+    The paper circle ('paper-circle') where the cart steers it at no more than :data:`DEFAULT_PATH_STOP_FRACTION`
+    of its stops (the C80 and the shipped carts: 0.659 of +-0.9 rad), with no line; else a loop of two half-turns
+    (:func:`turns_loop`) whose steady angle is that fraction of the stops, as canonical route JSON, and the line
+    that names it. A cart file's ``[paths] default`` comes first (``wmr_mj.sim.coerce.default_path``).
+    """
+    angle = DEFAULT_PATH_STOP_FRACTION * params.steering_range
+    if params.l1 <= PAPER_CIRCLE_RADIUS_M * math.sin(angle):  # the paper circle, steered with margin
+        return "paper-circle", None
+    radius = params.l1 / math.sin(angle)
+    route = turns_loop(params, radius, name=f"loop-of-{radius:.3g}-m-turns")
+    return route.text, (f"default path: route {route.name!r}, two half-circles of radius {radius:.3g} m joined by "
+                        f"straights, chosen from the cart's stops (steady steering angle {angle:.3g} rad, "
+                        f"{DEFAULT_PATH_STOP_FRACTION:g} of +-{params.steering_range:g} rad; the paper's 1 m circle "
+                        f"needs {_circle_angle(params.l1)}); declare [paths] default in the cart file to choose")
+
+
+def _circle_angle(l1: float) -> str:
+    """The steady steering angle the paper's 1 m circle needs with wheelbase ``l1`` [m], in words."""
+    ratio = l1 / PAPER_CIRCLE_RADIUS_M
+    return f"{math.asin(ratio):.3g} rad" if ratio < 1.0 else f"sin(alpha) = {ratio:.3g}, no angle"
 
 
 def load_route(spec: str | os.PathLike) -> Route:

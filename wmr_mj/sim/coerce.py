@@ -51,7 +51,12 @@ from wmr_mj.params import (
 from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS, TIMESTEP, TYRE_CONTACT_MODELS
 from wmr_mj.reference.bounds import ReferenceBounds, reference_bounds_from
 from wmr_mj.reference.named import PATH_NAMES
-from wmr_mj.reference.route import Route, route_of, route_spec_of, turns_loop
+from wmr_mj.reference.route import (
+    Route,
+    default_path_of,
+    route_of,
+    route_spec_of,
+)
 from wmr_mj.sim.signals import Signals, signals_from
 
 __all__ = ["PATH_NAMES", "DEFAULT_PATH", "default_path", "cart_file_of_record", "coerce", "m1_of_overrides",
@@ -401,17 +406,12 @@ def cart_file_of_record(record: Mapping[str, str] | None) -> CartFile | None:
     return None if record is None else _cart_of_text(record["text"], record["path"])
 
 
-#: the steady steering angle of a cart's default path where its file declares none, as a fraction of its stops
-DEFAULT_PATH_STOP_FRACTION = 0.85
-#: the radius of the paper's circle [m] (section 5; :data:`DEFAULT_PATH`)
-PAPER_CIRCLE_RADIUS_M = 1.0
-
-
 def default_path(cart: CartFile | None) -> str:
     """The path a run on ``cart`` takes where it names none: the one the cart declares (``[paths] default``); else
     the paper circle (:data:`DEFAULT_PATH`) where the cart steers it at no more than
-    :data:`DEFAULT_PATH_STOP_FRACTION` of its stops (the C80 and the shipped carts: 0.659 of +-0.9 rad); else a
-    loop of half-turns whose steady angle is that fraction of the stops (:func:`default_path_note` names it)."""
+    :data:`wmr_mj.reference.route.DEFAULT_PATH_STOP_FRACTION` of its stops (the C80 and the shipped carts: 0.659 of
+    +-0.9 rad); else a loop of half-turns whose steady angle is that fraction of the stops
+    (:func:`wmr_mj.reference.route.default_path_of`; :func:`default_path_note` names it)."""
     declared = None if cart is None else cart.default_path
     if declared is not None:
         return declared
@@ -428,23 +428,9 @@ def default_path_note(cart: CartFile | None) -> str | None:
 
 @functools.lru_cache(maxsize=8)
 def _derived_path(text: str, path: str) -> tuple[str, str | None]:
-    """(the default path of the cart of ``text``, the note naming it or None): :func:`default_path`'s rule."""
-    params = _parameters_of_text(text, path)
-    angle = DEFAULT_PATH_STOP_FRACTION * params.steering_range
-    if params.l1 <= PAPER_CIRCLE_RADIUS_M * math.sin(angle):  # the paper circle, steered with margin
-        return DEFAULT_PATH, None
-    radius = params.l1 / math.sin(angle)
-    route = turns_loop(params, radius, name=f"loop-of-{radius:.3g}-m-turns")
-    return route.text, (f"default path: route {route.name!r}, two half-circles of radius {radius:.3g} m joined by "
-                        f"straights, chosen from the cart's stops (steady steering angle {angle:.3g} rad, "
-                        f"{DEFAULT_PATH_STOP_FRACTION:g} of +-{params.steering_range:g} rad; the paper's 1 m circle "
-                        f"needs {_circle_angle(params.l1)}); declare [paths] default in the cart file to choose")
-
-
-def _circle_angle(l1: float) -> str:
-    """The steady steering angle the paper's 1 m circle needs with wheelbase ``l1`` [m], in words."""
-    ratio = l1 / PAPER_CIRCLE_RADIUS_M
-    return f"{math.asin(ratio):.3g} rad" if ratio < 1.0 else f"sin(alpha) = {ratio:.3g}, no angle"
+    """(the default path of the cart of ``text``, the note naming it or None): :func:`default_path`'s rule,
+    :func:`wmr_mj.reference.route.default_path_of` on the cart's parameters."""
+    return default_path_of(_parameters_of_text(text, path))
 
 
 def cart_file(config: Any) -> Any:
