@@ -3,7 +3,8 @@
 Two axes of the cart, each from the ideal sensor: an encoder on the steering axis of 10-16 bits (rounded, alpha'
 a backward difference over the 1 ms period), and an exact sensor read 0-50 ms late. At each point, for (a) the
 certified design (``--preset certified``) and (b) the design ``wmr-mj design`` finds for that cart
-(:func:`wmr_mj.searches.design_search.search_design`, CMA-ES from the preset's point, seed 0): the certified E_max on
+(:func:`wmr_mj.searches.design_search.search_design`, CMA-ES from its START_POINT, omega_n 10, seed 0; not
+the preset's point since the preset became omega_r 30): the certified E_max on
 the paper's circle over the m1 box (550-750 kg; none where the claim does not certify, with what binds), and the
 worst sup|E| that ``falsify`` finds over the m1 box at a small budget (its search and as many random runs;
 :func:`wmr_mj.experiments.tightness.cart_tightness`), with the verdicts of its runs.
@@ -12,7 +13,7 @@ Writes the figure (PNG) and its numbers (JSON) beside it.
 
 Usage::
 
-    python examples/design_tradeoff.py                         # docs/img/design_tradeoff.{png,json}; ~15 min
+    python examples/design_tradeoff.py                         # docs/img/design_tradeoff.{png,json}; ~6 min (2 cores)
     python examples/design_tradeoff.py --quick --out /tmp/t    # 2 + 2 carts, tiny budgets: seconds
 """
 

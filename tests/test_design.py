@@ -81,7 +81,7 @@ def test_design_beats_or_equals_the_certified_preset_on_the_cart(designed):
     _, _, printed = designed
     preset = resolve_run(RunConfig(**CERTIFIED.config_changes(), control_period=0.001,
                                    sensing=Sensing.from_spec(CART))).claim
-    assert preset.certified  # the sampled-data certificate's 0.1037 rad (docs/guides/certificates.md)
+    assert preset.certified  # the sampled-data certificate's 0.0463 rad at omega_r 30 (docs/guides/hardware.md)
     assert printed["E_max"] <= preset.E_max
 
 
