@@ -52,14 +52,15 @@ def test_design_file_round_trip_is_the_same_config(designed):
     """run --design FILE builds the RunConfig the design's settings give, field by field."""
     import argparse
 
-    from wmr_mj.cli.parsers.run import add_run_options
     from wmr_mj.cli.run import config_from_args
+    from wmr_mj.cli.run_options import add_options
     from wmr_mj.hardware import Sensing
     from wmr_mj.sim.config import RunConfig
 
     _, out, printed = designed
     p = argparse.ArgumentParser()
-    add_run_options(p)
+    add_options(p, "run")
+    add_options(p, "cart")
     config = config_from_args(p.parse_args(["--design", str(out)]))
     s = printed["settings"]
     expected = RunConfig.from_inputs(controller="computed-torque", model=s["model"], kp=s["kp"], kd=s["kd"],

@@ -51,11 +51,12 @@ def test_unknown_preset_lists_the_valid_ones():
 
 
 def _config(argv):
-    from wmr_mj.cli.parsers.run import add_run_options
     from wmr_mj.cli.run import config_from_args
+    from wmr_mj.cli.run_options import add_options
 
     p = argparse.ArgumentParser()
-    add_run_options(p)
+    add_options(p, "run")
+    add_options(p, "cart")
     p.add_argument("--m1", type=float, default=650.0)
     args = p.parse_args(argv)
     return config_from_args(args, m1=args.m1)

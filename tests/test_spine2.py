@@ -136,13 +136,11 @@ def test_every_run_option_is_in_the_table_and_the_table_is_the_parser():
     `wmr-mj run` that sets a RunConfig field is a row."""
     import argparse
 
-    from wmr_mj.cli.parsers.run import add_require_option, add_run_options, add_signal_options
-    from wmr_mj.cli.run_options import run_options
+    from wmr_mj.cli.run_options import add_options, run_options
 
     p = argparse.ArgumentParser()
-    add_run_options(p)
-    add_signal_options(p)
-    add_require_option(p)
+    for group in ("run", "cart", "signals", "require"):
+        add_options(p, group)
     actions = {a.option_strings[0]: a for a in p._actions if a.option_strings}
     rows = {r.flag: r for r in run_options()}
     for flag, row in rows.items():

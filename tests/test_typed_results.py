@@ -186,18 +186,27 @@ def test_sweep_result_round_trips():
     from wmr_mj.experiments.sweep import SweepSpec, SweepSummary
     from wmr_mj.experiments.sweep_result import SweepResult
 
-    spec = SweepSpec(n=2, seed=3, ranges={"mu": (0.01, 0.03)}, base=RunConfig(duration=5.0))
+    spec = SweepSpec(n=2, seed=3, ranges={"mu": (0.01, 0.03)}, base=RunConfig.from_inputs(duration=5.0))
     rows = ({"run": 0, "m1": 600.0, "mu": 0.02, "verdict": "certified-inside", "certificate": _CERT_OUT,
              "cert_E_ratio": 0.5, "cert_E_max": 0.05, "sup_E": 0.025, "sup_Edot": 0.1, "inside": None,
              "left_steering_range": False, "saturated_fraction": 0.0, "steps": 10, "batch_law": "compiled"},)
-    result = SweepResult(spec=spec, rows=rows, summary=SweepSummary.of(rows, names=spec.names))
+    result = SweepResult(spec=spec, rows=rows, summary=SweepSummary.of(rows, names=spec.names), wall_s=2.0,
+                         folder="logs/sweep-x")
     d = result.to_dict()
-    assert d["spec"]["n"] == 2 and d["spec"]["ranges"] == {"mu": [0.01, 0.03]} and d["rows"] == [rows[0]]
-    assert d["summary"] == result.summary.to_dict()
+    runs = d["runs"]
+    assert runs["spec"]["n"] == 2 and runs["spec"]["ranges"] == {"mu": [0.01, 0.03]} and runs["rows"] == [rows[0]]
+    assert runs["summary"] == result.summary.to_dict()
+    # sweep --json's object is the same JSON without its runs: the summary's keys, then the sweep's
+    assert result.to_dict(runs=False) == {k: v for k, v in d.items() if k != "runs"}
+    assert d["n"] == 1 and d["steps_per_s"] == 10 / 2.0 and d["folder"] == "logs/sweep-x" and d["seed"] == 3
     back = SweepResult.from_dict(d)
     assert back.to_dict() == d
     assert back.spec.ranges == spec.ranges and back.spec.base.duration == 5.0  # the base as the workers read it
     assert back.rows == rows and back.summary == result.summary
+    with pytest.raises(ParameterError, match="no 'runs'"):
+        SweepResult.from_dict(result.to_dict(runs=False))
+    with pytest.warns(DeprecationWarning, match="to_dict"):  # the old name of sweep --json's object
+        assert result.report(wall_s=2.0, folder="logs/sweep-x") == result.to_dict(runs=False)
 
 
 def test_compare_result_is_typed_and_round_trips():

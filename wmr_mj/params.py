@@ -38,7 +38,7 @@ from dataclasses import dataclass, fields
 from typing import Any, Literal, get_args
 
 from wmr_mj.carts import CartFile, load_cart
-from wmr_mj.carts.cartfile import MAX_ELECTRICAL_TIME_CONSTANT_S
+from wmr_mj.carts.cartfile import MAX_ELECTRICAL_TIME_CONSTANT_S, MOTOR_CONSTANT_RTOL
 from wmr_mj.errors import ParameterError, UnknownNameError
 
 __all__ = [
@@ -47,6 +47,7 @@ __all__ = [
     "C80_CART",
     "parameters_of_cart",
     "check_physical_sense",
+    "check_motor_constant",
     "Coefficients",
     "COEFFICIENT_NAMES",
     "CoefficientModel",
@@ -379,6 +380,23 @@ def tie_motor_constant(drawn: Mapping[str, float],
                                  "a run has k_b = k_i)")
         tied["k_b"] = tied["k_i"]
     return tied
+
+
+def check_motor_constant(k_i: float, k_b: float) -> None:
+    """k_b equal to k_i, as a cart file must have them (:mod:`wmr_mj.carts.cartfile`): one flux in SI units, and
+    MuJoCo's dcmotor has one constant (it would silently use their geometric mean). Every command that takes
+    ``--param`` checks it after its overrides.
+
+    Args:
+        k_i: the torque constant, N m/A. k_b: the back-EMF constant, V s/rad.
+
+    Raises:
+        ParameterError: they differ by more than a rounding (one line naming both and what is accepted).
+    """
+    if abs(k_b - k_i) > MOTOR_CONSTANT_RTOL * abs(k_i):
+        raise ParameterError(f"--param: k_b = {k_b!r} V s/rad and k_i = {k_i!r} N m/A differ; accepted: k_b equal to "
+                             "k_i (one flux in SI units; MuJoCo's dcmotor has one constant), e.g. --param "
+                             f"k_i={k_i!r} --param k_b={k_i!r}")
 
 
 #: One line per field: where its value comes from (the C80 cart file's sources, in the fields' order).

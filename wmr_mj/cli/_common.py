@@ -1,5 +1,6 @@
 """Helpers shared by the commands, light enough for their parsers (:mod:`wmr_mj.cli.parsers`): the exit status of
-a broken claim, ``NAME=VALUE`` options, ``--param m1=``, one JSON object on stdout, a default output folder (the
+a broken claim, ``NAME=VALUE`` options, ``--param m1=``, the parameter set of ``--cart``, one JSON object on stdout,
+a default output folder (the
 shared options: :mod:`wmr_mj.cli.options`, whose argparse types are also importable from here; --range:
 :mod:`wmr_mj.cli.ranges`)."""
 
@@ -12,13 +13,14 @@ import time
 from typing import Any
 
 from wmr_mj._util.files import json_safe
+from wmr_mj.carts import load_cart
 from wmr_mj.cli.options import (  # noqa: F401  (importable from here, as before)
     int_at_least,
     positive_float,
     positive_int,
 )
 from wmr_mj.errors import ParameterError
-from wmr_mj.params import M1_NOMINAL
+from wmr_mj.params import C80, M1_NOMINAL, C80Parameters, parameters_of_cart
 
 #: Exit status of ``run``, ``sweep``, ``compare`` and ``falsify`` when a run breaks its law's claim (a
 #: ``certified-outside`` run), and of ``falsify`` when it falsifies its ``--require``: a CI job can gate on
@@ -78,3 +80,14 @@ def print_json(obj: Any) -> None:
 def default_folder(prefix: str) -> str:
     """``logs/<prefix>-<local time>``: a command's output folder where --out is not given."""
     return f"logs/{prefix}-{time.strftime('%Y%m%d-%H%M%S')}"
+
+
+def cart_parameters(args: Any) -> C80Parameters:
+    """The parameter set of ``--cart`` (:class:`wmr_mj.params.C80Parameters`; the C80 where not given).
+
+    Raises:
+        ParameterError: a missing file, an unknown name, a file its schema or rules refuse (one line).
+    """
+    if getattr(args, "cart", None) is None:
+        return C80
+    return parameters_of_cart(load_cart(args.cart))

@@ -3,8 +3,8 @@
 Each command has two modules:
 
 * its parser, ``wmr_mj.cli.parsers.<name>``: ``HELP`` (its line in ``wmr-mj --help``) and ``register(subparsers)``,
-  which adds its parser and options; argparse and the light modules of the CLI only (the options,
-  :mod:`wmr_mj.cli.options`; the table of run options, :mod:`wmr_mj.cli.run_options`; the parameter set), a help
+  which adds its parser and its options, its rows of the options table (:mod:`wmr_mj.cli.command_options`, with the
+  table of run options, :mod:`wmr_mj.cli.run_options`); argparse and the light modules of the CLI only, a help
   that names what a heavy module holds being computed for ``--help`` alone
   (:func:`wmr_mj.cli.options.add_argument_with_help_of`, :func:`~wmr_mj.cli.options.names_in`);
 * its implementation, ``wmr_mj.cli.<name>``: ``run(args) -> int``, with every import at its top (the

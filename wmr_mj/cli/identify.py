@@ -17,18 +17,23 @@ from typing import Any
 
 from wmr_mj._util.files import check_output_path, write_json_atomic
 from wmr_mj.carts import load_cart, load_cart_text
-from wmr_mj.cli._common import parse_assignments, print_json
-from wmr_mj.cli.ranges import cart_parameters
+from wmr_mj.cli._common import cart_parameters, parse_assignments, print_json
 from wmr_mj.errors import ParameterError
 from wmr_mj.logs.recordings import parse_topics, read_ros2_bag, read_run_log
-from wmr_mj.params import COEFFICIENT_MODELS, COEFFICIENT_NAMES, M1_NOMINAL, parameters_of_cart, with_params
+from wmr_mj.params import (
+    COEFFICIENT_MODELS,
+    COEFFICIENT_NAMES,
+    M1_NOMINAL,
+    check_motor_constant,
+    parameters_of_cart,
+    with_params,
+)
 from wmr_mj.plant.identified_cart import identified_cart_text
 from wmr_mj.plant.identify import identify_plant
 from wmr_mj.plant.mjcf_rollouts import import_sysid, mjcf_rollout_nrmse
 from wmr_mj.plant.output_error import HOLDOUT_NRMSE_MAX, POORLY_DETERMINED, fit_recordings, holdout_error
 from wmr_mj.plant.recordings import check_recording, parse_columns, read_csv
 from wmr_mj.report.identify import IdentifyReport
-from wmr_mj.sim.config import check_motor_constant
 
 
 def run(args: argparse.Namespace) -> int:

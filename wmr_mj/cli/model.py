@@ -9,10 +9,9 @@ from typing import Any
 from wmr_mj._util.files import write_text_atomic
 from wmr_mj._util.resources import MODELS_IN_CHECKOUT
 from wmr_mj.carts import load_cart
-from wmr_mj.cli._common import parse_assignments, print_json
-from wmr_mj.cli.ranges import cart_parameters
+from wmr_mj.cli._common import cart_parameters, parse_assignments, print_json
 from wmr_mj.errors import ParameterError
-from wmr_mj.params import COEFFICIENT_NAMES, PARAMETER_SOURCES, with_params
+from wmr_mj.params import COEFFICIENT_NAMES, PARAMETER_SOURCES, check_motor_constant, with_params
 from wmr_mj.plant.friction import measure_friction_law
 from wmr_mj.plant.image import write_model_image
 from wmr_mj.plant.mjcf import (
@@ -24,7 +23,6 @@ from wmr_mj.plant.mjcf import (
     write_model_files,
 )
 from wmr_mj.plant.modelcard import render_model_card
-from wmr_mj.sim.config import check_motor_constant
 
 
 def run(args: argparse.Namespace) -> int:

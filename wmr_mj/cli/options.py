@@ -1,9 +1,11 @@
-"""The options every command shares: what a command's parser (:mod:`wmr_mj.cli.parsers`) is built from.
+"""What an options table is made of, and the argparse pieces every command's parser uses.
 
-* :func:`add_seed`, :func:`add_threads`, :func:`add_out`, :func:`add_json`: the shared options (``--seed``,
-  ``--nthread``, ``--out``, ``--json``), one type and one rule each, with the help the command gives.
+* :class:`Option`: one row of an options table (its flag, argparse settings and help), which adds itself to a parser;
+  the run options (:mod:`wmr_mj.cli.run_options`) and each command's own (:mod:`wmr_mj.cli.command_options`) are
+  tables of them.
 * :class:`OneLineParser`: a parser that refuses bad arguments in one line, exit status 2.
-* :func:`positive_float`, :func:`int_at_least`, :func:`positive_int`, :func:`non_negative_int`: argparse types.
+* :func:`positive_float`, :func:`non_negative_float`, :func:`int_at_least`, :func:`positive_int`,
+  :func:`non_negative_int`: argparse types.
 * :func:`add_argument_with_help_of`: an option whose help names what a heavy module holds (the laws, the paths),
   computed when the help is shown, so that building a parser imports no simulation (``wmr-mj --help`` and a bad
   option answer at once; ``bench/bench_cli_help.py``); such a help reads the names by :func:`names_in`, which
@@ -13,20 +15,23 @@ The reader of ``--range`` and of the boxes an option gives, used when a command 
 
 Usage::
 
-    from wmr_mj.cli.options import add_json, add_seed
-    add_seed(p, help="seed of the draw (default 0)")
-    add_json(p)
+    from wmr_mj.cli.options import Option, non_negative_int
+    SEED = Option(flag="--seed", settings=dict(type=non_negative_int, default=0), help="seed (default 0)")
+    SEED.with_help("seed of the draw (default 0)").add_to(parser)
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import importlib
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import Any
 
-__all__ = ["add_argument_with_help_of", "positive_float", "int_at_least", "positive_int", "non_negative_int",
-           "add_seed", "add_threads", "add_out", "add_json", "names_in", "OneLineParser"]
+__all__ = ["Option", "add_argument_with_help_of", "positive_float", "non_negative_float", "int_at_least",
+           "positive_int", "non_negative_int", "names_in", "OneLineParser"]
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -71,24 +76,43 @@ positive_int = int_at_least(1)
 non_negative_int = int_at_least(0)
 
 
-def add_seed(p: argparse.ArgumentParser, *, help: str) -> None:
-    """``--seed N``: an integer >= 0, default 0 (``help`` says what it seeds)."""
-    p.add_argument("--seed", type=non_negative_int, default=0, help=help)
+def non_negative_float(text: str) -> float:
+    """argparse type: a finite number >= 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number; a finite number >= 0 is accepted") from None
+    if not math.isfinite(value) or value < 0:
+        raise argparse.ArgumentTypeError(f"{text!r} is not accepted; a finite number >= 0 is required")
+    return value
 
 
-def add_threads(p: argparse.ArgumentParser, *, help: str = "threads of the batch (default 0: all cores)") -> None:
-    """``--nthread N``: the simulation threads, an integer >= 0, default 0 (every core)."""
-    p.add_argument("--nthread", type=non_negative_int, default=0, help=help)
+@dataclass(frozen=True, kw_only=True)
+class Option:
+    """One row of an options table: an option (or a positional argument) as argparse adds it.
 
+    Attributes:
+        flag: its name on the command line (``--kp``), or a positional argument's name (``action``).
+        settings: argparse's keywords (type, default, metavar, action, nargs, choices, required).
+        help: its help, or a function of nothing giving it (names a heavy module holds: called for --help only,
+            :func:`add_argument_with_help_of`).
+    """
 
-def add_out(p: argparse.ArgumentParser, *, help: str, metavar: str = "DIR") -> None:
-    """``--out PATH``: where the command writes (``help`` names the default, a folder or a file)."""
-    p.add_argument("--out", metavar=metavar, help=help)
+    flag: str
+    settings: Mapping[str, Any] = field(default_factory=dict)
+    help: str | Callable[[], str] = ""
 
+    def add_to(self, p: argparse.ArgumentParser | argparse._ArgumentGroup) -> None:
+        """Add this option to the parser (or argument group) ``p``."""
+        if callable(self.help):
+            add_argument_with_help_of(p, self.flag, self.help, **self.settings)
+        else:
+            p.add_argument(self.flag, help=self.help, **self.settings)
 
-def add_json(p: argparse.ArgumentParser, *, help: str = "print one JSON object") -> None:
-    """``--json``: print one JSON object on stdout instead of the text report."""
-    p.add_argument("--json", action="store_true", help=help)
+    def with_help(self, help: str | Callable[[], str], **settings: Any) -> Option:
+        """This row as a command words it: its own ``help``, and any of ``settings`` it gives otherwise (its
+        default, its metavar), the other settings kept."""
+        return dataclasses.replace(self, help=help, settings={**self.settings, **settings})
 
 
 class _HelpOnRead:

@@ -4,7 +4,7 @@ from its parsed options when it runs (the parser's options themselves: :mod:`wmr
 * :func:`parse_ranges`: ``--range NAME=LO:HI`` as every command reads it (:data:`RANGE_RULE`);
   :func:`command_ranges`: a command's, with the kinds it varies (:data:`RANGE_ACCEPTS`).
 * :func:`box_ranges_from_args`, :func:`hardware_ranges_from_args`: the certificate's plant box and the cart's
-  searched or drawn axes; :func:`cart_parameters`: the parameter set of ``--cart``.
+  searched or drawn axes (the parameter set of ``--cart``: :func:`wmr_mj.cli._common.cart_parameters`).
 
 Usage::
 
@@ -22,11 +22,11 @@ from dataclasses import dataclass, field
 
 from wmr_mj.carts import load_cart
 from wmr_mj.errors import ParameterError, UnknownNameError
-from wmr_mj.params import C80, parameter_names, parameters_of_cart, uncertainty_ranges
+from wmr_mj.params import parameter_names, uncertainty_ranges
 from wmr_mj.searches.search_space import hardware_axis, path_axis, signal_axis
 
 __all__ = ["parse_range", "RANGE_RULE", "RANGE_KINDS", "RANGE_ACCEPTS", "Ranges", "parse_ranges", "command_ranges",
-           "range_kind", "box_ranges_from_args", "hardware_ranges_from_args", "cart_parameters"]
+           "range_kind", "box_ranges_from_args", "hardware_ranges_from_args"]
 
 
 def parse_range(item: str) -> tuple[str, tuple[float, float]]:
@@ -180,14 +180,3 @@ def hardware_ranges_from_args(args: argparse.Namespace) -> dict[str, tuple[float
     or the search is built."""
     return command_ranges(args).cart
 
-
-def cart_parameters(args: argparse.Namespace):
-    """The parameter set of ``--cart`` (:class:`wmr_mj.params.C80Parameters`; the C80 where not given).
-
-    Raises:
-        ParameterError: a missing file, an unknown name, a file its schema or rules refuse (one line).
-    """
-    if getattr(args, "cart", None) is None:
-        return C80
-
-    return parameters_of_cart(load_cart(args.cart))

@@ -4,7 +4,8 @@ that field is written back as the option.
 The table (:func:`run_options`) drives both ways:
 
 * argparse: :func:`add_options` adds a group of rows (``wmr-mj run``'s options, the cart's, the signals', the
-  requirement) to a command's parser (``wmr_mj.cli.parsers.run.add_run_options`` and friends);
+  requirement) to a command's parser, as the command's table (:mod:`wmr_mj.cli.command_options`) names them; a row
+  a command words its own way is :func:`run_option`'s, with the command's help (:meth:`RunOption.with_help`);
 * the reproduce line: :func:`wmr_mj.cli.falsify.command_line` writes a RunConfig back as the ``wmr-mj run`` line
   that builds it,
   each row writing its own field (``wmr-mj falsify``'s reproduce line), so a field read by one row's parser is
@@ -24,14 +25,14 @@ import functools
 import json
 import shlex
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
-from wmr_mj.cli.options import add_argument_with_help_of, names_in, positive_float
+from wmr_mj.cli.options import Option, names_in, positive_float
 from wmr_mj.hardware.spec import spec_string
-from wmr_mj.params import M1_RANGE, UNCERTAINTY_NAMES, uncertainty_ranges
+from wmr_mj.params import M1_NOMINAL, M1_RANGE, UNCERTAINTY_NAMES, uncertainty_ranges
 
-__all__ = ["RunOption", "Replay", "run_options", "add_options", "add_option", "GROUPS"]
+__all__ = ["RunOption", "Replay", "run_options", "run_option", "add_options", "GROUPS", "SECTIONS"]
 
 #: --duration's default, s: the very object argparse keeps where --duration is not given (a message about the
 #: duration then says that it is the default: wmr_mj.cli.app)
@@ -64,30 +65,33 @@ def _nothing(config: Any, replay: Replay) -> list[str]:
 
 
 @dataclass(frozen=True, kw_only=True)
-class RunOption:
-    """One run option.
+class RunOption(Option):
+    """One run option: an :class:`~wmr_mj.cli.options.Option` (flag, argparse settings, help) that sets a RunConfig
+    field and writes it back.
 
     Attributes:
-        flag: its name on the command line (``--kp``).
-        group: which adder adds it (:data:`GROUPS`): 'run' (``add_run_options``), 'cart', 'signals', 'require',
-            or 'command' (each command adds its own, with its own help: ``--m1``, ``--range``).
+        group: which group of rows it is added with (:data:`GROUPS`): 'run', 'cart', 'signals', 'require', or
+            'command' (each command adds it from its own table, with its own help: ``--m1``, ``--range``).
         sets: the RunConfig field it sets ('' where it sets none directly: ``--preset``, ``--omega-r``).
-        settings: argparse's keywords (type, default, metavar, action, nargs, choices).
-        help: its help, or a function of nothing giving it (names a heavy module holds: called for --help only).
         write: ``write(config, replay)``: the words that give ``config``'s field back ([] where nothing needs
             writing: a default, an option another row writes, the same field written by another row).
     """
 
-    flag: str
     group: str
     sets: str
-    settings: Mapping[str, Any] = field(default_factory=dict)
-    help: str | Callable[[], str] = ""
     write: Callable[[Any, Replay], list[str]] = _nothing
 
 
-#: the adders of the table's rows (:attr:`RunOption.group`)
+#: the groups of the table's rows (:attr:`RunOption.group`)
 GROUPS = ("run", "cart", "signals", "require", "command")
+
+#: the groups a help page shows under a heading of their own (an argparse argument group), by group
+SECTIONS = {
+    "cart": "the cart as it is built (wmr_mj/hardware; default ideal: the exact alpha and alpha', no delay, no "
+            "inductance, no play); shown in every summary and JSON where not ideal",
+    "signals": "signals on the plant during the run (wmr_mj/sim/signals.py); reported under 'signals' in --json, "
+               "which --signals takes back to reproduce the run to the bit",
+}
 
 
 def _law(name: str) -> Callable[[Any, Replay], list[str]]:
@@ -188,7 +192,8 @@ def _law_rows() -> tuple[RunOption, ...]:
           help=_path_help, write=lambda c, r: ["--path", shlex.quote(r.path_file or c.path)]),
         R(flag="--duration", group="run", sets="duration", settings=dict(type=positive_float, default=DEFAULT_DURATION),
           help="simulated time, s (default 35)", write=lambda c, r: ["--duration", repr(c.duration)]),
-        R(flag="--m1", group="command", sets="m1", write=lambda c, r: ["--m1", repr(c.m1)]),
+        R(flag="--m1", group="command", sets="m1", settings=dict(type=positive_float, default=M1_NOMINAL),
+          write=lambda c, r: ["--m1", repr(c.m1)]),
         R(flag="--identified", group="run", sets="identified", settings=dict(metavar="PATH"),
           help="JSON from `wmr-mj identify --out` for --model identified (default: identify the nominal plant now)",
           write=_if(lambda c, r: isinstance(c.identified, str),
@@ -228,7 +233,8 @@ def _plant_rows() -> tuple[RunOption, ...]:
           write=lambda c, r: ["--m1-range", repr(c.m1_range[0]), repr(c.m1_range[1])]),
         R(flag="--uncertainty", group="run", sets="box_ranges", settings=dict(default=None), help=_uncertainty_help,
           write=_write_uncertainty),
-        R(flag="--range", group="command", sets="box_ranges", write=_write_ranges),
+        R(flag="--range", group="command", sets="box_ranges", settings=dict(action="append", metavar="NAME=LO:HI"),
+          write=_write_ranges),
     )
 
 
@@ -290,23 +296,18 @@ def _outer_signal_and_cart_rows() -> tuple[RunOption, ...]:
 
 
 def add_options(p: argparse.ArgumentParser | Any, group: str) -> None:
-    """Add the rows of ``group`` (:data:`GROUPS`) to the parser (or argument group) ``p``, in the table's order."""
+    """Add the rows of ``group`` (:data:`GROUPS`) to the parser ``p``, in the table's order: under their heading
+    where the group has one (:data:`SECTIONS`)."""
+    where = p.add_argument_group(SECTIONS[group]) if group in SECTIONS else p
     for row in run_options():
         if row.group == group:
-            _add_row(p, row)
+            row.add_to(where)
 
 
-def add_option(p: argparse.ArgumentParser | Any, flag: str) -> None:
-    """Add the one row ``flag`` of the table to ``p`` (``--cart`` in ``identify`` and ``model``)."""
-    _add_row(p, next(r for r in run_options() if r.flag == flag))
-
-
-def _add_row(p: argparse.ArgumentParser | Any, row: RunOption) -> None:
-    """One row's option; a help that is a function (it names what a heavy module holds) is called for --help only."""
-    if callable(row.help):
-        add_argument_with_help_of(p, row.flag, row.help, **row.settings)
-    else:
-        p.add_argument(row.flag, help=row.help, **row.settings)
+def run_option(flag: str) -> RunOption:
+    """The row of ``flag`` (``run_option("--cart")``): a command adds it alone, or words it its own way
+    (:meth:`RunOption.with_help`)."""
+    return next(r for r in run_options() if r.flag == flag)
 
 
 def _preset_help() -> str:

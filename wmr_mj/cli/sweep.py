@@ -86,13 +86,11 @@ def _log_runs(spec: Any, rows: Any, logs_dir: Path) -> None:
 def run(args: argparse.Namespace) -> int:
     out = check_output_path(args.out or f"logs/sweep-{time.strftime('%Y%m%d-%H%M%S')}", kind="dir", option="--out")
     spec, base_parts = _spec_from_args(args)
-    t0 = time.perf_counter()
     with progress_bar(spec.n, desc="sweep", unit="runs", fractional=True) as bar:
         result = sweep(spec, out_dir=out, chunk=args.chunk, nthread=args.nthread, scheduler=args.scheduler,
                        progress=counter_callback(bar))
-    wall = time.perf_counter() - t0
     runs = result.summary  # the one aggregator of sweep and validate
-    summary = result.report(wall_s=wall, folder=out)
+    summary = result.to_dict(runs=False)  # and the keys the command adds: its figure, its logs
     plot_path = _plot(result, out / "region")
     summary["plot"] = str(plot_path)
     if args.log:
@@ -103,7 +101,7 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print_json(summary)
     else:
-        _print_text(spec, runs, base_parts.controller, summary, wall)
+        _print_text(spec, runs, base_parts.controller, summary, result.wall_s)
         print(f"table: {out / 'runs.csv'}\nplot:  {plot_path}")
     return status
 

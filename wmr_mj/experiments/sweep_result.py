@@ -15,16 +15,21 @@ Usage::
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
+import time
+import warnings
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from wmr_mj.errors import ParameterError
 from wmr_mj.experiments.sweep import SweepSpec, SweepSummary, run_sweep, spec_from_json, spec_to_json
 from wmr_mj.hardware import cart_dict
 from wmr_mj.searches.search_space import HARDWARE_AXES, parameter_units
 from wmr_mj.sim import notebook
+from wmr_mj.sim.coerce import coerced
 from wmr_mj.sim.run_report import add_controller_source
 
 __all__ = ["SweepResult", "sweep"]
@@ -38,40 +43,31 @@ class SweepResult:
         spec: the sweep.
         rows: each run's row, in run order (runs.csv's columns: :func:`wmr_mj.sim.many_runs.flat_row`).
         summary: what the runs add up to.
+        wall_s: the sweep's wall time, s (its steps per second; 0: not measured).
+        folder: the sweep's folder (runs.csv, summary.json), where it wrote one.
     """
 
     spec: SweepSpec
     rows: tuple[Mapping[str, Any], ...]
     summary: SweepSummary
+    wall_s: float = 0.0
+    folder: str | None = None
 
-    def to_dict(self) -> dict[str, Any]:
-        """The sweep's JSON: ``spec`` (as sweep.json and the workers read it: its base as ``RunConfig.to_dict``),
-        ``rows`` (each run's row, in run order) and ``summary`` (:meth:`SweepSummary.to_dict`)."""
-        return {"spec": json.loads(spec_to_json(self.spec)), "rows": [dict(row) for row in self.rows],
-                "summary": self.summary.to_dict()}
-
-    @classmethod
-    def from_dict(cls, d: Mapping[str, Any]) -> SweepResult:
-        """The result of its JSON ``d`` (what :meth:`to_dict` wrote)."""
-        return cls(spec=spec_from_json(json.dumps(d["spec"])), rows=tuple(dict(row) for row in d["rows"]),
-                   summary=SweepSummary.from_dict(d["summary"]))
-
-    def report(self, *, wall_s: float, folder: str | os.PathLike) -> dict[str, Any]:
-        """``wmr-mj sweep --json`` (summary.json of the sweep's folder, before the CLI adds its figure's ``plot``
-        and ``mcap_dir``): :meth:`SweepSummary.sweep_dict`, then the sweep's folder, law, seed, sampling and
-        ranges, its fixed m1, signals, the law's source, the cart and the cart's axes drawn per run.
-
-        It is not :meth:`to_dict`: the CLI's JSON keeps the keys it always had (no rows: runs.csv holds them), and
-        ``to_dict`` is the whole result, which ``from_dict`` reads back.
+    def to_dict(self, *, runs: bool = True) -> dict[str, Any]:
+        """The sweep's JSON: ``wmr-mj sweep --json``'s keys (summary.json of the sweep's folder, before the CLI adds
+        its figure's ``plot`` and ``mcap_dir``: :meth:`SweepSummary.sweep_dict`, then the sweep's folder, law, seed,
+        sampling and ranges, its fixed m1, signals, the law's source, the cart and the cart's axes drawn per run),
+        then, with ``runs``, the key ``runs``: the spec (as sweep.json and the workers read it: its base as
+        ``RunConfig.to_dict``), each run's row (in run order) and the summary (:meth:`SweepSummary.to_dict`), which
+        :meth:`from_dict` reads back.
 
         Args:
-            wall_s: the sweep's wall time [s] (its steps per second).
-            folder: the sweep's folder (runs.csv, summary.json).
+            runs: add ``runs``; False: sweep --json's object exactly (runs.csv holds the rows).
         """
-        spec, base = self.spec, self.spec.base
-        out = self.summary.sweep_dict(wall_s)
-        out.update({"folder": str(folder), "model": base.model, "controller": base.controller, "seed": spec.seed,
-                    "sampling": spec.sampling,
+        spec, base = self.spec, coerced(self.spec.base)  # a base built directly: the config its runs ran as
+        out = self.summary.sweep_dict(self.wall_s)
+        out.update({"folder": None if self.folder is None else str(self.folder), "model": base.model,
+                    "controller": base.controller, "seed": spec.seed, "sampling": spec.sampling,
                     "ranges": {"m1": list(spec.m1_range), **{k: list(v) for k, v in spec.ranges.items()}}})
         if spec.m1 is not None:  # every run's m1 (ranges' m1: the certificate's box)
             out["fixed_m1"] = spec.m1
@@ -81,7 +77,31 @@ class SweepResult:
         out.update(cart_dict(base))  # the cart every run shares, where not ideal
         if spec.hardware_names:  # and the cart's axes each run draws, with what a drawn value becomes
             out["hardware_axes"] = {n: HARDWARE_AXES[n] for n in spec.hardware_names}
+        if runs:
+            out["runs"] = {"spec": json.loads(spec_to_json(self.spec)), "rows": [dict(row) for row in self.rows],
+                           "summary": self.summary.to_dict()}
         return out
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> SweepResult:
+        """The result of its JSON ``d`` (what :meth:`to_dict` wrote, with its ``runs``).
+
+        Raises:
+            ParameterError: ``d`` has no ``runs`` (sweep --json's object, summary.json): one line.
+        """
+        runs = d.get("runs")
+        if runs is None:
+            raise ParameterError("this JSON has no 'runs' (sweep --json and summary.json hold the summary only): "
+                                 "SweepResult.to_dict() writes every run, and from_dict reads that back")
+        return cls(spec=spec_from_json(json.dumps(runs["spec"])), rows=tuple(dict(row) for row in runs["rows"]),
+                   summary=SweepSummary.from_dict(runs["summary"]), wall_s=d["wall_s"], folder=d["folder"])
+
+    def report(self, *, wall_s: float, folder: str | os.PathLike) -> dict[str, Any]:
+        """Deprecated (kept one release): ``to_dict(runs=False)`` is sweep --json's object (the result carries its
+        wall time and folder)."""
+        warnings.warn("SweepResult.report() is deprecated: result.to_dict(runs=False) is sweep --json's object",
+                      DeprecationWarning, stacklevel=2)
+        return dataclasses.replace(self, wall_s=wall_s, folder=str(folder)).to_dict(runs=False)
 
     def to_pandas(self) -> Any:
         """One row per run: the values each run used (m1 and every ranged parameter, with units), its verdict,
@@ -123,8 +143,11 @@ def sweep(spec: SweepSpec, *, out_dir: str | os.PathLike | None = None, chunk: i
         out_dir, chunk, nthread, scheduler, progress: as :func:`~wmr_mj.experiments.sweep.run_sweep`.
 
     Returns:
-        SweepResult: the rows and their :class:`~wmr_mj.experiments.sweep.SweepSummary`.
+        SweepResult: the rows and their :class:`~wmr_mj.experiments.sweep.SweepSummary`, the wall time and the
+        folder.
     """
+    t0 = time.perf_counter()
     rows = run_sweep(spec, out_dir=out_dir, chunk=chunk, nthread=nthread, scheduler=scheduler, progress=progress)
     summary = SweepSummary.of(rows, spec.requirements, names=spec.names)
-    return SweepResult(spec=spec, rows=tuple(rows), summary=summary)
+    return SweepResult(spec=spec, rows=tuple(rows), summary=summary, wall_s=time.perf_counter() - t0,
+                       folder=None if out_dir is None else str(out_dir))

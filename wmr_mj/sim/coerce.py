@@ -34,7 +34,6 @@ from controllers.computed_torque import CONTROLLER_NAMES, FRICTION_SIGNS, MODEL_
 from controllers.registry import PluginSource, default_model, plugin_fresh, plugin_of
 from controllers.tracking import PathTracker
 from wmr_mj.carts import CartFile, cart_of, cart_of_text
-from wmr_mj.carts.cartfile import MOTOR_CONSTANT_RTOL
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.hardware import Actuation, Sensing, Transmission, check_cart, is_ideal_cart
 from wmr_mj.hardware.assembly import CART_PARTS, cart_dict
@@ -44,6 +43,7 @@ from wmr_mj.params import (
     M1_NOMINAL,
     M1_RANGE,
     C80Parameters,
+    check_motor_constant,
     parameter_names,
     parameters_of_cart,
     with_params,
@@ -213,23 +213,6 @@ def check_period_fits(control_period: float | None, duration: float) -> None:
                                                    if control_period is not None else "")
         raise ParameterError(f"the run's duration = {duration:g} s is not a whole multiple of {what} "
                              f"({duration / period:.6g} periods); {fix}")
-
-
-def check_motor_constant(k_i: float, k_b: float) -> None:
-    """k_b equal to k_i, as a cart file must have them (:mod:`wmr_mj.carts.cartfile`): one flux in SI units, and
-    MuJoCo's dcmotor has one constant (it would silently use their geometric mean). Every command that takes
-    ``--param`` checks it after its overrides.
-
-    Args:
-        k_i: the torque constant, N m/A. k_b: the back-EMF constant, V s/rad.
-
-    Raises:
-        ParameterError: they differ by more than a rounding (one line naming both and what is accepted).
-    """
-    if abs(k_b - k_i) > MOTOR_CONSTANT_RTOL * abs(k_i):
-        raise ParameterError(f"--param: k_b = {k_b!r} V s/rad and k_i = {k_i!r} N m/A differ; accepted: k_b equal to "
-                             "k_i (one flux in SI units; MuJoCo's dcmotor has one constant), e.g. --param "
-                             f"k_i={k_i!r} --param k_b={k_i!r}")
 
 
 # --------------------------------------------------------------------------- the coercer

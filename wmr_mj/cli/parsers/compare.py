@@ -26,8 +26,7 @@ from __future__ import annotations
 import argparse
 
 from wmr_mj.cli._common import CLAIM_BROKEN_EXIT
-from wmr_mj.cli.options import add_argument_with_help_of, add_json, add_out, add_seed, add_threads, names_in
-from wmr_mj.cli.parsers.run import add_hardware_options
+from wmr_mj.cli.command_options import add_command_options
 
 #: the command's line in ``wmr-mj --help`` (read without registering the command: wmr_mj/cli/app.py)
 HELP = ("every design on every scenario of a versioned suite, then the same adversary: one table (Markdown, "
@@ -40,24 +39,4 @@ def register(sub: argparse._SubParsersAction) -> None:
                        epilog=f"exit status: 0; {CLAIM_BROKEN_EXIT} when a run of a design (a scenario's or the "
                               "adversary's) is certified-outside: it breaks that design's claim (a banner above "
                               "the table names the run); 2 bad input")
-    p.add_argument("designs", nargs="+", metavar="DESIGN", help="a preset, a law's name, FILE.py:Class or "
-                                                               "module:Class, with ,key=value settings; or a "
-                                                               "design file FILE.json (wmr-mj design --out)")
-    add_argument_with_help_of(p, "--suite", _suite_help, default="standard-v1")
-    p.add_argument("--scenarios", action="append", metavar="PATTERN",
-                   help="only the scenarios whose id matches (shell pattern, e.g. 'circle/*'; repeatable)")
-    p.add_argument("--budget", type=int, default=32,
-                   help="the adversary's simulations per design, and as many random ones (default 32; 0: none)")
-    add_seed(p, help="the adversary's seed, the same for every design (default 0)")
-    p.add_argument("--method", default=None, help="the adversary's search method (default: falsify's)")
-    add_threads(p, help="threads (default 0: every core)")
-    p.add_argument("--scheduler", metavar="ADDRESS", help="run on a Dask cluster (e.g. tcp://127.0.0.1:8786)")
-    add_out(p, help="output folder (default logs/compare-<time>)")
-    add_json(p, help="print one JSON object")
-    p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
-                   help="progress bar (default: only on a terminal)")
-    add_hardware_options(p)  # every design's cart: its scenarios (but one that names its own) and its adversary
-
-
-def _suite_help() -> str:
-    return f"the scenario suite: one of {names_in('wmr_mj.experiments.suite', 'suite_names')} or a suite file (.toml)"
+    add_command_options(p, "compare")

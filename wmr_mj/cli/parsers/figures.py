@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import argparse
 
-from wmr_mj.cli.options import add_out, positive_float
+from wmr_mj.cli.command_options import add_command_options
 
 #: the command's line in ``wmr-mj --help`` (read without registering the command: wmr_mj/cli/app.py)
 HELP = "regenerate the paper's Figs. 4-7 (PNG and SVG, headless)"
@@ -19,6 +19,4 @@ HELP = "regenerate the paper's Figs. 4-7 (PNG and SVG, headless)"
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("figures", help=HELP,
                        description=__doc__.split("\n\n")[1] if __doc__ else None)
-    add_out(p, help="output folder (default logs/figures-<timestamp>/)")
-    p.add_argument("--duration", type=positive_float, default=35.0,
-                   help="length of the paper circle run, s (default 35; >= ~10 s reaches the circle)")
+    add_command_options(p, "figures")
