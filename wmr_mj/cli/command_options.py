@@ -243,7 +243,7 @@ VALIDATE = (
                           "or full (m1, steering and tyre friction, R_a, V_A; see wmr_mj/params.py)", default="m1"),
     PATH.with_help("path of C every run follows: a named path (paper-circle), a packaged route (agv-loop) or a "
                    "route file, as for wmr-mj run (default: the cart's own, [paths] default in its file, else "
-                   "paper-circle)"),
+                   "paper-circle where the cart steers it within 85%% of its stops, else a loop of turns it steers)"),
     Option(flag="--design", settings=dict(action="append", metavar="DESIGN", default=None),
            help="a design of your own, judged beside the ladder (its rung and its nominal run): a preset, "
                 "a law's name, FILE.py:Class or module:Class, with ,key=value settings as for wmr-mj "
@@ -264,7 +264,8 @@ DESIGN = (
         "on the non-holonomic model); both with the sign's width, tau_f and the period",
         default="computed-torque", metavar="LAW"),
     PATH.with_help("a path every certificate must hold on (repeatable; default: the cart's own, [paths] default "
-                   "in its file, else paper-circle)", action="append"),
+                   "in its file, else paper-circle where the cart steers it within 85%% of its stops, else a loop of "
+                   "turns it steers)", action="append"),
     UNCERTAINTY.with_help("the plant box: m1 (default) or full (wmr_mj/params.py)"),
     # type=float, not run's positive_float: argparse lets a bound <= 0 through here (as before the table)
     M1_RANGE.with_help("m1 range of the box, kg (default: the cart's m1 box, 550 750 on the C80)", type=float),
@@ -397,7 +398,8 @@ CART_COMMAND = (
     JSON,
     PATH.with_help("check: the path the certified design and the design search answer for (a path name, a "
                    "packaged route or a route file; default: the cart's own, [paths] default in its file, "
-                   "else paper-circle)"),
+                   "else paper-circle where the cart steers it within 85%% of its stops, else a loop of turns it "
+                   "steers)"),
     OUT.with_help("card: the Markdown file to write (default: logs/<cart file's stem>-card.md)", metavar="PATH"),
 )
 

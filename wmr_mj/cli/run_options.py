@@ -343,7 +343,7 @@ def _path_help() -> str:
     return (f"reference path of point C: one of {names_in('wmr_mj.sim.config', 'PATH_NAMES')}, a packaged route "
             "(agv-loop), or a route file (.toml/.json: segments or waypoints; see wmr_mj/reference/route.py); "
             "default: the --design file's path, else the cart's own ([paths] default in its file), else "
-            "paper-circle")
+            "paper-circle where the cart steers it within 85%% of its stops, else a loop of turns it steers")
 
 
 def _steering_friction_help() -> str:
