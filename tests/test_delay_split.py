@@ -28,10 +28,10 @@ from wmr_mj.analysis.plant_box import PlantBox, PlantLimits
 from wmr_mj.analysis.regions import BoxRegion
 from wmr_mj.analysis.robustness import ParameterBox
 from wmr_mj.carts import load_cart, load_cart_text
+from wmr_mj.carts.provenance import delay_split_unknown
 from wmr_mj.cli.app import main
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import C80
-from wmr_mj.plant.cart_data import delay_split_unknown
 from wmr_mj.plant.output_error import actuation_delay_of
 from wmr_mj.plant.recordings import Recording
 from wmr_mj.reference.bounds import ReferenceBounds

@@ -372,9 +372,9 @@ def test_sysid_without_the_extra_is_one_line_exit_2(tmp_path, capsys, monkeypatc
 
 
 def test_identified_from_reads_the_files_and_hashes_a_cart_names(tmp_path):
-    """wmr_mj.plant.cart_data: the recordings an identified cart's sources name, each once; none for a cart written
+    """wmr_mj.carts.provenance: the recordings an identified cart's sources name, each once; none for a cart written
     by hand. A file name with ' and ' in it stays whole."""
-    from wmr_mj.plant.cart_data import identified_from, identified_from_line
+    from wmr_mj.carts.provenance import identified_from, identified_from_line
 
     a, b = "0" * 64, "ab" * 32
     text = START.read_text(encoding="utf-8")

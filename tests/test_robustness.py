@@ -325,6 +325,17 @@ def test_derived_box_from_c80():
     assert nh.K == (0.0, 0.0)
 
 
+def test_cli_cart_alone_takes_the_box_derived_from_it(capsys):
+    """--cart with no --box: the box derived from the cart's parameters over its m1 box (the paper's (5.1) box is
+    the C80's); the same answer as --box derived given, and another than the paper's box."""
+    assert main(["robustness", "--json", "--cart", "c80-magmotor"]) == 0
+    alone = json.loads(capsys.readouterr().out)
+    assert main(["robustness", "--json", "--cart", "c80-magmotor", "--box", "derived"]) == 0
+    assert alone == json.loads(capsys.readouterr().out)
+    assert main(["robustness", "--json"]) == 0
+    assert alone["box"] != json.loads(capsys.readouterr().out)["box"]
+
+
 def test_cli_derived_box(capsys):
     assert main(["robustness", "--json", "--box", "derived", "--m1-range", "550", "750"]) == 0
     out = json.loads(capsys.readouterr().out)
@@ -369,7 +380,9 @@ def test_box_and_bounds_validation():
         (["--box", "derived", "--range", "m1=5:"], "NAME=LO:HI"),
         (["--box", "derived", "--range", "mu=0.02:0.01"], "inverted"),
         (["--box", "derived", "--range", "nope=1:2"], "unknown parameter 'nope'"),
-        (["--box", "paper", "--range", "mu=0.01:0.02"], "--box derived"),
+        (["--box", "paper", "--range", "mu=0.01:0.02"], "--range applies only to --box derived"),
+        (["--box", "paper", "--cart", "c80-magmotor", "--m1-range", "500", "600"],
+         "--m1-range, --cart apply only to --box derived"),
         (["--omega-r", "4", "--kd", "4"], "--omega-r"),
         (["--estimate", "X=1"], "unknown estimate name"),
     ],

@@ -299,7 +299,8 @@ ROBUSTNESS = (
     run_option("--omega-r").with_help("critical damping (3.6): K_P = omega_r^2/4, K_D = omega_r (not with --kp/--kd)"),
     # the box of the analysis: the paper's, or derived from a cart over ranges, by a reduced model
     run_option("--box").with_help(
-        "uncertainty box: the paper's (5.1) intervals (default), or derived from the C80 parameter set",
+        "uncertainty box: the paper's (5.1) intervals (default), or derived from the C80 parameter set (the "
+        "default with --cart: from the cart's)",
         choices=("paper", "derived"), default=None),
     M1_RANGE.with_help("chassis mass range [kg] for --box derived (default 550 750)", default=None),
     RANGE.with_help("extra C80 parameter range for --box derived (repeatable), e.g. mu=0.015:0.02"),

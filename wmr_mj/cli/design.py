@@ -11,13 +11,13 @@ import time
 from typing import Any
 
 from wmr_mj.analysis.delay_split import covered_split
+from wmr_mj.carts.provenance import identified_from_line
 from wmr_mj.cli._common import print_json
 from wmr_mj.cli.ranges import box_ranges_from_args
 from wmr_mj.cli.run import hardware_from_args
 from wmr_mj.errors import ParameterError
 from wmr_mj.experiments.sweep import sweep_over_box
 from wmr_mj.params import M1_RANGE
-from wmr_mj.plant.cart_data import identified_from_line
 from wmr_mj.reference.route import path_name
 from wmr_mj.searches.design_search import (
     DESIGN_FIELDS,

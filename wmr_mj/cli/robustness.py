@@ -71,7 +71,8 @@ def run(args: argparse.Namespace) -> int:
 
 def _fill_defaults(args: argparse.Namespace) -> None:
     """The defaults of the options left out (None: so that --certificate can tell them from given ones)."""
-    args.box = args.box or "paper"
+    # the paper's (5.1) box is the C80's: --cart (a cart's own parameter set and m1 box) asks for the derived one
+    args.box = args.box or ("derived" if args.cart is not None else "paper")
     args.reading = args.reading or "corrected"
     args.gammas = args.gammas or "exact"
     args.alpha_ddot = 0.4 if args.alpha_ddot is None else args.alpha_ddot
@@ -94,7 +95,8 @@ def _box(args: argparse.Namespace):
         used = [opt for opt, v in (("--m1-range", args.m1_range), ("--range", args.range), ("--model", args.model),
                                    ("--cart", args.cart)) if v]
         if used:
-            raise ParameterError(f"{', '.join(used)} only apply to --box derived (got --box paper)")
+            raise ParameterError(f"{', '.join(used)} {'applies' if len(used) == 1 else 'apply'} only to --box derived "
+                                 "(got --box paper: the paper's (5.1) intervals, the C80's)")
         return ParameterBox.paper(), "paper (5.1)"
 
     ranges = command_ranges(args, "robustness").plant  # m1's range is --m1-range (the one rule of --range)

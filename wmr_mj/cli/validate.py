@@ -10,13 +10,13 @@ import time
 from pathlib import Path
 
 from wmr_mj._util.files import check_output_path
+from wmr_mj.carts.provenance import identified_from_line
 from wmr_mj.cli._common import default_folder, print_json
 from wmr_mj.cli.run import hardware_from_args, with_design_file
 from wmr_mj.errors import ParameterError, WmrMjError
 from wmr_mj.experiments.compare import is_design_file
 from wmr_mj.hardware import cart_line, is_ideal_cart
 from wmr_mj.params import M1_RANGE
-from wmr_mj.plant.cart_data import identified_from_line
 from wmr_mj.report.text import format_headline
 from wmr_mj.report.validate import ValidateSettings, run_validate, write_pointer
 from wmr_mj.sim.coerce import cart_file_of_record, default_path, default_path_note

@@ -46,9 +46,9 @@ from typing import Any
 
 from wmr_mj.analysis.certificate import VERDICTS
 from wmr_mj.analysis.verdicts import WITHIN_THE_SUPPLY, format_unmet, paper_region_name
+from wmr_mj.carts.provenance import delay_split_unknown, identified_from
 from wmr_mj.hardware import Actuation, Sensing, Transmission
 from wmr_mj.params import COEFFICIENT_MODELS, COEFFICIENT_NAMES
-from wmr_mj.plant.cart_data import delay_split_unknown, identified_from
 from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS
 from wmr_mj.reference.route import path_name
 from wmr_mj.report.results import Rung, ValidateSummary

@@ -55,9 +55,9 @@ import numpy as np
 from wmr_mj._util.files import write_json_atomic
 from wmr_mj.analysis.claim_types import Assumption
 from wmr_mj.carts import cart_names, cart_path
+from wmr_mj.carts.provenance import identified_from
 from wmr_mj.errors import ParameterError
 from wmr_mj.hardware import Actuation, Sensing, Transmission
-from wmr_mj.plant.cart_data import identified_from
 from wmr_mj.plant.mjcf import TIMESTEP
 from wmr_mj.searches.design_options import (
     DEFAULT_BUDGET,

@@ -7,7 +7,7 @@ lines. Light on purpose (the standard library and the cart sections only): the d
 
 Usage::
 
-    from wmr_mj.plant.cart_data import identified_from
+    from wmr_mj.carts.provenance import identified_from
     identified_from(Path("new.toml").read_text())   # (("lane.csv", "8ab8..."), ("eight.csv", "e180..."))
 """
 
