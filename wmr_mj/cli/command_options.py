@@ -348,7 +348,8 @@ IDENTIFY = (
     OUT.with_help("also write the result as JSON (used by --model identified); with --data: the identified cart "
                   "file NEW.toml", metavar="PATH"),
     Option(flag="--data", settings=dict(action="append", metavar="FILE[:m1=KG]"),
-           help="a recording of the cart (CSV with the header t_s,u_V,alpha_rad[,speed_m_per_s], or a "
+           help="a recording of the cart (CSV with the header t_s,u_V,alpha_rad[,speed_m_per_s][,u_applied_V]: "
+                "u_applied_V, the voltage at the motor, separates the actuation delay from the sensing one; or a "
                 "wmr-mj run's MCAP log); :m1= gives the chassis mass during it (default: the cart's); "
                 "repeatable. Identifies P, C_V, F (as front_axle_mass, k_i = k_b, mu), the delay, the "
                 "encoder and the noise, and writes --out NEW.toml"),

@@ -145,5 +145,12 @@ class RunConfig:
         return record_of(self if is_coerced(self) else coerce(self))
 
     def replace(self, **changes: Any) -> RunConfig:
+        """The config with ``changes`` (field name -> value), nothing else touched, nothing read.
+
+        A field a coercion filled from the cart (the path, m1, the m1 box, the cart's default sensing, actuation
+        and play) is a plain value by then: ``RunConfig.from_inputs(cart=A).replace(cart=B)`` keeps A's. To move
+        a config to another cart, build it from the inputs again (``RunConfig.from_inputs(cart=B, ...)``) or
+        replace on the config as built (``RunConfig(cart=A).replace(cart=B)``, whose fields left None are B's).
+        """
         return dataclasses.replace(self, **changes)
 
