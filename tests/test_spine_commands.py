@@ -1,5 +1,5 @@
-"""Every command builds its laws through the spine, each once per resolution (issue 41: "resolve_run builds
-everything ... a test counts constructions over run, sweep, falsify, compare, design and validate").
+"""Every command builds its laws and references through the spine, each once per resolution (issue 41: "resolve_run
+builds everything ... a test counts constructions over run, sweep, falsify, compare, design and validate").
 
 The counter wraps each built-in law's constructor and ``claim``. At each call it looks up the Python stack:
 
@@ -8,12 +8,17 @@ The counter wraps each built-in law's constructor and ``claim``. At each call it
 - a claim must be computed by the spine's one caller of claims, ``wmr_mj.sim.certify.law_certificate``;
 - within one ``resolve_run`` call, each (law class, estimate's model) is built once and claims once.
 
+Likewise C's reference: ``wmr_mj.reference.named.build_reference`` is wrapped where every module holds it, and each
+call must come from the spine's one builder of a run's reference, ``wmr_mj.sim.parts.run_reference`` (which
+``resolve_run`` calls once per resolution; a log's replay, the certified design's rule, validate's path summary and
+cart check's feasibility probe call it for a 35 s or the run's own reference on the 1 ms grid, as a run builds it).
+
 ``resolve_run`` is counted by wrapping it where every imported module holds it (the modules import it by name),
 after importing every command's implementation, so each call is one numbered resolution.
 
-The one law built past the spine, named here: the paper's view in ``validate`` (``report/paper_example.py``), the
-law run on the reduced paper model with its estimate at a corner of the paper's (5.1) box and the plant at the
-other, which is no MuJoCo run and no RunConfig's law.
+The one law and the one reference built past the spine, named here: the paper's view in ``validate``
+(``report/paper_example.py``), the law run on the reduced paper model with its estimate at a corner of the paper's
+(5.1) box and the plant at the other, on its own reference of the paper circle: no MuJoCo run and no RunConfig's.
 """
 
 from __future__ import annotations
@@ -32,12 +37,16 @@ from controllers.computed_torque import ComputedTorque, PDController
 from controllers.sliding_mode import SlidingMode
 from wmr_mj.cli.app import COMMANDS as CLI_COMMANDS
 from wmr_mj.cli.app import main
-from wmr_mj.sim import parts
+from wmr_mj.params import C80
+from wmr_mj.reference import named
+from wmr_mj.sim import config, parts
 
 PACKAGE = Path(parts.__file__).parents[1]
 #: the spine's one builder of laws, its one caller of a law's claim, and the law built past it on purpose
 BUILDER = ("law_and_settings", str(PACKAGE / "sim" / "builders.py"))
 CLAIMER = ("law_certificate", str(PACKAGE / "sim" / "certify.py"))
+#: the spine's one builder of a run's reference (resolve_run's, and where a reference is needed without a run)
+REFERENCER = ("run_reference", str(PACKAGE / "sim" / "parts.py"))
 PAPER_VIEW = ("paper_example", str(PACKAGE / "report" / "paper_example.py"))
 
 
@@ -53,8 +62,9 @@ def _above(*functions: tuple[str, str]) -> bool:
 
 @pytest.fixture
 def counted(monkeypatch):
-    """(builds, claims, outside): Counters of (resolution number or None, law class, model source), and the laws
-    built or claims computed past the spine."""
+    """(builds, claims, references, outside): Counters of (resolution number or None, law class, model source),
+    a Counter of the references built by resolution number (or None), and the laws built, claims computed or
+    references built past the spine."""
     for name in CLI_COMMANDS:  # every command's implementation imported, so it holds resolve_run before the wrap
         importlib.import_module(f"wmr_mj.cli.{name}")
     resolving: list[int] = []
@@ -76,7 +86,22 @@ def counted(monkeypatch):
 
     builds: collections.Counter = collections.Counter()
     claims: collections.Counter = collections.Counter()
+    references: collections.Counter = collections.Counter()
     outside: list[str] = []
+
+    original_reference = named.build_reference
+
+    @functools.wraps(original_reference)
+    def build_reference(path, *args, **kwargs):
+        if not _above(REFERENCER, PAPER_VIEW):
+            outside.append(f"reference of {path!r}")
+        references[resolving[-1] if resolving else None] += 1
+        return original_reference(path, *args, **kwargs)
+
+    holders = [m for m in list(sys.modules.values()) if getattr(m, "build_reference", None) is original_reference]
+    assert {parts, named} <= set(holders)
+    for module in holders:
+        monkeypatch.setattr(module, "build_reference", build_reference)
 
     def key(law) -> tuple:
         return (resolving[-1] if resolving else None, type(law).__name__,
@@ -99,7 +124,7 @@ def counted(monkeypatch):
                 return __claim(self, context)
 
             monkeypatch.setattr(cls, "claim", claim)
-    return builds, claims, outside
+    return builds, claims, references, outside
 
 
 COMMANDS = {
@@ -117,7 +142,7 @@ COMMANDS = {
 def test_every_law_a_command_builds_is_built_by_the_spine_once_per_resolution(command, counted, tmp_path,
                                                                               monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
-    builds, claims, outside = counted
+    builds, claims, references, outside = counted
     argv = COMMANDS[command]
     if command != "run":
         argv = [*argv, "--out", str(tmp_path / ("design.json" if command == "design" else "out"))]
@@ -128,3 +153,15 @@ def test_every_law_a_command_builds_is_built_by_the_spine_once_per_resolution(co
     assert set(resolved.values()) == {1}, f"{command}: a law built twice in one resolution: {resolved}"
     resolved = {key: n for key, n in claims.items() if key[0] is not None}
     assert set(resolved.values()) <= {1}, f"{command}: a claim computed twice in one resolution: {resolved}"
+    resolved = {key: n for key, n in references.items() if key is not None}
+    assert resolved and set(resolved.values()) == {1}, f"{command}: references by resolution: {resolved}"
+
+
+def test_the_counter_sees_a_reference_built_past_the_spine(counted):
+    """The reference counter itself: a reference built by ``build_reference`` where a module holds it (as a
+    command's module would, importing it from the config) is counted outside; the spine's builder's is not."""
+    _, _, references, outside = counted
+    parts.run_reference("lane-change", C80, period=1e-3, duration=2.0)
+    assert outside == [] and references[None] == 1
+    config.build_reference("lane-change", C80, dt=1e-3, duration=2.0)
+    assert outside == ["reference of 'lane-change'"] and references[None] == 2

@@ -31,6 +31,7 @@ from wmr_mj.plant.cartcheck import (
     check_identification,
     step_with_random_controls,
 )
+from wmr_mj.plant.mjcf import TIMESTEP
 from wmr_mj.reference.route import path_name
 from wmr_mj.searches.design_search import (
     DEFAULT_BUDGET,
@@ -42,9 +43,9 @@ from wmr_mj.searches.design_search import (
 )
 from wmr_mj.sim import notebook
 from wmr_mj.sim.coerce import default_path, default_path_note
-from wmr_mj.sim.config import RunConfig, build_reference
+from wmr_mj.sim.config import RunConfig, estimate_parameters
 from wmr_mj.sim.designs import certified_design
-from wmr_mj.sim.parts import resolve_run
+from wmr_mj.sim.parts import resolve_run, run_reference
 
 __all__ = ["CartCheck", "NamedCart", "cart_check", "default_parts", "certified_on_cart", "design_on_cart"]
 
@@ -178,7 +179,7 @@ def cart_check(cart: Any, *, seed: int = 0, duration: float = 20.0, path: str | 
     parts = default_parts(cart)
     path = default_path(cart) if path is None else path
     try:  # a reference that cannot be built in bounded time is an absurd cart: refused before any step
-        build_reference(path, params, dt=1e-3, duration=35.0)
+        run_reference(path, estimate_parameters(params), period=TIMESTEP, duration=35.0)  # a 35 s run's, as resolved
     except StiffReferenceError as exc:
         raise ParameterError(f"cart file {str(cart.path)!r}: {exc}") from None
     except InfeasiblePathError:  # a circle the cart cannot steer: the cart's answer, reported below

@@ -24,11 +24,12 @@ from wmr_mj.experiments.sweep import (
 )
 from wmr_mj.hardware.assembly import CART_PARTS, cart_dict
 from wmr_mj.params import UNCERTAINTY_NAMES, uncertainty_ranges
+from wmr_mj.plant.mjcf import TIMESTEP
 from wmr_mj.report.defaults import DEFAULT_DURATION, DEFAULT_N, DEFAULT_SEARCH_BUDGET, FULL_BOX_FACTOR
 from wmr_mj.searches.falsify import cma_population
-from wmr_mj.sim.config import RunConfig, base_for, build_reference, cart_file
+from wmr_mj.sim.config import RunConfig, base_for, cart_file, estimate_parameters
 from wmr_mj.sim.designs import DesignLike, design_changes, on_cart
-from wmr_mj.sim.parts import resolve_run
+from wmr_mj.sim.parts import resolve_run, run_reference
 
 __all__ = [
     "DEFAULT_N",
@@ -203,8 +204,9 @@ def certificate_summary(cert: Any) -> dict[str, Any]:
 
 def reference_of(settings: ValidateSettings):
     """The reference of ``settings.path`` (the paper circle by default) for runs of ``settings.duration``
-    on the 1 ms grid."""
-    return build_reference(settings.path, settings.base, dt=1e-3, duration=settings.duration)[0]
+    on the 1 ms grid, built as :func:`wmr_mj.sim.parts.resolve_run` builds the runs' (on the cart's belief)."""
+    return run_reference(settings.path, estimate_parameters(settings.base), period=TIMESTEP,
+                         duration=settings.duration)[0]
 
 
 

@@ -71,8 +71,8 @@ from wmr_mj.searches.design_options import (
 from wmr_mj.searches.optimisers import CMAES, Chain, DifferentialEvolution, Optimiser, Points, drive
 from wmr_mj.sim import notebook
 from wmr_mj.sim.certify import certificate_name, certificate_of, measurement_errors_of
-from wmr_mj.sim.coerce import coerced
-from wmr_mj.sim.config import base_for, controller_and_settings
+from wmr_mj.sim.coerce import coerced, plant_parameters
+from wmr_mj.sim.config import controller_and_settings
 from wmr_mj.sim.designs import CERTIFIED
 from wmr_mj.sim.notebook import number
 from wmr_mj.sim.parts import resolve_run
@@ -316,8 +316,10 @@ def _check_law(law: Any) -> None:
 def uncovered(base: Any) -> str:
     """Why no certificate can cover ``base``'s cart (its sensing, actuation and play on its parameter set), so that
     no design can certify it (e.g. "Gaussian noise has no bound"); '' where its errors are covered. What ``wmr-mj
-    design`` refuses before any search and ``cart check`` reports as binding."""
-    measurement = measurement_errors_of(base, base_for(base))
+    design`` refuses before any search and ``cart check`` reports as binding. The errors are derived as
+    :func:`wmr_mj.sim.parts.resolve_run` derives a run's (:func:`wmr_mj.sim.certify.measurement_errors_of` on the
+    run's plant), without building the run."""
+    measurement = measurement_errors_of(base, plant_parameters(base))
     return "" if measurement.covered else str(measurement.why_not)
 
 

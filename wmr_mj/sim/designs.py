@@ -48,10 +48,12 @@ from controllers import CONTROLLER_NAMES, gains_from_omega_r
 from controllers.registry import parse_params
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import PAPER_KD, PAPER_KP
+from wmr_mj.plant.mjcf import TIMESTEP
 from wmr_mj.reference.route import path_name
 from wmr_mj.sim.certify import certificate_for
 from wmr_mj.sim.coerce import cart_file_of_record, default_path
-from wmr_mj.sim.config import RunConfig, base_for, build_reference, controller_for, estimate_parameters
+from wmr_mj.sim.config import RunConfig, base_for, controller_for, estimate_parameters
+from wmr_mj.sim.parts import run_reference
 
 __all__ = [
     "DesignPreset",
@@ -226,7 +228,9 @@ def certified_omega_r(*, error_spec: float = ERROR_SPEC, grid: tuple[float, ...]
     cart: the cart (anything ``RunConfig(cart=...)`` takes; None: the C80): its parameter set, its m1 box, its
     stops and supply."""
     on_cart = RunConfig.from_inputs(cart=cart)
-    reference, _ = build_reference(_path_of(cart, path), base_for(on_cart), dt=1e-3, duration=35.0)
+    # the reference of a 35 s run on the 1 ms grid, built as resolve_run builds a run's (on the cart's belief)
+    reference, _ = run_reference(_path_of(cart, path), estimate_parameters(base_for(on_cart)), period=TIMESTEP,
+                                 duration=35.0)
     for w in grid:
         config = RunConfig(model=CERTIFIED.model, kp=w * w / 4.0, kd=w, friction_sign=CERTIFIED.friction_sign,
                            friction_width=CERTIFIED.friction_width, cart=on_cart.cart)

@@ -211,13 +211,12 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
                              "give it; accepted: a law that estimates alpha' from the angle (reads_velocity = False, "
                              "docs/guides/plugins.md), or a velocity estimate (exact, tachometer, difference, "
                              "filtered)")
-    reference, settle_s = build_reference(config.path, estimate, dt=period, duration=n * period)  # run_reference's
+    reference, settle_s = run_reference(config.path, estimate, period=period, duration=config.duration)
     # the reference bounds the claims are computed for: the declared ones, else the reference's own
     bounds = reference.bounds() if config.reference_bounds is None else config.reference_bounds
     paper_estimate = estimate_of(controller)  # None: not the paper's law, whose region then says nothing of it
     analysis = analysis_of(box, bounds, estimate, kp=law.kp, kd=law.kd, estimate=paper_estimate)
-    measurement = certify.measurement_errors(config.sensing, config.actuation, config.transmission, plant,
-                                     period=claim_period)  # once: the claim and the run's parts share it
+    measurement = certify.measurement_errors_of(config, plant)  # once: the claim and the run's parts share it
     law_claim = certify.law_certificate(reference, controller=controller, tracker=tracker, box=box, base=base,
                                 estimate=estimate, plant=plant, period=claim_period, signals=config.signals,
                                 declared_bounds=config.reference_bounds, sensing=config.sensing,
@@ -241,7 +240,9 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
 def run_reference(path: str, estimate: C80Parameters, *, period: float, duration: float) -> tuple[Any, float]:
     """(reference, settle_s): C's reference of a run on its control grid, as :func:`resolve_run` builds it --
     ``round(duration / period)`` control steps of ``period`` [s] on the controller's belief ``estimate``
-    (:func:`wmr_mj.reference.named.build_reference`). A log's replay and a result made elsewhere build theirs here."""
+    (:func:`wmr_mj.reference.named.build_reference`): the one builder of a run's reference. A log's replay, a
+    result made elsewhere, the certified design's rule and the checks that refuse a path before any run build
+    theirs here."""
     n = int(round(duration / period))
     return build_reference(path, estimate, dt=period, duration=n * period)
 
