@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import functools
 import os
+from typing import Any
 
 import numpy as np
 
@@ -22,8 +23,8 @@ from wmr_mj.params import C80Parameters
 from wmr_mj.reference import paths as ref
 from wmr_mj.reference.route import default_path_of, is_route_spec, route_names, route_of, route_reference
 
-__all__ = ["PATH_NAMES", "build_reference", "REFERENCE_CACHE_SIZE", "path_label", "LANE_CHANGE_LEAD_IN_M",
-           "LANE_CHANGE_OFFSET_M", "LANE_CHANGE_LENGTH_M", "PATH_OPTION_HINT"]
+__all__ = ["PATH_NAMES", "build_reference", "run_reference", "REFERENCE_CACHE_SIZE", "path_label",
+           "LANE_CHANGE_LEAD_IN_M", "LANE_CHANGE_OFFSET_M", "LANE_CHANGE_LENGTH_M", "PATH_OPTION_HINT"]
 
 #: the paths of C a run names (the others are routes)
 PATH_NAMES = ("paper-circle", "lane-change", "figure-eight")
@@ -56,6 +57,16 @@ def build_reference(path: str | None, params: C80Parameters, *, dt: float, durat
         st = os.stat(path)
         file_key = (os.path.abspath(path), st.st_mtime_ns, st.st_size)
     return _cached_reference(path, file_key, params, float(dt), float(duration))
+
+
+def run_reference(path: str | None, estimate: C80Parameters, *, period: float,
+                  duration: float) -> tuple[Any, float]:
+    """(reference, settle_s): C's reference of a run on its control grid, as ``wmr_mj.sim.parts.resolve_run``
+    builds it -- ``round(duration / period)`` control steps of ``period`` [s] on the controller's belief
+    ``estimate`` (:func:`build_reference`): the one builder of a run's reference. A log's replay, a result made
+    elsewhere, the certified design's rule and the checks that refuse a path before any run build theirs here."""
+    n = int(round(duration / period))
+    return build_reference(path, estimate, dt=period, duration=n * period)
 
 
 #: references kept by :func:`build_reference`

@@ -413,7 +413,8 @@ def default_path_note(cart: CartFile | None) -> str | None:
 def _derived_path(text: str, path: str) -> tuple[str, str | None]:
     """(the default path of the cart of ``text``, the note naming it or None): :func:`default_path`'s rule,
     :func:`wmr_mj.reference.route.default_path_of` on the cart's parameters."""
-    return default_path_of(_parameters_of_text(text, path))
+    params = _parameters_of_text(text, path)
+    return default_path_of(params)
 
 
 def cart_file(config: Any) -> Any:

@@ -30,7 +30,7 @@ from wmr_mj.errors import ParameterError
 from wmr_mj.hardware import Actuation, Sensing, Transmission
 from wmr_mj.params import C80, C80Parameters, with_params
 from wmr_mj.plant.mjcf import TIMESTEP
-from wmr_mj.reference.named import build_reference
+from wmr_mj.reference.named import run_reference
 from wmr_mj.sim import certify
 from wmr_mj.sim.builders import (
     BoxSpec,
@@ -202,6 +202,8 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
     labels = RunLabels.named(config, law_name(config))
     route_length_m = (float(typed.route.path.length) if typed.route is not None
                       else manoeuvre_length(config.path))  # lane-change's
+    disturbance, loads = signal_inputs(config.signals, plant, options, n=n, period=period,
+                                       m1_inertia=config.m1_inertia)  # the signals' samples on the run's grid
     # then each part, built once and handed on in layer order: the parameter sets, the law and the tracker on the
     # belief, C's reference, the paper's analysis, the cart's measurement errors, the law's claim
     estimate = estimate_parameters(base)
@@ -216,16 +218,18 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
     bounds = reference.bounds() if config.reference_bounds is None else config.reference_bounds
     paper_estimate = estimate_of(controller)  # None: not the paper's law, whose region then says nothing of it
     analysis = analysis_of(box, bounds, estimate, kp=law.kp, kd=law.kd, estimate=paper_estimate)
-    measurement = certify.measurement_errors_of(config, plant)  # once: the claim and the run's parts share it
+    # once: the claim and the run's parts share them (the typed parts: measurement_errors_of would check again
+    # that the config is coerced, which it is here)
+    measurement = certify.measurement_errors(config.sensing, config.actuation, config.transmission, plant,
+                                             period=claim_period)
+    delay_split = certify.delay_split_of(config.cart)
     law_claim = certify.law_certificate(reference, controller=controller, tracker=tracker, box=box, base=base,
                                 estimate=estimate, plant=plant, period=claim_period, signals=config.signals,
                                 declared_bounds=config.reference_bounds, sensing=config.sensing,
                                 actuation=config.actuation, transmission=config.transmission,
                                 steering_friction=config.steering_friction, measurement=measurement,
-                                sampled_data=True, delay_split=certify.delay_split_of(config.cart))
+                                sampled_data=True, delay_split=delay_split)
     claims = claim_set(**{LAW_CLAIM: law_claim})
-    disturbance, loads = signal_inputs(config.signals, plant, options, n=n, period=period,
-                                       m1_inertia=config.m1_inertia)
     return RunParts(config=config, base=base, plant=plant, estimate=estimate, controller=controller,
                     controller_name=labels.controller, tracker=tracker, reference=reference,
                     settle_s=settle_s, substeps=substeps, period=period, n=n, options=options,
@@ -235,16 +239,6 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
                     reference_bounds=bounds, signals=config.signals,
                     disturbance=disturbance, loads=loads, route_length_m=route_length_m,
                     measurement=measurement, labels=labels, record=record)
-
-
-def run_reference(path: str, estimate: C80Parameters, *, period: float, duration: float) -> tuple[Any, float]:
-    """(reference, settle_s): C's reference of a run on its control grid, as :func:`resolve_run` builds it --
-    ``round(duration / period)`` control steps of ``period`` [s] on the controller's belief ``estimate``
-    (:func:`wmr_mj.reference.named.build_reference`): the one builder of a run's reference. A log's replay, a
-    result made elsewhere, the certified design's rule and the checks that refuse a path before any run build
-    theirs here."""
-    n = int(round(duration / period))
-    return build_reference(path, estimate, dt=period, duration=n * period)
 
 
 def plant_and_claim(config: RunConfig, shared: RunParts, *, base: C80Parameters = C80
