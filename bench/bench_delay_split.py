@@ -22,6 +22,7 @@ import time
 from pathlib import Path
 
 from wmr_mj.cli.app import main as wmr_mj
+from wmr_mj.plant.recordings import write_csv
 from wmr_mj.searches.design_search import design_file_box, design_file_settings
 from wmr_mj.sim.closed_loop import run_closed_loop
 from wmr_mj.sim.parts import resolve_run
@@ -36,11 +37,7 @@ def _record(out: Path, path: str, seed: int, sensing: str, actuation: str) -> Pa
                                 path=path, duration=20.0, controller=f"{DATA / 'identify_dithered_pd.py'}:DitheredPD",
                                 controller_params={"seed": seed})
     rows = run_closed_loop(cfg, progress=False).rows
-    with open(out, "w", encoding="utf-8") as f:
-        f.write("t_s,u_V,alpha_rad\n")
-        for t, u, a in zip(rows["t"], rows["voltage"], rows["alpha_measured"]):
-            f.write(f"{float(t)!r},{float(u)!r},{float(a)!r}\n")
-    return out
+    return write_csv(out, {"t_s": rows["t"], "u_V": rows["voltage"], "alpha_rad": rows["alpha_measured"]})
 
 
 def _quiet(argv: list[str]) -> None:

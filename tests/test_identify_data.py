@@ -23,7 +23,7 @@ from wmr_mj.errors import ParameterError
 from wmr_mj.logs.recordings import read_run_log
 from wmr_mj.params import parameters_of_cart
 from wmr_mj.plant.output_error import MODEL_ERROR_FLOOR, POORLY_DETERMINED, Interval, fit_recordings
-from wmr_mj.plant.recordings import Recording, check_recording, read_csv
+from wmr_mj.plant.recordings import Recording, check_recording, read_csv, write_csv
 from wmr_mj.report.identify import IdentifyReport
 
 DATA = Path(__file__).resolve().parent / "data"
@@ -45,11 +45,7 @@ def _record(path: str, seed: int, duration: float) -> dict[str, np.ndarray]:
 
 def _write_csv(rows: dict[str, np.ndarray], path: Path, n: int | None = None) -> Path:
     sl = slice(0, n)
-    with open(path, "w", encoding="utf-8") as f:
-        f.write("t_s,u_V,alpha_rad\n")
-        for t, u, a in zip(rows["t"][sl], rows["voltage"][sl], rows["alpha_measured"][sl]):
-            f.write(f"{float(t)!r},{float(u)!r},{float(a)!r}\n")
-    return path
+    return write_csv(path, {"t_s": rows["t"][sl], "u_V": rows["voltage"][sl], "alpha_rad": rows["alpha_measured"][sl]})
 
 
 @pytest.fixture(scope="module")
@@ -386,3 +382,18 @@ def test_identified_from_reads_the_files_and_hashes_a_cart_names(tmp_path):
     line = identified_from_line(named, "lab cart")
     assert line is not None and "runs/lane and turn.csv (SHA-256 000000000000...)" in line
     assert identified_from("not = [toml") == ()
+
+
+def test_a_recording_written_by_write_csv_reads_back_to_the_bit(tmp_path):
+    """write_csv is read_csv's format written: every sample back bit for bit (repr of a float is exact), the
+    optional column kept, and a column the reader does not know refused in one line."""
+    rng = np.random.default_rng(3)
+    t = np.arange(2500) * 1e-3
+    u, alpha, applied = rng.normal(0, 5, t.size), rng.normal(0, 0.3, t.size), rng.normal(0, 5, t.size)
+    rec = read_csv(write_csv(tmp_path / "r.csv", {"t_s": t, "u_V": u, "alpha_rad": alpha, "u_applied_V": applied}))
+    for got, want in ((rec.t, t), (rec.voltage, u), (rec.alpha, alpha), (rec.applied, applied)):
+        assert np.asarray(got).tobytes() == want.tobytes()
+    with pytest.raises(ParameterError, match="volts not known"):
+        write_csv(tmp_path / "bad.csv", {"t_s": t, "u_V": u, "alpha_rad": alpha, "volts": u})
+    with pytest.raises(ParameterError, match="differ in length"):
+        write_csv(tmp_path / "bad.csv", {"t_s": t, "u_V": u[:-1], "alpha_rad": alpha})

@@ -23,6 +23,7 @@ from wmr_mj.analysis.delay_split import DELAY_SPLIT_COVERED
 from wmr_mj.carts import load_cart
 from wmr_mj.cli.app import main
 from wmr_mj.hardware import Actuation, Sensing
+from wmr_mj.plant.recordings import write_csv
 from wmr_mj.sim.closed_loop import run_closed_loop
 from wmr_mj.sim.config import RunConfig
 
@@ -48,14 +49,9 @@ def _record_csv(path: str, seed: int, duration: float, out: Path) -> tuple[Path,
     rows = run_closed_loop(cfg, progress=False).rows
     d_a = round(ACTUATION_S / PERIOD_S)
     applied = np.concatenate([np.zeros(d_a), rows["voltage"][:-d_a]])
-    with_applied = out.with_name(out.stem + "-applied.csv")
-    with open(out, "w", encoding="utf-8") as f, open(with_applied, "w", encoding="utf-8") as g:
-        f.write("t_s,u_V,alpha_rad\n")
-        g.write("t_s,u_V,alpha_rad,u_applied_V\n")
-        for t, u, a, v in zip(rows["t"], rows["voltage"], rows["alpha_measured"], applied):
-            f.write(f"{float(t)!r},{float(u)!r},{float(a)!r}\n")
-            g.write(f"{float(t)!r},{float(u)!r},{float(a)!r},{float(v)!r}\n")
-    return out, with_applied
+    recorded = {"t_s": rows["t"], "u_V": rows["voltage"], "alpha_rad": rows["alpha_measured"]}
+    return (write_csv(out, recorded),
+            write_csv(out.with_name(out.stem + "-applied.csv"), {**recorded, "u_applied_V": applied}))
 
 
 def _main(argv: list[str]) -> tuple[int, str]:

@@ -25,6 +25,7 @@ from wmr_mj.carts import load_cart
 from wmr_mj.cli.app import main
 from wmr_mj.hardware.sensing import Sensing
 from wmr_mj.params import parameters_of_cart
+from wmr_mj.plant.recordings import write_csv
 
 DATA = Path(__file__).resolve().parent / "data"
 TRUTH = DATA / "identify_truth.toml"
@@ -45,11 +46,7 @@ def _record_csv(path: str, seed: int, duration: float, out: Path) -> Path:
     cfg = RunConfig.from_inputs(cart=str(TRUTH), sensing=SENSING, path=path, duration=duration,
                                 controller=f"{LAW}:DitheredPD", controller_params={"seed": seed})
     rows = run_closed_loop(cfg, progress=False).rows
-    with open(out, "w", encoding="utf-8") as f:
-        f.write("t_s,u_V,alpha_rad\n")
-        for t, u, a in zip(rows["t"], rows["voltage"], rows["alpha_measured"]):
-            f.write(f"{float(t)!r},{float(u)!r},{float(a)!r}\n")
-    return out
+    return write_csv(out, {"t_s": rows["t"], "u_V": rows["voltage"], "alpha_rad": rows["alpha_measured"]})
 
 
 def _main(argv: list[str]) -> tuple[int, str]:

@@ -30,7 +30,7 @@ import numpy as np
 
 from wmr_mj.errors import ParameterError
 
-__all__ = ["Recording", "COLUMNS", "REQUIRED_COLUMNS", "read_csv", "check_recording", "parse_columns",
+__all__ = ["Recording", "COLUMNS", "REQUIRED_COLUMNS", "read_csv", "write_csv", "check_recording", "parse_columns",
            "MIN_RECORDING_S", "GAP_TOLERANCE", "SUPPLY_TOLERANCE"]
 
 #: The CSV columns, by the name the header must give (quantity and unit in one): what each holds.
@@ -129,6 +129,38 @@ def parse_columns(text: str | None) -> dict[str, str]:
             raise ParameterError(f"--columns: {key!r} is not a column of a recording; accepted: {', '.join(COLUMNS)}")
         out[key] = value
     return out
+
+
+def write_csv(path: str | Path, columns: Mapping[str, np.ndarray]) -> Path:
+    """Write a recording as :func:`read_csv` reads it: a header of ``columns``' names (:data:`COLUMNS`, in the
+    order given), then one row per sample, each number as Python's ``repr`` of the float (read back to the bit).
+
+    Args:
+        path: the file written.
+        columns: our column name -> its samples, all of one length (``t_s``, ``u_V`` and ``alpha_rad`` at least).
+
+    Returns:
+        ``path``, as a Path.
+
+    Raises:
+        ParameterError: a name that is not one of :data:`COLUMNS`, a required column missing, or columns of
+            different lengths (one line).
+    """
+    unknown = [name for name in columns if name not in COLUMNS]
+    missing = [name for name in REQUIRED_COLUMNS if name not in columns]
+    if unknown or missing:
+        raise ParameterError(f"a recording's columns: {', '.join(unknown + missing)} "
+                             f"{'not known' if unknown else 'missing'}; accepted: {', '.join(COLUMNS)}, with "
+                             f"{', '.join(REQUIRED_COLUMNS)} required")
+    samples = [np.asarray(v, dtype=float) for v in columns.values()]
+    if len({len(v) for v in samples}) != 1:
+        raise ParameterError(f"a recording's columns differ in length: {[len(v) for v in samples]}")
+    path = Path(path)
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(",".join(columns) + "\n")
+        for row in zip(*samples):
+            f.write(",".join(repr(float(x)) for x in row) + "\n")
+    return path
 
 
 def read_csv(path: str | Path, *, m1: float | None = None, columns: Mapping[str, str] | None = None) -> Recording:
