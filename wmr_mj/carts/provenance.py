@@ -13,6 +13,7 @@ Usage::
 
 from __future__ import annotations
 
+import functools
 import re
 import tomllib
 from collections.abc import Mapping
@@ -56,9 +57,11 @@ def identified_from_line(text: str, cart: str) -> str | None:
             f"lies inside the identified box, which those data support at 95 % per parameter{split}")
 
 
+@functools.lru_cache(maxsize=16)  # read once per cart text: every resolution and design candidate asks
 def delay_split_unknown(text: str) -> bool:
     """Whether a cart file's text says that only the sum of its sensing and actuation delays is known
-    (``[defaults.delay_split]`` 'unknown': written by ``identify --data``)."""
+    (``[defaults.delay_split]`` 'unknown': written by ``identify --data``): the one reader of that key (the
+    certificates' ``wmr_mj.sim.certify.delay_split_of`` and the reports' words ask it)."""
     try:
         document = tomllib.loads(text)
     except tomllib.TOMLDecodeError:
