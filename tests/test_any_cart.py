@@ -299,7 +299,7 @@ def test_the_paper_objective_is_named_as_this_carts_off_the_c80_and_the_others_s
 
 def _undeclared_cart(tmp_path: Path) -> Path:
     """The new user's cart without its [paths] section: the paper's 1 m circle needs 1.12 rad of its +-0.7 rad stops,
-    so its own path is the one derived from its stops (wmr_mj.sim.coerce.default_path)."""
+    so its own path is the one derived from its stops (wmr_mj.reference.named.default_path)."""
     text = (DATA / "anycart.toml").read_text(encoding="utf-8")
     cut = re.sub(r"\[paths\]\ndefault = [^\n]+\nsource = [^\n]+\n", "", text)
     assert cut != text
@@ -315,9 +315,9 @@ def test_a_config_built_directly_on_a_cart_runs_on_the_carts_path(tmp_path, decl
     default, the paper circle, which this cart's stops cannot steer (run refused, the sweep's runs on the circle).
     The truth: the cart file's ``[paths] default``, else the loop derived from its stops (its note names it)."""
     from wmr_mj.experiments.sweep import run_sweep
+    from wmr_mj.reference.named import default_path, default_path_note
     from wmr_mj.searches.falsify import FalsifySpec, falsify
     from wmr_mj.sim.closed_loop import run_closed_loop
-    from wmr_mj.sim.coerce import default_path, default_path_note
 
     cart_path = DATA / "anycart.toml" if declared else _undeclared_cart(tmp_path)
     cart = load_cart(cart_path)

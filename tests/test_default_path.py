@@ -1,7 +1,7 @@
 """The default path of a cart whose file declares none (issue 42: "when none is declared, the default is a path the
 cart can steer, and it is named").
 
-The rule (wmr_mj.sim.coerce.default_path): the paper circle where the cart steers it at no more than 85 % of its
+The rule (wmr_mj.reference.named.default_path): the paper circle where the cart steers it at no more than 85 % of its
 stops (the C80 and the shipped carts: asin(0.612) = 0.659 rad of +-0.9 rad, 73 %, so their numbers do not move; issue
 37's cart with +-0.8 rad stops, 82 %, keeps it too); else a closed loop of two half-circles whose steady steering
 angle is 85 % of the stops, R = l1 / sin(0.85 x stops). The cart here
@@ -26,9 +26,9 @@ import pytest
 from wmr_mj.carts import load_cart
 from wmr_mj.errors import InfeasiblePathError
 from wmr_mj.params import parameters_of_cart
+from wmr_mj.reference.named import default_path, default_path_note
 from wmr_mj.reference.route import DEFAULT_PATH_STOP_FRACTION, load_route
 from wmr_mj.sim.builders import build_reference
-from wmr_mj.sim.coerce import default_path, default_path_note
 from wmr_mj.sim.config import RunConfig, coerce
 
 DATA = Path(__file__).resolve().parent / "data"

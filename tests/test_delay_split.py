@@ -35,7 +35,7 @@ from wmr_mj.params import C80
 from wmr_mj.plant.output_error import actuation_delay_of
 from wmr_mj.plant.recordings import Recording
 from wmr_mj.reference.bounds import ReferenceBounds
-from wmr_mj.sim.certify import delay_split_of
+from wmr_mj.sim.coerce import delay_split_of
 from wmr_mj.sim.parts import resolve_run
 from wmr_mj.sim.run_config import RunConfig
 

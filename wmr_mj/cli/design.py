@@ -18,6 +18,7 @@ from wmr_mj.cli.run import hardware_from_args
 from wmr_mj.errors import ParameterError
 from wmr_mj.experiments.sweep import sweep_over_box
 from wmr_mj.params import M1_RANGE
+from wmr_mj.reference.named import default_path, default_path_note
 from wmr_mj.reference.route import path_name
 from wmr_mj.searches.design_search import (
     DESIGN_FIELDS,
@@ -30,7 +31,7 @@ from wmr_mj.searches.design_search import (
     write_design,
 )
 from wmr_mj.sim.certify import certificate_name
-from wmr_mj.sim.coerce import cart_file_of_record, default_path, default_path_note
+from wmr_mj.sim.coerce import cart_file_of_record
 from wmr_mj.sim.config import RunConfig
 
 
@@ -106,7 +107,7 @@ def check_design(problem: Any, result: Any, n: int) -> dict[str, Any]:
 
 def _path_note(args: argparse.Namespace, problem: Any) -> str | None:
     """The line naming the default path derived from the cart's stops where no --path is given
-    (:func:`wmr_mj.sim.coerce.default_path_note`); None otherwise."""
+    (:func:`wmr_mj.reference.named.default_path_note`); None otherwise."""
     return None if args.path else default_path_note(cart_file_of_record(problem.base.cart))
 
 

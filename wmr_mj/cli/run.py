@@ -22,6 +22,7 @@ from wmr_mj.hardware import Actuation, Sensing, Transmission, cart_line, is_idea
 from wmr_mj.logs.writer import LogOptions, RunLogger, terminate_as_interrupt
 from wmr_mj.params import M1_NOMINAL, M1_RANGE, uncertainty_ranges
 from wmr_mj.plant.mjcf import TIMESTEP
+from wmr_mj.reference.named import default_path, default_path_note
 from wmr_mj.searches.design_search import (
     design_cart,
     design_cart_name,
@@ -30,7 +31,7 @@ from wmr_mj.searches.design_search import (
     read_design,
 )
 from wmr_mj.sim.closed_loop import MUJOCO_WITHOUT_WARNINGS, run_parts
-from wmr_mj.sim.coerce import cart_file_of_record, default_path, default_path_note
+from wmr_mj.sim.coerce import cart_file_of_record
 from wmr_mj.sim.config import RunConfig, plugin_source
 from wmr_mj.sim.engine import law_path
 from wmr_mj.sim.parts import resolve_run
@@ -155,7 +156,7 @@ def with_design_file(args: argparse.Namespace) -> argparse.Namespace:
 
 def default_path_note_of(args: argparse.Namespace, config: Any) -> str | None:
     """The line naming the config's path where it is the default derived from the cart's stops (no --path given,
-    none from a design; :func:`wmr_mj.sim.coerce.default_path_note`); None otherwise."""
+    none from a design; :func:`wmr_mj.reference.named.default_path_note`); None otherwise."""
     if getattr(args, "path", None) is not None:
         return None
     cart = cart_file_of_record(config.cart)

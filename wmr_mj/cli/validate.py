@@ -17,9 +17,10 @@ from wmr_mj.errors import ParameterError, WmrMjError
 from wmr_mj.experiments.compare import is_design_file
 from wmr_mj.hardware import cart_line, is_ideal_cart
 from wmr_mj.params import M1_RANGE
+from wmr_mj.reference.named import default_path, default_path_note
 from wmr_mj.report.text import format_headline
 from wmr_mj.report.validate import ValidateSettings, run_validate, write_pointer
-from wmr_mj.sim.coerce import cart_file_of_record, default_path, default_path_note
+from wmr_mj.sim.coerce import cart_file_of_record
 from wmr_mj.sim.config import RunConfig
 
 

@@ -32,6 +32,7 @@ from wmr_mj.plant.cartcheck import (
     step_with_random_controls,
 )
 from wmr_mj.plant.mjcf import TIMESTEP
+from wmr_mj.reference.named import default_path, default_path_note
 from wmr_mj.reference.route import path_name
 from wmr_mj.searches.design_search import (
     DEFAULT_BUDGET,
@@ -42,7 +43,6 @@ from wmr_mj.searches.design_search import (
     uncovered,
 )
 from wmr_mj.sim import notebook
-from wmr_mj.sim.coerce import default_path, default_path_note
 from wmr_mj.sim.config import RunConfig, estimate_parameters
 from wmr_mj.sim.designs import certified_design
 from wmr_mj.sim.parts import resolve_run, run_reference
@@ -79,7 +79,7 @@ class CartCheck:
         design: whether the design search certifies the cart (:func:`design_on_cart`).
         design_wall_s: the design search's wall time [s] (not in the JSON).
         path_note: the line naming the default path derived from the cart's stops where it answers on it
-            (:func:`wmr_mj.sim.coerce.default_path_note`); None otherwise.
+            (:func:`wmr_mj.reference.named.default_path_note`); None otherwise.
     """
 
     cart: Any
@@ -169,7 +169,7 @@ def cart_check(cart: Any, *, seed: int = 0, duration: float = 20.0, path: str | 
     """Check ``cart`` (a :class:`wmr_mj.carts.CartFile`): its default parts, the certified design's certificate
     on it, the design search, 1 s of random controls, and the identification over a ``duration`` s excitation,
     each seeded with ``seed``. ``path``: the path the certified design and the design search answer for (None: the
-    cart's own, :func:`wmr_mj.sim.coerce.default_path`; named in the answer).
+    cart's own, :func:`wmr_mj.reference.named.default_path`; named in the answer).
 
     Raises:
         ParameterError: a default part that cannot be built, or a reference that cannot be built in bounded time
@@ -235,7 +235,7 @@ def _answer(cart: Any, steps: Any, ident: Any, ident_error: str | None) -> str:
 
 def certified_on_cart(cart: Any, path: str | None = None) -> dict[str, Any]:
     """The certified design on ``cart`` (a checked CartFile) and its certificate on ``path`` (None: the cart's own,
-    :func:`wmr_mj.sim.coerce.default_path`) with the cart's default sensing, actuation and play: omega_r [rad/s],
+    :func:`wmr_mj.reference.named.default_path`) with the cart's default sensing, actuation and play: omega_r [rad/s],
     kp, kd, certified, E_max [rad], Edot_max [rad/s],
     voltage_max [V], voltage_limit [V], met, unmet (assumption names); or omega_r None and 'reason' where the rule
     finds no omega_r on its grid."""
@@ -256,7 +256,7 @@ def certified_on_cart(cart: Any, path: str | None = None) -> dict[str, Any]:
 def design_on_cart(cart: Any, *, seed: int | None = None, budget: int | None = None,
                    path: str | None = None) -> dict[str, Any]:
     """Can ``wmr-mj design`` certify ``cart`` (a checked CartFile) on its default sensing, actuation and play? The
-    design search on ``path`` (None: the cart's own, :func:`wmr_mj.sim.coerce.default_path`) over the cart's m1
+    design search on ``path`` (None: the cart's own, :func:`wmr_mj.reference.named.default_path`) over the cart's m1
     box, computed-torque law, 1 ms period, E_max minimised.
 
     Returns:

@@ -98,7 +98,7 @@ def design_from_token(token: str, suite: Suite, *, cart: Mapping[str, Any] | Non
             the suite's uncertainty on the cart.
         path: the design's own path (a design file's, ``wmr-mj compare``): a scenario (or the adversary) that
             names no path runs on it, one that names its own runs that; None: the cart's own
-            (:func:`wmr_mj.sim.coerce.default_path`, the paper circle on the C80).
+            (:func:`wmr_mj.reference.named.default_path`, the paper circle on the C80).
 
     Raises:
         UnknownNameError, ParameterError: an unknown preset or law, a bad setting (one line each).

@@ -18,20 +18,52 @@ from typing import Any
 
 import numpy as np
 
+from wmr_mj.carts import CartFile, cart_of_text
 from wmr_mj.errors import InfeasiblePathError, StiffReferenceError, UnknownNameError, WmrMjError
-from wmr_mj.params import C80Parameters
+from wmr_mj.params import C80Parameters, parameters_of_cart
 from wmr_mj.reference import paths as ref
 from wmr_mj.reference.route import default_path_of, is_route_spec, route_names, route_of, route_reference
 
-__all__ = ["PATH_NAMES", "build_reference", "run_reference", "REFERENCE_CACHE_SIZE", "path_label",
+__all__ = ["PATH_NAMES", "DEFAULT_PATH", "default_path", "default_path_note", "build_reference",
+           "run_reference", "REFERENCE_CACHE_SIZE", "path_label",
            "LANE_CHANGE_LEAD_IN_M", "LANE_CHANGE_OFFSET_M", "LANE_CHANGE_LENGTH_M", "PATH_OPTION_HINT"]
 
 #: the paths of C a run names (the others are routes)
 PATH_NAMES = ("paper-circle", "lane-change", "figure-eight")
 
+#: the path of a run that names none, on a cart that declares none (``[paths] default`` declares a cart's own)
+DEFAULT_PATH = "paper-circle"
+
 #: the named path lane-change: a lead-in line, the lane change (lateral offset over a length), then a line that
 #: fills the duration [m]
 LANE_CHANGE_LEAD_IN_M, LANE_CHANGE_OFFSET_M, LANE_CHANGE_LENGTH_M = 0.5, 0.5, 4.0
+
+
+def default_path(cart: CartFile | None) -> str:
+    """The path a run on ``cart`` takes where it names none: the one the cart declares (``[paths] default``); else
+    the paper circle (:data:`DEFAULT_PATH`) where the cart steers it at no more than
+    :data:`wmr_mj.reference.route.DEFAULT_PATH_STOP_FRACTION` of its stops (the C80 and the shipped carts: 0.659 of
+    +-0.9 rad); else a loop of half-turns whose steady angle is that fraction of the stops
+    (:func:`wmr_mj.reference.route.default_path_of`; :func:`default_path_note` names it). ``cart`` None: the C80.
+    ``wmr_mj.sim.coerce`` gives a config whose path is None this path."""
+    if cart is None:
+        return DEFAULT_PATH
+    return cart.default_path if cart.default_path is not None else _derived_path(cart.text, str(cart.path))[0]
+
+
+def default_path_note(cart: CartFile | None) -> str | None:
+    """The line that names the default path derived from ``cart``'s stops (:func:`default_path`); None where the
+    cart declares its own or takes the paper circle."""
+    if cart is None or cart.default_path is not None:
+        return None
+    return _derived_path(cart.text, str(cart.path))[1]
+
+
+@functools.lru_cache(maxsize=8)  # once per cart text: every coercion of a config on the cart asks
+def _derived_path(text: str, path: str) -> tuple[str, str | None]:
+    """(the default path of the cart of ``text``, the note naming it or None): :func:`default_path`'s rule,
+    :func:`wmr_mj.reference.route.default_path_of` on the cart's parameters."""
+    return default_path_of(parameters_of_cart(cart_of_text(text, path)))
 
 
 def build_reference(path: str | None, params: C80Parameters, *, dt: float, duration: float):

@@ -473,7 +473,7 @@ def default_path_of(params: C80Parameters) -> tuple[str, str | None]:
     The paper circle ('paper-circle') where the cart steers it at no more than :data:`DEFAULT_PATH_STOP_FRACTION`
     of its stops (the C80 and the shipped carts: 0.659 of +-0.9 rad), with no line; else a loop of two half-turns
     (:func:`turns_loop`) whose steady angle is that fraction of the stops, as canonical route JSON, and the line
-    that names it. A cart file's ``[paths] default`` comes first (``wmr_mj.sim.coerce.default_path``).
+    that names it. A cart file's ``[paths] default`` comes first (``wmr_mj.reference.named.default_path``).
     """
     angle = DEFAULT_PATH_STOP_FRACTION * params.steering_range
     if params.l1 <= PAPER_CIRCLE_RADIUS_M * math.sin(angle):  # the paper circle, steered with margin

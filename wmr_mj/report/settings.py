@@ -73,7 +73,7 @@ class ValidateSettings:
     m1_range: tuple[float, float] = None  # type: ignore[assignment]
     nominal_m1: float = None  # type: ignore[assignment]
     uncertainty: str = "m1"
-    # C's path of every run; None: the cart's own (wmr_mj.sim.coerce.default_path; the paper circle on the C80),
+    # C's path of every run; None: the cart's own (wmr_mj.reference.named.default_path; the paper circle on the C80),
     # resolved when checked, as validate takes it
     path: str = None  # type: ignore[assignment]
     designs: tuple[str, ...] = ()  # designs of the user's, each judged beside the ladder (validate --design)

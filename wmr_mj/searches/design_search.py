@@ -98,7 +98,7 @@ class DesignProblem:
         base: the run's configuration: the cart (sensing, actuation, transmission), the plant box (m1_range,
             box_ranges, box), the duration; the law's fields are the search's.
         paths: the paths every certificate must hold on (the worst counts); empty: the base's own path (its
-            ``path``, else its cart's: :func:`wmr_mj.sim.coerce.default_path`, the paper circle on the C80), as
+            ``path``, else its cart's: :func:`wmr_mj.reference.named.default_path`, the paper circle on the C80), as
             ``wmr-mj design`` takes it.
         periods: the control periods tried, s (each a whole number of physics steps).
         objective: one of :data:`OBJECTIVES` (default :data:`DEFAULT_OBJECTIVE`, the supply weighed).

@@ -41,13 +41,12 @@ from wmr_mj.analysis.plant_box import hull as _hull
 from wmr_mj.analysis.regions import SmallGainRegion
 from wmr_mj.analysis.robustness import ParameterBox
 from wmr_mj.analysis.verdicts import OUTSIDE_THE_BOX
-from wmr_mj.carts.provenance import delay_split_unknown
 from wmr_mj.errors import ParameterError
 from wmr_mj.hardware import Actuation, Sensing, Transmission
 from wmr_mj.params import C80, COEFFICIENT_NAMES, C80Parameters
 from wmr_mj.plant.mjcf import TIMESTEP
 from wmr_mj.sim.builders import BoxSpec, run_bounds
-from wmr_mj.sim.coerce import coerced
+from wmr_mj.sim.coerce import coerced, delay_split_of
 from wmr_mj.sim.config import (
     base_for,
     controller_and_settings,
@@ -59,7 +58,7 @@ from wmr_mj.sim.config import (
 
 __all__ = ["certificate_for", "certificate_of", "law_certificate", "measurement_errors", "outside_of",
            "claim_on_estimate", "identified_spread",
-           "box_spans", "outside_the_box", "reference_within", "certificate_name", "delay_split_of",
+           "box_spans", "outside_the_box", "reference_within", "certificate_name",
            "MAX_SAMPLED_DELAY_PERIODS", "section_4_beside"]
 
 
@@ -362,13 +361,6 @@ def law_certificate(reference: Any, *, controller: Any, tracker: Any, box: BoxSp
     if signals is not None:
         inputs.update(signals=signals.to_dict(), d_max=signals.declared_d_max)
     return replace_inputs(cert, inputs)
-
-
-def delay_split_of(cart: Mapping[str, str] | None) -> str:
-    """How the run's cart divides its delay (its ``[defaults.delay_split]``): 'unknown' for a cart identified from
-    recordings at the controller, which fix only the sum of the sensing and actuation delays; 'known' for any other
-    cart and the C80. ``cart``: a typed config's cart record (``RunConfig.cart``; None: the C80)."""
-    return "unknown" if cart is not None and delay_split_unknown(cart["text"]) else "known"
 
 
 def certificate_name(cert: Certificate) -> str:

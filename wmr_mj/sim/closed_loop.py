@@ -34,7 +34,6 @@ import numpy as np
 
 from controllers import SteeringController
 from controllers.tracking import within_declared
-from wmr_mj._util.memory import require_run_memory
 from wmr_mj._util.progress import progress_bar
 from wmr_mj.analysis.claim import with_measured
 from wmr_mj.analysis.claim_types import LAW_CLAIM, Assumption, CertificateJudgement, judge
@@ -423,8 +422,7 @@ def run_closed_loop(
     receives a block of rows every simulated second and is closed with the summary,
     also when the run is interrupted (KeyboardInterrupt or SIGTERM).
     """
-    require_run_memory(duration_s=config.duration, control_period_s=(config.control_period or TIMESTEP))
-    parts = resolve_run(config, base=base)  # before the arrays: what the run is made of, resolved once
+    parts = resolve_run(config, base=base)  # what the run is made of, resolved once (a run that does not fit refused)
     return run_parts(parts, logger_factory=logger_factory, progress=progress, law=law)
 
 

@@ -34,6 +34,7 @@ from controllers.computed_torque import CONTROLLER_NAMES, FRICTION_SIGNS, MODEL_
 from controllers.registry import PluginSource, default_model, plugin_fresh, plugin_of
 from controllers.tracking import PathTracker
 from wmr_mj.carts import CartFile, cart_of, cart_of_text
+from wmr_mj.carts.provenance import delay_split_unknown
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.hardware import Actuation, Sensing, Transmission, check_cart, is_ideal_cart
 from wmr_mj.hardware.assembly import CART_PARTS, cart_dict
@@ -50,22 +51,14 @@ from wmr_mj.params import (
 )
 from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS, TIMESTEP, TYRE_CONTACT_MODELS
 from wmr_mj.reference.bounds import ReferenceBounds, reference_bounds_from
-from wmr_mj.reference.named import PATH_NAMES
-from wmr_mj.reference.route import (
-    Route,
-    default_path_of,
-    route_of,
-    route_spec_of,
-)
+from wmr_mj.reference.named import PATH_NAMES, default_path
+from wmr_mj.reference.route import Route, route_of, route_spec_of
 from wmr_mj.sim.signals import Signals, signals_from
 
-__all__ = ["PATH_NAMES", "DEFAULT_PATH", "default_path", "cart_file_of_record", "coerce", "m1_of_overrides",
+__all__ = ["PATH_NAMES", "cart_file_of_record", "coerce", "m1_of_overrides",
            "coerce_with_classes", "Coerced", "is_coerced", "check_fields", "route_of", "cart_file", "base_for",
            "plant_parameters", "base_of_record", "plugin_source", "controller_source", "controller_name", "law_name",
-           "default_model", "check_motor_constant", "coerced", "record_of"]
-
-#: the path of a run that names none, on a cart that declares none (``[paths] default`` declares a cart's own)
-DEFAULT_PATH = "paper-circle"
+           "default_model", "check_motor_constant", "coerced", "record_of", "delay_split_of"]
 
 #: the cart's parts: field name -> its typed class
 _PARTS: tuple[tuple[str, Any], ...] = (("sensing", Sensing), ("actuation", Actuation),
@@ -238,6 +231,8 @@ class Coerced:
         base: the run's base parameter set: the cart's (the C80's without one), or the one the caller gave.
         plant: the plant's parameter set: ``base`` with m1 and the overrides.
         record: the config's record (:func:`record_of`: ``RunConfig.to_dict()``), as a run's log keeps it.
+        delay_split: how the cart divides its delay between sensing and actuation (:func:`delay_split_of` its
+            record): 'unknown' where recordings fixed only the sum, else 'known'.
     """
 
     config: Any
@@ -246,6 +241,7 @@ class Coerced:
     base: C80Parameters
     plant: C80Parameters
     record: Mapping[str, Any]
+    delay_split: str
 
 
 def coerce_with_classes(config: Any, *, classes: bool = True, base: C80Parameters = C80) -> Coerced:
@@ -300,7 +296,7 @@ def coerce_with_classes(config: Any, *, classes: bool = True, base: C80Parameter
     plant = checked_plant if base is C80 else with_params(base, m1_inertia=typed.m1_inertia, m1=typed.m1,
                                                           **dict(typed.plant_overrides))
     return Coerced(config=typed, classes=found, route=route, base=checked_base if base is C80 else base, plant=plant,
-                   record=record_of(typed))
+                   record=record_of(typed), delay_split=delay_split_of(typed.cart))
 
 
 def record_of(config: Any) -> dict[str, Any]:
@@ -389,32 +385,11 @@ def cart_file_of_record(record: Mapping[str, str] | None) -> CartFile | None:
     return None if record is None else _cart_of_text(record["text"], record["path"])
 
 
-def default_path(cart: CartFile | None) -> str:
-    """The path a run on ``cart`` takes where it names none: the one the cart declares (``[paths] default``); else
-    the paper circle (:data:`DEFAULT_PATH`) where the cart steers it at no more than
-    :data:`wmr_mj.reference.route.DEFAULT_PATH_STOP_FRACTION` of its stops (the C80 and the shipped carts: 0.659 of
-    +-0.9 rad); else a loop of half-turns whose steady angle is that fraction of the stops
-    (:func:`wmr_mj.reference.route.default_path_of`; :func:`default_path_note` names it)."""
-    declared = None if cart is None else cart.default_path
-    if declared is not None:
-        return declared
-    return DEFAULT_PATH if cart is None else _derived_path(cart.text, str(cart.path))[0]
-
-
-def default_path_note(cart: CartFile | None) -> str | None:
-    """The line that names the default path derived from ``cart``'s stops (:func:`default_path`); None where the
-    cart declares its own or takes the paper circle."""
-    if cart is None or cart.default_path is not None:
-        return None
-    return _derived_path(cart.text, str(cart.path))[1]
-
-
-@functools.lru_cache(maxsize=8)
-def _derived_path(text: str, path: str) -> tuple[str, str | None]:
-    """(the default path of the cart of ``text``, the note naming it or None): :func:`default_path`'s rule,
-    :func:`wmr_mj.reference.route.default_path_of` on the cart's parameters."""
-    params = _parameters_of_text(text, path)
-    return default_path_of(params)
+def delay_split_of(cart: Mapping[str, str] | None) -> str:
+    """How the run's cart divides its delay (its ``[defaults.delay_split]``): 'unknown' for a cart identified from
+    recordings at the controller, which fix only the sum of the sensing and actuation delays; 'known' for any other
+    cart and the C80. ``cart``: a typed config's cart record (``RunConfig.cart``; None: the C80)."""
+    return "unknown" if cart is not None and delay_split_unknown(cart["text"]) else "known"
 
 
 def cart_file(config: Any) -> Any:

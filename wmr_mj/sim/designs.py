@@ -49,9 +49,10 @@ from controllers.registry import parse_params
 from wmr_mj.errors import ParameterError, UnknownNameError
 from wmr_mj.params import PAPER_KD, PAPER_KP
 from wmr_mj.plant.mjcf import TIMESTEP
+from wmr_mj.reference.named import default_path
 from wmr_mj.reference.route import path_name
 from wmr_mj.sim.certify import certificate_for
-from wmr_mj.sim.coerce import cart_file_of_record, default_path
+from wmr_mj.sim.coerce import cart_file_of_record
 from wmr_mj.sim.config import RunConfig, base_for, controller_for, estimate_parameters
 from wmr_mj.sim.parts import run_reference
 
@@ -177,7 +178,7 @@ def _cart_record(cart: Any) -> dict[str, Any] | None:
 
 def certified_design(cart: Any = None, *, path: str | None = None) -> DesignPreset:
     """The certified design on ``cart`` (None, or the C80's numbers: the C80, :data:`CERTIFIED_C80`): the rule run
-    on the cart and on ``path`` (None: the cart's own default path, :func:`wmr_mj.sim.coerce.default_path`).
+    on the cart and on ``path`` (None: the cart's own default path, :func:`wmr_mj.reference.named.default_path`).
 
     Raises:
         ParameterError: no omega_r of :data:`OMEGA_R_GRID` gives a valid certificate within

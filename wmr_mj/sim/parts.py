@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from controllers import PathTracker, SteeringController
+from wmr_mj._util.memory import require_run_memory
 from wmr_mj.analysis.certificate import Certificate
 from wmr_mj.analysis.claim_types import LAW_CLAIM, Claims, claim_set
 from wmr_mj.analysis.measurement import MeasurementErrors
@@ -190,9 +191,12 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
 
     Raises:
         WmrMjError: what the config cannot build (a plug-in, a path too short, a period that does not fit).
+        NotEnoughMemoryError: a run whose rows would not fit in the memory available (before its reference).
     """
     typed = coerce_with_classes(config, base=base)  # the one read of the config's files and plug-ins
     config, classes, base, plant, record = typed.config, typed.classes, typed.base, typed.plant, typed.record
+    # a run whose rows would not fit is refused on the typed config, before its reference (as long as the run)
+    require_run_memory(duration_s=config.duration, control_period_s=config.control_period or TIMESTEP)
     # the typed config read once, here in the sim layer, into what each part is built from
     substeps = control_substeps(config.control_period)
     period = substeps * TIMESTEP
@@ -222,13 +226,12 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
     # that the config is coerced, which it is here)
     measurement = certify.measurement_errors(config.sensing, config.actuation, config.transmission, plant,
                                              period=claim_period)
-    delay_split = certify.delay_split_of(config.cart)
     law_claim = certify.law_certificate(reference, controller=controller, tracker=tracker, box=box, base=base,
                                 estimate=estimate, plant=plant, period=claim_period, signals=config.signals,
                                 declared_bounds=config.reference_bounds, sensing=config.sensing,
                                 actuation=config.actuation, transmission=config.transmission,
                                 steering_friction=config.steering_friction, measurement=measurement,
-                                sampled_data=True, delay_split=delay_split)
+                                sampled_data=True, delay_split=typed.delay_split)
     claims = claim_set(**{LAW_CLAIM: law_claim})
     return RunParts(config=config, base=base, plant=plant, estimate=estimate, controller=controller,
                     controller_name=labels.controller, tracker=tracker, reference=reference,

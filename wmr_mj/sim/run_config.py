@@ -62,7 +62,7 @@ class RunConfig:
     friction_width: float = 0.0  # rad/s, tanh smoothing of the Coulomb sign (0: exact sign)
     # C's path: one of PATH_NAMES, a packaged route name (wmr_mj.reference.route.route_names()), a
     # .toml/.json route file, or canonical route JSON; a Path or Route object is stored as its canonical JSON
-    # None: the cart's own (wmr_mj.sim.coerce.default_path: its file's [paths] default, else the paper circle where
+    # None: the cart's own (wmr_mj.reference.named.default_path: its file's [paths] default, else the paper circle where
     # its stops steer it, else a loop derived from them; the paper circle without a cart), resolved where the config
     # is coerced, so that RunConfig(cart=...), a sweep's or a search's base on it, and the commands agree
     path: str = None  # type: ignore[assignment]
@@ -128,7 +128,7 @@ class RunConfig:
         the commands, the config builders of compare and the reports, and ``config_from_dict`` call this.
 
         A config that names no path (``path`` None) takes the cart's own (its ``[paths] default``, else one it can
-        steer: :func:`wmr_mj.sim.coerce.default_path`; the paper circle without a cart), here as wherever the
+        steer: :func:`wmr_mj.reference.named.default_path`; the paper circle without a cart), here as wherever the
         config is coerced: ``RunConfig(cart=...)`` keeps None as plain data until then.
 
         Raises:
