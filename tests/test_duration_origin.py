@@ -9,6 +9,7 @@ not accepted" (run excepted) although the user gave no duration.
 
 from __future__ import annotations
 
+import argparse
 import re
 from pathlib import Path
 
@@ -16,7 +17,9 @@ import pytest
 from helpers import refused_line
 
 from wmr_mj.carts import CARTS_DIR
-from wmr_mj.cli.app import main
+from wmr_mj.cli.app import _with_where_duration_came_from, main
+from wmr_mj.errors import DurationError, ParameterError
+from wmr_mj.sim.config import RunConfig
 
 DEFAULT_SAID = "(the duration is --duration's default, 35 s, as none was given; give --duration)"
 
@@ -61,3 +64,23 @@ def test_cart_checks_runs_refused_name_the_runs_and_the_options_that_change_them
     line = refused_line(capsys, ["cart", "check", str(slow)])
     assert "duration = 35.0 s is not accepted" in line and "cart check's runs on the path" in line
     assert "--path" in line and "[paths] default" in line and "--duration's default" not in line
+
+
+def test_the_note_follows_the_errors_type_not_its_words():
+    """Only a run's refused duration (:class:`DurationError`) gets the note: an excitation's "duration = ..." (a
+    ParameterError, as identify's) is left as it is, and the note's default is the command's own."""
+    plain = ParameterError("duration = 1.0 s must be finite and > 0")
+    identify = argparse.Namespace(command="identify", duration=20.0)
+    assert _with_where_duration_came_from(plain, identify, []) == str(plain)
+    run = DurationError("duration = 35.0 s is not accepted")
+    said = _with_where_duration_came_from(run, argparse.Namespace(command="run", duration=35.0), [])
+    assert said == f"{run} {DEFAULT_SAID}"
+    assert _with_where_duration_came_from(run, argparse.Namespace(command="run", duration=35.0),
+                                          ["run", "--duration", "35"]) == str(run)
+
+
+@pytest.mark.parametrize("changes", [{"duration": -1.0}, {"duration": 1.0, "control_period": 3.0},
+                                     {"duration": 1.0, "control_period": 0.3}], ids=["negative", "longer", "part"])
+def test_a_runs_refused_duration_is_a_duration_error(changes):
+    with pytest.raises(DurationError):
+        RunConfig(**changes)

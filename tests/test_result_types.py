@@ -24,6 +24,7 @@ from matplotlib.figure import Figure
 from wmr_mj._util.files import json_safe
 from wmr_mj.analysis.claim_types import LAW_CLAIM, Assumption
 from wmr_mj.analysis.requirements import parse_requirement
+from wmr_mj.errors import ParameterError
 from wmr_mj.experiments.cart_check import CartCheck, NamedCart
 from wmr_mj.experiments.compare import CompareResult, DesignRow, ScenarioRun
 from wmr_mj.experiments.suite import load_suite
@@ -368,3 +369,16 @@ def _a_cart_checks_restored_fields_match(check: CartCheck, back: CartCheck) -> N
     assert (rb.identified, rb.predicted, rb.duration, rb.seed) == (r.identified, r.predicted, r.duration, r.seed)
     assert (back.defaults, back.certified_design, back.design) == (check.defaults, check.certified_design, check.design)
     assert (back.passed, back.answer, back.design_wall_s) == (check.passed, check.answer, 0.0)
+
+
+@pytest.mark.parametrize("result, holds", [(SweepResult, "sweep --json and summary.json hold the summary only"),
+                                           (FalsifyResult, "falsify --json and falsify.json hold the worst run only"),
+                                           (CompareResult, "compare.json and compare --json hold the rows only")],
+                         ids=["sweep", "falsify", "compare"])
+def test_a_commands_json_without_its_runs_is_refused_naming_what_holds_them(result, holds):
+    """A command's own JSON (no ``runs``) read back by ``from_dict``: one line naming what it holds and what writes
+    every run, the same words for each result."""
+    with pytest.raises(ParameterError) as caught:
+        result.from_dict({"wall_s": 1.0})
+    assert str(caught.value) == (f"this JSON has no 'runs' ({holds}): {result.__name__}.to_dict() writes every run, "
+                                 "and from_dict reads that back")

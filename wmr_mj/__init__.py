@@ -22,6 +22,7 @@ import warnings
 from typing import TYPE_CHECKING, Any
 
 from wmr_mj.errors import (
+    DurationError,
     InfeasiblePathError,
     LogError,
     ModelFileError,
@@ -176,6 +177,7 @@ __all__ = [
     # errors
     "WmrMjError",
     "ParameterError",
+    "DurationError",
     "UnknownNameError",
     "ModelFileError",
     "InfeasiblePathError",

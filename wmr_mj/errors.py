@@ -12,6 +12,7 @@ from collections.abc import Iterable
 __all__ = [
     "WmrMjError",
     "ParameterError",
+    "DurationError",
     "UnknownNameError",
     "ModelFileError",
     "InfeasiblePathError",
@@ -29,6 +30,11 @@ class WmrMjError(Exception):
 
 class ParameterError(WmrMjError, ValueError):
     """A parameter value is out of its accepted range (non-positive, non-finite...)."""
+
+
+class DurationError(ParameterError):
+    """A run's duration is refused: the path, the control period or a delay does not fit in it. The command line
+    says where a refused duration came from (the command's default where none was given)."""
 
 
 class UnknownNameError(WmrMjError, KeyError):

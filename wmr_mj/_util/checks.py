@@ -23,6 +23,7 @@ import numpy as np
 from wmr_mj.errors import ParameterError
 
 __all__ = [
+    "runs_of",
     "real",
     "positive_real",
     "finite_number",
@@ -126,3 +127,20 @@ def as_pair(value: Iterable[float]) -> tuple[float, float]:
     """``tuple(value)`` typed as the (lo, hi) pair it is: a range the caller already checked (a
     RunConfig, the CLI's two-value options); no conversion and no check here."""
     return cast("tuple[float, float]", tuple(value))
+
+
+def runs_of(d: Any, *, result: str, holds: str) -> Any:
+    """``d["runs"]``: every run of a result's JSON, as ``result.to_dict()`` wrote it (``from_dict`` reads it back).
+
+    Args:
+        d: the JSON object; result: the result type's name ('SweepResult'); holds: what the command's own JSON,
+            which has no runs, holds instead ('sweep --json and summary.json hold the summary only').
+
+    Raises:
+        ParameterError: ``d`` has no ``runs``, in one line naming what does.
+    """
+    runs = d.get("runs")
+    if runs is None:
+        raise ParameterError(f"this JSON has no 'runs' ({holds}): {result}.to_dict() writes every run, and "
+                             "from_dict reads that back")
+    return runs

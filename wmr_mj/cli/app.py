@@ -44,7 +44,7 @@ from wmr_mj.cli.parsers import (
     sweep,
     validate,
 )
-from wmr_mj.errors import WmrMjError
+from wmr_mj.errors import DurationError, WmrMjError
 
 #: each command's parser module (:mod:`wmr_mj.cli.parsers`), in the order ``wmr-mj --help`` lists them
 PARSERS = {"identify": identify, "robustness": robustness, "run": run, "replay": replay, "sweep": sweep,
@@ -106,7 +106,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         m1_of_param(args)  # --param m1=KG is --m1 KG wherever --m1 is an option
         return int(_implementation(args.command)(args) or 0)
     except WmrMjError as exc:
-        print(f"wmr-mj: error: {_with_where_duration_came_from(str(exc), args, argv)}", file=sys.stderr)
+        print(f"wmr-mj: error: {_with_where_duration_came_from(exc, args, argv)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("wmr-mj: interrupted", file=sys.stderr)
@@ -116,11 +116,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 0
 
 
-def _with_where_duration_came_from(message: str, args: argparse.Namespace, argv: Sequence[str]) -> str:
-    """``message``, and where a refused duration came from when the user gave none: the command's default
-    --duration (run's, design's, validate's, ...), or, for ``cart check`` (whose --duration is the identification's
-    excitation), the length of its runs on the cart's path."""
-    if "duration = " not in message or any(a == "--duration" or a.startswith("--duration=") for a in argv):
+def _with_where_duration_came_from(exc: WmrMjError, args: argparse.Namespace, argv: Sequence[str]) -> str:
+    """``exc``'s message, and, for a run's refused duration (:class:`~wmr_mj.errors.DurationError`), where it came
+    from when the user gave none: the command's default --duration (run's, design's, validate's, ...), or, for
+    ``cart check`` (whose --duration is the identification's excitation), the length of its runs on the cart's
+    path."""
+    message = str(exc)
+    if not isinstance(exc, DurationError) or any(a == "--duration" or a.startswith("--duration=") for a in argv):
         return message
     if getattr(args, "command", None) == "cart":
         return (f"{message} (the duration of cart check's runs on the path, run's default, as no --duration of a run "

@@ -37,6 +37,7 @@ from typing import Any
 
 import numpy as np
 
+from wmr_mj._util.checks import runs_of
 from wmr_mj._util.deprecation import deprecated_names
 from wmr_mj.analysis.requirements import parse_requirement
 from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE, count_unmet, unmet_assumptions
@@ -457,10 +458,7 @@ class CompareResult:
         Raises:
             ParameterError: ``d`` has no ``runs`` (compare.json), or the suite's file has changed: one line.
         """
-        runs = d.get("runs")
-        if runs is None:
-            raise ParameterError("this JSON has no 'runs' (compare.json and compare --json hold the rows only): "
-                                 "CompareResult.to_dict() writes every run, and from_dict reads that back")
+        runs = runs_of(d, result="CompareResult", holds="compare.json and compare --json hold the rows only")
         suite = load_suite(runs["suite_source"])
         if suite.sha256 != d["suite"]["sha256"]:
             raise ParameterError(f"suite {runs['suite_source']!r} has changed since the comparison (SHA-256 "

@@ -24,7 +24,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from wmr_mj.errors import ParameterError
+from wmr_mj._util.checks import runs_of
 from wmr_mj.experiments.sweep import SweepSpec, SweepSummary, run_sweep, spec_from_json, spec_to_json
 from wmr_mj.hardware import cart_dict
 from wmr_mj.searches.search_space import HARDWARE_AXES, parameter_units
@@ -89,10 +89,7 @@ class SweepResult:
         Raises:
             ParameterError: ``d`` has no ``runs`` (sweep --json's object, summary.json): one line.
         """
-        runs = d.get("runs")
-        if runs is None:
-            raise ParameterError("this JSON has no 'runs' (sweep --json and summary.json hold the summary only): "
-                                 "SweepResult.to_dict() writes every run, and from_dict reads that back")
+        runs = runs_of(d, result="SweepResult", holds="sweep --json and summary.json hold the summary only")
         return cls(spec=spec_from_json(json.dumps(runs["spec"])), rows=tuple(dict(row) for row in runs["rows"]),
                    summary=SweepSummary.from_dict(runs["summary"]), wall_s=d["wall_s"], folder=d["folder"])
 

@@ -32,7 +32,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from wmr_mj.errors import ParameterError
+from wmr_mj.errors import DurationError, ParameterError
 
 __all__ = ["CART_PARTS", "cart_dict", "cart_line", "is_ideal_cart", "check_cart", "MAX_ELECTRICAL_TIME_CONSTANT_S",
            "smallest_encoder_ticks"]
@@ -102,7 +102,7 @@ def check_cart(config: Any, parameters: Any) -> None:
     for part, delay, who in (("sensing", sensing.delay, "the law would read only the state at t = 0"),
                              ("actuation", actuation.delay, "the motor would receive no voltage of the law")):
         if delay >= duration:
-            raise ParameterError(f"{part}: delay = {delay:g} s is not shorter than the run (duration = {duration:g} "
+            raise DurationError(f"{part}: delay = {delay:g} s is not shorter than the run (duration = {duration:g} "
                                  f"s): {who}; accepted: a delay below the duration")
     stops = float(parameters.steering_range)
     _check_reading(sensing, gear_ratio=float(parameters.i2), stops=stops)

@@ -91,7 +91,7 @@ from scipy.optimize import brentq
 
 from wmr_mj._util.checks import positive_real as _positive
 from wmr_mj._util.checks import real as _number
-from wmr_mj.errors import InfeasiblePathError, ParameterError, StiffReferenceError
+from wmr_mj.errors import DurationError, InfeasiblePathError, ParameterError, StiffReferenceError
 from wmr_mj.params import C80, C80Parameters
 from wmr_mj.reference.bounds import PAPER_BOUNDS, ReferenceBounds, sin_cos3_of_samples
 
@@ -907,7 +907,7 @@ def _grid(run: _Run, h: float, T_req: float | None) -> np.ndarray:
     """The uniform time grid [s] of step h over the requested duration (or the whole path)."""
     T_path = run.t_end
     if T_req is not None and not run.stopped and T_req > T_path * (1 + 1e-12):
-        raise ParameterError(
+        raise DurationError(
             f"duration = {T_req} s is not accepted: the path takes {T_path:.6g} s; give duration <= that or None"
         )
     T = T_req if T_req is not None else T_path
@@ -1025,7 +1025,7 @@ def paper_circle(
     if not run.stopped or run.s_end <= head.length:
         # C's time over the lead-in and entry alone: the circle starts only after it
         t_head = _integrate(head, l1, V_A, 0.0, max_angle=0.5 * math.pi - 1e-6).t_end
-        raise ParameterError(
+        raise DurationError(
             f"duration = {T} s is not accepted: the lead-in and entry alone take {t_head:.3f} s; "
             f"give a longer duration (at least {math.ceil(t_head * 1e3) / 1e3:.3f} s)"
         )

@@ -18,7 +18,7 @@ import numpy as np
 
 from controllers import ComputedTorque
 from wmr_mj.analysis.robustness import BOX_COEFFICIENTS, ParameterBox, analyse
-from wmr_mj.errors import ParameterError
+from wmr_mj.errors import DurationError
 from wmr_mj.params import C80, PAPER_KD, PAPER_KP
 from wmr_mj.plant.reduced import SteeringModel
 from wmr_mj.reference.bounds import ReferenceBounds
@@ -56,7 +56,7 @@ def paper_example(*, duration: float = 35.0, friction_width: float = 1e-3, mujoc
     (b) ``run_closed_loop(RunConfig(model='paper'))`` on the MuJoCo plant.
     """
     if not (isinstance(duration, (int, float)) and math.isfinite(duration) and duration > 0):
-        raise ParameterError(f"duration = {duration!r} s is not accepted; a finite number > 0 is required")
+        raise DurationError(f"duration = {duration!r} s is not accepted; a finite number > 0 is required")
     box = ParameterBox.paper()
     kp, kd = PAPER_KP, PAPER_KD
     result = analyse(box, kp=kp, kd=kd, bounds=ReferenceBounds())

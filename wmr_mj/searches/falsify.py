@@ -99,7 +99,7 @@ from typing import Any
 
 import numpy as np
 
-from wmr_mj._util.checks import positive_range
+from wmr_mj._util.checks import positive_range, runs_of
 from wmr_mj._util.deprecation import deprecated_names
 from wmr_mj.analysis.requirements import parse_requirement
 from wmr_mj.analysis.verdicts import CERTIFIED_OUTSIDE, VERDICTS, unmet_assumptions
@@ -710,10 +710,7 @@ class FalsifyResult:
         Raises:
             ParameterError: ``d`` has no ``runs`` (falsify --json's object, falsify.json): one line.
         """
-        runs = d.get("runs")
-        if runs is None:
-            raise ParameterError("this JSON has no 'runs' (falsify --json and falsify.json hold the worst run only): "
-                                 "FalsifyResult.to_dict() writes every run, and from_dict reads that back")
+        runs = runs_of(d, result="FalsifyResult", holds="falsify --json and falsify.json hold the worst run only")
         return cls(spec=FalsifySpec.from_dict(runs["spec"]), search=[Evaluation.from_dict(e) for e in runs["search"]],
                    random=[Evaluation.from_dict(e) for e in runs["random"]], objective_source=d["objective_source"],
                    log=d.get("log"))

@@ -35,7 +35,7 @@ from controllers.registry import PluginSource, default_model, plugin_fresh, plug
 from controllers.tracking import PathTracker
 from wmr_mj.carts import CartFile, cart_of, cart_of_text
 from wmr_mj.carts.provenance import delay_split_unknown
-from wmr_mj.errors import ParameterError, UnknownNameError
+from wmr_mj.errors import DurationError, ParameterError, UnknownNameError
 from wmr_mj.hardware import Actuation, Sensing, Transmission, check_cart, is_ideal_cart
 from wmr_mj.hardware.assembly import CART_PARTS, cart_dict
 from wmr_mj.params import (
@@ -92,7 +92,8 @@ def check_fields(config: Any) -> None:
         if name == "m1" and value is None:
             continue  # the cart's, filled by coerce
         if not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
-            raise ParameterError(f"{name} = {value!r} is not accepted; a finite number > 0 is required")
+            error = DurationError if name == "duration" else ParameterError
+            raise error(f"{name} = {value!r} is not accepted; a finite number > 0 is required")
     if config.control_period is not None and (not math.isfinite(config.control_period) or config.control_period <= 0):
         raise ParameterError(f"control_period = {config.control_period!r} s must be finite and > 0")
     check_period_fits(config.control_period, config.duration)
@@ -198,13 +199,13 @@ def check_period_fits(control_period: float | None, duration: float) -> None:
     what = (f"control_period = {period:g} s" if control_period is not None
             else f"the physics step ({period:g} s, the default control period)")
     if period > duration:
-        raise ParameterError(f"{what} is longer than the run (duration = {duration:g} s); give --control-period "
+        raise DurationError(f"{what} is longer than the run (duration = {duration:g} s); give --control-period "
                              f"<= --duration and a whole fraction of it (e.g. 0.001-0.1 s)")
     n = round(duration / period)
     if abs(n * period - duration) > 1e-9 * max(1.0, duration):
         fix = f"give --duration {n * period:g}" + (" or a --control-period that divides it"
                                                    if control_period is not None else "")
-        raise ParameterError(f"the run's duration = {duration:g} s is not a whole multiple of {what} "
+        raise DurationError(f"the run's duration = {duration:g} s is not a whole multiple of {what} "
                              f"({duration / period:.6g} periods); {fix}")
 
 
