@@ -28,6 +28,7 @@ import functools
 import importlib
 import itertools
 import sys
+import threading
 from pathlib import Path
 
 import pytest
@@ -67,17 +68,25 @@ def counted(monkeypatch):
     references built past the spine."""
     for name in CLI_COMMANDS:  # every command's implementation imported, so it holds resolve_run before the wrap
         importlib.import_module(f"wmr_mj.cli.{name}")
-    resolving: list[int] = []
+    # each thread's own stack of the resolutions under way (compare runs its scenarios in threads: a shared stack
+    # would count one thread's reference against the other's resolution)
+    local = threading.local()
+
+    def stack() -> list[int]:
+        if not hasattr(local, "resolving"):
+            local.resolving = []
+        return local.resolving
+
     numbers = itertools.count()
     original = parts.resolve_run
 
     @functools.wraps(original)
     def resolve_run(*args, **kwargs):
-        resolving.append(next(numbers))
+        stack().append(next(numbers))
         try:
             return original(*args, **kwargs)
         finally:
-            resolving.pop()
+            stack().pop()
 
     holders = [m for m in list(sys.modules.values()) if getattr(m, "resolve_run", None) is original]
     assert len(holders) > 10  # the spine's users: run, sweep, falsify, compare, design, validate, ...
@@ -95,7 +104,7 @@ def counted(monkeypatch):
     def build_reference(path, *args, **kwargs):
         if not _above(REFERENCER, PAPER_VIEW):
             outside.append(f"reference of {path!r}")
-        references[resolving[-1] if resolving else None] += 1
+        references[stack()[-1] if stack() else None] += 1
         return original_reference(path, *args, **kwargs)
 
     holders = [m for m in list(sys.modules.values()) if getattr(m, "build_reference", None) is original_reference]
@@ -104,7 +113,7 @@ def counted(monkeypatch):
         monkeypatch.setattr(module, "build_reference", build_reference)
 
     def key(law) -> tuple:
-        return (resolving[-1] if resolving else None, type(law).__name__,
+        return (stack()[-1] if stack() else None, type(law).__name__,
                 getattr(getattr(law, "model", None), "name", None))
 
     for cls in (ComputedTorque, PDController, SlidingMode, AdaptiveComputedTorque):

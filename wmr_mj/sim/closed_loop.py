@@ -34,6 +34,7 @@ import numpy as np
 
 from controllers import SteeringController
 from controllers.tracking import within_declared
+from wmr_mj._util.memory import require_run_memory
 from wmr_mj._util.progress import progress_bar
 from wmr_mj.analysis.claim import with_measured
 from wmr_mj.analysis.claim_types import LAW_CLAIM, Assumption, CertificateJudgement, judge
@@ -422,7 +423,10 @@ def run_closed_loop(
     receives a block of rows every simulated second and is closed with the summary,
     also when the run is interrupted (KeyboardInterrupt or SIGTERM).
     """
-    parts = resolve_run(config, base=base)  # what the run is made of, resolved once (a run that does not fit refused)
+    # a run's rows, refused before anything is built where they would not fit (not in resolve_run: a batch resolves
+    # its first run and keeps fewer bytes a step, and refuses on its own count)
+    require_run_memory(duration_s=config.duration, control_period_s=(config.control_period or TIMESTEP))
+    parts = resolve_run(config, base=base)  # before the arrays: what the run is made of, resolved once
     return run_parts(parts, logger_factory=logger_factory, progress=progress, law=law)
 
 

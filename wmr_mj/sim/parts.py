@@ -23,7 +23,6 @@ from typing import Any
 import numpy as np
 
 from controllers import PathTracker, SteeringController
-from wmr_mj._util.memory import require_run_memory
 from wmr_mj.analysis.certificate import Certificate
 from wmr_mj.analysis.claim_types import LAW_CLAIM, Claims, claim_set
 from wmr_mj.analysis.measurement import MeasurementErrors
@@ -191,12 +190,9 @@ def resolve_run(config: RunConfig, *, base: C80Parameters = C80) -> RunParts:
 
     Raises:
         WmrMjError: what the config cannot build (a plug-in, a path too short, a period that does not fit).
-        NotEnoughMemoryError: a run whose rows would not fit in the memory available (before its reference).
     """
     typed = coerce_with_classes(config, base=base)  # the one read of the config's files and plug-ins
     config, classes, base, plant, record = typed.config, typed.classes, typed.base, typed.plant, typed.record
-    # a run whose rows would not fit is refused on the typed config, before its reference (as long as the run)
-    require_run_memory(duration_s=config.duration, control_period_s=config.control_period or TIMESTEP)
     # the typed config read once, here in the sim layer, into what each part is built from
     substeps = control_substeps(config.control_period)
     period = substeps * TIMESTEP
