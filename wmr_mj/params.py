@@ -32,12 +32,13 @@ I_z2, I_y3, I_z3 were per side: see ``kinetic_energy_coefficients``).
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, fields
 from typing import Any, Literal, get_args
 
-from wmr_mj.carts import CartFile, load_cart
+from wmr_mj.carts import CartFile, cart_of_text, load_cart
 from wmr_mj.carts.cartfile import MAX_ELECTRICAL_TIME_CONSTANT_S, MOTOR_CONSTANT_RTOL
 from wmr_mj.errors import ParameterError, UnknownNameError
 
@@ -46,6 +47,7 @@ __all__ = [
     "C80",
     "C80_CART",
     "parameters_of_cart",
+    "parameters_of_cart_text",
     "check_physical_sense",
     "check_motor_constant",
     "Coefficients",
@@ -470,6 +472,17 @@ def parameters_of_cart(cart: CartFile) -> C80Parameters:
         return params
     except ParameterError as exc:
         raise ParameterError(f"cart file {str(cart.path)!r}: {exc}") from None
+
+
+@functools.lru_cache(maxsize=8)  # once per cart text: each coercion of a config on the cart, and its default path, ask
+def parameters_of_cart_text(text: str, path: str) -> C80Parameters:
+    """:func:`parameters_of_cart` of a run's cart record (its text and path, :func:`wmr_mj.carts.cart_of_text`),
+    the last few kept.
+
+    Raises:
+        ParameterError: as :func:`parameters_of_cart`, or a text the cart file's schema refuses.
+    """
+    return parameters_of_cart(cart_of_text(text, path))
 
 
 def with_params(base: C80Parameters = C80, /, *, m1_inertia: str = "payload", **changes: Any) -> C80Parameters:

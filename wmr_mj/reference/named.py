@@ -18,9 +18,9 @@ from typing import Any
 
 import numpy as np
 
-from wmr_mj.carts import CartFile, cart_of_text
+from wmr_mj.carts import CartFile
 from wmr_mj.errors import InfeasiblePathError, StiffReferenceError, UnknownNameError, WmrMjError
-from wmr_mj.params import C80Parameters, parameters_of_cart
+from wmr_mj.params import C80Parameters, parameters_of_cart_text
 from wmr_mj.reference import paths as ref
 from wmr_mj.reference.route import default_path_of, is_route_spec, route_names, route_of, route_reference
 
@@ -63,7 +63,7 @@ def default_path_note(cart: CartFile | None) -> str | None:
 def _derived_path(text: str, path: str) -> tuple[str, str | None]:
     """(the default path of the cart of ``text``, the note naming it or None): :func:`default_path`'s rule,
     :func:`wmr_mj.reference.route.default_path_of` on the cart's parameters."""
-    return default_path_of(parameters_of_cart(cart_of_text(text, path)))
+    return default_path_of(parameters_of_cart_text(text, path))
 
 
 def build_reference(path: str | None, params: C80Parameters, *, dt: float, duration: float):

@@ -22,7 +22,6 @@ Usage::
 from __future__ import annotations
 
 import dataclasses
-import functools
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -46,7 +45,7 @@ from wmr_mj.params import (
     C80Parameters,
     check_motor_constant,
     parameter_names,
-    parameters_of_cart,
+    parameters_of_cart_text,
     with_params,
 )
 from wmr_mj.plant.mjcf import STEERING_FRICTION_MODELS, TIMESTEP, TYRE_CONTACT_MODELS
@@ -376,11 +375,6 @@ def _check_parts(config: Any, base: C80Parameters, plant: C80Parameters) -> None
 _cart_of_text = cart_of_text  # a cart record's CartFile, the last few kept (wmr_mj.carts.cart_of_text)
 
 
-@functools.lru_cache(maxsize=8)
-def _parameters_of_text(text: str, path: str) -> C80Parameters:
-    return parameters_of_cart(_cart_of_text(text, path))
-
-
 def cart_file_of_record(record: Mapping[str, str] | None) -> CartFile | None:
     """The cart (:class:`wmr_mj.carts.CartFile`) of a typed config's cart record; None for the C80."""
     return None if record is None else _cart_of_text(record["text"], record["path"])
@@ -409,7 +403,7 @@ def base_of_record(record: Mapping[str, str] | None, base: C80Parameters = C80) 
     """:func:`base_for` of a typed config's cart record (``config.cart``): read, nothing coerced."""
     if record is None or base is not C80:
         return base
-    return _parameters_of_text(record["text"], record["path"])
+    return parameters_of_cart_text(record["text"], record["path"])
 
 
 def plant_parameters(config: Any, base: C80Parameters = C80) -> C80Parameters:
